@@ -1,0 +1,18 @@
+"""contactlab BEM: frictionless normal contact of elastic half-spaces with an interface layer.
+
+Boundary elements on the elastic half-space with piecewise-linear (pyramid)
+pressure on a regular triangular lattice, closed-form influence coefficients,
+FFT-fast products, and Kalker's variational principle generalised to a
+nonlinear interface layer (paper sections 4-5, DESIGN.md).
+"""
+
+from . import gaps, layers
+from .lattice import Lattice
+from .materials import effective_modulus
+from .operator import InfluenceOperator
+from .result import ContactResult
+from .solve import METHODS, RegionTooSmallError, solve
+from .template import template
+
+__all__ = ["solve", "template", "Lattice", "InfluenceOperator", "ContactResult", "METHODS",
+           "RegionTooSmallError", "effective_modulus", "gaps", "layers"]

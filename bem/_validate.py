@@ -1,0 +1,102 @@
+"""Argument validation with uniform messages.
+
+Every check raises :class:`InputError` (a ``ValueError``) whose message names
+the argument, shows the value and states the rule, e.g.::
+
+    E1 = -2.0e11 is not allowed: it must be > 0.
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+
+import numpy as np
+
+__all__ = [
+    "InputError",
+    "check_positive",
+    "check_nonnegative",
+    "check_range",
+    "check_finite_array",
+    "check_choice",
+    "check_callable",
+]
+
+
+class InputError(ValueError):
+    """Bad input: the message names the argument, the value and the rule."""
+
+
+def _fail(name, value, rule):
+    raise InputError(f"{name} = {value!r} is not allowed: it must be {rule}.")
+
+
+def _real(name, value):
+    if isinstance(value, bool) or not isinstance(value, (Real, np.floating, np.integer)):
+        _fail(name, value, "a real number")
+    value = float(value)
+    if not math.isfinite(value):
+        _fail(name, value, "finite")
+    return value
+
+
+def check_positive(name, value):
+    """Return ``float(value)``; raise unless it is a finite real ``> 0``."""
+    value = _real(name, value)
+    if value <= 0:
+        _fail(name, value, "> 0")
+    return value
+
+
+def check_nonnegative(name, value):
+    """Return ``float(value)``; raise unless it is a finite real ``>= 0``."""
+    value = _real(name, value)
+    if value < 0:
+        _fail(name, value, ">= 0")
+    return value
+
+
+def check_range(name, value, low, high, *, low_open=False, high_open=False):
+    """Return ``float(value)``; raise unless ``low <(=) value <(=) high``."""
+    value = _real(name, value)
+    below = value <= low if low_open else value < low
+    above = value >= high if high_open else value > high
+    if below or above:
+        lo = "(" if low_open else "["
+        hi = ")" if high_open else "]"
+        _fail(name, value, f"in {lo}{low}, {high}{hi}")
+    return value
+
+
+def check_finite_array(name, value, *, ndim=None, min_size=1):
+    """Return ``value`` as a float array; raise on NaN/inf, wrong ``ndim`` or too few entries."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {value!r} is not allowed: it must be an array of real numbers.") from None
+    if ndim is not None and arr.ndim != ndim:
+        raise InputError(f"{name} has shape {arr.shape} which is not allowed: it must be {ndim}-dimensional.")
+    if arr.size < min_size:
+        raise InputError(f"{name} has {arr.size} entries which is not allowed: it must have at least {min_size}.")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise InputError(
+            f"{name} is not allowed to contain NaN or inf: entry {idx} is {arr[idx]!r}."
+        )
+    return arr
+
+
+def check_choice(name, value, choices):
+    """Return ``value``; raise unless it is one of ``choices``."""
+    if value not in choices:
+        _fail(name, value, "one of " + ", ".join(repr(c) for c in choices))
+    return value
+
+
+def check_callable(name, value):
+    """Return ``value``; raise unless it is callable."""
+    if not callable(value):
+        _fail(name, value, "callable")
+    return value

@@ -1,0 +1,185 @@
+"""The regular equilateral-triangle lattice of the pyramid pressure elements.
+
+Node ``(i, j)`` of the lattice with step ``c`` sits at ``c*(i*e1 + j*e2)``,
+``e1 = (1, 0)``, ``e2 = (1/2, sqrt(3)/2)`` (DESIGN.md section 2, paper Fig. 2).
+The candidate region is the rectangle ``|x| <= ex``, ``|y| <= ey`` centred on the
+origin. Its nodes are stored row by row in a 2-D "brick" array of shape
+``(n_rows, n_cols)``: row ``r`` holds lattice row ``j = r - J`` at
+``y = c*sqrt(3)/2*j``; column ``q`` holds ``x = c*(q - I + (j mod 2)/2)``, so odd
+rows are shifted by half a step. The last column of an odd row lies outside the
+symmetric rectangle and is masked out. A rectangular candidate region therefore
+fills its array with no waste, which keeps the FFT convolution of
+:mod:`bem.operator` as small as the problem.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ._validate import InputError, check_positive
+
+__all__ = ["Lattice", "SQRT3"]
+
+SQRT3 = math.sqrt(3.0)
+
+
+@dataclass(frozen=True)
+class Lattice:
+    """Brick-stored triangular lattice covering a rectangular candidate region.
+
+    Parameters
+    ----------
+    step : float
+        Lattice step ``c`` [length].
+    half_cols : int
+        ``I``: even rows hold ``x = c*i`` for ``i = -I..I``.
+    half_rows : int
+        ``J``: rows ``j = -J..J``.
+    """
+
+    step: float
+    half_cols: int
+    half_rows: int
+
+    @classmethod
+    def from_extent(cls, step, extent):
+        """Lattice of step ``step`` covering ``|x| <= ex``, ``|y| <= ey``.
+
+        Parameters
+        ----------
+        step : float
+            Lattice step ``c`` [length], > 0.
+        extent : float or (float, float)
+            Half-width of the candidate region [length]: one number for a square,
+            ``(ex, ey)`` for a rectangle. At least two steps.
+        """
+        step = check_positive("step", step)
+        ex, ey = (extent, extent) if np.ndim(extent) == 0 else tuple(extent)
+        ex = check_positive("extent", ex)
+        ey = check_positive("extent", ey)
+        half_cols = int(math.floor(ex / step + 1e-9))
+        half_rows = int(math.floor(ey / (step * SQRT3 / 2) + 1e-9))
+        if half_cols < 2 or half_rows < 2:
+            raise InputError(
+                f"extent = {extent!r} is not allowed with step = {step!r}: "
+                "it must span at least 2 steps each way (make extent larger or step smaller)."
+            )
+        return cls(step, half_cols, half_rows)
+
+    @property
+    def shape(self):
+        """Shape ``(n_rows, n_cols)`` of the brick array."""
+        return (2 * self.half_rows + 1, 2 * self.half_cols + 1)
+
+    @property
+    def node_area(self):
+        """Quadrature weight of a node, the pyramid volume ``sqrt(3)/2 c^2`` (eq. 9, 11)."""
+        return SQRT3 / 2 * self.step**2
+
+    @cached_property
+    def j(self):
+        """Lattice row index ``j`` of each brick row, shape ``(n_rows,)``."""
+        return np.arange(-self.half_rows, self.half_rows + 1)
+
+    @cached_property
+    def parity(self):
+        """``j mod 2`` of each brick row, shape ``(n_rows,)``."""
+        return np.mod(self.j, 2)
+
+    @cached_property
+    def x(self):
+        """Node abscissae [length], shape :attr:`shape`."""
+        q = np.arange(-self.half_cols, self.half_cols + 1)
+        return self.step * (q[None, :] + 0.5 * self.parity[:, None])
+
+    @cached_property
+    def y(self):
+        """Node ordinates [length], shape :attr:`shape`."""
+        row = self.step * SQRT3 / 2 * self.j
+        return np.broadcast_to(row[:, None], self.shape).copy()
+
+    @cached_property
+    def mask(self):
+        """Candidate nodes (inside the symmetric rectangle), shape :attr:`shape`."""
+        m = np.ones(self.shape, dtype=bool)
+        m[self.parity == 1, -1] = False
+        return m
+
+    @cached_property
+    def border(self):
+        """Candidate nodes on the border of the region, shape :attr:`shape`."""
+        b = np.zeros(self.shape, dtype=bool)
+        b[0, :] = b[-1, :] = True
+        b[:, 0] = True
+        b[self.parity == 0, -1] = True
+        b[self.parity == 1, -2] = True
+        return b & self.mask
+
+    @property
+    def n_nodes(self):
+        """Number of candidate nodes."""
+        return int(self.mask.sum())
+
+    def coarsen(self):
+        """The lattice of step ``2c`` whose nodes are every other node of this one.
+
+        Returns ``None`` when the coarse lattice would have fewer than 2 steps
+        each way.
+        """
+        hc, hr = self.half_cols // 2, self.half_rows // 2
+        if hc < 2 or hr < 2:
+            return None
+        return Lattice(2 * self.step, hc, hr)
+
+    def interpolate(self, values, x, y):
+        """Evaluate the piecewise-linear field ``sum values_n * pyramid_n`` at points.
+
+        Parameters
+        ----------
+        values : ndarray, shape :attr:`shape`
+            Nodal values (masked nodes are read as they are; keep them 0).
+        x, y : array_like
+            Points [length], any broadcastable shapes. Points outside the lattice
+            get 0 (the field vanishes outside the candidate region).
+
+        Returns
+        -------
+        ndarray
+            The field at the points (linear interpolation on the triangles).
+        """
+        values = np.asarray(values, dtype=float)
+        if values.shape != self.shape:
+            raise InputError(f"values has shape {values.shape} which is not allowed: it must be {self.shape}.")
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        c = self.step
+        # sheared (lattice) coordinates: point = c*(s*e1 + t*e2)
+        t = y / (c * SQRT3 / 2)
+        s = x / c - t / 2
+        i0, j0 = np.floor(s), np.floor(t)
+        fs, ft = s - i0, t - j0
+        upper = fs + ft > 1.0
+        # triangle vertices (sheared offsets) and barycentric weights
+        w_a = np.where(upper, fs + ft - 1.0, 1.0 - fs - ft)  # vertex A: (1,1) if upper else (0,0)
+        w_b = np.where(upper, 1.0 - ft, fs)  # vertex B: (1,0)
+        w_c = np.where(upper, 1.0 - fs, ft)  # vertex C: (0,1)
+        ia = i0 + np.where(upper, 1, 0)
+        ja = j0 + np.where(upper, 1, 0)
+        out = w_a * self._sample(values, ia, ja)
+        out += w_b * self._sample(values, i0 + 1, j0)
+        out += w_c * self._sample(values, i0, j0 + 1)
+        return out
+
+    def _sample(self, values, i, j):
+        """Nodal values at sheared lattice indices ``(i, j)``; 0 outside."""
+        i = i.astype(np.int64)
+        j = j.astype(np.int64)
+        r = j + self.half_rows
+        q = i + self.half_cols + np.floor_divide(j, 2)
+        inside = (r >= 0) & (r < self.shape[0]) & (q >= 0) & (q < self.shape[1])
+        out = np.zeros(i.shape)
+        out[inside] = values[r[inside], q[inside]]
+        return out

@@ -1,0 +1,116 @@
+"""The result object every BEM method returns."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["ContactResult"]
+
+
+@dataclass
+class ContactResult:
+    """Solution of the discrete contact problem on the candidate nodes.
+
+    Attributes
+    ----------
+    x, y : ndarray, shape (N,)
+        Candidate node coordinates [length].
+    p : ndarray, shape (N,)
+        Nodal pressures [pressure] (pyramid amplitudes).
+    displacement : ndarray, shape (N,)
+        Elastic closure ``(C p)_n`` of the two half-spaces [length].
+    closure : ndarray, shape (N,)
+        Layer closure ``w(p_n)`` [length] (zeros without a layer).
+    gap : ndarray, shape (N,)
+        Deformed gap ``C p + w(p) + h - delta`` [length]; 0 in contact.
+    approach : float
+        Total approach ``delta`` [length].
+    force : float
+        Total force ``sqrt(3)/2 c^2 sum p`` [force] (eq. 9).
+    p_max : float
+        Largest nodal pressure [pressure].
+    contact_area : float
+        Number of nodes with ``p > 0`` times the node area ``sqrt(3)/2 c^2`` [length^2].
+    converged : bool
+        Whether the method met its stopping rule; see ``message``.
+    message : str
+        Why the method stopped.
+    iterations : int
+        Iterations of the method (outer iterations for layered methods).
+    kkt_residual : float
+        :func:`bem.kkt.kkt_residual` of the returned state.
+    history : dict
+        Per-iteration lists (``residual``, ``p_max``, ``n_contact``, ``changes``
+        and method-specific entries).
+    method : str
+        The method that produced the result.
+    wall_time_s : float
+        Wall-clock time of the solve [s].
+    lattice : bem.lattice.Lattice
+        The candidate lattice; :meth:`grid` maps nodal arrays back onto it.
+    E_star : float
+        Effective modulus [pressure].
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    p: np.ndarray
+    displacement: np.ndarray
+    closure: np.ndarray
+    gap: np.ndarray
+    approach: float
+    force: float
+    p_max: float
+    contact_area: float
+    converged: bool
+    message: str
+    iterations: int
+    kkt_residual: float
+    method: str
+    wall_time_s: float
+    lattice: object
+    E_star: float
+    history: dict = field(default_factory=dict)
+    layer: object = None
+
+    @property
+    def contact_radius(self):
+        """Radius of the circle of the same area, ``sqrt(A / pi)`` [length]."""
+        return math.sqrt(self.contact_area / math.pi)
+
+    @property
+    def step(self):
+        """Lattice step ``c`` [length]."""
+        return self.lattice.step
+
+    def grid(self, values=None):
+        """Nodal values (default ``p``) as a brick array of ``lattice.shape`` (0 off the region)."""
+        out = np.zeros(self.lattice.shape)
+        out[self.lattice.mask] = self.p if values is None else values
+        return out
+
+    def pressure_at(self, x, y):
+        """The piecewise-linear pressure field at arbitrary points [pressure]."""
+        return self.lattice.interpolate(self.grid(), x, y)
+
+    def summary(self):
+        """Scalars of the result as a JSON-ready dict."""
+        return {
+            "method": self.method,
+            "converged": bool(self.converged),
+            "message": self.message,
+            "p_max": float(self.p_max),
+            "force": float(self.force),
+            "approach": float(self.approach),
+            "contact_area": float(self.contact_area),
+            "contact_radius": float(self.contact_radius),
+            "iterations": int(self.iterations),
+            "kkt_residual": float(self.kkt_residual),
+            "wall_time_s": float(self.wall_time_s),
+            "n_nodes": int(self.p.size),
+            "n_contact": int(np.count_nonzero(self.p > 0)),
+            "step": float(self.step),
+        }

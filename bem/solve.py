@@ -1,0 +1,210 @@
+"""The public entry point :func:`solve` of the half-space BEM."""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import numpy as np
+
+from ._validate import InputError, check_callable, check_choice, check_positive
+from .kkt import kkt_residual
+from .lattice import Lattice
+from .materials import effective_modulus
+from .operator import InfluenceOperator
+from .result import ContactResult
+
+__all__ = ["solve", "METHODS", "RegionTooSmallError"]
+
+log = logging.getLogger(__name__)
+
+METHODS = ("newton", "augmented_gap", "variable_compliance", "kalker")
+
+_COARSEST_NODES = 4096  # nested iteration stops coarsening below this many nodes
+
+
+class RegionTooSmallError(InputError):
+    """The computed contact reaches the border of the candidate region."""
+
+
+def _modulus(E_star, E1, nu1, E2, nu2):
+    given = [v is not None for v in (E1, nu1, E2, nu2)]
+    if E_star is not None:
+        if any(given):
+            raise InputError("E_star is not allowed together with E1, nu1, E2, nu2: give one or the other.")
+        return check_positive("E_star", E_star)
+    if not all(given):
+        raise InputError("E_star = None is not allowed without all of E1, nu1, E2, nu2: give E_star or all four.")
+    return effective_modulus(E1, nu1, E2, nu2)
+
+
+def _load(force, approach):
+    if (force is None) == (approach is None):
+        raise InputError(f"force = {force!r}, approach = {approach!r} is not allowed: give exactly one of them.")
+    if force is not None:
+        return check_positive("force", force), None
+    return None, float(check_positive("approach", approach))
+
+
+def _levels(lattice, nested):
+    """Lattices from coarsest to finest for nested iteration."""
+    levels = [lattice]
+    while nested:
+        coarse = levels[-1].coarsen()
+        if coarse is None or coarse.n_nodes < _COARSEST_NODES:
+            break
+        levels.append(coarse)
+    return levels[::-1]
+
+
+def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None, approach=None,
+          step, extent, layer=None, method="newton", rtol=1e-10, maxiter=None, x0=None,
+          nested=True, precondition=False, callback=None, **options):
+    """Frictionless normal contact of two elastic half-spaces with an interface layer.
+
+    Minimises the generalised Kalker functional (eq. 11, 15)
+    ``Phi(p) = a [1/2 p.C p + p.(h - delta)] + a sum W(p_n)`` over ``p >= 0``,
+    ``a = sqrt(3)/2 c^2``, on the triangular lattice of step ``c``.
+
+    Parameters
+    ----------
+    gap : callable
+        Initial gap ``h(x, y)`` [length] (a :mod:`bem.gaps` shape or any vectorised callable).
+    E_star : float, optional
+        Effective modulus [pressure]; or give ``E1, nu1, E2, nu2`` instead.
+    force, approach : float
+        Exactly one: total force ``P`` [force] (force control, eq. 9) or the
+        approach ``delta`` [length] (approach control).
+    step : float
+        Lattice step ``c`` [length].
+    extent : float or (float, float)
+        Half-width of the rectangular candidate region [length].
+    layer : bem.layers.Layer, optional
+        Interface layer law ``w(p)``; ``None`` for smooth bodies.
+    method : {"newton", "augmented_gap", "variable_compliance", "kalker"}
+        Solver. For no layer or a linear layer the functional is quadratic and
+        every method reduces to the Kalker QP (solved by constrained conjugate
+        gradients, :func:`bem.kalker.solve_qp`).
+    rtol : float
+        Tolerance on the KKT residual (:func:`bem.kkt.kkt_residual`).
+    maxiter : int, optional
+        Iteration limit of the method.
+    x0 : ndarray, optional
+        Initial nodal pressures on the candidate nodes, shape ``(N,)``.
+    nested : bool
+        Start from the solution on successively coarser lattices (step ``2c``,
+        ``4c``, ...) interpolated onto the finer one.
+    precondition : bool
+        Use the FFT preconditioner in the conjugate gradients.
+    callback : callable, optional
+        ``callback(k, p_grid)`` after every iteration on the finest lattice.
+    **options
+        Method-specific options (see the method's function).
+
+    Returns
+    -------
+    ContactResult
+
+    Raises
+    ------
+    bem._validate.InputError
+        Bad input (the message names the argument).
+    RegionTooSmallError
+        The contact reaches the border of the candidate region.
+    """
+    t_start = time.perf_counter()
+    check_callable("gap", gap)
+    E_star = _modulus(E_star, E1, nu1, E2, nu2)
+    force, approach = _load(force, approach)
+    check_choice("method", method, METHODS)
+    rtol = check_positive("rtol", rtol)
+    lattice = Lattice.from_extent(step, extent)
+    lam = _linear_compliance(layer, method)
+    if x0 is not None:
+        x0 = np.asarray(x0, dtype=float)
+        if x0.shape != (lattice.n_nodes,):
+            raise InputError(f"x0 has shape {x0.shape} which is not allowed: it must be ({lattice.n_nodes},).")
+        nested = False
+
+    from .kalker import solve_qp
+
+    guess = None
+    if x0 is not None:
+        guess = np.zeros(lattice.shape)
+        guess[lattice.mask] = x0
+    levels = _levels(lattice, nested)
+    for level, lat in enumerate(levels):
+        finest = level == len(levels) - 1
+        op = InfluenceOperator(lat, E_star)
+        h = _gap_values(gap, lat)
+        precond = op.preconditioner(lam=float(np.mean(lam))) if precondition else None
+        sol = solve_qp(op, h, force=force, approach=approach, lam=lam, x0=guess,
+                       rtol=rtol if finest else max(rtol, 1e-6), maxiter=maxiter,
+                       precondition=precond, callback=callback if finest else None)
+        if not finest:
+            guess = _prolong(lat, sol.p, levels[level + 1])
+    _check_border(lattice, sol.p, extent)
+    closure = lam * sol.p
+    return _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start)
+
+
+def _prolong(coarse, p, fine):
+    return coarse.interpolate(p, fine.x, fine.y) * fine.mask
+
+
+def _linear_compliance(layer, method):
+    if layer is None:
+        return 0.0
+    from .layers.base import Layer
+
+    if not isinstance(layer, Layer):
+        raise InputError(f"layer = {layer!r} is not allowed: it must be a bem.layers law or None.")
+    if layer.is_linear:
+        return float(layer.lam)
+    raise NotImplementedError("nonlinear layers are solved by bem.nonlinear (not yet available)")
+
+
+def _gap_values(gap, lattice):
+    h = np.asarray(gap(lattice.x, lattice.y), dtype=float)
+    if h.shape != lattice.shape:
+        raise InputError(f"gap returned shape {h.shape} which is not allowed: it must return the shape of x ({lattice.shape}).")
+    bad = lattice.mask & ~np.isfinite(h)
+    if bad.any():
+        r, q = np.argwhere(bad)[0]
+        raise InputError(
+            f"gap(x, y) = {h[r, q]!r} at (x, y) = ({lattice.x[r, q]:.6g}, {lattice.y[r, q]:.6g}) is not allowed: "
+            "the gap must be finite over the candidate region (make extent smaller or fix the gap)."
+        )
+    return np.where(lattice.mask, h, 0.0)
+
+
+def _check_border(lattice, p, extent):
+    touching = lattice.border & (p > 0)
+    if touching.any():
+        n = int(touching.sum())
+        raise RegionTooSmallError(
+            f"extent = {extent!r} is not allowed for this load: the contact reaches the border of the "
+            f"candidate region at {n} node(s). Make extent larger (the contact must stay inside it) "
+            "or reduce the load."
+        )
+
+
+def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start):
+    mask = lattice.mask
+    p = sol.p
+    u = op.matvec(p)
+    g = u + closure + h - sol.approach
+    a = lattice.node_area
+    kkt = kkt_residual(p[mask], g[mask], displacement_scale=float(np.abs(u + closure).max()),
+                       force=force, node_area=a)
+    if not np.all(np.isfinite(p)):
+        raise FloatingPointError(f"{method}: the solver produced non-finite pressures ({sol.message})")
+    return ContactResult(
+        x=lattice.x[mask], y=lattice.y[mask], p=p[mask], displacement=u[mask],
+        closure=closure[mask], gap=g[mask],
+        approach=float(sol.approach), force=float(a * p.sum()), p_max=float(p.max()),
+        contact_area=float(a * np.count_nonzero(p[mask] > 0)), converged=bool(sol.converged),
+        message=sol.message, iterations=int(sol.iterations), kkt_residual=float(kkt), method=method,
+        wall_time_s=time.perf_counter() - t_start, lattice=lattice, E_star=E_star,
+        history=sol.history, layer=layer,
+    )

@@ -1,0 +1,69 @@
+"""The FFT influence operator against the dense matrix of eq. 6."""
+
+import math
+
+import numpy as np
+import pytest
+
+from bem.lattice import Lattice
+from bem.operator import InfluenceOperator
+from bem.template import template
+
+
+@pytest.mark.parametrize("extent", [1.0, (1.0, 0.45), (0.55, 1.0), (0.73, 0.81)])
+def test_fft_product_equals_dense_product(extent):
+    lat = Lattice.from_extent(0.1, extent)
+    op = InfluenceOperator(lat, 2.5)
+    dense = op.dense()
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        p = rng.random(lat.shape) * lat.mask
+        ref = dense @ p[lat.mask]
+        got = op.matvec(p)[lat.mask]
+        assert np.abs(got - ref).max() <= 1e-13 * np.abs(ref).max()
+
+
+def test_dense_matrix_is_eq6_and_symmetric_positive_definite():
+    lat = Lattice.from_extent(0.2, 1.0)
+    op = InfluenceOperator(lat, 3.0)
+    C = op.dense()
+    x, y = lat.x[lat.mask], lat.y[lat.mask]
+    n, m = 5, 17
+    expected = 0.2 / (math.pi * 3.0) * template((x[n] - x[m]) / 0.2, (y[n] - y[m]) / 0.2)
+    assert C[n, m] == pytest.approx(float(expected), rel=1e-14)
+    assert op.diagonal == pytest.approx(0.2 / (math.pi * 3.0) * 1.5 * math.sqrt(3) * math.log(3), rel=1e-14)
+    np.testing.assert_allclose(C, C.T, rtol=1e-12)  # template round-off, mirrored points
+    assert np.linalg.eigvalsh(C).min() > 0
+
+
+def test_linear_operator_wraps_the_same_product():
+    lat = Lattice.from_extent(0.25, 1.0)
+    op = InfluenceOperator(lat, 1.0)
+    v = np.random.default_rng(1).random(lat.n_nodes)
+    np.testing.assert_allclose(op.as_linear_operator() @ v, op.dense() @ v, rtol=1e-12)
+
+
+def test_preconditioner_is_symmetric_positive_definite():
+    lat = Lattice.from_extent(0.2, 1.0)
+    op = InfluenceOperator(lat, 1.0)
+    M = op.preconditioner(lam=0.1)
+    n = lat.n_nodes
+    cols = []
+    for k in range(n):
+        e = np.zeros(n)
+        e[k] = 1.0
+        grid = np.zeros(lat.shape)
+        grid[lat.mask] = e
+        cols.append(M(grid)[lat.mask])
+    Mm = np.array(cols).T
+    np.testing.assert_allclose(Mm, Mm.T, atol=1e-12 * np.abs(Mm).max())
+    assert np.linalg.eigvalsh((Mm + Mm.T) / 2).min() > 0
+
+
+def test_matvec_does_not_modify_input():
+    lat = Lattice.from_extent(0.2, 1.0)
+    op = InfluenceOperator(lat, 1.0)
+    p = np.random.default_rng(2).random(lat.shape) * lat.mask
+    keep = p.copy()
+    op.matvec(p)
+    np.testing.assert_array_equal(p, keep)

@@ -1,0 +1,54 @@
+"""bem.solve refuses bad input early and reports an undersized candidate region."""
+
+import numpy as np
+import pytest
+
+import bem
+from bem._validate import InputError
+from bem.gaps import Paraboloid
+
+GOOD = dict(E_star=1.0, force=0.01, step=0.05, extent=0.5)
+
+
+@pytest.mark.parametrize("change, name", [
+    (dict(E_star=-1.0), "E_star"),
+    (dict(E_star=float("nan")), "E_star"),
+    (dict(force=0.0), "force"),
+    (dict(force=None), "approach"),
+    (dict(approach=0.1), "approach"),
+    (dict(step=0.0), "step"),
+    (dict(extent=-1.0), "extent"),
+    (dict(method="simplex"), "method"),
+    (dict(rtol=-1e-3), "rtol"),
+    (dict(layer="soft"), "layer"),
+    (dict(E_star=None, E1=2e11, nu1=0.3, E2=2e11), "E_star"),
+    (dict(E_star=None, E1=2e11, nu1=0.7, E2=2e11, nu2=0.3), "nu1"),
+    (dict(x0=np.zeros(3)), "x0"),
+])
+def test_bad_input_is_refused_naming_the_argument(change, name):
+    kw = {**GOOD, **change}
+    with pytest.raises(InputError, match=name):
+        bem.solve(Paraboloid(1.0), **kw)
+
+
+def test_gap_with_nan_is_refused():
+    with pytest.raises(InputError, match="gap"):
+        bem.solve(lambda x, y: np.where(x > 0.2, np.nan, x * x + y * y), **GOOD)
+
+
+def test_contact_reaching_the_border_says_so():
+    with pytest.raises(bem.RegionTooSmallError, match="extent"):
+        bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=0.5)
+
+
+def test_e1_nu1_e2_nu2_give_the_same_answer_as_e_star():
+    a = bem.solve(Paraboloid(1.0), E_star=1.0 / (2 * (1 - 0.3**2) / 2.0), force=0.01, step=0.05, extent=0.5)
+    b = bem.solve(Paraboloid(1.0), E1=2.0, nu1=0.3, E2=2.0, nu2=0.3, force=0.01, step=0.05, extent=0.5)
+    np.testing.assert_allclose(a.p, b.p, rtol=1e-12)
+
+
+def test_non_convergence_is_reported_not_hidden():
+    res = bem.solve(Paraboloid(1.0), maxiter=2, nested=False, **GOOD)
+    assert not res.converged
+    assert "maxiter" in res.message
+    assert np.all(np.isfinite(res.p))
