@@ -61,7 +61,7 @@ def _initial(op, h, lam, force, approach, x0):
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, precondition=None, callback=None):
+             maxiter=None, precondition=None, callback=None, frozen=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
 
     Parameters
@@ -85,6 +85,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         Callable ``z = M(r)`` on brick arrays approximating ``(C + lam)^-1``.
     callback : callable, optional
         ``callback(k, p)`` after every iteration.
+    frozen : ndarray of bool, optional
+        Nodes held at ``p = 0`` (infinite compliance); they are left out of the
+        problem and of the KKT residual.
 
     Returns
     -------
@@ -102,14 +105,17 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     recomputed ``C p``.
     """
     lat = op.lattice
-    mask = lat.mask
+    mask = lat.mask if frozen is None else lat.mask & ~frozen
     a = lat.node_area
     lam = np.where(mask, lam, 0.0) if np.ndim(lam) else float(lam)
     h = np.where(mask, h, 0.0)
     if maxiter is None:
         maxiter = max(200, int(10 * np.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
-    p = _initial(op, h, lam, force, approach, x0)
+    p = np.where(mask, _initial(op, h, lam, force, approach, x0), 0.0)
+    if target is not None:
+        p = p if p.sum() > 0 else mask.astype(float)
+        p *= target / p.sum()
 
     def apply(v):
         return op.matvec(v) + lam * v

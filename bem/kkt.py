@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["kkt_residual"]
+__all__ = ["kkt_residual", "layered_state"]
 
 
 def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
@@ -61,3 +61,45 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
     if force is not None:
         parts.append(abs(node_area * float(p.sum()) - force) / force)
     return max(parts)
+
+
+def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None):
+    """Deformed gap, approach and KKT residual of a pressure with a layer.
+
+    Parameters
+    ----------
+    op : bem.operator.InfluenceOperator
+        Supplies the lattice (node area, candidate mask).
+    h, p, u : ndarray
+        Gap [length], pressure [pressure] and elastic closure ``C p`` [length]
+        as brick arrays.
+    layer : bem.layers.Layer or None
+        Interface law ``w(p)``.
+    force, approach : float
+        The load: under force control ``delta`` is the mean of
+        ``C p + w(p) + h`` over the contact nodes (the multiplier of eq. 9).
+    mask : ndarray of bool, optional
+        Nodes of the problem (default: the lattice's candidate nodes).
+
+    Returns
+    -------
+    gap : ndarray
+        ``C p + w(p) + h - delta`` (0 off ``mask``).
+    delta : float
+        Approach [length].
+    kkt : float
+        :func:`kkt_residual` of the state.
+    """
+    lat = op.lattice
+    mask = lat.mask if mask is None else mask
+    closure = np.zeros_like(p) if layer is None else np.where(mask, layer.w(p), 0.0)
+    total = u + closure
+    contact = mask & (p > 0)
+    if force is not None:
+        delta = float(np.mean(total[contact] + h[contact])) if contact.any() else 0.0
+    else:
+        delta = float(approach)
+    gap = np.where(mask, total + h - delta, 0.0)
+    kkt = kkt_residual(p[mask], gap[mask], displacement_scale=float(np.abs(total[mask]).max()),
+                       force=force, node_area=lat.node_area)
+    return gap, delta, kkt
