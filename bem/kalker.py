@@ -174,7 +174,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         clipped = p_new < 0
         p_new[clipped] = 0.0
         overlap = mask & (p_new == 0) & (g < 0)
-        p_new[overlap] -= tau * g[overlap]
+        # re-entering nodes: Polonsky-Keer's -tau g, capped by the Jacobi estimate
+        # -g / (C_nn + lam) so that a node with a large layer compliance cannot overshoot
+        p_new[overlap] = -g[overlap] * np.minimum(tau, 1.0 / (op.diagonal + (lam[overlap] if np.ndim(lam) else lam)))
         restart = bool(overlap.any())
         s = 1.0
         if target is not None:

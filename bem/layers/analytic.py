@@ -1,0 +1,241 @@
+"""Closed-form layer laws: linear (eq. 12), power (eq. 16), root, bilinear, elastic-rigid.
+
+The root, elastic-rigid and bilinear laws are those of the paper's test problems (section 6,
+Fig. 4 b-d). Every method is vectorised, clips ``p < 0`` to 0 and returns the right derivative
+at kinks (``dw`` is the tangent compliance of the branch that starts at ``p``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import check_nonnegative, check_positive
+from ._common import LawBase, as_closure, as_pressure, out
+
+__all__ = ["Linear", "Power", "Root", "Bilinear", "ElasticRigid"]
+
+
+class Linear(LawBase):
+    """Winkler layer ``w = lam * p`` (paper eq. 12).
+
+    Parameters
+    ----------
+    lam : float
+        Compliance [length/pressure], ``> 0``.
+
+    Notes
+    -----
+    ``dw = secant = lam``, ``W = lam p**2 / 2``, ``inverse(c) = c / lam``. The only law with
+    ``is_linear = True``: the Kalker QP adds ``lam`` to the diagonal (eq. 13).
+    """
+
+    law = "linear"
+    _required = ("lam",)
+    is_linear = True
+
+    def __init__(self, lam):
+        self.lam = check_positive("lam", lam)
+
+    def _params(self):
+        return {"lam": self.lam}
+
+    def w(self, p):
+        with np.errstate(over="ignore"):
+            return out(self.lam * as_pressure(p))
+
+    def dw(self, p):
+        p = as_pressure(p)
+        return out(np.where(np.isnan(p), np.nan, self.lam))
+
+    def energy(self, p):
+        with np.errstate(over="ignore"):
+            return out(0.5 * self.lam * as_pressure(p) ** 2)
+
+    def inverse(self, closure):
+        c = as_closure(closure)
+        return out(np.where(c <= 0, 0.0, c) / self.lam)
+
+    def secant(self, p):
+        return self.dw(p)
+
+
+class Power(LawBase):
+    """Power law ``w = lam * p**s`` (paper eq. 16).
+
+    Parameters
+    ----------
+    lam : float
+        Coefficient [length/pressure**s], ``> 0``.
+    s : float
+        Exponent [-], ``> 0`` (``s < 1``: stiffening, typical of roughness).
+
+    Notes
+    -----
+    ``dw = lam s p**(s-1)``: ``+inf`` at ``p = 0`` for ``s < 1``, ``lam`` for ``s = 1``, 0 for
+    ``s > 1``; ``W = lam p**(s+1) / (s+1)``; ``inverse(c) = (c / lam)**(1/s)``.
+    Overflow gives ``inf`` silently.
+    """
+
+    law = "power"
+    _required = ("lam", "s")
+
+    def __init__(self, lam, s):
+        self.lam = check_positive("lam", lam)
+        self.s = check_positive("s", s)
+
+    def _params(self):
+        return {"lam": self.lam, "s": self.s}
+
+    def w(self, p):
+        with np.errstate(over="ignore"):
+            return out(self.lam * as_pressure(p) ** self.s)
+
+    def dw(self, p):
+        with np.errstate(divide="ignore", over="ignore"):
+            return out(self.lam * self.s * as_pressure(p) ** (self.s - 1.0))
+
+    def energy(self, p):
+        with np.errstate(over="ignore"):
+            return out(self.lam * as_pressure(p) ** (self.s + 1.0) / (self.s + 1.0))
+
+    def inverse(self, closure):
+        c = as_closure(closure)
+        with np.errstate(over="ignore"):
+            return out((np.where(c <= 0, 0.0, c) / self.lam) ** (1.0 / self.s))
+
+    def secant(self, p):
+        """``lam p**(s-1)``; at ``p = 0`` the limit (``inf``, ``lam`` or 0 as for ``dw``)."""
+        with np.errstate(divide="ignore", over="ignore"):
+            return out(self.lam * as_pressure(p) ** (self.s - 1.0))
+
+
+class Root(Power):
+    """Root law ``w = lam * sqrt(p)`` (paper Fig. 4 c): :class:`Power` with ``s = 1/2``.
+
+    Parameters
+    ----------
+    lam : float
+        Coefficient [length/pressure**0.5], ``> 0``.
+
+    Notes
+    -----
+    ``dw = lam / (2 sqrt p)`` (``+inf`` at 0), ``W = 2 lam p**1.5 / 3``, ``inverse = (c/lam)**2``.
+    """
+
+    law = "root"
+    _required = ("lam",)
+
+    def __init__(self, lam):
+        super().__init__(lam, 0.5)
+
+    def _params(self):
+        return {"lam": self.lam}
+
+    def w(self, p):
+        return out(self.lam * np.sqrt(as_pressure(p)))
+
+
+class Bilinear(LawBase):
+    """Bilinear law: slope ``lam1`` up to ``p_star``, slope ``lam2`` beyond (paper Fig. 4 d).
+
+    ``w = lam1 min(p, p_star) + lam2 max(p - p_star, 0)``.
+
+    Parameters
+    ----------
+    lam1 : float
+        Compliance below ``p_star`` [length/pressure], ``> 0``.
+    lam2 : float
+        Compliance above ``p_star`` [length/pressure], ``>= 0`` (0: elastic-rigid).
+    p_star : float
+        Pressure of the kink [pressure], ``> 0``.
+
+    Notes
+    -----
+    ``dw`` is the right derivative: ``lam1`` for ``p < p_star``, ``lam2`` for ``p >= p_star``.
+    ``inverse(c)`` is ``c / lam1`` up to ``w* = lam1 p_star``, ``p_star + (c - w*) / lam2``
+    beyond; with ``lam2 = 0`` it is ``+inf`` for ``c > w*`` (the rigid branch cannot close
+    further) and ``p_star`` (the smallest pressure reaching it) at ``c = w*``.
+    """
+
+    law = "bilinear"
+    _required = ("lam1", "lam2", "p_star")
+
+    def __init__(self, lam1, lam2, p_star):
+        self.lam1 = check_positive("lam1", lam1)
+        self.lam2 = check_nonnegative("lam2", lam2)
+        self.p_star = check_positive("p_star", p_star)
+
+    def _params(self):
+        return {"lam1": self.lam1, "lam2": self.lam2, "p_star": self.p_star}
+
+    @property
+    def p_scale(self):
+        return self.p_star
+
+    def w(self, p):
+        p = as_pressure(p)
+        w = self.lam1 * np.minimum(p, self.p_star)
+        if self.lam2 > 0:  # skip 0 * inf
+            with np.errstate(over="ignore"):
+                w = w + self.lam2 * np.maximum(p - self.p_star, 0.0)
+        return out(w)
+
+    def dw(self, p):
+        p = as_pressure(p)
+        return out(np.where(p < self.p_star, self.lam1, np.where(np.isnan(p), np.nan, self.lam2)))
+
+    def energy(self, p):
+        p = as_pressure(p)
+        ps, l1 = self.p_star, self.lam1
+        q = np.minimum(p, ps)
+        beyond = np.maximum(p - ps, 0.0)
+        with np.errstate(over="ignore"):
+            energy = 0.5 * l1 * q**2 + l1 * ps * beyond
+            if self.lam2 > 0:  # skip 0 * inf
+                energy = energy + 0.5 * self.lam2 * beyond**2
+        return out(energy)
+
+    def inverse(self, closure):
+        c = as_closure(closure)
+        w_star = self.lam1 * self.p_star
+        elastic = np.where(c <= 0, 0.0, np.minimum(c, w_star)) / self.lam1
+        elastic = np.where(c == w_star, self.p_star, elastic)
+        beyond = np.inf  # lam2 = 0: the rigid branch cannot close further
+        if self.lam2 > 0:
+            with np.errstate(over="ignore"):
+                beyond = self.p_star + np.maximum(c - w_star, 0.0) / self.lam2
+        return out(np.where(c > w_star, beyond, elastic))
+
+
+class ElasticRigid(Bilinear):
+    """Elastic-rigid law ``w = lam * min(p, p_cr)`` (paper Fig. 4 b).
+
+    Parameters
+    ----------
+    lam : float
+        Compliance of the elastic branch [length/pressure], ``> 0``.
+    p_cr : float
+        Pressure at which the layer turns rigid [pressure], ``> 0``.
+
+    Notes
+    -----
+    :class:`Bilinear` with ``lam2 = 0``: ``dw`` is ``lam`` below ``p_cr`` and 0 from ``p_cr``
+    on; ``inverse(c) = +inf`` for ``c > lam p_cr``, ``p_cr`` at ``c = lam p_cr``.
+    """
+
+    law = "elastic_rigid"
+    _required = ("lam", "p_cr")
+
+    def __init__(self, lam, p_cr):
+        super().__init__(check_positive("lam", lam), 0.0, check_positive("p_cr", p_cr))
+
+    @property
+    def lam(self):
+        return self.lam1
+
+    @property
+    def p_cr(self):
+        return self.p_star
+
+    def _params(self):
+        return {"lam": self.lam, "p_cr": self.p_cr}
