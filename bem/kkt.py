@@ -41,20 +41,20 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
     -------
     float
         ``max( max(-p)_+ / p_max, max_{p>0} |g| / s, max_{p=0} (-g)_+ / s, force balance )``
-        with ``s`` = ``displacement_scale``; 0 for an exact solution. ``inf`` if
-        anything is not finite.
+        with ``s`` = ``displacement_scale`` (``max |g|`` when that is 0, e.g.
+        for ``p = 0``); 0 for an exact solution. ``inf`` if anything is not finite.
     """
     p = np.asarray(p, dtype=float)
     gap = np.asarray(gap, dtype=float)
     if not (np.all(np.isfinite(p)) and np.all(np.isfinite(gap))):
         return float("inf")
     s = float(displacement_scale)
+    if s <= 0:  # no deformation at all: measure the gap against itself
+        s = float(np.abs(gap).max(initial=0.0)) or 1.0
     p_max = float(p.max(initial=0.0))
-    if s <= 0 or p_max <= 0:
-        return float("inf") if force else 0.0
     contact = p > 0
     parts = [
-        max(0.0, float(-p.min(initial=0.0))) / p_max,
+        max(0.0, float(-p.min(initial=0.0))) / p_max if p_max > 0 else 0.0,
         float(np.abs(gap[contact]).max(initial=0.0)) / s,
         max(0.0, float(-gap[~contact].min(initial=0.0))) / s,
     ]

@@ -26,7 +26,7 @@ import logging
 import numpy as np
 from scipy.optimize import brentq
 
-from .kalker import QPSolution, solve_qp
+from .kalker import QPSolution, compliance_preconditioner, solve_qp
 from .kkt import layered_state
 
 __all__ = ["solve_newton"]
@@ -42,27 +42,6 @@ def _tangent(layer, p, gap, p_ref):
         reach = np.minimum(reach, 1e6 * p_ref)
         secant = np.asarray(layer.w(reach), dtype=float) / reach
     return np.where(np.isfinite(d) & (p > 0), d, secant)
-
-
-def _preconditioner(op, D, contact, threshold=4.0):
-    """Block-diagonal SPD preconditioner for ``C + diag(D)``.
-
-    Nodes whose layer compliance dominates (``D > threshold * C_nn``) are nearly
-    decoupled: Jacobi ``r / (C_nn + D)``. The others get the FFT inverse of
-    ``C + lam`` with ``lam`` the median of their ``D`` on the contact.
-    """
-    stiff = D <= threshold * op.diagonal
-    sel = stiff & contact
-    lam = float(np.median(D[sel])) if sel.any() else 0.0
-    fft = op.preconditioner(lam=lam)
-    jacobi = 1.0 / (op.diagonal + D)
-    if stiff.all():
-        return fft
-
-    def apply(r):
-        return np.where(stiff, fft(np.where(stiff, r, 0.0)), jacobi * r)
-
-    return apply
 
 
 def _line_search(layer, p, d, u, cd, h, delta, mask):
@@ -99,7 +78,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     force, approach : float
         Exactly one: total force [force] or approach [length].
     x0 : ndarray, optional
-        Initial pressure (brick array); default: the smooth-body solution.
+        Initial pressure (brick array); default: the smooth-body solution
+        followed by one step of the variable compliance method (eq. 22).
     rtol : float
         Tolerance on the KKT residual of eq. 14 (:func:`bem.kkt.kkt_residual`).
     maxiter : int
@@ -129,8 +109,15 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     h = np.where(mask, h, 0.0)
     applies = 0
     if x0 is None:
+        # smooth-body solution, then one secant (variable compliance) step: a start
+        # that is fair for stiff and for layer-dominated problems alike
         start = solve_qp(op, h, force=force, approach=approach, rtol=1e-3,
                          precondition=op.preconditioner() if precondition else None)
+        contact = start.p > 0
+        lam = float(layer.secant(np.mean(start.p[contact]))) if contact.any() else 0.0
+        if np.isfinite(lam) and lam > 0:
+            start = solve_qp(op, h, force=force, approach=approach, lam=lam, rtol=1e-3,
+                             precondition=op.preconditioner(lam=lam) if precondition else None)
         p, applies = start.p, start.applies
     else:
         p = np.where(mask, np.maximum(x0, 0.0), 0.0)
@@ -167,7 +154,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         b = h + np.where(mask, layer.w(p), 0.0) - D * p
         inner = max(rtol / 3, min(1e-2, 0.1 * kkt**1.5))
         sub = solve_qp(op, b, force=force, approach=approach, lam=D, x0=p, rtol=inner, maxiter=inner_maxiter,
-                       precondition=_preconditioner(op, D, contact) if precondition else None)
+                       precondition=compliance_preconditioner(op, D, contact) if precondition else None)
         applies += sub.applies
         d = sub.p - p
         cd = (sub.displacement - D * sub.p) - u

@@ -59,7 +59,7 @@ def _levels(lattice, nested):
 
 def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None, approach=None,
           step, extent, layer=None, method="newton", rtol=1e-10, maxiter=None, x0=None,
-          nested=True, precondition=False, callback=None, **options):
+          nested=None, precondition=True, callback=None, **options):
     """Frictionless normal contact of two elastic half-spaces with an interface layer.
 
     Minimises the generalised Kalker functional (eq. 11, 15)
@@ -82,24 +82,34 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     layer : bem.layers.Layer, optional
         Interface layer law ``w(p)``; ``None`` for smooth bodies.
     method : {"newton", "augmented_gap", "variable_compliance", "kalker"}
-        Solver. For no layer or a linear layer the functional is quadratic and
-        every method reduces to the Kalker QP (solved by constrained conjugate
-        gradients, :func:`bem.kalker.solve_qp`).
+        ``"newton"`` (default): direct minimisation of eq. 15
+        (:func:`bem.newton.solve_newton`); ``"augmented_gap"`` (eq. 17-20) and
+        ``"variable_compliance"`` (eq. 21-23): the paper's methods
+        (:mod:`bem.fixed_point`); ``"kalker"``: the QP of eq. 11/13
+        (:func:`bem.kalker.solve_qp`), smooth or linear layer only. Without a
+        layer, and for ``"newton"`` with a linear layer, the functional is
+        quadratic and the QP is solved directly.
     rtol : float
         Tolerance on the KKT residual (:func:`bem.kkt.kkt_residual`).
     maxiter : int, optional
         Iteration limit of the method.
     x0 : ndarray, optional
         Initial nodal pressures on the candidate nodes, shape ``(N,)``.
-    nested : bool
+    nested : bool, optional
         Start from the solution on successively coarser lattices (step ``2c``,
-        ``4c``, ...) interpolated onto the finer one.
+        ``4c``, ...) interpolated onto the finer one. Default: on for
+        ``"newton"`` and the QP, off for the paper's methods so that their
+        iteration histories start from ``p = 0`` as in the paper.
     precondition : bool
         Use the FFT preconditioner in the conjugate gradients.
     callback : callable, optional
         ``callback(k, p_grid)`` after every iteration on the finest lattice.
     **options
-        Method-specific options (see the method's function).
+        Method-specific options: ``relaxation``, ``eps_h``, ``eps_p``, ``kkt_tol``
+        (:func:`bem.fixed_point.solve_augmented_gap`,
+        :func:`bem.fixed_point.solve_variable_compliance`), ``record`` (keep
+        every iterate in ``history["p"]``), ``inner_maxiter``
+        (:func:`bem.newton.solve_newton`).
 
     Returns
     -------
@@ -119,49 +129,66 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     check_choice("method", method, METHODS)
     rtol = check_positive("rtol", rtol)
     lattice = Lattice.from_extent(step, extent)
-    lam = _linear_compliance(layer, method)
+    _check_layer(layer, method)
+    quadratic = layer is None or layer.is_linear and method in ("kalker", "newton")
+    if nested is None:
+        nested = quadratic or method == "newton"
+    guess = None
     if x0 is not None:
         x0 = np.asarray(x0, dtype=float)
         if x0.shape != (lattice.n_nodes,):
             raise InputError(f"x0 has shape {x0.shape} which is not allowed: it must be ({lattice.n_nodes},).")
-        nested = False
-
-    from .kalker import solve_qp
-
-    guess = None
-    if x0 is not None:
         guess = np.zeros(lattice.shape)
         guess[lattice.mask] = x0
+        nested = False
     levels = _levels(lattice, nested)
     for level, lat in enumerate(levels):
         finest = level == len(levels) - 1
         op = InfluenceOperator(lat, E_star)
         h = _gap_values(gap, lat)
-        precond = op.preconditioner(lam=float(np.mean(lam))) if precondition else None
-        sol = solve_qp(op, h, force=force, approach=approach, lam=lam, x0=guess,
-                       rtol=rtol if finest else max(rtol, 1e-6), maxiter=maxiter,
-                       precondition=precond, callback=callback if finest else None)
+        kw = dict(force=force, approach=approach, x0=guess, rtol=rtol if finest else max(rtol, 1e-6),
+                  callback=callback if finest else None)
+        if maxiter is not None:
+            kw["maxiter"] = maxiter
+        sol = _run(method, quadratic, op, h, layer, precondition, kw, options)
         if not finest:
             guess = _prolong(lat, sol.p, levels[level + 1])
     _check_border(lattice, sol.p, extent)
-    closure = lam * sol.p
+    closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
     return _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start)
+
+
+def _run(method, quadratic, op, h, layer, precondition, kw, options):
+    """Dispatch one lattice level to the method."""
+    from .fixed_point import solve_augmented_gap, solve_variable_compliance
+    from .kalker import solve_qp
+    from .newton import solve_newton
+
+    if layer is None or quadratic:
+        lam = 0.0 if layer is None else layer.lam
+        precond = op.preconditioner(lam=lam) if precondition else None
+        return solve_qp(op, h, lam=lam, precondition=precond, **kw, **options)
+    solver = {"newton": solve_newton, "augmented_gap": solve_augmented_gap,
+              "variable_compliance": solve_variable_compliance}[method]
+    return solver(op, h, layer=layer, precondition=precondition, **kw, **options)
 
 
 def _prolong(coarse, p, fine):
     return coarse.interpolate(p, fine.x, fine.y) * fine.mask
 
 
-def _linear_compliance(layer, method):
+def _check_layer(layer, method):
     if layer is None:
-        return 0.0
+        return
     from .layers.base import Layer
 
     if not isinstance(layer, Layer):
         raise InputError(f"layer = {layer!r} is not allowed: it must be a bem.layers law or None.")
-    if layer.is_linear:
-        return float(layer.lam)
-    raise NotImplementedError("nonlinear layers are solved by bem.nonlinear (not yet available)")
+    if method == "kalker" and not layer.is_linear:
+        raise InputError(
+            f"method = 'kalker' is not allowed with layer = {layer!r}: Kalker's QP solves smooth bodies "
+            "and linear layers only; use method='newton' (or a paper method) for a nonlinear layer."
+        )
 
 
 def _gap_values(gap, lattice):

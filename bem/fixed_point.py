@@ -1,0 +1,258 @@
+"""The paper's two iterative methods for a nonlinear layer (section 5).
+
+Both reduce the structurally and physically nonlinear problem (eq. 14) to a
+sequence of Kalker QPs (eq. 11, 13), each solved by
+:func:`bem.kalker.solve_qp`:
+
+* augmented gap method (eq. 17-20): the layer closure of the previous iterate
+  is added to the gap, ``h_bar = h + w(p_k)``, and the smooth-body QP is solved
+  again; optional relaxation ``p_{k+1} = (1 - omega) p_k + omega p_QP``;
+* variable compliance coefficients (eq. 21-23): the layer is replaced by a
+  linear Winkler layer of per-node compliance ``lam_n = w(p_n) / p_n`` (the
+  secant), i.e. the matrix ``C + diag(lam)`` changes and the gap stays.
+
+They are fixed-point iterations: they converge where the map is a
+contraction and may stall or diverge elsewhere (a soft layer for the augmented
+gap method). Each says so in its result: ``converged`` is True only if the
+paper's stopping rule is met AND the KKT residual of the final state is at
+most ``kkt_tol``, so a stalled iteration is never reported as a solution.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from .kalker import QPSolution, compliance_preconditioner, solve_qp
+from .kkt import layered_state
+
+__all__ = ["solve_augmented_gap", "solve_variable_compliance"]
+
+log = logging.getLogger(__name__)
+
+_DIVERGING_STEPS = 8  # increments growing this many times in a row = diverging
+_STALL_STEPS = 15  # no new smallest increment for this many iterations = stalled
+
+
+def _increment(new, old):
+    norm = float(np.linalg.norm(new))
+    return float(np.linalg.norm(new - old)) / norm if norm > 0 else float(np.linalg.norm(new - old))
+
+
+class _Tracker:
+    """History, divergence watch and the final verdict shared by both methods."""
+
+    def __init__(self, op, h, layer, force, approach, record):
+        self.op, self.h, self.layer, self.force, self.approach = op, h, layer, force, approach
+        self.hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "increment_p": [],
+                     "increment_h": [], "inner_iterations": []}
+        if record:
+            self.hist["p"] = []
+        self.growing = 0
+        self.applies = 0
+        self.best, self.since_best = np.inf, 0
+
+    def record(self, p, u, prev_contact, inc_p, inc_h, inner):
+        gap, delta, kkt = layered_state(self.op, self.h, self.layer, p, u, force=self.force,
+                                        approach=self.approach)
+        contact = p > 0
+        h = self.hist
+        if h["increment_p"] and inc_p > h["increment_p"][-1]:
+            self.growing += 1
+        else:
+            self.growing = 0
+        if inc_p < 0.9 * self.best:
+            self.best, self.since_best = inc_p, 0
+        else:
+            self.since_best += 1
+        for key, val in (("residual", kkt), ("p_max", float(p.max())), ("n_contact", int(contact.sum())),
+                         ("changes", int(np.count_nonzero(contact != prev_contact))), ("increment_p", inc_p),
+                         ("increment_h", inc_h), ("inner_iterations", inner)):
+            h[key].append(val)
+        if "p" in h:
+            h["p"].append(p[self.op.lattice.mask].copy())
+        return delta, kkt
+
+    def failing(self):
+        """Why the iteration is hopeless, or ``""``."""
+        if self.growing >= _DIVERGING_STEPS:
+            return f"diverging: the pressure increment grew {_DIVERGING_STEPS} times in a row"
+        if self.since_best >= _STALL_STEPS:
+            return (f"stalled: the pressure increment did not fall below 0.9 x its best value "
+                    f"{self.best:.2e} in {_STALL_STEPS} iterations")
+        return ""
+
+    def finish(self, name, p, u, delta, kkt, rule_met, reason, kkt_tol):
+        if rule_met and kkt <= kkt_tol:
+            converged, message = True, f"{reason}; KKT residual {kkt:.2e}"
+        elif rule_met:
+            converged = False
+            message = (f"{reason}, but the KKT residual {kkt:.2e} > kkt_tol {kkt_tol:.1e}: "
+                       "the iteration stalled on a state that is not a solution")
+        else:
+            converged, message = False, f"{reason} (KKT residual {kkt:.2e})"
+        if not converged:
+            log.warning("%s: %s", name, message)
+        return QPSolution(p=p, approach=delta, iterations=len(self.hist["residual"]), converged=converged,
+                          message=message, kkt_residual=float(kkt), displacement=u, history=self.hist,
+                          applies=self.applies)
+
+
+def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, eps_h=None,
+                        eps_p=None, kkt_tol=None, maxiter=300, relaxation=1.0, precondition=True,
+                        callback=None, record=False):
+    """Augmented gap method (eq. 17-20).
+
+    Iterates ``h_bar_k = h + w(p_k)``, ``(p_{k+1}, delta_{k+1}) = K^-1 (h_bar_k, P)``
+    from ``p_0 = 0`` (eq. 19), with optional relaxation ``omega``.
+
+    Parameters
+    ----------
+    op, h, layer, force, approach, x0, precondition, callback, record
+        As for :func:`bem.newton.solve_newton`.
+    rtol : float
+        Tolerance of each inner QP and default of ``eps_h``, ``eps_p``.
+    eps_h, eps_p : float, optional
+        Limits of the increments of eq. 20.
+    kkt_tol : float, optional
+        KKT residual required to call the result converged (default ``1000 rtol``).
+    maxiter : int
+        Iteration limit.
+    relaxation : float
+        ``omega`` in ``(0, 1]``; 1 is the paper's method.
+
+    Returns
+    -------
+    bem.kalker.QPSolution
+
+    Notes
+    -----
+    Stopping rule (eq. 20), Euclidean norms over the nodes:
+
+    ``||dh_k - dh_{k-1}|| / ||dh_k|| <= eps_h`` and ``||p_k - p_{k-1}|| / ||p_k|| <= eps_p``
+
+    with ``dh_k = w(p_k)``. The iteration is declared diverging when the
+    pressure increment grows 8 times in a row, and stalled when it has not
+    fallen below 0.9 times its smallest value for 15 iterations.
+    """
+    eps_h = rtol if eps_h is None else eps_h
+    eps_p = rtol if eps_p is None else eps_p
+    kkt_tol = 1e3 * rtol if kkt_tol is None else kkt_tol
+    mask = op.lattice.mask
+    h = np.where(mask, h, 0.0)
+    track = _Tracker(op, h, layer, force, approach, record)
+    precond = op.preconditioner() if precondition else None
+    p = np.zeros(op.lattice.shape) if x0 is None else np.where(mask, np.maximum(x0, 0.0), 0.0)
+    u = op.matvec(p)
+    dh_old = np.where(mask, layer.w(p), 0.0)
+    delta, kkt, rule_met, reason = approach, np.inf, False, f"no convergence in maxiter = {maxiter} iterations"
+    for k in range(1, maxiter + 1):
+        dh = np.where(mask, layer.w(p), 0.0)
+        sub = solve_qp(op, h + dh, force=force, approach=approach, x0=p if p.any() else None,
+                       rtol=rtol / 10, precondition=precond)
+        track.applies += sub.applies
+        omega = relaxation if k > 1 else 1.0
+        p_new = (1 - omega) * p + omega * sub.p
+        if not np.all(np.isfinite(p_new)):
+            reason = f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
+            break
+        u = (1 - omega) * u + omega * sub.displacement
+        inc_p, inc_h = _increment(p_new, p), _increment(dh, dh_old) if k > 1 else 1.0
+        prev_contact = p > 0
+        p, dh_old = p_new, dh
+        delta, kkt = track.record(p, u, prev_contact, inc_p, inc_h, sub.iterations)
+        if callback is not None:
+            callback(k, p)
+        if not np.isfinite(kkt):
+            reason = "the iteration produced a non-finite value"
+            break
+        if k > 1 and inc_h <= eps_h and inc_p <= eps_p:
+            rule_met, reason = True, f"increments of eq. 20 below eps after {k} iterations"
+            break
+        if track.failing():
+            reason = track.failing() + " (try relaxation < 1)"
+            break
+    return track.finish("augmented gap", p, u, delta, kkt, rule_met, reason, kkt_tol)
+
+
+def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10,
+                              eps_p=None, kkt_tol=None, maxiter=300, precondition=True, callback=None,
+                              record=False):
+    """Variable compliance coefficients (eq. 21-23).
+
+    Starts from ``C_bar_0 = C`` (the smooth-body solution) and iterates
+    ``C_bar_k = C + diag(lam_k)``, ``lam_k = w(p_k) / p_k``,
+    ``(p_{k+1}, delta_{k+1}) = K(C_bar_k)^-1 (h, P)``.
+
+    At a node without pressure the paper's secant ``w(p)/p`` is ``w'(0)``,
+    which is infinite for the root and power (``s < 1``) laws and would bar the
+    node from ever entering the contact. There (and only there) this
+    implementation uses the secant at the mean contact pressure of the current
+    iterate, so the contact can grow; where ``w'(0)`` is finite it is used as the
+    paper states.
+
+    Parameters
+    ----------
+    op, h, layer, force, approach, x0, precondition, callback, record
+        As for :func:`bem.newton.solve_newton`.
+    rtol : float
+        Tolerance of each inner QP and default of ``eps_p``.
+    eps_p : float, optional
+        Limit of the pressure increment.
+    kkt_tol : float, optional
+        KKT residual required to call the result converged (default ``1000 rtol``).
+    maxiter : int
+        Iteration limit.
+
+    Returns
+    -------
+    bem.kalker.QPSolution
+
+    Notes
+    -----
+    Stopping rule (eq. 23 and the pressure increment of eq. 20):
+    ``J_k = J_{k-1}`` (same contact set) and ``||p_k - p_{k-1}|| / ||p_k|| <= eps_p``.
+    """
+    eps_p = rtol if eps_p is None else eps_p
+    kkt_tol = 1e3 * rtol if kkt_tol is None else kkt_tol
+    mask = op.lattice.mask
+    h = np.where(mask, h, 0.0)
+    track = _Tracker(op, h, layer, force, approach, record)
+    p = None if x0 is None else np.where(mask, np.maximum(x0, 0.0), 0.0)
+    u = np.zeros(op.lattice.shape) if p is None else op.matvec(p)
+    lam = np.zeros(op.lattice.shape)
+    delta, kkt, rule_met, reason = approach, np.inf, False, f"no convergence in maxiter = {maxiter} iterations"
+    for k in range(1, maxiter + 1):
+        contact = np.zeros(op.lattice.shape, bool) if p is None else p > 0
+        if p is not None:
+            p_ref = float(np.mean(p[contact])) if contact.any() else 1.0
+            with np.errstate(divide="ignore", invalid="ignore"):
+                lam = np.where(contact, layer.secant(p), layer.secant(np.zeros_like(p)))
+            lam = np.where(np.isfinite(lam), lam, float(layer.secant(p_ref)))
+            lam = np.where(mask, lam, 0.0)
+        precond = compliance_preconditioner(op, lam, contact) if precondition else None
+        sub = solve_qp(op, h, force=force, approach=approach, lam=lam, x0=p, rtol=rtol / 10,
+                       precondition=precond)
+        track.applies += sub.applies
+        p_new = sub.p
+        if not np.all(np.isfinite(p_new)):
+            reason = f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
+            break
+        u = sub.displacement - lam * p_new
+        inc_p = 1.0 if p is None else _increment(p_new, p)
+        same_set = p is not None and np.array_equal(p_new > 0, contact)
+        p = p_new
+        delta, kkt = track.record(p, u, contact, inc_p, np.nan, sub.iterations)
+        if callback is not None:
+            callback(k, p)
+        if not np.isfinite(kkt):
+            reason = "the iteration produced a non-finite value"
+            break
+        if same_set and inc_p <= eps_p:
+            rule_met, reason = True, f"contact set and pressure stable after {k} iterations"
+            break
+        if track.failing():
+            reason = track.failing()
+            break
+    return track.finish("variable compliance", p, u, delta, kkt, rule_met, reason, kkt_tol)
