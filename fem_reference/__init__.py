@@ -1,0 +1,17 @@
+"""Axisymmetric FEM reference for the layered contact of two elastic bodies (DESIGN.md section 4).
+
+gmsh meshes of the two bodies in the (r, z) half-plane (:mod:`fem_reference.mesh`),
+axisymmetric linear elasticity in scikit-fem with quadratic triangles
+(:mod:`fem_reference.model`), the interface layer law of :mod:`bem.layers` as a penalty
+(:mod:`fem_reference.interface`), Newton's method on the statically condensed interface
+problem (:mod:`fem_reference.newton`), and the fields written for ParaView with meshio
+(:mod:`fem_reference.fields`). Heavy packages are imported inside the functions.
+"""
+
+from .estimate import estimate_contact_radius, hertz_radius, layer_radius
+from .mesh import AxiMesh, build_mesh
+from .result import FemResult
+from .solve import solve
+
+__all__ = ["solve", "FemResult", "build_mesh", "AxiMesh", "estimate_contact_radius", "hertz_radius",
+           "layer_radius"]

@@ -1,0 +1,123 @@
+"""Nodal stress recovery and the ParaView (.vtu) file of an FEM solution.
+
+Stresses (Hooke's law per body, axisymmetric)::
+
+    sigma_rr = lam tr(eps) + 2 mu eps_rr       sigma_zz = lam tr(eps) + 2 mu eps_zz
+    sigma_tt = lam tr(eps) + 2 mu u_r / r      sigma_rz = mu (du_r/dz + du_z/dr)
+    von_mises = sqrt(((s_rr - s_zz)^2 + (s_zz - s_tt)^2 + (s_tt - s_rr)^2) / 2 + 3 s_rz^2)
+
+are evaluated at the quadrature points and L2-projected onto the continuous quadratic
+space of each body (the bodies share no node, so nothing is averaged across the
+interface). ``tr(eps) = eps_rr + eps_zz + eps_tt``; tension positive.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+
+import numpy as np
+from scipy.sparse.linalg import splu
+
+__all__ = ["nodal_stresses", "write_vtu", "STRESS_NAMES"]
+
+STRESS_NAMES = ("sigma_rr", "sigma_zz", "sigma_tt", "sigma_rz", "von_mises")
+
+
+def _quadrature_stresses(model, u):
+    from .model import _strain
+
+    ui = model.basis.interpolate(u)
+    r = np.asarray(model.basis.global_coordinates())[0]
+    e_rr, e_zz, e_tt, g_rz = _strain(ui, r)
+    lam, mu = model.lam_w, model.mu_w
+    tr = lam * (e_rr + e_zz + e_tt)
+    return tr + 2 * mu * e_rr, tr + 2 * mu * e_zz, tr + 2 * mu * e_tt, mu * g_rz
+
+
+def nodal_stresses(model, u):
+    """Projected nodal stresses [pressure] on the scalar quadratic nodes of ``model``.
+
+    Parameters
+    ----------
+    model : fem_reference.model.AxiModel
+        The assembled model.
+    u : ndarray, shape (model.n_dofs,)
+        Displacement [length].
+
+    Returns
+    -------
+    dict
+        ``sigma_rr``, ``sigma_zz``, ``sigma_tt``, ``sigma_rz``, ``von_mises``: arrays of shape
+        ``(model.scalar_basis.N,)``.
+    """
+    from skfem import BilinearForm, LinearForm, asm
+
+    @BilinearForm
+    def mass(a, b, w):
+        return a * b
+
+    @LinearForm
+    def load(v, w):
+        return w.s * v
+
+    basis = model.scalar_basis
+    lu = splu(asm(mass, basis).tocsc())
+    out = {}
+    for name, s in zip(STRESS_NAMES[:4], _quadrature_stresses(model, u)):
+        out[name] = lu.solve(asm(load, basis, s=s))
+    s_rr, s_zz, s_tt, s_rz = (out[k] for k in STRESS_NAMES[:4])
+    out["von_mises"] = np.sqrt(0.5 * ((s_rr - s_zz) ** 2 + (s_zz - s_tt) ** 2 + (s_tt - s_rr) ** 2)
+                               + 3.0 * s_rz**2)
+    return out
+
+
+def write_vtu(path, model, u, pressure):
+    """Write the whole field to ``path`` (.vtu, 6-node triangles) atomically.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file; written to a temporary file in the same directory, then
+        ``os.replace``-d, so a reader never sees a half-written file.
+    model : fem_reference.model.AxiModel
+        The model.
+    u : ndarray
+        Displacement [length].
+    pressure : ndarray, shape (n_if,)
+        Contact pressure at the interface pairs [pressure].
+
+    Notes
+    -----
+    Points are ``(r, z, 0)``; point data ``displacement`` (``u_r, u_z, 0``), the stresses of
+    :func:`nodal_stresses` and ``contact_pressure`` (0 off the interface); cell data
+    ``body`` (0 upper, 1 lower).
+    """
+    import meshio
+
+    basis = model.scalar_basis
+    x = basis.doflocs
+    points = np.column_stack([x[0], x[1], np.zeros(x.shape[1])])
+    fields = nodal_stresses(model, u)
+    disp = np.column_stack([u[0::2], u[1::2], np.zeros(x.shape[1])])
+    p_nodes = np.zeros(x.shape[1])
+    p_nodes[model.node_up] = pressure
+    p_nodes[model.node_lo] = pressure
+    mesh = meshio.Mesh(
+        points,
+        [("triangle6", np.ascontiguousarray(basis.element_dofs.T, dtype=np.int64))],
+        point_data={"displacement": disp, **fields, "contact_pressure": p_nodes},
+        cell_data={"body": [model.amesh.body.astype(np.int32)]},
+    )
+    path = os.fspath(path)
+    directory = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".vtu", dir=directory)
+    os.close(fd)
+    try:
+        meshio.write(tmp, mesh, file_format="vtu")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+    return path

@@ -1,0 +1,120 @@
+"""gmsh meshes: matching interface nodes, named groups, quadratic elements, grading."""
+
+import numpy as np
+import pytest
+
+from bem._validate import InputError
+from fem_reference import build_mesh
+from fem_reference.mesh import BOUNDARIES
+
+
+def _facet_nodes(mesh, name):
+    f = mesh.boundaries[name]
+    return np.unique(np.concatenate([mesh.facets[:, f].ravel(), mesh.nvertices + f]))
+
+
+def test_interface_nodes_match_and_are_distinct(coarse_mesh):
+    from skfem import Basis, ElementTriP2
+
+    mesh = coarse_mesh.mesh
+    x = Basis(mesh, ElementTriP2()).doflocs
+    up, lo = _facet_nodes(mesh, "interface_upper"), _facet_nodes(mesh, "interface_lower")
+    assert up.size == lo.size > 10
+    assert np.intersect1d(up, lo).size == 0  # separate node sets
+    ru, rl = np.sort(x[0, up]), np.sort(x[0, lo])
+    np.testing.assert_array_equal(ru, rl)  # same 1-D mesh on both sides, exactly
+    assert np.all(x[1, up] == 0.0) and np.all(x[1, lo] == 0.0)
+    assert ru[0] == 0.0 and ru[-1] == pytest.approx(coarse_mesh.radius)
+
+
+def test_bodies_and_named_boundaries(coarse_mesh):
+    mesh, R, H = coarse_mesh.mesh, coarse_mesh.radius, coarse_mesh.depth
+    assert set(BOUNDARIES) <= set(mesh.boundaries)
+    assert set(mesh.subdomains) == {"upper", "lower"}
+    mid = mesh.p[:, mesh.t].mean(axis=1)
+    assert np.all(mid[1, mesh.subdomains["upper"]] > 0) and np.all(mid[1, mesh.subdomains["lower"]] < 0)
+    assert mesh.subdomains["upper"].size + mesh.subdomains["lower"].size == mesh.nelements
+    where = {"axis_upper": (0, 0.0), "axis_lower": (0, 0.0), "outer_upper": (0, R), "outer_lower": (0, R),
+             "top": (1, H), "bottom": (1, -H), "interface_upper": (1, 0.0), "interface_lower": (1, 0.0)}
+    for name, (coord, value) in where.items():
+        nodes = mesh.facets[:, mesh.boundaries[name]]
+        assert nodes.size > 0
+        np.testing.assert_allclose(mesh.p[coord, nodes], value, atol=1e-12 * R, err_msg=name)
+    # the interface facets of each body belong to elements of that body
+    for name, body in (("interface_upper", 0), ("interface_lower", 1)):
+        elems = mesh.f2t[0, mesh.boundaries[name]]
+        assert np.all(coarse_mesh.body[elems] == body)
+    # total area of the two rectangles
+    (x0, y0), (x1, y1), (x2, y2) = (mesh.p[:, mesh.t[k]] for k in range(3))
+    area = np.sum(0.5 * np.abs((x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)))
+    assert area == pytest.approx(2 * R * H, rel=1e-12)
+
+
+def test_quadratic_elements_from_gmsh(coarse_mesh):
+    """gmsh's 6-node triangles: mid-nodes at edge midpoints, the same nodes as skfem's P2."""
+    from skfem import Basis, ElementTriP2
+
+    n6, c6 = coarse_mesh.nodes6, coarse_mesh.cells6
+    assert c6.shape == (6, coarse_mesh.n_elements)
+    for corner_a, corner_b, mid in ((0, 1, 3), (1, 2, 4), (2, 0, 5)):
+        np.testing.assert_allclose(n6[:, c6[mid]], 0.5 * (n6[:, c6[corner_a]] + n6[:, c6[corner_b]]),
+                                   atol=1e-12 * coarse_mesh.radius)
+    x = Basis(coarse_mesh.mesh, ElementTriP2()).doflocs
+    assert x.shape[1] == n6.shape[1]
+    key = lambda pts: np.round(pts / coarse_mesh.h_fine * 1e6).astype(np.int64)  # noqa: E731
+    # same multiset of points (each body has its own interface copy in both)
+    a = np.unique(key(x), axis=1, return_counts=True)
+    b = np.unique(key(n6), axis=1, return_counts=True)
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a[1], b[1])
+
+
+def test_grading_fine_at_contact_coarse_far(coarse_mesh):
+    mesh = coarse_mesh.mesh
+    L = np.linalg.norm(mesh.p[:, mesh.facets[0]] - mesh.p[:, mesh.facets[1]], axis=0)
+    mid = 0.5 * (mesh.p[:, mesh.facets[0]] + mesh.p[:, mesh.facets[1]])
+    dist = np.linalg.norm(mid, axis=0)
+    near = L[dist < 0.8 * coarse_mesh.a_est]
+    far = L[dist > 0.5 * coarse_mesh.radius]
+    assert near.max() < 1.6 * coarse_mesh.h_fine and near.mean() > 0.5 * coarse_mesh.h_fine
+    assert far.mean() > 10 * coarse_mesh.h_fine
+    # interface elements across a_est: about n_contact
+    iface = np.sort(np.unique(mesh.p[0, mesh.facets[:, mesh.boundaries["interface_upper"]]]))
+    across = np.count_nonzero(iface[1:] <= coarse_mesh.a_est * (1 + 1e-9))
+    assert abs(across - coarse_mesh.n_contact) <= 2
+
+
+def test_msh_file_has_physical_groups(tmp_path, hertz_same):
+    import meshio
+
+    path = tmp_path / "bodies.msh"
+    build_mesh(hertz_same[0], n_contact=3, extent=20.0, msh_path=path)
+    m = meshio.read(path)
+    names = set(m.field_data)
+    assert {"upper", "lower", "interface", "axis", "top", "bottom", "outer"} <= names
+    assert any(block.type == "triangle6" for block in m.cells)
+    assert not [p for p in tmp_path.iterdir() if p.name != "bodies.msh"]
+
+
+def test_gmsh_finalized_on_error(monkeypatch):
+    import gmsh
+
+    import fem_reference.mesh as mesh_module
+
+    def boom(*args, **kwargs):
+        raise RuntimeError("simulated failure")
+
+    monkeypatch.setattr(mesh_module, "_extract", boom)
+    with pytest.raises(RuntimeError, match="simulated"):
+        build_mesh(1.0, n_contact=3, extent=20.0)
+    assert gmsh.isInitialized() == 0
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"a_est": -1.0}, "a_est"), ({"a_est": 1.0, "n_contact": 1}, "n_contact"),
+    ({"a_est": 1.0, "n_contact": 4.5}, "n_contact"), ({"a_est": 1.0, "extent": 2.0}, "extent"),
+    ({"a_est": float("nan")}, "a_est"), ({"a_est": 1.0, "growth": 0.0}, "growth"),
+])
+def test_bad_mesh_input(kwargs, name):
+    with pytest.raises(InputError, match=name):
+        build_mesh(**kwargs)

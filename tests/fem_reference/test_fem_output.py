@@ -1,0 +1,110 @@
+"""Result file, failure reporting, input validation, inputs left untouched."""
+
+import numpy as np
+import pytest
+from .fem_cases import E, NU, P
+
+import fem_reference as fr
+from bem._validate import InputError
+from bem.layers import Linear, Root
+
+
+@pytest.fixture(scope="module")
+def result(gap, coarse_mesh):
+    return fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, mesh=coarse_mesh)
+
+
+def test_vtu_readable_with_expected_fields(result, tmp_path):
+    import meshio
+
+    path = tmp_path / "field.vtu"
+    assert result.write(path) == str(path)
+    m = meshio.read(path)
+    assert [c.type for c in m.cells] == ["triangle6"]
+    assert m.cells[0].data.shape == (result.n_elements, 6)
+    assert m.points.shape == (result.n_dofs // 2, 3)
+    names = {"displacement", "sigma_rr", "sigma_zz", "sigma_tt", "sigma_rz", "von_mises", "contact_pressure"}
+    assert names <= set(m.point_data)
+    assert m.point_data["displacement"].shape == (m.points.shape[0], 3)
+    np.testing.assert_array_equal(np.unique(m.cell_data["body"][0]), [0, 1])
+    for values in m.point_data.values():
+        assert np.all(np.isfinite(values))
+    # contact traction equals -sigma_zz at the interface centre (projected stress, coarse mesh)
+    centre = np.nonzero((np.abs(m.points[:, 0]) < 1e-12) & (np.abs(m.points[:, 1]) < 1e-12))[0]
+    assert centre.size == 2
+    np.testing.assert_allclose(-m.point_data["sigma_zz"][centre], result.p_max, rtol=0.05)
+    np.testing.assert_allclose(m.point_data["contact_pressure"][centre], result.p[0])
+    # the top moved down by the far-boundary approach
+    top = m.points[:, 1] == m.points[:, 1].max()
+    np.testing.assert_allclose(m.point_data["displacement"][top, 1], -result.truncation["approach_far"], rtol=1e-12)
+    # von Mises >= 0 and the bodies deform symmetrically (same materials): |u_z| mirrors
+    assert np.all(m.point_data["von_mises"] >= 0)
+    assert [p.name for p in tmp_path.iterdir()] == ["field.vtu"]  # no temporary file left
+
+
+def test_out_argument_and_atomic_failure(gap, coarse_mesh, tmp_path, monkeypatch):
+    import meshio
+
+    path = tmp_path / "solve.vtu"
+    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, mesh=coarse_mesh, out=path)
+    assert path.exists() and res.converged
+
+    def broken(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(meshio, "write", broken)
+    target = tmp_path / "never.vtu"
+    with pytest.raises(OSError, match="disk full"):
+        res.write(target)
+    assert not target.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["solve.vtu"]
+
+
+def test_not_converged_says_so_without_nan(gap, coarse_mesh):
+    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, mesh=coarse_mesh, layer=Root(1e-3),
+                   maxiter=1, rtol=1e-14)
+    assert res.converged is False and "maxiter" in res.reason
+    for value in (res.p, res.closure, [res.approach, res.force, res.p_max, res.contact_radius]):
+        assert np.all(np.isfinite(value))
+
+
+def test_inputs_not_modified(gap, coarse_mesh):
+    layer = Linear(2e-6)
+    before = {k: getattr(coarse_mesh, k).copy() for k in ("body", "nodes6", "cells6")}
+    p_before, t_before = coarse_mesh.mesh.p.copy(), coarse_mesh.mesh.t.copy()
+    fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, mesh=coarse_mesh, layer=layer)
+    for k, v in before.items():
+        np.testing.assert_array_equal(getattr(coarse_mesh, k), v)
+    np.testing.assert_array_equal(coarse_mesh.mesh.p, p_before)
+    np.testing.assert_array_equal(coarse_mesh.mesh.t, t_before)
+    assert layer.lam == 2e-6
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"E1": -1.0}, "E1"), ({"nu2": 0.5}, "nu2"), ({"nu1": -1.0}, "nu1"),
+    ({"approach": 0.01}, "approach"), ({"force": -5.0}, "force"), ({"layer": "linear"}, "layer"),
+    ({"penalty": 0.0}, "penalty"), ({"maxiter": 0}, "maxiter"), ({"a_est": -1.0}, "a_est"),
+])
+def test_bad_input_names_the_argument(gap, kwargs, name):
+    args = dict(E1=E, nu1=NU, E2=E, nu2=NU, force=P)
+    args.update(kwargs)
+    with pytest.raises(InputError, match=name):
+        fr.solve(gap, **args)
+
+
+def test_bad_gap():
+    with pytest.raises(InputError, match="gap"):
+        fr.solve("sphere", E1=E, nu1=NU, E2=E, nu2=NU, force=P)
+    with pytest.raises(InputError, match="gap"):
+        fr.solve(lambda x, y: np.full_like(x, np.nan), E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=0.2,
+                 n_contact=3, extent=20.0)
+
+
+def test_vtk_reader_opens_the_file(result, tmp_path):
+    """ParaView's reader (VTK, here through pyvista) sees quadratic triangles and the fields."""
+    pv = pytest.importorskip("pyvista")
+    path = result.write(tmp_path / "paraview.vtu")
+    grid = pv.read(path)
+    assert grid.n_cells == result.n_elements
+    assert set(np.unique(grid.celltypes)) == {22}  # VTK_QUADRATIC_TRIANGLE
+    assert {"displacement", "von_mises", "sigma_tt"} <= set(grid.point_data.keys())
