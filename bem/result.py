@@ -39,7 +39,9 @@ class ContactResult:
     message : str
         Why the method stopped.
     iterations : int
-        Iterations of the method (outer iterations for layered methods).
+        Iterations of the method on the finest lattice: conjugate-gradient
+        iterations of the QP (no layer, linear layer with ``"newton"`` or
+        ``"kalker"``), Newton steps, or outer iterations of the paper's methods.
     kkt_residual : float
         :func:`bem.kkt.kkt_residual` of the returned state.
     history : dict
