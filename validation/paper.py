@@ -116,7 +116,10 @@ def check_layer(d, path="layer"):
     table(path, d)
     law = choice_law(path, d)
     if law == "none":
-        unknown_keys(path, d, ("law",))
+        for key, value in d.items():
+            if key != "law":
+                raise SceneError(f"{path}.{key} = {value!r} is not allowed with {path}.law = 'none': "
+                                 "a scene without a layer takes no layer parameters.")
         return None
     if law not in PAPER_LAWS or not any(k in d for k in PAPER_KEYS):
         _check_law_keys(path, d)

@@ -84,12 +84,17 @@ class _BemRunner:
                 self.solves += 1
                 return bem.solve(self.scene.gap, layer=layer, extent=self.extent, callback=callback, **self.kw)
             except bem.RegionTooSmallError:
-                if not self.scene.bem["extent_auto"] or attempt == _MAX_GROW:
+                if not self.scene.bem["extent_auto"]:
                     raise
                 hx, hy = inner_domain(self.scene.gap)
-                grown = (min(_GROW * self.extent[0], (1 - DOMAIN_MARGIN) * hx),
-                         min(_GROW * self.extent[1], (1 - DOMAIN_MARGIN) * hy))
-                if grown == self.extent:
+                limit = ((1 - DOMAIN_MARGIN) * hx, (1 - DOMAIN_MARGIN) * hy)
+                grown = (min(_GROW * self.extent[0], limit[0]), min(_GROW * self.extent[1], limit[1]))
+                if attempt == _MAX_GROW or grown == self.extent:
+                    if any(e >= lim for e, lim in zip(self.extent, limit)):
+                        raise bem.RegionTooSmallError(
+                            f"bem.extent = ({self.extent[0]:.6g}, {self.extent[1]:.6g}) cannot hold this load: "
+                            f"the contact reaches the end of the gap's domain (|x| < {hx:.6g}, |y| < {hy:.6g}); "
+                            "reduce the load or change the shape (e.g. a larger crown).") from None
                     raise
                 msg = (f"the contact reached the border of the automatic candidate region; extent enlarged "
                        f"from ({self.extent[0]:.4g}, {self.extent[1]:.4g}) to ({grown[0]:.4g}, {grown[1]:.4g})")

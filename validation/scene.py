@@ -126,7 +126,7 @@ def apply_overrides(raw, overrides):
     ----------
     raw : dict
         Scene content.
-    overrides : dict or iterable of str
+    overrides : dict or iterable of str or (key, value) pairs
         ``{"bem.nodes_across": 20}`` or ``["bem.nodes_across=20", ...]``; the short names
         ``alpha_a``, ``alpha_b``, ``alpha_c`` mean ``layer.alpha_*``. Setting one key of an
         alternative pair drops the other (``bem.step`` replaces ``bem.nodes_across``,
@@ -134,7 +134,10 @@ def apply_overrides(raw, overrides):
         ``layer.law = "none"`` removes the layer.
     """
     out = copy.deepcopy(raw)
-    items = overrides.items() if isinstance(overrides, dict) else map(parse_override, overrides or ())
+    if isinstance(overrides, dict):
+        items = list(overrides.items())
+    else:
+        items = [o if isinstance(o, tuple) else parse_override(o) for o in overrides or ()]
     for key, value in items:
         key = ALIASES.get(key, key)
         parts = key.split(".")
