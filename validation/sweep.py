@@ -177,23 +177,18 @@ def _dask_client(scheduler):
     return distributed.Client(scheduler), True
 
 
-def _dask_map(jobs, scheduler):
-    """Yield ``(point, result, error)`` as Dask futures finish."""
+def _dask_map(jobs, client):
+    """Yield ``(point, result, error)`` as Dask futures finish on ``client``."""
     from dask.distributed import as_completed as dask_completed
 
-    client, owned = _dask_client(scheduler)
-    try:
-        futures = {client.submit(_solve_point, p.scene.raw, p.scene.source, pure=False): p for p in jobs}
-        for fut in dask_completed(list(futures)):
-            point = futures[fut]
-            if fut.status == "error":
-                exc = fut.exception()
-                yield point, None, "".join(traceback.format_exception(type(exc), exc, exc.__traceback__, limit=3))
-            else:
-                yield point, fut.result(), None
-    finally:
-        if owned:
-            client.close()
+    futures = {client.submit(_solve_point, p.scene.raw, p.scene.source, pure=False): p for p in jobs}
+    for fut in dask_completed(list(futures)):
+        point = futures[fut]
+        if fut.status == "error":
+            exc = fut.exception()
+            yield point, None, "".join(traceback.format_exception(type(exc), exc, exc.__traceback__, limit=3))
+        else:
+            yield point, fut.result(), None
 
 
 def _write_summary(out, meta, rows):
@@ -239,6 +234,7 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
     parameter, key, points = sweep_points(scene, parameter, values, overrides=overrides)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SceneError(f"workers = {workers!r} is not allowed: it must be an integer >= 1.")
+    client = _dask_client(scheduler) if scheduler is not None else None  # fails before any work
     out = Path(out_dir)
     (out / "points").mkdir(parents=True, exist_ok=True)
     rows, jobs = [], []
@@ -251,20 +247,24 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
         else:
             jobs.append(point)
     log.info("sweep of %s over %d values: %d on disk, %d to run", key, len(points), len(rows), len(jobs))
-    if scheduler is not None:
-        results = _dask_map(jobs, scheduler)
-    else:
-        results = _local_map(jobs, min(workers or os.cpu_count() or 1, max(len(jobs), 1)))
-    for point, result, error in results if jobs else ():
-        if error is None:
-            atomic_write_json(out / "points" / point.file, {
-                "index": point.index, "parameter": parameter, "key": key, "value": point.value,
-                "fingerprint": point.fingerprint, "scene": point.scene.raw, "result": result})
+    try:
+        if client is not None:
+            results = _dask_map(jobs, client[0])
         else:
-            log.warning("sweep point %d (%s = %r) failed:\n%s", point.index, key, point.value, error)
-        rows.append(_row(point, result, computed=True, error=error))
-        if progress is not None:
-            progress(len(rows), len(points), rows[-1])
+            results = _local_map(jobs, min(workers or os.cpu_count() or 1, max(len(jobs), 1)))
+        for point, result, error in results if jobs else ():
+            if error is None:
+                atomic_write_json(out / "points" / point.file, {
+                    "index": point.index, "parameter": parameter, "key": key, "value": point.value,
+                    "fingerprint": point.fingerprint, "scene": point.scene.raw, "result": result})
+            else:
+                log.warning("sweep point %d (%s = %r) failed:\n%s", point.index, key, point.value, error)
+            rows.append(_row(point, result, computed=True, error=error))
+            if progress is not None:
+                progress(len(rows), len(points), rows[-1])
+    finally:
+        if client is not None and client[1]:
+            client[0].close()
     base = points[0].scene
     meta = {"scene": base.name, "title": base.title, "units": base.units, "parameter": parameter, "key": key,
             "values": [p.value for p in points]}

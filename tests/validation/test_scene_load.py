@@ -64,7 +64,7 @@ def test_roller_region_stays_inside_the_roller():
     Es = e_star(STEEL_E, STEEL_NU, STEEL_E, STEEL_NU)
     b = math.sqrt(4 * 5000.0 * 0.004 / (math.pi * 0.01 * Es))  # Hertz line contact half-width
     assert ey == pytest.approx(1.6 * b, rel=1e-9)
-    assert scene.gap.A == pytest.approx(5000.0 / (math.pi * 0.01 * Es), rel=1e-12)  # E* from [bodies]
+    assert scene.gap.A == pytest.approx(7500.0 / (math.pi * 0.01 * Es), rel=1e-12)  # E* from [bodies]
 
 
 def test_override_replaces_its_alternative():
