@@ -7,6 +7,7 @@ Exit codes: 0 success; 1 a solver did not converge (results are still written, f
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import logging
 import re
@@ -282,6 +283,26 @@ def _cmd_report(args):
     return _dispatch("validation.report", args, "the report builder")
 
 
+@contextlib.contextmanager
+def _log_to_stderr(verbose):
+    """Show the library's log records on the current stderr while a command runs."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("contactlab: %(levelname)s: %(message)s"))
+    loggers = [logging.getLogger(name) for name in ("bem", "fem_reference", "validation")]
+    saved = [(lg.level, lg.propagate) for lg in loggers]
+    for lg in loggers:
+        lg.addHandler(handler)
+        lg.setLevel(logging.INFO if verbose else logging.WARNING)
+        lg.propagate = False
+    try:
+        yield
+    finally:
+        for lg, (level, propagate) in zip(loggers, saved):
+            lg.removeHandler(handler)
+            lg.setLevel(level)
+            lg.propagate = propagate
+
+
 _COMMANDS = {"run": _cmd_run, "scenes": _cmd_scenes, "check": _cmd_check, "sweep": _cmd_sweep,
              "study": _cmd_study, "report": _cmd_report}
 
@@ -296,10 +317,9 @@ def main(argv=None):
     except SystemExit as exc:
         return exc.code
     args.extra = extra
-    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
-                        format="contactlab: %(levelname)s: %(message)s")
     try:
-        return _COMMANDS[args.command](args)
+        with _log_to_stderr(args.verbose):
+            return _COMMANDS[args.command](args)
     except (InputError, OutputError) as exc:
         print(f"contactlab: error: {exc}", file=sys.stderr)
         return 2

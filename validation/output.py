@@ -10,6 +10,7 @@ included) removes the temporary directory and leaves any previous result untouch
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import logging
 import math
@@ -64,7 +65,12 @@ def atomic_write_text(path, text):
 
 
 def to_jsonable(obj):
-    """Plain JSON types from numpy scalars/arrays, tuples, paths; non-finite floats become None."""
+    """Plain JSON types from numpy scalars/arrays, tuples, paths, dataclasses and objects with
+    ``to_dict()``; non-finite floats become None."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return to_jsonable(dataclasses.asdict(obj))
+    if hasattr(obj, "to_dict") and callable(obj.to_dict):
+        return to_jsonable(obj.to_dict())
     if isinstance(obj, dict):
         return {str(k): to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):

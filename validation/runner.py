@@ -109,10 +109,10 @@ def _analytic(scene, layer):
 
     kind = scene.analytic["kind"]
     g, load = scene.gap, scene.load
+    rx, ry = (g.R, g.R) if g.type_name == "paraboloid" else (getattr(g, "Rx", None), getattr(g, "Ry", None))
     if kind == "hertz":
-        return an.hertz_sphere(g.R, scene.E_star, **load)
+        return an.hertz_sphere(rx, scene.E_star, **load)
     if kind == "hertz_elliptic":
-        rx, ry = (g.R, g.R) if g.type_name == "paraboloid" else (g.Rx, g.Ry)
         return an.hertz_elliptic(rx, ry, scene.E_star, **load)
     return an.rigid_layer_paraboloid(layer, g.R, **load)
 

@@ -11,14 +11,14 @@ import inspect
 import math
 import re
 
-from bem import METHODS
-from bem.gaps import _TYPES as GAP_TYPES
+from bem import METHODS, gaps
 from bem.gaps import gap_from_dict
 from bem.lattice import Lattice
+from bem.layers import Linear, from_dict
 from bem.materials import effective_modulus
 
 from . import _checks as ck
-from .paper import c_nn, check_layer
+from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
 from .sizing import DOMAIN_MARGIN, MAX_NODES, check_estimate, inner_domain, node_count
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "bem_options", "fem_options", "analytic",
@@ -35,6 +35,8 @@ _BEM_KEYS = ("step", "nodes_across", "extent", "extent_factor", "method", "rtol"
              "nested", "relaxation")
 _FEM_KEYS = ("n_contact", "extent", "fine_radius", "growth", "penalty", "rtol", "maxiter", "remesh",
              "truncation_correction")
+GAP_TYPES = {cls.type_name: cls for cls in (gaps.Paraboloid, gaps.EllipticParaboloid, gaps.CrownedRoller,
+                                            gaps.FlatPunch, gaps.Callable, gaps.Table)}
 DEFAULT_NODES_ACROSS = 40
 DEFAULT_EXTENT_FACTOR = 1.5
 
@@ -109,10 +111,6 @@ def layer(d):
 
 def _sizing_layer(spec, step, E_star):
     """A layer object that sizes the region (paper laws: their linear reference)."""
-    from bem.layers import Linear, from_dict
-
-    from .paper import PAPER_KEYS, PAPER_LAWS
-
     if spec is None:
         return None
     law = spec["law"]
@@ -262,9 +260,13 @@ def analytic(d, shape, layer_spec):
         if layer_spec is not None:
             raise ck.SceneError(f"analytic.kind = {kind!r} is not allowed with layer.law = {layer_spec['law']!r}: "
                                 "Hertz's solution has no layer; remove [analytic] or the layer.")
-        ok = t == "elliptic_paraboloid" or (t == "paraboloid" and kind == "hertz")
-        if not ok or (kind == "hertz" and t == "elliptic_paraboloid" and not shape.is_axisymmetric):
-            need = "paraboloid" if kind == "hertz" else "elliptic_paraboloid (or paraboloid)"
+        if kind == "hertz":
+            ok = t == "paraboloid" or (t == "elliptic_paraboloid" and shape.is_axisymmetric)
+            need = "paraboloid (or an elliptic_paraboloid with Rx = Ry)"
+        else:
+            ok = t in ("paraboloid", "elliptic_paraboloid")
+            need = "elliptic_paraboloid or paraboloid"
+        if not ok:
             raise ck.SceneError(f"analytic.kind = {kind!r} is not allowed with gap.type = {t!r}: it needs a "
                                 f"{need} gap.")
     else:
@@ -294,8 +296,6 @@ def report(d):
 
 def sweep_spec(d, known_sections):
     """``[sweep]``: ``parameter`` (alpha_a, alpha_b, alpha_c or a dotted key) and ``values``."""
-    from .paper import ALIASES
-
     if d is None:
         return None
     ck.table("sweep", d)

@@ -28,7 +28,6 @@ from pathlib import Path
 
 from ._checks import SceneError
 from .output import atomic_write_json, atomic_write_text
-from .paper import ALIASES
 from .scene import Scene, apply_overrides, load_scene, parse_scene
 
 __all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values"]

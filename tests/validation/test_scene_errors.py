@@ -115,6 +115,9 @@ CASES = {
     "unknown_fem_key": (BASE + "\n[fem]\nmesh_size = 1e-5\n", "fem.mesh_size"),
     "unknown_analytic_kind": (BASE + '\n[analytic]\nkind = "exact"\n', "analytic.kind"),
     "hertz_with_layer": (PAPER_ER + '\n[analytic]\nkind = "hertz"\n', "analytic.kind"),
+    "hertz_on_flat_punch": (BASE.replace('type = "paraboloid"\nR = 0.01', 'type = "flat_punch"\na = 1e-4\n'
+                                         'edge_radius = 1e-3') + '\n[analytic]\nkind = "hertz"\n', "analytic.kind"),
+    "rigid_layer_with_elastic_rigid_law": (PAPER_ER + '\n[analytic]\nkind = "rigid_layer"\n', "analytic.kind"),
     "sweep_unknown_parameter": (BASE + '\n[sweep]\nparameter = "foo"\nvalues = [1.0]\n', "sweep.parameter"),
     "sweep_no_values": (BASE + '\n[sweep]\nparameter = "load.force"\nvalues = []\n', "sweep.values"),
     "sweep_value_out_of_range": (PAPER_ER + '\n[sweep]\nparameter = "alpha_a"\nvalues = [0.5, 2.0]\n',
