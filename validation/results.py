@@ -80,7 +80,7 @@ def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=Non
     """Assemble the JSON-ready result dict of a run (see the module docstring)."""
     converged = bool(res.converged) and (fem is None or bool(fem.converged))
     bem_part = dict(res.summary(), E_star=scene.E_star, extent=list(extent), n_nodes=int(res.p.size),
-                    nodes_across=(2 * res.contact_radius / res.step), history=_history(res))
+                    nodes_across_contact=(2 * res.contact_radius / res.step), history=_history(res))
     loaded = res.p > 0
     out = {
         "schema": SCHEMA,

@@ -95,8 +95,8 @@ def sweep_points(scene, parameter=None, values=None, *, overrides=None):
     if parameter is None and values is None and base.sweep is not None:
         parameter, values = base.sweep["parameter"], base.sweep["values"]
     if parameter is None or values is None:
-        raise SceneError("sweep.parameter is missing: give --param and --values, or a [sweep] section "
-                         "with parameter and values.")
+        raise SceneError(f"sweep parameter = {parameter!r}, values = {values!r} is not allowed: give both "
+                         "(--param and --values), or neither to use the scene's [sweep] section.")
     raw = {k: v for k, v in base.raw.items() if k != "sweep"}
     raw["sweep"] = {"parameter": parameter, "values": list(values)}
     checked = parse_scene(raw, source=base.source)  # checks the parameter and every value
