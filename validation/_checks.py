@@ -1,0 +1,130 @@
+"""Scene-file checks: every failure names the dotted key, shows the value and states the rule.
+
+Thin wrappers over :mod:`bem._validate` that raise :class:`SceneError` (an
+:class:`bem._validate.InputError`, hence a ``ValueError``) with the key written as a dotted
+path into the scene file (``layer.lam``, ``bem.nodes_across``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Mapping
+
+from bem import _validate as v
+from bem._validate import InputError
+
+__all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one", "positive",
+           "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair"]
+
+
+class SceneError(InputError):
+    """A scene (file, overrides or sweep) is invalid; the message names the dotted key."""
+
+
+@contextlib.contextmanager
+def scene_errors(prefix=""):
+    """Re-raise :class:`InputError` from library checks as :class:`SceneError`.
+
+    ``prefix`` (e.g. ``"gap."``) is prepended to the message unless it already starts with a
+    dotted scene key, so ``R = -1.0 is not allowed ...`` from :mod:`bem.gaps` becomes
+    ``gap.R = -1.0 is not allowed ...``.
+    """
+    try:
+        yield
+    except SceneError:
+        raise
+    except InputError as exc:
+        msg = str(exc)
+        if prefix and not msg.startswith(prefix):
+            msg = prefix + msg
+        raise SceneError(msg) from None
+
+
+def _wrap(check, name, *args, **kw):
+    with scene_errors():
+        return check(name, *args, **kw)
+
+
+def table(path, value):
+    """``value`` must be a TOML table (a mapping)."""
+    if not isinstance(value, Mapping):
+        raise SceneError(f"{path} = {value!r} is not allowed: it must be a table ([{path}] section "
+                         "or {key = value, ...}).")
+    return value
+
+
+def unknown_keys(path, d, allowed):
+    """Refuse keys of ``d`` not in ``allowed``; the message lists the known keys."""
+    for key, value in d.items():
+        if key not in allowed:
+            shown = value if not isinstance(value, Mapping) else "{...}"
+            raise SceneError(
+                f"{path}.{key} = {shown!r} is not allowed: [{path}] has no key {key!r} "
+                f"(known keys: {', '.join(allowed)}). Check the spelling.")
+
+
+def require(path, d, key, hint):
+    """Refuse a missing ``key``; ``hint`` says what to give."""
+    if key not in d:
+        raise SceneError(f"{path}.{key} is missing: {hint}.")
+    return d[key]
+
+
+def exactly_one(path, d, keys, hint):
+    """Exactly one of ``keys`` present in ``d``; returns it."""
+    present = [k for k in keys if k in d]
+    if len(present) == 1:
+        return present[0]
+    names = " or ".join(f"{path}.{k}" for k in keys)
+    if not present:
+        raise SceneError(f"{names} is missing: give exactly one of them ({hint}).")
+    shown = ", ".join(f"{path}.{k} = {d[k]!r}" for k in present)
+    raise SceneError(f"{shown} is not allowed: give exactly one of them, not several ({hint}).")
+
+
+def positive(path, value):
+    return _wrap(v.check_positive, path, value)
+
+
+def nonnegative(path, value):
+    return _wrap(v.check_nonnegative, path, value)
+
+
+def in_range(path, value, low, high, **kw):
+    return _wrap(v.check_range, path, value, low, high, **kw)
+
+
+def integer(path, value, minimum, maximum=math.inf):
+    """An integer (not a bool, not a float) in ``[minimum, maximum]``."""
+    if isinstance(value, bool) or not isinstance(value, int) or not minimum <= value <= maximum:
+        rule = f"an integer >= {minimum}" + (f" and <= {maximum}" if maximum < math.inf else "")
+        raise SceneError(f"{path} = {value!r} is not allowed: it must be {rule}.")
+    return value
+
+
+def boolean(path, value):
+    if not isinstance(value, bool):
+        raise SceneError(f"{path} = {value!r} is not allowed: it must be true or false.")
+    return value
+
+
+def string(path, value):
+    if not isinstance(value, str):
+        raise SceneError(f"{path} = {value!r} is not allowed: it must be a string (in quotes).")
+    return value
+
+
+def choice(path, value, choices):
+    string(path, value)
+    return _wrap(v.check_choice, path, value, tuple(choices))
+
+
+def number_or_pair(path, value, check):
+    """A number, or a pair ``[x, y]`` of numbers, each passed through ``check(path, value)``."""
+    if isinstance(value, (list, tuple)):
+        if len(value) != 2:
+            raise SceneError(f"{path} = {value!r} is not allowed: it must be a number or a pair [x, y].")
+        return (check(f"{path}[0]", value[0]), check(f"{path}[1]", value[1]))
+    x = check(path, value)
+    return (x, x)

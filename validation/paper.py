@@ -1,0 +1,235 @@
+"""The paper's parameterisation of the interface layers of its test problems (section 6).
+
+The test problem is the contact of two paraboloids with a layer between them (Fig. 4 a);
+the layer laws are those of Fig. 4 b-d, given relative to quantities of the discrete problem:
+
+- compliance relative to the diagonal influence coefficient (eq. 6):
+  ``lam = lam_over_cnn * C_nn``, ``C_nn = c / (pi E*) * w_t(0, 0)``, ``w_t(0, 0) =
+  (3 sqrt3 / 2) ln 3`` (:func:`bem.template`), ``c`` the scene's BEM step. Fig. 5 uses
+  ``lam = 10 C_nn``. As in the paper, the layer so defined depends on the mesh step: refining
+  the lattice makes the layer stiffer. Give ``lam`` directly to pin it.
+- ``p_max^lambda``: the peak pressure of the SAME problem (gap, bodies, load, lattice) with
+  the linear layer ``w = lam p``, solved first.
+- elastic-rigid (Fig. 4 b): ``w = lam min(p, p_cr)``, ``alpha_a = p_cr / p_max^lambda``
+  in ``[0, 1]``; ``alpha_a = 0`` is the contact of smooth bodies (no layer), ``alpha_a = 1``
+  the linear layer.
+- bilinear (Fig. 4 d): ``lam1 = lam``, ``alpha_c = arctan(lam2 / lam1)`` in ``[0, pi/2)``
+  (``lam2 = lam1 tan(alpha_c)``; ``alpha_c = 0`` is elastic-rigid), kink at
+  ``p_star = alpha_a p_max^lambda``.
+- root (Fig. 4 c): ``w = lam_r sqrt(p)``. Choice made here (the paper does not state it):
+  ``lam_r = lam sqrt(p_max^lambda)``, i.e. the root law closes exactly as much as the linear
+  layer at ``p = p_max^lambda`` (more below it, less above). The paper's
+  ``alpha_b = p_max^root / p_max^lambda`` is reported as an output. Given ``alpha_b``
+  instead, ``lam_r`` is found (root of ``p_max^root(lam_r) = alpha_b p_max^lambda``,
+  a few extra solves) so that a family of root laws can be swept by ``alpha_b``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+from bem import template
+from bem.layers import LAWS, Bilinear, ElasticRigid, Linear, Root, from_dict
+
+from ._checks import SceneError, in_range, positive, scene_errors, string, table, unknown_keys
+
+__all__ = ["c_nn", "check_layer", "resolve_layer", "PAPER_LAWS", "PAPER_KEYS", "EXCLUSIVE", "ALIASES"]
+
+log = logging.getLogger(__name__)
+
+#: law -> {constructor parameter: (direct key, paper key)}
+PAPER_LAWS = {
+    "linear": {"lam": ("lam", "lam_over_cnn")},
+    "elastic_rigid": {"lam": ("lam", "lam_over_cnn"), "p_cr": ("p_cr", "alpha_a")},
+    "bilinear": {"lam1": ("lam1", "lam_over_cnn"), "lam2": ("lam2", "alpha_c"), "p_star": ("p_star", "alpha_a")},
+    "root": {"lam": ("lam", "lam_over_cnn")},
+}
+PAPER_KEYS = ("lam_over_cnn", "alpha_a", "alpha_c", "alpha_b")
+#: groups of layer keys that replace each other (a ``--set`` of one drops the others)
+EXCLUSIVE = (("lam", "lam_over_cnn"), ("lam1", "lam_over_cnn"), ("p_cr", "alpha_a"), ("p_star", "alpha_a"),
+             ("lam2", "alpha_c"))
+#: sweep parameter short names
+ALIASES = {"alpha_a": "layer.alpha_a", "alpha_b": "layer.alpha_b", "alpha_c": "layer.alpha_c"}
+
+_ALPHA_B_XTOL = 1e-5  # relative tolerance on lam_r when targeting alpha_b
+
+
+def c_nn(step, E_star):
+    """Diagonal influence coefficient ``C_nn = c / (pi E*) w_t(0, 0)`` [length/pressure] (eq. 6)."""
+    return step / (math.pi * E_star) * float(template(0.0, 0.0))
+
+
+def _check_paper_values(path, d):
+    """Range checks of the direct and paper parameters of the four paper laws."""
+    for key in ("lam", "lam1", "p_cr", "p_star", "lam_over_cnn", "alpha_b"):
+        if key in d:
+            positive(f"{path}.{key}", d[key])
+    if "lam2" in d:
+        in_range(f"{path}.lam2", d["lam2"], 0.0, math.inf)
+    if "alpha_a" in d:
+        in_range(f"{path}.alpha_a", d["alpha_a"], 0.0, 1.0)
+    if "alpha_c" in d:
+        in_range(f"{path}.alpha_c", d["alpha_c"], 0.0, math.pi / 2, high_open=True)
+    if "alpha_b" in d and "lam_over_cnn" not in d:
+        raise SceneError(f"{path}.alpha_b = {d['alpha_b']!r} is not allowed without {path}.lam_over_cnn: "
+                         "alpha_b is relative to the linear layer lam = lam_over_cnn * C_nn.")
+
+
+def _check_law_keys(path, d):
+    """Recursive key check of a non-paper law (series holds two nested laws)."""
+    table(path, d)
+    law = choice_law(path, d, allow_none=False)
+    cls = LAWS[law]
+    keys = ("law", *cls._required, *cls._optional)
+    unknown_keys(path, d, keys)
+    for key in cls._required:
+        if key not in d:
+            raise SceneError(f"{path}.{key} is missing: a {law!r} layer needs " + ", ".join(cls._required) + ".")
+    if law == "series":
+        for key in ("a", "b"):
+            _check_law_keys(f"{path}.{key}", d[key])
+
+
+def choice_law(path, d, *, allow_none=True):
+    """The ``law`` key of a layer table, checked against the known laws."""
+    if "law" not in d:
+        raise SceneError(f"{path}.law is missing: give one of " + ", ".join(
+            repr(k) for k in (("none",) if allow_none else ()) + tuple(LAWS)) + ".")
+    law = string(f"{path}.law", d["law"])
+    known = (("none",) if allow_none else ()) + tuple(LAWS)
+    if law not in known:
+        raise SceneError(f"{path}.law = {law!r} is not allowed: it must be one of "
+                         + ", ".join(repr(k) for k in known) + ".")
+    return law
+
+
+def check_layer(d, path="layer"):
+    """Validate a ``[layer]`` table; returns the spec dict, or ``None`` for no layer.
+
+    Direct parameters are those of :mod:`bem.layers` (``from_dict``); the four paper laws
+    also take the paper's parameters (module docstring): each constructor parameter from
+    exactly one of its direct or paper key.
+    """
+    if d is None:
+        return None
+    table(path, d)
+    law = choice_law(path, d)
+    if law == "none":
+        for key, value in d.items():
+            if key != "law":
+                raise SceneError(f"{path}.{key} = {value!r} is not allowed with {path}.law = 'none': "
+                                 "a scene without a layer takes no layer parameters.")
+        return None
+    if law not in PAPER_LAWS or not any(k in d for k in PAPER_KEYS):
+        _check_law_keys(path, d)
+        with scene_errors(f"{path}."):
+            from_dict(d)  # value checks (monotone table, callables, ...)
+        return dict(d)
+    params = PAPER_LAWS[law]
+    allowed = ["law"] + [k for pair in params.values() for k in pair] + (["alpha_b"] if law == "root" else [])
+    unknown_keys(path, d, allowed)
+    for param, (direct, paper) in params.items():
+        present = [k for k in (direct, paper) if k in d]
+        if not present:
+            raise SceneError(f"{path}.{direct} or {path}.{paper} is missing: a {law!r} layer needs {param}.")
+        if len(present) == 2:
+            raise SceneError(f"{path}.{direct} = {d[direct]!r} and {path}.{paper} = {d[paper]!r} are not "
+                             f"allowed together: give one of them ({param} directly or the paper's {paper}).")
+    if "alpha_b" in d and "lam" in d:
+        raise SceneError(f"{path}.alpha_b = {d['alpha_b']!r} is not allowed together with {path}.lam: "
+                         "alpha_b sets the root coefficient; give lam_over_cnn and alpha_b, or lam alone.")
+    _check_paper_values(path, d)
+    return dict(d)
+
+
+def _root_for_alpha_b(alpha_b, p_lambda, lam_r0, solve):
+    """``lam_r`` with ``p_max(Root(lam_r)) = alpha_b p_lambda``: bracket in log, then Brent."""
+    from scipy.optimize import brentq
+
+    target = alpha_b * p_lambda
+    cache = {}
+
+    def f(t):
+        if t not in cache:
+            cache[t] = math.log(solve(Root(math.exp(t))).p_max / target)
+        return cache[t]
+
+    t0 = math.log(lam_r0)
+    step = 2.0 if f(t0) > 0 else -2.0  # p_max decreases as lam_r grows
+    t1 = t0
+    for _ in range(12):
+        t1 = t1 + step
+        if (f(t1) > 0) != (f(t0) > 0):
+            break
+        t0 = t1
+    else:
+        raise SceneError(
+            f"layer.alpha_b = {alpha_b!r} is not allowed: no root law reaches p_max = alpha_b p_max^lambda "
+            f"(p_max^lambda = {p_lambda:.6g}); the root law's peak ranges from near 0 (soft) up to the "
+            "smooth contact's peak (stiff): choose alpha_b between those.")
+    lo, hi = sorted((t0, t1))
+    t = brentq(f, lo, hi, xtol=_ALPHA_B_XTOL)
+    return math.exp(t), len(cache)
+
+
+def resolve_layer(spec, *, step, E_star, solve):
+    """Build the layer law of a validated spec, solving the linear reference first if needed.
+
+    Parameters
+    ----------
+    spec : dict or None
+        Output of :func:`check_layer`.
+    step : float
+        BEM step ``c`` [length] (for ``C_nn``).
+    E_star : float
+        Effective modulus [pressure].
+    solve : callable
+        ``solve(layer) -> bem.ContactResult`` of the scene's problem with that layer.
+
+    Returns
+    -------
+    layer : bem.layers.Layer or None
+    info : dict
+        ``law`` and, when the paper's parameters are used, ``c_nn``, ``lam_over_cnn``,
+        ``lam_ref`` (the linear reference compliance), ``p_max_lambda``, ``alpha_a``,
+        ``alpha_c``, ``alpha_b_target``, ``reference_solves``; ``parameters`` (the resolved
+        law's ``to_dict()``).
+    """
+    if spec is None:
+        return None, {"law": "none", "parameters": None}
+    law = spec["law"]
+    info = {"law": law}
+    if law not in PAPER_LAWS or not any(k in spec for k in PAPER_KEYS):
+        layer = from_dict(spec)
+        return layer, dict(info, parameters=layer.to_dict())
+    cnn = c_nn(step, E_star)
+    direct = PAPER_LAWS[law][next(iter(PAPER_LAWS[law]))][0]  # lam or lam1
+    lam_ref = spec[direct] if direct in spec else spec["lam_over_cnn"] * cnn
+    info.update(c_nn=cnn, lam_over_cnn=spec.get("lam_over_cnn", lam_ref / cnn), lam_ref=lam_ref)
+    p_lambda = None
+    if "alpha_a" in spec or law == "root":
+        p_lambda = solve(Linear(lam_ref)).p_max
+        info.update(p_max_lambda=p_lambda, reference_solves=1)
+        log.info("linear reference layer lam = %.6g: p_max^lambda = %.6g", lam_ref, p_lambda)
+    if law == "linear":
+        layer = Linear(lam_ref)
+    elif law == "elastic_rigid":
+        p_cr = spec.get("p_cr", p_lambda * spec["alpha_a"] if "alpha_a" in spec else None)
+        info["alpha_a"] = spec.get("alpha_a")
+        layer = ElasticRigid(lam_ref, p_cr) if p_cr > 0 else None
+    elif law == "bilinear":
+        lam2 = spec["lam2"] if "lam2" in spec else lam_ref * math.tan(spec["alpha_c"])
+        p_star = spec["p_star"] if "p_star" in spec else p_lambda * spec["alpha_a"]
+        info.update(alpha_a=spec.get("alpha_a"), alpha_c=math.atan2(lam2, lam_ref))
+        layer = Bilinear(lam_ref, lam2, p_star) if p_star > 0 else (Linear(lam2) if lam2 > 0 else None)
+    else:  # root
+        lam_r = lam_ref * math.sqrt(p_lambda)
+        if "alpha_b" in spec:
+            info["alpha_b_target"] = spec["alpha_b"]
+            lam_r, n = _root_for_alpha_b(spec["alpha_b"], p_lambda, lam_r, solve)
+            info["reference_solves"] += n
+        layer = Root(lam_r)
+    if layer is None:
+        log.info("%s layer with a zero threshold: smooth contact (no layer), as in the paper", law)
+    return layer, dict(info, parameters=None if layer is None else layer.to_dict())

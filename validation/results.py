@@ -1,0 +1,119 @@
+"""The result dictionary of a scene run (the content of ``result.json``).
+
+Contract (DESIGN.md section 6): ``p_max``, ``force``, ``approach``, ``contact_area``,
+``contact_radius`` (axisymmetric scenes), ``iterations``, ``converged``, ``kkt_residual``,
+``wall_time_s`` per part, and the comparison metrics when a comparison was asked. The scalars
+at the top level are the BEM's (the product); ``converged`` is true only when every part that
+ran converged. Units are those of the scene (``units``).
+"""
+
+from __future__ import annotations
+
+import math
+import platform
+
+import numpy as np
+
+__all__ = ["build_result", "axial_profile", "SCHEMA", "CONTRACT_KEYS"]
+
+SCHEMA = "contactlab.result/1"
+#: Keys every result.json holds (contact_radius: axisymmetric scenes only).
+CONTRACT_KEYS = ("scene", "units", "method", "p_max", "force", "approach", "contact_area", "iterations",
+                 "converged", "kkt_residual", "wall_time_s", "messages")
+
+
+def axial_profile(res):
+    """Pressure along the x axis (lattice row ``y = 0``) and along the y axis (interpolated at x = 0).
+
+    Returns
+    -------
+    dict
+        ``{"x": [...], "p": [...], "closure": [...]}`` on the nodes of the row ``y = 0``, and
+        ``"y_axis": {"y": [...], "p": [...]}`` at the row ordinates.
+    """
+    lat = res.lattice
+    row = lat.half_rows  # lattice row j = 0
+    x = lat.x[row]
+    p = res.grid()[row]
+    closure = res.grid(res.closure)[row]
+    y = lat.y[:, 0]
+    p_y = res.pressure_at(np.zeros_like(y), y)
+    return {"x": x, "p": p, "closure": closure, "y_axis": {"y": y, "p": p_y}}
+
+
+def _history(res):
+    """Per-iteration scalar lists of the BEM history (iterates left out)."""
+    out = {}
+    for key, values in (res.history or {}).items():
+        if key == "p" or not isinstance(values, (list, tuple, np.ndarray)):
+            continue
+        arr = np.asarray(values)
+        if arr.ndim == 1 and arr.dtype.kind in "biuf":
+            out[key] = arr.tolist()
+    return out
+
+
+def _analytic_summary(kind, ref):
+    """Scalars of the closed-form reference (HertzSphere, HertzElliptic, RigidLayerParaboloid)."""
+    out = {"kind": kind, "force": ref.force, "approach": ref.delta}
+    if kind == "hertz":
+        out.update(p_max=ref.p0, contact_radius=ref.a, contact_area=math.pi * ref.a**2)
+    elif kind == "hertz_elliptic":
+        out.update(p_max=ref.p0, a=ref.a, b=ref.b, contact_area=math.pi * ref.a * ref.b)
+    else:
+        out.update(p_max=ref.p_max, contact_radius=ref.contact_radius,
+                   contact_area=math.pi * ref.contact_radius**2)
+    return out
+
+
+def _scales(scene):
+    """Hertz's peak, radius and approach of the gap's paraboloid (no layer): Fig. 5's scale."""
+    if scene.gap.type_name != "paraboloid":
+        return None
+    from .analytic import hertz_sphere
+
+    hz = hertz_sphere(scene.gap.R, scene.E_star, **scene.load)
+    return {"p_hertz": hz.p0, "a_hertz": hz.a, "approach_hertz": hz.delta, "force_hertz": hz.force}
+
+
+def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=None, times, messages, extent):
+    """Assemble the JSON-ready result dict of a run (see the module docstring)."""
+    converged = bool(res.converged) and (fem is None or bool(fem.converged))
+    bem_part = dict(res.summary(), E_star=scene.E_star, extent=list(extent), n_nodes=int(res.p.size),
+                    nodes_across_contact=(2 * res.contact_radius / res.step), history=_history(res))
+    loaded = res.p > 0
+    out = {
+        "schema": SCHEMA,
+        "scene": scene.name, "title": scene.title, "units": scene.units, "source": scene.source,
+        "overrides": list(scene.overrides), "method": res.method,
+        "p_max": res.p_max, "force": res.force, "approach": res.approach, "contact_area": res.contact_area,
+    }
+    if scene.axisymmetric:
+        out["contact_radius"] = res.contact_radius
+    out.update({
+        "contact_extent": {"x": float(np.abs(res.x[loaded]).max()) if loaded.any() else 0.0,
+                           "y": float(np.abs(res.y[loaded]).max()) if loaded.any() else 0.0},
+        "iterations": res.iterations, "converged": converged, "kkt_residual": res.kkt_residual,
+        "message": res.message, "messages": list(messages),
+        "wall_time_s": {k: v for k, v in times.items()},
+        "bem": bem_part, "layer": layer_info,
+    })
+    if "alpha_b" in layer_info:
+        out["alpha_b"] = layer_info["alpha_b"]
+    if fem is not None:
+        out["fem"] = fem.summary()
+        out["fem_profile"] = {"r": fem.r, "p": fem.p}
+    if analytic is not None:
+        out["analytic"] = _analytic_summary(scene.analytic["kind"], analytic)
+    if metrics is not None:
+        out["comparison"] = metrics
+    scales = _scales(scene)
+    if scales is not None:
+        out["scales"] = scales
+    out["profile"] = axial_profile(res)
+    if scene.report is not None:
+        out["report"] = scene.report
+    out["environment"] = {"python": platform.python_version(), "numpy": np.__version__}
+    from .output import to_jsonable
+
+    return to_jsonable(out)

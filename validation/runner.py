@@ -1,0 +1,253 @@
+"""Run a scene: the BEM always, the FEM reference, closed form and comparisons only when named.
+
+:func:`run_scene` returns the JSON-ready result dict and, given ``out_dir``, writes it whole or
+not at all (:mod:`validation.output`) with the BEM nodal field (ParaView ``.vtu``, pure numpy)
+and, when the FEM ran, its field. Heavy packages (gmsh, scikit-fem, meshio) are imported only
+by the FEM reference, so a BEM-only scene never loads them.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import bem
+
+from . import paper
+from .output import atomic_directory, atomic_write_json, atomic_write_text
+from .results import build_result
+from .scene import Scene, load_scene
+from .sizing import DOMAIN_MARGIN, inner_domain
+from .tomlwrite import dumps
+from .vtk import lattice_triangles, write_vtu
+
+__all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES"]
+
+log = logging.getLogger(__name__)
+
+#: Names of the files of a result directory.
+FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_field.vtu",
+         "fem_field": "fem_field.vtu"}
+_GROW, _MAX_GROW = 1.5, 3  # automatic region: enlarge x1.5, at most 3 times
+
+
+@dataclass
+class RunOutcome:
+    """Everything a run produced: the result dict and the solver objects behind it."""
+
+    scene: Scene
+    result: dict
+    bem: object
+    fem: object = None
+    analytic: object = None
+    layer: object = None
+
+
+def _notify(progress, stage, status, **info):
+    if progress is not None:
+        progress(stage, status, info)
+
+
+def planned_stages(scene, *, write=False):
+    """Stage names :func:`run_scene` will report for ``scene`` (for progress bars)."""
+    stages = []
+    spec = scene.layer_spec
+    if spec is not None and ("alpha_a" in spec or (spec["law"] == "root" and "lam_over_cnn" in spec)):
+        stages.append("layer")
+    stages.append("bem")
+    if scene.fem is not None:
+        stages.append("fem")
+    if scene.fem is not None or scene.analytic is not None:
+        stages.append("compare")
+    if write:
+        stages.append("write")
+    return stages
+
+
+class _BemRunner:
+    """Solves the scene's BEM problem for a given layer; enlarges an automatic region if needed."""
+
+    def __init__(self, scene, messages):
+        self.scene, self.messages = scene, messages
+        opts = scene.bem
+        self.extent = tuple(opts["extent"])
+        self.kw = dict(E_star=scene.E_star, force=scene.load["force"], approach=scene.load["approach"],
+                       step=opts["step"], method=opts["method"])
+        self.kw.update({k: opts[k] for k in ("rtol", "maxiter", "precondition", "nested", "relaxation")
+                        if k in opts})
+        self.solves = 0
+
+    def __call__(self, layer, callback=None):
+        for attempt in range(_MAX_GROW + 1):
+            try:
+                self.solves += 1
+                return bem.solve(self.scene.gap, layer=layer, extent=self.extent, callback=callback, **self.kw)
+            except bem.RegionTooSmallError:
+                if not self.scene.bem["extent_auto"]:
+                    raise
+                hx, hy = inner_domain(self.scene.gap)
+                limit = ((1 - DOMAIN_MARGIN) * hx, (1 - DOMAIN_MARGIN) * hy)
+                grown = (min(_GROW * self.extent[0], limit[0]), min(_GROW * self.extent[1], limit[1]))
+                if attempt == _MAX_GROW or grown == self.extent:
+                    if any(e >= lim for e, lim in zip(self.extent, limit)):
+                        raise bem.RegionTooSmallError(
+                            f"bem.extent = ({self.extent[0]:.6g}, {self.extent[1]:.6g}) cannot hold this load: "
+                            f"the contact reaches the end of the gap's domain (|x| < {hx:.6g}, |y| < {hy:.6g}); "
+                            "reduce the load or change the shape (e.g. a larger crown).") from None
+                    raise
+                msg = (f"the contact reached the border of the automatic candidate region; extent enlarged "
+                       f"from ({self.extent[0]:.4g}, {self.extent[1]:.4g}) to ({grown[0]:.4g}, {grown[1]:.4g})")
+                log.info(msg)
+                self.messages.append(msg)
+                self.extent = grown
+        raise AssertionError("unreachable")  # pragma: no cover
+
+
+def _analytic(scene, layer):
+    from . import analytic as an
+
+    kind = scene.analytic["kind"]
+    g, load = scene.gap, scene.load
+    rx, ry = (g.R, g.R) if g.type_name == "paraboloid" else (getattr(g, "Rx", None), getattr(g, "Ry", None))
+    if kind == "hertz":
+        return an.hertz_sphere(rx, scene.E_star, **load)
+    if kind == "hertz_elliptic":
+        return an.hertz_elliptic(rx, ry, scene.E_star, **load)
+    return an.rigid_layer_paraboloid(layer, g.R, **load)
+
+
+def _compare(bem_result, fem, analytic, messages):
+    try:
+        from .metrics import compare
+    except ModuleNotFoundError as exc:
+        if exc.name not in ("validation.metrics", __package__ + ".metrics"):
+            raise
+        msg = "comparison skipped: validation.metrics is not available"
+        log.warning(msg)
+        messages.append(msg)
+        return None
+    return compare(bem_result, fem=fem, analytic=analytic)
+
+
+def _fem(scene, layer):
+    import fem_reference
+
+    m = scene.materials
+    return fem_reference.solve(scene.gap, E1=m["E1"], nu1=m["nu1"], E2=m["E2"], nu2=m["nu2"],
+                               force=scene.load["force"], approach=scene.load["approach"], layer=layer,
+                               **scene.fem)
+
+
+def execute_scene(scene, *, progress=None, overrides=None):
+    """Run what ``scene`` names and return a :class:`RunOutcome` (nothing is written).
+
+    Parameters
+    ----------
+    scene : Scene, str, path-like or dict
+        A validated scene, a built-in name, a TOML path or a scene dict.
+    progress : callable, optional
+        ``progress(stage, status, info)``: ``stage`` in :func:`planned_stages`, ``status`` one
+        of ``"start"``, ``"iteration"`` (BEM, ``info["iteration"]``), ``"done"``.
+    overrides : dict or list of str, optional
+        Dotted-key overrides (:func:`validation.scene.apply_overrides`), validated first.
+    """
+    t0 = time.perf_counter()
+    if not isinstance(scene, Scene) or overrides:
+        scene = load_scene(scene, overrides=overrides)
+    messages, times = [], {"bem": None, "fem": None, "layer_reference": None}
+    solve = _BemRunner(scene, messages)
+    if "layer" in planned_stages(scene):
+        _notify(progress, "layer", "start")
+    t = time.perf_counter()
+    layer, layer_info = paper.resolve_layer(scene.layer_spec, step=scene.bem["step"], E_star=scene.E_star,
+                                            solve=solve)
+    if solve.solves:
+        times["layer_reference"] = time.perf_counter() - t
+        _notify(progress, "layer", "done")
+    _notify(progress, "bem", "start")
+
+    def callback(k, _p):
+        _notify(progress, "bem", "iteration", iteration=k)
+
+    t = time.perf_counter()
+    res = solve(layer, callback=callback if progress is not None else None)
+    times["bem"] = time.perf_counter() - t
+    _notify(progress, "bem", "done", converged=res.converged)
+    if not res.converged:
+        messages.append(f"BEM did not converge: {res.message}")
+        log.warning("BEM did not converge: %s", res.message)
+    if "p_max_lambda" in layer_info and scene.layer_spec["law"] == "root":
+        layer_info["alpha_b"] = res.p_max / layer_info["p_max_lambda"]
+    fem = ref = metrics = None
+    if scene.fem is not None:
+        _notify(progress, "fem", "start")
+        fem = _fem(scene, layer)
+        times["fem"] = fem.wall_time_s
+        _notify(progress, "fem", "done", converged=fem.converged)
+        if not fem.converged:
+            messages.append(f"FEM did not converge: {fem.reason}")
+    if scene.analytic is not None:
+        ref = _analytic(scene, layer)
+    if fem is not None or ref is not None:
+        _notify(progress, "compare", "start")
+        metrics = _compare(res, fem, ref, messages)
+        _notify(progress, "compare", "done")
+    times["total"] = time.perf_counter() - t0
+    result = build_result(scene, res, layer_info, fem=fem, analytic=ref, metrics=metrics, times=times,
+                          messages=messages, extent=solve.extent)
+    return RunOutcome(scene=scene, result=result, bem=res, fem=fem, analytic=ref, layer=layer)
+
+
+def write_outputs(outcome, out_dir, *, progress=None):
+    """Write the result directory of ``outcome`` atomically (whole or not at all); returns its path."""
+    _notify(progress, "write", "start")
+    res, scene = outcome.bem, outcome.scene
+    files = {"result": FILES["result"], "scene": FILES["scene"], "bem_field": FILES["bem_field"]}
+    if outcome.fem is not None:
+        files["fem_field"] = FILES["fem_field"]
+    outcome.result["files"] = dict(files)
+    with atomic_directory(out_dir) as tmp:
+        fields = {"p": res.p, "gap": res.gap, "closure": res.closure, "displacement": res.displacement,
+                  "initial_gap": scene.gap(res.x, res.y)}
+        write_vtu(tmp / files["bem_field"], res.x, res.y, lattice_triangles(res.lattice), fields)
+        if outcome.fem is not None:
+            outcome.fem.write(tmp / files["fem_field"])
+        atomic_write_text(tmp / files["scene"], dumps(scene.raw))
+        atomic_write_json(tmp / files["result"], outcome.result)
+    _notify(progress, "write", "done")
+    return out_dir
+
+
+def run_scene(scene, out_dir=None, *, progress=None, overrides=None):
+    """Run a scene and (given ``out_dir``) write its result directory.
+
+    Parameters
+    ----------
+    scene : Scene, str, path-like or dict
+        A validated scene, a built-in name, a TOML path or a scene dict.
+    out_dir : path-like, optional
+        Result directory: ``result.json``, ``scene.toml`` (the effective scene, re-runnable),
+        ``bem_field.vtu`` and, with an FEM reference, ``fem_field.vtu``. Written atomically:
+        an existing result directory is replaced only when the run succeeded.
+    progress : callable, optional
+        See :func:`execute_scene`.
+    overrides : dict or list of str, optional
+        Dotted-key overrides, validated with the scene before any work.
+
+    Returns
+    -------
+    dict
+        The JSON-ready result (the content of ``result.json``).
+
+    Raises
+    ------
+    validation.scene.SceneError
+        Bad scene (nothing run, nothing written).
+    bem.RegionTooSmallError
+        The contact reaches the border of an explicitly given region.
+    """
+    outcome = execute_scene(scene, progress=progress, overrides=overrides)
+    if out_dir is not None:
+        write_outputs(outcome, out_dir, progress=progress)
+    return outcome.result

@@ -1,0 +1,240 @@
+"""Scenes: TOML files that describe one contact problem and what to run on it (DESIGN.md section 6).
+
+A scene file has the sections (units: those of ``[scene] units``, SI by default)::
+
+    [scene]    name, title, description, units           (name required)
+    [bodies]   E1, nu1, E2, nu2 [Pa, -]  -- or E_star [Pa] alone
+    [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...)
+    [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn, alpha_a,
+               alpha_b, alpha_c (validation.paper); absent or law = "none": no layer
+    [load]     force [N] or approach [m]
+    [bem]      step [m] or nodes_across; extent [m] or extent_factor; method, rtol, maxiter,
+               precondition, nested, relaxation
+    [fem]      only when an FEM reference is wanted (axisymmetric gaps): n_contact, extent, ...
+    [analytic] only when wanted: kind = "hertz" | "hertz_elliptic" | "rigid_layer"
+    [sweep]    only when wanted: parameter, values
+    [report]   only when wanted: sections, format
+
+:func:`load_scene` validates the WHOLE scene (every point of its sweep included) before any
+work: unknown keys, wrong types, out-of-range values, missing keys and impossible combinations
+raise :class:`SceneError` whose message names the dotted key (``layer.lam``), the value and
+the rule. Built-in scenes ship in ``validation/scenes/*.toml`` and are addressed by name.
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+from . import scene_sections as sec
+from ._checks import SceneError
+from .paper import ALIASES, EXCLUSIVE
+
+__all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
+           "apply_overrides", "parse_override", "SECTIONS"]
+
+SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report")
+_REQUIRED = ("scene", "bodies", "gap", "load")
+_BODY_KEYS = ("E1", "nu1", "E2", "nu2")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene. ``raw`` is the TOML content (overrides applied), re-loadable as is."""
+
+    name: str
+    title: str
+    description: str
+    units: str
+    source: str
+    raw: dict
+    E_star: float
+    materials: dict | None
+    gap: object
+    gap_spec: dict
+    layer_spec: dict | None
+    load: dict
+    bem: dict
+    fem: dict | None = None
+    analytic: dict | None = None
+    sweep: dict | None = None
+    report: dict | None = None
+    overrides: tuple = field(default=())
+
+    @property
+    def axisymmetric(self):
+        """Whether the gap is axisymmetric (contact radius and FEM reference apply)."""
+        return bool(self.gap.is_axisymmetric)
+
+
+def builtin_dir():
+    """The folder of the built-in scene files."""
+    return Path(str(resources.files("validation") / "scenes"))
+
+
+def builtin_scenes():
+    """``{name: one-line description}`` of the built-in scenes, sorted by name."""
+    out = {}
+    for path in sorted(builtin_dir().glob("*.toml")):
+        with path.open("rb") as fh:
+            meta = tomllib.load(fh).get("scene", {})
+        out[path.stem] = meta.get("description") or meta.get("title", "")
+    return out
+
+
+def builtin_path(name):
+    """Path of the built-in scene ``name``; SceneError listing the names if there is none."""
+    path = builtin_dir() / f"{name}.toml"
+    if not path.is_file():
+        raise SceneError(f"scene = {name!r} is not allowed: it must be a built-in scene name ("
+                         + ", ".join(builtin_scenes()) + ") or a path to a .toml file.")
+    return path
+
+
+def parse_override(text):
+    """``"section.key=value"`` -> ``("section.key", value)``; value parsed as TOML, else a string."""
+    if not isinstance(text, str) or "=" not in text:
+        raise SceneError(f"--set {text!r} is not allowed: it must be section.key=value, e.g. bem.nodes_across=20.")
+    key, value = (s.strip() for s in text.split("=", 1))
+    try:
+        parsed = tomllib.loads(f"v = {value}")["v"]
+    except tomllib.TOMLDecodeError:
+        parsed = value
+    return key, parsed
+
+
+def _exclusive_partners(section, key):
+    """Keys of ``section`` that a new value of ``key`` replaces."""
+    groups = {"bem": (("step", "nodes_across"), ("extent", "extent_factor")),
+              "load": (("force", "approach"),), "layer": EXCLUSIVE}
+    drop = set()
+    for group in groups.get(section, ()):
+        if key in group:
+            drop.update(k for k in group if k != key)
+    if section == "bodies":
+        drop.update(_BODY_KEYS if key == "E_star" else ("E_star",) if key in _BODY_KEYS else ())
+    return drop
+
+
+def apply_overrides(raw, overrides):
+    """A deep copy of ``raw`` with dotted-key overrides applied.
+
+    Parameters
+    ----------
+    raw : dict
+        Scene content.
+    overrides : dict or iterable of str or (key, value) pairs
+        ``{"bem.nodes_across": 20}`` or ``["bem.nodes_across=20", ...]``; the short names
+        ``alpha_a``, ``alpha_b``, ``alpha_c`` mean ``layer.alpha_*``. Setting one key of an
+        alternative pair drops the other (``bem.step`` replaces ``bem.nodes_across``,
+        ``load.force`` replaces ``load.approach``, ``layer.alpha_a`` replaces ``layer.p_cr``...);
+        ``layer.law = "none"`` removes the layer.
+    """
+    out = copy.deepcopy(raw)
+    if isinstance(overrides, dict):
+        items = list(overrides.items())
+    else:
+        items = [o if isinstance(o, tuple) else parse_override(o) for o in overrides or ()]
+    for key, value in items:
+        key = ALIASES.get(key, key)
+        parts = key.split(".")
+        if len(parts) < 2 or not all(parts):
+            raise SceneError(f"--set {key!r} is not allowed: the key must be section.key (e.g. load.force).")
+        node = out
+        for part in parts[:-1]:
+            child = node.setdefault(part, {})
+            if not isinstance(child, dict):
+                raise SceneError(f"--set {key!r} is not allowed: {part} is not a table in this scene.")
+            node = child
+        if len(parts) == 2:
+            for other in _exclusive_partners(parts[0], parts[1]):
+                node.pop(other, None)
+            if parts == ["layer", "law"] and value == "none":
+                node.clear()
+        node[parts[-1]] = value
+    return out
+
+
+def _validate(raw, source, overrides):
+    if not isinstance(raw, dict):
+        raise SceneError(f"scene = {raw!r} is not allowed: it must be a table of sections.")
+    for key, value in raw.items():
+        if key not in SECTIONS:
+            raise SceneError(f"{key} = {'{...}' if isinstance(value, dict) else repr(value)} is not allowed: "
+                             f"there is no section [{key}] (sections: {', '.join(SECTIONS)}).")
+    for key in _REQUIRED:
+        if key not in raw:
+            raise SceneError(f"[{key}] is missing: every scene needs the sections " + ", ".join(_REQUIRED) + ".")
+    meta = sec.scene_meta(raw["scene"])
+    body = sec.bodies(raw["bodies"])
+    load = sec.load(raw["load"])
+    gap_spec, shape = sec.gap(raw["gap"], body["E_star"])
+    layer_spec = sec.layer(raw.get("layer"))
+    bem = sec.bem_options(raw.get("bem"), shape, layer_spec, body["E_star"], load)
+    return Scene(
+        name=meta["name"], title=meta["title"], description=meta["description"], units=meta["units"],
+        source=source, raw=raw, E_star=body["E_star"], materials=body["materials"], gap=shape,
+        gap_spec=gap_spec, layer_spec=layer_spec, load=load, bem=bem,
+        fem=sec.fem_options(raw.get("fem"), shape, body["materials"]),
+        analytic=sec.analytic(raw.get("analytic"), shape, layer_spec),
+        sweep=sec.sweep_spec(raw.get("sweep"), SECTIONS), report=sec.report(raw.get("report")),
+        overrides=tuple(overrides),
+    )
+
+
+def _check_sweep_points(scene):
+    """Every point of the scene's own sweep must be a valid scene too."""
+    base = {k: v for k, v in scene.raw.items() if k != "sweep"}
+    for i, value in enumerate(scene.sweep["values"]):
+        try:
+            _validate(apply_overrides(base, {scene.sweep["key"]: value}), scene.source, ())
+        except SceneError as exc:
+            raise SceneError(f"sweep.values[{i}] = {value!r} gives an invalid scene: {exc}") from None
+
+
+def parse_scene(raw, *, source="<dict>", overrides=None):
+    """Validate a scene given as a dict (the parsed TOML); returns a :class:`Scene`."""
+    overrides = list(overrides.items()) if isinstance(overrides, dict) else list(overrides or ())
+    raw = apply_overrides(raw, overrides)
+    scene = _validate(raw, source, [o if isinstance(o, str) else f"{o[0]}={o[1]!r}" for o in overrides])
+    if scene.sweep is not None:
+        _check_sweep_points(scene)
+    return scene
+
+
+def load_scene(source, *, overrides=None):
+    """Load and validate a scene: a built-in name, a path to a TOML file, a dict or a Scene.
+
+    Parameters
+    ----------
+    source : str, path-like, dict or Scene
+        Built-in name (``contactlab scenes`` lists them) or TOML file path.
+    overrides : dict or list of str, optional
+        Dotted-key overrides (:func:`apply_overrides`), validated with the rest.
+
+    Raises
+    ------
+    SceneError
+        Anything wrong in the scene (the message names the key), or an unknown scene.
+    """
+    if isinstance(source, Scene):
+        return parse_scene(source.raw, source=source.source, overrides=overrides)
+    if isinstance(source, dict):
+        return parse_scene(source, overrides=overrides)
+    path = Path(source)
+    if path.suffix == ".toml" or path.exists():
+        if not path.is_file():
+            raise SceneError(f"scene = {str(source)!r} is not allowed: there is no such file.")
+        label = str(path)
+    else:
+        path = builtin_path(str(source))
+        label = f"builtin:{source}"
+    try:
+        with path.open("rb") as fh:
+            raw = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"scene file {str(path)!r} is not valid TOML: {exc}.") from None
+    return parse_scene(raw, source=label, overrides=overrides)

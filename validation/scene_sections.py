@@ -1,0 +1,320 @@
+"""Validators of the sections of a scene file (one function per section).
+
+Each takes the raw TOML table (and what earlier sections produced) and returns the
+normalised section, raising :class:`validation._checks.SceneError` that names the dotted key.
+Nothing here solves anything: the whole scene is checked before any work.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import re
+
+from bem import METHODS, gaps
+from bem.gaps import gap_from_dict
+from bem.lattice import Lattice
+from bem.layers import Linear, from_dict
+from bem.materials import effective_modulus
+
+from . import _checks as ck
+from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
+from .sizing import DOMAIN_MARGIN, MAX_NODES, check_estimate, inner_domain, node_count
+
+__all__ = ["scene_meta", "bodies", "gap", "load", "layer", "bem_options", "fem_options", "analytic",
+           "report", "sweep_spec", "REPORT_SECTIONS", "ANALYTIC_KINDS", "DEFAULT_UNITS"]
+
+DEFAULT_UNITS = "SI (m, Pa, N)"
+#: Section names the report builder knows (validation only; the builder lives in validation.report).
+REPORT_SECTIONS = ("summary", "scene", "profile", "pressure_map", "comparison", "convergence", "layer_law",
+                   "fem_field", "sweep", "timings")
+ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
+_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
+_BODY_KEYS = ("E1", "nu1", "E2", "nu2")
+_BEM_KEYS = ("step", "nodes_across", "extent", "extent_factor", "method", "rtol", "maxiter", "precondition",
+             "nested", "relaxation")
+_FEM_KEYS = ("n_contact", "extent", "fine_radius", "growth", "penalty", "rtol", "maxiter", "remesh",
+             "truncation_correction")
+GAP_TYPES = {cls.type_name: cls for cls in (gaps.Paraboloid, gaps.EllipticParaboloid, gaps.CrownedRoller,
+                                            gaps.FlatPunch, gaps.Callable, gaps.Table)}
+DEFAULT_NODES_ACROSS = 40
+DEFAULT_EXTENT_FACTOR = 1.5
+
+
+def scene_meta(d):
+    """``[scene]``: name (required), title, description, units."""
+    ck.table("scene", d)
+    ck.unknown_keys("scene", d, ("name", "title", "description", "units"))
+    name = ck.string("scene.name", ck.require("scene", d, "name", 'give a short name, e.g. name = "hertz"'))
+    if not _NAME.match(name):
+        raise ck.SceneError(f"scene.name = {name!r} is not allowed: it must be letters, digits, '_', '.', '-' "
+                            "(it names the result directory).")
+    out = {"name": name, "units": DEFAULT_UNITS, "title": name, "description": ""}
+    for key in ("title", "description", "units"):
+        if key in d:
+            out[key] = ck.string(f"scene.{key}", d[key])
+    return out
+
+
+def bodies(d):
+    """``[bodies]``: ``E_star`` alone, or ``E1, nu1, E2, nu2`` (``E = inf``: rigid body)."""
+    ck.table("bodies", d)
+    ck.unknown_keys("bodies", d, ("E_star", *_BODY_KEYS))
+    if "E_star" in d:
+        if any(k in d for k in _BODY_KEYS):
+            given = ", ".join(f"bodies.{k}" for k in _BODY_KEYS if k in d)
+            raise ck.SceneError(f"bodies.E_star = {d['E_star']!r} is not allowed together with {given}: "
+                                "give E_star alone or all of E1, nu1, E2, nu2.")
+        return {"E_star": ck.positive("bodies.E_star", d["E_star"]), "materials": None}
+    for key in _BODY_KEYS:
+        ck.require("bodies", d, key, "give E1, nu1, E2, nu2 [Pa, -] (or E_star alone)")
+    with ck.scene_errors("bodies."):
+        E_star = effective_modulus(*(d[k] for k in _BODY_KEYS))
+    return {"E_star": E_star, "materials": {k: float(d[k]) for k in _BODY_KEYS}}
+
+
+def gap(d, E_star):
+    """``[gap]``: ``type`` and the parameters of the :mod:`bem.gaps` shape; returns (spec, Gap).
+
+    A log-crowned roller given by ``design_force`` takes ``E_star`` from ``[bodies]`` when the
+    gap table leaves it out.
+    """
+    ck.table("gap", d)
+    kind = ck.require("gap", d, "type", "give one of " + ", ".join(map(repr, GAP_TYPES)))
+    ck.choice("gap.type", kind, GAP_TYPES)
+    allowed = ["type", *(p for p in inspect.signature(GAP_TYPES[kind].__init__).parameters if p != "self")]
+    ck.unknown_keys("gap", d, allowed)
+    spec = dict(d)
+    if kind == "crowned_roller" and "design_force" in spec and "E_star" not in spec:
+        spec["E_star"] = E_star
+    for name, p in inspect.signature(GAP_TYPES[kind].__init__).parameters.items():
+        if name != "self" and p.default is inspect.Parameter.empty and name not in spec:
+            raise ck.SceneError(f"gap.{name} is missing: a {kind!r} gap needs " + ", ".join(allowed[1:]) + ".")
+    with ck.scene_errors("gap."):
+        shape = gap_from_dict(spec)
+    return spec, shape
+
+
+def load(d):
+    """``[load]``: exactly one of ``force`` [N] and ``approach`` [m], > 0."""
+    ck.table("load", d)
+    ck.unknown_keys("load", d, ("force", "approach"))
+    key = ck.exactly_one("load", d, ("force", "approach"), "force control: force [N]; approach control: "
+                         "approach [m]")
+    return {"force": None, "approach": None, key: ck.positive(f"load.{key}", d[key])}
+
+
+def layer(d):
+    """``[layer]``: see :func:`validation.paper.check_layer`; absent or ``law = "none"``: no layer."""
+    return check_layer(d, "layer")
+
+
+def _sizing_layer(spec, step, E_star):
+    """A layer object that sizes the region (paper laws: their linear reference)."""
+    if spec is None:
+        return None
+    law = spec["law"]
+    if law in PAPER_LAWS and any(k in spec for k in PAPER_KEYS):
+        direct = next(iter(PAPER_LAWS[law].values()))[0]
+        return Linear(spec[direct] if direct in spec else spec["lam_over_cnn"] * c_nn(step, E_star))
+    return from_dict(spec)
+
+
+def _estimate(shape, layer_spec, E_star, load_, step, n_across):
+    """Expected semi-axes; with ``lam_over_cnn`` and an automatic step, iterate step <-> layer."""
+    kw = dict(E_star=E_star, force=load_["force"], approach=load_["approach"])
+    with ck.scene_errors():
+        axes = check_estimate(shape, layer=None, **kw)
+    if axes is None or layer_spec is None:
+        return axes
+    s = step if step is not None else 2 * min(axes) / n_across
+    for _ in range(30):
+        with ck.scene_errors():
+            axes = check_estimate(shape, layer=_sizing_layer(layer_spec, s, E_star), **kw)
+        if step is not None:
+            break
+        s_new = 2 * min(axes) / n_across
+        if abs(s_new / s - 1.0) < 1e-9:
+            break
+        s = s_new
+    return axes
+
+
+def bem_options(d, shape, layer_spec, E_star, load_):
+    """``[bem]``: lattice (``step`` | ``nodes_across``, ``extent`` | ``extent_factor``) and solver options.
+
+    Returns the options with the resolved ``step`` [m], ``extent`` ``(ex, ey)`` [m],
+    ``expected`` semi-axes (or None) and ``extent_auto`` (the region may be enlarged).
+    """
+    d = {} if d is None else ck.table("bem", d)
+    ck.unknown_keys("bem", d, _BEM_KEYS)
+    for a, b in (("step", "nodes_across"), ("extent", "extent_factor")):
+        if a in d and b in d:
+            raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
+                                "give one of them.")
+    out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
+    if "rtol" in d:
+        out["rtol"] = ck.positive("bem.rtol", d["rtol"])
+    if "maxiter" in d:
+        out["maxiter"] = ck.integer("bem.maxiter", d["maxiter"], 1)
+    for key in ("precondition", "nested"):
+        if key in d:
+            out[key] = ck.boolean(f"bem.{key}", d[key])
+    if "relaxation" in d:
+        if out["method"] != "augmented_gap":
+            raise ck.SceneError(f"bem.relaxation = {d['relaxation']!r} is not allowed with bem.method = "
+                                f"{out['method']!r}: it is an option of method = 'augmented_gap' only.")
+        out["relaxation"] = ck.in_range("bem.relaxation", d["relaxation"], 0.0, 1.0, low_open=True)
+    if out["method"] == "kalker" and layer_spec is not None and layer_spec["law"] != "linear":
+        raise ck.SceneError(f"bem.method = 'kalker' is not allowed with layer.law = {layer_spec['law']!r}: "
+                            "Kalker's QP solves smooth bodies and linear layers; use 'newton'.")
+    step = ck.positive("bem.step", d["step"]) if "step" in d else None
+    n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
+    axes = _estimate(shape, layer_spec, E_star, load_, step, n_across)
+    if axes is None and ("step" not in d or "extent" not in d):
+        raise ck.SceneError(f"bem.step and bem.extent are missing: a {shape.type_name!r} gap has no estimate "
+                            "of the contact size, so give the lattice step [m] and the region half-width [m].")
+    if step is None:
+        step = 2 * min(axes) / n_across
+    elif axes is not None and 2 * min(axes) / step < 4:
+        raise ck.SceneError(f"bem.step = {step!r} is not allowed for this load: the expected contact is only "
+                            f"{2 * min(axes):.4g} across ({2 * min(axes) / step:.1f} steps); make step smaller "
+                            "(at least 4 nodes across the contact).")
+    hx, hy = inner_domain(shape)
+    if "extent" in d:
+        ex, ey = ck.number_or_pair("bem.extent", d["extent"], ck.positive)
+        if ex >= hx or ey >= hy:
+            raise ck.SceneError(f"bem.extent = {d['extent']!r} is not allowed: the candidate region must lie "
+                                f"inside the gap's domain, |x| < {hx:.6g}, |y| < {hy:.6g}.")
+        if axes is not None and (ex < axes[0] or ey < axes[1]):
+            raise ck.SceneError(
+                f"bem.extent = {d['extent']!r} is not allowed for this load: the expected contact semi-axes "
+                f"are ({axes[0]:.4g}, {axes[1]:.4g}), beyond the region; make extent larger (or use "
+                "extent_factor) or reduce the load.")
+        auto = False
+    else:
+        fx, fy = ck.number_or_pair("bem.extent_factor", d.get("extent_factor", DEFAULT_EXTENT_FACTOR),
+                                   lambda p, v: ck.in_range(p, v, 1.0, 100.0))
+        ex = min(fx * axes[0], (1 - DOMAIN_MARGIN) * hx)
+        ey = min(fy * axes[1], (1 - DOMAIN_MARGIN) * hy)
+        auto = True
+    with ck.scene_errors():
+        Lattice.from_extent(step, (ex, ey))
+    n = node_count(step, (ex, ey))
+    if n > MAX_NODES:
+        raise ck.SceneError(f"bem.{'step' if 'step' in d else 'nodes_across'} = "
+                            f"{d.get('step', n_across)!r} is not allowed: the region would hold {n} nodes "
+                            f"(limit {MAX_NODES}); make the lattice coarser or the region smaller.")
+    out.update(step=step, extent=(ex, ey), extent_auto=auto, expected=axes,
+               nodes_across=2 * min(axes) / step if axes else None, n_nodes=n)
+    return out
+
+
+def fem_options(d, shape, materials):
+    """``[fem]``: options of :func:`fem_reference.solve`; axisymmetric gaps and E1..nu2 only."""
+    if d is None:
+        return None
+    ck.table("fem", d)
+    ck.unknown_keys("fem", d, _FEM_KEYS)
+    if not shape.is_axisymmetric:
+        raise ck.SceneError(f"fem = {{...}} is not allowed with gap.type = {shape.type_name!r}: the FEM "
+                            "reference is axisymmetric; remove [fem] or use an axisymmetric gap.")
+    if materials is None:
+        raise ck.SceneError("fem = {...} is not allowed with bodies.E_star: the FEM models each body; "
+                            "give bodies.E1, nu1, E2, nu2.")
+    for key in ("E1", "E2"):
+        if not math.isfinite(materials[key]):
+            raise ck.SceneError(f"bodies.{key} = inf is not allowed with [fem]: the FEM bodies are elastic.")
+    for key in ("nu1", "nu2"):
+        if materials[key] > 0.499:
+            raise ck.SceneError(f"bodies.{key} = {materials[key]!r} is not allowed with [fem]: it must be "
+                                "<= 0.499 (the displacement FEM locks).")
+    out = {}
+    if "n_contact" in d:
+        out["n_contact"] = ck.integer("fem.n_contact", d["n_contact"], 4, 400)
+    for key in ("extent", "fine_radius", "growth", "penalty", "rtol"):
+        if key in d:
+            out[key] = ck.positive(f"fem.{key}", d[key])
+    if "maxiter" in d:
+        out["maxiter"] = ck.integer("fem.maxiter", d["maxiter"], 1)
+    for key in ("remesh", "truncation_correction"):
+        if key in d:
+            out[key] = ck.boolean(f"fem.{key}", d[key])
+    extent, fine = out.get("extent", 40.0), out.get("fine_radius", 1.5)
+    if extent < 4 * fine:
+        raise ck.SceneError(f"fem.extent = {extent!r} is not allowed: it must be >= 4 * fem.fine_radius = "
+                            f"{4 * fine!r} (domain size in expected contact radii).")
+    return out
+
+
+def analytic(d, shape, layer_spec):
+    """``[analytic]``: ``kind`` of the closed-form comparison and its applicability."""
+    if d is None:
+        return None
+    ck.table("analytic", d)
+    ck.unknown_keys("analytic", d, ("kind",))
+    kind = ck.choice("analytic.kind", ck.require("analytic", d, "kind", "give one of " + ", ".join(
+        map(repr, ANALYTIC_KINDS))), ANALYTIC_KINDS)
+    t = shape.type_name
+    if kind in ("hertz", "hertz_elliptic"):
+        if layer_spec is not None:
+            raise ck.SceneError(f"analytic.kind = {kind!r} is not allowed with layer.law = {layer_spec['law']!r}: "
+                                "Hertz's solution has no layer; remove [analytic] or the layer.")
+        if kind == "hertz":
+            ok = t == "paraboloid" or (t == "elliptic_paraboloid" and shape.is_axisymmetric)
+            need = "paraboloid (or an elliptic_paraboloid with Rx = Ry)"
+        else:
+            ok = t in ("paraboloid", "elliptic_paraboloid")
+            need = "elliptic_paraboloid or paraboloid"
+        if not ok:
+            raise ck.SceneError(f"analytic.kind = {kind!r} is not allowed with gap.type = {t!r}: it needs a "
+                                f"{need} gap.")
+    else:
+        law = None if layer_spec is None else layer_spec["law"]
+        if t != "paraboloid" or law not in ("linear", "power", "root"):
+            raise ck.SceneError(f"analytic.kind = 'rigid_layer' is not allowed with gap.type = {t!r} and "
+                                f"layer.law = {law!r}: it needs a paraboloid gap and a linear, power or root layer.")
+    return {"kind": kind}
+
+
+def report(d):
+    """``[report]``: ``sections`` (names checked) and ``format``."""
+    if d is None:
+        return None
+    ck.table("report", d)
+    ck.unknown_keys("report", d, ("sections", "format"))
+    out = {"format": ck.choice("report.format", d.get("format", "html"), ("html", "markdown", "both"))}
+    sections = d.get("sections", ["summary"])
+    if not isinstance(sections, list) or not sections:
+        raise ck.SceneError(f"report.sections = {sections!r} is not allowed: it must be a non-empty list of "
+                            "section names, e.g. [\"summary\", \"profile\"].")
+    for i, name in enumerate(sections):
+        ck.choice(f"report.sections[{i}]", name, REPORT_SECTIONS)
+    out["sections"] = list(sections)
+    return out
+
+
+def sweep_spec(d, known_sections):
+    """``[sweep]``: ``parameter`` (alpha_a, alpha_b, alpha_c or a dotted key) and ``values``."""
+    if d is None:
+        return None
+    ck.table("sweep", d)
+    ck.unknown_keys("sweep", d, ("parameter", "values"))
+    param = ck.string("sweep.parameter", ck.require("sweep", d, "parameter",
+                                                    "give alpha_a, alpha_b, alpha_c or a dotted key like layer.lam"))
+    key = ALIASES.get(param, param)
+    parts = key.split(".")
+    if len(parts) < 2 or parts[0] not in known_sections or parts[0] in ("scene", "sweep", "report") or not all(parts):
+        raise ck.SceneError(f"sweep.parameter = {param!r} is not allowed: it must be alpha_a, alpha_b, alpha_c "
+                            "or a dotted key section.key of bodies, gap, layer, load, bem, fem (e.g. load.force).")
+    values = ck.require("sweep", d, "values", "give a list of numbers, e.g. values = [0.0, 0.5, 1.0]")
+    if not isinstance(values, list) or not values:
+        raise ck.SceneError(f"sweep.values = {values!r} is not allowed: it must be a non-empty list.")
+    for i, value in enumerate(values):
+        if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+            raise ck.SceneError(f"sweep.values[{i}] = {value!r} is not allowed: it must be a number or a string.")
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ck.SceneError(f"sweep.values[{i}] = {value!r} is not allowed: it must be finite.")
+    if len(set(map(repr, values))) != len(values):
+        raise ck.SceneError(f"sweep.values = {values!r} is not allowed: the values must be distinct.")
+    return {"parameter": param, "key": key, "values": list(values)}
