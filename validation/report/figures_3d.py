@@ -14,7 +14,7 @@ import numpy as np
 
 from bem._validate import InputError, check_positive
 
-from .style import new_figure, save_figure
+from .style import axis_labels, new_figure, save_figure
 
 __all__ = ["contact_patch", "plot_pressure_surfaces", "plot_contact_map"]
 
@@ -112,7 +112,7 @@ def _trim(img, pad=6):
 
 
 def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, panel_size=(520, 420),
-                           title=None, section=True):
+                           title=None, section=True, labels=None):
     """Isometric 3-D pressure surfaces, one panel per result, on a common colour scale.
 
     Each panel is rendered off-screen by pyvista (lit surface, faint lattice edges, the
@@ -137,6 +137,8 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
         Figure title.
     section : bool
         Draw the axial section ``y = 0`` on each surface.
+    labels : dict, optional
+        ``{"p": colour-bar label}`` (:func:`validation.report.style.axis_labels`).
 
     Returns
     -------
@@ -175,13 +177,13 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
             ax.set_title(label, fontsize=9.5)
         sm = mpl.cm.ScalarMappable(norm=mpl.colors.Normalize(0.0, vmax), cmap="viridis")
         bar = fig.colorbar(sm, ax=axes.ravel().tolist(), shrink=0.8, pad=0.01, aspect=25)
-        bar.set_label(r"contact pressure $p\,/\,p_0$")
+        bar.set_label(axis_labels(labels)["p"])
         if title:
             fig.suptitle(title, fontsize=10.5)
         return save_figure(fig, path)
 
 
-def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=()):
+def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(), labels=None):
     """Map of the contact pressure ``p / p0`` over the plane with the contact boundary.
 
     The boundary is drawn midway between the loaded nodes (``p > 0``) and their unloaded
@@ -205,6 +207,8 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=())
     levels : sequence of (str, float)
         Labelled pressure contours [pressure] (e.g. ``("p = p_cr", p_cr)``: the line between
         the rigid and elastic branches of an elastic-rigid layer).
+    labels : dict, optional
+        ``{"x", "y", "p"}`` axis labels (:func:`validation.report.style.axis_labels`).
 
     Returns
     -------
@@ -236,11 +240,12 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=())
             ax.plot(circle / a * np.cos(t), circle / a * np.sin(t), color="#ff7f0e", ls="--", lw=1.2,
                     label=r"equal-area circle $r = \sqrt{A/\pi}$")
         bar = fig.colorbar(pc, ax=ax, pad=0.01)
-        bar.set_label(r"$p\,/\,p_0$")
+        lab = axis_labels(labels)
+        bar.set_label(lab["p"])
         ax.set_aspect("equal")
         ax.grid(False)
-        ax.set_xlabel(r"$x\,/\,a_H$")
-        ax.set_ylabel(r"$y\,/\,a_H$")
+        ax.set_xlabel(lab["x"])
+        ax.set_ylabel(lab["y"])
         if title:
             ax.set_title(title)
         leg = fig.legend(loc="outside lower center", ncols=2, fontsize=8, facecolor="#555555", framealpha=1.0)

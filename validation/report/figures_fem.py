@@ -11,13 +11,13 @@ import numpy as np
 
 from bem._validate import InputError, check_positive
 
-from .style import new_figure, save_figure
+from .style import axis_labels, new_figure, save_figure
 
 __all__ = ["plot_section_field", "plot_von_mises", "von_mises_of", "section_field_from_vtu"]
 
 
 def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window=3.0, contact_radius=None,
-                       title=None):
+                       title=None, labels=None):
     """A scalar field on an (r, z) triangulation, mirrored about the axis for readability.
 
     Parameters
@@ -42,6 +42,8 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
         Edge of the contact [length], marked on the interface.
     title : str, optional
         Axes title.
+    labels : dict, optional
+        ``{"r", "z"}`` axis labels (:func:`validation.report.style.axis_labels`).
 
     Returns
     -------
@@ -77,7 +79,7 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
         if contact_radius:
             rc = contact_radius / a
             ax.plot([-rc, rc], [0.0, 0.0], color="#00d0ff", lw=3.0, solid_capstyle="butt",
-                    label=f"contact, $r_c$ = {rc:.3f} $a_H$")
+                    label=f"contact, $r_c$ = {rc:.4g}" + (" $a_H$" if labels is None else ""))
             ax.legend(loc="upper right", fontsize=8, facecolor="#333333", labelcolor="white", framealpha=0.8)
         bar = fig.colorbar(pc, ax=ax, pad=0.01)
         bar.set_label(label)
@@ -85,8 +87,9 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
         ax.set_ylim(-window, window)
         ax.set_aspect("equal")
         ax.grid(False)
-        ax.set_xlabel(r"$r\,/\,a_H$ (mirrored about the axis)")
-        ax.set_ylabel(r"$z\,/\,a_H$  (upper body $z > 0$)")
+        lab = axis_labels(labels)
+        ax.set_xlabel(lab["r"] + " (mirrored about the axis)")
+        ax.set_ylabel(lab["z"] + "  (upper body $z > 0$)")
         if title:
             ax.set_title(title)
         return save_figure(fig, path)

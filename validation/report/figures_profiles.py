@@ -10,7 +10,7 @@ import numpy as np
 
 from bem._validate import InputError, check_positive
 
-from .style import color_for, new_figure, save_figure
+from .style import axis_labels, color_for, new_figure, save_figure
 
 __all__ = ["axial_section", "section_of", "auto_xlim", "curve_style", "plot_pressure_profiles", "plot_layer_laws"]
 
@@ -79,7 +79,7 @@ def curve_style(data, index):
             "marker": "o" if dashed else None, "markersize": 3.5, "markevery": 2}
 
 
-def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim=None):
+def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim=None, labels=None):
     """Pressure in the axial section ``y = 0``, ``p / p0`` against ``x / a`` (paper Fig. 5).
 
     Parameters
@@ -99,6 +99,9 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim
         Also draw Hertz's ``p0 sqrt(1 - x^2/a^2)`` as a thin grey reference.
     xlim : (float, float), optional
         Range of ``x / a``; default: the widest contact with a margin (:func:`auto_xlim`).
+    labels : dict, optional
+        Axis labels ``{"x": ..., "p": ...}`` (:func:`validation.report.style.axis_labels`);
+        default: normalised by the Hertz radius and peak.
 
     Returns
     -------
@@ -109,6 +112,7 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim
     if not curves:
         raise InputError("curves = [] is not allowed: give at least one (label, result) pair.")
     sections = [section_of(item[1]) for item in curves]
+    lab = axis_labels(labels)
     with new_figure((8.2, 4.0)) as (fig, ax):
         if hertz:
             s = np.linspace(-1.0, 1.0, 401)
@@ -123,8 +127,8 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim
             ax.plot(x / a, p / p0, label=label, zorder=3, **style)
         ax.set_xlim(*(xlim or auto_xlim(sections, a)))
         ax.set_ylim(bottom=0.0)
-        ax.set_xlabel(r"$x\,/\,a_H$  (axial section $y = 0$; $a_H$: Hertz contact radius)")
-        ax.set_ylabel(r"contact pressure $p\,/\,p_0$  ($p_0$: Hertz peak)")
+        ax.set_xlabel(lab["x"] + r"  (axial section $y = 0$)")
+        ax.set_ylabel(lab["p"])
         if title:
             ax.set_title(title)
         fig.legend(loc="outside right upper", frameon=False)

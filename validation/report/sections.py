@@ -38,17 +38,14 @@ def status_class(status):
 
 
 def fmt(value, digits=4):
-    """A number for a table: ``digits`` significant digits, plain or scientific."""
+    """A cell of a table: floats with ``digits`` significant digits (``%g``), ints as they are,
+    booleans as yes/no, ``None`` as "-"."""
     if isinstance(value, bool) or value is None:
         return "-" if value is None else ("yes" if value else "no")
     if isinstance(value, int):
         return str(value)
     if isinstance(value, float):
-        if not math.isfinite(value):
-            return str(value)
-        if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e5):
-            return f"{value:.{digits - 1}e}"
-        return f"{value:.{digits}g}"
+        return f"{value:.{digits}g}" if math.isfinite(value) else str(value)
     return str(value)
 
 

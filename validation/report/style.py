@@ -15,7 +15,7 @@ import contextlib
 import os
 import tempfile
 
-__all__ = ["DPI", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS", "color_for", "new_figure",
+__all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS", "color_for", "new_figure",
            "save_figure", "atomic_path", "METHOD_LABELS", "method_label"]
 
 DPI = 120  #: resolution of every PNG [dots per inch]
@@ -66,6 +66,29 @@ _RC = {
     "savefig.dpi": DPI,
     "mathtext.fontset": "dejavusans",
 }
+
+
+#: default axis labels of pressure plots: lengths over the Hertz radius, pressures over the Hertz peak
+NORMALISED_LABELS = {
+    "x": r"$x\,/\,a_H$",
+    "y": r"$y\,/\,a_H$",
+    "r": r"$r\,/\,a_H$",
+    "z": r"$z\,/\,a_H$",
+    "p": r"contact pressure $p\,/\,p_0$",
+}
+
+
+def axis_labels(labels=None, units=None):
+    """Axis labels: :data:`NORMALISED_LABELS` updated by ``labels``; with ``units``
+    (``{"length": "mm", "pressure": "MPa"}``) the physical labels ``x [mm]``, ``p [MPa]``
+    (use then ``p0 = a = 1`` so the data are drawn as they are)."""
+    out = dict(NORMALISED_LABELS)
+    if units is not None:
+        length, pressure = units.get("length", "length"), units.get("pressure", "pressure")
+        out.update({k: f"${k}$ [{length}]" for k in ("x", "y", "r", "z")})
+        out["p"] = f"contact pressure $p$ [{pressure}]"
+    out.update(labels or {})
+    return out
 
 
 def method_label(method):
