@@ -126,7 +126,17 @@ def test_section_validation(tmp_path):
 def test_status_and_format():
     assert [status_class(s) for s in ("converged", "Converged (KKT 1e-9)", "stalled", "diverged: x",
                                       "not converged", "pending")] == ["ok", "ok", "warn", "bad", "bad", "other"]
-    assert fmt(0.000123456) == "0.0001235" and fmt(2.5e-9) == "2.5e-09" and fmt(12.34567) == "12.35" and fmt(3) == "3" and fmt(True) == "yes"
+    assert fmt(0.000123456) == "0.0001235" and fmt(2.5e-9) == "2.5e-09" and fmt(12.34567) == "12.35"
+    assert fmt(3) == "3" and fmt(True) == "yes" and fmt(None) == "-"
+
+
+def test_table_from_rows():
+    from validation.report.sections import table_from_rows
+
+    t = table_from_rows([{"case": "a", "status": "diverged", "extra": {"x": 1}}, {"case": "b", "n": 3}])
+    assert t.columns == ("case", "status", "n") and t.status_column == "status"
+    assert t.rows == (("a", "diverged", "-"), ("b", "-", "3")) and [t.status(r) for r in t.rows] == ["bad", "other"]
+    assert table_from_rows([{"a": 1}]).status_column is None
 
 
 def test_problem_section_lists_inputs(tmp_path):

@@ -158,6 +158,13 @@ def test_pressure_surfaces_3d_png(cases, tmp_path):
     assert img.shape[1] > 2 * img.shape[0]  # three panels side by side
 
 
+def test_pressure_surface_without_axis_nodes(tmp_path):
+    x, y = np.meshgrid(np.linspace(-1, 1, 20), np.linspace(-1, 1, 20))  # even count: no node on y = 0
+    p = np.clip(1 - x**2 - y**2, 0, None)
+    check_png(f3d.plot_pressure_surfaces([("cap", (x.ravel(), y.ravel(), p.ravel()))], tmp_path / "s.png",
+                                         p0=1.0, a=1.0))
+
+
 def test_contact_map_png(cases, tmp_path):
     er = cases["er"]
     check_png(f3d.plot_contact_map(er, tmp_path / "m.png", p0=P0, a=A, levels=[("p_cr", cases["er_law"].p_cr)]),

@@ -21,10 +21,10 @@ from .paper import PaperProblem, solve_paper_problem
 from .paper_report import report_paper_problem
 from .results import load_results
 from .run_report import report_results_dir
-from .sections import Figure, Section, Table, problem_section, results_table
+from .sections import Figure, Section, Table, problem_section, results_table, table_from_rows
 
 __all__ = [
-    "build_report", "BuiltReport", "Section", "Figure", "Table", "problem_section", "results_table",
+    "build_report", "BuiltReport", "Section", "Figure", "Table", "problem_section", "results_table", "table_from_rows",
     "plot_pressure_profiles", "plot_layer_laws", "axial_section", "plot_iteration_profiles", "plot_convergence",
     "plot_pressure_surfaces", "plot_contact_map", "plot_sweep", "plot_transition_line", "transition_radius",
     "edge_radius", "plot_profile_comparison", "plot_work_precision", "plot_von_mises", "plot_section_field",

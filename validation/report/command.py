@@ -38,7 +38,8 @@ def main(args):
     if target == "paper":
         from .paper_report import report_paper_problem
 
-        built = report_paper_problem(DEFAULT_PAPER_OUT if out is None else out, quick=bool(getattr(args, "quick", False)))
+        quick = bool(getattr(args, "quick", False))
+        built = report_paper_problem(DEFAULT_PAPER_OUT if out is None else out, quick=quick)
     elif Path(target).is_dir():
         from .run_report import report_results_dir
 
@@ -46,7 +47,8 @@ def main(args):
     else:
         raise InputError(
             f"target = {target!r} is not allowed: it must be 'paper' or a results directory holding result.json. "
-            f"To report a scene, run it first: contactlab run {target or 'SCENE'} --out DIR, then contactlab report DIR."
+            f"To report a scene, run it first: contactlab run {target or 'SCENE'} --out DIR, "
+            "then contactlab report DIR."
         )
     log.info("report written: %s and %s (%d figures)", built.html, built.markdown, len(built.figures))
     return 0

@@ -136,7 +136,7 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
     title : str, optional
         Figure title.
     section : bool
-        Draw the axial section ``y = 0`` on each surface.
+        Draw the axial section ``y = 0`` on each surface (where nodes lie on it).
     labels : dict, optional
         ``{"p": colour-bar label}`` (:func:`validation.report.style.axis_labels`).
 
@@ -162,7 +162,8 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
     with _quiet_vtk():
         for _, (x, y, p) in data:
             xs, ys, ps, tri = contact_patch(x, y, p)
-            sec = axial_section(xs, ys, ps) if section else None
+            on_axis = np.abs(ys) <= 1e-9 * float(np.abs(xs).max(initial=1.0))
+            sec = axial_section(xs, ys, ps) if section and on_axis.sum() > 1 else None
             images.append(_render_panel(pv, xs, ys, ps, tri, p0=p0, a=a, height=height, vmax=vmax,
                                         size=panel_size, section=sec))
     import matplotlib as mpl

@@ -29,7 +29,8 @@ figure { margin: 1.2em 0; text-align: center; }
 figure img { max-width: 100%; height: auto; border: 1px solid var(--line); border-radius: 4px; }
 figcaption { text-align: left; color: var(--muted); font-size: 0.92em; margin-top: 0.4em; }
 figcaption b, caption b { color: var(--ink); }
-table { border-collapse: collapse; margin: 1em 0; font-size: 0.92em; width: 100%; }
+div.table-wrap { overflow-x: auto; margin: 1em 0; }
+table { border-collapse: collapse; font-size: 0.92em; width: 100%; }
 caption { caption-side: top; text-align: left; color: var(--muted); padding-bottom: 0.3em; }
 th, td { border: 1px solid var(--line); padding: 4px 8px; text-align: left; vertical-align: top; }
 th { background: #eef1f6; }
@@ -57,7 +58,7 @@ def _figure(fig, number, data):
 
 
 def _table(tab, number):
-    out = ["<table>"]
+    out = ['<div class="table-wrap"><table>']
     cap = f"<b>Table {number}.</b> {html.escape(tab.caption)}" if tab.caption else f"<b>Table {number}.</b>"
     out.append(f"<caption>{cap}</caption>")
     out.append("<thead><tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in tab.columns) + "</tr></thead>")
@@ -68,7 +69,7 @@ def _table(tab, number):
         cells = "".join(f'<td class="num">{html.escape(c)}</td>' if _is_number(c) else f"<td>{html.escape(c)}</td>"
                         for c in row)
         out.append(f"<tr{attr}>{cells}</tr>")
-    out.append("</tbody></table>")
+    out.append("</tbody></table></div>")
     return "\n".join(out)
 
 

@@ -21,7 +21,7 @@ from . import figures_validation as fva
 from .build import build_report
 from .figures_fem import plot_von_mises
 from .paper import AG_RELAXATION, solve_paper_problem
-from .sections import Figure, Section, Table, fmt, problem_section
+from .sections import Figure, Section, Table, problem_section
 from .style import method_label
 
 __all__ = ["report_paper_problem", "paper_sections"]
@@ -173,7 +173,8 @@ def _sweeps(res, work):
     pick = [0.0, 0.3, 0.5, 0.7, 0.9, 1.0] if not res.quick else alphas
     panels = [(rf"$\alpha_a$ = {al:g}", r) for al, r in res.sweep_a if any(abs(al - q) < 1e-9 for q in pick)]
     f9 = f3d.plot_pressure_surfaces(panels, work / "fig09_alpha_a_3d.png", p0=pb.p0, a=pb.a,
-                                    title=r"elastic-rigid law: pressure over the contact as $\alpha_a$ varies (paper Fig. 9)")
+                                    title=r"elastic-rigid law: pressure over the contact as $\alpha_a$ varies "
+                                          "(paper Fig. 9)")
     lin_x, lin_p = fpr.section_of(res.base["linear Winkler"])
     fb = fsw.plot_sweep([(ab, *fpr.section_of(r)) for _, ab, r in res.sweep_b], work / "fig10_sweep_alpha_b.png",
                         p0=pb.p0, a=pb.a, name=r"$\alpha_b = p_{max}^{root} / p_{max}^{\lambda}$",
@@ -243,11 +244,13 @@ def _validation(res, work):
         path = fva.plot_profile_comparison(curves, work / f"fig_validation_{name}.png", p0=pb.p0, a=pb.a,
                                            reference=("FEM reference", f.r, f.p),
                                            title=f"{label} layer: BEM against the FEM reference")
-        items.append(Figure(path, f"{label.capitalize()} layer: BEM ({_method(b)}, a_H/c = {pb.nodes_per_radius}) against the FEM "
-                                  f"reference carrying the same law as a penalty ({n_fem} elements across the "
-                                  "contact); error relative to p0 at the BEM nodes (FEM interpolated linearly)."))
+        items.append(Figure(path, f"{label.capitalize()} layer: BEM ({_method(b)}, a_H/c = "
+                                  f"{pb.nodes_per_radius}) against the FEM reference carrying the same law as a "
+                                  f"penalty ({n_fem} elements across the contact); error relative to p0 at the BEM "
+                                  "nodes (FEM interpolated linearly)."))
     for label, (b, f) in res.fem.items():
-        rows.append((label, b.p_max / pb.p0, f.p_max / pb.p0, f"{(b.p_max - f.p_max) / f.p_max:+.2%}", b.contact_radius / pb.a,
+        rows.append((label, b.p_max / pb.p0, f.p_max / pb.p0, f"{(b.p_max - f.p_max) / f.p_max:+.2%}",
+                     b.contact_radius / pb.a,
                      f.contact_radius / pb.a, b.approach / pb.hertz.delta, f.approach / pb.hertz.delta,
                      b.wall_time_s, f.wall_time_s, "converged" if (b.converged and f.converged) else "failed"))
     table = Table(("case", "BEM p_max / p0", "FEM p_max / p0", "rel. difference", "BEM r_c / a_H", "FEM r_c / a_H",

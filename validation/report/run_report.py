@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .build import build_report
-from .sections import Figure, Section, Table, fmt, problem_section, quantity_rows, results_table
+from .sections import Figure, Section, Table, fmt, problem_section, quantity_rows, results_table, table_from_rows
 from .style import axis_labels
 
 __all__ = ["run_sections", "report_results_dir", "unit_map"]
@@ -146,13 +146,10 @@ def _study(title, study, work, k):
                                    error_label=str(study.get("error_label", "error")), title=title)
         items.append(Figure(path, f"Work-precision of the study '{title}': error against wall time, one line per "
                                   "solver/method, one marker per resolution."))
-    columns = list(dict.fromkeys(key for row in rows for key in row if not isinstance(row[key], (Mapping, list))))
-    columns = columns[:12]
-    status = "status" if "status" in columns else None
-    table = Table(tuple(columns), tuple(tuple(row.get(c, "-") for c in columns) for row in rows),
-                  caption=f"Study '{title}'.", status_column=status)
+    table = table_from_rows(rows, caption=f"Study '{title}'.")
     items.append(table)
-    return Section(f"Study: {title}", kind="stability" if status else "validation", items=tuple(items))
+    kind = "stability" if table.status_column else "validation"
+    return Section(f"Study: {title}", kind=kind, items=tuple(items))
 
 
 def run_sections(res, work):

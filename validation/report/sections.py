@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from bem._validate import InputError
 
 __all__ = ["Figure", "Table", "Section", "KINDS", "status_class", "fmt", "problem_section", "results_table",
-           "quantity_rows"]
+           "quantity_rows", "table_from_rows"]
 
 #: kinds of section; ``"fem"`` marks anything that needs an FEM result
 KINDS = ("problem", "results", "iterations", "sweeps", "validation", "fem", "stability", "notes")
@@ -158,6 +158,29 @@ def quantity_rows(values, units):
     ``units`` maps a scalar name to its unit string; names missing there get ``"-"``.
     """
     return [(name, fmt(v) if not isinstance(v, str) else v, units.get(name, "-")) for name, v in values.items()]
+
+
+def table_from_rows(rows, *, columns=None, caption="", status="status", max_columns=12):
+    """A :class:`Table` from row dicts (e.g. a stability study), coloured by ``status``.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        One dict per row; missing cells show "-", nested values are left out.
+    columns : sequence of str, optional
+        Keys to show, in order; default: every scalar key in order of appearance (at most
+        ``max_columns``).
+    caption : str
+        Table caption.
+    status : str
+        Key whose value colours the row (:func:`status_class`), used when present.
+    """
+    if columns is None:
+        keys = (k for row in rows for k, v in row.items() if not isinstance(v, (Mapping, list, tuple)))
+        columns = list(dict.fromkeys(keys))[:max_columns]
+    columns = tuple(columns)
+    return Table(columns, tuple(tuple(row.get(c, "-") for c in columns) for row in rows), caption=caption,
+                 status_column=status if status in columns else None)
 
 
 def results_table(rows, *, caption="Key results."):

@@ -15,7 +15,8 @@ import contextlib
 import os
 import tempfile
 
-__all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS", "color_for", "new_figure",
+__all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS", "color_for",
+           "new_figure",
            "save_figure", "atomic_path", "METHOD_LABELS", "method_label"]
 
 DPI = 120  #: resolution of every PNG [dots per inch]
