@@ -2,7 +2,6 @@
 the helpers behind the figures are checked against hand-computed values; inputs stay untouched;
 files are written atomically."""
 
-import logging
 import math
 import os
 
@@ -32,7 +31,6 @@ def _solve(layer=None, **kw):
 
 @pytest.fixture(scope="module")
 def cases():
-    logging.getLogger("bem").setLevel(logging.ERROR)
     smooth = _solve()
     lin = _solve(bem.layers.Linear(LAM))
     er = bem.layers.ElasticRigid(LAM, 0.5 * lin.p_max)

@@ -20,7 +20,6 @@ from .test_report_figures import check_png
 
 @pytest.fixture(scope="module")
 def paper():
-    logging.getLogger("bem").setLevel(logging.ERROR)
     return solve_paper_problem(quick=True)
 
 
@@ -117,3 +116,30 @@ def test_main_dispatches_paper(monkeypatch, tmp_path):
     assert command.main(Namespace(target="paper", out=str(tmp_path), quick=True)) == 0
     assert command.main(Namespace(target="paper", out=None)) == 0
     assert calls == [(str(tmp_path), True), (str(command.DEFAULT_PAPER_OUT), False)]
+
+
+def test_example_script_passes_its_options(monkeypatch, tmp_path):
+    import runpy
+    from pathlib import Path
+
+    calls = []
+
+    def fake(out, *, quick, fem):
+        calls.append((out, quick, fem))
+
+        class Built:
+            html = markdown = out_dir = Path(out)
+            figures = ()
+
+        return Built()
+
+    monkeypatch.setattr("validation.report.report_paper_problem", fake)
+    script = Path(__file__).parents[2] / "docs" / "examples" / "paper_report.py"
+    ns = runpy.run_path(str(script), run_name="example")
+    levels = {name: logging.getLogger(name).level for name in ("bem", "fem_reference")}
+    try:
+        assert ns["main"](["--out", str(tmp_path), "--quick", "--no-fem"]) == 0
+    finally:
+        for name, level in levels.items():
+            logging.getLogger(name).setLevel(level)
+    assert calls == [(str(tmp_path), True, False)]

@@ -45,7 +45,8 @@ def _clip(text, n=90):
 
 def _how(result, pb):
     n = round(pb.a / result.step)
-    return (f"{_method(result)}; lattice step c = {result.step:.4g} (a_H/c = {n}), "
+    name = _method(result)
+    return (f"{name[0].upper()}{name[1:]}; lattice step c = {result.step:.4g} (a_H/c = {n}), "
             f"{result.p.size} candidate nodes, {int(np.count_nonzero(result.p > 0))} in contact; "
             f"KKT tolerance {pb.rtol:.0e}")
 
@@ -137,13 +138,15 @@ def _iterations(res, work):
               for k in ks]
     f11 = f3d.plot_pressure_surfaces(panels, work / "fig11_root_iterations_3d.png", p0=pb.p0, a=pb.a,
                                      title="root law: iterates of the variable compliance method (paper Fig. 11)")
+    aug = it["elastic-rigid, augmented gap"]
     text = (
         "The paper's two iterative methods start from the smooth-body solution (k = 1) and approach the layered "
-        "solution step by step. With lam = 10 C_nn the layer is soft compared with the bodies, and the augmented "
-        "gap method as printed (no relaxation) does not converge for these laws (see the stability table); it "
-        f"converges with the relaxation omega = {AG_RELAXATION} (p_(k+1) = (1 - omega) p_k + omega "
-        "p_QP). The Newton method on the generalised functional (eq. 15, the toolkit's default) needs a few "
-        "steps from p = 0.",)
+        f"solution step by step. {_augmented_gap_summary(res)} With the relaxation omega = {AG_RELAXATION} "
+        "(p_(k+1) = (1 - omega) p_k + omega p_QP) it "
+        + ("converges" if aug.converged else "does not converge either")
+        + f" on the elastic-rigid law with alpha_a = {pb.alpha_a_iterations} ({aug.iterations} iterations). The "
+        "Newton method on the generalised functional (eq. 15, the toolkit's default) needs a few steps from "
+        "p = 0.",)
     return Section("Iterations of the methods (Fig. 6, 8, 10, 11)", kind="iterations", text=text, items=(
         Figure(f6, "Axial-section pressure of the iterates k of the variable compliance method (eq. 21-23) for "
                    f"the elastic-rigid law, alpha_a = {pb.alpha_a_iterations} (analogue of Fig. 6); the colour "
@@ -219,9 +222,22 @@ def _stability(res):
                   caption=f"Every method on the same problems (a_H/c = {res.problem.nodes_per_radius}, tolerance "
                           f"{res.problem.rtol:.0e}); green: converged, amber: stalled, red: diverged or failed.")
     return Section("Stability of the methods", kind="stability", items=(table,), text=(
-        "A method that does not reach its tolerance says so; its result is never used as an answer. The "
-        "augmented gap method as printed in the paper (omega = 1) stalls or diverges here because the layer "
-        "(lam = 10 C_nn) is much softer than the bodies on the scale of one node.",))
+        "A method that does not reach its tolerance says so; its result is never used as an answer. "
+        + _augmented_gap_summary(res),))
+
+
+def _augmented_gap_summary(res):
+    """What the stability table says about the augmented gap method as printed (omega = 1)."""
+    rows = [r for r in res.stability if r["method"].startswith("augmented gap, omega = 1 ")]
+    failed = [r["law"] for r in rows if r["status"] != "converged"]
+    if not rows:
+        return ""
+    if not failed:
+        return "The augmented gap method as printed in the paper (omega = 1) converges on every law tested."
+    return (f"The augmented gap method as printed in the paper (omega = 1) does not converge for {len(failed)} of "
+            f"{len(rows)} laws ({', '.join(failed)}; see the stability table): with lam = {res.problem.lam_factor:g} "
+            "C_nn the layer is much softer than the bodies on the scale of one node, and the fixed-point map "
+            "h_bar = h + w(p_k) is not a contraction.")
 
 
 def _validation(res, work):
