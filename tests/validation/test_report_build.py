@@ -1,0 +1,230 @@
+"""Report documents: strict-HTML5 validity, no network references, embedded figures, Markdown
+with relative figure files, written whole or not at all, only the sections the results support."""
+
+import base64
+import json
+import os
+import re
+from argparse import Namespace
+
+import numpy as np
+import pytest
+
+from bem._validate import InputError
+from validation.report import build as build_mod
+from validation.report import build_report, load_results, main, report_results_dir
+from validation.report.sections import Figure, Section, Table, fmt, problem_section, status_class
+
+html5lib = pytest.importorskip("html5lib")
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def _png(path, value=0):
+    """A small real PNG written with PIL (independent of the figure code)."""
+    from PIL import Image
+
+    img = np.full((20, 30, 3), 255, dtype=np.uint8)
+    img[5:15, 5 + value:25] = (31, 119, 180)
+    Image.fromarray(img).save(path)
+    return str(path)
+
+
+def assert_valid_offline_html(text):
+    """Parses in html5lib's strict mode; no http(s) in src/href; no <link>, <script>, @import, url()."""
+    html5lib.HTMLParser(strict=True).parse(text)
+    refs = re.findall(r'(?:src|href)\s*=\s*"([^"]*)"', text, flags=re.I)
+    assert refs, "no reference at all: the check would be empty"
+    assert not [r for r in refs if r.lower().startswith(("http:", "https:", "//", "ftp:"))]
+    assert not re.search(r"<link\b|<script\b|@import|url\(", text, flags=re.I)
+    assert "http://" not in text and "https://" not in text
+
+
+@pytest.fixture()
+def sections(tmp_path):
+    f1 = Figure(_png(tmp_path / "one.png"), "First figure. Computed by hand & <checked>.")
+    f2 = Figure(_png(tmp_path / "two.png", 3), "Second figure, a_H/c = 8.")
+    table = Table(("case", "p_max / p0", "status"), (("a | b", 0.123456, "converged"), ("c", 1e-9, "diverged"),
+                                                     ("d", 2, "stalled")), caption="Statuses.",
+                  status_column="status")
+    return [Section("Problem <statement>", kind="problem", text=("Para & graph.",), items=(f1,)),
+            Section("Results", items=(table, f2))]
+
+
+def test_html_is_valid_self_contained_and_embeds_every_figure(sections, tmp_path):
+    built = build_report(sections, tmp_path / "rep", title="T & <t>")
+    text = built.html.read_text(encoding="utf-8")
+    assert_valid_offline_html(text)
+    uris = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
+    assert len(uris) == 2
+    embedded = sorted(base64.b64decode(u) for u in uris)
+    on_disk = sorted(p.read_bytes() for p in built.figures)
+    assert embedded == on_disk and all(b.startswith(PNG_MAGIC) for b in embedded)
+    # escaping and status colours
+    assert "Problem &lt;statement&gt;" in text and "<statement>" not in text
+    assert re.search(r'<tr class="ok">.*converged', text) and re.search(r'<tr class="bad">.*diverged', text)
+    assert re.search(r'<tr class="warn">.*stalled', text)
+
+
+def test_markdown_links_relative_figures_that_exist(sections, tmp_path):
+    built = build_report(sections, tmp_path / "rep", title="T")
+    md = built.markdown.read_text(encoding="utf-8")
+    links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md)
+    assert links == ["figures/one.png", "figures/two.png"]
+    for link in links:
+        assert not os.path.isabs(link) and (built.out_dir / link).read_bytes().startswith(PNG_MAGIC)
+    assert "a \\| b" in md  # pipes in cells escaped
+    assert "| c | 1e-09 | diverged | FAIL |" in md and "| a \\| b | 0.1235 | converged | OK |" in md
+
+
+def test_build_replaces_previous_report_whole(sections, tmp_path):
+    out = tmp_path / "rep"
+    build_report(sections, out, title="first")
+    build_report(sections[:1], out, title="second")
+    assert sorted(os.listdir(out)) == ["figures", "report.html", "report.md"]
+    assert os.listdir(out / "figures") == ["one.png"]  # the old figure is gone
+    assert "second" in (out / "report.html").read_text()
+    assert sorted(os.listdir(tmp_path)) == ["one.png", "rep", "two.png"]  # no temporary directories
+
+
+def test_build_interrupted_leaves_previous_report(sections, tmp_path, monkeypatch):
+    out = tmp_path / "rep"
+    build_report(sections, out, title="first")
+    before = {p: (out / p).read_bytes() for p in ("report.html", "report.md")}
+
+    def boom(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(build_mod, "render_markdown", boom)
+    with pytest.raises(KeyboardInterrupt):
+        build_report(sections, out, title="second")
+    assert {p: (out / p).read_bytes() for p in before} == before
+    assert sorted(os.listdir(tmp_path)) == ["one.png", "rep", "two.png"]
+
+
+def test_build_refuses_directory_with_other_files(sections, tmp_path):
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "result.json").write_text("{}")
+    with pytest.raises(InputError, match="not a report"):
+        build_report(sections, out, title="T")
+    assert os.listdir(out) == ["result.json"]
+    with pytest.raises(InputError, match="at least one section"):
+        build_report([], tmp_path / "x", title="T")
+
+
+def test_section_validation(tmp_path):
+    with pytest.raises(InputError, match="existing PNG"):
+        Figure(str(tmp_path / "missing.png"), "c")
+    with pytest.raises(InputError, match="kind"):
+        Section("x", kind="bogus")
+    with pytest.raises(InputError, match="cells"):
+        Table(("a", "b"), (("1",),))
+    assert Figure(_png(tmp_path / "f.png"), "See Fig. 5 of the paper. Then more.").alt_text == "See Fig. 5 of the paper"
+
+
+def test_status_and_format():
+    assert [status_class(s) for s in ("converged", "Converged (KKT 1e-9)", "stalled", "diverged: x",
+                                      "not converged", "pending")] == ["ok", "ok", "warn", "bad", "bad", "other"]
+    assert fmt(0.000123456) == "0.0001235" and fmt(2.5e-9) == "2.5e-09" and fmt(12.34567) == "12.35"
+    assert fmt(3) == "3" and fmt(True) == "yes" and fmt(None) == "-"
+
+
+def test_table_from_rows():
+    from validation.report.sections import table_from_rows
+
+    t = table_from_rows([{"case": "a", "status": "diverged", "extra": {"x": 1}}, {"case": "b", "n": 3}])
+    assert t.columns == ("case", "status", "n") and t.status_column == "status"
+    assert t.rows == (("a", "diverged", "-"), ("b", "-", "3")) and [t.status(r) for r in t.rows] == ["bad", "other"]
+    assert table_from_rows([{"a": 1}]).status_column is None
+
+
+def test_problem_section_lists_inputs(tmp_path):
+    import bem
+
+    sec = problem_section(gap=bem.gaps.Paraboloid(2.0), materials={"E1": 210e3, "nu1": 0.3},
+                          load={"force": 100.0}, units={"length": "mm", "pressure": "MPa", "force": "N"},
+                          layers=[("root", bem.layers.Root(0.5))])
+    rows = {r[0]: r[1:] for r in sec.items[0].rows}
+    assert rows["gap h(x, y)"] == ("paraboloid: R = 2", "mm")
+    assert rows["material E1"] == ("2.1e+05", "MPa") and rows["material nu1"] == ("0.3", "-")
+    assert rows["load: force"] == ("100", "N") and rows["layer: root"][0] == "root: lam = 0.5"
+
+
+# ---------------------------------------------------------------- results directories
+
+def _results_dir(tmp_path, *, fem):
+    d = tmp_path / "run"
+    d.mkdir()
+    data = {"p_max": 0.58, "force": 1.0, "approach": 0.83, "contact_area": 2.6, "contact_radius": 0.91,
+            "iterations": 7, "converged": True, "kkt_residual": 1e-11, "method": "newton",
+            "wall_time_s": {"bem": 0.2, "fem": 1.5 if fem else None},
+            "units": {"length": "mm", "pressure": "MPa", "force": "N"},
+            "scene": {"name": "hertz-demo", "gap": {"type": "paraboloid", "R": 1.0},
+                      "layer": {"law": "linear", "lam": 0.1}, "materials": {"E_star": 1.0}, "load": {"force": 1.0}},
+            "solver_build": "x"}
+    if fem:
+        data["fem"] = {"p_max": 0.578, "contact_radius": 0.905, "converged": True}
+        data["comparison"] = {"p_max": {"rel_diff": 0.003}, "profile_l2": 0.01}
+    (d / "result.json").write_text(json.dumps(data))
+    # nodal BEM field: a Hertz-like cap on a lattice
+    import bem
+
+    lat = bem.Lattice.from_extent(0.1, 1.5)
+    x, y = lat.x[lat.mask], lat.y[lat.mask]
+    p = 0.58 * np.sqrt(np.clip(1 - (x**2 + y**2) / 0.91**2, 0, None))
+    np.savez(d / "fields.npz", x=x, y=y, p=p)
+    (d / "convergence.json").write_text(json.dumps({"title": "resolution study", "rows": [
+        {"solver": "BEM", "method": "newton", "resolution": "a/c=10", "N": 800, "error": 1e-3, "wall_time_s": 0.1},
+        {"solver": "BEM", "method": "newton", "resolution": "a/c=20", "N": 3200, "error": 2e-4, "wall_time_s": 0.3}]}))
+    (d / "stability.json").write_text(json.dumps([{"case": "soft", "method": "augmented_gap", "status": "diverged"},
+                                                  {"case": "soft", "method": "newton", "status": "converged"}]))
+    return d
+
+
+def test_load_results_tolerant(tmp_path):
+    res = load_results(_results_dir(tmp_path, fem=False))
+    assert res.fem is None and res.bem["p_max"] == 0.58 and res.bem["wall_time_s"] == 0.2
+    assert res.other == {"solver_build": "x"} and res.bem_field is not None
+    assert [t for t, _ in res.studies] == ["resolution study", "stability"]
+    (tmp_path / "b").mkdir()
+    res = load_results(_results_dir(tmp_path / "b", fem=True))
+    assert res.fem == {"p_max": 0.578, "contact_radius": 0.905, "converged": True, "wall_time_s": 1.5}
+    assert res.comparison == {"p_max.rel_diff": 0.003, "profile_l2": 0.01}
+    with pytest.raises(InputError, match="result.json"):
+        load_results(tmp_path)
+
+
+def test_bem_only_run_has_no_fem_section(tmp_path):
+    built = report_results_dir(_results_dir(tmp_path, fem=False), tmp_path / "out")
+    text = built.html.read_text(encoding="utf-8")
+    assert_valid_offline_html(text)
+    assert "kind-fem" not in text and "FEM" not in text
+    assert "FEM" not in built.markdown.read_text(encoding="utf-8")
+    assert "kind-results" in text and "kind-problem" in text and "kind-stability" in text
+    assert len(built.figures) == 4  # layer law, profile, map, work-precision
+
+
+def test_run_with_fem_has_fem_section(tmp_path):
+    d = _results_dir(tmp_path, fem=True)
+    import meshio
+
+    # a synthetic (r, z) section with a von Mises field, as the FEM writes it
+    r, z = np.meshgrid(np.linspace(0, 3, 13), np.linspace(-3, 3, 25))
+    pts = np.column_stack([r.ravel(), z.ravel(), np.zeros(r.size)])
+    from scipy.spatial import Delaunay
+
+    tri = Delaunay(pts[:, :2]).simplices
+    vm = np.exp(-((pts[:, 0]) ** 2 + (np.abs(pts[:, 1]) - 0.5) ** 2))
+    meshio.write(d / "fem.vtu", meshio.Mesh(pts, [("triangle", tri)], point_data={"von_mises": vm}))
+    built = main(Namespace(target=str(d), out=str(tmp_path / "out"))) == 0
+    assert built
+    text = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+    assert_valid_offline_html(text)
+    assert 'class="kind-fem"' in text and "FEM reference" in text and "Comparison metrics" in text
+    assert (tmp_path / "out" / "figures" / "fem_von_mises.png").is_file()
+
+
+def test_main_rejects_unknown_target(tmp_path):
+    with pytest.raises(InputError, match="contactlab run"):
+        main(Namespace(target=str(tmp_path / "no-such-scene.toml"), out=None))

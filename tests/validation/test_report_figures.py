@@ -1,0 +1,275 @@
+"""Every figure type of validation.report renders a real, non-blank PNG of the expected size;
+the helpers behind the figures are checked against hand-computed values; inputs stay untouched;
+files are written atomically."""
+
+import math
+import os
+
+import numpy as np
+import pytest
+
+import bem
+from bem._validate import InputError
+from validation.analytic import hertz_sphere
+from validation.report import figures_3d as f3d
+from validation.report import figures_iterations as fit
+from validation.report import figures_profiles as fpr
+from validation.report import figures_sweeps as fsw
+from validation.report import figures_validation as fva
+from validation.report.style import DPI, atomic_path, save_figure
+
+HERTZ = hertz_sphere(R=1.0, E_star=1.0, force=1.0)
+A, P0 = HERTZ.a, HERTZ.p0
+STEP = A / 6
+LAM = 10 * STEP / math.pi * bem.template(0.0, 0.0)
+
+
+def _solve(layer=None, **kw):
+    return bem.solve(bem.gaps.Paraboloid(1.0), E_star=1.0, force=1.0, step=STEP, extent=2.0 * A, layer=layer,
+                     rtol=1e-8, **kw)
+
+
+@pytest.fixture(scope="module")
+def cases():
+    smooth = _solve()
+    lin = _solve(bem.layers.Linear(LAM))
+    er = bem.layers.ElasticRigid(LAM, 0.5 * lin.p_max)
+    return {"smooth": smooth, "linear": lin, "er_law": er, "er": _solve(er),
+            "er_vc": _solve(er, method="variable_compliance", record=True),
+            "er_newton": _solve(er, method="newton", record=True, nested=False)}
+
+
+def _image(path):
+    from PIL import Image
+
+    with Image.open(path) as img:
+        assert img.format == "PNG"
+        return np.asarray(img.convert("RGB"), dtype=float)
+
+
+def check_png(path, size_in=None, *, floor=8.0):
+    """A real PNG, of ``size_in`` inches at DPI when given, with visible content."""
+    assert os.path.isfile(path)
+    img = _image(path)
+    if size_in is not None:
+        assert img.shape[:2] == (round(size_in[1] * DPI), round(size_in[0] * DPI))
+    assert img.std() > floor, "blank image"
+    # not only background: a sizeable share of pixels is not white
+    assert np.mean(img.min(axis=2) < 200) > 0.01
+    return img
+
+
+# ---------------------------------------------------------------- helpers against hand values
+
+def test_axial_section_selects_y0_and_sorts():
+    x = np.array([0.3, -0.1, 0.2, 0.0, 0.5])
+    y = np.array([0.0, 0.0, 0.1, 0.0, -0.2])
+    v = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
+    xs, vs = fpr.axial_section(x, y, v)
+    np.testing.assert_array_equal(xs, [-0.1, 0.0, 0.3])
+    np.testing.assert_array_equal(vs, [2.0, 4.0, 1.0])
+    with pytest.raises(InputError, match="y = 0"):
+        fpr.axial_section(x, y + 1.0, v)
+
+
+def test_section_of_result_is_lattice_row_zero(cases):
+    r = cases["er"]
+    lat = r.lattice
+    row = lat.half_rows  # brick row of lattice row j = 0
+    x, p = fpr.section_of(r)
+    np.testing.assert_allclose(x, lat.x[row][lat.mask[row]])
+    np.testing.assert_allclose(p, r.grid()[row][lat.mask[row]])
+
+
+def test_section_of_fem_like_is_mirrored():
+    class Fem:
+        r = np.array([0.0, 1.0, 2.0])
+        p = np.array([3.0, 2.0, 0.0])
+
+    x, p = fpr.section_of(Fem())
+    np.testing.assert_array_equal(x, [-2.0, -1.0, 0.0, 1.0, 2.0])
+    np.testing.assert_array_equal(p, [0.0, 2.0, 3.0, 2.0, 0.0])
+
+
+def test_transition_radius_exact_on_piecewise_linear_profile():
+    x = np.linspace(-1.0, 1.0, 11)  # nodes every 0.2
+    p = 1.0 - np.abs(x)  # linear between nodes: the interpolated crossing is exact
+    assert fsw.transition_radius(x, p, 0.3) == pytest.approx(0.7)
+    assert fsw.transition_radius(x, p, 0.85) == pytest.approx(0.15)
+    assert fsw.transition_radius(x, p, 1.5) == 0.0  # no node reaches p_cr: no rigid region
+    assert fsw.edge_radius(x, np.where(np.abs(x) < 0.5, p, 0.0)) == pytest.approx(0.5)  # midway 0.4 | 0.6
+
+
+def test_pick_iterations():
+    np.testing.assert_array_equal(fit.pick_iterations(4), [1, 2, 3, 4])
+    ks = fit.pick_iterations(200, most=10)
+    assert ks[0] == 1 and ks[-1] == 200 and len(ks) <= 10 and np.all(np.diff(ks) > 0)
+
+
+def test_work_precision_rows_accepts_tuples_and_drops_unplottable():
+    rows = fva.work_precision_rows([("BEM", "qp", "a/c=5", 100, 1e-3, 0.1), {"solver": "FEM", "error": 0.0,
+                                                                              "wall_time_s": 1.0},
+                                    {"solver": "FEM", "error": float("nan"), "wall_time_s": 1.0}])
+    assert len(rows) == 1 and rows[0]["N"] == 100 and rows[0]["resolution"] == "a/c=5"
+    with pytest.raises(InputError, match="lacks"):
+        fva.work_precision_rows([{"solver": "BEM"}])
+
+
+# ---------------------------------------------------------------- every figure type
+
+def test_pressure_profiles_png(cases, tmp_path):
+    curves = [("smooth", cases["smooth"]), ("linear", cases["linear"]), ("elastic-rigid", cases["er"])]
+    path = fpr.plot_pressure_profiles(curves, tmp_path / "p.png", p0=P0, a=A, hertz=True)
+    img = check_png(path, (8.2, 4.0))
+    # the data matter: a different set of curves gives a different picture
+    other = fpr.plot_pressure_profiles(curves[:1], tmp_path / "q.png", p0=P0, a=A)
+    assert np.abs(_image(other) - img).mean() > 0.5
+
+
+def test_layer_laws_png(cases, tmp_path):
+    laws = [("smooth", None), ("linear", cases["linear"].layer), ("elastic-rigid", cases["er_law"]),
+            ("root", bem.layers.Root(LAM))]
+    check_png(fpr.plot_layer_laws(laws, tmp_path / "w.png", p_max=P0, marks=[("p_cr", cases["er_law"].p_cr)]),
+              (6.0, 3.8))
+
+
+def test_iteration_profiles_png(cases, tmp_path):
+    r = cases["er_vc"]
+    assert len(r.history["p"]) == r.iterations
+    check_png(fit.plot_iteration_profiles(r, tmp_path / "it.png", p0=P0, a=A), (6.8, 4.0))
+    with pytest.raises(InputError, match="record=True"):
+        fit.plot_iteration_profiles(cases["er"], tmp_path / "x.png", p0=P0, a=A)
+    with pytest.raises(InputError, match="iterations"):
+        fit.plot_iteration_profiles(r, tmp_path / "x.png", p0=P0, a=A, iterations=[0, 1])
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_convergence_png(cases, tmp_path):
+    runs = [("variable compliance", cases["er_vc"]), ("Newton", cases["er_newton"])]
+    check_png(fit.plot_convergence(runs, tmp_path / "c.png", p0=P0, tol=1e-8), (6.6, 5.2))
+
+
+def test_pressure_surfaces_3d_png(cases, tmp_path):
+    r = cases["er_vc"]
+    panels = [("smooth", cases["smooth"]), ("k = 1", (r.x, r.y, r.history["p"][0])), ("final", r)]
+    img = check_png(f3d.plot_pressure_surfaces(panels, tmp_path / "s.png", p0=P0, a=A, title="t"))
+    assert img.shape[1] > 2 * img.shape[0]  # three panels side by side
+
+
+def test_pressure_surface_without_axis_nodes(tmp_path):
+    x, y = np.meshgrid(np.linspace(-1, 1, 20), np.linspace(-1, 1, 20))  # even count: no node on y = 0
+    p = np.clip(1 - x**2 - y**2, 0, None)
+    check_png(f3d.plot_pressure_surfaces([("cap", (x.ravel(), y.ravel(), p.ravel()))], tmp_path / "s.png",
+                                         p0=1.0, a=1.0))
+
+
+def test_contact_map_png(cases, tmp_path):
+    er = cases["er"]
+    check_png(f3d.plot_contact_map(er, tmp_path / "m.png", p0=P0, a=A, levels=[("p_cr", cases["er_law"].p_cr)]),
+              (5.4, 4.4))
+
+
+def test_contact_patch_covers_contact(cases):
+    r = cases["er"]
+    xs, ys, ps, tri = f3d.contact_patch(r.x, r.y, r.p)
+    assert np.count_nonzero(ps > 0) == np.count_nonzero(r.p > 0)
+    # equilateral lattice: every Delaunay triangle has the area sqrt(3)/4 c^2
+    e1 = np.stack([xs[tri[:, 1]] - xs[tri[:, 0]], ys[tri[:, 1]] - ys[tri[:, 0]]], axis=1)
+    e2 = np.stack([xs[tri[:, 2]] - xs[tri[:, 0]], ys[tri[:, 2]] - ys[tri[:, 0]]], axis=1)
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    np.testing.assert_allclose(area, math.sqrt(3) / 4 * STEP**2, rtol=1e-9)
+
+
+def test_sweep_and_transition_line_png(cases, tmp_path):
+    curves = [(al, *fpr.section_of(r)) for al, r in ((0.0, cases["smooth"]), (0.5, cases["er"]),
+                                                      (1.0, cases["linear"]))]
+    check_png(fsw.plot_sweep(curves, tmp_path / "sw.png", p0=P0, a=A, name=r"$\alpha_a$"), (6.8, 4.0))
+    check_png(fsw.plot_transition_line([0.0, 0.5, 1.0], [1.0, 0.8, 0.0], tmp_path / "tl.png", a=1.0,
+                                       r_contact=[1.0, 1.1, 1.2]), (6.0, 4.0))
+
+
+def test_profile_comparison_png(cases, tmp_path):
+    s = cases["smooth"]
+    x, p = fpr.section_of(s)
+    curves = [("BEM", x, p, "bem"), ("shifted", x, 0.98 * p, "fem")]
+    check_png(fva.plot_profile_comparison(curves, tmp_path / "cmp.png", p0=P0, a=A,
+                                          reference=("Hertz", HERTZ.pressure)), (6.6, 5.4))
+    # reference given as samples (no callable)
+    check_png(fva.plot_profile_comparison(curves, tmp_path / "cmp2.png", p0=P0, a=A))
+
+
+def test_work_precision_png(tmp_path):
+    rows = [("BEM", "qp", f"a/c={m}", 100 * m, 0.3 / m**1.5, 0.01 * m) for m in (5, 10, 20)]
+    rows += [{"solver": "FEM", "method": "P2", "resolution": f"{n}/a", "N": 1000 * n, "error": 0.1 / n**2,
+              "wall_time_s": 0.1 * n} for n in (4, 8)]
+    check_png(fva.plot_work_precision(rows, tmp_path / "wp.png"), (6.6, 4.4))
+    with pytest.raises(InputError, match="nothing to draw"):
+        fva.plot_work_precision([("BEM", "qp", "x", 1, 0.0, 1.0)], tmp_path / "none.png")
+
+
+def test_von_mises_png(tmp_path):
+    from validation.report.figures_fem import plot_von_mises, von_mises_of
+
+    import fem_reference
+
+    e_body = 2.0 * (1.0 - 0.09)
+    fem = fem_reference.solve(bem.gaps.Paraboloid(1.0), E1=e_body, nu1=0.3, E2=e_body, nu2=0.3, force=1.0,
+                              n_contact=6)
+    r, z, tri, vm = von_mises_of(fem)
+    # Hertz (Johnson 1985, Fig. 4.4 / eq. 3.73-3.74, nu = 0.3): max von Mises ~0.62 p0 at z ~ 0.48 a on the axis
+    k = int(np.argmax(vm))
+    assert vm[k] / P0 == pytest.approx(0.62, abs=0.03)
+    assert abs(z[k]) / A == pytest.approx(0.48, abs=0.12) and r[k] / A < 0.25
+    check_png(plot_von_mises(fem, tmp_path / "vm.png", a=A, p0=P0), (5.8, 4.6))
+
+
+# ---------------------------------------------------------------- inputs untouched, atomic writes
+
+def test_figures_do_not_modify_inputs(cases, tmp_path):
+    x, p = fpr.section_of(cases["er"])
+    x0, p0 = x.copy(), p.copy()
+    r = cases["er_vc"]
+    hist = [h.copy() for h in r.history["p"]]
+    fsw.plot_sweep([(0.5, x, p)], tmp_path / "a.png", p0=P0, a=A, name="a")
+    fsw.transition_radius(x, p, 0.1)
+    fva.plot_profile_comparison([("c", x, p)], tmp_path / "b.png", p0=P0, a=A, reference=("h", HERTZ.pressure))
+    fit.plot_iteration_profiles(r, tmp_path / "c.png", p0=P0, a=A)
+    np.testing.assert_array_equal(x, x0)
+    np.testing.assert_array_equal(p, p0)
+    for h, h0 in zip(r.history["p"], hist):
+        np.testing.assert_array_equal(h, h0)
+
+
+def test_save_figure_is_atomic(tmp_path, monkeypatch):
+    from matplotlib.figure import Figure
+
+    target = tmp_path / "f.png"
+    target.write_bytes(b"old")
+    fig = Figure()
+    fig.subplots().plot([0, 1], [0, 1])
+
+    def boom(*args, **kwargs):
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(fig, "savefig", boom)
+    with pytest.raises(RuntimeError, match="disk full"):
+        save_figure(fig, target)
+    assert target.read_bytes() == b"old"
+    assert sorted(os.listdir(tmp_path)) == ["f.png"]  # no temporary left behind
+
+
+def test_atomic_path_leaves_nothing_on_error(tmp_path):
+    with pytest.raises(ValueError):
+        with atomic_path(tmp_path / "x.png") as tmp:
+            with open(tmp, "wb") as fh:
+                fh.write(b"partial")
+            raise ValueError("interrupted")
+    assert os.listdir(tmp_path) == []
+
+
+def test_bad_scales_raise(cases, tmp_path):
+    with pytest.raises(InputError, match="p0"):
+        fpr.plot_pressure_profiles([("s", cases["smooth"])], tmp_path / "z.png", p0=-1.0, a=A)
+    with pytest.raises(InputError, match="curves"):
+        fpr.plot_pressure_profiles([], tmp_path / "z.png", p0=P0, a=A)
+    assert not (tmp_path / "z.png").exists()

@@ -1,0 +1,145 @@
+"""The paper report (quick version): every figure, valid offline HTML, and the trends the paper
+describes (section 6) checked on the solved cases."""
+
+import logging
+import math
+import re
+from argparse import Namespace
+
+import numpy as np
+import pytest
+
+from validation.report import command
+from validation.report.build import build_report
+from validation.report.paper import solve_paper_problem
+from validation.report.paper_report import TITLE, paper_sections
+
+from .test_report_build import PNG_MAGIC, assert_valid_offline_html
+from .test_report_figures import check_png
+
+
+@pytest.fixture(scope="module")
+def paper():
+    return solve_paper_problem(quick=True)
+
+
+@pytest.fixture(scope="module")
+def report(paper, tmp_path_factory):
+    work = tmp_path_factory.mktemp("work")
+    out = tmp_path_factory.mktemp("out") / "paper"
+    return build_report(paper_sections(paper, work), out, title=TITLE)
+
+
+def test_paper_report_files(report):
+    text = report.html.read_text(encoding="utf-8")
+    assert_valid_offline_html(text)
+    assert len(report.figures) == 18
+    assert len(re.findall(r'src="data:image/png;base64,', text)) == 18
+    for path in report.figures:
+        assert path.read_bytes().startswith(PNG_MAGIC)
+        check_png(path)
+    total = sum(p.stat().st_size for p in report.out_dir.rglob("*") if p.is_file())
+    assert total < 6e6, f"report is {total / 1e6:.1f} MB"
+    for kind in ("problem", "results", "iterations", "sweeps", "stability", "fem"):
+        assert f'class="kind-{kind}"' in text
+    md = report.markdown.read_text(encoding="utf-8")
+    for link in re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md):
+        assert (report.out_dir / link).is_file()
+
+
+def test_paper_report_without_fem_has_no_fem_section(paper, tmp_path):
+    import dataclasses
+
+    bem_only = dataclasses.replace(paper, fem={}, work_precision=[])
+    built = build_report(paper_sections(bem_only, tmp_path / "w"), tmp_path / "out", title=TITLE)
+    text = built.html.read_text(encoding="utf-8")
+    assert "kind-fem" not in text and "FEM reference" not in text
+    assert len(built.figures) == 12
+
+
+def test_paper_trends(paper):
+    """Section 6 of the paper: alpha_a moves the distribution from smooth to linear, region I
+    shrinks as alpha_a grows, the root law lowers the peak as it softens, alpha_c -> 0 is the
+    elastic-rigid law and alpha_c growing lowers the peak."""
+    from validation.report import figures_profiles as fpr
+    from validation.report import figures_sweeps as fsw
+
+    p_lin, p0 = paper.p_lin, paper.problem.p0
+    alphas = [al for al, _ in paper.sweep_a]
+    assert alphas[0] == 0.0 and alphas[-1] == 1.0
+    peaks = [r.p_max for _, r in paper.sweep_a]
+    assert np.all(np.diff(peaks) < 0) and peaks[0] == pytest.approx(paper.base["smooth"].p_max)
+    r_tr = [fsw.transition_radius(*fpr.section_of(r), al * p_lin) for al, r in paper.sweep_a[1:]]
+    assert np.all(np.diff(r_tr) < 0) and r_tr[-1] < 0.2 * paper.problem.a
+    radii = [r.contact_radius for _, r in paper.sweep_a]
+    assert np.all(np.diff(radii) >= 0)
+    ab = [ab for _, ab, _ in paper.sweep_b]
+    assert np.all(np.diff(ab) < 0)  # softer root layer (larger lam_b): lower peak
+    # alpha_c = 0: the bilinear law with lam2 = 0 is the elastic-rigid law (two independent classes)
+    t0, r0 = paper.sweep_c[0]
+    assert t0 == 0.0
+    np.testing.assert_allclose(r0.p, paper.sweep_a[alphas.index(0.5)][1].p, atol=1e-6 * p0)
+    pc = [r.p_max for _, r in paper.sweep_c]
+    assert np.all(np.diff(pc) < 0)
+    # alpha_c = pi/4: lam2 = lam1, the linear layer
+    r45 = dict(paper.sweep_c)[math.pi / 4]
+    np.testing.assert_allclose(r45.p, paper.base["linear Winkler"].p, atol=1e-6 * p0)
+
+
+def test_paper_methods_and_validation(paper):
+    newton = [r for r in paper.stability if r["method"] == "Newton"]
+    assert newton and all(r["status"] == "converged" for r in newton)
+    conv = [r for r in paper.stability if r["status"] == "converged"]
+    for row in conv:  # every converged method agrees with Newton on the same law
+        ref = next(r for r in newton if r["law"] == row["law"])
+        assert row["p_max/p0"] == pytest.approx(ref["p_max/p0"], rel=1e-4)
+    for label, (b, f) in paper.fem.items():
+        assert f.converged and b.p_max == pytest.approx(f.p_max, rel=0.01), label
+    bem_err = [r["error"] for r in paper.work_precision if r["solver"] == "BEM"]
+    fem_err = [r["error"] for r in paper.work_precision if r["solver"] == "FEM"]
+    assert bem_err[-1] < bem_err[0] and fem_err[-1] < fem_err[0]
+
+
+def test_main_dispatches_paper(monkeypatch, tmp_path):
+    calls = []
+
+    def fake(out, *, quick):
+        calls.append((str(out), quick))
+
+        class Built:
+            html = markdown = out
+            figures = ()
+
+        return Built()
+
+    monkeypatch.setattr("validation.report.paper_report.report_paper_problem", fake)
+    assert command.main(Namespace(target="paper", out=str(tmp_path), quick=True)) == 0
+    assert command.main(Namespace(target="paper", out=None)) == 0
+    assert calls == [(str(tmp_path), True), (str(command.DEFAULT_PAPER_OUT), False)]
+
+
+def test_example_script_passes_its_options(monkeypatch, tmp_path):
+    import runpy
+    from pathlib import Path
+
+    calls = []
+
+    def fake(out, *, quick, fem):
+        calls.append((out, quick, fem))
+
+        class Built:
+            html = markdown = out_dir = Path(out)
+            figures = ()
+
+        return Built()
+
+    monkeypatch.setattr("validation.report.report_paper_problem", fake)
+    script = Path(__file__).parents[2] / "docs" / "examples" / "paper_report.py"
+    ns = runpy.run_path(str(script), run_name="example")
+    levels = {name: logging.getLogger(name).level for name in ("bem", "fem_reference")}
+    try:
+        assert ns["main"](["--out", str(tmp_path), "--quick", "--no-fem"]) == 0
+    finally:
+        for name, level in levels.items():
+            logging.getLogger(name).setLevel(level)
+    assert calls == [(str(tmp_path), True, False)]

@@ -1,0 +1,151 @@
+"""How the iterations of a method approach the solution (the paper's Fig. 6, 8 and 10).
+
+The curves come from ``result.history``: ``"p"`` (every iterate as nodal values on
+``result.x, result.y``, kept by ``bem.solve(..., record=True)``), ``"p_max"`` and
+``"residual"`` (the KKT residual of each iterate, :func:`bem.kkt.kkt_residual`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bem._validate import InputError, check_positive
+
+from .figures_profiles import auto_xlim, axial_section
+from .style import color_for, method_label, new_figure, save_figure
+
+__all__ = ["pick_iterations", "plot_iteration_profiles", "plot_convergence"]
+
+
+def pick_iterations(n, most=10):
+    """At most ``most`` iteration numbers out of ``1..n``: all when few, else log-spaced.
+
+    Always holds 1 and ``n``. Returns a sorted int array.
+    """
+    if n < 1:
+        return np.zeros(0, dtype=int)
+    if n <= most:
+        return np.arange(1, n + 1)
+    ks = np.unique(np.round(np.geomspace(1, n, most)).astype(int))
+    return ks
+
+
+def plot_iteration_profiles(result, path, *, p0, a, iterations=None, title=None, xlim=None):
+    """Axial-section pressure of the iterates ``k = 1..K``, coloured by ``k`` (Fig. 6, 10).
+
+    Parameters
+    ----------
+    result : bem.ContactResult
+        Solved with ``record=True``: ``result.history["p"][k-1]`` is iterate ``k``.
+    path : path-like
+        PNG file to write.
+    p0, a : float
+        Hertz peak pressure [pressure] and contact radius [length] (the scales).
+    iterations : sequence of int, optional
+        Iterates to draw (1-based); default :func:`pick_iterations`.
+    title : str, optional
+        Axes title.
+    xlim : (float, float), optional
+        Range of ``x / a`` (default: the widest iterate with a margin).
+
+    Returns
+    -------
+    str
+        ``path``.
+    """
+    import matplotlib as mpl
+
+    p0, a = check_positive("p0", p0), check_positive("a", a)
+    iterates = result.history.get("p") if isinstance(result.history, dict) else None
+    if not iterates:
+        raise InputError("result.history['p'] is missing or empty: solve with bem.solve(..., record=True).")
+    n = len(iterates)
+    ks = pick_iterations(n) if iterations is None else np.asarray(sorted(set(iterations)), dtype=int)
+    if ks.size == 0 or ks.min() < 1 or ks.max() > n:
+        raise InputError(f"iterations = {list(ks)} is not allowed: they must lie in 1..{n}.")
+    cmap = mpl.colormaps["viridis"]
+    norm = mpl.colors.LogNorm(1, n) if n > 20 else mpl.colors.Normalize(1, max(n, 2))
+    sections = {k: axial_section(result.x, result.y, iterates[k - 1]) for k in ks}
+    with new_figure((6.8, 4.0)) as (fig, ax):
+        for k in ks:
+            x, p = sections[k]
+            ax.plot(x / a, p / p0, color=cmap(norm(k)), lw=1.3, marker=".", markersize=3)
+        x, p = axial_section(result.x, result.y, result.p)
+        state = "converged" if result.converged else "NOT converged"
+        ax.plot(x / a, p / p0, color="black", lw=1.0, ls="--", label=f"final ({state}, k = {result.iterations})")
+        sm = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
+        bar = fig.colorbar(sm, ax=ax, pad=0.01)
+        bar.set_label("iteration $k$")
+        ax.set_xlim(*(xlim or auto_xlim([*sections.values(), (x, p)], a)))
+        ax.set_ylim(bottom=0.0)
+        ax.set_xlabel(r"$x\,/\,a_H$  (axial section $y = 0$)")
+        ax.set_ylabel(r"contact pressure $p\,/\,p_0$")
+        ax.set_title(title or f"iterates of the {method_label(result.method)}")
+        ax.legend(loc="upper right", frameon=False)
+        return save_figure(fig, path)
+
+
+def _markevery(n):
+    """Markers on every iterate for short runs; on about 30 log-spaced iterates otherwise."""
+    if n <= 30:
+        return None
+    return sorted(set(np.round(np.geomspace(1, n, 30)).astype(int) - 1))
+
+
+def _history(run):
+    hist = run.history if hasattr(run, "history") else run
+    if not isinstance(hist, dict) or not hist.get("p_max"):
+        raise InputError("a run without history['p_max'] is not allowed: every run needs its iteration history.")
+    return hist
+
+
+def plot_convergence(runs, path, *, p0, title=None, tol=None):
+    """Maximum pressure and KKT residual against the iteration, one line per run (Fig. 8).
+
+    Parameters
+    ----------
+    runs : sequence of (str, bem.ContactResult or dict)
+        Label and a result (or its ``history`` dict with ``p_max`` and ``residual``).
+    path : path-like
+        PNG file to write.
+    p0 : float
+        Scale of the maximum pressure (Hertz peak) [pressure].
+    title : str, optional
+        Title of the upper panel.
+    tol : float, optional
+        Tolerance drawn as a line on the residual panel.
+
+    Returns
+    -------
+    str
+        ``path``.
+    """
+    p0 = check_positive("p0", p0)
+    if not runs:
+        raise InputError("runs = [] is not allowed: give at least one (label, result) pair.")
+    with new_figure((6.6, 5.2), nrows=2, sharex=True, gridspec_kw={"height_ratios": [3, 2]}) as (fig, (top, bot)):
+        for i, (label, run) in enumerate(runs):
+            hist = _history(run)
+            key = getattr(run, "method", None)
+            color = color_for(key, i)
+            pm = np.asarray(hist["p_max"], dtype=float)
+            k = np.arange(1, pm.size + 1)
+            if getattr(run, "converged", True) is False:
+                label = f"{label} - not converged"
+            marks = dict(marker="o", markersize=3, markevery=_markevery(pm.size))
+            top.plot(k, pm / p0, color=color, label=label, **marks)
+            res = np.asarray(hist.get("residual", []), dtype=float)
+            if res.size:
+                good = np.isfinite(res) & (res > 0)
+                bot.semilogy(np.arange(1, res.size + 1)[good], res[good], color=color, **marks)
+        if tol is not None:
+            bot.axhline(tol, color="#666666", ls=":", lw=1.0)
+            bot.annotate(f"tolerance {tol:.0e}", (0.0, tol), xycoords=("axes fraction", "data"),
+                         xytext=(4, -11), textcoords="offset points", ha="left", fontsize=8, color="#444444")
+        top.set_ylabel(r"max. pressure $p_{max}\,/\,p_0$")
+        top.set_title(title or "maximum contact pressure during the iterations")
+        top.legend(frameon=False, loc="best")
+        bot.set_xscale("log")
+        bot.set_xlabel("iteration $k$")
+        bot.set_ylabel("KKT residual")
+        return save_figure(fig, path)

@@ -1,0 +1,179 @@
+"""Parameter sweeps of the layer law (paper Fig. 5, 7, 9): families of axial-section curves
+and the line of transition between the elastic and rigid branches of the elastic-rigid law.
+
+For the elastic-rigid law ``w = lam min(p, p_cr)`` the contact splits into region I
+(``p >= p_cr``: the layer is on its rigid branch) around the centre and region II
+(``0 < p < p_cr``: elastic branch) around it; the transition radius is where the
+axial-section pressure crosses ``p_cr``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bem._validate import InputError, check_positive
+
+from .figures_profiles import auto_xlim
+from .style import new_figure, save_figure
+
+__all__ = ["transition_radius", "edge_radius", "plot_sweep", "plot_transition_line"]
+
+
+def _radial(x, p):
+    """Half-profile ``x >= 0`` sorted by radius."""
+    x, p = np.asarray(x, dtype=float), np.asarray(p, dtype=float)
+    keep = x >= 0
+    order = np.argsort(x[keep], kind="stable")
+    return x[keep][order], p[keep][order]
+
+
+def transition_radius(x, p, level):
+    """Outermost radius where the section pressure falls through ``level`` [length].
+
+    Scans the half-profile ``x >= 0`` outwards from the last node with ``p >= level``
+    and interpolates linearly to the crossing with the next node. Returns 0 when no
+    node reaches ``level`` (no rigid region, region I is empty).
+
+    Parameters
+    ----------
+    x, p : array_like
+        Axial section (any order; only ``x >= 0`` is used) [length], [pressure].
+    level : float
+        The pressure of the crossing (``p_cr``) [pressure], ``> 0``.
+    """
+    level = check_positive("level", level)
+    r, q = _radial(x, p)
+    above = np.nonzero(q >= level)[0]
+    if above.size == 0:
+        return 0.0
+    k = int(above[-1])
+    if k + 1 >= r.size:
+        return float(r[-1])
+    return float(r[k] + (r[k + 1] - r[k]) * (q[k] - level) / (q[k] - q[k + 1]))
+
+
+def edge_radius(x, p):
+    """Radius of the contact edge on the section: midway between the last loaded node
+    and the next one [length] (0 without contact)."""
+    r, q = _radial(x, p)
+    loaded = np.nonzero(q > 0)[0]
+    if loaded.size == 0:
+        return 0.0
+    k = int(loaded[-1])
+    return float(r[k] if k + 1 >= r.size else 0.5 * (r[k] + r[k + 1]))
+
+
+def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=None, extra=()):
+    """A family of axial-section curves coloured by the swept parameter (paper Fig. 5, 9).
+
+    Parameters
+    ----------
+    curves : sequence of (float, array_like, array_like)
+        ``(alpha, x, p)``: parameter value, section abscissae [length], pressures [pressure].
+    path : path-like
+        PNG file to write.
+    p0, a : float
+        Pressure and length scales (Hertz peak and radius).
+    name : str
+        Parameter name for the colour bar, mathtext allowed (e.g. ``r"$\\alpha_a$"``).
+    title : str, optional
+        Axes title.
+    cmap : str
+        Matplotlib colormap.
+    xlim : (float, float), optional
+        Range of ``x / a`` (default: the widest contact with a margin).
+    extra : sequence of (str, array_like, array_like, dict)
+        Reference curves ``(label, x, p, style)`` drawn on top (e.g. the limits).
+
+    Returns
+    -------
+    str
+        ``path``.
+    """
+    import matplotlib as mpl
+
+    p0, a = check_positive("p0", p0), check_positive("a", a)
+    if not curves:
+        raise InputError("curves = [] is not allowed: give at least one (alpha, x, p) triple.")
+    alphas = np.array([float(c[0]) for c in curves])
+    lo, hi = float(alphas.min()), float(alphas.max())
+    norm = mpl.colors.Normalize(lo, hi if hi > lo else lo + 1.0)
+    colors = mpl.colormaps[cmap]
+    with new_figure((6.8, 4.0)) as (fig, ax):
+        for alpha, x, p in curves:
+            x, p = np.asarray(x, dtype=float), np.asarray(p, dtype=float)
+            ax.plot(x / a, p / p0, color=colors(0.9 * norm(alpha)), lw=1.4)
+        for label, x, p, style in extra:
+            ax.plot(np.asarray(x) / a, np.asarray(p) / p0, label=label, **{"lw": 1.2, **style})
+        sm = mpl.cm.ScalarMappable(norm=mpl.colors.Normalize(lo, hi if hi > lo else lo + 1.0),
+                                   cmap=mpl.colors.ListedColormap(colors(np.linspace(0, 0.9, 256))))
+        bar = fig.colorbar(sm, ax=ax, pad=0.01)
+        bar.set_label(name)
+        if len(alphas) <= 12:
+            bar.set_ticks(alphas)
+            bar.set_ticklabels([f"{v:.3g}" for v in alphas])
+        sections = [(np.asarray(c[1], dtype=float), np.asarray(c[2], dtype=float)) for c in curves]
+        ax.set_xlim(*(xlim or auto_xlim(sections, a)))
+        ax.set_ylim(bottom=0.0)
+        ax.set_xlabel(r"$x\,/\,a_H$  (axial section $y = 0$)")
+        ax.set_ylabel(r"contact pressure $p\,/\,p_0$")
+        if title:
+            ax.set_title(title)
+        if extra:
+            ax.legend(loc="upper right", frameon=False)
+        return save_figure(fig, path)
+
+
+def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
+                         name=r"$\alpha_a = p_{cr}\,/\,p_{max}^{\lambda}$", title=None):
+    """Radius of the transition between the rigid and elastic branches against the
+    threshold parameter (paper Fig. 7), with regions I and II shaded.
+
+    Parameters
+    ----------
+    alpha : array_like
+        Values of the parameter (``alpha_a = p_cr / p_max^lambda``).
+    r_transition : array_like
+        Transition radii [length] (:func:`transition_radius`).
+    path : path-like
+        PNG file to write.
+    a : float
+        Length scale (Hertz radius) [length].
+    r_contact : array_like, optional
+        Contact radii [length]; region II lies between the two lines.
+    name : str
+        Label of the parameter axis (mathtext).
+    title : str, optional
+        Axes title.
+
+    Returns
+    -------
+    str
+        ``path``.
+    """
+    a = check_positive("a", a)
+    alpha = np.asarray(alpha, dtype=float)
+    rt = np.asarray(r_transition, dtype=float) / a
+    if alpha.shape != rt.shape or alpha.size < 2:
+        raise InputError(f"alpha, r_transition have shapes {alpha.shape}, {rt.shape} which is not allowed: "
+                         "they must be equal, with at least 2 values.")
+    order = np.argsort(alpha)
+    alpha, rt = alpha[order], rt[order]
+    with new_figure((6.0, 4.0)) as (fig, ax):
+        ax.fill_between(alpha, 0.0, rt, color="#d62728", alpha=0.18, lw=0, label="I: rigid branch, $p \\geq p_{cr}$")
+        ax.plot(alpha, rt, color="#d62728", marker="o", markersize=4, label="transition line $p = p_{cr}$")
+        if r_contact is not None:
+            rc = np.asarray(r_contact, dtype=float)[order] / a
+            ax.fill_between(alpha, rt, rc, color="#1f77b4", alpha=0.15, lw=0,
+                            label="II: elastic branch, $0 < p < p_{cr}$")
+            ax.plot(alpha, rc, color="#1f77b4", marker="s", markersize=3.5, label="contact edge")
+            ax.set_ylim(0.0, 1.08 * float(rc.max()))
+        else:
+            ax.set_ylim(bottom=0.0)
+        ax.set_xlim(float(alpha.min()), float(alpha.max()))
+        ax.set_xlabel(name)
+        ax.set_ylabel(r"radius $r\,/\,a_H$")
+        if title:
+            ax.set_title(title)
+        ax.legend(loc="lower left", frameon=True, framealpha=0.85)
+        return save_figure(fig, path)

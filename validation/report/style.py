@@ -1,0 +1,170 @@
+"""Shared look of the report figures and the atomic writing of image files.
+
+Every 2-D figure is a bare :class:`matplotlib.figure.Figure` drawn with the Agg
+canvas (no ``pyplot``, so no global state and no GUI backend is ever touched)
+and saved by :func:`save_figure`: rendered to a temporary file in the target
+directory, then ``os.replace``-d, so a reader never sees a half-written PNG.
+
+Colours are fixed per layer law, per method and per solver so that a law keeps
+its colour from one figure of a report to the next.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+
+__all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS", "color_for",
+           "new_figure",
+           "save_figure", "atomic_path", "METHOD_LABELS", "method_label"]
+
+DPI = 120  #: resolution of every PNG [dots per inch]
+
+#: colour of each layer law (``Layer.law``; ``"smooth"`` for no layer)
+LAW_COLORS = {
+    "smooth": "#222222",
+    "linear": "#1f77b4",
+    "elastic_rigid": "#d62728",
+    "root": "#2ca02c",
+    "bilinear": "#9467bd",
+    "power": "#ff7f0e",
+    "tabulated": "#8c564b",
+    "custom": "#7f7f7f",
+    "series": "#17becf",
+}
+
+#: colour of each BEM method
+METHOD_COLORS = {
+    "newton": "#1f77b4",
+    "augmented_gap": "#ff7f0e",
+    "variable_compliance": "#2ca02c",
+    "kalker": "#9467bd",
+}
+
+METHOD_LABELS = {
+    "newton": "Newton (eq. 15)",
+    "augmented_gap": "augmented gap (eq. 17-20)",
+    "variable_compliance": "variable compliance (eq. 21-23)",
+    "kalker": "Kalker QP (eq. 11)",
+}
+
+#: colour of each solver in comparisons
+SOLVER_COLORS = {"analytic": "#222222", "bem": "#1f77b4", "fem": "#ff7f0e"}
+
+_RC = {
+    "font.size": 9.5,
+    "axes.titlesize": 10.5,
+    "axes.labelsize": 10,
+    "legend.fontsize": 8.5,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "grid.linewidth": 0.6,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "lines.linewidth": 1.7,
+    "figure.dpi": DPI,
+    "savefig.dpi": DPI,
+    "mathtext.fontset": "dejavusans",
+}
+
+
+#: default axis labels of pressure plots: lengths over the Hertz radius, pressures over the Hertz peak
+NORMALISED_LABELS = {
+    "x": r"$x\,/\,a_H$",
+    "y": r"$y\,/\,a_H$",
+    "r": r"$r\,/\,a_H$",
+    "z": r"$z\,/\,a_H$",
+    "p": r"contact pressure $p\,/\,p_0$",
+}
+
+
+def axis_labels(labels=None, units=None):
+    """Axis labels: :data:`NORMALISED_LABELS` updated by ``labels``; with ``units``
+    (``{"length": "mm", "pressure": "MPa"}``) the physical labels ``x [mm]``, ``p [MPa]``
+    (use then ``p0 = a = 1`` so the data are drawn as they are)."""
+    out = dict(NORMALISED_LABELS)
+    if units is not None:
+        length, pressure = units.get("length", "length"), units.get("pressure", "pressure")
+        out.update({k: f"${k}$ [{length}]" for k in ("x", "y", "r", "z")})
+        out["p"] = f"contact pressure $p$ [{pressure}]"
+    out.update(labels or {})
+    return out
+
+
+def method_label(method):
+    """Readable name of a BEM method (the key itself when unknown)."""
+    return METHOD_LABELS.get(method, str(method))
+
+
+def color_for(key, index=0):
+    """Colour of a law, method or solver key; the ``index``-th colour of ``tab10`` otherwise."""
+    for table in (LAW_COLORS, METHOD_COLORS, SOLVER_COLORS):
+        if key in table:
+            return table[key]
+    palette = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+               "#7f7f7f", "#bcbd22", "#17becf")
+    return palette[index % len(palette)]
+
+
+@contextlib.contextmanager
+def new_figure(figsize=(6.4, 4.0), **subplots):
+    """A fresh Agg figure with the report style; yields ``(fig, axes)``.
+
+    ``subplots`` are passed to :meth:`matplotlib.figure.Figure.subplots`
+    (``nrows``, ``ncols``, ``sharex``, ``gridspec_kw``, ...).
+    """
+    import matplotlib
+
+    with matplotlib.rc_context(_RC):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=figsize, layout="constrained")
+        FigureCanvasAgg(fig)
+        axes = fig.subplots(**subplots)
+        yield fig, axes
+
+
+@contextlib.contextmanager
+def atomic_path(path, suffix=".png"):
+    """Yield a temporary path beside ``path``; on success ``os.replace`` it onto ``path``.
+
+    On any error the temporary file is removed and ``path`` is left as it was.
+    """
+    path = os.fspath(path)
+    directory = os.path.dirname(os.path.abspath(path))
+    os.makedirs(directory, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=suffix, dir=directory)
+    os.close(fd)
+    try:
+        yield tmp
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+def save_figure(fig, path, *, colors=256):
+    """Write ``fig`` as a PNG to ``path`` atomically; returns ``path`` (a string).
+
+    The RGBA rendering is reduced to an adaptive palette of ``colors`` colours (lossless
+    for line plots, invisible banding for colour maps), which makes the files about three
+    times smaller; ``colors=None`` keeps full RGB.
+    """
+    import io
+
+    from PIL import Image
+
+    path = os.fspath(path)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI, facecolor="white")
+    buf.seek(0)
+    with Image.open(buf) as img:
+        rgb = img.convert("RGB")
+    out = rgb if colors is None else rgb.quantize(colors, method=Image.Quantize.MEDIANCUT)
+    with atomic_path(path) as tmp:
+        out.save(tmp, format="PNG", optimize=True)
+    return path
