@@ -21,8 +21,10 @@ def main(args):
     Parameters
     ----------
     args : argparse.Namespace
-        ``target``: ``"paper"`` (solve the paper's test problem and report it) or a
-        results directory holding ``result.json`` (see :mod:`validation.report.results`);
+        ``target``: ``"paper"`` (solve the paper's test problem and report it), a
+        built-in scene name or a scene TOML file (run it into ``OUT/result``, report into
+        ``OUT/report``, ``OUT`` defaulting to ``results/NAME``), or a results directory
+        holding ``result.json`` (see :mod:`validation.report.results`);
         ``out`` (optional): the report directory (default ``reports/paper`` for ``paper``,
         ``TARGET/report`` for a results directory); ``quick`` (optional, bool): coarse
         preview of the paper report.
@@ -44,11 +46,33 @@ def main(args):
         from .run_report import report_results_dir
 
         built = report_results_dir(target, out)
+    elif _is_scene(target):
+        built = _report_scene(target, out)
     else:
         raise InputError(
-            f"target = {target!r} is not allowed: it must be 'paper' or a results directory holding result.json. "
-            f"To report a scene, run it first: contactlab run {target or 'SCENE'} --out DIR, "
-            "then contactlab report DIR."
+            f"target = {target!r} is not allowed: it must be 'paper', a built-in scene name, a scene "
+            "TOML file or a results directory holding result.json (see `contactlab scenes`)."
         )
     log.info("report written: %s and %s (%d figures)", built.html, built.markdown, len(built.figures))
     return 0
+
+
+def _is_scene(target):
+    from validation.scene import builtin_scenes
+
+    return target in builtin_scenes() or (target.endswith(".toml") and Path(target).is_file())
+
+
+def _report_scene(target, out):
+    """Run the scene into ``OUT/result`` and report it into ``OUT/report``.
+
+    ``OUT`` defaults to ``results/NAME``. The run writes its result directory
+    atomically, the report is built from it as for any results directory.
+    """
+    from validation.runner import run_scene
+
+    from .run_report import report_results_dir
+
+    base = Path(out) if out is not None else Path("results") / Path(target).stem
+    run_scene(target, base / "result")
+    return report_results_dir(base / "result", base / "report")
