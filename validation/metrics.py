@@ -156,7 +156,7 @@ class _Source:
     contact_radius: float
     approach: float
     force: float
-    axisymmetric: bool  # may stand for an axisymmetric field (a BEM field is sampled at (r, 0))
+    axisymmetric: bool  # may be compared with the axisymmetric FEM (a BEM field is sampled at (r, 0))
 
 
 def _check_bem(result):
