@@ -1,0 +1,286 @@
+"""Comparison metrics: BEM nodal pressures against the FEM profile ``p(r)`` and closed forms.
+
+Three kinds of pressure source are compared:
+
+- a BEM result (:class:`bem.ContactResult`): nodal pressures on the triangular lattice, all
+  nodes carrying the same quadrature weight ``sqrt(3)/2 c^2`` (eq. 9);
+- an FEM reference result (:class:`fem_reference.FemResult`): the axisymmetric profile
+  ``p(r)`` at the interface nodes, linear between them;
+- a closed form of :mod:`validation.analytic` (:class:`~validation.analytic.HertzSphere`,
+  :class:`~validation.analytic.RigidLayerParaboloid`, the non-axisymmetric
+  :class:`~validation.analytic.HertzElliptic`).
+
+Relative L2 error of a candidate ``a`` against a reference ``b`` at the candidate's nodes
+``n`` with quadrature weights ``A_n``::
+
+    l2_rel = sqrt(sum A_n (p_a,n - p_b(x_n))^2 / sum A_n p_b(x_n)^2)
+
+The sums run over the union of the two contact zones (``p_a > 0`` or ``p_b > 0``); outside
+it both pressures vanish, so the union changes nothing but the point count. For the BEM
+the weights are equal and the formula is ``||p_a - p_b||_2 / ||p_b||_2`` over the nodes;
+for the FEM they are the ring areas of :func:`ring_weights`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from bem._validate import InputError, check_finite_array, check_positive
+from bem.result import ContactResult
+from fem_reference.result import FemResult
+
+from .analytic import HertzElliptic, HertzSphere, RigidLayerParaboloid
+
+__all__ = ["RadialProfile", "radial_profile", "ring_weights", "relative_l2", "pair_metrics", "compare",
+           "PAIR_KEYS"]
+
+#: keys of one pair of :func:`pair_metrics` / :func:`compare`
+PAIR_KEYS = ("l2_rel", "max_rel", "peak_rel", "contact_radius_rel", "approach_rel", "force_rel", "n_points")
+
+
+@dataclass(frozen=True)
+class RadialProfile:
+    """Radial pressure profile of a BEM result.
+
+    Attributes
+    ----------
+    r, p : ndarray
+        All candidate nodes sorted by radius ``r = hypot(x, y)`` [length] and their
+        pressures [pressure].
+    r_bin, p_bin : ndarray
+        Binned profile: mean radius and mean pressure of the nodes in each non-empty bin of
+        width ``bin_width`` [length], [pressure].
+    count : ndarray of int
+        Nodes per bin.
+    bin_width : float
+        Width of the radial bins [length].
+    x_section, p_section : ndarray
+        The axial section ``y = 0`` (lattice row ``j = 0``), sorted by ``x`` [length],
+        [pressure].
+    """
+
+    r: np.ndarray
+    p: np.ndarray
+    r_bin: np.ndarray
+    p_bin: np.ndarray
+    count: np.ndarray
+    bin_width: float
+    x_section: np.ndarray
+    p_section: np.ndarray
+
+    def to_dict(self):
+        """JSON-ready dict (lists of floats)."""
+        return {
+            "r": self.r.tolist(), "p": self.p.tolist(), "r_bin": self.r_bin.tolist(),
+            "p_bin": self.p_bin.tolist(), "count": self.count.tolist(), "bin_width": float(self.bin_width),
+            "x_section": self.x_section.tolist(), "p_section": self.p_section.tolist(),
+        }
+
+
+def radial_profile(result, *, n=None):
+    """Radial profile of a BEM result: sorted nodes, binned averages and the axial section.
+
+    Parameters
+    ----------
+    result : bem.ContactResult
+        The BEM solution (any gap; the profile is meaningful for axisymmetric scenes).
+    n : int, optional
+        Number of radial bins over ``[0, r_max]`` (``r_max`` the largest node radius);
+        default: bins one lattice step ``c`` wide.
+
+    Returns
+    -------
+    RadialProfile
+    """
+    _check_bem(result)
+    r = np.hypot(result.x, result.y)
+    r_max = float(r.max())
+    if n is None:
+        n = max(1, math.ceil(r_max / result.step))
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise InputError(f"n = {n!r} is not allowed: it must be an integer >= 1.")
+    width = r_max / n if r_max > 0 else 1.0
+    order = np.argsort(r, kind="stable")
+    k = np.minimum((r / width).astype(int), n - 1)
+    count = np.bincount(k, minlength=n)
+    sum_r = np.bincount(k, weights=r, minlength=n)
+    sum_p = np.bincount(k, weights=result.p, minlength=n)
+    full = count > 0
+    on_axis = np.abs(result.y) <= 1e-9 * result.step
+    xs = result.x[on_axis]
+    sec = np.argsort(xs, kind="stable")
+    return RadialProfile(r=r[order], p=result.p[order].copy(), r_bin=sum_r[full] / count[full],
+                         p_bin=sum_p[full] / count[full], count=count[full], bin_width=float(width),
+                         x_section=xs[sec], p_section=result.p[on_axis][sec])
+
+
+def ring_weights(r):
+    """Ring areas ``A_i = 2 pi integral phi_i(r) r dr`` of the linear hats on the nodes ``r`` [length^2].
+
+    ``r`` increasing, ``r >= 0``. The weights integrate any function linear between
+    the nodes exactly: ``sum A_i f(r_i) = 2 pi integral_{r_0}^{r_last} f r dr``.
+    """
+    r = check_finite_array("r", r, ndim=1, min_size=2)
+    dr = np.diff(r)
+    if np.any(dr <= 0) or r[0] < 0:
+        raise InputError("r is not allowed: it must be increasing and >= 0.")
+    to_right = dr * (r[:-1] + 2.0 * r[1:]) / 6.0  # integral of the right node's hat on [r_i, r_i+1]
+    to_left = dr * (2.0 * r[:-1] + r[1:]) / 6.0  # ... and of the left node's
+    w = np.zeros_like(r)
+    w[1:] += to_right
+    w[:-1] += to_left
+    return 2.0 * math.pi * w
+
+
+def relative_l2(p, p_ref, weights=None):
+    """``sqrt(sum w (p - p_ref)^2 / sum w p_ref^2)`` (equal weights by default).
+
+    Returns ``None`` when the reference is identically 0 (the ratio is undefined).
+    """
+    p = np.asarray(p, dtype=float)
+    p_ref = np.asarray(p_ref, dtype=float)
+    w = np.ones_like(p) if weights is None else np.asarray(weights, dtype=float)
+    den = float(np.sum(w * p_ref**2))
+    return math.sqrt(float(np.sum(w * (p - p_ref) ** 2)) / den) if den > 0 else None
+
+
+@dataclass(frozen=True)
+class _Source:
+    """A pressure source reduced to what the metrics need."""
+
+    pressure: object  # (x, y) -> p
+    p_max: float
+    contact_radius: float
+    approach: float
+    force: float
+    axisymmetric: bool  # may be compared with the axisymmetric FEM (a BEM field is sampled at (r, 0))
+
+
+def _check_bem(result):
+    if not isinstance(result, ContactResult):
+        raise InputError(f"result = {type(result).__name__} is not allowed: it must be a bem.ContactResult.")
+
+
+def _source(name, obj):
+    """Wrap a BEM result, an FEM result or a closed form."""
+    if isinstance(obj, ContactResult):
+        return _Source(obj.pressure_at, obj.p_max, obj.contact_radius, obj.approach, obj.force, True)
+    if isinstance(obj, FemResult):
+        r, p = obj.r, obj.p
+
+        def fem_pressure(x, y):
+            return np.interp(np.hypot(x, y), r, p, right=0.0)
+
+        return _Source(fem_pressure, obj.p_max, obj.contact_radius, obj.approach, obj.force, True)
+    if isinstance(obj, (HertzSphere, RigidLayerParaboloid)):
+        radius = obj.a if isinstance(obj, HertzSphere) else obj.contact_radius
+        p_max = obj.p0 if isinstance(obj, HertzSphere) else obj.p_max
+        return _Source(lambda x, y: obj.pressure(np.hypot(x, y)), p_max, radius, obj.delta, obj.force, True)
+    if isinstance(obj, HertzElliptic):
+        return _Source(obj.pressure, obj.p0, math.sqrt(obj.a * obj.b), obj.delta, obj.force, obj.a == obj.b)
+    raise InputError(
+        f"{name} = {type(obj).__name__} is not allowed: it must be a bem.ContactResult, a "
+        "fem_reference.FemResult or a validation.analytic HertzSphere / RigidLayerParaboloid / HertzElliptic."
+    )
+
+
+def _nodes(obj):
+    """Evaluation points ``(x, y, p, weights)`` of a BEM or FEM result."""
+    if isinstance(obj, ContactResult):
+        return obj.x, obj.y, obj.p, None
+    return obj.r, np.zeros_like(obj.r), obj.p, ring_weights(obj.r)
+
+
+def _rel(a, b):
+    """Signed ``(a - b) / b``; ``None`` where undefined."""
+    return float((a - b) / b) if b != 0 and math.isfinite(a) and math.isfinite(b) else None
+
+
+def pair_metrics(candidate, reference):
+    """Metrics of ``candidate`` (BEM or FEM result) against ``reference`` (any source).
+
+    Pressures are compared at the candidate's nodes, the reference evaluated there (an FEM
+    profile interpolated linearly in ``r``; a BEM field by its piecewise-linear pyramids).
+
+    Returns
+    -------
+    dict
+        ``l2_rel`` (module docstring; at the BEM nodes equal weights, at the FEM nodes ring
+        areas), ``max_rel`` = ``max |p_a - p_b| / max p_b``, and the signed relative
+        differences ``(a - b) / b`` of the peak pressure ``peak_rel``, contact radius
+        ``contact_radius_rel`` (BEM: radius of the circle of the contact area), approach
+        ``approach_rel`` and total force ``force_rel``; ``n_points``: nodes in the union
+        of the contact zones. ``None`` marks an undefined value (reference 0).
+    """
+    a, b = _source("candidate", candidate), _source("reference", reference)
+    if not isinstance(candidate, (ContactResult, FemResult)):
+        raise InputError(f"candidate = {type(candidate).__name__} is not allowed: it must be a BEM or FEM result.")
+    if isinstance(candidate, FemResult) and not b.axisymmetric:
+        raise InputError("reference = non-axisymmetric is not allowed with an FEM candidate: the FEM is axisymmetric.")
+    x, y, p, w = _nodes(candidate)
+    p_ref = np.asarray(b.pressure(x, y), dtype=float)
+    union = (p > 0) | (p_ref > 0)
+    diff = np.abs(p - p_ref)
+    scale = float(p_ref.max(initial=0.0))
+    return {
+        "l2_rel": relative_l2(p[union], p_ref[union], None if w is None else w[union]),
+        "max_rel": float(diff.max(initial=0.0)) / scale if scale > 0 else None,
+        "peak_rel": _rel(a.p_max, b.p_max),
+        "contact_radius_rel": _rel(a.contact_radius, b.contact_radius),
+        "approach_rel": _rel(a.approach, b.approach),
+        "force_rel": _rel(a.force, b.force),
+        "n_points": int(union.sum()),
+    }
+
+
+def compare(bem_result, *, fem=None, analytic=None, force=None):
+    """All available comparisons of a BEM result with an FEM reference and a closed form.
+
+    Parameters
+    ----------
+    bem_result : bem.ContactResult
+        The BEM solution.
+    fem : fem_reference.FemResult, optional
+        Axisymmetric FEM reference of the same scene.
+    analytic : HertzSphere, RigidLayerParaboloid or HertzElliptic, optional
+        Closed form of the same scene (a non-axisymmetric one is compared at the BEM nodes
+        in ``x, y`` and not with the FEM).
+    force : float, optional
+        Target force [force] for the force balance; default the closed form's force.
+
+    Returns
+    -------
+    dict
+        JSON-ready; present only for what was given:
+
+        - ``"bem_vs_fem"``: :func:`pair_metrics` at the BEM nodes, FEM ``p(r)`` interpolated;
+        - ``"bem_vs_analytic"``: at the BEM nodes;
+        - ``"fem_vs_analytic"``: at the FEM nodes with ring-area weights
+          (only for an axisymmetric closed form);
+        - ``"force_balance"``: ``{"target": P, "bem": |F - P| / P, "fem": ...}``.
+
+        Each pair holds :data:`PAIR_KEYS`: ``l2_rel``, ``max_rel``, ``peak_rel``,
+        ``contact_radius_rel``, ``approach_rel``, ``force_rel`` (the last four signed,
+        ``(a - b) / b``), ``n_points``; ``None`` where undefined.
+    """
+    _check_bem(bem_result)
+    if fem is not None and not isinstance(fem, FemResult):
+        raise InputError(f"fem = {type(fem).__name__} is not allowed: it must be a fem_reference.FemResult or None.")
+    out = {}
+    if fem is not None:
+        out["bem_vs_fem"] = pair_metrics(bem_result, fem)
+    if analytic is not None:
+        out["bem_vs_analytic"] = pair_metrics(bem_result, analytic)
+        if fem is not None and _source("analytic", analytic).axisymmetric:
+            out["fem_vs_analytic"] = pair_metrics(fem, analytic)
+    target = force if force is not None else (None if analytic is None else analytic.force)
+    if target is not None:
+        target = check_positive("force", target)
+        balance = {"target": target, "bem": abs(bem_result.force - target) / target}
+        if fem is not None:
+            balance["fem"] = abs(fem.force - target) / target
+        out["force_balance"] = balance
+    return out
