@@ -61,7 +61,7 @@ def _initial(op, h, lam, force, approach, x0):
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, precondition=None, callback=None, frozen=None):
+             maxiter=None, precondition=None, callback=None, frozen=None, scale=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
 
     Parameters
@@ -88,6 +88,10 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     frozen : ndarray of bool, optional
         Nodes held at ``p = 0`` (infinite compliance); they are left out of the
         problem and of the KKT residual.
+    scale : float, optional
+        Displacement scale of the KKT residual [length]; default
+        ``max |C p + lam p|``. A caller whose ``lam`` is a model curvature (Newton)
+        passes the scale of the problem it linearises.
 
     Returns
     -------
@@ -127,12 +131,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
     converged, message, kkt, delta = False, "", np.inf, approach
     prev_contact = p > 0
+    m_one = None
+    fixed_scale = scale
     for k in range(1, maxiter + 1):
         contact = p > 0
         if force is not None:
             delta = float(np.mean(u[contact] + h[contact]))
         g = np.where(mask, u + h - delta, 0.0)
-        scale = float(np.abs(u).max())
+        scale = float(np.abs(u).max()) if fixed_scale is None else fixed_scale
         kkt = kkt_residual(p[mask], g[mask], displacement_scale=scale, force=force, node_area=a)
         if kkt <= rtol and stale:
             u, stale = apply(p), 0  # confirm on an exact product
@@ -155,12 +161,23 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 converged, message, kkt = True, "no contact at this approach", 0.0
                 break
         g_c = np.where(contact, g, 0.0)
-        z = g_c if precondition is None else np.where(contact, precondition(g_c), 0.0)
-        if force is not None and contact.any():
-            z = np.where(contact, z - z[contact].mean(), 0.0)
+        if precondition is None:
+            z = g_c
+            if force is not None:
+                z = np.where(contact, z - z[contact].mean(), 0.0)
+        else:
+            z = np.where(contact, precondition(g_c), 0.0)
+            if force is not None:
+                # oblique projection onto sum z = 0: z - M1 (1.z) / (1.M1), M1 cached per contact set
+                if m_one is None or changes:
+                    m_one = np.where(contact, precondition(contact.astype(float)), 0.0)
+                    applies += 1
+                z = z - m_one * (z[contact].sum() / m_one[contact].sum())
         gz = float(np.sum(g_c * z))
         beta = 0.0 if restart else gz / gz_old
         t = np.where(contact, z + beta * t, 0.0)
+        if force is not None:  # nodes that left the contact broke the zero mean of t
+            t = np.where(contact, t - t[contact].mean(), 0.0)
         gz_old = gz
         r = apply(t)
         applies += 1
