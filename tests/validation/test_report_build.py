@@ -1,8 +1,8 @@
 """Report documents: strict-HTML5 validity, no network references, embedded figures, Markdown
-with relative figure files, written whole or not at all, only the sections the results support."""
+with relative figure files, written whole or not at all. (Reports of result directories:
+test_report_run.py.)"""
 
 import base64
-import json
 import os
 import re
 from argparse import Namespace
@@ -12,7 +12,7 @@ import pytest
 
 from bem._validate import InputError
 from validation.report import build as build_mod
-from validation.report import build_report, load_results, main, report_results_dir
+from validation.report import build_report, main
 from validation.report.sections import Figure, Section, Table, fmt, problem_section, status_class
 
 html5lib = pytest.importorskip("html5lib")
@@ -151,80 +151,8 @@ def test_problem_section_lists_inputs(tmp_path):
     assert rows["load: force"] == ("100", "N") and rows["layer: root"][0] == "root: lam = 0.5"
 
 
-# ---------------------------------------------------------------- results directories
-
-def _results_dir(tmp_path, *, fem):
-    d = tmp_path / "run"
-    d.mkdir()
-    data = {"p_max": 0.58, "force": 1.0, "approach": 0.83, "contact_area": 2.6, "contact_radius": 0.91,
-            "iterations": 7, "converged": True, "kkt_residual": 1e-11, "method": "newton",
-            "wall_time_s": {"bem": 0.2, "fem": 1.5 if fem else None},
-            "units": {"length": "mm", "pressure": "MPa", "force": "N"},
-            "scene": {"name": "hertz-demo", "gap": {"type": "paraboloid", "R": 1.0},
-                      "layer": {"law": "linear", "lam": 0.1}, "materials": {"E_star": 1.0}, "load": {"force": 1.0}},
-            "solver_build": "x"}
-    if fem:
-        data["fem"] = {"p_max": 0.578, "contact_radius": 0.905, "converged": True}
-        data["comparison"] = {"p_max": {"rel_diff": 0.003}, "profile_l2": 0.01}
-    (d / "result.json").write_text(json.dumps(data))
-    # nodal BEM field: a Hertz-like cap on a lattice
-    import bem
-
-    lat = bem.Lattice.from_extent(0.1, 1.5)
-    x, y = lat.x[lat.mask], lat.y[lat.mask]
-    p = 0.58 * np.sqrt(np.clip(1 - (x**2 + y**2) / 0.91**2, 0, None))
-    np.savez(d / "fields.npz", x=x, y=y, p=p)
-    (d / "convergence.json").write_text(json.dumps({"title": "resolution study", "rows": [
-        {"solver": "BEM", "method": "newton", "resolution": "a/c=10", "N": 800, "error": 1e-3, "wall_time_s": 0.1},
-        {"solver": "BEM", "method": "newton", "resolution": "a/c=20", "N": 3200, "error": 2e-4, "wall_time_s": 0.3}]}))
-    (d / "stability.json").write_text(json.dumps([{"case": "soft", "method": "augmented_gap", "status": "diverged"},
-                                                  {"case": "soft", "method": "newton", "status": "converged"}]))
-    return d
-
-
-def test_load_results_tolerant(tmp_path):
-    res = load_results(_results_dir(tmp_path, fem=False))
-    assert res.fem is None and res.bem["p_max"] == 0.58 and res.bem["wall_time_s"] == 0.2
-    assert res.other == {"solver_build": "x"} and res.bem_field is not None
-    assert [t for t, _ in res.studies] == ["resolution study", "stability"]
-    (tmp_path / "b").mkdir()
-    res = load_results(_results_dir(tmp_path / "b", fem=True))
-    assert res.fem == {"p_max": 0.578, "contact_radius": 0.905, "converged": True, "wall_time_s": 1.5}
-    assert res.comparison == {"p_max.rel_diff": 0.003, "profile_l2": 0.01}
-    with pytest.raises(InputError, match="result.json"):
-        load_results(tmp_path)
-
-
-def test_bem_only_run_has_no_fem_section(tmp_path):
-    built = report_results_dir(_results_dir(tmp_path, fem=False), tmp_path / "out")
-    text = built.html.read_text(encoding="utf-8")
-    assert_valid_offline_html(text)
-    assert "kind-fem" not in text and "FEM" not in text
-    assert "FEM" not in built.markdown.read_text(encoding="utf-8")
-    assert "kind-results" in text and "kind-problem" in text and "kind-stability" in text
-    assert len(built.figures) == 4  # layer law, profile, map, work-precision
-
-
-def test_run_with_fem_has_fem_section(tmp_path):
-    d = _results_dir(tmp_path, fem=True)
-    import meshio
-
-    # a synthetic (r, z) section with a von Mises field, as the FEM writes it
-    r, z = np.meshgrid(np.linspace(0, 3, 13), np.linspace(-3, 3, 25))
-    pts = np.column_stack([r.ravel(), z.ravel(), np.zeros(r.size)])
-    from scipy.spatial import Delaunay
-
-    tri = Delaunay(pts[:, :2]).simplices
-    vm = np.exp(-((pts[:, 0]) ** 2 + (np.abs(pts[:, 1]) - 0.5) ** 2))
-    meshio.write(d / "fem.vtu", meshio.Mesh(pts, [("triangle", tri)], point_data={"von_mises": vm}))
-    built = main(Namespace(target=str(d), out=str(tmp_path / "out"))) == 0
-    assert built
-    text = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
-    assert_valid_offline_html(text)
-    assert 'class="kind-fem"' in text and "FEM reference" in text and "Comparison metrics" in text
-    assert (tmp_path / "out" / "figures" / "fem_von_mises.png").is_file()
-
+# ---------------------------------------------------------------- command
 
 def test_main_rejects_unknown_target(tmp_path):
-    with pytest.raises(InputError, match="contactlab run"):
+    with pytest.raises(InputError, match="built-in scene name, a scene TOML file or a results directory"):
         main(Namespace(target=str(tmp_path / "no-such-scene.toml"), out=None))

@@ -184,7 +184,8 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
         return save_figure(fig, path)
 
 
-def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(), labels=None):
+def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(), labels=None, b=None,
+                     aspect="equal", figsize=(5.4, 4.4)):
     """Map of the contact pressure ``p / p0`` over the plane with the contact boundary.
 
     The boundary is drawn midway between the loaded nodes (``p > 0``) and their unloaded
@@ -210,6 +211,13 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
         the rigid and elastic branches of an elastic-rigid layer).
     labels : dict, optional
         ``{"x", "y", "p"}`` axis labels (:func:`validation.report.style.axis_labels`).
+    b : float, optional
+        Length scale of the y axis [length] (default ``a``); with ``aspect="auto"`` an
+        elongated contact (a roller) fills the axes.
+    aspect : {"equal", "auto"} or float
+        Aspect of the axes in the scaled coordinates.
+    figsize : (float, float)
+        Figure size [inch].
 
     Returns
     -------
@@ -219,12 +227,13 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
     import matplotlib.tri as mtri
 
     p0, a = check_positive("p0", p0), check_positive("a", a)
+    b = a if b is None else check_positive("b", b)
     x, y, p = _nodal(result)
     xs, ys, ps, tri = contact_patch(x, y, p, margin=0.3)
-    triang = mtri.Triangulation(xs / a, ys / a, tri)
+    triang = mtri.Triangulation(xs / a, ys / b, tri)
     if circle is None and hasattr(result, "contact_radius"):
         circle = result.contact_radius
-    with new_figure((5.4, 4.4)) as (fig, ax):
+    with new_figure(figsize) as (fig, ax):
         pc = ax.tripcolor(triang, ps / p0, shading="gouraud", cmap="viridis", vmin=0.0)
         loaded = (ps > 0).astype(float)
         if loaded.min() < 0.5:
@@ -238,12 +247,12 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
             ax.plot([], [], color=color, lw=1.3, ls=":", label=label)
         if circle:
             t = np.linspace(0.0, 2.0 * np.pi, 361)
-            ax.plot(circle / a * np.cos(t), circle / a * np.sin(t), color="#ff7f0e", ls="--", lw=1.2,
+            ax.plot(circle / a * np.cos(t), circle / b * np.sin(t), color="#ff7f0e", ls="--", lw=1.2,
                     label=r"equal-area circle $r = \sqrt{A/\pi}$")
         bar = fig.colorbar(pc, ax=ax, pad=0.01)
         lab = axis_labels(labels)
         bar.set_label(lab["p"])
-        ax.set_aspect("equal")
+        ax.set_aspect(aspect)
         ax.grid(False)
         ax.set_xlabel(lab["x"])
         ax.set_ylabel(lab["y"])

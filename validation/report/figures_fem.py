@@ -17,7 +17,7 @@ __all__ = ["plot_section_field", "plot_von_mises", "von_mises_of", "section_fiel
 
 
 def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window=3.0, contact_radius=None,
-                       title=None, labels=None):
+                       title=None, labels=None, length_unit=None):
     """A scalar field on an (r, z) triangulation, mirrored about the axis for readability.
 
     Parameters
@@ -44,6 +44,9 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
         Axes title.
     labels : dict, optional
         ``{"r", "z"}`` axis labels (:func:`validation.report.style.axis_labels`).
+    length_unit : str, optional
+        Unit of ``r / a`` shown with the contact radius in the legend (default: ``a_H``
+        without ``labels``, nothing with them).
 
     Returns
     -------
@@ -79,7 +82,8 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
         if contact_radius:
             rc = contact_radius / a
             ax.plot([-rc, rc], [0.0, 0.0], color="#00d0ff", lw=3.0, solid_capstyle="butt",
-                    label=f"contact, $r_c$ = {rc:.4g}" + (" $a_H$" if labels is None else ""))
+                    label=f"contact, $r_c$ = {rc:.4g}" + (" $a_H$" if labels is None and length_unit is None
+                                                           else f" {length_unit}" if length_unit else ""))
             ax.legend(loc="upper right", fontsize=8, facecolor="#333333", labelcolor="white", framealpha=0.8)
         bar = fig.colorbar(pc, ax=ax, pad=0.01)
         bar.set_label(label)

@@ -99,7 +99,7 @@ def _history(run):
     return hist
 
 
-def plot_convergence(runs, path, *, p0, title=None, tol=None):
+def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
     """Maximum pressure and KKT residual against the iteration, one line per run (Fig. 8).
 
     Parameters
@@ -114,6 +114,8 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None):
         Title of the upper panel.
     tol : float, optional
         Tolerance drawn as a line on the residual panel.
+    p_label : str, optional
+        Label of the maximum-pressure axis (default: normalised by the Hertz peak ``p0``).
 
     Returns
     -------
@@ -141,8 +143,8 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None):
         if tol is not None:
             bot.axhline(tol, color="#666666", ls=":", lw=1.0)
             bot.annotate(f"tolerance {tol:.0e}", (0.0, tol), xycoords=("axes fraction", "data"),
-                         xytext=(4, -11), textcoords="offset points", ha="left", fontsize=8, color="#444444")
-        top.set_ylabel(r"max. pressure $p_{max}\,/\,p_0$")
+                         xytext=(4, 3), textcoords="offset points", ha="left", fontsize=8, color="#444444")
+        top.set_ylabel(p_label or r"max. pressure $p_{max}\,/\,p_0$")
         top.set_title(title or "maximum contact pressure during the iterations")
         top.legend(frameon=False, loc="best")
         bot.set_xscale("log")

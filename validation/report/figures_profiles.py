@@ -79,7 +79,8 @@ def curve_style(data, index):
             "marker": "o" if dashed else None, "markersize": 3.5, "markevery": 2}
 
 
-def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim=None, labels=None):
+def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim=None, labels=None,
+                           section=r"axial section $y = 0$"):
     """Pressure in the axial section ``y = 0``, ``p / p0`` against ``x / a`` (paper Fig. 5).
 
     Parameters
@@ -102,6 +103,8 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim
     labels : dict, optional
         Axis labels ``{"x": ..., "p": ...}`` (:func:`validation.report.style.axis_labels`);
         default: normalised by the Hertz radius and peak.
+    section : str, optional
+        Which line the profile lies on, appended to the x label (``None``: nothing).
 
     Returns
     -------
@@ -127,7 +130,7 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=False, xlim
             ax.plot(x / a, p / p0, label=label, zorder=3, **style)
         ax.set_xlim(*(xlim or auto_xlim(sections, a)))
         ax.set_ylim(bottom=0.0)
-        ax.set_xlabel(lab["x"] + r"  (axial section $y = 0$)")
+        ax.set_xlabel(lab["x"] + (f"  ({section})" if section else ""))
         ax.set_ylabel(lab["p"])
         if title:
             ax.set_title(title)
@@ -163,18 +166,25 @@ def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, mark
     if not laws:
         raise InputError("laws = [] is not allowed: give at least one (label, layer) pair.")
     p = np.linspace(0.0, p_max, 600)
+    w_top = 0.0
     with new_figure((6.0, 3.8)) as (fig, ax):
         for i, (label, layer) in enumerate(laws):
             law = "smooth" if layer is None else getattr(layer, "law", None)
             w = np.zeros_like(p) if layer is None else np.asarray(layer.w(p), dtype=float)
+            w_top = max(w_top, float(np.max(w, initial=0.0)))
             ax.plot(p, w, color=color_for(law, i), label=label, lw=max(3.0 - 0.45 * i, 1.2),
                     linestyle="--" if layer is None else "-")
         for k, (label, value) in enumerate(marks or ()):
             ax.axvline(value, color="#666666", lw=0.9, ls=":")
-            ax.annotate(label, (value, 1.0), xycoords=("data", "axes fraction"), xytext=(3, -12 - 11 * k),
-                        textcoords="offset points", fontsize=8.5, color="#444444")
+            right = value > 0.6 * p_max  # label on the left of a line near the right border
+            ax.annotate(label, (value, 1.0), xycoords=("data", "axes fraction"), xytext=(-3 if right else 3,
+                                                                                       -12 - 11 * k),
+                        textcoords="offset points", fontsize=8.5, color="#444444", ha="right" if right else "left")
         ax.set_xlim(0.0, p_max)
-        ax.set_ylim(bottom=0.0)
+        if w_top > 0:
+            ax.set_ylim(0.0, 1.15 * w_top)  # headroom for the labels of the marks
+        else:
+            ax.set_ylim(bottom=0.0)
         ax.set_xlabel("pressure $p$" + (f" [{p_unit}]" if p_unit else ""))
         ax.set_ylabel("layer closure $w(p)$" + (f" [{w_unit}]" if w_unit else ""))
         if title:

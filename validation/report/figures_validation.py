@@ -27,7 +27,8 @@ def _radial(r, p):
     return r[keep][order], p[keep][order]
 
 
-def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, rmax=None):
+def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, rmax=None, labels=None,
+                            error_scale=None):
     """Radial pressure profiles of several solvers with their error against a reference.
 
     Upper panel: ``p(r) / p0`` of every curve (and of the reference). Lower panel
@@ -49,6 +50,12 @@ def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, 
         Upper panel title.
     rmax : float, optional
         Largest ``r / a`` shown (default: the widest loaded zone of the curves plus 25 %).
+    labels : dict, optional
+        ``{"x", "p", "err", "err_of"}``: axis labels of the abscissa, the pressure and the
+        error, and what the error is a fraction of in the legend (default: normalised by
+        the Hertz radius and peak, error in units of ``p0``).
+    error_scale : float, optional
+        Pressure the error is divided by [pressure] (default ``p0``).
 
     Returns
     -------
@@ -56,6 +63,9 @@ def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, 
         ``path``.
     """
     p0, a = check_positive("p0", p0), check_positive("a", a)
+    e0 = p0 if error_scale is None else check_positive("error_scale", error_scale)
+    lab = {"x": r"radius $r\,/\,a_H$", "p": r"contact pressure $p\,/\,p_0$",
+           "err": r"error $(p - p_{ref})\,/\,p_0$", "err_of": "$p_0$", **(labels or {})}
     if not curves:
         raise InputError("curves = [] is not allowed: give at least one (label, r, p) curve.")
     curves = list(curves)
@@ -85,20 +95,20 @@ def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, 
             label, r, p = item[0], item[1], item[2]
             color = color_for(item[3] if len(item) > 3 else None, i + 1)
             r, p = _radial(r, p)
-            err = (p - ref_fn(r)) / p0
+            err = (p - ref_fn(r)) / e0
             shown = r <= rmax * a
             worst = max(worst, float(np.abs(err[shown]).max(initial=0.0)))
             marker = dict(marker="o", markersize=3) if r.size <= 80 else {}
             top.plot(r / a, p / p0, color=color, label=label, lw=1.5, **marker)
             bot.plot(r[shown] / a, err[shown], color=color, lw=1.2, **marker,
-                     label=f"{label}: max |error| {np.abs(err[shown]).max(initial=0.0):.2%} of $p_0$")
+                     label=f"{label}: max |error| {np.abs(err[shown]).max(initial=0.0):.2%} of {lab['err_of']}")
         top.set_xlim(0.0, rmax)
         top.set_ylim(bottom=0.0)
-        top.set_ylabel(r"contact pressure $p\,/\,p_0$")
+        top.set_ylabel(lab["p"])
         top.set_title(title or f"pressure profiles against {ref_label}")
         top.legend(loc="upper right", frameon=False)
-        bot.set_xlabel(r"radius $r\,/\,a_H$")
-        bot.set_ylabel(r"error $(p - p_{ref})\,/\,p_0$")
+        bot.set_xlabel(lab["x"])
+        bot.set_ylabel(lab["err"])
         if worst > 0:
             bot.set_ylim(-1.15 * worst, 1.15 * worst)
         bot.legend(loc="lower left", frameon=False, fontsize=7.5)

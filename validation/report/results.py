@@ -1,32 +1,31 @@
-"""Reading a results directory written by ``contactlab run`` (tolerantly).
+"""Reading a result directory written by ``contactlab run`` (:func:`validation.runner.run_scene`).
 
-What is read, all optional except ``result.json``:
+What is read (the names are those of :data:`validation.runner.FILES`, taken from
+``result.json["files"]`` when present):
 
-``result.json``
-    Scalars of the run. Either flat (``p_max``, ``force``, ``approach``, ``contact_area``,
-    ``contact_radius``, ``iterations``, ``converged``, ``kkt_residual``, ``method``,
-    ``message``, ``wall_time_s``) or split by solver (``{"bem": {...}, "fem": {...}}``);
-    ``wall_time_s`` a number or ``{"bem": s, "fem": s}``. Optional ``units`` (a string or
-    ``{"length", "pressure", "force"}``), ``scene`` (``name``, ``gap``, ``layer``, ``bodies``
-    or ``materials``, ``load``, ``units``) and comparison metrics under ``comparison``,
-    ``comparisons`` or ``metrics`` (a flat or nested dict of scalars). The FEM took part
-    when there is a ``fem`` dict or a ``wall_time_s["fem"]`` that is a number. Unknown keys
-    are kept and shown as "other values"; malformed values are skipped with a log message.
-study files
-    Any other ``*.json`` in the directory or in ``studies/``: a list of row dicts, or a dict
-    with ``rows`` (and optional ``title``/``name``, ``error_label``). Rows with ``error`` and
-    ``wall_time_s`` make a work-precision plot, rows with ``status`` a coloured table.
-nodal fields
-    ``*.npz`` with arrays ``x, y, p`` (BEM pressure on the plane), or ParaView files
-    (``.vtu``, ``.vtk``, ``.vtp``) read with meshio: point data ``pressure``, ``p`` or
-    ``contact_pressure`` on points in a plane is a BEM field; ``von_mises`` on
-    (6-node) triangles is an FEM (r, z) section.
+``result.json`` (required)
+    The run's result dict (:func:`validation.results.build_result`, schema
+    ``contactlab.result/1``): top-level BEM scalars ``p_max``, ``force``, ``approach``,
+    ``contact_area``, ``contact_radius`` (axisymmetric scenes), ``contact_extent``,
+    ``iterations``, ``converged``, ``kkt_residual``, ``message``, ``messages``,
+    ``wall_time_s`` ``{bem, fem, layer_reference, total}``; ``bem`` (the BEM summary with
+    ``step``, ``extent``, ``n_nodes``, ``n_contact``, ``E_star``, ``history``), ``layer``
+    (``law``, ``parameters`` and the paper quantities ``c_nn``, ``p_max_lambda``, ...),
+    ``profile`` (the axial sections), ``scales`` (Hertz ``p_hertz``, ``a_hertz``, ... of a
+    paraboloid), and only when they ran ``fem`` / ``fem_profile``, ``analytic`` and
+    ``comparison``; ``scene``, ``title``, ``units`` (the scene's units label).
+``scene.toml``
+    The effective scene (overrides applied): bodies, gap, layer, load, options.
+``bem_field.vtu``, ``fem_field.vtu``
+    The BEM nodal field (pressure ``p`` on the lattice nodes) and the FEM (r, z) field.
 """
 
 from __future__ import annotations
 
 import json
 import logging
+import re
+import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,87 +34,158 @@ import numpy as np
 
 from bem._validate import InputError
 
-__all__ = ["RunResults", "load_results", "SCALAR_KEYS"]
+__all__ = ["RunResults", "Units", "load_results", "parse_units", "display_unit"]
 
 log = logging.getLogger(__name__)
 
-#: scalar keys of a solver part of result.json, in display order
-SCALAR_KEYS = ("p_max", "force", "approach", "contact_area", "contact_radius", "iterations", "converged",
-               "kkt_residual", "method", "message", "wall_time_s", "n_nodes", "n_contact", "step", "n_dofs")
-_META_KEYS = ("bem", "fem", "units", "scene", "comparison", "comparisons", "metrics", "wall_time_s")
-_PRESSURE_NAMES = ("pressure", "p", "contact_pressure")
+_DEFAULT_FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_field.vtu",
+                  "fem_field": "fem_field.vtu"}
+_KINDS = {  # unit kind -> regular expression of a unit token of that kind
+    "pressure": re.compile(r"^(?:[kMG]?Pa|psi|ksi|bar)$"),
+    "force": re.compile(r"^(?:[mkM]?N|lbf|kgf)$"),
+    "length": re.compile(r"^(?:[nuµcmk]?m|in|ft)$"),
+}
+
+
+@dataclass(frozen=True)
+class Units:
+    """Units of a scene, parsed from its ``[scene] units`` label.
+
+    Attributes
+    ----------
+    label : str
+        The label as written in the scene (e.g. ``"SI (m, Pa, N)"``).
+    length, pressure, force : str or None
+        Unit symbols; ``None`` when the label does not name them.
+    """
+
+    label: str
+    length: str | None = None
+    pressure: str | None = None
+    force: str | None = None
+
+    @property
+    def known(self):
+        """Whether all three units were recognised."""
+        return None not in (self.length, self.pressure, self.force)
+
+    def of(self, kind):
+        """Unit of a quantity kind: ``length``, ``pressure``, ``force``, ``area``,
+        ``compliance`` (length/pressure), ``s`` or ``-``; ``"-"`` when unknown."""
+        if kind in ("-", "s"):
+            return kind
+        if kind == "area":
+            return f"{self.length}^2" if self.length else "-"
+        if kind == "compliance":
+            return f"{self.length}/{self.pressure}" if self.length and self.pressure else "-"
+        return getattr(self, kind, None) or "-"
+
+    def as_dict(self):
+        """``{"length", "pressure", "force"}`` of the known units."""
+        return {k: v for k, v in (("length", self.length), ("pressure", self.pressure), ("force", self.force)) if v}
+
+
+_PREFIXES = {"m": (("", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9)),
+             "Pa": (("GPa", 1e9), ("MPa", 1e6), ("kPa", 1e3), ("", 1.0)),
+             "N": (("MN", 1e6), ("kN", 1e3), ("", 1.0), ("mN", 1e-3))}
+
+
+def display_unit(unit, magnitude):
+    """``(symbol, factor)`` to draw values of size ``magnitude`` [unit] as ``value / factor``.
+
+    SI base units (m, Pa, N) get the prefix that puts ``magnitude`` in [1, 1000)
+    (e.g. 1.9e-4 m -> ("µm", 1e-6)); any other unit is kept (factor 1, "" when unknown).
+    """
+    if unit not in _PREFIXES:
+        return (unit or ""), 1.0
+    choices = _PREFIXES[unit]
+    if not (magnitude > 0 and np.isfinite(magnitude)):
+        return unit, 1.0
+    for prefix, factor in choices:
+        if magnitude >= factor:
+            return (prefix or unit), factor
+    prefix, factor = choices[-1]
+    return (prefix or unit), factor
+
+
+def parse_units(label):
+    """Units named by a scene's units label.
+
+    ``"SI (m, Pa, N)"`` and ``"SI"`` give m, Pa, N; ``"mm, MPa, N"`` gives mm, MPa, N; the
+    tokens may come in any order (each is recognised by its form). A label naming none
+    (e.g. ``"normalised: R = E* = P = 1"``) gives unknown units.
+    """
+    label = str(label or "SI (m, Pa, N)")
+    inner = re.search(r"\(([^)]*)\)", label)
+    tokens = re.split(r"[\s,;/]+", inner.group(1) if inner else label)
+    found = {}
+    for token in (t.strip() for t in tokens if t.strip()):
+        for kind, rx in _KINDS.items():
+            if rx.match(token):
+                found.setdefault(kind, token)
+    if not found and re.match(r"^\s*SI\b", label):
+        found = {"length": "m", "pressure": "Pa", "force": "N"}
+    return Units(label, **found)
 
 
 @dataclass
 class RunResults:
-    """The content of a results directory.
+    """The content of a result directory.
 
     Attributes
     ----------
     directory : Path
-    bem : dict
-        Scalars of the BEM part (may be empty).
-    fem : dict or None
-        Scalars of the FEM part; ``None`` when the FEM did not run.
-    comparison : dict
-        Flattened comparison metrics (``"a.b"`` keys for nested dicts).
+    data : dict
+        ``result.json``.
     scene : dict
-        Scene description, if recorded.
-    units : dict or str or None
-    other : dict
-        Top-level scalars not understood otherwise.
-    studies : list of (str, dict)
-        ``(title, {"rows": [...], ...})`` per study file.
-    bem_field : tuple or None
-        ``(x, y, p)`` nodal arrays.
-    fem_field : tuple or None
-        ``(r, z, triangles, von_mises)``.
+        ``scene.toml`` (empty when missing).
+    units : Units
+    bem_field : tuple of ndarray or None
+        ``(x, y, p)`` nodal BEM pressures [length], [pressure].
+    fem_field_path : Path or None
+        The FEM field file, when the FEM ran.
     """
 
     directory: Path
-    bem: dict = field(default_factory=dict)
-    fem: dict | None = None
-    comparison: dict = field(default_factory=dict)
+    data: dict
     scene: dict = field(default_factory=dict)
-    units: object = None
-    other: dict = field(default_factory=dict)
-    studies: list = field(default_factory=list)
+    units: Units = field(default_factory=lambda: parse_units(None))
     bem_field: tuple | None = None
-    fem_field: tuple | None = None
+    fem_field_path: Path | None = None
 
+    def section(self, name):
+        """A table of ``scene.toml`` (empty dict when absent)."""
+        value = self.scene.get(name)
+        return value if isinstance(value, Mapping) else {}
 
-def _scalar(v):
-    return isinstance(v, (int, float, str, bool)) or v is None
+    @property
+    def name(self):
+        return str(self.data.get("scene") or self.section("scene").get("name") or self.directory.name)
 
+    @property
+    def title(self):
+        return str(self.data.get("title") or self.section("scene").get("title") or self.name)
 
-def _flatten(d, prefix=""):
-    out = {}
-    for k, v in d.items():
-        key = f"{prefix}{k}"
-        if isinstance(v, Mapping):
-            out.update(_flatten(v, key + "."))
-        elif _scalar(v):
-            out[key] = v
-    return out
+    @property
+    def bem(self):
+        value = self.data.get("bem")
+        return value if isinstance(value, Mapping) else {}
 
+    @property
+    def fem(self):
+        """The FEM summary, or ``None`` when the FEM did not run."""
+        value = self.data.get("fem")
+        return value if isinstance(value, Mapping) else None
 
-def _split(data):
-    """BEM scalars, FEM scalars (or None) and the leftovers of result.json."""
-    times = data.get("wall_time_s")
-    bem = dict(data["bem"]) if isinstance(data.get("bem"), Mapping) else {
-        k: data[k] for k in SCALAR_KEYS if k in data and k != "wall_time_s"}
-    fem = dict(data["fem"]) if isinstance(data.get("fem"), Mapping) else None
-    if isinstance(times, Mapping):
-        if times.get("bem") is not None:
-            bem.setdefault("wall_time_s", times["bem"])
-        if isinstance(times.get("fem"), (int, float)) and not isinstance(times.get("fem"), bool):
-            fem = {} if fem is None else fem
-            fem.setdefault("wall_time_s", times["fem"])
-    elif isinstance(times, (int, float)):
-        bem.setdefault("wall_time_s", times)
-    used = set(_META_KEYS) | (set(SCALAR_KEYS) if not isinstance(data.get("bem"), Mapping) else set())
-    other = {k: v for k, v in data.items() if k not in used and _scalar(v)}
-    return bem, fem, other
+    @property
+    def axisymmetric(self):
+        """Axisymmetric scenes record ``contact_radius``."""
+        return self.data.get("contact_radius") is not None
+
+    def get(self, key, default=None):
+        """A top-level entry of ``result.json`` that is a dict (``default`` otherwise)."""
+        value = self.data.get(key)
+        return value if isinstance(value, Mapping) else default
 
 
 def _read_json(path):
@@ -125,89 +195,66 @@ def _read_json(path):
         raise InputError(f"{path} is not allowed: it must be a readable JSON file ({exc}).") from None
 
 
-def _study(path):
+def _read_scene(path):
+    if not path.is_file():
+        log.warning("%s is missing: the problem statement is built from result.json alone", path)
+        return {}
     try:
-        data = _read_json(path)
-    except InputError as exc:
-        log.warning("skipping %s: %s", path, exc)
+        with path.open("rb") as fh:
+            return tomllib.load(fh)
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        log.warning("%s is not readable TOML (%s): the problem statement is built from result.json alone",
+                    path, exc)
+        return {}
+
+
+def _bem_field(path):
+    """``(x, y, p)`` of the BEM ``.vtu`` (pressure array ``p``), or None."""
+    if not path.is_file():
         return None
-    if isinstance(data, Mapping) and isinstance(data.get("rows"), list):
-        rows, meta = data["rows"], {k: v for k, v in data.items() if k != "rows"}
-    elif isinstance(data, list):
-        rows, meta = data, {}
-    else:
-        return None
-    rows = [r for r in rows if isinstance(r, Mapping)]
-    if not rows:
-        return None
-    title = str(meta.get("title") or meta.get("name") or Path(path).stem.replace("_", " "))
-    return title, {"rows": rows, **meta}
-
-
-def _bem_field_npz(path):
-    with np.load(path) as z:
-        if all(k in z for k in ("x", "y", "p")):
-            return tuple(np.asarray(z[k], dtype=float).ravel() for k in ("x", "y", "p"))
-    return None
-
-
-def _mesh_fields(path):
-    """``("bem", (x, y, p))`` or ``("fem", (r, z, tri, vm))`` from a ParaView file, or None."""
     import meshio
 
     try:
         mesh = meshio.read(path)
-    except Exception as exc:  # noqa: BLE001 - any reader error means "not a field we understand"
+    except Exception as exc:  # noqa: BLE001 - any reader error means "no field"
         log.warning("skipping %s: meshio cannot read it (%s)", path, exc)
         return None
-    tris = [c.data[:, :3] for c in mesh.cells if c.type in ("triangle", "triangle6")]
-    if "von_mises" in mesh.point_data and tris:
-        return "fem", (mesh.points[:, 0], mesh.points[:, 1], np.vstack(tris),
-                       np.asarray(mesh.point_data["von_mises"], dtype=float))
-    for name in _PRESSURE_NAMES:
-        if name in mesh.point_data:
-            p = np.asarray(mesh.point_data[name], dtype=float).ravel()
-            if p.size == mesh.points.shape[0]:
-                return "bem", (mesh.points[:, 0], mesh.points[:, 1], p)
-    return None
+    p = mesh.point_data.get("p")
+    if p is None or np.asarray(p).size != mesh.points.shape[0]:
+        log.warning("skipping %s: it has no nodal pressure 'p'", path)
+        return None
+    return mesh.points[:, 0].copy(), mesh.points[:, 1].copy(), np.asarray(p, dtype=float).ravel()
 
 
 def load_results(directory):
-    """Read a results directory (see the module docstring for what is understood).
+    """Read a result directory of ``contactlab run`` (see the module docstring).
 
     Raises
     ------
     bem._validate.InputError
-        ``directory`` is not a directory or has no readable ``result.json``.
+        ``directory`` is not a directory or has no readable ``result.json`` holding an object.
     """
     directory = Path(directory)
     if not directory.is_dir():
-        raise InputError(f"directory = {str(directory)!r} is not allowed: it must be a results directory.")
-    main = directory / "result.json"
+        raise InputError(f"directory = {str(directory)!r} is not allowed: it must be a result directory.")
+    main = directory / _DEFAULT_FILES["result"]
     if not main.is_file():
         raise InputError(f"directory = {str(directory)!r} is not allowed: it has no result.json "
                          "(run the scene first: contactlab run SCENE --out DIR).")
     data = _read_json(main)
     if not isinstance(data, Mapping):
         raise InputError(f"{main} is not allowed: it must hold a JSON object.")
-    bem, fem, other = _split(data)
-    comparison = next((data[k] for k in ("comparison", "comparisons", "metrics") if isinstance(data.get(k), Mapping)),
-                      {})
-    scene = dict(data["scene"]) if isinstance(data.get("scene"), Mapping) else {}
-    res = RunResults(directory=directory, bem=bem, fem=fem, comparison=_flatten(comparison), scene=scene,
-                     units=data.get("units", scene.get("units")), other=other)
-    candidates = sorted(directory.glob("*.json")) + sorted((directory / "studies").glob("*.json"))
-    for path in candidates:
-        if path.name != "result.json":
-            study = _study(path)
-            if study is not None:
-                res.studies.append(study)
-    for path in sorted(directory.glob("*.npz")):
-        res.bem_field = res.bem_field or _bem_field_npz(path)
-    for path in sorted(p for ext in ("vtu", "vtk", "vtp") for p in directory.glob(f"*.{ext}")):
-        got = _mesh_fields(path)
-        if got is not None and got[0] == "bem" and res.bem_field is None:
-            res.bem_field = got[1]
-        elif got is not None and got[0] == "fem" and res.fem_field is None:
-            res.fem_field = got[1]
+    if not str(data.get("schema", "")).startswith("contactlab.result/"):
+        log.warning("%s has schema %r: it was not written by contactlab run; parts may be missing",
+                    main, data.get("schema"))
+    files = dict(_DEFAULT_FILES)
+    if isinstance(data.get("files"), Mapping):
+        files.update({k: str(v) for k, v in data["files"].items()})
+    scene = _read_scene(directory / files["scene"])
+    label = data.get("units") or (scene.get("scene") or {}).get("units")
+    res = RunResults(directory=directory, data=dict(data), scene=scene, units=parse_units(label),
+                     bem_field=_bem_field(directory / files["bem_field"]))
+    fem_path = directory / files["fem_field"]
+    if isinstance(data.get("fem"), Mapping) and fem_path.is_file():
+        res.fem_field_path = fem_path
     return res

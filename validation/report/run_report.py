@@ -1,5 +1,10 @@
-"""The report of a results directory (``contactlab run SCENE --out DIR``): only the sections the
-results support - no FEM section unless the FEM ran, no figure without its data."""
+"""The report of a result directory written by ``contactlab run`` (:func:`validation.runner.run_scene`).
+
+Only the sections the results support: the problem statement (from ``scene.toml``), the
+results table, the pressure profiles against the FEM and the closed form when they ran,
+the contact map, the convergence history, the FEM reference only when the FEM ran and the
+comparison metrics only when they were recorded. Units are the scene's (``[scene] units``).
+"""
 
 from __future__ import annotations
 
@@ -8,170 +13,233 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
-import numpy as np
-
+from . import run_figures as rf
 from .build import build_report
-from .sections import Figure, Section, Table, fmt, problem_section, quantity_rows, results_table, table_from_rows
-from .style import axis_labels
+from .run_problem import method_text, problem_statement, rebuild_layer
+from .sections import Section, Table, fmt
 
-__all__ = ["run_sections", "report_results_dir", "unit_map"]
+__all__ = ["run_sections", "report_results_dir", "results_rows", "comparison_tables"]
 
 log = logging.getLogger(__name__)
 
+#: rows of the results table: (key in result.json / fem / analytic, label, unit kind)
+_QUANTITIES = (("p_max", "peak pressure p_max", "pressure"),
+               ("force", "total force P", "force"),
+               ("approach", "approach delta", "length"),
+               ("contact_area", "contact area A", "area"),
+               ("contact_radius", "contact radius r_c", "length"))
+#: ratio rows: (key, label, key in result["scales"])
+_RATIOS = (("p_max", "p_max / p_H (Hertz peak)", "p_hertz"), ("contact_radius", "r_c / a_H (Hertz radius)", "a_hertz"),
+           ("approach", "delta / delta_H (Hertz approach)", "approach_hertz"))
+_FEM_TIMES = (("mesh", "mesh generation"), ("assembly", "assembly"), ("factorize", "factorisation"),
+              ("compliance", "contact-node compliance"), ("newton", "contact iterations"),
+              ("recover", "stress recovery"), ("total", "total"))
 
-def unit_map(units):
-    """Units of the scalars of result.json from the run's units (dict or label)."""
-    u = units if isinstance(units, Mapping) else {}
-    length, pressure, force = u.get("length", "length"), u.get("pressure", "pressure"), u.get("force", "force")
-    return {"p_max": pressure, "force": force, "approach": length, "contact_area": f"{length}^2",
-            "contact_radius": length, "iterations": "-", "converged": "-", "kkt_residual": "-", "wall_time_s": "s",
-            "step": length, "n_nodes": "-", "n_contact": "-", "n_dofs": "-"}
+
+def _num(value):
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def _layer_figure(scene, work, units):
-    from bem.layers import from_dict
+def results_rows(res):
+    """``(columns, rows)`` of the results table: one column per solver that ran, then the unit.
 
-    from .figures_profiles import plot_layer_laws
+    Every cell is a formatted scalar (:func:`validation.report.sections.fmt`) or ``"-"``.
+    """
+    parts = [("BEM", res.data)]
+    if res.fem is not None:
+        parts.append(("FEM", res.fem))
+    if res.get("analytic"):
+        parts.append(("closed form", res.get("analytic")))
+    rows = []
+    for key, label, kind in _QUANTITIES:
+        cells = [part.get(key) for _, part in parts]
+        if any(_num(c) for c in cells):
+            rows.append((label, *(fmt(c) if _num(c) else "-" for c in cells), res.units.of(kind)))
+    ext = res.get("contact_extent")
+    if ext and not res.axisymmetric:
+        cells = {"closed form": "{}, {}".format(*map(fmt, (ref.get("a"), ref.get("b"))))
+                 for ref in [res.get("analytic") or {}] if _num(ref.get("a")) and _num(ref.get("b"))}
+        rows.append(("contact half-widths along x, y", f"{fmt(ext.get('x'))}, {fmt(ext.get('y'))}",
+                     *(cells.get(name, "-") for name, _ in parts[1:]), res.units.of("length")))
+    scales = res.get("scales")
+    if scales:
+        for key, label, skey in _RATIOS:
+            if _num(scales.get(skey)) and scales[skey] > 0:
+                cells = [part.get(key) for _, part in parts]
+                rows.append((label, *(fmt(c / scales[skey]) if _num(c) else "-" for c in cells), "-"))
+    if _num(res.data.get("alpha_b")):
+        rows.append(("alpha_b = p_max / p_max^lambda", fmt(res.data["alpha_b"]), *("-" for _ in parts[1:]), "-"))
+    return ("quantity", *(name for name, _ in parts), "unit"), tuple(rows)
 
-    spec = scene.get("layer")
-    if not isinstance(spec, Mapping):
+
+def _run_rows(res):
+    """How the BEM ran: method, lattice, iterations, residual, times."""
+    d, b, u = res.data, res.bem, res.units
+    law = getattr(rebuild_layer(res), "law", None)
+    rows = [("method", method_text(d.get("method"), law), "-"),
+            ("status", "converged" if d.get("converged") else "not converged", "-"),
+            ("solver message", str(d.get("message", "-")), "-"),
+            ("iterations (finest lattice)", fmt(d.get("iterations")), "-"),
+            ("KKT residual", fmt(d.get("kkt_residual")), "-")]
+    if _num(b.get("step")):
+        rows.append(("lattice step c", fmt(b["step"]), u.of("length")))
+    ext = b.get("extent")
+    if isinstance(ext, list) and len(ext) == 2:
+        rows.append(("candidate region |x| <= X, |y| <= Y (X, Y)", f"{fmt(ext[0])}, {fmt(ext[1])}", u.of("length")))
+    for key, label in (("n_nodes", "candidate nodes"), ("n_contact", "nodes in contact"),
+                       ("nodes_across_contact", "nodes across the contact, 2 sqrt(A / pi) / c")):
+        if _num(b.get(key)):
+            rows.append((label, fmt(b[key], 3), "-"))
+    times = res.get("wall_time_s") or {}
+    for key, label in (("layer_reference", "wall time: reference solve of the layer"), ("bem", "wall time: BEM"),
+                       ("fem", "wall time: FEM"), ("total", "wall time: whole run")):
+        if _num(times.get(key)):
+            rows.append((label, fmt(times[key], 3), "s"))
+    return tuple(rows)
+
+
+def _results(res, work):
+    columns, rows = results_rows(res)
+    solvers = ", ".join(columns[1:-1])
+    status = "The run converged." if res.data.get("converged") else "The run did NOT converge."
+    text = [f"Computed: {solvers}. {status}"]
+    messages = [str(m) for m in res.data.get("messages") or ()]
+    if messages:
+        text.append("Run messages: " + "; ".join(messages) + ".")
+    caption = "Key results in the scene's units."
+    if res.axisymmetric:
+        caption += " BEM: r_c = sqrt(A / pi), A = loaded node count times the node area"
+        caption += ("; FEM: edge of the loaded zone, interpolated between the interface nodes."
+                    if res.fem is not None else ".")
+    else:
+        caption += " Half-widths: the farthest loaded node along each axis."
+    if res.get("scales"):
+        caption += (" Ratios: to Hertz's peak, radius and approach of the smooth paraboloid at the same load "
+                    "(the scale of the figures).")
+    items = [Table(columns, rows, caption=caption),
+             Table(("quantity", "value", "unit"), _run_rows(res), caption="How the BEM solution was computed.",
+                   status_column=None)]
+    items.extend(rf.profile_figures(res, work))
+    fig = rf.contact_map_figure(res, work)
+    if fig is not None:
+        items.append(fig)
+    return Section("Results", kind="results", text=tuple(text), items=tuple(items))
+
+
+def _convergence(res, work):
+    fig = rf.convergence_figure(res, work)
+    if fig is None:
         return None
-    try:
-        layer = from_dict(dict(spec))
-    except (ValueError, TypeError, KeyError) as exc:
-        log.warning("layer of the scene not drawn: %s", exc)
-        return None
-    p_top = scene.get("p_max_plot")
-    if not p_top:
-        p_top = getattr(layer, "p_scale", None) or 1.0
-        p_top = 3.0 * float(p_top)
-    u = units if isinstance(units, Mapping) else {}
-    path = plot_layer_laws([(spec.get("law", spec.get("type", "layer")), layer)], work / "layer_law.png",
-                           p_max=float(p_top), p_unit=u.get("pressure", ""), w_unit=u.get("length", ""),
-                           title="interface layer law $w(p)$")
-    return Figure(path, "The layer law w(p) of the scene, drawn from the bem.layers object rebuilt from the "
-                        "scene file.")
-
-
-def _problem(res, work):
-    scene = res.scene
-    if not scene:
-        return None
-    materials = scene.get("materials") or scene.get("bodies") or {}
-    materials = {k: v for k, v in _flatten_one(materials).items() if not isinstance(v, Mapping)}
-    load = scene.get("load") if isinstance(scene.get("load"), Mapping) else {}
-    units = res.units or "as in the scene file"
-    figure = _layer_figure(scene, work, units)
-    text = (f"Scene: {scene['name']}.",) if scene.get("name") else ()
-    gap = scene.get("gap") if isinstance(scene.get("gap"), Mapping) else {"type": "not recorded"}
-    return problem_section(gap=gap, materials=materials, load=load, units=units, figure=figure, text=text,
-                           layers=[("law", scene.get("layer"))] if isinstance(scene.get("layer"), Mapping) else ())
-
-
-def _flatten_one(d):
-    out = {}
-    for k, v in (d.items() if isinstance(d, Mapping) else ()):
-        if isinstance(v, Mapping):
-            out.update({f"{k}.{kk}": vv for kk, vv in v.items()})
-        else:
-            out[k] = v
-    return out
-
-
-def _status(part):
-    conv = part.get("converged")
-    return "-" if conv is None else ("converged" if conv else "not converged")
-
-
-def _bem(res, work):
-    units = unit_map(res.units)
-    values = {k: res.bem[k] for k in res.bem if k != "message"}
-    items = [results_table(quantity_rows(values, units), caption="BEM results (result.json).")]
-    if res.bem.get("message"):
-        items[0] = Table(items[0].columns, items[0].rows + (("message", res.bem["message"], "-"),),
-                         caption=items[0].caption)
-    if res.bem_field is not None:
-        from .figures_3d import plot_contact_map
-        from .figures_profiles import plot_pressure_profiles
-
-        x, y, p = res.bem_field
-        labels = axis_labels(units=res.units if isinstance(res.units, Mapping) else {})
-        on = np.abs(y) <= 1e-9 * float(np.abs(x).max(initial=1.0))
-        if np.any(p[on] > 0):
-            order = np.argsort(x[on])
-            path = plot_pressure_profiles([("BEM", (x[on][order], p[on][order]))], work / "bem_profile.png",
-                                          p0=1.0, a=1.0, labels=labels, title="contact pressure in the axial section")
-            items.append(Figure(path, "BEM contact pressure along the axial section y = 0 (nodal values)."))
-        if np.any(p > 0):
-            path = plot_contact_map((x, y, p), work / "bem_contact_map.png", p0=1.0, a=1.0, labels=labels,
-                                    title="contact pressure over the plane")
-            items.append(Figure(path, "BEM contact pressure over the plane with the contact boundary."))
-    return Section("BEM results", kind="results", items=tuple(items))
+    return Section("Convergence of the BEM", kind="iterations", items=(fig,))
 
 
 def _fem(res, work):
-    units = unit_map(res.units)
-    fem = {k: v for k, v in res.fem.items() if not isinstance(v, Mapping)}
-    items = [results_table(quantity_rows(fem, units), caption="FEM reference results (result.json).")]
-    if res.fem_field is not None:
-        from .figures_fem import plot_section_field
-
-        r, z, tri, vm = res.fem_field
-        a = float(res.fem.get("contact_radius") or res.bem.get("contact_radius") or 1.0)
-        labels = axis_labels(units=res.units if isinstance(res.units, Mapping) else {})
-        u = res.units.get("pressure", "") if isinstance(res.units, Mapping) else ""
-        path = plot_section_field(r, z, tri, vm, work / "fem_von_mises.png", a=1.0, scale=1.0, window=3.0 * a,
-                                  label="von Mises stress" + (f" [{u}]" if u else ""), labels=labels,
-                                  contact_radius=res.fem.get("contact_radius"),
-                                  title="FEM reference: von Mises stress in the axial section")
-        items.append(Figure(path, "Von Mises stress of the FEM reference in the (r, z) section, read from the "
-                                  "run's .vtu file."))
+    fem, u = res.fem, res.units
+    mesh, penalty, trunc = (fem.get(k) if isinstance(fem.get(k), Mapping) else {}
+                            for k in ("mesh", "penalty", "truncation"))
+    rows = [("status", "converged" if fem.get("converged") else "not converged", "-"),
+            ("stopping reason", str(fem.get("reason", "-")), "-"),
+            ("contact iterations", fmt(fem.get("iterations")), "-"),
+            ("degrees of freedom", fmt(fem.get("n_dofs")), "-"),
+            ("elements", fmt(fem.get("n_elements")), "-"),
+            ("elements across the contact radius", fmt(fem.get("n_elements_across_contact"), 3), "-")]
+    if _num(mesh.get("h_fine")):
+        rows.append(("element size at the contact", fmt(mesh["h_fine"]), u.of("length")))
+    if _num(mesh.get("extent")):
+        rows.append(("mesh half-size / estimated contact radius", fmt(mesh["extent"]), "-"))
+    if _num(penalty.get("relative_penetration")):
+        rows.append(("penalty: largest penetration / approach", fmt(penalty["relative_penetration"]), "-"))
+    if "applied" in trunc:
+        rows.append(("far-field (truncation) correction applied", fmt(bool(trunc["applied"])), "-"))
+    timings = fem.get("timings") if isinstance(fem.get("timings"), Mapping) else {}
+    for key, label in _FEM_TIMES:
+        if _num(timings.get(key)):
+            rows.append((f"wall time: {label}", fmt(timings[key], 3), "s"))
+    items = [Table(("quantity", "value", "unit"), tuple(rows),
+                   caption="FEM reference (fem_reference, axisymmetric, quadratic triangles): mesh, solver and "
+                           "time split. Its pressure, force, approach and radius are in the results table.")]
+    fig = rf.von_mises_figure(res, work)
+    if fig is not None:
+        items.append(fig)
     return Section("FEM reference", kind="fem", items=tuple(items))
 
 
-def _comparison(res):
-    rows = tuple((k, fmt(v) if not isinstance(v, str) else v) for k, v in res.comparison.items())
-    return Section("Comparison metrics", kind="validation",
-                   items=(Table(("metric", "value"), rows, caption="Comparison metrics recorded by the run."),))
+_METRICS = {"l2_rel": "relative L2 error of p", "max_rel": "max |p - p_ref| / max p_ref",
+            "peak_rel": "peak pressure (a - b) / b", "contact_radius_rel": "contact radius (a - b) / b",
+            "approach_rel": "approach (a - b) / b", "force_rel": "force (a - b) / b",
+            "n_points": "nodes compared (union of contacts)"}
 
 
-def _study(title, study, work, k):
-    from .figures_validation import plot_work_precision, work_precision_rows
+def _metric_cell(key, value):
+    if not _num(value):
+        return "-" if value is None else str(value)
+    if key == "n_points" or isinstance(value, int):
+        return str(value)
+    return f"{100.0 * value:.3g} %"
 
-    rows = study["rows"]
-    items = []
-    plottable = all(k in row for row in rows for k in ("solver", "error", "wall_time_s"))
-    if plottable and work_precision_rows(rows):
-        path = plot_work_precision(rows, work / f"study_{k}_work_precision.png",
-                                   error_label=str(study.get("error_label", "error")), title=title)
-        items.append(Figure(path, f"Work-precision of the study '{title}': error against wall time, one line per "
-                                  "solver/method, one marker per resolution."))
-    table = table_from_rows(rows, caption=f"Study '{title}'.")
-    items.append(table)
-    kind = "stability" if table.status_column else "validation"
-    return Section(f"Study: {title}", kind=kind, items=tuple(items))
+
+def _pair_name(key):
+    """``"bem_vs_analytic"`` -> ``"BEM vs closed form"``."""
+    names = {"bem": "BEM", "fem": "FEM", "analytic": "closed form"}
+    return " vs ".join(names.get(part, part.replace("_", " ")) for part in key.split("_vs_"))
+
+
+def comparison_tables(comparison, units):
+    """Tables of ``result["comparison"]``: one column per compared pair, then the force balance.
+
+    Relative values are shown in per cent; nested containers never reach a cell.
+    """
+    pairs = {k: v for k, v in comparison.items() if isinstance(v, Mapping) and k != "force_balance"}
+    tables = []
+    if pairs:
+        keys = list(dict.fromkeys(k for v in pairs.values() for k, x in v.items()
+                                  if not isinstance(x, (Mapping, list))))
+        rows = tuple((_METRICS.get(k, k), *(_metric_cell(k, v.get(k)) for v in pairs.values())) for k in keys)
+        tables.append(Table(("metric", *(_pair_name(k) for k in pairs)), rows,
+                            caption="Comparison metrics of the run (candidate vs reference at the candidate's "
+                                    "nodes; signed differences are (candidate - reference) / reference)."))
+    balance = comparison.get("force_balance")
+    rows = []
+    if isinstance(balance, Mapping):
+        for key, value in balance.items():
+            if key == "target" and _num(value):
+                rows.append(("target force P", fmt(value), units.of("force")))
+            elif _num(value):
+                rows.append((f"force balance |F - P| / P ({key.upper()})", _metric_cell(key, value), "-"))
+    rows += [(k, _metric_cell(k, v), "-") for k, v in comparison.items() if _num(v)]
+    if rows:
+        tables.append(Table(("quantity", "value", "unit"), tuple(rows), caption="Force balance of the solvers."))
+    return tables
 
 
 def run_sections(res, work):
-    """Sections for :class:`validation.report.results.RunResults`; figures go to ``work``."""
+    """The report sections of :class:`validation.report.results.RunResults`; figures go to ``work``."""
     work = Path(work)
-    sections = [s for s in (_problem(res, work),) if s is not None]
-    sections.append(_bem(res, work))
+    sections = [problem_statement(res, work), _results(res, work)]
+    conv = _convergence(res, work)
+    if conv is not None:
+        sections.append(conv)
     if res.fem is not None:
         sections.append(_fem(res, work))
-    if res.comparison:
-        sections.append(_comparison(res))
-    for k, (title, study) in enumerate(res.studies, 1):
-        sections.append(_study(title, study, work, k))
-    if res.other:
-        rows = tuple((k, fmt(v) if not isinstance(v, str) else v) for k, v in res.other.items())
-        sections.append(Section("Other recorded values", kind="notes",
-                                items=(Table(("key", "value"), rows, caption="Other scalars of result.json."),)))
+    comparison = res.get("comparison")
+    if comparison:
+        tables = comparison_tables(comparison, res.units)
+        if tables:
+            sections.append(Section("Comparison metrics", kind="validation", items=tuple(tables)))
     return sections
 
 
 def report_results_dir(directory, out_dir=None, *, title=None):
-    """Report of a results directory; default ``out_dir`` is ``directory/report``.
+    """Report of a result directory; default ``out_dir`` is ``directory/report``.
+
+    Parameters
+    ----------
+    directory : path-like
+        Written by ``contactlab run`` (``result.json``, ``scene.toml``, fields).
+    out_dir : path-like, optional
+        Report directory (``report.html``, ``report.md``, ``figures/``).
+    title : str, optional
+        Default: the scene's title.
 
     Returns
     -------
@@ -181,8 +249,9 @@ def report_results_dir(directory, out_dir=None, *, title=None):
 
     res = load_results(directory)
     out_dir = Path(directory) / "report" if out_dir is None else Path(out_dir)
-    name = res.scene.get("name") or Path(directory).resolve().name
+    source = res.data.get("source")
+    subtitle = f"Scene '{res.name}'" + (f" ({source})" if source else "") + \
+        f"; results read from {Path(directory).resolve()}"
     with tempfile.TemporaryDirectory(prefix="contactlab-figures-") as work:
         sections = run_sections(res, work)
-        return build_report(sections, out_dir, title=title or f"contactlab report: {name}",
-                            subtitle=f"Results read from {Path(directory).resolve()}")
+        return build_report(sections, out_dir, title=title or res.title, subtitle=subtitle)

@@ -1,0 +1,267 @@
+"""Reports of REAL result directories: built-in scenes run by validation.runner.run_scene at small
+settings, then reported. Checks: the scene's title and units, tables without raw containers,
+profile windows that hold the contact, an FEM section only when the FEM ran, comparison metrics
+when recorded, valid self-contained HTML, inputs untouched."""
+
+import copy
+import json
+import re
+import shutil
+import tomllib
+from argparse import Namespace
+
+import numpy as np
+import pytest
+
+from validation.report import main, report_results_dir
+from validation.report.build import build_report
+from validation.report.results import display_unit, load_results, parse_units
+from validation.report.run_figures import profile_view
+from validation.report.run_report import run_sections
+from validation.report.sections import Figure, Table
+from validation.runner import run_scene
+from validation.scene import builtin_path
+from validation.tomlwrite import dumps
+
+from .conftest import e_star, hertz
+from .test_report_build import assert_valid_offline_html
+
+SMALL = {
+    "hertz": ["bem.nodes_across=16", "fem.n_contact=6"],  # FEM + closed form
+    "paper_elastic_rigid": ["bem.nodes_across=16", "fem.n_contact=6"],  # layer + FEM
+    "elliptic": ["bem.nodes_across=16"],  # BEM only + closed form, not axisymmetric
+    "roller": ["bem.nodes_across=12"],  # BEM only, no reference, elongated
+}
+
+
+def _scene_file(name):
+    with open(builtin_path(name), "rb") as fh:
+        return tomllib.load(fh)
+
+
+@pytest.fixture(scope="module")
+def reports(tmp_path_factory):
+    """name -> {"dir", "res", "sections", "built", "scene"} for every scene of SMALL."""
+    root = tmp_path_factory.mktemp("runs")
+    out = {}
+    for name, small in SMALL.items():
+        run_scene(name, root / name, overrides=small)
+        res = load_results(root / name)
+        work = root / f"{name}-figures"
+        work.mkdir()
+        sections = run_sections(res, work)
+        built = build_report(sections, root / f"{name}-report", title=res.title)
+        out[name] = {"dir": root / name, "res": res, "sections": sections, "built": built,
+                     "scene": _scene_file(name)}
+    return out
+
+
+def _tables(sections):
+    return [item for sec in sections for item in sec.items if isinstance(item, Table)]
+
+
+def _results_table(sections):
+    sec = next(s for s in sections if s.title == "Results")
+    return next(item for item in sec.items if isinstance(item, Table))
+
+
+def _row(table, label):
+    return next(r for r in table.rows if r[0] == label)
+
+
+@pytest.mark.parametrize("name", list(SMALL))
+def test_tables_hold_no_raw_containers(reports, name):
+    for table in _tables(reports[name]["sections"]):
+        for row in table.rows:
+            for cell in row:
+                assert "{" not in cell and "[" not in cell, (table.caption, row)
+    md = reports[name]["built"].markdown.read_text(encoding="utf-8")
+    table_lines = [line for line in md.splitlines() if line.startswith("|")]
+    assert table_lines and not [line for line in table_lines if "{" in line or "[" in line]
+
+
+@pytest.mark.parametrize("name", list(SMALL))
+def test_title_and_units_are_the_scenes(reports, name):
+    meta = reports[name]["scene"]["scene"]
+    html = reports[name]["built"].html.read_text(encoding="utf-8")
+    assert f"<h1>{meta['title']}</h1>" in html.replace("&#x27;", "'") and "contactlab report: result" not in html
+    assert meta["units"] == "SI (m, Pa, N)"
+    units = {row[-1] for row in _results_table(reports[name]["sections"]).rows}
+    assert {"Pa", "N", "m", "m^2"} <= units and not units & {"pressure", "length", "force", "length^2"}
+    problem = reports[name]["sections"][0]
+    assert problem.kind == "problem" and any(meta["units"] in t for t in problem.text)
+
+
+def test_problem_statement_of_the_layer_scene(reports):
+    rep = reports["paper_elastic_rigid"]
+    problem = rep["sections"][0]
+    rows = {r[0]: r[1:] for r in problem.items[0].rows}
+    bodies = rep["scene"]["bodies"]
+    es = e_star(bodies["E1"], bodies["nu1"], bodies["E2"], bodies["nu2"])
+    label = next(k for k in rows if k.startswith("effective modulus"))
+    assert float(rows[label][0]) == pytest.approx(es, rel=1e-3) and rows[label][1] == "Pa"
+    assert rows["gap R"] == ("0.01", "m") and rows["load: total force P (force control)"] == ("100", "N")
+    assert rows["interface layer"][0].startswith("elastic-rigid")
+    p_cr = rep["res"].data["layer"]["parameters"]["p_cr"]
+    assert float(rows["layer p_cr"][0]) == pytest.approx(p_cr, rel=1e-3) and rows["layer p_cr"][1] == "Pa"
+    assert rows["layer lam"][1] == "m/Pa"
+    figures = [i for i in problem.items if isinstance(i, Figure)]
+    assert len(figures) == 1 and "w(p)" in figures[0].caption
+    # smooth scene: a row saying so, no law figure
+    hertz_problem = reports["hertz"]["sections"][0]
+    assert not [i for i in hertz_problem.items if isinstance(i, Figure)]
+    assert _row(hertz_problem.items[0], "interface layer")[1].startswith("none")
+
+
+def test_profile_window_holds_the_contact_normalised(reports):
+    rep = reports["hertz"]
+    scene = rep["scene"]
+    b = scene["bodies"]
+    a_h, p_h, _ = hertz(scene["load"]["force"], scene["gap"]["R"], e_star(b["E1"], b["nu1"], b["E2"], b["nu2"]))
+    prof = rep["res"].data["profile"]
+    x, p = np.array(prof["x"]), np.array(prof["p"])
+    view = profile_view(rep["res"], [(x, p)])
+    assert view.normalised and view.x_factor == pytest.approx(a_h, rel=1e-9)
+    assert view.p_factor == pytest.approx(p_h, rel=1e-9)
+    edge = np.abs(x[p > 0]).max() / view.x_factor  # the plotted contact edge
+    assert 0.8 < edge < 1.2  # a Hertz contact of radius a_H (16 nodes across: within a step)
+    assert view.xlim[0] < -edge and edge < view.xlim[1] <= 2.0 * edge
+    assert view.xlim[0] == -view.xlim[1]
+
+
+def test_profile_window_holds_the_contact_in_scene_units(reports):
+    rep = reports["roller"]
+    prof = rep["res"].data["profile"]
+    for key, line in (("x", prof), ("y", prof["y_axis"])):
+        s, p = np.array(line[key]), np.array(line["p"])
+        view = profile_view(rep["res"], [(s, p)], axis=key)
+        assert not view.normalised
+        edge_m = np.abs(s[p > 0]).max()
+        edge = edge_m / view.x_factor
+        assert view.xlim[0] < -edge and edge < view.xlim[1] <= 2.0 * edge, key
+        assert 1.0 <= edge < 1000.0  # a readable prefix
+        unit = {1e-3: "mm", 1e-6: "µm"}[view.x_factor]
+        assert f"[{unit}]" in view.x_label and "GPa" in view.p_label
+    length = rep["scene"]["gap"]["length"]
+    x_edge = np.abs(np.array(prof["x"])[np.array(prof["p"]) > 0]).max()
+    assert 0.8 * length / 2 < x_edge <= length / 2  # the crowned roller loads nearly its whole length
+
+
+def test_sections_follow_the_data(reports):
+    kinds = {name: [s.kind for s in rep["sections"]] for name, rep in reports.items()}
+    for name, rep in reports.items():  # comparison metrics exactly when the run recorded them
+        assert (kinds[name][-1] == "validation") == bool(rep["res"].data.get("comparison")), name
+        if kinds[name][-1] == "validation":
+            kinds[name].pop()
+    assert kinds["hertz"] == ["problem", "results", "iterations", "fem"]
+    assert kinds["paper_elastic_rigid"] == ["problem", "results", "iterations", "fem"]
+    assert kinds["elliptic"] == kinds["roller"] == ["problem", "results", "iterations"]
+    names = {name: sorted(p.name for p in rep["built"].figures) for name, rep in reports.items()}
+    assert names["hertz"] == ["contact_map.png", "convergence.png", "fem_von_mises.png", "profile_x.png"]
+    assert names["paper_elastic_rigid"] == sorted(names["hertz"] + ["layer_law.png"])
+    assert names["elliptic"] == names["roller"] == ["contact_map.png", "convergence.png", "profile_x.png",
+                                                    "profile_y.png"]
+
+
+@pytest.mark.parametrize("name", ["elliptic", "roller"])
+def test_bem_only_report_has_no_fem(reports, name):
+    built = reports[name]["built"]
+    html = built.html.read_text(encoding="utf-8")
+    assert_valid_offline_html(html)
+    text = re.sub(r'data:image/png;base64,[^"]*', "", html)  # the words of the document, not of the images
+    assert "kind-fem" not in text and "FEM" not in text and "FEM" not in built.markdown.read_text()
+    assert _results_table(reports[name]["sections"]).columns[1] == "BEM"
+
+
+def test_fem_section_and_columns(reports):
+    rep = reports["hertz"]
+    data = rep["res"].data
+    html = rep["built"].html.read_text(encoding="utf-8")
+    assert_valid_offline_html(html)
+    assert 'class="kind-fem"' in html
+    table = _results_table(rep["sections"])
+    assert table.columns == ("quantity", "BEM", "FEM", "closed form", "unit")
+    fem_sec = next(s for s in rep["sections"] if s.kind == "fem")
+    fem_rows = {r[0]: r[1] for r in fem_sec.items[0].rows}
+    assert fem_rows["degrees of freedom"] == str(data["fem"]["n_dofs"])
+    assert float(fem_rows["wall time: total"]) == pytest.approx(data["fem"]["timings"]["total"], rel=1e-2)
+    # ratios to Hertz: independent closed form
+    scene = rep["scene"]
+    b = scene["bodies"]
+    a_h, p_h, d_h = hertz(scene["load"]["force"], scene["gap"]["R"], e_star(b["E1"], b["nu1"], b["E2"], b["nu2"]))
+    ratio = _row(table, "p_max / p_H (Hertz peak)")
+    assert float(ratio[1]) == pytest.approx(data["p_max"] / p_h, rel=1e-3)
+    assert float(ratio[3]) == pytest.approx(1.0, rel=1e-3)  # the closed form is Hertz
+    assert float(_row(table, "delta / delta_H (Hertz approach)")[3]) == pytest.approx(1.0, rel=1e-3)
+    run_rows = {r[0]: r[1] for r in next(s for s in rep["sections"] if s.title == "Results").items[1].rows}
+    assert run_rows["iterations (finest lattice)"] == str(data["iterations"])
+    assert float(run_rows["lattice step c"]) == pytest.approx(data["bem"]["step"], rel=1e-3)
+
+
+def test_comparison_metrics_when_recorded(reports, tmp_path):
+    d = tmp_path / "run"
+    shutil.copytree(reports["hertz"]["dir"], d)
+    data = json.loads((d / "result.json").read_text())
+    pair = {"l2_rel": 0.0123, "max_rel": 0.02, "peak_rel": -0.0004, "contact_radius_rel": 0.003,
+            "approach_rel": 1e-5, "force_rel": 0.0, "n_points": 321}
+    data["comparison"] = {"bem_vs_fem": pair, "bem_vs_analytic": dict(pair, l2_rel=0.5),
+                          "force_balance": {"target": 100.0, "bem": 1e-12, "fem": 2e-4}}
+    (d / "result.json").write_text(json.dumps(data))
+    sections = run_sections(load_results(d), tmp_path / "fig")
+    sec = next(s for s in sections if s.title == "Comparison metrics")
+    pairs, balance = sec.items
+    assert pairs.columns == ("metric", "BEM vs FEM", "BEM vs closed form")
+    assert _row(pairs, "relative L2 error of p")[1:] == ("1.23 %", "50 %")
+    assert _row(pairs, "nodes compared (union of contacts)")[1:] == ("321", "321")
+    rows = {r[0]: r[1:] for r in balance.rows}
+    assert rows["target force P"] == ("100", "N") and rows["force balance |F - P| / P (FEM)"] == ("0.02 %", "-")
+    for table in (pairs, balance):
+        assert not [c for r in table.rows for c in r if "{" in c or "[" in c]
+
+
+def test_report_results_dir_and_command(reports, tmp_path):
+    built = report_results_dir(reports["elliptic"]["dir"], tmp_path / "rep")
+    html = built.html.read_text(encoding="utf-8")
+    assert_valid_offline_html(html)
+    assert "<h1>Elliptic Hertz contact</h1>" in html
+    # contactlab report SCENE.toml: run into OUT/result, report into OUT/report
+    raw = _scene_file("elliptic")
+    raw["bem"]["nodes_across"] = 12
+    scene = tmp_path / "small.toml"
+    scene.write_text(dumps(raw))
+    assert main(Namespace(target=str(scene), out=str(tmp_path / "out"))) == 0
+    assert (tmp_path / "out" / "result" / "result.json").is_file()
+    md = (tmp_path / "out" / "report" / "report.md").read_text(encoding="utf-8")
+    assert md.startswith("# Elliptic Hertz contact\n")
+
+
+def test_units_parsing_and_display():
+    u = parse_units("SI (m, Pa, N)")
+    assert (u.length, u.pressure, u.force, u.of("area"), u.of("compliance")) == ("m", "Pa", "N", "m^2", "m/Pa")
+    assert parse_units("SI").as_dict() == {"length": "m", "pressure": "Pa", "force": "N"}
+    assert parse_units("mm, MPa, N").as_dict() == {"length": "mm", "pressure": "MPa", "force": "N"}
+    odd = parse_units("normalised: R = E* = P = 1")
+    assert not odd.known and odd.of("pressure") == "-" and odd.of("area") == "-"
+    assert display_unit("m", 1.87e-4) == ("µm", 1e-6) and display_unit("m", 5e-3) == ("mm", 1e-3)
+    assert display_unit("Pa", 1.37e9) == ("GPa", 1e9) and display_unit("Pa", 4e5) == ("kPa", 1e3)
+    assert display_unit("mm", 0.2) == ("mm", 1.0) and display_unit(None, 3.0) == ("", 1.0)
+
+
+def test_report_does_not_modify_the_results(reports, tmp_path):
+    res = reports["paper_elastic_rigid"]["res"]
+    before = copy.deepcopy(res.data), copy.deepcopy(res.scene), [a.copy() for a in res.bem_field]
+    run_sections(res, tmp_path)
+    assert res.data == before[0] and res.scene == before[1]
+    assert all(np.array_equal(a, b) for a, b in zip(res.bem_field, before[2]))
+    files = sorted(p.name for p in reports["paper_elastic_rigid"]["dir"].iterdir())
+    assert files == ["bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
+
+
+def test_captions_say_how(reports):
+    rep = reports["hertz"]
+    data = rep["res"].data
+    captions = [i.caption for s in rep["sections"] for i in s.items if isinstance(i, Figure)]
+    profile = next(c for c in captions if c.startswith("Contact pressure along"))
+    assert "Kalker QP" in profile and "tolerance 1e-10" in profile and f"{data['bem']['n_nodes']} candidate" in profile
+    assert re.search(r"FEM: axisymmetric quadratic triangles, [\d.]+ elements across", profile)
+    assert "p_H = " in profile and "a_H = " in profile
