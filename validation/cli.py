@@ -111,9 +111,13 @@ def build_parser():
 
     p = sub.add_parser("study", help="error-time and stability studies", formatter_class=fmt,
                        description="Studies of the methods (validation.studies).",
-                       epilog="examples:\n  contactlab study error-time hertz\n  contactlab study stability")
+                       epilog="examples:\n  contactlab study error-time hertz --out reports/studies\n"
+                       "  contactlab study stability --quick\n"
+                       "  contactlab report reports/studies      (work-precision plot and tables)")
     p.add_argument("study", choices=("error-time", "stability"), metavar="{error-time,stability}")
-    p.add_argument("scene", nargs="?", metavar="SCENE", help="scene for error-time (default: the study's own)")
+    p.add_argument("scene", nargs="?", metavar="SCENE",
+                   help="problem for error-time: hertz or paper_root (default: both)")
+    p.add_argument("--quick", action="store_true", help="a short ladder / case list (minutes instead of ~5)")
     p.add_argument("--out", metavar="DIR")
     _add_set(p)
 

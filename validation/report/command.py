@@ -23,8 +23,10 @@ def main(args):
     args : argparse.Namespace
         ``target``: ``"paper"`` (solve the paper's test problem and report it), a
         built-in scene name or a scene TOML file (run it into ``OUT/result``, report into
-        ``OUT/report``, ``OUT`` defaulting to ``results/NAME``), or a results directory
-        holding ``result.json`` (see :mod:`validation.report.results`);
+        ``OUT/report``, ``OUT`` defaulting to ``results/NAME``), a results directory
+        holding ``result.json`` (see :mod:`validation.report.results`), or a directory of
+        study files (``error_time.json``, ``stability.json``:
+        :mod:`validation.report.study_report`);
         ``out`` (optional): the report directory (default ``reports/paper`` for ``paper``,
         ``TARGET/report`` for a results directory); ``quick`` (optional, bool): coarse
         preview of the paper report.
@@ -42,6 +44,10 @@ def main(args):
 
         quick = bool(getattr(args, "quick", False))
         built = report_paper_problem(DEFAULT_PAPER_OUT if out is None else out, quick=quick)
+    elif Path(target).is_dir() and not (Path(target) / "result.json").is_file() and _studies(target):
+        from .study_report import report_studies_dir
+
+        built = report_studies_dir(target, out)
     elif Path(target).is_dir():
         from .run_report import report_results_dir
 
@@ -55,6 +61,12 @@ def main(args):
         )
     log.info("report written: %s and %s (%d figures)", built.html, built.markdown, len(built.figures))
     return 0
+
+
+def _studies(target):
+    from .study_report import is_study_dir
+
+    return is_study_dir(target)
 
 
 def _is_scene(target):

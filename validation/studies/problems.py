@@ -187,6 +187,7 @@ ERROR_TIME_PROBLEMS = {
 
 def get_problem(name):
     """A built-in error-time problem by name (``"hertz"``, ``"paper-root"``)."""
+    name = str(name).replace("_", "-")  # the built-in scene is called paper_root
     check_choice("scene", name, tuple(ERROR_TIME_PROBLEMS))
     return ERROR_TIME_PROBLEMS[name]
 

@@ -1,0 +1,130 @@
+"""Report of the validation studies: error against run time, and stability.
+
+Reads what ``contactlab study error-time --out DIR`` and ``contactlab study stability
+--out DIR`` write (``error_time.json``, ``stability.json``) and builds a report with the
+work-precision plot per problem, the "first to reach" table and the stability table
+coloured by status. Only the studies present in ``DIR`` get a section.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+from pathlib import Path
+
+from bem._validate import InputError
+
+from .build import build_report
+from .figures_validation import plot_work_precision
+from .sections import Figure, Section, Table, table_from_rows
+
+__all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "report_studies_dir"]
+
+STUDY_FILES = ("error_time.json", "stability.json")
+
+
+def is_study_dir(directory):
+    """True when ``directory`` holds at least one study file."""
+    return any((Path(directory) / name).is_file() for name in STUDY_FILES)
+
+
+def _label(row):
+    method = row["method"]
+    if row.get("relaxation") not in (None, 1, 1.0):
+        method = f"{method} (omega={row['relaxation']:g})"
+    return method
+
+
+def _error_time_sections(data, work):
+    rows = data.get("rows", [])
+    sections = []
+    for problem in dict.fromkeys(r["problem"] for r in rows):
+        mine = [r for r in rows if r["problem"] == problem]
+        ref = data.get("references", {}).get(problem, {})
+        ref_text = ref.get("description") if isinstance(ref, dict) else str(ref)
+        items = []
+        for metric, label in (("error_l2", "relative L2 error of p over the contact"),
+                              ("error_peak", "relative error of the peak pressure")):
+            wp = [{"solver": r["solver"], "method": _label(r), "resolution": r["resolution"], "N": r["n"],
+                   "error": r[metric], "wall_time_s": r["wall_time_s"]} for r in mine if r["converged"]]
+            if not wp:
+                continue
+            path = plot_work_precision(wp, Path(work) / f"work_precision_{problem}_{metric}.png",
+                                       error_label=label, title=f"{problem}: {label} against run time")
+            items.append(Figure(path, f"Work-precision, {problem}: {label} against the wall time "
+                                      "(median of repeats) of every converged run; one line per solver "
+                                      "and method, a marker per resolution (nodes across the contact for "
+                                      "the BEM, elements across the contact radius for the FEM); dotted "
+                                      "lines at 1 % and 0.1 %."))
+        columns = ("solver", "method", "resolution", "N", "L2 error", "peak error", "time [s]", "iterations",
+                   "status")
+        table_rows = [(r["solver"], _label(r), r["resolution"], r["n"], r["error_l2"], r["error_peak"],
+                       r["wall_time_s"], r["iterations"], "converged" if r["converged"] else "failed")
+                      for r in mine]
+        items.append(Table(columns, tuple(table_rows), caption=f"Every run of the {problem} ladder.",
+                           status_column="status"))
+        text = [f"Reference: {ref_text}."] if ref_text else []
+        sections.append(Section(f"Error against run time: {problem}", "validation", text, items))
+    first = data.get("first_to_reach", {})
+    if first:
+        flat = []
+        for problem, metrics in first.items():
+            for metric, targets in metrics.items():
+                for target, hit in targets.items():
+                    hit = hit or {}
+                    flat.append({"problem": problem, "error": metric.replace("error_", ""),
+                                 "target": f"{float(target):.1%}", "first": " ".join(
+                                     str(hit[k]) for k in ("solver", "method") if hit.get(k)) or "none reached it",
+                                 "resolution": hit.get("resolution", "-"), "time [s]": hit.get("wall_time_s")})
+        table = table_from_rows(flat, caption="The fastest converged run that reaches each target and stays "
+                                              "below it at every finer level of the same method.", status="")
+        notes = [str(n) for n in data.get("notes", [])]
+        sections.append(Section("Which method reaches 1 % and 0.1 % first", "validation", notes, (table,)))
+    return sections
+
+
+def _stability_sections(data):
+    rows = data.get("rows", [])
+    columns = [c for c in ("case", "solver", "method", "status", "kkt_residual", "error_vs_reference",
+                           "iterations", "wall_time_s", "message") if any(c in r for r in rows)]
+    counts = {}
+    for r in rows:
+        key = (r.get("solver", ""), r.get("method", ""))
+        counts.setdefault(key, {}).setdefault(r.get("status", "?"), 0)
+        counts[key][r.get("status", "?")] += 1
+    statuses = ("converged", "reported failure", "wrong")
+    summary = Table(("solver", "method") + statuses,
+                    tuple((s, m) + tuple(c.get(st, 0) for st in statuses) for (s, m), c in counts.items()),
+                    caption="Outcomes per solver and method: converged (and agreeing with the reference), "
+                            "reported failure (converged = false with a reason), wrong (a converged answer "
+                            "that disagrees with the reference, or NaN anywhere).")
+    detail = table_from_rows(rows, columns=columns, caption="Every case and method.", status="status")
+    text = ["Stiff and extreme cases: layer compliance over six decades, power exponents from 0.2 to 3, "
+            "a tiny elastic-rigid threshold, a contact of a few nodes, a contact filling the region, very "
+            "dissimilar moduli, and Poisson's ratio near 0.5 in the FEM. The study raises on any NaN or "
+            "wrong answer."]
+    return [Section("Stability", "stability", text, (summary, detail))]
+
+
+def study_sections(directory, work):
+    """Sections for the study files present in ``directory``."""
+    directory = Path(directory)
+    sections = []
+    path = directory / "error_time.json"
+    if path.is_file():
+        sections += _error_time_sections(json.loads(path.read_text()), work)
+    path = directory / "stability.json"
+    if path.is_file():
+        sections += _stability_sections(json.loads(path.read_text()))
+    if not sections:
+        raise InputError(f"directory = {str(directory)!r} is not allowed: it holds none of {list(STUDY_FILES)}.")
+    return sections
+
+
+def report_studies_dir(directory, out_dir=None, *, title="contactlab validation studies"):
+    """Report of the study files in ``directory`` (default ``out_dir``: ``directory/report``)."""
+    out_dir = Path(directory) / "report" if out_dir is None else Path(out_dir)
+    with tempfile.TemporaryDirectory(prefix="contactlab-figures-") as work:
+        sections = study_sections(directory, work)
+        return build_report(sections, out_dir, title=title,
+                            subtitle=f"Studies read from {Path(directory).resolve()}")
