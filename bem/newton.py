@@ -44,6 +44,27 @@ def _tangent(layer, p, gap, p_ref):
     return np.where(np.isfinite(d) & (p > 0), d, secant)
 
 
+def _majorant(layer, p, q, D, mask):
+    """``D`` raised where the quadratic model underestimates ``W`` on the move ``p -> q``.
+
+    The curvature that makes the model exact at ``q``,
+    ``D_maj = 2 [W(q) - W(p) - w(p) (q - p)] / (q - p)^2``, replaces ``D`` where it is
+    larger. For a concave law (``s < 1``) the tangent at ``p`` is too soft for a pressure
+    that falls towards 0, and a secant is too soft for a node entering the contact: the
+    model then drives such nodes to or from almost zero, where ``w'`` is huge, and the
+    step finds no descent. The raised ``D`` majorises ``W`` on the move.
+    """
+    moves = mask & (q != p)
+    qq, pp = np.maximum(q[moves], 0.0), p[moves]
+    step = qq - pp
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        d_maj = 2.0 * (layer.energy(qq) - layer.energy(pp) - layer.w(pp) * step) / (step * step)
+    out = D.copy()
+    raise_ = np.isfinite(d_maj) & (d_maj > D[moves])
+    out.flat[np.flatnonzero(moves)[raise_]] = d_maj[raise_]
+    return out
+
+
 def _line_search(layer, p, d, u, cd, h, delta, mask):
     """Exact minimiser of ``Phi(p + t d)`` on ``(0, 1]``: root of ``d.grad Phi(p + t d)``.
 
@@ -159,6 +180,17 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         d = sub.p - p
         cd = (sub.displacement - D * sub.p) - u
         t = _line_search(layer, p, d, u, cd, h, delta, mask)
+        if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
+            scale = float(np.abs(u + np.where(mask, layer.w(p), 0.0)).max())
+            D = _majorant(layer, p, sub.p, D, mask)
+            b = h + np.where(mask, layer.w(p), 0.0) - D * p
+            sub = solve_qp(op, b, force=force, approach=approach, lam=D, x0=p, rtol=max(rtol / 3, 1e-3 * kkt),
+                           maxiter=4 * inner_maxiter, scale=scale,
+                           precondition=compliance_preconditioner(op, D, contact) if precondition else None)
+            applies += sub.applies
+            d = sub.p - p
+            cd = (sub.displacement - D * sub.p) - u
+            t = _line_search(layer, p, d, u, cd, h, delta, mask)
         hist["step"].append(t)
         hist["inner_iterations"].append(sub.iterations)
         if t == 0.0:
