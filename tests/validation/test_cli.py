@@ -1,6 +1,5 @@
 """The contactlab command line: help, listing, check, run exit codes, dispatch to studies/reports."""
 
-import importlib.util
 import json
 import sys
 import types
@@ -91,25 +90,6 @@ def test_default_output_directory(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code, out, _ = cli("run", "elliptic", "--set", "bem.nodes_across=16")
     assert code == 0 and (tmp_path / "results" / "elliptic" / "result.json").is_file()
-
-
-def _missing(module):
-    try:
-        return importlib.util.find_spec(module) is None
-    except ModuleNotFoundError:
-        return True
-
-
-@pytest.mark.parametrize("argv, module", [
-    (["study", "error-time", "hertz"], "validation.studies.error_time"),
-    (["study", "stability"], "validation.studies.stability"),
-    (["report", "hertz"], "validation.report"),
-])
-def test_missing_study_or_report_is_a_clear_error(argv, module):
-    if not _missing(module):
-        pytest.skip(f"{module} is installed")
-    code, _out, err = cli(*argv)
-    assert code == 2 and "not available" in err and module in err
 
 
 @pytest.mark.parametrize("argv, module", [
