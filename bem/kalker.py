@@ -61,7 +61,7 @@ def _initial(op, h, lam, force, approach, x0):
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, precondition=None, callback=None, frozen=None, scale=None):
+             maxiter=None, precondition=None, callback=None, scale=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
 
     Parameters
@@ -85,9 +85,6 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         Callable ``z = M(r)`` on brick arrays approximating ``(C + lam)^-1``.
     callback : callable, optional
         ``callback(k, p)`` after every iteration.
-    frozen : ndarray of bool, optional
-        Nodes held at ``p = 0`` (infinite compliance); they are left out of the
-        problem and of the KKT residual.
     scale : float, optional
         Displacement scale of the KKT residual [length]; default
         ``max |C p + lam p|``. A caller whose ``lam`` is a model curvature (Newton)
@@ -109,7 +106,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     recomputed ``C p``.
     """
     lat = op.lattice
-    mask = lat.mask if frozen is None else lat.mask & ~frozen
+    mask = lat.mask
     a = lat.node_area
     lam = np.where(mask, lam, 0.0) if np.ndim(lam) else float(lam)
     h = np.where(mask, h, 0.0)
