@@ -9,10 +9,10 @@ nonlinear interface layer (paper sections 4-5, DESIGN.md).
 from . import gaps, layers
 from .lattice import Lattice
 from .materials import effective_modulus
-from .operator import InfluenceOperator
+from .operator import InfluenceOperator, diagonal_coefficient
 from .result import ContactResult
 from .solve import METHODS, RegionTooSmallError, solve
 from .template import template
 
 __all__ = ["solve", "template", "Lattice", "InfluenceOperator", "ContactResult", "METHODS",
-           "RegionTooSmallError", "effective_modulus", "gaps", "layers"]
+           "RegionTooSmallError", "diagonal_coefficient", "effective_modulus", "gaps", "layers"]

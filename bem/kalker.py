@@ -130,6 +130,11 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     prev_contact = p > 0
     m_one = None
     fixed_scale = scale
+    # With a per-node compliance the preconditioner holds Jacobi blocks that differ by
+    # decades, and plain mean subtraction would wreck it: project obliquely. For a uniform
+    # compliance the FFT preconditioner is translation invariant and the mean is cheaper
+    # (measured on Hertz, 1,050,113 nodes: 15 iterations and 3.7 s against 21 and 6.6 s).
+    oblique = np.ndim(lam) > 0
     for k in range(1, maxiter + 1):
         contact = p > 0
         if force is not None:
@@ -164,7 +169,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 z = np.where(contact, z - z[contact].mean(), 0.0)
         else:
             z = np.where(contact, precondition(g_c), 0.0)
-            if force is not None:
+            if force is not None and not oblique:
+                z = np.where(contact, z - z[contact].mean(), 0.0)
+            elif force is not None:
                 # oblique projection onto sum z = 0: z - M1 (1.z) / (1.M1), M1 cached per contact set
                 if m_one is None or changes:
                     m_one = np.where(contact, precondition(contact.astype(float)), 0.0)

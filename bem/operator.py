@@ -22,7 +22,16 @@ import numpy as np
 from ._validate import check_positive
 from .template import template
 
-__all__ = ["InfluenceOperator"]
+__all__ = ["InfluenceOperator", "diagonal_coefficient"]
+
+
+def diagonal_coefficient(step, E_star):
+    """Diagonal influence coefficient ``C_nn = c / (pi E*) w_t(0, 0)`` [length/pressure] (eq. 6).
+
+    The closure of a node under its own unit pyramid; the paper states layer
+    compliances in units of it (``lam = 10 C_nn``, Fig. 5).
+    """
+    return check_positive("step", step) / (math.pi * check_positive("E_star", E_star)) * float(template(0.0, 0.0))
 
 
 def _workers():
@@ -73,7 +82,7 @@ class InfluenceOperator:
                 t = (np.abs(dm)[None, :] - n % 2) // 2
                 kernel[a, b][np.ix_(dk % lk, dq % lq)] = table[n, t]
         self._kernel_hat = sfft.rfft2(kernel * scale, workers=_workers())
-        self.diagonal = scale * table[0, 0]
+        self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
 
     def _template_table(self):
         """``w_t`` at every offset ``(m/2, n*sqrt(3)/2)`` with ``m = n mod 2`` (lattice units)."""

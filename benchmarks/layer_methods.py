@@ -45,7 +45,7 @@ def main(argv=None):
     a = (3 / 4) ** (1 / 3)
     p0 = 3 / (2 * math.pi * a * a)
     step = 2 * a / args.across
-    lam = args.factor * step / math.pi * float(bem.template(0, 0))
+    lam = args.factor * bem.diagonal_coefficient(step, 1.0)
     print(f"paper problem, {args.across} nodes across, lam = {args.factor:g} C_nn, omega = {args.relaxation:g}")
     print("| law | method | converged | iterations | time [s] | KKT residual | L2 diff. from Newton | message |")
     print("|---|---|---|---|---|---|---|---|")

@@ -29,7 +29,7 @@ from __future__ import annotations
 import logging
 import math
 
-from bem import template
+from bem.operator import diagonal_coefficient
 from bem.layers import LAWS, Bilinear, ElasticRigid, Linear, Root, from_dict
 
 from ._checks import SceneError, in_range, positive, scene_errors, string, table, unknown_keys
@@ -55,9 +55,7 @@ ALIASES = {"alpha_a": "layer.alpha_a", "alpha_b": "layer.alpha_b", "alpha_c": "l
 _ALPHA_B_XTOL = 1e-5  # relative tolerance on lam_r when targeting alpha_b
 
 
-def c_nn(step, E_star):
-    """Diagonal influence coefficient ``C_nn = c / (pi E*) w_t(0, 0)`` [length/pressure] (eq. 6)."""
-    return step / (math.pi * E_star) * float(template(0.0, 0.0))
+c_nn = diagonal_coefficient  # ``C_nn = c / (pi E*) w_t(0, 0)``, defined once in bem.operator
 
 
 def _check_paper_values(path, d):
@@ -173,6 +171,32 @@ def _root_for_alpha_b(alpha_b, p_lambda, lam_r0, solve):
     return math.exp(t), len(cache)
 
 
+def paper_law(law, lam, p_lambda=None, *, alpha_a=None, alpha_c=None, p_cr=None, p_star=None, lam2=None,
+              root_factor=1.0):
+    """A layer law of the paper's section 6 from its parameters.
+
+    ``p_lambda`` is ``p_max^lambda``, the peak pressure of the same problem with the
+    linear layer ``lam``. Elastic-rigid: ``p_cr = alpha_a p_lambda``; bilinear:
+    ``lam2 = lam tan(alpha_c)``, ``p_star = alpha_a p_lambda``; root:
+    ``lam_r = root_factor lam sqrt(p_lambda)`` (closes as the linear layer does at
+    ``p_lambda`` for ``root_factor = 1``). Explicit ``p_cr``, ``p_star``, ``lam2`` win over
+    the alphas. A zero threshold gives no layer (``None``: the paper's ``alpha_a = 0`` is
+    the smooth contact), a bilinear law with a zero knee the linear layer ``lam2``.
+    """
+    if law == "linear":
+        return Linear(lam)
+    if law == "elastic_rigid":
+        p_cr = alpha_a * p_lambda if p_cr is None else p_cr
+        return ElasticRigid(lam, p_cr) if p_cr > 0 else None
+    if law == "bilinear":
+        lam2 = lam * math.tan(alpha_c) if lam2 is None else lam2
+        p_star = alpha_a * p_lambda if p_star is None else p_star
+        return Bilinear(lam, lam2, p_star) if p_star > 0 else (Linear(lam2) if lam2 > 0 else None)
+    if law == "root":
+        return Root(root_factor * lam * math.sqrt(p_lambda))
+    raise SceneError(f"layer.law = {law!r} is not allowed: it must be one of {sorted(PAPER_LAWS)}.")
+
+
 def resolve_layer(spec, *, step, E_star, solve):
     """Build the layer law of a validated spec, solving the linear reference first if needed.
 
@@ -212,23 +236,17 @@ def resolve_layer(spec, *, step, E_star, solve):
         p_lambda = solve(Linear(lam_ref)).p_max
         info.update(p_max_lambda=p_lambda, reference_solves=1)
         log.info("linear reference layer lam = %.6g: p_max^lambda = %.6g", lam_ref, p_lambda)
-    if law == "linear":
-        layer = Linear(lam_ref)
-    elif law == "elastic_rigid":
-        p_cr = spec.get("p_cr", p_lambda * spec["alpha_a"] if "alpha_a" in spec else None)
+    layer = paper_law(law, lam_ref, p_lambda, alpha_a=spec.get("alpha_a"), alpha_c=spec.get("alpha_c"),
+                      p_cr=spec.get("p_cr"), p_star=spec.get("p_star"), lam2=spec.get("lam2"))
+    if law in ("elastic_rigid", "bilinear"):
         info["alpha_a"] = spec.get("alpha_a")
-        layer = ElasticRigid(lam_ref, p_cr) if p_cr > 0 else None
-    elif law == "bilinear":
+    if law == "bilinear":
         lam2 = spec["lam2"] if "lam2" in spec else lam_ref * math.tan(spec["alpha_c"])
-        p_star = spec["p_star"] if "p_star" in spec else p_lambda * spec["alpha_a"]
-        info.update(alpha_a=spec.get("alpha_a"), alpha_c=math.atan2(lam2, lam_ref))
-        layer = Bilinear(lam_ref, lam2, p_star) if p_star > 0 else (Linear(lam2) if lam2 > 0 else None)
-    else:  # root
-        lam_r = lam_ref * math.sqrt(p_lambda)
-        if "alpha_b" in spec:
-            info["alpha_b_target"] = spec["alpha_b"]
-            lam_r, n = _root_for_alpha_b(spec["alpha_b"], p_lambda, lam_r, solve)
-            info["reference_solves"] += n
+        info["alpha_c"] = math.atan2(lam2, lam_ref)
+    if law == "root" and "alpha_b" in spec:
+        info["alpha_b_target"] = spec["alpha_b"]
+        lam_r, n = _root_for_alpha_b(spec["alpha_b"], p_lambda, layer.lam, solve)
+        info["reference_solves"] += n
         layer = Root(lam_r)
     if layer is None:
         log.info("%s layer with a zero threshold: smooth contact (no layer), as in the paper", law)

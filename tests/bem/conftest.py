@@ -12,7 +12,7 @@ A_HERTZ = (3 * FORCE * R / (4 * E_STAR)) ** (1 / 3)
 P0_HERTZ = 3 * FORCE / (2 * math.pi * A_HERTZ**2)
 STEP = 2 * A_HERTZ / 30
 EXTENT = 2.2 * A_HERTZ
-C_NN = STEP / (math.pi * E_STAR) * float(bem.template(0, 0))
+C_NN = bem.diagonal_coefficient(STEP, E_STAR)
 
 
 def paper_laws(factor):

@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+import bem
 from bem.lattice import Lattice
 from bem.operator import InfluenceOperator
 from bem.template import template
@@ -31,7 +32,10 @@ def test_dense_matrix_is_eq6_and_symmetric_positive_definite():
     n, m = 5, 17
     expected = 0.2 / (math.pi * 3.0) * template((x[n] - x[m]) / 0.2, (y[n] - y[m]) / 0.2)
     assert C[n, m] == pytest.approx(float(expected), rel=1e-14)
-    assert op.diagonal == pytest.approx(0.2 / (math.pi * 3.0) * 1.5 * math.sqrt(3) * math.log(3), rel=1e-14)
+    expected_diagonal = 0.2 / (math.pi * 3.0) * 1.5 * math.sqrt(3) * math.log(3)
+    assert op.diagonal == pytest.approx(expected_diagonal, rel=1e-14)
+    assert C[0, 0] == pytest.approx(expected_diagonal, rel=1e-14)
+    assert bem.diagonal_coefficient(0.2, 3.0) == pytest.approx(expected_diagonal, rel=1e-14)
     np.testing.assert_allclose(C, C.T, rtol=1e-12)  # template round-off, mirrored points
     assert np.linalg.eigvalsh(C).min() > 0
 

@@ -26,8 +26,9 @@ def _errors(res, ref):
 
 
 def _solve(n_across, **kw):
+    kw = {"precondition": True, **kw}
     return bem.solve(Paraboloid(R), E_star=E_STAR, force=FORCE, step=2 * HERTZ.a / n_across,
-                     extent=1.5 * HERTZ.a, precondition=True, **kw)
+                     extent=1.5 * HERTZ.a, **kw)
 
 
 @pytest.fixture(scope="module")
@@ -86,10 +87,12 @@ def test_approach_control_reproduces_force_control():
 
 
 def test_preconditioning_and_nesting_do_not_change_the_answer():
-    plain = _solve(40, nested=False)
+    plain = _solve(40, nested=False, precondition=False)
     fast = _solve(40)
     assert plain.converged and fast.converged
     assert np.abs(plain.p - fast.p).max() <= 1e-8 * plain.p_max
+    # and they pay: fewer iterations on the finest lattice (measured 46 -> 25 at this size)
+    assert fast.iterations < plain.iterations
 
 
 def test_elliptic_hertz():

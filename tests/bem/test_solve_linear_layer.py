@@ -27,7 +27,7 @@ def _dense_reference(res, lam, approach):
 @pytest.mark.parametrize("lam_factor", [0.1, 10.0])
 def test_winkler_layer_matches_dense_nnls(lam_factor):
     step = 0.05
-    lam = lam_factor * step / (np.pi * E_STAR) * bem.template(0, 0)  # multiples of C_nn
+    lam = lam_factor * bem.diagonal_coefficient(step, E_STAR)
     res = bem.solve(Paraboloid(R), E_star=E_STAR, force=0.02, step=step, extent=0.6, layer=Linear(lam),
                     method="kalker", rtol=1e-12)
     assert res.converged and res.p.size < 700

@@ -21,7 +21,7 @@ from validation.report.style import DPI, atomic_path, save_figure
 HERTZ = hertz_sphere(R=1.0, E_star=1.0, force=1.0)
 A, P0 = HERTZ.a, HERTZ.p0
 STEP = A / 6
-LAM = 10 * STEP / math.pi * bem.template(0.0, 0.0)
+LAM = 10 * bem.diagonal_coefficient(STEP, 1.0)
 
 
 def _solve(layer=None, **kw):

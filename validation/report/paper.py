@@ -29,6 +29,7 @@ import numpy as np
 
 import bem
 from validation.analytic import hertz_sphere
+from validation.paper import paper_law
 
 __all__ = ["PaperProblem", "PaperResults", "solve_paper_problem", "AG_RELAXATION"]
 
@@ -101,8 +102,7 @@ class PaperProblem:
     @property
     def C_nn(self):
         """Diagonal influence coefficient of the reference step, ``c / (pi E*) w_t(0, 0)``."""
-        c_ref = self.a / self.lam_nodes_per_radius
-        return c_ref / (math.pi * self.E_star) * bem.template(0.0, 0.0)
+        return bem.diagonal_coefficient(self.a / self.lam_nodes_per_radius, self.E_star)
 
     @property
     def lam(self):
@@ -119,14 +119,14 @@ class PaperProblem:
         return 2.0 * (1.0 - self.nu**2) * self.E_star
 
     def elastic_rigid(self, alpha_a, p_lin):
-        return bem.layers.ElasticRigid(self.lam, alpha_a * p_lin)
+        return paper_law("elastic_rigid", self.lam, p_lin, alpha_a=alpha_a)
 
     def root(self, factor, p_lin):
-        return bem.layers.Root(factor * self.lam * math.sqrt(p_lin))
+        return paper_law("root", self.lam, p_lin, root_factor=factor)
 
     def bilinear(self, alpha_c, p_lin, alpha_a=None):
         alpha_a = self.alpha_a if alpha_a is None else alpha_a
-        return bem.layers.Bilinear(self.lam, self.lam * math.tan(alpha_c), alpha_a * p_lin)
+        return paper_law("bilinear", self.lam, p_lin, alpha_a=alpha_a, alpha_c=alpha_c)
 
     def solve(self, layer=None, *, method="newton", nodes_per_radius=None, **options):
         """:func:`bem.solve` of the problem; the candidate region grows until it holds the contact."""
