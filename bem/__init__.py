@@ -6,13 +6,14 @@ FFT-fast products, and Kalker's variational principle generalised to a
 nonlinear interface layer (paper sections 4-5, DESIGN.md).
 """
 
-from . import gaps, layers
+from . import checks, gaps, layers
+from .errors import InputError, RegionTooSmallError
 from .lattice import Lattice
 from .materials import effective_modulus
 from .operator import InfluenceOperator, diagonal_coefficient
 from .result import ContactResult
-from .solve import METHODS, RegionTooSmallError, solve
+from .solve import METHODS, solve
 from .template import template
 
 __all__ = ["solve", "template", "Lattice", "InfluenceOperator", "ContactResult", "METHODS",
-           "RegionTooSmallError", "diagonal_coefficient", "effective_modulus", "gaps", "layers"]
+           "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient", "effective_modulus", "gaps", "layers"]

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bem._validate import InputError, _fail, check_choice, check_finite_array
+from bem.checks import InputError, fail, check_choice, check_finite_array
 
 from .gaps import Gap
 
@@ -48,10 +48,10 @@ class Table(Gap):
         except InputError as exc:
             raise InputError(str(exc).rstrip(".") + self._where_nonfinite(h) + ".") from None
         if self.h.shape != (self.x.size, self.y.size):
-            _fail("h.shape", self.h.shape, f"(len(x), len(y)) = {(self.x.size, self.y.size)}")
+            fail("h.shape", self.h.shape, f"(len(x), len(y)) = {(self.x.size, self.y.size)}")
         if (self.h < 0).any():
             i, j = np.argwhere(self.h < 0)[0]
-            _fail(f"h[{i}, {j}] (at x = {float(self.x[i])!r}, y = {float(self.y[j])!r})", float(self.h[i, j]),
+            fail(f"h[{i}, {j}] (at x = {float(self.x[i])!r}, y = {float(self.y[j])!r})", float(self.h[i, j]),
                   ">= 0 (a gap is a separation; subtract h.min() from the table)")
         self.domain = ((self.x[0], self.x[-1]), (self.y[0], self.y[-1]))
         from scipy.interpolate import RegularGridInterpolator
@@ -73,7 +73,7 @@ class Table(Gap):
         if not ok.all():
             i = np.unravel_index(np.argmin(ok), ok.shape)
             pt = (v[i], other[i]) if name == "x" else (other[i], v[i])
-            _fail("point (x, y)", tuple(float(c) for c in pt),
+            fail("point (x, y)", tuple(float(c) for c in pt),
                   f"inside the gap table, x in [{self.x[0]}, {self.x[-1]}] and y in [{self.y[0]}, {self.y[-1]}]")
         return np.clip(v, lo, hi)
 
@@ -96,5 +96,5 @@ def _axis(name, values, min_points):
     arr = np.array(check_finite_array(name, values, ndim=1, min_size=min_points))
     if (np.diff(arr) <= 0).any():
         k = int(np.argmax(np.diff(arr) <= 0))
-        _fail(f"{name}[{k + 1}]", float(arr[k + 1]), f"> {name}[{k}] = {float(arr[k])!r} (strictly increasing)")
+        fail(f"{name}[{k + 1}]", float(arr[k + 1]), f"> {name}[{k}] = {float(arr[k])!r} (strictly increasing)")
     return arr

@@ -26,7 +26,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from bem._validate import InputError, _fail, check_callable, check_choice, check_finite_array, check_positive
+from bem.checks import InputError, fail, check_callable, check_choice, check_finite_array, check_positive
 
 __all__ = ["Gap", "Paraboloid", "EllipticParaboloid", "CrownedRoller", "FlatPunch", "Callable",
            "Table", "gap_from_dict", "lundberg_coefficient"]
@@ -203,17 +203,17 @@ class CrownedRoller(Gap):
         given = {"A": A, "crown_radius": crown_radius, "design_force": design_force, "E_star": E_star}
         for name, value in given.items():
             if value is not None and name not in self.CROWN_KEYS[self.crown]:
-                _fail(name, value, f'left out for crown="{self.crown}"')
+                fail(name, value, f'left out for crown="{self.crown}"')
         self.A = self.crown_radius = None
         if self.crown == "log":
             if (A is None) == (design_force is None):
-                _fail("(A, design_force)", (A, design_force), 'exactly one given for crown="log"')
+                fail("(A, design_force)", (A, design_force), 'exactly one given for crown="log"')
             if A is not None:
                 if E_star is not None:
-                    _fail("E_star", E_star, "left out when A is given (it only sets A from design_force)")
+                    fail("E_star", E_star, "left out when A is given (it only sets A from design_force)")
                 self.A = check_positive("A", A)
             elif E_star is None:
-                _fail("E_star", E_star, "given with design_force (A = design_force / (pi length E_star))")
+                fail("E_star", E_star, "given with design_force (A = design_force / (pi length E_star))")
             else:
                 self.A = lundberg_coefficient(design_force, self.length, E_star)
         elif self.crown == "circular":
@@ -271,20 +271,20 @@ class FlatPunch(_Axisymmetric):
 def _function_path(f):
     module, qualname = getattr(f, "__module__", None), getattr(f, "__qualname__", "")
     if not module or "<" in qualname or module == "__main__":
-        _fail("function", f, "a module-level function (importable as 'module:name') to be written to a dict")
+        fail("function", f, "a module-level function (importable as 'module:name') to be written to a dict")
     return f"{module}:{qualname}"
 
 
 def _import_function(path):
     if not isinstance(path, str) or path.count(":") != 1:
-        _fail("function", path, "a string 'module:name'")
+        fail("function", path, "a string 'module:name'")
     module, qualname = path.split(":")
     try:
         obj = importlib.import_module(module)
         for part in qualname.split("."):
             obj = getattr(obj, part)
     except (ImportError, AttributeError) as exc:
-        _fail("function", path, f"importable ({exc})")
+        fail("function", path, f"importable ({exc})")
     return obj
 
 
@@ -362,12 +362,12 @@ def gap_from_dict(d):
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         Unknown type, unknown or missing key (the message names it), or a bad
         parameter value.
     """
     if not isinstance(d, Mapping):
-        _fail("gap", d, "a mapping with a 'type' key")
+        fail("gap", d, "a mapping with a 'type' key")
     params = dict(d)
     kind = check_choice("gap['type']", params.pop("type", None), tuple(_TYPES))
     cls = _TYPES[kind]
@@ -375,9 +375,9 @@ def gap_from_dict(d):
     allowed = [p for p in sig.parameters if p != "self"]
     for key in params:
         if key not in allowed:
-            _fail(f"gap key {key!r}", params[key],
+            fail(f"gap key {key!r}", params[key],
                   f"left out: a {kind!r} gap takes only " + ", ".join(map(repr, allowed)))
     for name, p in sig.parameters.items():
         if name != "self" and p.default is inspect.Parameter.empty and name not in params:
-            _fail(f"gap[{name!r}]", None, f"given for a {kind!r} gap")
+            fail(f"gap[{name!r}]", None, f"given for a {kind!r} gap")
     return cls(**params)

@@ -20,7 +20,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ._validate import InputError, check_positive
+from .checks import InputError, check_positive
 
 __all__ = ["Lattice", "SQRT3"]
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from bem._validate import _fail, check_positive, check_range
+from bem.checks import fail, check_positive, check_range
 
 __all__ = ["NU_MIN", "NU_MAX", "compliance", "effective_modulus"]
 
@@ -43,7 +43,7 @@ def compliance(E, nu, *, name="E", nu_name="nu"):
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         If ``E`` is not a positive real (``inf`` allowed) or ``nu`` is outside
         ``(-1, 0.5]``.
     """
@@ -78,12 +78,12 @@ def effective_modulus(E1, nu1, E2, nu2):
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         Names the offending argument; also raised when both bodies are rigid.
     """
     total = compliance(E1, nu1, name="E1", nu_name="nu1") + compliance(
         E2, nu2, name="E2", nu_name="nu2"
     )
     if total == 0.0:
-        _fail("(E1, E2)", (E1, E2), "not both infinite (two rigid bodies have no contact modulus)")
+        fail("(E1, E2)", (E1, E2), "not both infinite (two rigid bodies have no contact modulus)")
     return 1.0 / total

@@ -19,7 +19,7 @@ import os
 
 import numpy as np
 
-from ._validate import check_positive
+from .checks import check_positive
 from .template import template
 
 __all__ = ["InfluenceOperator", "diagonal_coefficient"]

@@ -7,7 +7,8 @@ import time
 
 import numpy as np
 
-from ._validate import InputError, check_callable, check_choice, check_positive
+from .checks import check_callable, check_choice, check_positive
+from .errors import InputError, RegionTooSmallError
 from .kkt import kkt_residual
 from .lattice import Lattice
 from .materials import effective_modulus
@@ -21,10 +22,6 @@ log = logging.getLogger(__name__)
 METHODS = ("newton", "augmented_gap", "variable_compliance", "kalker")
 
 _COARSEST_NODES = 4096  # nested iteration stops coarsening below this many nodes
-
-
-class RegionTooSmallError(InputError):
-    """The computed contact reaches the border of the candidate region."""
 
 
 def _modulus(E_star, E1, nu1, E2, nu2):
@@ -117,7 +114,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         Bad input (the message names the argument).
     RegionTooSmallError
         The contact reaches the border of the candidate region.

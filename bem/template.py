@@ -63,7 +63,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from ._validate import InputError, check_finite_array
+from .checks import InputError, check_finite_array
 
 __all__ = ["template", "R_SWITCH"]
 
@@ -199,7 +199,7 @@ def template(x, y):
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         If ``x`` or ``y`` holds NaN/inf or the two do not broadcast.
 
     Notes

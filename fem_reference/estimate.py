@@ -30,7 +30,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from bem._validate import InputError, check_callable, check_positive
+from bem.checks import InputError, check_callable, check_positive
 
 __all__ = ["estimate_contact_radius", "hertz_radius", "layer_radius"]
 

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bem._validate import InputError, check_positive
+from bem.checks import InputError, check_positive
 
 __all__ = ["AxiMesh", "build_mesh", "BOUNDARIES"]
 

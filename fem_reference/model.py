@@ -37,7 +37,7 @@ import time
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from bem._validate import InputError, check_positive, check_range
+from bem.checks import InputError, check_positive, check_range
 
 __all__ = ["AxiModel", "lame", "check_materials"]
 

@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from bem._validate import InputError, check_callable, check_positive
+from bem.checks import InputError, check_callable, check_positive
 from bem.materials import effective_modulus
 
 from .estimate import estimate_contact_radius

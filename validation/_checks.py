@@ -1,7 +1,7 @@
 """Scene-file checks: every failure names the dotted key, shows the value and states the rule.
 
-Thin wrappers over :mod:`bem._validate` that raise :class:`SceneError` (an
-:class:`bem._validate.InputError`, hence a ``ValueError``) with the key written as a dotted
+Thin wrappers over :mod:`bem.checks` that raise :class:`SceneError` (an
+:class:`bem.InputError`, hence a ``ValueError``) with the key written as a dotted
 path into the scene file (``layer.lam``, ``bem.nodes_across``).
 """
 
@@ -11,8 +11,8 @@ import contextlib
 import math
 from collections.abc import Mapping
 
-from bem import _validate as v
-from bem._validate import InputError
+from bem import checks as v
+from bem.checks import InputError
 
 __all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one", "positive",
            "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair"]

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import elliprd, elliprf
 
-from bem._validate import _fail, check_callable, check_choice, check_finite_array, check_nonnegative, check_positive
+from bem.checks import fail, check_callable, check_choice, check_finite_array, check_nonnegative, check_positive
 
 __all__ = [
     "HertzSphere",
@@ -39,7 +39,7 @@ __all__ = [
 def _load(force, approach):
     """Exactly one of ``force`` / ``approach``, validated ``> 0``: ``(name, value)``."""
     if (force is None) == (approach is None):
-        _fail("(force, approach)", (force, approach), "exactly one given (force control or approach control)")
+        fail("(force, approach)", (force, approach), "exactly one given (force control or approach control)")
     return ("force", check_positive("force", force)) if force is not None else (
         "approach", check_positive("approach", approach))
 
@@ -266,20 +266,20 @@ def _power_parameters(law, lam, s):
             return lam, check_positive("s", s)
         fixed = _FIXED_EXPONENT[law]
         if s is not None and s != fixed:
-            _fail("s", s, f"left out (or {fixed}) for law={law!r}")
+            fail("s", s, f"left out (or {fixed}) for law={law!r}")
         return lam, fixed
     if lam is not None or s is not None:
-        _fail("(lam, s)", (lam, s), "left out when law is a layer object (they are read from it)")
+        fail("(lam, s)", (lam, s), "left out when law is a layer object (they are read from it)")
     lam = check_positive("law.lam", getattr(law, "lam", None))
     s = getattr(law, "s", None)
     if s is None:
         s = 1.0 if getattr(law, "is_linear", False) else 0.5 if type(law).__name__ == "Root" else None
     if s is None:
-        _fail("law", law, "a Linear, Power or Root layer, or 'linear', 'power', 'root' with lam (and s)")
+        fail("law", law, "a Linear, Power or Root layer, or 'linear', 'power', 'root' with lam (and s)")
     s = check_positive("law.s", s)
     p = np.array([0.5, 2.0])
     if not np.allclose(law.w(p), lam * p**s, rtol=1e-12, atol=0.0):
-        _fail("law", law, f"a power law w = lam * p**s with lam = {lam}, s = {s}")
+        fail("law", law, f"a power law w = lam * p**s with lam = {lam}, s = {s}")
     return lam, s
 
 

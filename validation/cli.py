@@ -14,7 +14,7 @@ import re
 import sys
 from pathlib import Path
 
-from bem._validate import InputError
+from bem.checks import InputError
 
 from .output import OutputError
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bem._validate import InputError, check_finite_array, check_positive
+from bem.checks import InputError, check_finite_array, check_positive
 from bem.result import ContactResult
 from fem_reference.result import FemResult
 

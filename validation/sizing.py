@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.gaps import CrownedRoller, EllipticParaboloid, Paraboloid
 from bem.lattice import SQRT3
 
@@ -47,7 +47,7 @@ def expected_semi_axes(gap, *, E_star, force=None, approach=None, layer=None):
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         The estimate failed (e.g. a gap that does not grow with the radius).
     """
     if gap.is_axisymmetric:

@@ -14,7 +14,7 @@ import importlib
 
 import numpy as np
 
-from .._validate import InputError, check_callable
+from ..checks import InputError, check_callable
 from .base import Layer
 
 __all__ = ["LawBase", "as_pressure", "as_closure", "out", "callable_ref", "resolve_callable"]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import check_nonnegative, check_positive
+from ..checks import check_nonnegative, check_positive
 from ._common import LawBase, as_closure, as_pressure, out
 
 __all__ = ["Linear", "Power", "Root", "Bilinear", "ElasticRigid"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import InputError, check_positive
+from ..checks import InputError, check_positive
 from ._common import LawBase, as_closure, as_pressure, callable_ref, out, resolve_callable
 from ._solve import invert
 

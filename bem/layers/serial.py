@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from .._validate import InputError, check_choice
+from ..checks import InputError, check_choice
 from .analytic import Bilinear, ElasticRigid, Linear, Power, Root
 from .base import Layer
 from .custom import Custom

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import InputError
+from ..checks import InputError
 from ._common import LawBase, as_closure, as_pressure, out
 from ._solve import invert
 from .base import Layer

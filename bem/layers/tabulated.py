@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import InputError, check_finite_array, check_nonnegative
+from ..checks import InputError, check_finite_array, check_nonnegative
 from ._common import LawBase, as_closure, as_pressure, out
 from ._solve import newton_bisect
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.gaps import (
     Callable,
     CrownedRoller,

@@ -63,7 +63,7 @@ def test_kkt_of_eq14_holds_at_every_returned_solution(paper, method, law):
 
 
 def test_kalker_refuses_a_nonlinear_layer(paper):
-    with pytest.raises(bem._validate.InputError, match="method"):
+    with pytest.raises(bem.InputError, match="method"):
         paper(layers.Root(1.0), "kalker")
 
 

@@ -7,7 +7,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.layers import (
     LAWS,
     Bilinear,

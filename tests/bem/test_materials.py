@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.materials import compliance, effective_modulus
 
 

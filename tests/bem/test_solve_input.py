@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import bem
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.gaps import Paraboloid
 
 GOOD = dict(E_star=1.0, force=0.01, step=0.05, extent=0.5)

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from scipy.integrate import dblquad
 
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.template import R_SWITCH, template
 
 tmpl_module = sys.modules["bem.template"]

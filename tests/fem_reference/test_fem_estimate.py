@@ -7,7 +7,7 @@ import pytest
 from .fem_cases import E, NU, P, R, e_star, hertz
 
 import fem_reference as fr
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.gaps import Paraboloid
 from bem.layers import Linear
 

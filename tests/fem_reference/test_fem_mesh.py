@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from bem._validate import InputError
+from bem.checks import InputError
 from fem_reference import build_mesh
 from fem_reference.mesh import BOUNDARIES
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from bem._validate import InputError
+from bem.checks import InputError
 from fem_reference.fields import nodal_stresses
 from fem_reference.model import AxiModel
 

@@ -5,7 +5,7 @@ import pytest
 from .fem_cases import E, NU, P
 
 import fem_reference as fr
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.layers import Linear, Root
 
 

@@ -8,7 +8,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.special import ellipe, ellipk
 
-from bem._validate import InputError
+from bem.checks import InputError
 from validation.analytic import (
     hertz_elliptic,
     hertz_sphere,

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import bem
-from bem._validate import InputError
+from bem.checks import InputError
 from bem.gaps import EllipticParaboloid, Paraboloid
 from fem_reference.result import FemResult
 from validation.analytic import hertz_elliptic, hertz_sphere

@@ -10,7 +10,7 @@ from argparse import Namespace
 import numpy as np
 import pytest
 
-from bem._validate import InputError
+from bem.checks import InputError
 from validation.report import build as build_mod
 from validation.report import build_report, main
 from validation.report.sections import Figure, Section, Table, fmt, problem_section, status_class

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import bem
-from bem._validate import InputError
+from bem.checks import InputError
 from validation.analytic import hertz_sphere
 from validation.report import figures_3d as f3d
 from validation.report import figures_iterations as fit

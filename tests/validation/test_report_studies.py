@@ -7,7 +7,7 @@ import html5lib
 import numpy as np
 import pytest
 
-from bem._validate import InputError
+from bem.checks import InputError
 from validation.report.study_report import report_studies_dir
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import bem
-from bem._validate import InputError
+from bem.checks import InputError
 from validation.analytic import hertz_sphere
 from validation.studies import error_time, stability
 from validation.studies.error_time import ErrorTimeRow, ErrorTimeStudy, run_error_time

@@ -17,7 +17,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from bem._validate import InputError
+from bem.checks import InputError
 
 from .html import render_html
 from .markdown import render_markdown
@@ -93,7 +93,7 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None):
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         No sections, a non-Section item, or an ``out_dir`` that is not a report directory.
     """
     sections = list(sections)

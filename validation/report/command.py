@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from bem._validate import InputError
+from bem.checks import InputError
 
 __all__ = ["main", "DEFAULT_PAPER_OUT"]
 
@@ -33,7 +33,7 @@ def main(args):
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         Unknown target (a scene must be run first with ``contactlab run``) or an output
         directory that holds other files.
     """

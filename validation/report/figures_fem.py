@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bem._validate import InputError, check_positive
+from bem.checks import InputError, check_positive
 
 from .style import axis_labels, new_figure, save_figure
 

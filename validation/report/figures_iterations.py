@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bem._validate import InputError, check_positive
+from bem.checks import InputError, check_positive
 
 from .figures_profiles import auto_xlim, axial_section
 from .style import color_for, method_label, new_figure, save_figure

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bem._validate import InputError, check_positive
+from bem.checks import InputError, check_positive
 
 from .style import axis_labels, color_for, new_figure, save_figure
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bem._validate import InputError, check_positive
+from bem.checks import InputError, check_positive
 
 from .figures_profiles import auto_xlim
 from .style import new_figure, save_figure

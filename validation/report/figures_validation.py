@@ -8,7 +8,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from bem._validate import InputError, check_positive
+from bem.checks import InputError, check_positive
 
 from .style import SOLVER_COLORS, color_for, new_figure, save_figure
 

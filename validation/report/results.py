@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bem._validate import InputError
+from bem.checks import InputError
 
 __all__ = ["RunResults", "Units", "load_results", "parse_units", "display_unit"]
 
@@ -231,7 +231,7 @@ def load_results(directory):
 
     Raises
     ------
-    bem._validate.InputError
+    bem.InputError
         ``directory`` is not a directory or has no readable ``result.json`` holding an object.
     """
     directory = Path(directory)

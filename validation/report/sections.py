@@ -13,7 +13,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from bem._validate import InputError
+from bem.checks import InputError
 
 __all__ = ["Figure", "Table", "Section", "KINDS", "status_class", "fmt", "problem_section", "results_table",
            "quantity_rows", "table_from_rows"]

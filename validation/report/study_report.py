@@ -12,7 +12,7 @@ import json
 import tempfile
 from pathlib import Path
 
-from bem._validate import InputError
+from bem.checks import InputError
 
 from .build import build_report
 from .figures_validation import plot_work_precision

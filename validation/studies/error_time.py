@@ -26,7 +26,7 @@ import logging
 import math
 from dataclasses import asdict, dataclass, field
 
-from bem._validate import InputError, check_choice, check_positive
+from bem.checks import InputError, check_choice, check_positive
 
 from ..metrics import pair_metrics, relative_l2
 from . import fmt, markdown_table, timed, write_atomic, write_json

@@ -21,7 +21,7 @@ import numpy as np
 import bem
 import fem_reference
 from bem import layers
-from bem._validate import check_choice
+from bem.checks import check_choice
 from bem.gaps import Paraboloid
 from bem.materials import effective_modulus
 

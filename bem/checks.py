@@ -1,4 +1,4 @@
-"""Argument validation with uniform messages.
+"""Public argument checks with uniform messages.
 
 Every check raises :class:`InputError` (a ``ValueError``) whose message names
 the argument, shows the value and states the rule, e.g.::
@@ -13,8 +13,11 @@ from numbers import Real
 
 import numpy as np
 
+from .errors import InputError
+
 __all__ = [
     "InputError",
+    "fail",
     "check_positive",
     "check_nonnegative",
     "check_range",
@@ -24,20 +27,16 @@ __all__ = [
 ]
 
 
-class InputError(ValueError):
-    """Bad input: the message names the argument, the value and the rule."""
-
-
-def _fail(name, value, rule):
+def fail(name, value, rule):
     raise InputError(f"{name} = {value!r} is not allowed: it must be {rule}.")
 
 
 def _real(name, value):
     if isinstance(value, bool) or not isinstance(value, (Real, np.floating, np.integer)):
-        _fail(name, value, "a real number")
+        fail(name, value, "a real number")
     value = float(value)
     if not math.isfinite(value):
-        _fail(name, value, "finite")
+        fail(name, value, "finite")
     return value
 
 
@@ -45,7 +44,7 @@ def check_positive(name, value):
     """Return ``float(value)``; raise unless it is a finite real ``> 0``."""
     value = _real(name, value)
     if value <= 0:
-        _fail(name, value, "> 0")
+        fail(name, value, "> 0")
     return value
 
 
@@ -53,7 +52,7 @@ def check_nonnegative(name, value):
     """Return ``float(value)``; raise unless it is a finite real ``>= 0``."""
     value = _real(name, value)
     if value < 0:
-        _fail(name, value, ">= 0")
+        fail(name, value, ">= 0")
     return value
 
 
@@ -65,7 +64,7 @@ def check_range(name, value, low, high, *, low_open=False, high_open=False):
     if below or above:
         lo = "(" if low_open else "["
         hi = ")" if high_open else "]"
-        _fail(name, value, f"in {lo}{low}, {high}{hi}")
+        fail(name, value, f"in {lo}{low}, {high}{hi}")
     return value
 
 
@@ -91,12 +90,12 @@ def check_finite_array(name, value, *, ndim=None, min_size=1):
 def check_choice(name, value, choices):
     """Return ``value``; raise unless it is one of ``choices``."""
     if value not in choices:
-        _fail(name, value, "one of " + ", ".join(repr(c) for c in choices))
+        fail(name, value, "one of " + ", ".join(repr(c) for c in choices))
     return value
 
 
 def check_callable(name, value):
     """Return ``value``; raise unless it is callable."""
     if not callable(value):
-        _fail(name, value, "callable")
+        fail(name, value, "callable")
     return value
