@@ -180,8 +180,11 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         gz = float(np.sum(g_c * z))
         beta = 0.0 if restart else gz / gz_old
         t = np.where(contact, z + beta * t, 0.0)
-        if force is not None:  # nodes that left the contact broke the zero mean of t
-            t = np.where(contact, t - t[contact].mean(), 0.0)
+        if force is not None:  # nodes that left the contact broke the zero sum of t
+            if oblique and m_one is not None:
+                t = np.where(contact, t - m_one * (t[contact].sum() / m_one[contact].sum()), 0.0)
+            else:
+                t = np.where(contact, t - t[contact].mean(), 0.0)
         gz_old = gz
         r = apply(t)
         applies += 1
