@@ -24,6 +24,8 @@ __all__ = [
     "check_finite_array",
     "check_choice",
     "check_callable",
+    "check_int",
+    "check_bool",
 ]
 
 
@@ -99,3 +101,19 @@ def check_callable(name, value):
     if not callable(value):
         fail(name, value, "callable")
     return value
+
+
+def check_int(name, value, *, minimum=1):
+    """Return ``int(value)``; raise unless it is an integer ``>= minimum`` (not a bool)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        fail(name, value, f"an integer >= {minimum}")
+    if value < minimum:
+        fail(name, value, f">= {minimum}")
+    return int(value)
+
+
+def check_bool(name, value):
+    """Return ``value``; raise unless it is ``True`` or ``False``."""
+    if not isinstance(value, (bool, np.bool_)):
+        fail(name, value, "True or False")
+    return bool(value)

@@ -61,7 +61,7 @@ def _initial(op, h, lam, force, approach, x0):
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, precondition=None, callback=None, scale=None):
+             maxiter=None, preconditioner=None, callback=None, scale=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
 
     Parameters
@@ -81,8 +81,10 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         Tolerance on the KKT residual.
     maxiter : int, optional
         Iteration limit (default ``max(200, 10 * sqrt(N))``).
-    precondition : PreconditionerLike, optional
-        Callable ``z = M(r)`` on brick arrays approximating ``(C + lam)^-1``.
+    preconditioner : callable, optional
+        ``z = M(r)`` on brick arrays approximating ``(C + lam)^-1``
+        (:meth:`bem.operator.InfluenceOperator.preconditioner`,
+        :func:`compliance_preconditioner`).
     callback : callable, optional
         ``callback(k, p)`` after every iteration.
     scale : float, optional
@@ -163,18 +165,18 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 converged, message, kkt = True, "no contact at this approach", 0.0
                 break
         g_c = np.where(contact, g, 0.0)
-        if precondition is None:
+        if preconditioner is None:
             z = g_c
             if force is not None:
                 z = np.where(contact, z - z[contact].mean(), 0.0)
         else:
-            z = np.where(contact, precondition(g_c), 0.0)
+            z = np.where(contact, preconditioner(g_c), 0.0)
             if force is not None and not oblique:
                 z = np.where(contact, z - z[contact].mean(), 0.0)
             elif force is not None:
                 # oblique projection onto sum z = 0: z - M1 (1.z) / (1.M1), M1 cached per contact set
                 if m_one is None or changes:
-                    m_one = np.where(contact, precondition(contact.astype(float)), 0.0)
+                    m_one = np.where(contact, preconditioner(contact.astype(float)), 0.0)
                     applies += 1
                 z = z - m_one * (z[contact].sum() / m_one[contact].sum())
         gz = float(np.sum(g_c * z))
@@ -190,17 +192,23 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         applies += 1
         r_c = r[contact] - (r[contact].mean() if force is not None else 0.0)
         tt = float(np.sum(t[contact] * r_c))
-        if tt <= 0 or not np.isfinite(tt):
+        if not np.any(t[contact]):
+            # a single contact node under force control leaves no direction that keeps the
+            # force: only nodes entering the contact (below) can move the iterate
+            tau = 0.0
+        elif tt <= 0 or not np.isfinite(tt):
             message = f"search direction lost positive curvature (t.Ct = {tt:.3e})"
             break
-        tau = gz / tt
+        else:
+            tau = gz / tt
         p_new = p - tau * t
         clipped = p_new < 0
         p_new[clipped] = 0.0
         overlap = mask & (p_new == 0) & (g < 0)
         # re-entering nodes: Polonsky-Keer's -tau g, capped by the Jacobi estimate
         # -g / (C_nn + lam) so that a node with a large layer compliance cannot overshoot
-        p_new[overlap] = -g[overlap] * np.minimum(tau, 1.0 / (op.diagonal + (lam[overlap] if np.ndim(lam) else lam)))
+        jacobi = 1.0 / (op.diagonal + (lam[overlap] if np.ndim(lam) else lam))
+        p_new[overlap] = -g[overlap] * (np.minimum(tau, jacobi) if tau > 0 else jacobi)
         restart = bool(overlap.any())
         s = 1.0
         if target is not None:
@@ -217,7 +225,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     else:
         message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
     if not converged:
-        log.warning("Kalker QP: %s", message)
+        log.debug("Kalker QP: %s", message)
     return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
                       message=message, kkt_residual=float(kkt), displacement=u, history=hist,
                       applies=applies)

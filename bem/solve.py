@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from .checks import check_callable, check_choice, check_positive
+from .checks import check_bool, check_callable, check_choice, check_int, check_positive, check_range
 from .errors import InputError, RegionTooSmallError
 from .kkt import kkt_residual
 from .lattice import Lattice
@@ -15,7 +15,7 @@ from .materials import effective_modulus
 from .operator import InfluenceOperator
 from .result import ContactResult
 
-__all__ = ["solve", "METHODS", "RegionTooSmallError"]
+__all__ = ["solve", "solver_for", "METHODS", "OPTIONS", "RegionTooSmallError"]
 
 log = logging.getLogger(__name__)
 
@@ -54,6 +54,54 @@ def _levels(lattice, nested):
     return levels[::-1]
 
 
+#: Options each solver takes besides the common ones (``rtol``, ``maxiter``, ``x0``,
+#: ``nested``, ``precondition``, ``callback``). "kalker" is the QP, which also solves
+#: every problem without a layer and, for ``"newton"``, a linear layer.
+OPTIONS = {
+    "newton": ("record", "inner_maxiter"),
+    "augmented_gap": ("relaxation", "eps_h", "eps_p", "record"),
+    "variable_compliance": ("eps_p", "record"),
+    "kalker": (),
+}
+
+
+def solver_for(method, layer):
+    """The solver that runs for ``method`` and ``layer``: ``"kalker"`` where the problem is a QP.
+
+    Without a layer the functional is quadratic whatever the method, and so it is for
+    ``"newton"`` with a linear layer: Kalker's QP solves it directly.
+    """
+    if layer is None or (layer.is_linear and method in ("kalker", "newton")):
+        return "kalker"
+    return method
+
+
+def _check_options(method, solver, options):
+    """Refuse an unknown option, or one that does not apply to the solver that runs."""
+    known = {k for keys in OPTIONS.values() for k in keys}
+    for key, value in options.items():
+        if key not in known:
+            raise InputError(f"{key} = {value!r} is not allowed: it is not an option of bem.solve "
+                             f"(options: {', '.join(sorted(known))}).")
+        if key not in OPTIONS[solver]:
+            why = (f"method = {method!r} is solved by Kalker's QP here (no layer, or a linear layer)"
+                   if solver != method else f"method = {method!r} does not take it")
+            users = [m for m, keys in OPTIONS.items() if key in keys]
+            raise InputError(f"{key} = {value!r} is not allowed: {why}; it applies to "
+                             f"{' and '.join(repr(m) for m in users)} with a nonlinear layer.")
+    checked = {}
+    for key, value in options.items():
+        if key == "relaxation":
+            checked[key] = check_range(key, value, 0.0, 1.0, low_open=True)
+        elif key in ("eps_h", "eps_p"):
+            checked[key] = check_positive(key, value)
+        elif key == "record":
+            checked[key] = check_bool(key, value)
+        else:  # inner_maxiter
+            checked[key] = check_int(key, value)
+    return checked
+
+
 def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None, approach=None,
           step, extent, layer=None, method="newton", rtol=1e-10, maxiter=None, x0=None,
           nested=None, precondition=True, callback=None, **options):
@@ -85,28 +133,32 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         (:mod:`bem.fixed_point`); ``"kalker"``: the QP of eq. 11/13
         (:func:`bem.kalker.solve_qp`), smooth or linear layer only. Without a
         layer, and for ``"newton"`` with a linear layer, the functional is
-        quadratic and the QP is solved directly.
+        quadratic and the QP is solved directly (:func:`solver_for`);
+        ``result.method`` names the solver that ran.
     rtol : float
-        Tolerance on the KKT residual (:func:`bem.kkt.kkt_residual`).
+        Tolerance on the KKT residual ``r`` (:func:`bem.kkt.kkt_residual`) of the
+        returned state, the same for every method: ``converged`` means ``r <= rtol``.
     maxiter : int, optional
-        Iteration limit of the method.
+        Iteration limit of the solver that runs (CG iterations of the QP, Newton steps,
+        outer iterations of the paper's methods).
     x0 : ndarray, optional
         Initial nodal pressures on the candidate nodes, shape ``(N,)``.
     nested : bool, optional
         Start from the solution on successively coarser lattices (step ``2c``,
         ``4c``, ...) interpolated onto the finer one. Default: on for
         ``"newton"`` and the QP, off for the paper's methods so that their
-        iteration histories start from ``p = 0`` as in the paper.
+        iteration histories start as in the paper.
     precondition : bool
-        Use the FFT preconditioner in the conjugate gradients.
+        Use the FFT (and, with a layer, block-Jacobi) preconditioner in the conjugate
+        gradients.
     callback : callable, optional
         ``callback(k, p_grid)`` after every iteration on the finest lattice.
     **options
-        Method-specific options: ``relaxation``, ``eps_h``, ``eps_p``, ``kkt_tol``
-        (:func:`bem.fixed_point.solve_augmented_gap`,
-        :func:`bem.fixed_point.solve_variable_compliance`), ``record`` (keep
-        every iterate in ``history["p"]``), ``inner_maxiter``
-        (:func:`bem.newton.solve_newton`).
+        Options of one solver, refused (:class:`bem.InputError`) where they do not apply
+        to the solver that runs (:data:`OPTIONS`): ``record`` (keep every iterate in
+        ``history["p"]``; Newton and the paper's methods), ``inner_maxiter`` (Newton),
+        ``relaxation`` in ``(0, 1]`` (augmented gap), ``eps_h``, ``eps_p`` (the
+        increments of eq. 20; augmented gap, and ``eps_p`` for variable compliance).
 
     Returns
     -------
@@ -118,6 +170,26 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         Bad input (the message names the argument).
     RegionTooSmallError
         The contact reaches the border of the candidate region.
+
+    Notes
+    -----
+    Stopping rules, with ``r_k`` the KKT residual of iterate ``k`` (relative to the
+    largest surface closure ``max |C p + w(p)|``; force balance relative to ``P``):
+
+    - Kalker's QP: ``r_k <= rtol``, checked on an exactly recomputed ``C p``.
+    - Newton: ``r_k <= rtol`` on an exact product; each inner QP is solved to
+      ``max(rtol / 3, min(1e-2, 0.1 r_k^1.5))``.
+    - Augmented gap: the increments of eq. 20,
+      ``||w(p_k) - w(p_{k-1})|| / ||w(p_k)|| <= eps_h`` and
+      ``||p_k - p_{k-1}|| / ||p_k|| <= eps_p``, AND ``r_k <= rtol``.
+    - Variable compliance: the same contact set twice (eq. 23) and
+      ``||p_k - p_{k-1}|| / ||p_k|| <= eps_p``, AND ``r_k <= rtol``.
+
+    ``eps_h`` and ``eps_p`` default to ``rtol``. A paper method that stalls (no 10 %
+    smaller increment in 15 iterations) or diverges (8 growing increments) stops and
+    says so. A result that does not meet its rule has ``converged = False`` and the
+    reason in ``message``, and one warning is logged (with a summary of inner solves
+    that missed their tolerance); a converged run logs no warning.
     """
     t_start = time.perf_counter()
     check_callable("gap", gap)
@@ -125,11 +197,19 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     force, approach = _load(force, approach)
     check_choice("method", method, METHODS)
     rtol = check_positive("rtol", rtol)
+    if maxiter is not None:
+        maxiter = check_int("maxiter", maxiter)
+    precondition = check_bool("precondition", precondition)
+    if nested is not None:
+        nested = check_bool("nested", nested)
+    if callback is not None:
+        check_callable("callback", callback)
     lattice = Lattice.from_extent(step, extent)
     _check_layer(layer, method)
-    quadratic = layer is None or layer.is_linear and method in ("kalker", "newton")
+    solver = solver_for(method, layer)
+    options = _check_options(method, solver, options)
     if nested is None:
-        nested = quadratic or method == "newton"
+        nested = solver in ("kalker", "newton")
     guess = None
     if x0 is not None:
         x0 = np.asarray(x0, dtype=float)
@@ -147,27 +227,38 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
                   callback=callback if finest else None)
         if maxiter is not None:
             kw["maxiter"] = maxiter
-        sol = _run(method, quadratic, op, h, layer, precondition, kw, options)
+        sol = _run(solver, op, h, layer, precondition, kw, options)
         if not finest:
             guess = _prolong(lat, sol.p, levels[level + 1])
     _check_border(lattice, sol.p, extent)
     closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
-    return _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start)
+    result = _result(lattice, op, h, sol, closure, E_star, layer, solver, force, t_start)
+    if not result.converged:
+        log.warning("%s: %s%s", solver, result.message, _inner_summary(sol.history))
+    return result
 
 
-def _run(method, quadratic, op, h, layer, precondition, kw, options):
-    """Dispatch one lattice level to the method."""
+def _inner_summary(history):
+    missed = history.get("inner_missed", 0)
+    if not missed:
+        return ""
+    return (f" ({missed} inner QP solve(s) stopped before their tolerance; worst KKT residual "
+            f"{history['inner_worst']:.2e})")
+
+
+def _run(solver, op, h, layer, precondition, kw, options):
+    """Dispatch one lattice level to the solver."""
     from .fixed_point import solve_augmented_gap, solve_variable_compliance
     from .kalker import solve_qp
     from .newton import solve_newton
 
-    if layer is None or quadratic:
+    if solver == "kalker":
         lam = 0.0 if layer is None else layer.lam
         precond = op.preconditioner(lam=lam) if precondition else None
-        return solve_qp(op, h, lam=lam, precondition=precond, **kw, **options)
-    solver = {"newton": solve_newton, "augmented_gap": solve_augmented_gap,
-              "variable_compliance": solve_variable_compliance}[method]
-    return solver(op, h, layer=layer, precondition=precondition, **kw, **options)
+        return solve_qp(op, h, lam=lam, preconditioner=precond, **kw, **options)
+    run = {"newton": solve_newton, "augmented_gap": solve_augmented_gap,
+           "variable_compliance": solve_variable_compliance}[solver]
+    return run(op, h, layer=layer, precondition=precondition, **kw, **options)
 
 
 def _prolong(coarse, p, fine):
