@@ -15,7 +15,7 @@ from .materials import effective_modulus
 from .operator import InfluenceOperator
 from .result import ContactResult
 
-__all__ = ["solve", "solver_for", "METHODS", "OPTIONS", "RegionTooSmallError"]
+__all__ = ["solve", "solver_for", "check_options", "METHODS", "OPTIONS", "RegionTooSmallError"]
 
 log = logging.getLogger(__name__)
 
@@ -70,14 +70,25 @@ def solver_for(method, layer):
 
     Without a layer the functional is quadratic whatever the method, and so it is for
     ``"newton"`` with a linear layer: Kalker's QP solves it directly.
+
+    Parameters
+    ----------
+    method : str
+        One of :data:`METHODS`.
+    layer : bem.layers.Layer or {None, "linear", "nonlinear"}
+        The layer, or only its kind (a scene checks its options before building it).
     """
-    if layer is None or (layer.is_linear and method in ("kalker", "newton")):
+    kind = layer if layer is None or isinstance(layer, str) else ("linear" if layer.is_linear else "nonlinear")
+    if kind is None or (kind == "linear" and method in ("kalker", "newton")):
         return "kalker"
     return method
 
 
-def _check_options(method, solver, options):
-    """Refuse an unknown option, or one that does not apply to the solver that runs."""
+def check_options(method, solver, options):
+    """Checked solver ``options`` (a dict); refuse an unknown one, or one the solver does not take.
+
+    Raises :class:`bem.InputError` naming the option, its value and the rule.
+    """
     known = {k for keys in OPTIONS.values() for k in keys}
     for key, value in options.items():
         if key not in known:
@@ -207,7 +218,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     lattice = Lattice.from_extent(step, extent)
     _check_layer(layer, method)
     solver = solver_for(method, layer)
-    options = _check_options(method, solver, options)
+    options = check_options(method, solver, options)
     if nested is None:
         nested = solver in ("kalker", "newton")
     guess = None

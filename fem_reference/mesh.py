@@ -258,7 +258,7 @@ def _write_msh(gmsh, path):
         raise
 
 
-def build_mesh(a_est, *, n_contact=16, extent=40.0, fine_radius=1.5, growth=0.25, h_coarse=None,
+def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None,
                msh_path=None):
     """Mesh the two bodies with gmsh and convert the mesh to scikit-fem.
 
@@ -268,8 +268,8 @@ def build_mesh(a_est, *, n_contact=16, extent=40.0, fine_radius=1.5, growth=0.25
         Expected contact radius [length] (see :func:`fem_reference.estimate_contact_radius`).
     n_contact : int
         Elements across ``a_est`` in the contact zone: ``h_fine = a_est / n_contact``.
-    extent : float
-        Domain width and depth of each body in units of ``a_est``: ``R = H = extent a_est``.
+    extent_factor : float
+        Domain width and depth of each body in units of ``a_est``: ``R = H = extent_factor a_est``.
     fine_radius : float
         Radius of the uniformly fine zone in units of ``a_est``.
     growth : float
@@ -287,12 +287,12 @@ def build_mesh(a_est, *, n_contact=16, extent=40.0, fine_radius=1.5, growth=0.25
     a_est = check_positive("a_est", a_est)
     if isinstance(n_contact, bool) or not isinstance(n_contact, (int, np.integer)) or n_contact < 2:
         raise InputError(f"n_contact = {n_contact!r} is not allowed: it must be an integer >= 2.")
-    extent = check_positive("extent", extent)
+    extent_factor = check_positive("extent_factor", extent_factor)
     fine_radius = check_positive("fine_radius", fine_radius)
     growth = check_positive("growth", growth)
-    if extent < 4.0 * fine_radius:
-        raise InputError(f"extent = {extent!r} is not allowed: it must be >= 4 * fine_radius = {4 * fine_radius!r}.")
-    R = H = extent * a_est
+    if extent_factor < 4.0 * fine_radius:
+        raise InputError(f"extent_factor = {extent_factor!r} is not allowed: it must be >= 4 * fine_radius = {4 * fine_radius!r}.")
+    R = H = extent_factor * a_est
     h_fine = a_est / int(n_contact)
     h_coarse = R / 8.0 if h_coarse is None else check_positive("h_coarse", h_coarse)
     h_coarse = max(h_coarse, h_fine)

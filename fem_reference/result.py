@@ -106,7 +106,7 @@ class FemResult:
         ``delta_far = delta - dc P``) [length], ``correction`` (``dc P``) [length],
         ``applied`` (bool), ``radius``, ``depth`` [length].
     mesh : dict
-        ``a_est``, ``h_fine``, ``n_contact``, ``extent``, ``remeshed``.
+        ``a_est``, ``h_fine``, ``n_contact``, ``extent_factor``, ``remeshed``.
     history : dict
         Newton history (last mesh).
     E_star : float

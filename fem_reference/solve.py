@@ -1,6 +1,6 @@
 """The public entry point :func:`solve` of the axisymmetric FEM reference.
 
-Truncation of the half-spaces. The FEM bodies are finite (``R = H = extent a_est``)
+Truncation of the half-spaces. The FEM bodies are finite (``R = H = extent_factor a_est``)
 and supported far away, so they are stiffer than half-spaces: the displacement of the
 top relative to the bottom (``delta_far``) is smaller than the half-space approach
 ``delta`` (the displacement of the contact relative to points at infinity) by a term
@@ -12,12 +12,12 @@ the centre displacement under a smooth reference load against its closed-form
 half-space value), and the interface compliance used by Newton is
 ``C + dc 1 1^T``: ``delta`` is then the half-space approach the BEM computes, and
 the top is moved by ``delta_far = delta - dc P``. Measured (Hertz, 16 elements
-across ``a``): the raw ``delta_far`` is 2.8 % (``extent = 15``) and 1.04 % (``extent = 40``)
+across ``a``): the raw ``delta_far`` is 2.8 % (``extent_factor = 15``) and 1.04 % (``extent_factor = 40``)
 below Hertz's approach, i.e. ``~0.42 a / R``; the corrected ``delta`` is within 0.003 % and
 0.012 %. Under force control the correction only shifts ``delta`` (the pressure is
 identical); under approach control without it the force would come out ~1.5 % high
 (``P ~ delta^(3/2)``). The truncation changes the peak pressure by < 1e-4
-(extent 15 vs 40).
+(extent_factor 15 vs 40).
 """
 
 from __future__ import annotations
@@ -107,7 +107,7 @@ def _one_mesh(amesh, gap, materials, E_star, layer, penalty, force, approach, tr
 
 
 def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est=None, n_contact=24,
-          extent=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5, truncation_correction=True,
+          extent_factor=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5, truncation_correction=True,
           remesh=True, rtol=1e-9, maxiter=60, out=None, msh_path=None):
     """Axisymmetric FEM reference solution of the layered contact of two elastic bodies.
 
@@ -129,7 +129,7 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     a_est : float, optional
         Expected contact radius [length] that sizes the mesh; default
         :func:`fem_reference.estimate_contact_radius`.
-    n_contact, extent, fine_radius, growth : optional
+    n_contact, extent_factor, fine_radius, growth : optional
         Mesh options of :func:`fem_reference.build_mesh` (elements across ``a_est``, domain
         size and fine-zone radius in units of ``a_est``, size grading).
     mesh : fem_reference.mesh.AxiMesh, optional
@@ -176,7 +176,7 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     remeshed, mesh_time = False, 0.0
     for attempt in range(2):
         if mesh is None or remeshed:
-            amesh = build_mesh(a_est, n_contact=n_contact, extent=extent, fine_radius=fine_radius,
+            amesh = build_mesh(a_est, n_contact=n_contact, extent_factor=extent_factor, fine_radius=fine_radius,
                                growth=growth, msh_path=msh_path)
         else:
             amesh = mesh
@@ -209,7 +209,7 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     timings = dict(timings, mesh=mesh_time, recover=time.perf_counter() - t0)
     converged, reason = sol.converged, sol.reason
     if p[-1] > 0:
-        converged, reason = False, "the contact reaches the outer boundary r = R: increase extent"
+        converged, reason = False, "the contact reaches the outer boundary r = R: increase extent_factor"
     g = sol.g[A > 0]  # the axis node (ring area 0) carries no force: its closure is free
     if layer is None:
         penetration = float(max(g.max(), 0.0))
@@ -233,7 +233,7 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
         truncation={"compliance": dc, "correction": dc * force, "approach_far": delta_far,
                     "applied": bool(dc != 0.0), "radius": amesh.radius, "depth": amesh.depth},
         mesh={"a_est": amesh.a_est, "h_fine": amesh.h_fine, "n_contact": amesh.n_contact,
-              "extent": amesh.radius / amesh.a_est, "remeshed": remeshed},
+              "extent_factor": amesh.radius / amesh.a_est, "remeshed": remeshed},
         E_star=E_star, history=sol.history, model=model, displacement=u,
     )
     if not converged:

@@ -16,6 +16,8 @@ from pathlib import Path
 
 from bem.checks import InputError
 
+from .paper import CalibrationError
+
 from .output import OutputError
 
 __all__ = ["main", "build_parser"]
@@ -327,6 +329,9 @@ def main(argv=None):
     except (InputError, OutputError) as exc:
         print(f"contactlab: error: {exc}", file=sys.stderr)
         return 2
+    except CalibrationError as exc:
+        print(f"contactlab: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("contactlab: interrupted (no partial result directory was left)", file=sys.stderr)
         return 130

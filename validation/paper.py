@@ -34,9 +34,13 @@ from bem.layers import LAWS, Bilinear, ElasticRigid, Linear, Root, from_dict
 
 from ._checks import SceneError, in_range, positive, scene_errors, string, table, unknown_keys
 
-__all__ = ["c_nn", "check_layer", "resolve_layer", "PAPER_LAWS", "PAPER_KEYS", "EXCLUSIVE", "ALIASES"]
+__all__ = ["CalibrationError", "c_nn", "check_layer", "resolve_layer", "PAPER_LAWS", "PAPER_KEYS", "EXCLUSIVE", "ALIASES"]
 
 log = logging.getLogger(__name__)
+
+
+class CalibrationError(RuntimeError):
+    """A solve that calibrates a layer law (``alpha_a``, ``alpha_b``, ``lam_over_cnn``) failed."""
 
 #: law -> {constructor parameter: (direct key, paper key)}
 PAPER_LAWS = {

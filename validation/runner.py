@@ -18,6 +18,7 @@ from . import paper
 from .output import atomic_directory, atomic_write_json, atomic_write_text
 from .results import build_result
 from .scene import Scene, load_scene
+from .scene_sections import SOLVER_KEYS
 from .sizing import DOMAIN_MARGIN, inner_domain
 from .tomlwrite import dumps
 from .vtk import lattice_triangles, write_vtu
@@ -68,17 +69,28 @@ def planned_stages(scene, *, write=False):
 class _BemRunner:
     """Solves the scene's BEM problem for a given layer; enlarges an automatic region if needed."""
 
-    def __init__(self, scene, messages):
-        self.scene, self.messages = scene, messages
+    def __init__(self, scene, messages, *, calibration=False):
+        self.scene, self.messages, self.calibration = scene, messages, calibration
         opts = scene.bem
         self.extent = tuple(opts["extent"])
         self.kw = dict(E_star=scene.E_star, force=scene.load["force"], approach=scene.load["approach"],
                        step=opts["step"], method=opts["method"])
-        self.kw.update({k: opts[k] for k in ("rtol", "maxiter", "precondition", "nested", "relaxation")
-                        if k in opts})
+        self.kw.update({k: opts[k] for k in SOLVER_KEYS[1:] if k in opts})
+        if calibration:  # the robust solver with its defaults, whatever the scene's method
+            self.kw["method"] = "newton"
+            for key in ("maxiter", "relaxation", "eps_h", "eps_p"):
+                self.kw.pop(key, None)
         self.solves = 0
 
     def __call__(self, layer, callback=None):
+        res = self._solve(layer, callback)
+        if self.calibration and not res.converged:
+            raise paper.CalibrationError(
+                f"the calibration of the layer law ({layer!r}) did not converge with method 'newton': "
+                f"{res.message}. The run stops: the layer parameters would be wrong.")
+        return res
+
+    def _solve(self, layer, callback):
         for attempt in range(_MAX_GROW + 1):
             try:
                 self.solves += 1
@@ -156,14 +168,15 @@ def execute_scene(scene, *, progress=None, overrides=None):
     if not isinstance(scene, Scene) or overrides:
         scene = load_scene(scene, overrides=overrides)
     messages, times = [], {"bem": None, "fem": None, "layer_reference": None}
-    solve = _BemRunner(scene, messages)
+    solve, calibrate = _BemRunner(scene, messages), _BemRunner(scene, messages, calibration=True)
     if "layer" in planned_stages(scene):
         _notify(progress, "layer", "start")
     t = time.perf_counter()
     layer, layer_info = paper.resolve_layer(scene.layer_spec, step=scene.bem["step"], E_star=scene.E_star,
-                                            solve=solve)
-    if solve.solves:
+                                            solve=calibrate)
+    if calibrate.solves:
         times["layer_reference"] = time.perf_counter() - t
+        solve.extent = calibrate.extent
         _notify(progress, "layer", "done")
     _notify(progress, "bem", "start")
 

@@ -11,7 +11,7 @@ import inspect
 import math
 import re
 
-from bem import METHODS, gaps
+from bem import METHODS, InputError, gaps
 from bem.gaps import gap_from_dict
 from bem.lattice import Lattice
 from bem.layers import Linear, from_dict
@@ -31,9 +31,11 @@ REPORT_SECTIONS = ("summary", "scene", "profile", "pressure_map", "comparison", 
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
-_BEM_KEYS = ("step", "nodes_across", "extent", "extent_factor", "method", "rtol", "maxiter", "precondition",
-             "nested", "relaxation")
-_FEM_KEYS = ("n_contact", "extent", "fine_radius", "growth", "penalty", "rtol", "maxiter", "remesh",
+#: solver options a scene may set: the common ones and each solver's own (bem.solve.OPTIONS)
+SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested", "relaxation", "eps_h", "eps_p",
+               "inner_maxiter")
+_BEM_KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
+_FEM_KEYS = ("n_contact", "extent_factor", "fine_radius", "growth", "penalty", "rtol", "maxiter", "remesh",
              "truncation_correction")
 GAP_TYPES = {cls.type_name: cls for cls in (gaps.Paraboloid, gaps.EllipticParaboloid, gaps.CrownedRoller,
                                             gaps.FlatPunch, gaps.Callable, gaps.Table)}
@@ -140,6 +142,21 @@ def _estimate(shape, layer_spec, E_star, load_, step, n_across):
     return axes
 
 
+def _solver_options(d, method, layer_spec):
+    """The options of the solver that will run, checked by the BEM itself (one rule, one message)."""
+    from bem.solve import check_options, solver_for
+
+    kind = None if layer_spec is None else ("linear" if layer_spec["law"] == "linear" else "nonlinear")
+    if method == "kalker" and kind == "nonlinear":
+        raise ck.SceneError(f"bem.method = 'kalker' is not allowed with layer.law = {layer_spec['law']!r}: "
+                            "Kalker's QP solves smooth bodies and linear layers; use 'newton'.")
+    own = {k: d[k] for k in SOLVER_KEYS[5:] if k in d}
+    try:
+        return check_options(method, solver_for(method, kind), own)
+    except InputError as exc:
+        raise ck.SceneError(f"bem.{exc}") from None
+
+
 def bem_options(d, shape, layer_spec, E_star, load_):
     """``[bem]``: lattice (``step`` | ``nodes_across``, ``extent`` | ``extent_factor``) and solver options.
 
@@ -160,14 +177,7 @@ def bem_options(d, shape, layer_spec, E_star, load_):
     for key in ("precondition", "nested"):
         if key in d:
             out[key] = ck.boolean(f"bem.{key}", d[key])
-    if "relaxation" in d:
-        if out["method"] != "augmented_gap":
-            raise ck.SceneError(f"bem.relaxation = {d['relaxation']!r} is not allowed with bem.method = "
-                                f"{out['method']!r}: it is an option of method = 'augmented_gap' only.")
-        out["relaxation"] = ck.in_range("bem.relaxation", d["relaxation"], 0.0, 1.0, low_open=True)
-    if out["method"] == "kalker" and layer_spec is not None and layer_spec["law"] != "linear":
-        raise ck.SceneError(f"bem.method = 'kalker' is not allowed with layer.law = {layer_spec['law']!r}: "
-                            "Kalker's QP solves smooth bodies and linear layers; use 'newton'.")
+    out.update(_solver_options(d, out["method"], layer_spec))
     step = ck.positive("bem.step", d["step"]) if "step" in d else None
     n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
     axes = _estimate(shape, layer_spec, E_star, load_, step, n_across)
@@ -232,7 +242,7 @@ def fem_options(d, shape, materials):
     out = {}
     if "n_contact" in d:
         out["n_contact"] = ck.integer("fem.n_contact", d["n_contact"], 4, 400)
-    for key in ("extent", "fine_radius", "growth", "penalty", "rtol"):
+    for key in ("extent_factor", "fine_radius", "growth", "penalty", "rtol"):
         if key in d:
             out[key] = ck.positive(f"fem.{key}", d[key])
     if "maxiter" in d:

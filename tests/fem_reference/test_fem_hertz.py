@@ -6,7 +6,7 @@ from .fem_cases import E, E_SOFT, NU, NU_SOFT, P, R, e_star, hertz, hertz_pressu
 
 import fem_reference as fr
 
-COARSE = {"n_contact": 8, "extent": 30.0}
+COARSE = {"n_contact": 8, "extent_factor": 30.0}
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +40,7 @@ def test_mesh_convergence(gap, hertz_same):
     a, p0, _ = hertz_same
     errors = []
     for n in (4, 8, 16):
-        res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, n_contact=n, extent=30.0)
+        res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, n_contact=n, extent_factor=30.0)
         assert res.converged
         assert res.contact_radius == pytest.approx(a, rel=0.02)
         errors.append(abs(res.p_max / p0 - 1))
@@ -89,7 +89,7 @@ def test_approach_control_inverts_force_control(gap, coarse_mesh):
 
 def test_bad_estimate_is_remeshed(gap, hertz_same):
     a, p0, _ = hertz_same
-    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=3 * a, n_contact=8, extent=30.0)
+    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=3 * a, n_contact=8, extent_factor=30.0)
     assert res.converged and res.mesh["remeshed"]
     assert res.mesh["a_est"] == pytest.approx(a, rel=0.1)
     assert res.p_max == pytest.approx(p0, rel=0.02)
@@ -98,7 +98,7 @@ def test_bad_estimate_is_remeshed(gap, hertz_same):
 
 def test_contact_reaching_the_outer_boundary_is_not_an_answer(gap, hertz_same):
     a = hertz_same[0]
-    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=a / 25, n_contact=3, extent=20.0,
+    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=a / 25, n_contact=3, extent_factor=20.0,
                    remesh=False)
     assert not res.converged and "outer boundary" in res.reason
     assert np.all(np.isfinite(res.p))

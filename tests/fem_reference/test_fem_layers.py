@@ -20,7 +20,7 @@ def test_layer_dominated_limit(gap, kind):
     layer = Linear(soft) if kind == "linear" else Power(DELTA / p_ref**0.5, 0.5)
     inverse = (lambda g: g / soft) if kind == "linear" else (lambda g: (g / DELTA) ** 2 * p_ref)
     res = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, approach=DELTA, layer=layer,
-                   n_contact=8, extent=30.0)
+                   n_contact=8, extent_factor=30.0)
     assert res.converged, res.reason
     expected = inverse(np.clip(DELTA - res.r**2 / (2 * R), 0, None))
     np.testing.assert_allclose(res.p, expected, atol=5e-3 * expected.max())
@@ -39,7 +39,7 @@ def test_nonlinear_laws_satisfy_the_contact_conditions(gap, name):
     layer = {"power_s2": Power(lam / p_ref, 2.0), "elastic_rigid": ElasticRigid(lam, 0.6 * p_ref),
              "bilinear": Bilinear(lam, 0.1 * lam, 0.5 * p_ref)}[name]
     res = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=layer, n_contact=8,
-                   extent=30.0)
+                   extent_factor=30.0)
     assert res.converged, res.reason
     assert res.force == pytest.approx(P, rel=1e-8)
     assert np.all(np.isfinite(res.p)) and np.all(res.p >= 0)

@@ -88,7 +88,7 @@ def test_msh_file_has_physical_groups(tmp_path, hertz_same):
     import meshio
 
     path = tmp_path / "bodies.msh"
-    build_mesh(hertz_same[0], n_contact=3, extent=20.0, msh_path=path)
+    build_mesh(hertz_same[0], n_contact=3, extent_factor=20.0, msh_path=path)
     m = meshio.read(path)
     names = set(m.field_data)
     assert {"upper", "lower", "interface", "axis", "top", "bottom", "outer"} <= names
@@ -106,13 +106,13 @@ def test_gmsh_finalized_on_error(monkeypatch):
 
     monkeypatch.setattr(mesh_module, "_extract", boom)
     with pytest.raises(RuntimeError, match="simulated"):
-        build_mesh(1.0, n_contact=3, extent=20.0)
+        build_mesh(1.0, n_contact=3, extent_factor=20.0)
     assert gmsh.isInitialized() == 0
 
 
 @pytest.mark.parametrize("kwargs, name", [
     ({"a_est": -1.0}, "a_est"), ({"a_est": 1.0, "n_contact": 1}, "n_contact"),
-    ({"a_est": 1.0, "n_contact": 4.5}, "n_contact"), ({"a_est": 1.0, "extent": 2.0}, "extent"),
+    ({"a_est": 1.0, "n_contact": 4.5}, "n_contact"), ({"a_est": 1.0, "extent_factor": 2.0}, "extent_factor"),
     ({"a_est": float("nan")}, "a_est"), ({"a_est": 1.0, "growth": 0.0}, "growth"),
 ])
 def test_bad_mesh_input(kwargs, name):

@@ -97,7 +97,7 @@ def test_bad_gap():
         fr.solve("sphere", E1=E, nu1=NU, E2=E, nu2=NU, force=P)
     with pytest.raises(InputError, match="gap"):
         fr.solve(lambda x, y: np.full_like(x, np.nan), E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=0.2,
-                 n_contact=3, extent=20.0)
+                 n_contact=3, extent_factor=20.0)
 
 
 def test_vtk_reader_opens_the_file(result, tmp_path):

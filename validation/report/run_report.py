@@ -145,8 +145,8 @@ def _fem(res, work):
             ("elements across the contact radius", fmt(fem.get("n_elements_across_contact"), 3), "-")]
     if _num(mesh.get("h_fine")):
         rows.append(("element size at the contact", fmt(mesh["h_fine"]), u.of("length")))
-    if _num(mesh.get("extent")):
-        rows.append(("mesh half-size / estimated contact radius", fmt(mesh["extent"]), "-"))
+    if _num(mesh.get("extent_factor")):
+        rows.append(("mesh half-size / estimated contact radius", fmt(mesh["extent_factor"]), "-"))
     if _num(penalty.get("relative_penetration")):
         rows.append(("penalty: largest penetration / approach", fmt(penalty["relative_penetration"]), "-"))
     if "applied" in trunc:

@@ -1,0 +1,183 @@
+"""The solver contract: every option checked, one meaning per name, a result meets rtol or says so."""
+
+import ast
+import logging
+import math
+import pathlib
+
+import numpy as np
+import pytest
+
+import bem
+from bem import layers
+from bem.gaps import Paraboloid
+from validation.analytic import rigid_layer_paraboloid
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def _hertz(**kw):
+    return bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.2, **kw)
+
+
+def _dense_kkt(res, layer, gap=Paraboloid(1.0)):
+    """KKT residual of eq. 14 recomputed with the dense C (independent of the FFT path)."""
+    C = bem.InfluenceOperator(res.lattice, res.E_star).dense()
+    w = np.zeros_like(res.p) if layer is None else layer.w(res.p)
+    total = C @ res.p + w
+    g = total + gap(res.x, res.y) - res.approach
+    return bem.kkt.kkt_residual(res.p, g, displacement_scale=float(np.abs(total).max()), force=res.force,
+                                node_area=res.lattice.node_area)
+
+
+# --- item 2: options are checked, result.method names the solver that ran -----------------------
+
+def test_an_unknown_option_is_refused_by_name():
+    with pytest.raises(bem.InputError, match="frobnicate = 1 is not allowed"):
+        _hertz(frobnicate=1)
+
+
+def test_an_option_of_another_solver_is_refused():
+    with pytest.raises(bem.InputError, match=r"relaxation = 0.5 .*Kalker's QP"):
+        _hertz(method="augmented_gap", relaxation=0.5)
+    with pytest.raises(bem.InputError, match="eps_p = 1e-08 is not allowed: method = 'newton' does not take it"):
+        _hertz(layer=layers.Root(0.1), eps_p=1e-8)
+
+
+@pytest.mark.parametrize("kw, name", [({"relaxation": 1.5}, "relaxation"), ({"relaxation": 0.0}, "relaxation"),
+                                      ({"eps_h": -1.0}, "eps_h"), ({"record": "yes"}, "record")])
+def test_option_values_are_checked(kw, name):
+    with pytest.raises(bem.InputError, match=f"^{name} = "):
+        _hertz(layer=layers.Root(0.1), method="augmented_gap", **kw)
+
+
+@pytest.mark.parametrize("kw, name", [({"maxiter": 0}, "maxiter"), ({"maxiter": 2.5}, "maxiter"),
+                                      ({"precondition": "no"}, "precondition"), ({"nested": 1}, "nested"),
+                                      ({"callback": 3}, "callback")])
+def test_common_option_values_are_checked(kw, name):
+    with pytest.raises(bem.InputError, match=f"^{name} = "):
+        _hertz(**kw)
+
+
+@pytest.mark.parametrize("method", bem.METHODS)
+def test_result_method_is_the_solver_that_ran(method):
+    res = _hertz(method=method)  # no layer: Kalker's QP for every method
+    assert res.method == "kalker" and res.converged
+    assert res.iterations == len(res.history["residual"])  # CG iterations, counted as such
+    layered = _hertz(layer=layers.Root(0.05), method=method) if method != "kalker" else None
+    if layered is not None:
+        assert layered.method == method
+
+
+# --- item 3: one name, one meaning --------------------------------------------------------------
+
+def test_rtol_is_the_kkt_tolerance_of_every_method():
+    layer = layers.Root(0.02)
+    for method, kw in (("newton", {}), ("variable_compliance", {}), ("augmented_gap", {"relaxation": 0.5})):
+        res = _hertz(layer=layer, method=method, rtol=1e-9, **kw)
+        if res.converged:
+            assert res.kkt_residual <= 1e-9, method
+            assert _dense_kkt(res, layer) <= 1.01e-9, method
+        else:
+            assert res.kkt_residual > 1e-9, method
+
+
+def test_fem_reference_names_its_relative_extent_extent_factor():
+    import inspect
+
+    import fem_reference
+
+    params = inspect.signature(fem_reference.solve).parameters
+    assert "extent_factor" in params and "extent" not in params
+
+
+def test_qp_takes_a_preconditioner_callable_and_solve_a_precondition_flag():
+    import inspect
+
+    from bem.kalker import solve_qp
+
+    assert "preconditioner" in inspect.signature(solve_qp).parameters
+    assert "precondition" not in inspect.signature(solve_qp).parameters
+    assert inspect.signature(bem.solve).parameters["precondition"].default is True
+
+
+# --- item 4: public errors ----------------------------------------------------------------------
+
+def test_errors_are_public_value_errors():
+    assert issubclass(bem.InputError, ValueError)
+    assert issubclass(bem.RegionTooSmallError, bem.InputError)
+    assert bem.checks.InputError is bem.InputError
+
+
+def test_nothing_outside_bem_imports_its_private_modules():
+    offenders = []
+    for path in list(ROOT.glob("fem_reference/**/*.py")) + list(ROOT.glob("validation/**/*.py")) + \
+            list(ROOT.glob("tests/**/*.py")) + list(ROOT.glob("benchmarks/*.py")) + list(ROOT.glob("docs/**/*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = []
+            if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("bem"):
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            if any(part.startswith("_") for n in names if n.startswith("bem") for part in n.split(".")):
+                offenders.append(str(path.relative_to(ROOT)))
+    assert not offenders
+
+
+# --- items 1 and 7: Newton reaches rtol; near the rigid limit with a small exponent -------------
+
+@pytest.mark.parametrize("n_across", [20, 60, 100, 160, 200])
+def test_newton_near_the_rigid_limit_with_a_small_exponent(n_across):
+    """Power(1, 0.3), E* = 1e9, force control: `converged=False` at 100 and 160 nodes across before."""
+    layer = layers.Power(1.0, 0.3)
+    a = rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius
+    res = bem.solve(Paraboloid(1.0), E_star=1e9, force=1.0, step=2 * a / n_across, extent=1.25 * a, layer=layer)
+    assert res.converged, res.message
+    assert res.kkt_residual <= 1e-10
+    assert res.history["inner_worst"] < 1e-2  # no inner solve diverged (it reached 1.2e16 before)
+    if n_across <= 20:
+        assert _dense_kkt(res, layer) <= 1.01e-10
+
+
+# --- item 6: variable compliance under force control where the layer dominates ------------------
+
+@pytest.mark.parametrize("layer, E_star", [(layers.Linear(1.0), 1e4), (layers.Root(1.0), 1e2),
+                                           (layers.Root(1.0), 1e4)])
+def test_variable_compliance_where_the_layer_dominates(layer, E_star):
+    """The layer-free first step collapses to about one node; the QP must let the contact grow."""
+    a = rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius
+    kw = dict(E_star=E_star, force=1.0, step=2 * a / 40, extent=1.3 * a, layer=layer)
+    vc = bem.solve(Paraboloid(1.0), method="variable_compliance", **kw)
+    newton = bem.solve(Paraboloid(1.0), **kw)
+    assert vc.converged, vc.message
+    assert np.linalg.norm(vc.p - newton.p) / np.linalg.norm(newton.p) <= 1e-6
+
+
+def test_variable_compliance_reports_failure_where_it_cannot_converge():
+    """s >= 2 with a dominating layer: the secant map has derivative -(s - 1) <= -1."""
+    layer = layers.Power(1.0, 3.0)
+    a = rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius
+    res = bem.solve(Paraboloid(1.0), E_star=1e4, force=1.0, step=2 * a / 30, extent=1.3 * a, layer=layer,
+                    method="variable_compliance", maxiter=60)
+    assert not res.converged and res.kkt_residual > 1e-6
+    assert "stalled" in res.message or "diverg" in res.message or "maxiter" in res.message
+
+
+# --- item 8: one warning, only when it failed ---------------------------------------------------
+
+def test_a_converged_run_logs_no_warning(caplog):
+    layer = layers.Power(1.0, 0.3)
+    a = rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius
+    with caplog.at_level(logging.DEBUG, logger="bem"):
+        res = bem.solve(Paraboloid(1.0), E_star=1e9, force=1.0, step=2 * a / 60, extent=1.25 * a, layer=layer)
+    assert res.converged
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+
+
+def test_a_failed_run_logs_one_warning(caplog):
+    with caplog.at_level(logging.WARNING, logger="bem"):
+        res = _hertz(layer=layers.Root(1.0), method="augmented_gap", maxiter=40)
+    assert not res.converged
+    warnings = [r for r in caplog.records if r.levelno >= logging.WARNING]
+    assert len(warnings) == 1 and res.message in warnings[0].getMessage()
+    assert math.isfinite(res.kkt_residual)

@@ -1,0 +1,61 @@
+"""Scenes hand the solver options to the BEM's own check; calibrations use the robust solver."""
+
+import tomllib
+from importlib import resources
+
+import pytest
+
+import bem
+from validation import paper, runner
+from validation.scene import SceneError, load_scene
+
+from .conftest import cli
+
+
+def _scene(name, drop=("fem", "sweep", "report")):
+    raw = tomllib.loads(resources.files("validation").joinpath("scenes", f"{name}.toml").read_text())
+    return {k: v for k, v in raw.items() if k not in drop}
+
+
+def test_check_refuses_an_option_the_solver_that_runs_does_not_take():
+    code, _, err = cli("check", "hertz", "--set", 'bem.method="augmented_gap"', "--set", "bem.relaxation=0.5")
+    assert code == 2
+    assert "bem.relaxation = 0.5 is not allowed" in err and "Kalker's QP" in err
+
+
+@pytest.mark.parametrize("override, key", [("bem.eps_p=1e-8", "bem.eps_p"), ("bem.inner_maxiter=0", "bem.inner_maxiter"),
+                                           ("bem.relaxation=2.0", "bem.relaxation")])
+def test_scene_solver_options_are_checked_per_method(override, key):
+    with pytest.raises(SceneError, match=key.replace(".", r"\.")):
+        load_scene(_scene("paper_root"), overrides=['bem.method="augmented_gap"' if "relax" in key else
+                                                    'bem.method="newton"', override])
+
+
+def test_scene_solver_options_reach_the_solver():
+    scene = load_scene(_scene("paper_root"), overrides=['bem.method="augmented_gap"', "bem.relaxation=0.5",
+                                                        "bem.eps_p=1e-9"])
+    assert scene.bem["relaxation"] == 0.5 and scene.bem["eps_p"] == 1e-9
+
+
+def test_calibration_does_not_depend_on_the_method():
+    """alpha_b / lam_over_cnn calibrations use Newton even when the scene asks for a paper method."""
+    lam = {}
+    for method in ("newton", "augmented_gap"):
+        out = runner.execute_scene(load_scene(_scene("paper_root"), overrides=[f'bem.method="{method}"']))
+        lam[method] = out.result["layer"]["parameters"]["lam"]
+        assert out.result["layer"]["reference_solves"] >= 1
+    assert lam["augmented_gap"] == pytest.approx(lam["newton"], rel=1e-12)
+
+
+def test_a_calibration_that_fails_stops_the_run(monkeypatch):
+    real = bem.solve
+
+    def failing(*args, **kw):
+        res = real(*args, **kw)
+        if kw["layer"].is_linear:  # the reference solve of the calibration
+            res.converged, res.message = False, "forced failure"
+        return res
+
+    monkeypatch.setattr(runner.bem, "solve", failing)
+    with pytest.raises(paper.CalibrationError, match="forced failure"):
+        runner.execute_scene(load_scene(_scene("paper_root")))
