@@ -256,18 +256,22 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             d = sub.p - p
             cd = (sub.displacement - D * sub.p) - u
             t = _line_search(layer, p, d, u, cd, h, delta, mask)
-        judged = False
+        judged = None
         if t == 0.0:
-            # No decrease of Phi measurable along d: near the solution the change of Phi falls
-            # below its round-off while nodes of tiny pressure (where w' is huge) still violate
-            # their gap. The full Newton step is then judged by the KKT residual instead.
-            trial = _scaled(np.maximum(p + d, 0.0), force, op.lattice.node_area)
-            u_trial = op.matvec(trial)
-            applies += 1
-            judged = layered_state(op, h, layer, trial, u_trial, force=force, approach=approach)[2] < kkt
-        hist["step"].append(1.0 if judged else t)
+            # No decrease of Phi measurable along d: the change of Phi falls below its round-off
+            # while nodes of tiny pressure (where w' is huge, e.g. a power law with small s)
+            # still violate their gap. The step is then chosen by the KKT residual instead:
+            # t = 1, 1/2, 1/4, 1/8, the first that lowers it.
+            for t_try in (1.0, 0.5, 0.25, 0.125):
+                trial = _scaled(np.maximum(p + t_try * d, 0.0), force, op.lattice.node_area)
+                u_trial = op.matvec(trial)
+                applies += 1
+                if layered_state(op, h, layer, trial, u_trial, force=force, approach=approach)[2] < kkt:
+                    judged = t_try
+                    break
+        hist["step"].append(t if judged is None else judged)
         hist["inner_iterations"].append(sub.iterations)
-        if judged:
+        if judged is not None:
             p, u, exact = trial, u_trial, True
         elif t == 0.0:
             message = f"line search found no descent (KKT residual {kkt:.2e} > rtol {rtol:.1e})"

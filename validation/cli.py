@@ -55,6 +55,7 @@ examples:
   contactlab sweep hertz --param load.force --values 50,100,200 --scheduler tcp://10.0.0.5:8786
   contactlab study error-time hertz                  error vs time of the BEM methods
   contactlab study stability                         convergence of the methods across layers
+  contactlab study robustness                        every layer method over 12 decades of compliance
   contactlab report results/hertz --out report/      figures + HTML/Markdown report
 
 result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
@@ -116,7 +117,8 @@ def build_parser():
                        epilog="examples:\n  contactlab study error-time hertz --out reports/studies\n"
                        "  contactlab study stability --quick\n"
                        "  contactlab report reports/studies      (work-precision plot and tables)")
-    p.add_argument("study", choices=("error-time", "stability"), metavar="{error-time,stability}")
+    p.add_argument("study", choices=("error-time", "stability", "robustness"),
+                   metavar="{error-time,stability,robustness}")
     p.add_argument("scene", nargs="?", metavar="SCENE",
                    help="problem for error-time: hertz or paper_root (default: both)")
     p.add_argument("--quick", action="store_true", help="a short ladder / case list (minutes instead of ~5)")
@@ -281,7 +283,8 @@ def _dispatch(module, args, what):
 
 
 def _cmd_study(args):
-    module = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability"}
+    module = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
+              "robustness": "validation.studies.robustness"}
     return _dispatch(module[args.study], args, f"the {args.study} study")
 
 

@@ -1,0 +1,219 @@
+"""Robustness grid: every layer method over 12 decades of layer compliance, exponents and moduli.
+
+Problem: a paraboloid (``R = 1``) on a flat under force ``P = 1`` (force control) or under the
+approach that force gives (approach control), with a power layer ``w = lam p^s``. The grid:
+
+- ``s`` in :data:`EXPONENTS` (0.05 .. 10),
+- ``k`` in :data:`COMPLIANCES`: the layer's secant compliance at the mean contact pressure,
+  ``w(p_m) / p_m``, is ``k`` times the elastic compliance of the contact ``a_H^2 / (R p_0)``
+  (12 decades, from a layer far stiffer than the bodies to a layer far softer),
+- ``E*`` in :data:`MODULI` (``1e-3 .. 1e12`` relative to ``P / R^2``),
+- each layer method of :func:`bem.solve` (Newton, variable compliance, augmented gap) and both
+  controls, on a lattice of :data:`NODES_ACROSS` nodes across the contact diameter.
+
+Each outcome gets one status: ``"converged"`` (the solver says so and the KKT residual of
+eq. 14 recomputed with the dense influence matrix, independently of the FFT path, is at most
+``2 rtol``), ``"reported failure"`` (``converged = False`` with a message, every value finite)
+or ``"wrong"`` (``converged = True`` with the dense KKT residual above ``2 rtol``, or a NaN).
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import time
+from collections import Counter
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from . import fmt, markdown_table, write_atomic, write_json
+
+__all__ = ["RobustnessRow", "run_robustness", "summary_markdown", "main", "EXPONENTS", "COMPLIANCES", "MODULI"]
+
+log = logging.getLogger(__name__)
+
+EXPONENTS = (0.05, 0.2, 0.5, 1.0, 2.0, 3.0, 10.0)
+COMPLIANCES = (1e-6, 1e-3, 1.0, 1e3, 1e6)
+MODULI = (1e-3, 1.0, 1e3, 1e6, 1e12)
+LAYER_METHODS = ("newton", "variable_compliance", "augmented_gap")
+NODES_ACROSS = 16
+RTOL = 1e-10
+
+
+@dataclass
+class RobustnessRow:
+    """One method on one grid point; ``kkt_dense`` is the independent check (``None`` if it raised)."""
+
+    s: float
+    k: float
+    E_star: float
+    control: str
+    method: str
+    status: str
+    converged: bool
+    kkt_dense: float | None
+    iterations: int
+    wall_time_s: float
+    message: str
+
+
+def _layer(s, k, E_star):
+    """``Power(lam, s)`` whose secant at the Hertz mean pressure is ``k`` elastic compliances."""
+    from bem.layers import Power
+
+    a = (3 / (4 * E_star)) ** (1 / 3)  # Hertz, R = P = 1
+    p0 = 3 / (2 * math.pi * a * a)
+    p_m = 2 * p0 / 3
+    return Power(k * (a * a / p0) * p_m ** (1 - s), s)
+
+
+def _contact_radius(layer, E_star):
+    """The larger of the Hertz and the layer-only contact radius (the softer mechanism wins)."""
+    from validation.analytic import rigid_layer_paraboloid
+
+    return max((3 / (4 * E_star)) ** (1 / 3), rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius)
+
+
+def _dense_kkt(res, layer):
+    import bem
+
+    C = bem.InfluenceOperator(res.lattice, res.E_star).dense()
+    total = C @ res.p + layer.w(res.p)
+    g = total + 0.5 * (res.x ** 2 + res.y ** 2) - res.approach
+    return float(bem.kkt.kkt_residual(res.p, g, displacement_scale=float(np.abs(total).max()),
+                                      force=None, node_area=res.lattice.node_area))
+
+
+def _solve(layer, E_star, load, method, a):
+    import bem
+    from bem.gaps import Paraboloid
+
+    extent = 1.5 * a
+    for _ in range(4):
+        try:
+            return bem.solve(Paraboloid(1.0), E_star=E_star, step=2 * a / NODES_ACROSS, extent=extent,
+                             layer=layer, method=method, rtol=RTOL, **load)
+        except bem.RegionTooSmallError:
+            extent *= 1.5
+    raise RuntimeError(f"the contact kept reaching the border of the region (extent {extent:.3g})")
+
+
+def _row(s, k, E_star, control, method, layer, load, a):
+    t0 = time.perf_counter()
+    try:
+        res = _solve(layer, E_star, load, method, a)
+    except (ValueError, ArithmeticError, RuntimeError) as exc:
+        return RobustnessRow(s, k, E_star, control, method, "reported failure", False, None, 0,
+                             time.perf_counter() - t0, f"{type(exc).__name__}: {exc}"), None
+    elapsed = time.perf_counter() - t0
+    finite = bool(np.all(np.isfinite(res.p))) and math.isfinite(res.approach)
+    kkt = _dense_kkt(res, layer) if finite else math.inf
+    if not finite:
+        status = "wrong"
+    elif res.converged:
+        status = "converged" if kkt <= 2 * RTOL else "wrong"
+    else:
+        status = "reported failure"
+    return RobustnessRow(s, k, E_star, control, method, status, bool(res.converged), kkt, int(res.iterations),
+                         elapsed, res.message), res
+
+
+def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODULI, methods=LAYER_METHODS,
+                   progress=False):
+    """Run the grid; returns the list of :class:`RobustnessRow`.
+
+    Approach control uses the approach of the force-controlled Newton solve of the same point
+    (the same discrete problem), or, if that failed, the layer-only closed form.
+    """
+    from tqdm import tqdm
+
+    from validation.analytic import rigid_layer_paraboloid
+
+    points = list(itertools.product(exponents, compliances, moduli))
+    rows = []
+    for s, k, E_star in tqdm(points, disable=not progress, desc="robustness", unit="point"):
+        layer = _layer(s, k, E_star)
+        a = _contact_radius(layer, E_star)
+        approach = None
+        for control in ("force", "approach"):
+            if control == "approach" and approach is None:
+                approach = rigid_layer_paraboloid(layer, 1.0, force=1.0).delta
+            load = {"force": 1.0} if control == "force" else {"approach": approach}
+            for method in methods:
+                row, res = _row(s, k, E_star, control, method, layer, load, a)
+                rows.append(row)
+                if control == "force" and method == "newton" and res is not None and res.converged:
+                    approach = res.approach
+    return rows
+
+
+def _counts(rows, key):
+    out = {}
+    for r in rows:
+        out.setdefault(key(r), Counter())[r.status] += 1
+    return out
+
+
+def summary_markdown(rows):
+    """Markdown: counts and times per method and control, the map of outcomes over (s, k), the failures."""
+    lines = ["# Robustness of the layer methods", "",
+             f"Paraboloid R = 1, P = 1, power layer `w = lam p^s`; {NODES_ACROSS} nodes across the contact; "
+             f"rtol = {RTOL:g}; KKT of eq. 14 checked with the dense influence matrix. `k`: the layer's secant "
+             "compliance at the Hertz mean pressure over the elastic compliance of the contact; E* relative "
+             "to P/R^2.", "", "## Outcomes per method and control", ""]
+    body = []
+    for (method, control), c in sorted(_counts(rows, lambda r: (r.method, r.control)).items()):
+        times = [r.wall_time_s for r in rows if r.method == method and r.control == control]
+        kkts = [r.kkt_dense for r in rows if r.method == method and r.control == control and r.converged
+                and r.kkt_dense is not None]
+        body.append([method, control, c["converged"], c["reported failure"], c["wrong"],
+                     fmt(float(np.median(times)), ".3f"), fmt(max(times), ".3f"),
+                     fmt(max(kkts), ".1e") if kkts else "-"])
+    lines += [markdown_table(["method", "control", "converged", "reported failure", "wrong", "median time [s]",
+                              "max time [s]", "worst dense KKT when converged"], body), ""]
+    lines += ["## Converged out of all (E*, control) per exponent s and compliance k", ""]
+    ks = sorted({r.k for r in rows})
+    for method in LAYER_METHODS:
+        sel = [r for r in rows if r.method == method]
+        if not sel:
+            continue
+        lines += [f"### {method}", ""]
+        body = []
+        for s in sorted({r.s for r in sel}):
+            cells = []
+            for k in ks:
+                cell = [r for r in sel if r.s == s and r.k == k]
+                n_ok = sum(r.status == "converged" for r in cell)
+                n_wrong = sum(r.status == "wrong" for r in cell)
+                cells.append(f"{n_ok}/{len(cell)}" + (f" ({n_wrong} wrong)" if n_wrong else ""))
+            body.append([fmt(s, "g")] + cells)
+        lines += [markdown_table(["s \\ k"] + [fmt(k, "g") for k in ks], body), ""]
+    bad = [r for r in rows if r.status != "converged"]
+    if bad:
+        lines += ["## Every outcome that is not converged", ""]
+        lines += [markdown_table(["method", "control", "s", "k", "E*", "status", "dense KKT", "message"],
+                                 [[r.method, r.control, fmt(r.s, "g"), fmt(r.k, "g"), fmt(r.E_star, "g"), r.status,
+                                   fmt(r.kkt_dense, ".1e"), r.message[:110]] for r in bad]), ""]
+    return "\n".join(lines)
+
+
+def main(args):
+    """Command-line entry: ``contactlab study robustness [--out DIR] [--quick]``.
+
+    Writes ``robustness.json`` and ``robustness.md``; prints the summary. Returns 1 if any
+    outcome is wrong, else 0.
+    """
+    from pathlib import Path
+
+    out = Path(getattr(args, "out", None) or ".")
+    kw = {}
+    if getattr(args, "quick", False):
+        kw = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
+    rows = run_robustness(progress=True, **kw)
+    write_json(out / "robustness.json", [asdict(r) for r in rows])
+    text = summary_markdown(rows)
+    write_atomic(out / "robustness.md", text + "\n")
+    print(text)
+    return 1 if any(r.status == "wrong" for r in rows) else 0
