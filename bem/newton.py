@@ -38,8 +38,9 @@ def _tangent(layer, p, gap, p_ref):
     """Per-node model compliance ``D``: ``w'(p)`` where finite, else a secant."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         d = np.asarray(layer.dw(p), dtype=float)
-        reach = np.maximum(np.asarray(layer.inverse(np.maximum(-gap, 0.0)), dtype=float), p_ref)
-        reach = np.minimum(reach, 1e6 * p_ref)
+        # the pressure at which the layer alone closes the gap, w^-1(-g); p_ref where it has none
+        reach = np.asarray(layer.inverse(np.maximum(-gap, 0.0)), dtype=float)
+        reach = np.where((reach > 0) & np.isfinite(reach), np.minimum(reach, 1e6 * p_ref), p_ref)
         secant = np.asarray(layer.w(reach), dtype=float) / reach
     return np.where(np.isfinite(d) & (p > 0), d, secant)
 
