@@ -3,7 +3,7 @@
 Boundary elements on the elastic half-space with piecewise-linear (pyramid)
 pressure on a regular triangular lattice, closed-form influence coefficients,
 FFT-fast products, and Kalker's variational principle generalised to a
-nonlinear interface layer (paper sections 4-5, DESIGN.md).
+nonlinear interface layer (paper sections 4-5, docs/method.md).
 """
 
 from . import checks, gaps, layers

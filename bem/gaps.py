@@ -1,7 +1,7 @@
 """Initial gap shapes ``h(x, y) >= 0`` between the two bodies.
 
 The gap is the initial separation ``h = z1 + z2`` of the two surfaces when
-they first touch (paper section 4, DESIGN.md section 1); lengths are in the
+they first touch (paper section 4, docs/method.md section 1); lengths are in the
 user's units. For the symmetric shapes ``h = 0`` at the origin, the first
 touching point, which lies on the line of the force.
 

@@ -1,7 +1,7 @@
 """The regular equilateral-triangle lattice of the pyramid pressure elements.
 
 Node ``(i, j)`` of the lattice with step ``c`` sits at ``c*(i*e1 + j*e2)``,
-``e1 = (1, 0)``, ``e2 = (1/2, sqrt(3)/2)`` (DESIGN.md section 2, paper Fig. 2).
+``e1 = (1, 0)``, ``e2 = (1/2, sqrt(3)/2)`` (docs/method.md section 2, paper Fig. 2).
 The candidate region is the rectangle ``|x| <= ex``, ``|y| <= ey`` centred on the
 origin. Its nodes are stored row by row in a 2-D "brick" array of shape
 ``(n_rows, n_cols)``: row ``r`` holds lattice row ``j = r - J`` at

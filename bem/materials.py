@@ -1,6 +1,6 @@
 """Elastic constants of the two contacting bodies.
 
-The half-space kernel (paper eq. 2-3, DESIGN.md section 1) depends on the two
+The half-space kernel (paper eq. 2-3, docs/method.md section 1) depends on the two
 bodies only through Johnson's effective (contact) modulus ``E*``::
 
     1 / E* = (1 - nu1**2) / E1 + (1 - nu2**2) / E2

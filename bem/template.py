@@ -4,7 +4,7 @@
 ``rho = sqrt((x - xi)^2 + (y - eta)^2)``, in lattice units (step ``c = 1``). The
 hexagon has side 1, centre 0 and vertices ``v_k = (cos(k pi/3), sin(k pi/3))``;
 the pyramid ``pyr`` is 1 at the centre, 0 at the ``v_k`` and linear on the six
-triangles ``(0, v_k, v_{k+1})`` (DESIGN.md section 2). The influence matrix is
+triangles ``(0, v_k, v_{k+1})`` (docs/method.md section 2). The influence matrix is
 ``C[n, m] = c / (pi E*) * w_t((r_n - r_m) / c)`` (eq. 6).
 
 Near field, ``r < R_SWITCH`` -- closed form

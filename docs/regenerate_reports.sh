@@ -5,11 +5,17 @@
 #   reports/studies/      raw study output (error_time.*, stability.*)
 #   reports/validation/   the report of the two studies (work-precision plots, stability table)
 # Usage, from the repository root:  bash docs/regenerate_reports.sh
+# Every path given is relative: the reports name their sources relative to the working
+# directory and record the command in their footer, so nothing kept names a machine path.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 contactlab --no-progress report paper --out reports/paper
-contactlab --no-progress report hertz --out /tmp/contactlab-hertz
-rm -rf reports/hertz && cp -r /tmp/contactlab-hertz/report reports/hertz
+contactlab --no-progress report hertz --out build/hertz   # build/ is not kept (.gitignore)
+rm -rf reports/hertz && cp -r build/hertz/report reports/hertz
 contactlab --no-progress study error-time --out reports/studies
 contactlab --no-progress study stability --out reports/studies
 contactlab --no-progress report reports/studies --out reports/validation
+if grep -rlE --include="*.md" --include="*.json" "(/tmp/|/home/|/root/|/work/|/Users/)" reports/; then
+    echo "regenerate_reports.sh: the files above name machine paths" >&2
+    exit 1
+fi

@@ -1,4 +1,4 @@
-"""Axisymmetric FEM reference for the layered contact of two elastic bodies (DESIGN.md section 4).
+"""Axisymmetric FEM reference for the layered contact of two elastic bodies (docs/method.md section 4).
 
 gmsh meshes of the two bodies in the (r, z) half-plane (:mod:`fem_reference.mesh`),
 axisymmetric linear elasticity in scikit-fem with quadratic triangles

@@ -14,10 +14,11 @@ interface). ``tr(eps) = eps_rr + eps_zz + eps_tt``; tension positive.
 from __future__ import annotations
 
 import os
-import tempfile
 
 import numpy as np
 from scipy.sparse.linalg import splu
+
+from bem.files import write_vtu as write_mesh_vtu
 
 __all__ = ["nodal_stresses", "write_vtu", "STRESS_NAMES"]
 
@@ -73,13 +74,13 @@ def nodal_stresses(model, u):
 
 
 def write_vtu(path, model, u, pressure):
-    """Write the whole field to ``path`` (.vtu, 6-node triangles) atomically.
+    """Write the whole field to ``path`` (.vtu, 6-node triangles), atomically.
 
     Parameters
     ----------
     path : path-like
-        Target file; written to a temporary file in the same directory, then
-        ``os.replace``-d, so a reader never sees a half-written file.
+        Target file, written by :func:`bem.files.write_vtu` (compressed VTK XML, whole or
+        not at all, permissions of any new file).
     model : fem_reference.model.AxiModel
         The model.
     u : ndarray
@@ -87,14 +88,17 @@ def write_vtu(path, model, u, pressure):
     pressure : ndarray, shape (n_if,)
         Contact pressure at the interface pairs [pressure].
 
+    Returns
+    -------
+    str
+        ``path``.
+
     Notes
     -----
-    Points are ``(r, z, 0)``; point data ``displacement`` (``u_r, u_z, 0``), the stresses of
-    :func:`nodal_stresses` and ``contact_pressure`` (0 off the interface); cell data
-    ``body`` (0 upper, 1 lower).
+    Points are ``(r, z, 0)`` [length]; point data ``displacement`` (``u_r, u_z, 0``) [length],
+    the stresses of :func:`nodal_stresses` and ``contact_pressure`` (0 off the interface)
+    [pressure]; cell data ``body`` (0 upper, 1 lower).
     """
-    import meshio
-
     basis = model.scalar_basis
     x = basis.doflocs
     points = np.column_stack([x[0], x[1], np.zeros(x.shape[1])])
@@ -103,21 +107,7 @@ def write_vtu(path, model, u, pressure):
     p_nodes = np.zeros(x.shape[1])
     p_nodes[model.node_up] = pressure
     p_nodes[model.node_lo] = pressure
-    mesh = meshio.Mesh(
-        points,
-        [("triangle6", np.ascontiguousarray(basis.element_dofs.T, dtype=np.int64))],
-        point_data={"displacement": disp, **fields, "contact_pressure": p_nodes},
-        cell_data={"body": [model.amesh.body.astype(np.int32)]},
-    )
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".vtu", dir=directory)
-    os.close(fd)
-    try:
-        meshio.write(tmp, mesh, file_format="vtu")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
-    return path
+    write_mesh_vtu(path, points, [("triangle6", np.ascontiguousarray(basis.element_dofs.T, dtype=np.int64))],
+                   point_data={"displacement": disp, **fields, "contact_pressure": p_nodes},
+                   cell_data={"body": [model.amesh.body.astype(np.int32)]})
+    return os.fspath(path)

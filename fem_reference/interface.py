@@ -1,6 +1,6 @@
 """The interface traction law of the FEM: the layer law as a penalty, regularised for Newton.
 
-The closure of an interface node pair is (DESIGN.md section 1, eq. 14)::
+The closure of an interface node pair is (docs/method.md section 1, eq. 14)::
 
     g = delta - h(r) - d,     d = u_z^upper - u_z^lower + delta_far   (elastic part)
 

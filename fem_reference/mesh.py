@@ -29,14 +29,13 @@ boundaries split per body (``interface_upper``, ``interface_lower``,
 from __future__ import annotations
 
 import logging
-import os
-import tempfile
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from bem.checks import InputError, check_positive
+from bem.files import atomic_path
 
 __all__ = ["AxiMesh", "build_mesh", "BOUNDARIES"]
 
@@ -245,17 +244,8 @@ def _to_skfem(xy, parts):
 
 
 def _write_msh(gmsh, path):
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(suffix=".msh", dir=directory)
-    os.close(fd)
-    try:
+    with atomic_path(path, suffix=".msh") as tmp:
         gmsh.write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
 
 
 def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None,

@@ -1,10 +1,11 @@
-"""Atomic output: files and result directories are written whole or not at all.
+"""Result output: JSON of numpy data, and result directories written whole or not at all.
 
-A file is written to a temporary name in its own directory and moved over the target
-with :func:`os.replace` (atomic on POSIX and Windows within one file system). A result
-directory is assembled in a hidden temporary directory beside the target and renamed into
-place at the end (:func:`atomic_directory`); an exception or an interrupt (``KeyboardInterrupt``
-included) removes the temporary directory and leaves any previous result untouched.
+Single files are written by :func:`bem.files.atomic_path` and the helpers built on it (a
+temporary file in the target's directory moved over the target with :func:`os.replace`,
+ordinary permissions). A directory is assembled in a hidden temporary directory beside the
+target and renamed into place at the end (:func:`atomic_directory`); an exception or an
+interrupt (``KeyboardInterrupt`` included) removes the temporary directory and leaves any
+previous result untouched. Result directories and report directories both use it.
 """
 
 from __future__ import annotations
@@ -21,8 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["atomic_write_bytes", "atomic_write_text", "atomic_write_json", "atomic_directory",
-           "to_jsonable", "OutputError", "RESULT_MARKER"]
+from bem.files import umask, write_text
+
+__all__ = ["atomic_write_json", "atomic_directory", "to_jsonable", "OutputError", "RESULT_MARKER",
+           "check_result_dir"]
 
 log = logging.getLogger(__name__)
 
@@ -30,38 +33,8 @@ log = logging.getLogger(__name__)
 RESULT_MARKER = "result.json"
 
 
-def _umask():
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 class OutputError(OSError):
     """The output location cannot be used (e.g. it is a non-empty foreign directory)."""
-
-
-def atomic_write_bytes(path, data):
-    """Write ``data`` to ``path`` via a temporary file and :func:`os.replace`. Returns the path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; give the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    return path
-
-
-def atomic_write_text(path, text):
-    """Write the string ``text`` (UTF-8) to ``path`` atomically. Returns the path."""
-    return atomic_write_bytes(path, text.encode("utf-8"))
 
 
 def to_jsonable(obj):
@@ -92,11 +65,17 @@ def to_jsonable(obj):
 def atomic_write_json(path, obj):
     """Write ``obj`` as indented JSON (strict: NaN/inf written as null) atomically."""
     text = json.dumps(to_jsonable(obj), indent=2, allow_nan=False) + "\n"
-    return atomic_write_text(path, text)
+    return write_text(path, text)
 
 
-def _check_replaceable(target):
-    """A target may be replaced if it does not exist, is empty, or is a result directory."""
+def check_result_dir(target):
+    """A result directory may be replaced if it does not exist, is empty, or holds ``result.json``.
+
+    Raises
+    ------
+    OutputError
+        ``target`` is a file, or a non-empty directory that is not a contactlab result.
+    """
     if not target.exists():
         return
     if not target.is_dir():
@@ -108,13 +87,23 @@ def _check_replaceable(target):
 
 
 @contextlib.contextmanager
-def atomic_directory(target):
+def atomic_directory(target, *, check=check_result_dir):
     """Assemble a directory in a temporary place; move it to ``target`` only on success.
 
-    Yields the temporary directory (a :class:`pathlib.Path`). On success an existing
-    ``target`` (empty, or a previous result directory holding ``result.json``) is
-    replaced; on any exception the temporary directory is removed and ``target`` is
-    left as it was.
+    Parameters
+    ----------
+    target : path-like
+        The directory to create or replace.
+    check : callable, optional
+        ``check(target)`` raises if ``target`` may not be replaced (default
+        :func:`check_result_dir`; the report builder passes its own rule).
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary directory (beside ``target``, permissions of a new directory). On
+        success an existing ``target`` is replaced; on any exception the temporary
+        directory is removed and ``target`` is left as it was.
 
     Raises
     ------
@@ -122,11 +111,11 @@ def atomic_directory(target):
         ``target`` is a file or a non-empty directory that is not a result directory.
     """
     target = Path(target).absolute()
-    _check_replaceable(target)
+    check(target)
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
     try:
-        os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp creates 0700
+        os.chmod(tmp, 0o777 & ~umask())  # mkdtemp creates 0700
         yield tmp
         old = None
         if target.exists():
@@ -140,7 +129,7 @@ def atomic_directory(target):
             raise
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
-        log.info("results written to %s", target)
+        log.info("written: %s", target)
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)

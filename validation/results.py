@@ -1,18 +1,20 @@
 """The result dictionary of a scene run (the content of ``result.json``).
 
-Contract (DESIGN.md section 6): ``p_max``, ``force``, ``approach``, ``contact_area``,
+Every field and its unit: docs/results.md. Contract: ``p_max``, ``force``, ``approach``, ``contact_area``,
 ``contact_radius`` (axisymmetric scenes), ``iterations``, ``converged``, ``kkt_residual``,
 ``wall_time_s`` per part, and the comparison metrics when a comparison was asked. The scalars
 at the top level are the BEM's (the product); ``converged`` is true only when every part that
-ran converged. Units are those of the scene (``units``).
+ran converged. Units are those of the scene (``units``). ``provenance`` records what made the
+result (:mod:`validation.provenance`).
 """
 
 from __future__ import annotations
 
 import math
-import platform
 
 import numpy as np
+
+from .provenance import provenance
 
 __all__ = ["build_result", "axial_profile", "SCHEMA", "CONTRACT_KEYS"]
 
@@ -113,7 +115,7 @@ def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=Non
     out["profile"] = axial_profile(res)
     if scene.report is not None:
         out["report"] = scene.report
-    out["environment"] = {"python": platform.python_version(), "numpy": np.__version__}
+    out["provenance"] = provenance()
     from .output import to_jsonable
 
     return to_jsonable(out)

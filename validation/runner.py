@@ -1,9 +1,9 @@
 """Run a scene: the BEM always, the FEM reference, closed form and comparisons only when named.
 
 :func:`run_scene` returns the JSON-ready result dict and, given ``out_dir``, writes it whole or
-not at all (:mod:`validation.output`) with the BEM nodal field (ParaView ``.vtu``, pure numpy)
-and, when the FEM ran, its field. Heavy packages (gmsh, scikit-fem, meshio) are imported only
-by the FEM reference, so a BEM-only scene never loads them.
+not at all (:mod:`validation.output`) with the BEM nodal field and, when the FEM ran, its
+field (ParaView ``.vtu``, both by :func:`bem.files.write_vtu`). gmsh and scikit-fem (the
+``[fem]`` extra) are imported only by the FEM reference, so a BEM-only scene never loads them.
 """
 
 from __future__ import annotations
@@ -12,16 +12,17 @@ import logging
 import time
 from dataclasses import dataclass
 
+import tomli_w
+
 import bem
+from bem.files import write_result_vtu, write_text
 
 from . import paper
-from .output import atomic_directory, atomic_write_json, atomic_write_text
+from .output import atomic_directory, atomic_write_json
 from .results import build_result
 from .scene import Scene, load_scene
 from .scene_sections import SOLVER_KEYS
 from .sizing import DOMAIN_MARGIN, inner_domain
-from .tomlwrite import dumps
-from .vtk import lattice_triangles, write_vtu
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES"]
 
@@ -221,12 +222,10 @@ def write_outputs(outcome, out_dir, *, progress=None):
         files["fem_field"] = FILES["fem_field"]
     outcome.result["files"] = dict(files)
     with atomic_directory(out_dir) as tmp:
-        fields = {"p": res.p, "gap": res.gap, "closure": res.closure, "displacement": res.displacement,
-                  "initial_gap": scene.gap(res.x, res.y)}
-        write_vtu(tmp / files["bem_field"], res.x, res.y, lattice_triangles(res.lattice), fields)
+        write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
         if outcome.fem is not None:
             outcome.fem.write(tmp / files["fem_field"])
-        atomic_write_text(tmp / files["scene"], dumps(scene.raw))
+        write_text(tmp / files["scene"], tomli_w.dumps(scene.raw))
         atomic_write_json(tmp / files["result"], outcome.result)
     _notify(progress, "write", "done")
     return out_dir

@@ -1,4 +1,4 @@
-"""Scenes: TOML files that describe one contact problem and what to run on it (DESIGN.md section 6).
+"""Scenes: TOML files that describe one contact problem and what to run on it (docs/scenes.md).
 
 A scene file has the sections (units: those of ``[scene] units``, SI by default)::
 
@@ -31,7 +31,9 @@ from pathlib import Path
 
 from . import scene_sections as sec
 from ._checks import SceneError
+from .extras import require as require_extra
 from .paper import ALIASES, EXCLUSIVE
+from .provenance import display_path
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
            "apply_overrides", "parse_override", "SECTIONS"]
@@ -196,12 +198,23 @@ def _check_sweep_points(scene):
 
 
 def parse_scene(raw, *, source="<dict>", overrides=None):
-    """Validate a scene given as a dict (the parsed TOML); returns a :class:`Scene`."""
+    """Validate a scene given as a dict (the parsed TOML); returns a :class:`Scene`.
+
+    Raises
+    ------
+    SceneError
+        Anything wrong in the scene.
+    validation.extras.MissingExtraError
+        The scene has ``[fem]`` but gmsh or scikit-fem cannot be imported ("install
+        contactlab[fem]"); nothing has run.
+    """
     overrides = list(overrides.items()) if isinstance(overrides, dict) else list(overrides or ())
     raw = apply_overrides(raw, overrides)
     scene = _validate(raw, source, [o if isinstance(o, str) else f"{o[0]}={o[1]!r}" for o in overrides])
     if scene.sweep is not None:
         _check_sweep_points(scene)
+    if scene.fem is not None:
+        require_extra("fem", f"[fem] of scene {scene.name!r} (the FEM reference)")
     return scene
 
 
@@ -228,7 +241,7 @@ def load_scene(source, *, overrides=None):
     if path.suffix == ".toml" or path.exists():
         if not path.is_file():
             raise SceneError(f"scene = {str(source)!r} is not allowed: there is no such file.")
-        label = str(path)
+        label = display_path(path)
     else:
         path = builtin_path(str(source))
         label = f"builtin:{source}"

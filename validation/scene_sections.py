@@ -14,7 +14,7 @@ import re
 from bem import METHODS, InputError, gaps
 from bem.gaps import gap_from_dict
 from bem.lattice import Lattice
-from bem.layers import Linear, from_dict
+from bem.layers import LAWS, Linear, from_dict
 from bem.materials import effective_modulus
 
 from . import _checks as ck
@@ -22,7 +22,7 @@ from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
 from .sizing import DOMAIN_MARGIN, MAX_NODES, check_estimate, inner_domain, node_count
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "bem_options", "fem_options", "analytic",
-           "report", "sweep_spec", "REPORT_SECTIONS", "ANALYTIC_KINDS", "DEFAULT_UNITS"]
+           "report", "sweep_spec", "scene_keys", "KEYS", "REPORT_SECTIONS", "ANALYTIC_KINDS", "DEFAULT_UNITS"]
 
 DEFAULT_UNITS = "SI (m, Pa, N)"
 #: Section names the report builder knows (validation only; the builder lives in validation.report).
@@ -37,16 +37,44 @@ SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested", "relaxatio
 _BEM_KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
 _FEM_KEYS = ("n_contact", "extent_factor", "fine_radius", "growth", "penalty", "rtol", "maxiter", "remesh",
              "truncation_correction")
+#: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
+KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *_BODY_KEYS),
+        "load": ("force", "approach"), "bem": _BEM_KEYS, "fem": _FEM_KEYS, "analytic": ("kind",),
+        "sweep": ("parameter", "values"), "report": ("sections", "format")}
 GAP_TYPES = {cls.type_name: cls for cls in (gaps.Paraboloid, gaps.EllipticParaboloid, gaps.CrownedRoller,
                                             gaps.FlatPunch, gaps.Callable, gaps.Table)}
 DEFAULT_NODES_ACROSS = 40
 DEFAULT_EXTENT_FACTOR = 1.5
 
 
+def scene_keys():
+    """Every key a scene file may hold: the schema that ``docs/scenes.md`` documents.
+
+    Returns
+    -------
+    dict
+        ``{section: {variant: keys}}``. Variant ``""`` holds the keys of every table of the
+        section; ``[gap]`` has one more variant per gap type (its parameters, from the
+        :mod:`bem.gaps` constructors), ``[layer]`` one per law (its :mod:`bem.layers`
+        parameters, and the paper's keys for the four paper laws, :mod:`validation.paper`).
+    """
+    out = {name: {"": keys} for name, keys in KEYS.items()}
+    out["gap"] = {"": ("type",), **{kind: tuple(p for p in inspect.signature(cls.__init__).parameters if p != "self")
+                                    for kind, cls in GAP_TYPES.items()}}
+    out["layer"] = {"": ("law",)}
+    for law, cls in LAWS.items():
+        keys = [*cls._required, *cls._optional]
+        if law in PAPER_LAWS:
+            keys += [k for pair in PAPER_LAWS[law].values() for k in pair if k not in keys]
+            keys += ["alpha_b"] if law == "root" else []
+        out["layer"][law] = tuple(keys)
+    return out
+
+
 def scene_meta(d):
     """``[scene]``: name (required), title, description, units."""
     ck.table("scene", d)
-    ck.unknown_keys("scene", d, ("name", "title", "description", "units"))
+    ck.unknown_keys("scene", d, KEYS["scene"])
     name = ck.string("scene.name", ck.require("scene", d, "name", 'give a short name, e.g. name = "hertz"'))
     if not _NAME.match(name):
         raise ck.SceneError(f"scene.name = {name!r} is not allowed: it must be letters, digits, '_', '.', '-' "
@@ -61,7 +89,7 @@ def scene_meta(d):
 def bodies(d):
     """``[bodies]``: ``E_star`` alone, or ``E1, nu1, E2, nu2`` (``E = inf``: rigid body)."""
     ck.table("bodies", d)
-    ck.unknown_keys("bodies", d, ("E_star", *_BODY_KEYS))
+    ck.unknown_keys("bodies", d, KEYS["bodies"])
     if "E_star" in d:
         if any(k in d for k in _BODY_KEYS):
             given = ", ".join(f"bodies.{k}" for k in _BODY_KEYS if k in d)
@@ -100,8 +128,8 @@ def gap(d, E_star):
 def load(d):
     """``[load]``: exactly one of ``force`` [N] and ``approach`` [m], > 0."""
     ck.table("load", d)
-    ck.unknown_keys("load", d, ("force", "approach"))
-    key = ck.exactly_one("load", d, ("force", "approach"), "force control: force [N]; approach control: "
+    ck.unknown_keys("load", d, KEYS["load"])
+    key = ck.exactly_one("load", d, KEYS["load"], "force control: force [N]; approach control: "
                          "approach [m]")
     return {"force": None, "approach": None, key: ck.positive(f"load.{key}", d[key])}
 
@@ -164,7 +192,7 @@ def bem_options(d, shape, layer_spec, E_star, load_):
     ``expected`` semi-axes (or None) and ``extent_auto`` (the region may be enlarged).
     """
     d = {} if d is None else ck.table("bem", d)
-    ck.unknown_keys("bem", d, _BEM_KEYS)
+    ck.unknown_keys("bem", d, KEYS["bem"])
     for a, b in (("step", "nodes_across"), ("extent", "extent_factor")):
         if a in d and b in d:
             raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
@@ -225,7 +253,7 @@ def fem_options(d, shape, materials):
     if d is None:
         return None
     ck.table("fem", d)
-    ck.unknown_keys("fem", d, _FEM_KEYS)
+    ck.unknown_keys("fem", d, KEYS["fem"])
     if not shape.is_axisymmetric:
         raise ck.SceneError(f"fem = {{...}} is not allowed with gap.type = {shape.type_name!r}: the FEM "
                             "reference is axisymmetric; remove [fem] or use an axisymmetric gap.")
@@ -262,7 +290,7 @@ def analytic(d, shape, layer_spec):
     if d is None:
         return None
     ck.table("analytic", d)
-    ck.unknown_keys("analytic", d, ("kind",))
+    ck.unknown_keys("analytic", d, KEYS["analytic"])
     kind = ck.choice("analytic.kind", ck.require("analytic", d, "kind", "give one of " + ", ".join(
         map(repr, ANALYTIC_KINDS))), ANALYTIC_KINDS)
     t = shape.type_name
@@ -292,7 +320,7 @@ def report(d):
     if d is None:
         return None
     ck.table("report", d)
-    ck.unknown_keys("report", d, ("sections", "format"))
+    ck.unknown_keys("report", d, KEYS["report"])
     out = {"format": ck.choice("report.format", d.get("format", "html"), ("html", "markdown", "both"))}
     sections = d.get("sections", ["summary"])
     if not isinstance(sections, list) or not sections:
@@ -309,7 +337,7 @@ def sweep_spec(d, known_sections):
     if d is None:
         return None
     ck.table("sweep", d)
-    ck.unknown_keys("sweep", d, ("parameter", "values"))
+    ck.unknown_keys("sweep", d, KEYS["sweep"])
     param = ck.string("sweep.parameter", ck.require("sweep", d, "parameter",
                                                     "give alpha_a, alpha_b, alpha_c or a dotted key like layer.lam"))
     key = ALIASES.get(param, param)

@@ -26,8 +26,11 @@ import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
+from bem.files import write_text
+
 from ._checks import SceneError
-from .output import atomic_write_json, atomic_write_text
+from .extras import require as require_extra
+from .output import atomic_write_json
 from .scene import Scene, apply_overrides, load_scene, parse_scene
 
 __all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values"]
@@ -166,11 +169,10 @@ def _local_map(jobs, workers):
 
 def _dask_client(scheduler):
     """A ``dask.distributed.Client`` for an address (or a Client/cluster object); owned flag."""
-    try:
-        from dask import distributed
-    except ImportError:
-        raise SceneError(f"--scheduler {scheduler!r} is not allowed here: dask.distributed is not installed "
-                         "(pip install 'dask[distributed]'), or run without --scheduler on local cores.") from None
+    if isinstance(scheduler, str):
+        require_extra("dask", f"--scheduler {scheduler!r} (a Dask cluster; without it the sweep runs on local cores)")
+    from dask import distributed
+
     if isinstance(scheduler, distributed.Client):
         return scheduler, False
     return distributed.Client(scheduler), True
@@ -198,7 +200,7 @@ def _write_summary(out, meta, rows):
     writer.writeheader()
     for row in rows:
         writer.writerow({k: "" if row.get(k) is None else row.get(k) for k in SUMMARY_COLUMNS})
-    atomic_write_text(out / "summary.csv", buf.getvalue())
+    write_text(out / "summary.csv", buf.getvalue())
     return rows
 
 

@@ -1,6 +1,6 @@
 """Shared plumbing of the concrete layer laws: argument handling and serialisation.
 
-Conventions every law follows (DESIGN.md section 1):
+Conventions every law follows (docs/method.md section 1):
 
 - pressures ``p`` are compressive; ``p < 0`` is treated as ``p = 0`` (clipped), NaN propagates;
 - closures ``c <= 0`` invert to ``p = 0``;

@@ -1,7 +1,7 @@
 """The interface-layer protocol shared by every solver (BEM and FEM).
 
 A layer is a normal compliance law ``w(p)``: the extra closure (length) of the
-interface under the compressive pressure ``p >= 0`` (DESIGN.md section 1).
+interface under the compressive pressure ``p >= 0`` (docs/method.md section 1).
 Every law satisfies ``w(0) = 0`` and is non-decreasing; its energy density
 ``W(p) = integral_0^p w(s) ds`` enters Kalker's generalised functional (eq. 15
 of the paper).

@@ -10,7 +10,7 @@ and the validation against Hertz and the FEM reference; then writes ``report.htm
 Usage (from the repository root)::
 
     python docs/examples/paper_report.py --out reports/paper          # about a minute
-    python docs/examples/paper_report.py --out /tmp/paper --quick     # coarse preview, ~20 s
+    python docs/examples/paper_report.py --out build/paper --quick    # coarse preview, ~20 s
 
 The same report: ``contactlab report paper --out reports/paper``.
 """

@@ -1,4 +1,4 @@
-"""Tests of the closed-form pyramid template ``w_t`` (paper eq. 5, DESIGN.md section 2).
+"""Tests of the closed-form pyramid template ``w_t`` (paper eq. 5, docs/method.md section 2).
 
 References are independent of the code under test:
 - near the hexagon: ``scipy.integrate.dblquad`` in polar coordinates about the

@@ -100,6 +100,29 @@ def test_bad_gap():
                  n_contact=3, extent_factor=20.0)
 
 
+def test_vtu_is_compressed_with_ordinary_permissions(result, tmp_path):
+    """The one writer (bem.files.write_vtu): zlib-compressed VTK XML, read here by an independent
+    decoder of the format; the file gets the permissions of any new file (it was 0600)."""
+    import os
+    import stat
+
+    from bem.files import file_mode
+
+    from ..vtu_reader import read_vtu
+
+    path = result.write(tmp_path / "f.vtu")
+    assert stat.S_IMODE(os.stat(path).st_mode) == file_mode()
+    points, (conn, offsets, types), point_data, cell_data, attrs = read_vtu(path)
+    assert attrs["compressor"] == "vtkZLibDataCompressor"
+    assert set(types) == {22} and types.size == result.n_elements  # VTK_QUADRATIC_TRIANGLE
+    np.testing.assert_array_equal(offsets, 6 * np.arange(1, result.n_elements + 1))
+    assert points.shape == (result.n_dofs // 2, 3)
+    assert point_data["displacement"].shape == (points.shape[0], 3)
+    np.testing.assert_array_equal(np.unique(cell_data["body"]), [0, 1])
+    centre = np.nonzero((np.abs(points[:, 0]) < 1e-12) & (np.abs(points[:, 1]) < 1e-12))[0]
+    np.testing.assert_allclose(point_data["contact_pressure"][centre], result.p[0])
+
+
 def test_vtk_reader_opens_the_file(result, tmp_path):
     """ParaView's reader (VTK, here through pyvista) sees quadratic triangles and the fields."""
     pv = pytest.importorskip("pyvista")

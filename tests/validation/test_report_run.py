@@ -12,6 +12,7 @@ from argparse import Namespace
 
 import numpy as np
 import pytest
+from tomli_w import dumps
 
 from validation.report import main, report_results_dir
 from validation.report.build import build_report
@@ -21,7 +22,6 @@ from validation.report.run_report import run_sections
 from validation.report.sections import Figure, Table
 from validation.runner import run_scene
 from validation.scene import builtin_path
-from validation.tomlwrite import dumps
 
 from .conftest import e_star, hertz
 from .test_report_build import assert_valid_offline_html

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 import validation.runner as runner
+from bem.files import lattice_triangles
 from validation.output import OutputError, atomic_directory, atomic_write_json
 from validation.runner import execute_scene, run_scene
 from validation.scene import load_scene
-from validation.vtk import lattice_triangles
 
 ROOT = Path(__file__).resolve().parents[2]
 FAST = ["bem.nodes_across=16"]
@@ -30,7 +30,7 @@ def test_interrupted_run_leaves_no_result_directory(tmp_path, monkeypatch, exc):
         Path(path).write_text("half a file")
         raise exc
 
-    monkeypatch.setattr(runner, "write_vtu", failing_write)
+    monkeypatch.setattr(runner, "write_result_vtu", failing_write)
     out = tmp_path / "res"
     with pytest.raises(type(exc)):
         run_scene("elliptic", out, overrides=FAST)
@@ -46,7 +46,7 @@ def test_failed_rerun_keeps_the_previous_result(tmp_path, monkeypatch):
     def failing_write(path, *a, **k):
         raise RuntimeError("interrupted")
 
-    monkeypatch.setattr(runner, "write_vtu", failing_write)
+    monkeypatch.setattr(runner, "write_result_vtu", failing_write)
     with pytest.raises(RuntimeError):
         run_scene("elliptic", out, overrides=["bem.nodes_across=20"])
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
@@ -122,7 +122,13 @@ def test_lattice_triangles_tile_the_region():
 
 
 def test_scene_file_in_the_result_reruns_identically(tmp_path):
+    from bem.files import file_mode
+
     first = run_scene("paper_bilinear", tmp_path / "a", overrides=["bem.nodes_across=16", "fem.n_contact=8"])
+    files = sorted(p.name for p in (tmp_path / "a").iterdir())
+    assert files == ["bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
+    for name in files:  # every file has the permissions of a new file (fem_field.vtu was 0600)
+        assert ((tmp_path / "a" / name).stat().st_mode & 0o777) == file_mode(), name
     second = run_scene(tmp_path / "a" / "scene.toml")
     assert second["p_max"] == first["p_max"] and second["approach"] == first["approach"]
     assert second["fem"]["p_max"] == first["fem"]["p_max"]
@@ -159,7 +165,7 @@ def test_run_does_not_modify_the_scene():
     assert json.dumps(scene.raw, sort_keys=True) == raw
 
 
-HEAVY = ("gmsh", "skfem", "meshio", "pyvista", "matplotlib")
+HEAVY = ("gmsh", "skfem", "pyvista", "matplotlib")  # meshio is core: it writes bem_field.vtu
 
 
 def test_bem_only_runs_import_no_heavy_package(tmp_path):

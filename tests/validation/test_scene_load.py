@@ -5,10 +5,10 @@ import math
 import tomllib
 
 import pytest
+from tomli_w import dumps
 
 from validation.scene import (SceneError, apply_overrides, builtin_path, builtin_scenes, load_scene,
                               parse_override, parse_scene)
-from validation.tomlwrite import dumps
 
 from .conftest import STEEL_E, STEEL_NU, e_star, hertz
 

@@ -12,7 +12,7 @@ from validation.runner import run_scene
 
 from .conftest import STEEL_E, STEEL_NU, e_star
 
-W_T00 = 1.5 * math.sqrt(3.0) * math.log(3.0)  # template at the origin, (3 sqrt3 / 2) ln 3 (DESIGN.md)
+W_T00 = 1.5 * math.sqrt(3.0) * math.log(3.0)  # template at the origin, (3 sqrt3 / 2) ln 3 (docs/method.md)
 P_LAMBDA = 7.0e8  # a stand-in peak pressure of the linear reference
 
 

@@ -9,6 +9,7 @@ import pytest
 
 import bem
 import validation.runner as runner
+from validation.extras import MissingExtraError
 from validation.runner import run_scene
 from validation.scene import SceneError
 from validation.sweep import parse_values, run_sweep, sweep_points
@@ -158,11 +159,12 @@ def test_dask_path_with_a_stand_in_client(tmp_path, monkeypatch):
 
 def test_dask_missing_is_a_clear_error(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "dask", None)  # import dask -> ImportError
-    with pytest.raises(SceneError, match="dask.distributed is not installed"):
+    with pytest.raises(MissingExtraError, match=r"install contactlab\[dask\]"):
         _sweep(tmp_path, scheduler="tcp://nowhere:8786")
+    assert not (tmp_path / "points").exists()  # stopped before any work
     code, _out, err = cli("sweep", "elliptic", "--param", "load.force", "--values", "50", "--scheduler",
                           "tcp://nowhere:8786", "--out", tmp_path / "c", "--set", "bem.nodes_across=16")
-    assert code == 2 and "dask" in err
+    assert code == 2 and "install contactlab[dask]" in err
 
 
 def test_real_dask_local_cluster(tmp_path):

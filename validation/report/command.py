@@ -7,6 +7,8 @@ from pathlib import Path
 
 from bem.checks import InputError
 
+from ..extras import require as require_extra
+
 __all__ = ["main", "DEFAULT_PAPER_OUT"]
 
 log = logging.getLogger(__name__)
@@ -36,10 +38,15 @@ def main(args):
     bem.InputError
         Unknown target (a scene must be run first with ``contactlab run``) or an output
         directory that holds other files.
+    validation.extras.MissingExtraError
+        matplotlib or pillow (``contactlab[report]``), or for ``paper`` gmsh or scikit-fem
+        (``contactlab[fem]``), cannot be imported; nothing has run.
     """
     target = str(getattr(args, "target", "") or "")
     out = getattr(args, "out", None)
+    require_extra("report", "contactlab report (figures)")
     if target == "paper":
+        require_extra("fem", "contactlab report paper (the FEM validation)")
         from .paper_report import report_paper_problem
 
         quick = bool(getattr(args, "quick", False))

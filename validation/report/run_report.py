@@ -13,6 +13,7 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
+from ..provenance import display_path
 from . import run_figures as rf
 from .build import build_report
 from .run_problem import method_text, problem_statement, rebuild_layer
@@ -251,7 +252,7 @@ def report_results_dir(directory, out_dir=None, *, title=None):
     out_dir = Path(directory) / "report" if out_dir is None else Path(out_dir)
     source = res.data.get("source")
     subtitle = f"Scene '{res.name}'" + (f" ({source})" if source else "") + \
-        f"; results read from {Path(directory).resolve()}"
+        f"; results read from {display_path(directory)}"
     with tempfile.TemporaryDirectory(prefix="contactlab-figures-") as work:
         sections = run_sections(res, work)
         return build_report(sections, out_dir, title=title or res.title, subtitle=subtitle)

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from bem.checks import InputError
 
+from ..provenance import display_path
 from .build import build_report
 from .figures_validation import plot_work_precision
 from .sections import Figure, Section, Table, table_from_rows
@@ -127,4 +128,4 @@ def report_studies_dir(directory, out_dir=None, *, title="contactlab validation 
     with tempfile.TemporaryDirectory(prefix="contactlab-figures-") as work:
         sections = study_sections(directory, work)
         return build_report(sections, out_dir, title=title,
-                            subtitle=f"Studies read from {Path(directory).resolve()}")
+                            subtitle=f"Studies read from {display_path(directory)}")

@@ -2,8 +2,8 @@
 
 Every 2-D figure is a bare :class:`matplotlib.figure.Figure` drawn with the Agg
 canvas (no ``pyplot``, so no global state and no GUI backend is ever touched)
-and saved by :func:`save_figure`: rendered to a temporary file in the target
-directory, then ``os.replace``-d, so a reader never sees a half-written PNG.
+and saved by :func:`save_figure` through :func:`bem.files.atomic_path` (a temporary file
+in the target directory, then ``os.replace``-d), so a reader never sees a half-written PNG.
 
 Colours are fixed per layer law, per method and per solver so that a law keeps
 its colour from one figure of a report to the next.
@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
+
+from bem.files import atomic_path
 
 __all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS", "color_for",
            "new_figure",
@@ -124,27 +125,6 @@ def new_figure(figsize=(6.4, 4.0), **subplots):
         FigureCanvasAgg(fig)
         axes = fig.subplots(**subplots)
         yield fig, axes
-
-
-@contextlib.contextmanager
-def atomic_path(path, suffix=".png"):
-    """Yield a temporary path beside ``path``; on success ``os.replace`` it onto ``path``.
-
-    On any error the temporary file is removed and ``path`` is left as it was.
-    """
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    os.makedirs(directory, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=suffix, dir=directory)
-    os.close(fd)
-    try:
-        yield tmp
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
 
 
 def save_figure(fig, path, *, colors=256):

@@ -15,34 +15,17 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import statistics
-import tempfile
 import time
-from pathlib import Path
 
-__all__ = ["write_atomic", "write_json", "markdown_table", "fmt", "timed"]
+from bem.files import write_text
 
-
-def write_atomic(path, text):
-    """Write ``text`` to ``path`` whole or not at all (temporary file + ``os.replace``). Returns the path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=path.suffix, dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private; a result file is for everyone
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+__all__ = ["write_text", "write_json", "markdown_table", "fmt", "timed"]
 
 
 def write_json(path, data):
-    """:func:`write_atomic` of ``data`` as indented JSON (``NaN``/``inf`` refused: JSON has none)."""
-    return write_atomic(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
+    """Write ``data`` as indented JSON, whole or not at all (``NaN``/``inf`` refused: JSON has none)."""
+    return write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
 
 
 def fmt(value, spec=".2e"):

@@ -29,7 +29,7 @@ from dataclasses import asdict, dataclass, field
 from bem.checks import InputError, check_choice, check_positive
 
 from ..metrics import pair_metrics, relative_l2
-from . import fmt, markdown_table, timed, write_atomic, write_json
+from . import fmt, markdown_table, timed, write_json, write_text
 from .problems import ERROR_TIME_PROBLEMS, get_problem
 
 __all__ = ["ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "LADDERS", "TARGETS"]
@@ -367,12 +367,16 @@ def main(args):
     """
     from pathlib import Path
 
+    from ..extras import require
+
+    require("fem", "contactlab study error-time (the FEM reference)")
+
     scene = getattr(args, "scene", None)
     problems = None if scene is None else [get_problem(str(scene))]
     out = Path(getattr(args, "out", None) or ".")
     study = run_error_time(problems, quick=bool(getattr(args, "quick", False)), progress=True)
     study.to_json(out / "error_time.json")
     text = study.markdown()
-    write_atomic(out / "error_time.md", text)
+    write_text(out / "error_time.md", text)
     print(text)
     return 0

@@ -42,7 +42,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..metrics import pair_metrics
-from . import fmt, markdown_table, write_atomic, write_json
+from . import fmt, markdown_table, write_json, write_text
 from .problems import stability_cases
 
 __all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main",
@@ -312,11 +312,15 @@ def main(args):
     """
     from pathlib import Path
 
+    from ..extras import require
+
+    require("fem", "contactlab study stability (the FEM cases)")
+
     out = Path(getattr(args, "out", None) or ".")
     study = run_stability(quick=bool(getattr(args, "quick", False)), check=False, progress=True)
     study.to_json(out / "stability.json")
     text = study.markdown()
-    write_atomic(out / "stability.md", text)
+    write_text(out / "stability.md", text)
     print(text)
     study.check()
     return 0
