@@ -199,6 +199,14 @@ def summary_markdown(rows):
     return "\n".join(lines)
 
 
+def _json_row(row):
+    """The row as a dict; a non-finite KKT residual (an overflowed closure) becomes the string "inf"."""
+    out = asdict(row)
+    if out["kkt_dense"] is not None and not math.isfinite(out["kkt_dense"]):
+        out["kkt_dense"] = str(out["kkt_dense"])
+    return out
+
+
 def main(args):
     """Command-line entry: ``contactlab study robustness [--out DIR] [--quick]``.
 
@@ -212,8 +220,8 @@ def main(args):
     if getattr(args, "quick", False):
         kw = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
     rows = run_robustness(progress=True, **kw)
-    write_json(out / "robustness.json", [asdict(r) for r in rows])
     text = summary_markdown(rows)
     write_atomic(out / "robustness.md", text + "\n")
+    write_json(out / "robustness.json", [_json_row(r) for r in rows])
     print(text)
     return 1 if any(r.status == "wrong" for r in rows) else 0
