@@ -59,6 +59,7 @@ class InfluenceOperator:
         import scipy.fft as sfft
 
         self.lattice = lattice
+        self.n_matvec = 0  # products C p so far (the work measure of ContactResult.n_matvec)
         self.E_star = check_positive("E_star", E_star)
         n_rows, n_cols = lattice.shape
         par = lattice.parity
@@ -95,6 +96,7 @@ class InfluenceOperator:
 
     def matvec(self, p):
         """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]."""
+        self.n_matvec += 1
         return self._block_convolve(self._kernel_hat, np.asarray(p, dtype=float))
 
     __call__ = matvec

@@ -44,6 +44,9 @@ class ContactResult:
         ``"kalker"``), Newton steps, or outer iterations of the paper's methods.
     kkt_residual : float
         :func:`bem.kkt.kkt_residual` of the returned state.
+    n_matvec : int
+        Products with the influence matrix ``C`` (FFT convolutions) on the finest lattice,
+        inner solves included: the measure of work that does not depend on the method.
     history : dict
         Per-iteration lists (``residual``, ``p_max``, ``n_contact``, ``changes``
         and method-specific entries).
@@ -77,6 +80,7 @@ class ContactResult:
     E_star: float
     history: dict = field(default_factory=dict)
     layer: object = None
+    n_matvec: int = 0
 
     @property
     def contact_radius(self):
@@ -110,6 +114,7 @@ class ContactResult:
             "contact_area": float(self.contact_area),
             "contact_radius": float(self.contact_radius),
             "iterations": int(self.iterations),
+            "n_matvec": int(self.n_matvec),
             "kkt_residual": float(self.kkt_residual),
             "wall_time_s": float(self.wall_time_s),
             "n_nodes": int(self.p.size),

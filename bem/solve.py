@@ -332,5 +332,5 @@ def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start)
         contact_area=float(a * np.count_nonzero(p[mask] > 0)), converged=bool(sol.converged),
         message=sol.message, iterations=int(sol.iterations), kkt_residual=float(kkt), method=method,
         wall_time_s=time.perf_counter() - t_start, lattice=lattice, E_star=E_star,
-        history=sol.history, layer=layer,
+        history=sol.history, layer=layer, n_matvec=op.n_matvec,
     )

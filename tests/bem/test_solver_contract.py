@@ -69,6 +69,21 @@ def test_result_method_is_the_solver_that_ran(method):
         assert layered.method == method
 
 
+def test_n_matvec_counts_the_products_with_c(monkeypatch):
+    calls = []
+    real = bem.InfluenceOperator.matvec
+
+    def counting(self, p):
+        calls.append(self.lattice.n_nodes)
+        return real(self, p)
+
+    monkeypatch.setattr(bem.InfluenceOperator, "matvec", counting)
+    for kw in ({}, {"layer": layers.Root(0.05)}):
+        calls.clear()
+        res = _hertz(nested=False, **kw)
+        assert res.n_matvec == len(calls) > res.iterations
+
+
 # --- item 3: one name, one meaning --------------------------------------------------------------
 
 def test_rtol_is_the_kkt_tolerance_of_every_method():
