@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from . import fmt, markdown_table, write_atomic, write_json
+from . import fmt, markdown_table, write_json, write_text
 
 __all__ = ["RobustnessRow", "run_robustness", "summary_markdown", "main", "EXPONENTS", "COMPLIANCES", "MODULI"]
 
@@ -221,7 +221,7 @@ def main(args):
         kw = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
     rows = run_robustness(progress=True, **kw)
     text = summary_markdown(rows)
-    write_atomic(out / "robustness.md", text + "\n")
+    write_text(out / "robustness.md", text + "\n")
     write_json(out / "robustness.json", [_json_row(r) for r in rows])
     print(text)
     return 1 if any(r.status == "wrong" for r in rows) else 0
