@@ -91,7 +91,8 @@ def command_line(argv=None, orig_argv=None):
     argv = list(sys.argv if argv is None else argv)
     orig = list(getattr(sys, "orig_argv", []) if orig_argv is None else orig_argv)
     # the interpreter's own options come before the tokens that became sys.argv
-    head = orig[:len(orig) - len(argv) + 1] if argv and len(orig) > len(argv) else []
+    same = argv and len(orig) > len(argv) and orig[len(orig) - len(argv) + 1:] == argv[1:]
+    head = orig[:len(orig) - len(argv) + 1] if same else []
     if len(head) >= 3 and head[-2] == "-m":
         prog = ["python", "-m", head[-1]]
     elif len(head) >= 3 and head[-2] == "-c":
