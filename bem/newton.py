@@ -286,5 +286,64 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             callback(k + 1, p)
     if not converged:
         log.debug("Newton: %s", message)
-    return QPSolution(p=p, approach=delta, iterations=len(hist["step"]), converged=converged, message=message,
-                      kkt_residual=float(kkt), displacement=u, history=hist, applies=applies)
+    out = QPSolution(p=p, approach=delta, iterations=len(hist["step"]), converged=converged, message=message,
+                     kkt_residual=float(kkt), displacement=u, history=hist, applies=applies)
+    if force is not None and not converged and np.isfinite(delta) and delta > 0:
+        out = _force_by_approach(op, h, layer, force, out, rtol=rtol, maxiter=maxiter, precondition=precondition,
+                                 inner_maxiter=inner_maxiter)
+    return out
+
+
+class _ApproachFailed(Exception):
+    pass
+
+
+def _force_by_approach(op, h, layer, force, failed, *, rtol, **kw):
+    """Force control as a root of ``P(delta) = force`` over approach-controlled solves.
+
+    The fallback when Newton under force control stops short (seen only with power laws of
+    ``s`` near 0 and a dominating layer, where nodal pressures span tens of decades): the force
+    is monotone in the approach, and approach control has no force constraint coupling the
+    nodes. Brent's method on ``delta``, each evaluation an approach-controlled Newton solve.
+    Returns ``failed`` unchanged if an inner solve fails.
+    """
+    from scipy.optimize import brentq
+
+    a = op.lattice.node_area
+    solved = {}
+
+    def excess(delta):  # a cold start each time: warm starts across a steep P(delta) stall
+        sol = solve_newton(op, h, layer=layer, approach=delta, rtol=rtol, **kw)
+        if not sol.converged:
+            raise _ApproachFailed(sol.message)
+        solved[delta] = sol
+        return a * float(sol.p.sum()) / force - 1.0
+
+    delta = failed.approach
+    try:
+        f0 = excess(delta)
+        step, other = 1e-3, None
+        for _ in range(60):
+            trial = delta * (1 + step) if f0 < 0 else delta / (1 + step)
+            if excess(trial) * f0 <= 0:
+                other = trial
+                break
+            step *= 2
+        if other is None:
+            return failed
+        root = brentq(excess, min(delta, other), max(delta, other), xtol=4 * np.finfo(float).eps * delta,
+                      rtol=4 * np.finfo(float).eps, maxiter=200)
+        excess(root)
+    except _ApproachFailed:
+        return failed
+    sol = solved[root]
+    u = op.matvec(sol.p)
+    _, delta_f, kkt = layered_state(op, h, layer, sol.p, u, force=force)
+    steps = sum(s.iterations for s in solved.values())
+    hist = dict(failed.history, outer_approaches=sorted(solved))
+    converged = kkt <= rtol
+    message = (f"KKT residual {kkt:.2e} {'<=' if converged else '>'} rtol {rtol:.1e}: force control by "
+               f"{len(solved)} approach-controlled solves ({steps} Newton steps) after '{failed.message}'")
+    return QPSolution(p=sol.p, approach=delta_f, iterations=failed.iterations + steps, converged=converged,
+                      message=message, kkt_residual=float(kkt), displacement=u, history=hist,
+                      applies=failed.applies + sum(s.applies for s in solved.values()) + 1)

@@ -154,6 +154,22 @@ def test_newton_near_the_rigid_limit_with_a_small_exponent(n_across):
         assert _dense_kkt(res, layer) <= 1.01e-10
 
 
+@pytest.mark.parametrize("k", [1e3, 1e6])
+def test_newton_force_control_with_an_extreme_concave_layer(k):
+    """s = 0.05 with a layer 1e3-1e6 times softer than the bodies: pressures span tens of decades.
+
+    Newton under force control stalls there; the force is then found as the root of P(delta)
+    over approach-controlled solves (which converge)."""
+    from validation.studies.robustness import _contact_radius, _layer
+
+    layer = _layer(0.05, k, 1.0)
+    a = _contact_radius(layer, 1.0)
+    res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * a / 16, extent=1.5 * a, layer=layer)
+    assert res.converged, res.message
+    assert _dense_kkt(res, layer) <= 1.01e-10
+    assert res.force == pytest.approx(1.0, rel=1e-10)
+
+
 # --- item 6: variable compliance under force control where the layer dominates ------------------
 
 @pytest.mark.parametrize("layer, E_star", [(layers.Linear(1.0), 1e4), (layers.Root(1.0), 1e2),
