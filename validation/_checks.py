@@ -19,7 +19,23 @@ __all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one
 
 
 class SceneError(InputError):
-    """A scene (file, overrides or sweep) is invalid; the message names the dotted key."""
+    """A scene (file, overrides or sweep) is invalid; the message names the dotted key.
+
+    ``errors`` holds every message when a scene had several independent errors
+    (:meth:`of`); empty for a single error (the message is ``str(exc)``).
+    """
+
+    errors = ()
+
+    @classmethod
+    def of(cls, messages):
+        """One error reporting every message of ``messages`` (each naming its key)."""
+        messages = list(messages)
+        if len(messages) == 1:
+            return cls(messages[0])
+        exc = cls(f"{len(messages)} errors in the scene:\n" + "\n".join(f"  {m}" for m in messages))
+        exc.errors = tuple(messages)
+        return exc
 
 
 @contextlib.contextmanager

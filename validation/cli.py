@@ -10,6 +10,7 @@ import argparse
 import contextlib
 import importlib
 import logging
+import os
 import re
 import sys
 from pathlib import Path
@@ -57,17 +58,28 @@ examples:
   contactlab study stability                         convergence of the methods across layers
   contactlab study robustness                        every layer method over 12 decades of compliance
   contactlab report results/hertz --out report/      figures + HTML/Markdown report
+  contactlab report results/hertz-sweep-load.force   report of a sweep directory
+  contactlab report paper --quick                    the paper's test problem, a quick preview
 
 result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
 iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.toml (the
 effective scene, re-runnable), bem_field.vtu and fem_field.vtu (open in ParaView).
-Written whole or not at all. Exit codes: 0 ok, 1 not converged, 2 bad input.
+Written whole or not at all. Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
+scene is listed), or an unknown option.
 """
 
 
-def _add_set(p):
+#: measured wall time of `contactlab report paper --quick` and of the full paper report on 2 cores shared
+#: with other jobs (load 2.3-5; CPU time 15-18 s and 36-42 s)
+QUICK_TIME, FULL_TIME = "18-26 s", "50-80 s"
+#: figure formats of `contactlab report --format` (validation.report.style.FORMATS, kept here so the
+#: parser needs no import of the report package)
+FORMATS = ("png", "svg", "pdf")
+
+
+def _add_set(p, scope=""):
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene key, e.g. bem.nodes_across=20, layer.alpha_a=0.3, "
+                   help=f"{scope}override a scene key, e.g. bem.nodes_across=20, layer.alpha_a=0.3, "
                         "load.force=250.0 (value parsed as TOML; repeatable)")
 
 
@@ -113,7 +125,8 @@ def build_parser():
     _add_set(p)
 
     p = sub.add_parser("study", help="error-time and stability studies", formatter_class=fmt,
-                       description="Studies of the methods (validation.studies).",
+                       description="Studies of the methods (validation.studies) on their built-in problems "
+                                   "(no scene keys to override).",
                        epilog="examples:\n  contactlab study error-time hertz --out reports/studies\n"
                        "  contactlab study stability --quick\n"
                        "  contactlab report reports/studies      (work-precision plot and tables)")
@@ -123,14 +136,34 @@ def build_parser():
                    help="problem for error-time: hertz or paper_root (default: both)")
     p.add_argument("--quick", action="store_true", help="a short ladder / case list (minutes instead of ~5)")
     p.add_argument("--out", metavar="DIR")
-    _add_set(p)
 
     p = sub.add_parser("report", help="figures and an HTML/Markdown report", formatter_class=fmt,
-                       description="Build a report from a scene (runs it) or a result/sweep directory.",
-                       epilog="examples:\n  contactlab report hertz\n  contactlab report results/hertz --out rep/")
-    p.add_argument("target", metavar="SCENE_OR_DIR")
-    p.add_argument("--out", metavar="DIR")
-    _add_set(p)
+                       description="Build a report (report.html, report.md, figures/) from the paper's test\n"
+                                   "problem, a scene (runs it first), a result directory of `contactlab run`, a\n"
+                                   "sweep directory of `contactlab sweep` or a directory of study files.\n"
+                                   "Prints where it wrote report.html; a progress bar on stderr shows the stages.",
+                       epilog="examples:\n  contactlab report hertz                     runs it into results/hertz/\n"
+                              "  contactlab report results/hertz --out rep/\n"
+                              "  contactlab report results/paper_elastic_rigid-sweep-alpha_a      (a sweep)\n"
+                              "  contactlab report reports/studies                (study files)\n"
+                              "  contactlab report paper --quick --out /tmp/paper\n"
+                              "  contactlab report hertz --units dimensionless --format pdf")
+    p.add_argument("target", metavar="SCENE_OR_DIR",
+                   help="'paper', a scene (built-in name or .toml), or a result, sweep or study directory")
+    p.add_argument("--out", metavar="DIR", help="report directory (default: reports/paper for 'paper', "
+                                                "DIR/report for a directory, results/NAME/report for a scene)")
+    p.add_argument("--format", choices=FORMATS, default="png",
+                   help="figure files: png (300 dpi, default), svg (vector, shown in the HTML), or pdf "
+                        "(vector, beside a PNG for the HTML)")
+    p.add_argument("--units", choices=("scene", "dimensionless"),
+                   help="axes of a scene, result or sweep report: in the scene's units (mm and MPa for SI "
+                        "scenes; the default when the scene's units label names them) or divided by the "
+                        "contact's scales (Hertz's p_H and a_H for a paraboloid, else p_max and the contact "
+                        "half-width)")
+    p.add_argument("--quick", action="store_true",
+                   help=f"'paper' only: a coarse preview (a_H/c = 8, short sweeps): {QUICK_TIME} instead of "
+                        f"{FULL_TIME} on 2 cores")
+    _add_set(p, "scene targets only: ")
     return parser
 
 
@@ -269,27 +302,58 @@ def _cmd_sweep(args):
     return 1 if bad else 0
 
 
-def _dispatch(module, args, what):
+def _load(module, what):
+    """``module`` imported, or ``None`` after saying on stderr that it is not installed."""
     try:
-        mod = importlib.import_module(module)
+        return importlib.import_module(module)
     except ModuleNotFoundError as exc:
         if exc.name is not None and module.startswith(exc.name):
             print(f"contactlab: error: {what} is not available in this installation ({module} is missing).",
                   file=sys.stderr)
-            return 2
+            return None
         raise
-    code = mod.main(args)
-    return 0 if code is None else int(code)
 
 
 def _cmd_study(args):
     module = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
               "robustness": "validation.studies.robustness"}
-    return _dispatch(module[args.study], args, f"the {args.study} study")
+    mod = _load(module[args.study], f"the {args.study} study")
+    if mod is None:
+        return 2
+    code = mod.main(args)
+    return 0 if code is None else int(code)
+
+
+class _ReportBar:
+    """tqdm bar (stderr) over the stages of a report build."""
+
+    def __init__(self, disable):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=1, desc="report", unit="stage", disable=disable, leave=False)
+
+    def __call__(self, stage, done, total):
+        self.bar.total = total
+        self.bar.n = done
+        self.bar.set_description(stage)
+        self.bar.refresh()
+
+    def close(self):
+        self.bar.close()
 
 
 def _cmd_report(args):
-    return _dispatch("validation.report", args, "the report builder")
+    command = _load("validation.report.command", "the report builder")
+    if command is None:
+        return 2
+    bar = _ReportBar(args.no_progress or None)
+    try:
+        built = command.build_from_args(args, progress=bar)
+    finally:
+        bar.close()
+    print(f"report written to {built.html}")
+    print(f"  (also {built.markdown.name} and {len(built.figures)} figures in {built.out_dir / 'figures'}{os.sep})")
+    return 0
 
 
 @contextlib.contextmanager
@@ -319,18 +383,16 @@ _COMMANDS = {"run": _cmd_run, "scenes": _cmd_scenes, "check": _cmd_check, "sweep
 def main(argv=None):
     """Entry point of the ``contactlab`` console script; returns the exit code."""
     parser = build_parser()
-    try:  # argparse exits on --help (0) and on bad options (2): return the code instead
-        args, extra = parser.parse_known_args(argv)
-        if extra and args.command not in ("study", "report"):
-            parser.error(f"unrecognized arguments: {' '.join(extra)}")
+    try:  # argparse exits on --help (0) and on bad or unknown options (2): return the code instead
+        args = parser.parse_args(argv)
     except SystemExit as exc:
         return exc.code
-    args.extra = extra
     try:
         with _log_to_stderr(args.verbose):
             return _COMMANDS[args.command](args)
     except (InputError, OutputError) as exc:
-        print(f"contactlab: error: {exc}", file=sys.stderr)
+        for message in getattr(exc, "errors", None) or (str(exc),):
+            print(f"contactlab: error: {message}", file=sys.stderr)
         return 2
     except CalibrationError as exc:
         print(f"contactlab: error: {exc}", file=sys.stderr)

@@ -4,7 +4,8 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
 
     [scene]    name, title, description, units           (name required)
     [bodies]   E1, nu1, E2, nu2 [Pa, -]  -- or E_star [Pa] alone
-    [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...)
+    [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...), or
+               type = "measured" with a file (validation.measured)
     [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn, alpha_a,
                alpha_b, alpha_c (validation.paper); absent or law = "none": no layer
     [load]     force [N] or approach [m]
@@ -32,6 +33,7 @@ from pathlib import Path
 from . import scene_sections as sec
 from ._checks import SceneError
 from .extras import require as require_extra
+from .measured import measured_region
 from .paper import ALIASES, EXCLUSIVE
 from .provenance import display_path
 
@@ -160,30 +162,63 @@ def apply_overrides(raw, overrides):
     return out
 
 
+class _Collect:
+    """Runs section validators and keeps every :class:`SceneError` instead of stopping at the first.
+
+    ``check(fn, *needs)`` returns ``fn(*needs)``, or :attr:`FAILED` after recording its
+    error; a validator whose inputs (``needs``) failed is skipped (its errors would only
+    repeat the first).
+    """
+
+    FAILED = object()
+
+    def __init__(self):
+        self.errors = []
+
+    def __call__(self, fn, *needs):
+        if any(n is self.FAILED for n in needs):
+            return self.FAILED
+        try:
+            return fn(*needs)
+        except SceneError as exc:
+            self.errors.extend(getattr(exc, "errors", None) or (str(exc),))
+            return self.FAILED
+
+    def fail(self, message):
+        self.errors.append(message)
+
+
 def _validate(raw, source, overrides):
     if not isinstance(raw, dict):
         raise SceneError(f"scene = {raw!r} is not allowed: it must be a table of sections.")
+    check = _Collect()
     for key, value in raw.items():
         if key not in SECTIONS:
-            raise SceneError(f"{key} = {'{...}' if isinstance(value, dict) else repr(value)} is not allowed: "
-                             f"there is no section [{key}] (sections: {', '.join(SECTIONS)}).")
+            check.fail(f"{key} = {'{...}' if isinstance(value, dict) else repr(value)} is not allowed: "
+                       f"there is no section [{key}] (sections: {', '.join(SECTIONS)}).")
     for key in _REQUIRED:
         if key not in raw:
-            raise SceneError(f"[{key}] is missing: every scene needs the sections " + ", ".join(_REQUIRED) + ".")
-    meta = sec.scene_meta(raw["scene"])
-    body = sec.bodies(raw["bodies"])
-    load = sec.load(raw["load"])
-    gap_spec, shape = sec.gap(raw["gap"], body["E_star"])
-    layer_spec = sec.layer(raw.get("layer"))
-    bem = sec.bem_options(raw.get("bem"), shape, layer_spec, body["E_star"], load)
+            check.fail(f"[{key}] is missing: every scene needs the sections " + ", ".join(_REQUIRED) + ".")
+    section = {k: (raw[k] if k in raw else check.FAILED) for k in _REQUIRED}
+    meta = check(sec.scene_meta, section["scene"])
+    body = check(sec.bodies, section["bodies"])
+    load = check(sec.load, section["load"])
+    shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"]), section["gap"], body, meta)
+    layer_spec = check(sec.layer, raw.get("layer"))
+    bem = check(lambda g, ls, b, ld: sec.bem_options(raw.get("bem"), g[1], ls, b["E_star"], ld),
+                shape, layer_spec, body, load)
+    shape = check(lambda g, b: (g[0], measured_region(g[1], b["extent"])), shape, bem)
+    fem = check(lambda g, b: sec.fem_options(raw.get("fem"), g[1], b["materials"]), shape, body)
+    analytic = check(lambda g, ls: sec.analytic(raw.get("analytic"), g[1], ls), shape, layer_spec)
+    sweep = check(sec.sweep_spec, raw.get("sweep"), SECTIONS)
+    report = check(sec.report, raw.get("report"))
+    if check.errors:
+        raise SceneError.of(check.errors)
     return Scene(
         name=meta["name"], title=meta["title"], description=meta["description"], units=meta["units"],
-        source=source, raw=raw, E_star=body["E_star"], materials=body["materials"], gap=shape,
-        gap_spec=gap_spec, layer_spec=layer_spec, load=load, bem=bem,
-        fem=sec.fem_options(raw.get("fem"), shape, body["materials"]),
-        analytic=sec.analytic(raw.get("analytic"), shape, layer_spec),
-        sweep=sec.sweep_spec(raw.get("sweep"), SECTIONS), report=sec.report(raw.get("report")),
-        overrides=tuple(overrides),
+        source=source, raw=raw, E_star=body["E_star"], materials=body["materials"], gap=shape[1],
+        gap_spec=shape[0], layer_spec=layer_spec, load=load, bem=bem, fem=fem, analytic=analytic, sweep=sweep,
+        report=report, overrides=tuple(overrides),
     )
 
 
@@ -197,8 +232,19 @@ def _check_sweep_points(scene):
             raise SceneError(f"sweep.values[{i}] = {value!r} gives an invalid scene: {exc}") from None
 
 
-def parse_scene(raw, *, source="<dict>", overrides=None):
+def _resolve_files(raw, base_dir):
+    """Make the file a scene names (``gap.file`` of a measured gap) absolute, relative to ``base_dir``."""
+    gap = raw.get("gap")
+    if isinstance(gap, dict) and gap.get("type") == "measured" and isinstance(gap.get("file"), str):
+        gap["file"] = str((Path(base_dir) / Path(gap["file"]).expanduser()).absolute())
+
+
+def parse_scene(raw, *, source="<dict>", overrides=None, base_dir=None):
     """Validate a scene given as a dict (the parsed TOML); returns a :class:`Scene`.
+
+    ``base_dir`` is the folder that relative file names in the scene (``gap.file``) start
+    from: the scene file's folder (:func:`load_scene`), the current directory by default.
+    ``Scene.raw`` holds them made absolute, so it re-loads from anywhere.
 
     Raises
     ------
@@ -210,6 +256,7 @@ def parse_scene(raw, *, source="<dict>", overrides=None):
     """
     overrides = list(overrides.items()) if isinstance(overrides, dict) else list(overrides or ())
     raw = apply_overrides(raw, overrides)
+    _resolve_files(raw, Path.cwd() if base_dir is None else base_dir)
     scene = _validate(raw, source, [o if isinstance(o, str) else f"{o[0]}={o[1]!r}" for o in overrides])
     if scene.sweep is not None:
         _check_sweep_points(scene)
@@ -250,4 +297,4 @@ def load_scene(source, *, overrides=None):
             raw = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"scene file {str(path)!r} is not valid TOML: {exc}.") from None
-    return parse_scene(raw, source=label, overrides=overrides)
+    return parse_scene(raw, source=label, overrides=overrides, base_dir=path.parent)

@@ -18,6 +18,8 @@ from bem.layers import LAWS, Linear, from_dict
 from bem.materials import effective_modulus
 
 from . import _checks as ck
+from .measured import KEYS as MEASURED_KEYS
+from .measured import measured_gap
 from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
 from .sizing import DOMAIN_MARGIN, MAX_NODES, check_estimate, inner_domain, node_count
 
@@ -60,7 +62,8 @@ def scene_keys():
     """
     out = {name: {"": keys} for name, keys in KEYS.items()}
     out["gap"] = {"": ("type",), **{kind: tuple(p for p in inspect.signature(cls.__init__).parameters if p != "self")
-                                    for kind, cls in GAP_TYPES.items()}}
+                                    for kind, cls in GAP_TYPES.items()},
+                  "measured": tuple(k for k in MEASURED_KEYS if k != "type")}
     out["layer"] = {"": ("law",)}
     for law, cls in LAWS.items():
         keys = [*cls._required, *cls._optional]
@@ -103,15 +106,21 @@ def bodies(d):
     return {"E_star": E_star, "materials": {k: float(d[k]) for k in _BODY_KEYS}}
 
 
-def gap(d, E_star):
+def gap(d, E_star, *, units=DEFAULT_UNITS):
     """``[gap]``: ``type`` and the parameters of the :mod:`bem.gaps` shape; returns (spec, Gap).
 
     A log-crowned roller given by ``design_force`` takes ``E_star`` from ``[bodies]`` when the
-    gap table leaves it out.
+    gap table leaves it out. ``type = "measured"`` reads a file (:mod:`validation.measured`;
+    ``units`` is the scene's units label) and returns a
+    :class:`validation.measured.MeasuredSurface`, which the scene turns into a gap table
+    over the candidate region.
     """
     ck.table("gap", d)
-    kind = ck.require("gap", d, "type", "give one of " + ", ".join(map(repr, GAP_TYPES)))
-    ck.choice("gap.type", kind, GAP_TYPES)
+    kinds = (*GAP_TYPES, "measured")
+    kind = ck.require("gap", d, "type", "give one of " + ", ".join(map(repr, kinds)))
+    ck.choice("gap.type", kind, kinds)
+    if kind == "measured":
+        return measured_gap(d, units=units)
     allowed = ["type", *(p for p in inspect.signature(GAP_TYPES[kind].__init__).parameters if p != "self")]
     ck.unknown_keys("gap", d, allowed)
     spec = dict(d)

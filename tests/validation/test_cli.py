@@ -93,11 +93,10 @@ def test_default_output_directory(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("argv, module", [
-    (["study", "error-time", "hertz", "--out", "x", "--levels", "3"], "validation.studies.error_time"),
+    (["study", "error-time", "hertz", "--out", "x", "--quick"], "validation.studies.error_time"),
     (["study", "stability"], "validation.studies.stability"),
-    (["report", "results/hertz", "--out", "rep"], "validation.report"),
 ])
-def test_study_and_report_dispatch_their_arguments(argv, module, monkeypatch):
+def test_study_dispatches_its_arguments(argv, module, monkeypatch):
     seen = {}
     fake = types.ModuleType(module)
     fake.main = lambda args: seen.setdefault("args", args) and 7
@@ -105,14 +104,95 @@ def test_study_and_report_dispatch_their_arguments(argv, module, monkeypatch):
     code, _out, _err = cli(*argv)
     assert code == 7
     args = seen["args"]
-    if argv[0] == "report":
-        assert args.target == "results/hertz" and args.out == "rep"
-    else:
-        assert args.study == argv[1]
-        assert getattr(args, "scene", None) == (argv[2] if len(argv) > 2 else None)
-    if "--levels" in argv:
-        assert args.extra == ["--levels", "3"]
+    assert args.study == argv[1]
+    assert getattr(args, "scene", None) == (argv[2] if len(argv) > 2 else None)
+    assert args.quick == ("--quick" in argv)
+
+
+def test_report_dispatches_its_arguments_and_prints_where(monkeypatch, tmp_path):
+    from pathlib import Path
+
+    from validation.report import command
+    from validation.report.build import BuiltReport
+
+    seen = {}
+
+    def fake(args, progress=None):
+        seen["args"] = args
+        for k in range(3):
+            progress(f"stage {k}", k, 3)
+        out = Path(args.out)
+        return BuiltReport(out, out / "report.html", out / "report.md", (out / "figures" / "a.svg",))
+
+    monkeypatch.setattr(command, "build_from_args", fake)
+    code, out, err = cli("report", "results/hertz", "--out", tmp_path / "rep", "--format", "svg", "--units",
+                         "dimensionless")
+    assert code == 0, err
+    args = seen["args"]
+    assert (args.target, args.out, args.format, args.units) == ("results/hertz", str(tmp_path / "rep"), "svg",
+                                                                "dimensionless")
+    assert f"report written to {tmp_path / 'rep' / 'report.html'}" in out
+    assert "1 figures" in out
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["study", "error-time", "hertz", "--levels", "3"], "--levels"),  # was silently ignored
+    (["study", "stability", "--set", "bem.rtol=1e-6"], "--set"),  # studies have no scene keys
+    (["report", "paper", "--bogus"], "--bogus"),
+    (["check", "hertz", "--quick"], "--quick"),
+    (["report", "hertz", "--format", "jpg"], "jpg"),
+])
+def test_unknown_options_are_refused(argv, word):
+    code, out, err = cli(*argv)
+    assert code == 2 and word in err and out == ""
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["report", "hertz", "--quick"], "--quick"),  # paper only
+    (["report", "paper", "--units", "scene"], "--units"),  # the paper report is normalised
+    (["report", "paper", "--set", "load.force=2"], "--set"),  # scenes only
+])
+def test_options_that_do_not_apply_to_the_target_are_refused(argv, word, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = cli(*argv)
+    assert code == 2 and word in err and out == ""
+    assert list(tmp_path.iterdir()) == []  # nothing ran, nothing written
+
+
+def test_report_of_a_scene_applies_set(tmp_path):
+    code, out, err = cli("report", "elliptic", "--out", tmp_path / "e", "--set", "bem.nodes_across=12",
+                         "--set", "load.force=50.0")
+    assert code == 0, err
+    result = json.loads((tmp_path / "e" / "result" / "result.json").read_text())
+    assert result["force"] == pytest.approx(50.0) and result["overrides"] == ["bem.nodes_across=12",
+                                                                              "load.force=50.0"]
+    assert f"report written to {tmp_path / 'e' / 'report' / 'report.html'}" in out
+
+
+def test_quick_help_states_the_measured_time(capsys):
+    from validation import cli as cli_mod
+
+    assert main(["report", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert cli_mod.QUICK_TIME in text and cli_mod.FULL_TIME in text
+    assert "sweep" in text and "--format" in text and "--units" in text
 
 
 def test_parser_is_buildable_without_heavy_imports():
     assert build_parser().prog == "contactlab"
+
+
+def test_report_progress_bar_shows_the_stages_on_stderr(monkeypatch):
+    import io
+
+    from validation import cli as cli_mod
+
+    err = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    bar = cli_mod._ReportBar(False)
+    for k, stage in enumerate(("layer laws", "parameter sweeps", "figures")):
+        bar(stage, k, 3)
+    bar("done", 3, 3)
+    bar.close()
+    text = err.getvalue()
+    assert "layer laws" in text and "parameter sweeps" in text and "2/3" in text

@@ -154,5 +154,5 @@ def test_problem_section_lists_inputs(tmp_path):
 # ---------------------------------------------------------------- command
 
 def test_main_rejects_unknown_target(tmp_path):
-    with pytest.raises(InputError, match="built-in scene name, a scene TOML file or a results directory"):
+    with pytest.raises(InputError, match="built-in scene name, a scene TOML file, a results directory"):
         main(Namespace(target=str(tmp_path / "no-such-scene.toml"), out=None))

@@ -16,7 +16,8 @@ from validation.report import figures_iterations as fit
 from validation.report import figures_profiles as fpr
 from validation.report import figures_sweeps as fsw
 from validation.report import figures_validation as fva
-from validation.report.style import DPI, atomic_path, save_figure
+from bem.files import atomic_path
+from validation.report.style import DPI, save_figure
 
 HERTZ = hertz_sphere(R=1.0, E_star=1.0, force=1.0)
 A, P0 = HERTZ.a, HERTZ.p0
@@ -169,6 +170,26 @@ def test_contact_map_png(cases, tmp_path):
               (5.4, 4.4))
 
 
+def test_contact_map_window_is_covered_by_the_triangles(cases):
+    """The map's axes show only the rectangle the lattice triangles cover: no white notch at the
+    corners where the outermost rows are the ones shifted by half a step."""
+    from scipy.spatial import Delaunay
+
+    r = cases["er"]
+    notched = 0
+    for margin in np.linspace(0.2, 0.5, 7):
+        xs, ys, _ps, _tri = f3d.contact_patch(r.x, r.y, r.p, margin=margin)
+        (x0, x1), (y0, y1) = f3d.covered_window(xs, ys)
+        assert x0 <= -np.abs(xs).max() + STEP / 2 + 1e-12 and x1 >= np.abs(xs).max() - STEP / 2 - 1e-12
+        assert (y0, y1) == (ys.min(), ys.max())
+        hull = Delaunay(np.column_stack([xs, ys]))
+        gx, gy = np.meshgrid(np.linspace(x0, x1, 81), np.linspace(y0, y1, 81))
+        assert (hull.find_simplex(np.column_stack([gx.ravel(), gy.ravel()]), tol=1e-12) >= 0).all(), margin
+        corners = [(u, v) for u in (xs.min(), xs.max()) for v in (ys.min(), ys.max())]
+        notched += bool((hull.find_simplex(corners) < 0).any())  # autoscaled axes showed white there
+    assert notched > 0
+
+
 def test_contact_patch_covers_contact(cases):
     r = cases["er"]
     xs, ys, ps, tri = f3d.contact_patch(r.x, r.y, r.p)
@@ -202,7 +223,14 @@ def test_work_precision_png(tmp_path):
     rows = [("BEM", "qp", f"a/c={m}", 100 * m, 0.3 / m**1.5, 0.01 * m) for m in (5, 10, 20)]
     rows += [{"solver": "FEM", "method": "P2", "resolution": f"{n}/a", "N": 1000 * n, "error": 0.1 / n**2,
               "wall_time_s": 0.1 * n} for n in (4, 8)]
-    check_png(fva.plot_work_precision(rows, tmp_path / "wp.png"), (6.6, 4.4))
+    check_png(fva.plot_work_precision(rows, tmp_path / "wp.png"), (7.0, 4.6))
+    # repeats: the marker at the median, the bar from the fastest to the slowest
+    spread = [dict(r, wall_times_s=[0.8 * r["wall_time_s"], r["wall_time_s"], 1.5 * r["wall_time_s"]])
+              for r in fva.work_precision_rows(rows)]
+    assert fva.time_spread(spread[0]) == pytest.approx((0.05, 0.04, 0.075))
+    assert fva.time_spread(fva.work_precision_rows(rows)[0]) == pytest.approx((0.05, 0.05, 0.05))  # one run
+    with_bars = check_png(fva.plot_work_precision(spread, tmp_path / "wp2.png"), (7.0, 4.6))
+    assert np.abs(with_bars - _image(tmp_path / "wp.png")).mean() > 0.1  # the bars are drawn
     with pytest.raises(InputError, match="nothing to draw"):
         fva.plot_work_precision([("BEM", "qp", "x", 1, 0.0, 1.0)], tmp_path / "none.png")
 

@@ -18,9 +18,12 @@ from .test_report_build import PNG_MAGIC, assert_valid_offline_html
 from .test_report_figures import check_png
 
 
+STAGES_SEEN = []
+
+
 @pytest.fixture(scope="module")
 def paper():
-    return solve_paper_problem(quick=True)
+    return solve_paper_problem(quick=True, progress=STAGES_SEEN.append)
 
 
 @pytest.fixture(scope="module")
@@ -103,8 +106,8 @@ def test_paper_methods_and_validation(paper):
 def test_main_dispatches_paper(monkeypatch, tmp_path):
     calls = []
 
-    def fake(out, *, quick):
-        calls.append((str(out), quick))
+    def fake(out, *, quick, fmt="png", progress=None):
+        calls.append((str(out), quick, fmt))
 
         class Built:
             html = markdown = out
@@ -114,8 +117,8 @@ def test_main_dispatches_paper(monkeypatch, tmp_path):
 
     monkeypatch.setattr("validation.report.paper_report.report_paper_problem", fake)
     assert command.main(Namespace(target="paper", out=str(tmp_path), quick=True)) == 0
-    assert command.main(Namespace(target="paper", out=None)) == 0
-    assert calls == [(str(tmp_path), True), (str(command.DEFAULT_PAPER_OUT), False)]
+    assert command.main(Namespace(target="paper", out=None, format="pdf")) == 0
+    assert calls == [(str(tmp_path), True, "png"), (str(command.DEFAULT_PAPER_OUT), False, "pdf")]
 
 
 def test_example_script_passes_its_options(monkeypatch, tmp_path):
@@ -143,3 +146,25 @@ def test_example_script_passes_its_options(monkeypatch, tmp_path):
         for name, level in levels.items():
             logging.getLogger(name).setLevel(level)
     assert calls == [(str(tmp_path), True, False)]
+
+
+def test_paper_report_tells_its_stages(paper, monkeypatch, tmp_path):
+    from validation.report import paper_report
+    from validation.report.paper import SOLVE_STAGES
+    from validation.report.sections import Section
+
+    assert STAGES_SEEN == list(SOLVE_STAGES)  # the real solve, in order
+
+    def fake_solve(problem, *, quick, fem, progress):
+        for stage in SOLVE_STAGES[:3 + fem]:
+            progress(stage)
+        return paper
+
+    monkeypatch.setattr(paper_report, "solve_paper_problem", fake_solve)
+    monkeypatch.setattr(paper_report, "paper_sections", lambda res, work: [Section("x", text="y")])
+    for fem, stages in ((True, paper_report.STAGES), (False, [s for s in paper_report.STAGES if "FEM" not in s])):
+        calls = []
+        paper_report.report_paper_problem(tmp_path / f"p{fem}", quick=True, fem=fem,
+                                          progress=lambda *a: calls.append(a))
+        n = len(stages)
+        assert calls == [(s, k, n) for k, s in enumerate(stages)] + [("done", n, n)]

@@ -16,7 +16,7 @@ from tomli_w import dumps
 
 from validation.report import main, report_results_dir
 from validation.report.build import build_report
-from validation.report.results import display_unit, load_results, parse_units
+from validation.report.results import display_unit, load_results, parse_units, report_unit
 from validation.report.run_figures import profile_view
 from validation.report.run_report import run_sections
 from validation.report.sections import Figure, Table
@@ -120,7 +120,9 @@ def test_profile_window_holds_the_contact_normalised(reports):
     a_h, p_h, _ = hertz(scene["load"]["force"], scene["gap"]["R"], e_star(b["E1"], b["nu1"], b["E2"], b["nu2"]))
     prof = rep["res"].data["profile"]
     x, p = np.array(prof["x"]), np.array(prof["p"])
-    view = profile_view(rep["res"], [(x, p)])
+    assert not profile_view(rep["res"], [(x, p)]).normalised  # an SI scene is drawn in mm and MPa by default
+    view = profile_view(load_results(rep["dir"], units="dimensionless"), [(x, p)])
+    assert view.x_label == r"$x\,/\,a_H$" and view.p_label == r"contact pressure $p\,/\,p_H$"
     assert view.normalised and view.x_factor == pytest.approx(a_h, rel=1e-9)
     assert view.p_factor == pytest.approx(p_h, rel=1e-9)
     edge = np.abs(x[p > 0]).max() / view.x_factor  # the plotted contact edge
@@ -139,9 +141,13 @@ def test_profile_window_holds_the_contact_in_scene_units(reports):
         edge_m = np.abs(s[p > 0]).max()
         edge = edge_m / view.x_factor
         assert view.xlim[0] < -edge and edge < view.xlim[1] <= 2.0 * edge, key
-        assert 1.0 <= edge < 1000.0  # a readable prefix
-        unit = {1e-3: "mm", 1e-6: "µm"}[view.x_factor]
-        assert f"[{unit}]" in view.x_label and "GPa" in view.p_label
+        assert view.x_factor == 1e-3 and view.p_factor == 1e6  # SI scene: mm and MPa
+        assert "[mm]" in view.x_label and "[MPa]" in view.p_label
+    # dimensionless: divided by the peak pressure and the contact half-width (no Hertz scale for a roller)
+    view = profile_view(load_results(rep["dir"], units="dimensionless"), [(np.array(prof["x"]), np.array(prof["p"]))])
+    assert view.normalised and view.p_factor == pytest.approx(rep["res"].data["p_max"])
+    assert view.x_factor == pytest.approx(rep["res"].data["contact_extent"]["x"])
+    assert view.x_label == r"$x\,/\,a_c$" and view.p_label == r"contact pressure $p\,/\,p_{max}$"
     length = rep["scene"]["gap"]["length"]
     x_edge = np.abs(np.array(prof["x"])[np.array(prof["p"]) > 0]).max()
     assert 0.8 * length / 2 < x_edge <= length / 2  # the crowned roller loads nearly its whole length
@@ -245,6 +251,10 @@ def test_units_parsing_and_display():
     assert display_unit("m", 1.87e-4) == ("µm", 1e-6) and display_unit("m", 5e-3) == ("mm", 1e-3)
     assert display_unit("Pa", 1.37e9) == ("GPa", 1e9) and display_unit("Pa", 4e5) == ("kPa", 1e3)
     assert display_unit("mm", 0.2) == ("mm", 1.0) and display_unit(None, 3.0) == ("", 1.0)
+    assert report_unit("m") == ("mm", 1e-3) and report_unit("Pa") == ("MPa", 1e6)
+    assert report_unit("N") == ("N", 1.0) and report_unit("mm") == ("mm", 1.0) and report_unit(None) == ("", 1.0)
+    # auto: the scene's units when its label names them, dimensionless otherwise
+    assert parse_units("normalised: R = E* = P = 1").known is False
 
 
 def test_report_does_not_modify_the_results(reports, tmp_path):
@@ -257,11 +267,15 @@ def test_report_does_not_modify_the_results(reports, tmp_path):
     assert files == ["bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
 
 
-def test_captions_say_how(reports):
+def test_captions_say_how(reports, tmp_path):
     rep = reports["hertz"]
     data = rep["res"].data
     captions = [i.caption for s in rep["sections"] for i in s.items if isinstance(i, Figure)]
     profile = next(c for c in captions if c.startswith("Contact pressure along"))
     assert "Kalker QP" in profile and "tolerance 1e-10" in profile and f"{data['bem']['n_nodes']} candidate" in profile
     assert re.search(r"FEM: axisymmetric quadratic triangles, [\d.]+ elements across", profile)
+    assert "p_H = " not in profile  # drawn in mm and MPa
+    sections = run_sections(load_results(rep["dir"], units="dimensionless"), tmp_path)
+    captions = [i.caption for s in sections for i in s.items if isinstance(i, Figure)]
+    profile = next(c for c in captions if c.startswith("Contact pressure along"))
     assert "p_H = " in profile and "a_H = " in profile

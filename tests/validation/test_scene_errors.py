@@ -219,3 +219,32 @@ def test_bad_override_is_refused(override, key):
     code, _out, err = cli("check", "paper_elastic_rigid", "--set", override)
     assert code == 2
     assert key in err
+
+
+def test_check_lists_every_error_at_once(tmp_path):
+    """Three independent errors in three sections: all reported, each naming its key, exit 2."""
+    text = (BASE.replace("nu1 = 0.3", "nu1 = 0.7").replace("force = 100.0", "force = -5.0")
+            + '\n[layer]\nlaw = "magic"\n')
+    path = _write(tmp_path, text)
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    errors = info.value.errors
+    assert len(errors) == 3
+    for key, error in zip(("bodies.nu1 = 0.7", "load.force = -5.0", "layer.law = 'magic'"), errors):
+        assert error.startswith(key)
+    assert str(info.value).startswith("3 errors in the scene:")
+    code, out, err = cli("check", path)
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and len(lines) == 3
+    assert all(line.startswith("contactlab: error: ") for line in lines)
+    assert [line.split()[2] for line in lines] == ["bodies.nu1", "load.force", "layer.law"]
+
+
+def test_errors_of_dependent_sections_are_not_repeated(tmp_path):
+    """A bad [bodies] leaves [gap] and [bem], which need E*, unchecked rather than reported twice;
+    independent sections are still checked."""
+    text = BASE.replace("E1 = 210e9", "E1 = -1.0") + '\n[report]\nformat = "word"\n\n[solver]\nx = 1\n'
+    with pytest.raises(SceneError) as info:
+        load_scene(_write(tmp_path, text))
+    keys = sorted(e.split()[0] for e in info.value.errors)
+    assert keys == ["bodies.E1", "report.format", "solver"]

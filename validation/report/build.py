@@ -1,7 +1,7 @@
 """Write a report directory whole or not at all.
 
-``out_dir/report.html`` (self-contained), ``out_dir/report.md`` and ``out_dir/figures/*.png``
-are first written into a fresh temporary directory beside ``out_dir``; only when all of
+``out_dir/report.html`` (self-contained), ``out_dir/report.md`` and ``out_dir/figures/`` (the
+PNG or SVG of every figure, and the PDF beside a PNG drawn in ``"pdf"`` format) are first written into a fresh temporary directory beside ``out_dir``; only when all of
 them are complete is that directory renamed onto ``out_dir`` (a previous report there is
 moved aside first and deleted afterwards: :func:`validation.output.atomic_directory`). An
 interrupted build leaves the previous report, or nothing, never a mixture.
@@ -10,6 +10,7 @@ interrupted build leaves the previous report, or nothing, never a mixture.
 from __future__ import annotations
 
 import logging
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,8 +21,9 @@ from ..provenance import report_footer
 from .html import render_html
 from .markdown import render_markdown
 from .sections import Figure, Section
+from .style import figure_format, vector_copy
 
-__all__ = ["build_report", "BuiltReport", "REPORT_FILES"]
+__all__ = ["build_report", "BuiltReport", "REPORT_FILES", "Progress", "draw_and_build"]
 
 log = logging.getLogger(__name__)
 
@@ -39,6 +41,56 @@ class BuiltReport:
     figures: tuple
 
 
+class Progress:
+    """The stages of a report build, told to ``callback(stage, done, total)``.
+
+    Calling the object with a stage name reports its start (``done``: the stages before
+    it); :meth:`done` reports the end (``"done", total, total``). Without a callback
+    nothing happens.
+    """
+
+    def __init__(self, stages, callback=None):
+        self.stages, self.callback = list(stages), callback
+
+    def __call__(self, stage):
+        if self.callback is not None:
+            self.callback(stage, self.stages.index(stage), len(self.stages))
+
+    def done(self):
+        if self.callback is not None:
+            self.callback("done", len(self.stages), len(self.stages))
+
+
+def draw_and_build(make_sections, out_dir, *, title, subtitle="", fmt="png", notify=None):
+    """Draw the figures of ``make_sections(work)`` in ``fmt`` into a temporary folder and build the report.
+
+    Parameters
+    ----------
+    make_sections : callable
+        ``make_sections(work)`` -> list of Section, writing its figures into the folder ``work``.
+    out_dir : path-like
+        Report directory (:func:`build_report`).
+    title, subtitle : str
+        As for :func:`build_report`.
+    fmt : {"png", "svg", "pdf"}
+        Figure files (:func:`validation.report.style.figure_format`).
+    notify : Progress, optional
+        Told the stages ``"figures"`` and ``"writing"``, then :meth:`Progress.done`.
+
+    Returns
+    -------
+    BuiltReport
+    """
+    notify = notify or Progress(("figures", "writing"))
+    with figure_format(fmt), tempfile.TemporaryDirectory(prefix="contactlab-figures-") as work:
+        notify("figures")
+        sections = make_sections(work)
+        notify("writing")
+        built = build_report(sections, out_dir, title=title, subtitle=subtitle)
+    notify.done()
+    return built
+
+
 def _check_replaceable(out_dir):
     if not out_dir.exists():
         return
@@ -53,18 +105,18 @@ def _check_replaceable(out_dir):
 
 
 def _figure_names(sections):
-    """Unique ``figures/<name>.png`` for every figure path, in order of appearance."""
+    """Unique ``figures/<name>.<png|svg>`` for every figure path, in order of appearance."""
     names, used = {}, set()
     for sec in sections:
         for item in sec.items:
             if isinstance(item, Figure) and item.path not in names:
-                stem = Path(item.path).stem or "figure"
-                name, k = f"{stem}.png", 1
+                stem, ext = Path(item.path).stem or "figure", Path(item.path).suffix.lower()
+                name, k = stem, 1
                 while name in used:
                     k += 1
-                    name = f"{stem}-{k}.png"
+                    name = f"{stem}-{k}"
                 used.add(name)
-                names[item.path] = f"figures/{name}"
+                names[item.path] = f"figures/{name}{ext}"
     return names
 
 
@@ -106,14 +158,19 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None):
         footer = report_footer()
     names = _figure_names(sections)
     images = {path: Path(path).read_bytes() for path in names}
+    vectors = {names[path][:-4] + ".pdf": Path(pdf).read_bytes() for path in names
+               if (pdf := vector_copy(path)) is not None}
     with atomic_directory(out_dir, check=_check_replaceable) as tmp:
         (tmp / "figures").mkdir()
         for path, name in names.items():
             (tmp / name).write_bytes(images[path])
+        for name, data in vectors.items():
+            (tmp / name).write_bytes(data)
         (tmp / "report.html").write_text(
             render_html(sections, title=title, subtitle=subtitle, images=images, footer=footer), encoding="utf-8")
         (tmp / "report.md").write_text(
-            render_markdown(sections, title=title, subtitle=subtitle, names=names, footer=footer), encoding="utf-8")
+            render_markdown(sections, title=title, subtitle=subtitle, names=names, footer=footer,
+                            vectors=vectors), encoding="utf-8")
     log.info("report written to %s (%d figures)", out_dir, len(names))
     return BuiltReport(out_dir, out_dir / "report.html", out_dir / "report.md",
                        tuple(out_dir / n for n in names.values()))

@@ -1,4 +1,4 @@
-"""``contactlab report TARGET [--out DIR]``: the entry point the command line calls."""
+"""``contactlab report TARGET [--out DIR] [options]``: the entry point the command line calls."""
 
 from __future__ import annotations
 
@@ -9,89 +9,130 @@ from bem.checks import InputError
 
 from ..extras import require as require_extra
 
-__all__ = ["main", "DEFAULT_PAPER_OUT"]
+__all__ = ["main", "build_from_args", "target_kind", "DEFAULT_PAPER_OUT", "OPTIONS"]
 
 log = logging.getLogger(__name__)
 
 #: where ``contactlab report paper`` writes without ``--out`` (relative to the working directory)
 DEFAULT_PAPER_OUT = Path("reports") / "paper"
 
+#: which targets each option applies to (option -> (attribute, default, kinds))
+OPTIONS = {"--quick": ("quick", False, ("paper",)),
+           "--units": ("units", None, ("scene", "results", "sweep")),
+           "--set": ("overrides", [], ("scene",))}
 
-def main(args):
-    """Write the report of ``args.target``; returns the exit status 0 (errors raise).
 
-    Parameters
-    ----------
-    args : argparse.Namespace
-        ``target``: ``"paper"`` (solve the paper's test problem and report it), a
-        built-in scene name or a scene TOML file (run it into ``OUT/result``, report into
-        ``OUT/report``, ``OUT`` defaulting to ``results/NAME``), a results directory
-        holding ``result.json`` (see :mod:`validation.report.results`), or a directory of
-        study files (``error_time.json``, ``stability.json``:
-        :mod:`validation.report.study_report`);
-        ``out`` (optional): the report directory (default ``reports/paper`` for ``paper``,
-        ``TARGET/report`` for a results directory); ``quick`` (optional, bool): coarse
-        preview of the paper report.
+def target_kind(target):
+    """What ``target`` is: ``"paper"``, ``"studies"``, ``"sweep"``, ``"results"``, ``"scene"``.
 
     Raises
     ------
     bem.InputError
-        Unknown target (a scene must be run first with ``contactlab run``) or an output
-        directory that holds other files.
+        None of them (a scene must be a built-in name or an existing ``.toml`` file).
+    """
+    from validation.scene import builtin_scenes
+
+    from .study_report import is_study_dir
+    from .sweep_report import is_sweep_dir
+
+    path = Path(target)
+    if target == "paper":
+        return "paper"
+    if path.is_dir():
+        if (path / "result.json").is_file():
+            return "results"
+        if is_sweep_dir(path):
+            return "sweep"
+        if is_study_dir(path):
+            return "studies"
+        return "results"  # load_results explains what is missing
+    if target in builtin_scenes() or (target.endswith(".toml") and path.is_file()):
+        return "scene"
+    raise InputError(
+        f"target = {target!r} is not allowed: it must be 'paper', a built-in scene name, a scene TOML file, "
+        "a results directory holding result.json, a sweep directory (summary.json, points/) or a directory "
+        "of study files (see `contactlab scenes`)."
+    )
+
+
+def _check_options(kind, target, args):
+    for option, (attr, default, kinds) in OPTIONS.items():
+        value = getattr(args, attr, default)
+        if value not in (default, None) and kind not in kinds:
+            raise InputError(f"{option} is not allowed with target {target!r} (a {kind} target): it applies to "
+                             + " and ".join(f"{k} targets" if k != "paper" else "'paper'" for k in kinds) + ".")
+
+
+def build_from_args(args, progress=None):
+    """Write the report ``args`` ask for and return it.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``target``: ``"paper"`` (solve the paper's test problem and report it), a built-in
+        scene name or a scene TOML file (run it, with ``overrides``, into ``OUT/result``,
+        report into ``OUT/report``, ``OUT`` defaulting to ``results/NAME``), a results
+        directory holding ``result.json`` (:mod:`validation.report.results`), a sweep
+        directory (:mod:`validation.report.sweep_report`) or a directory of study files
+        (``error_time.json``, ``stability.json``: :mod:`validation.report.study_report`);
+        ``out`` (optional): the report directory (default ``reports/paper`` for ``paper``,
+        ``TARGET/report`` for a directory); ``quick`` (bool, paper only): coarse preview;
+        ``units`` (``"auto"``, ``"scene"``, ``"dimensionless"``; scenes, results and sweeps);
+        ``overrides`` (list of ``KEY=VALUE``; scenes only); ``format`` (``"png"``,
+        ``"svg"``, ``"pdf"``): the figure files.
+    progress : callable, optional
+        ``progress(stage, done, total)`` at the start of each stage and at the end
+        (:class:`validation.report.build.Progress`).
+
+    Returns
+    -------
+    validation.report.build.BuiltReport
+
+    Raises
+    ------
+    bem.InputError
+        Unknown target, an option that does not apply to it, or an output directory that
+        holds other files.
     validation.extras.MissingExtraError
         matplotlib or pillow (``contactlab[report]``), or for ``paper`` gmsh or scikit-fem
         (``contactlab[fem]``), cannot be imported; nothing has run.
     """
     target = str(getattr(args, "target", "") or "")
     out = getattr(args, "out", None)
+    fmt = getattr(args, "format", None) or "png"
+    units = getattr(args, "units", None) or "auto"
+    kind = target_kind(target)
+    _check_options(kind, target, args)
     require_extra("report", "contactlab report (figures)")
-    if target == "paper":
+    if kind == "paper":
         require_extra("fem", "contactlab report paper (the FEM validation)")
         from .paper_report import report_paper_problem
 
-        quick = bool(getattr(args, "quick", False))
-        built = report_paper_problem(DEFAULT_PAPER_OUT if out is None else out, quick=quick)
-    elif Path(target).is_dir() and not (Path(target) / "result.json").is_file() and _studies(target):
+        return report_paper_problem(DEFAULT_PAPER_OUT if out is None else out,
+                                    quick=bool(getattr(args, "quick", False)), fmt=fmt, progress=progress)
+    if kind == "studies":
         from .study_report import report_studies_dir
 
-        built = report_studies_dir(target, out)
-    elif Path(target).is_dir():
-        from .run_report import report_results_dir
+        return report_studies_dir(target, out, fmt=fmt, progress=progress)
+    if kind == "sweep":
+        from .sweep_report import report_sweep_dir
 
-        built = report_results_dir(target, out)
-    elif _is_scene(target):
-        built = _report_scene(target, out)
-    else:
-        raise InputError(
-            f"target = {target!r} is not allowed: it must be 'paper', a built-in scene name, a scene "
-            "TOML file or a results directory holding result.json (see `contactlab scenes`)."
-        )
-    log.info("report written: %s and %s (%d figures)", built.html, built.markdown, len(built.figures))
-    return 0
-
-
-def _studies(target):
-    from .study_report import is_study_dir
-
-    return is_study_dir(target)
-
-
-def _is_scene(target):
-    from validation.scene import builtin_scenes
-
-    return target in builtin_scenes() or (target.endswith(".toml") and Path(target).is_file())
-
-
-def _report_scene(target, out):
-    """Run the scene into ``OUT/result`` and report it into ``OUT/report``.
-
-    ``OUT`` defaults to ``results/NAME``. The run writes its result directory
-    atomically, the report is built from it as for any results directory.
-    """
-    from validation.runner import run_scene
-
+        return report_sweep_dir(target, out, units=units, fmt=fmt, progress=progress)
     from .run_report import report_results_dir
 
+    if kind == "results":
+        return report_results_dir(target, out, units=units, fmt=fmt, progress=progress)
+    from validation.runner import run_scene
+
     base = Path(out) if out is not None else Path("results") / Path(target).stem
-    run_scene(target, base / "result")
-    return report_results_dir(base / "result", base / "report")
+    if progress is not None:
+        progress("running the scene", 0, 1)
+    run_scene(target, base / "result", overrides=getattr(args, "overrides", None) or None)
+    return report_results_dir(base / "result", base / "report", units=units, fmt=fmt, progress=progress)
+
+
+def main(args):
+    """Write the report of ``args.target`` (:func:`build_from_args`); returns the exit status 0."""
+    built = build_from_args(args)
+    log.info("report written: %s and %s (%d figures)", built.html, built.markdown, len(built.figures))
+    return 0

@@ -2,12 +2,11 @@
 
 The surface is the piecewise-linear pressure on a Delaunay triangulation of the lattice
 nodes in and around the contact (the lattice is equilateral, so the triangulation is the
-lattice's own), lifted by ``p / p0`` and drawn off-screen with pyvista.
+lattice's own), lifted by ``p / p0`` and drawn with matplotlib's mplot3d.
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
 
 import numpy as np
@@ -16,7 +15,7 @@ from bem.checks import InputError, check_positive
 
 from .style import axis_labels, new_figure, save_figure
 
-__all__ = ["contact_patch", "plot_pressure_surfaces", "plot_contact_map"]
+__all__ = ["contact_patch", "covered_window", "plot_pressure_surfaces", "plot_contact_map"]
 
 
 def _nodal(data):
@@ -58,127 +57,134 @@ def contact_patch(x, y, p, *, margin=0.25):
     return xs, ys, ps, tri.simplices.astype(np.int64)
 
 
-@contextlib.contextmanager
-def _quiet_vtk():
-    """Keep VTK's own logger off stderr below errors (e.g. 'bad X server connection')."""
-    try:
-        from vtkmodules.vtkCommonCore import vtkLogger
-    except ImportError:  # pragma: no cover - very old VTK
-        yield
-        return
-    old = vtkLogger.GetCurrentVerbosityCutoff()
-    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
-    try:
-        yield
-    finally:
-        vtkLogger.SetStderrVerbosity(old)
+def _surface_panel(ax, xs, ys, ps, tri, *, p0, a, height, vmax, section, lab):
+    """One isometric pressure surface on the 3-D axes ``ax`` (orthographic view, labelled axes)."""
+    surf = ax.plot_trisurf(xs / a, ys / a, ps / p0, triangles=tri, cmap="viridis", vmin=0.0, vmax=vmax,
+                           linewidth=0.0, antialiased=False, rasterized=True, zorder=1)
+    if section is not None:
+        xs0, ps0 = section
+        ax.plot(xs0 / a, np.zeros_like(xs0), ps0 / p0, color="black", lw=1.2, zorder=3)
+    half = float(max(np.abs(xs).max(), np.abs(ys).max())) / a
+    ax.set_xlim(-half, half)
+    ax.set_ylim(-half, half)
+    ax.set_zlim(0.0, vmax)
+    ax.set_box_aspect((1.0, 1.0, height * vmax / (2.0 * half)), zoom=0.98)
+    ax.set_proj_type("ortho")
+    ax.view_init(elev=34.0, azim=-58.0)
+    ax.computed_zorder = False
+    for axis, bins in ((ax.xaxis, 4), (ax.yaxis, 4), (ax.zaxis, 2)):
+        axis.set_major_locator(_locator(bins))
+        axis.pane.set_facecolor((0.96, 0.96, 0.96, 1.0))
+        axis.set_tick_params(labelsize=7, pad=0)
+        axis.label.set_size(8)
+    ax.set_xlabel(lab["x"], labelpad=-1)
+    ax.set_ylabel(lab["y"], labelpad=-1)
+    ax.set_zlabel(lab["p_short"], labelpad=-3)
+    return surf
 
 
-def _render_panel(pv, xs, ys, ps, tri, *, p0, a, height, vmax, size, section):
-    """One off-screen isometric rendering of a lifted pressure surface, as an RGB array."""
-    pts = np.column_stack([xs / a, ys / a, height * ps / p0])
-    faces = np.column_stack([np.full(len(tri), 3), tri]).ravel()
-    mesh = pv.PolyData(pts, faces)
-    mesh["p / p0"] = ps / p0
-    pl = pv.Plotter(off_screen=True, window_size=size)
-    try:
-        pl.set_background("white")
-        pl.add_mesh(mesh, scalars="p / p0", cmap="viridis", clim=(0.0, vmax), show_scalar_bar=False,
-                    smooth_shading=True, specular=0.15, ambient=0.25)
-        pl.add_mesh(mesh.extract_all_edges(), color="#1a1a1a", opacity=0.12, line_width=0.5)
-        if section is not None:
-            xs0, ps0 = section
-            line = np.column_stack([xs0 / a, np.zeros_like(xs0), height * ps0 / p0 + 0.004])
-            pl.add_mesh(pv.lines_from_points(line), color="black", line_width=4.0)
-        pl.view_isometric()
-        pl.enable_parallel_projection()
-        pl.reset_camera(bounds=mesh.bounds)
-        pl.camera.zoom(1.1)
-        img = np.asarray(pl.screenshot(return_img=True))
-    finally:
-        pl.close()
-    return _trim(img)
+def _locator(bins):
+    from matplotlib.ticker import MaxNLocator
+
+    return MaxNLocator(nbins=bins, steps=[1, 2, 2.5, 5, 10])
 
 
-def _trim(img, pad=6):
-    """Crop the white border of an RGB(A) image, keeping ``pad`` pixels."""
-    ink = np.any(img[..., :3] < 250, axis=-1)
-    rows, cols = np.nonzero(ink.any(axis=1))[0], np.nonzero(ink.any(axis=0))[0]
-    if rows.size == 0:
-        return img
-    r0, r1 = max(rows[0] - pad, 0), min(rows[-1] + pad + 1, img.shape[0])
-    c0, c1 = max(cols[0] - pad, 0), min(cols[-1] + pad + 1, img.shape[1])
-    return img[r0:r1, c0:c1]
+def covered_window(x, y):
+    """The largest axis-parallel rectangle that the triangulation of lattice nodes covers [length].
+
+    The rows of the equilateral lattice are shifted by half a step in turn, so the nodes of a
+    square patch end alternately half a step short at the left and right; their triangles
+    leave notches there and at the corners. The window runs from the largest row start to the
+    smallest row end, and from the lowest to the highest row.
+
+    Parameters
+    ----------
+    x, y : ndarray, shape (N,)
+        Node coordinates [length].
+
+    Returns
+    -------
+    (x0, x1), (y0, y1) : tuple of float
+    """
+    _, row = np.unique(np.round(y / max(float(np.ptp(y)), 1e-300) * 1e6), return_inverse=True)
+    row_min = np.full(row.max() + 1, np.inf)
+    row_max = np.full(row.max() + 1, -np.inf)
+    np.minimum.at(row_min, row, x)
+    np.maximum.at(row_max, row, x)
+    return (float(row_min.max()), float(row_max.min())), (float(y.min()), float(y.max()))
 
 
-def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, panel_size=(520, 420),
+def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, panel_inches=(3.3, 2.8),
                            title=None, section=True, labels=None):
     """Isometric 3-D pressure surfaces, one panel per result, on a common colour scale.
 
-    Each panel is rendered off-screen by pyvista (lit surface, faint lattice edges, the
-    axial section ``y = 0`` as a black line) and the panels are laid out by matplotlib
-    with one shared colour bar.
+    Each panel is the piecewise-linear pressure on the lattice triangles, drawn with
+    matplotlib's mplot3d (orthographic view, axes with ticks and labels, the axial
+    section ``y = 0`` as a black line); one colour bar gives the scale of all panels.
+    The coloured surface is rasterised at the figure's DPI in SVG/PDF output (the axes,
+    ticks and text stay vector).
 
     Parameters
     ----------
     panels : sequence of (str, data)
         Panel title and a :class:`bem.ContactResult` or ``(x, y, p)`` nodal arrays.
     path : path-like
-        PNG file to write.
+        PNG file to write (:func:`validation.report.style.save_figure`).
     p0, a : float
-        Pressure scale [pressure] and length scale [length] (Hertz peak and radius).
+        Pressure scale [pressure] and length scale [length] (Hertz peak and radius; ``1``
+        and ``1`` draw the data as they are, in the units named by ``labels``).
     height : float
-        Height of ``p = p0`` in units of ``a`` (vertical exaggeration of the surface).
+        Drawn height of the highest peak relative to the width of the patch.
     columns : int, optional
         Panels per row (default: all in one row up to 3, then rows of 3; 2 x 2 for 4).
-    panel_size : (int, int)
-        Pixels of one rendering.
+    panel_inches : (float, float)
+        Size of one panel [inch].
     title : str, optional
         Figure title.
     section : bool
         Draw the axial section ``y = 0`` on each surface (where nodes lie on it).
     labels : dict, optional
-        ``{"p": colour-bar label}`` (:func:`validation.report.style.axis_labels`).
+        ``{"x", "y", "p"}`` axis and colour-bar labels, and ``"p_short"`` for the vertical
+        axis (:func:`validation.report.style.axis_labels`; default ``x / a_H``, ``p / p0``).
 
     Returns
     -------
     str
-        ``path``.
+        The written file.
     """
-    import pyvista as pv
+    import matplotlib as mpl
 
     from .figures_profiles import axial_section
 
     p0, a = check_positive("p0", p0), check_positive("a", a)
     if not panels:
         raise InputError("panels = [] is not allowed: give at least one (title, result) pair.")
-    pv.OFF_SCREEN = True
     data = [(label, _nodal(d)) for label, d in panels]
     vmax = max(float(p.max()) for _, (_, _, p) in data) / p0
     n = len(data)
     ncol = columns or (2 if n == 4 else min(n, 3))
     nrow = math.ceil(n / ncol)
-    images = []
-    with _quiet_vtk():
-        for _, (x, y, p) in data:
+    lab = axis_labels(labels)
+    lab.setdefault("p_short", lab["p"].replace("contact pressure ", ""))
+    w, h = panel_inches
+    with new_figure((w * ncol + 0.9, h * nrow + (0.35 if title else 0.0))) as (fig, _):
+        fig.delaxes(_)
+        fig.set_layout_engine("none")
+        grid = fig.add_gridspec(nrow, ncol + 1, width_ratios=[1.0] * ncol + [0.045], left=0.0, right=0.92,
+                                bottom=0.03, top=0.91 if title else 0.98, wspace=0.22, hspace=0.1)
+        for k, (label, (x, y, p)) in enumerate(data):
+            ax = fig.add_subplot(grid[k // ncol, k % ncol], projection="3d")
             xs, ys, ps, tri = contact_patch(x, y, p)
             on_axis = np.abs(ys) <= 1e-9 * float(np.abs(xs).max(initial=1.0))
             sec = axial_section(xs, ys, ps) if section and on_axis.sum() > 1 else None
-            images.append(_render_panel(pv, xs, ys, ps, tri, p0=p0, a=a, height=height, vmax=vmax,
-                                        size=panel_size, section=sec))
-    import matplotlib as mpl
-
-    width = 3.3 * ncol + 0.9
-    with new_figure((width, 2.75 * nrow + (0.35 if title else 0.0)), nrows=nrow, ncols=ncol,
-                    squeeze=False) as (fig, axes):
-        for ax in axes.ravel():
-            ax.set_axis_off()
-        for ax, (label, _), img in zip(axes.ravel(), data, images):
-            ax.imshow(img, interpolation="lanczos")
-            ax.set_title(label, fontsize=9.5)
+            _surface_panel(ax, xs, ys, ps, tri, p0=p0, a=a, height=height, vmax=vmax, section=sec, lab=lab)
+            ax.set_title(label, fontsize=9.5, pad=-6)
         sm = mpl.cm.ScalarMappable(norm=mpl.colors.Normalize(0.0, vmax), cmap="viridis")
-        bar = fig.colorbar(sm, ax=axes.ravel().tolist(), shrink=0.8, pad=0.01, aspect=25)
-        bar.set_label(axis_labels(labels)["p"])
+        cax = fig.add_subplot(grid[:, ncol])
+        bar = fig.colorbar(sm, cax=cax)
+        bar.set_label(lab["p"])
+        box = cax.get_position()
+        cax.set_position([box.x0, box.y0 + 0.1 * box.height, box.width, 0.8 * box.height])
         if title:
             fig.suptitle(title, fontsize=10.5)
         return save_figure(fig, path)
@@ -234,7 +240,7 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
     if circle is None and hasattr(result, "contact_radius"):
         circle = result.contact_radius
     with new_figure(figsize) as (fig, ax):
-        pc = ax.tripcolor(triang, ps / p0, shading="gouraud", cmap="viridis", vmin=0.0)
+        pc = ax.tripcolor(triang, ps / p0, shading="gouraud", cmap="viridis", vmin=0.0, rasterized=True)
         loaded = (ps > 0).astype(float)
         if loaded.min() < 0.5:
             ax.tricontour(triang, loaded, levels=[0.5], colors="white", linewidths=1.4)
@@ -253,6 +259,9 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
         lab = axis_labels(labels)
         bar.set_label(lab["p"])
         ax.set_aspect(aspect)
+        (x0, x1), (y0, y1) = covered_window(xs, ys)
+        ax.set_xlim(x0 / a, x1 / a)
+        ax.set_ylim(y0 / b, y1 / b)
         ax.grid(False)
         ax.set_xlabel(lab["x"])
         ax.set_ylabel(lab["y"])

@@ -75,7 +75,7 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
     triang = mtri.Triangulation(rr, zz, tt)
     vmax = float(np.percentile(vv[np.unique(tt)], 99.8))
     with new_figure((5.8, 4.6)) as (fig, ax):
-        pc = ax.tripcolor(triang, vv, shading="gouraud", cmap="magma", vmin=0.0, vmax=vmax)
+        pc = ax.tripcolor(triang, vv, shading="gouraud", cmap="magma", vmin=0.0, vmax=vmax, rasterized=True)
         ax.tricontour(triang, vv, levels=np.linspace(0, vmax, 9)[1:-1], colors="white", linewidths=0.5,
                       alpha=0.6)
         ax.axhline(0.0, color="#00d0ff", lw=1.0, ls="--")

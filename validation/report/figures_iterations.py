@@ -99,6 +99,15 @@ def _history(run):
     return hist
 
 
+def _integer_ticks(axis):
+    """Iteration numbers on a log axis as plain integers (1, 2, 5, 10, 20, ...), no minor labels."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:.0f}" if v >= 1 else ""))
+    axis.set_minor_formatter(NullFormatter())
+
+
 def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
     """Maximum pressure and KKT residual against the iteration, one line per run (Fig. 8).
 
@@ -148,6 +157,7 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
         top.set_title(title or "maximum contact pressure during the iterations")
         top.legend(frameon=False, loc="best")
         bot.set_xscale("log")
+        _integer_ticks(bot.xaxis)
         bot.set_xlabel("iteration $k$")
         bot.set_ylabel("KKT residual")
         return save_figure(fig, path)

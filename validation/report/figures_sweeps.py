@@ -16,7 +16,7 @@ from bem.checks import InputError, check_positive
 from .figures_profiles import auto_xlim
 from .style import new_figure, save_figure
 
-__all__ = ["transition_radius", "edge_radius", "plot_sweep", "plot_transition_line"]
+__all__ = ["transition_radius", "edge_radius", "plot_sweep", "plot_transition_line", "plot_sweep_scalars"]
 
 
 def _radial(x, p):
@@ -63,7 +63,8 @@ def edge_radius(x, p):
     return float(r[k] if k + 1 >= r.size else 0.5 * (r[k] + r[k + 1]))
 
 
-def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=None, extra=()):
+def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=None, extra=(), labels=None,
+               ticklabels=None):
     """A family of axial-section curves coloured by the swept parameter (paper Fig. 5, 9).
 
     Parameters
@@ -84,11 +85,16 @@ def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=Non
         Range of ``x / a`` (default: the widest contact with a margin).
     extra : sequence of (str, array_like, array_like, dict)
         Reference curves ``(label, x, p, style)`` drawn on top (e.g. the limits).
+    labels : dict, optional
+        ``{"x", "p"}`` axis labels (default ``x / a_H`` on the axial section, ``p / p0``).
+    ticklabels : sequence of str, optional
+        Colour-bar tick labels, one per curve (e.g. values that are not numbers, the
+        curves then given their index as ``alpha``).
 
     Returns
     -------
     str
-        ``path``.
+        The written file.
     """
     import matplotlib as mpl
 
@@ -111,12 +117,13 @@ def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=Non
         bar.set_label(name)
         if len(alphas) <= 12:
             bar.set_ticks(alphas)
-            bar.set_ticklabels([f"{v:.3g}" for v in alphas])
+            bar.set_ticklabels(list(ticklabels) if ticklabels is not None else [f"{v:.3g}" for v in alphas])
         sections = [(np.asarray(c[1], dtype=float), np.asarray(c[2], dtype=float)) for c in curves]
         ax.set_xlim(*(xlim or auto_xlim(sections, a)))
         ax.set_ylim(bottom=0.0)
-        ax.set_xlabel(r"$x\,/\,a_H$  (axial section $y = 0$)")
-        ax.set_ylabel(r"contact pressure $p\,/\,p_0$")
+        lab = {"x": r"$x\,/\,a_H$", "p": r"contact pressure $p\,/\,p_0$", **(labels or {})}
+        ax.set_xlabel(lab["x"] + "  (axial section $y = 0$)")
+        ax.set_ylabel(lab["p"])
         if title:
             ax.set_title(title)
         if extra:
@@ -176,4 +183,47 @@ def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
         if title:
             ax.set_title(title)
         ax.legend(loc="lower left", frameon=True, framealpha=0.85)
+        return save_figure(fig, path)
+
+
+def plot_sweep_scalars(values, series, path, *, name, title=None, ticklabels=None):
+    """Scalar results of a sweep against the swept value, one panel per quantity.
+
+    Parameters
+    ----------
+    values : array_like
+        The swept values (numbers; give ``ticklabels`` for values that are not).
+    series : sequence of (str, array_like)
+        ``(axis label with unit, values)`` per panel; ``NaN`` marks a missing point.
+    path : path-like
+        PNG file to write.
+    name : str
+        Label of the swept parameter (mathtext allowed).
+    title : str, optional
+        Title of the upper panel.
+    ticklabels : sequence of str, optional
+        Tick labels at ``values``.
+
+    Returns
+    -------
+    str
+        The written file.
+    """
+    x = np.asarray(values, dtype=float)
+    if not series or x.size < 1:
+        raise InputError("series = [] is not allowed: give at least one (label, values) pair.")
+    with new_figure((6.4, 1.2 + 1.9 * len(series)), nrows=len(series), sharex=True, squeeze=False) as (fig, axes):
+        for ax, (label, y) in zip(axes[:, 0], series):
+            y = np.asarray(y, dtype=float)
+            if y.shape != x.shape:
+                raise InputError(f"series {label!r} has shape {y.shape} which is not allowed: it must match "
+                                 f"values, {x.shape}.")
+            ax.plot(x, y, marker="o", markersize=4, color="#1f77b4")
+            ax.set_ylabel(label)
+        bottom = axes[-1, 0]
+        bottom.set_xlabel(name)
+        if ticklabels is not None:
+            bottom.set_xticks(x, list(ticklabels))
+        if title:
+            axes[0, 0].set_title(title)
         return save_figure(fig, path)

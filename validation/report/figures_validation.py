@@ -12,7 +12,7 @@ from bem.checks import InputError, check_positive
 
 from .style import SOLVER_COLORS, color_for, new_figure, save_figure
 
-__all__ = ["plot_profile_comparison", "plot_work_precision", "WP_FIELDS", "work_precision_rows"]
+__all__ = ["plot_profile_comparison", "plot_work_precision", "WP_FIELDS", "work_precision_rows", "time_spread"]
 
 #: fields of one row of a resolution study
 WP_FIELDS = ("solver", "method", "resolution", "N", "error", "wall_time_s")
@@ -118,9 +118,9 @@ def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, 
 def work_precision_rows(rows):
     """Rows of a resolution study as dicts with the keys :data:`WP_FIELDS`.
 
-    Accepts dicts (extra keys kept) or sequences in the order of :data:`WP_FIELDS`.
-    Rows whose error or time is not a positive finite number are dropped (they cannot be
-    drawn on log axes).
+    Accepts dicts (extra keys kept, e.g. ``wall_times_s``: the times of every repeat [s])
+    or sequences in the order of :data:`WP_FIELDS`. Rows whose error or time is not a
+    positive finite number are dropped (they cannot be drawn on log axes).
     """
     out = []
     for row in rows:
@@ -136,13 +136,39 @@ def work_precision_rows(rows):
     return out
 
 
+def time_spread(row):
+    """``(median, low, high)`` wall time of a row [s]: the spread of its repeats ``wall_times_s``
+    (min and max), or the median alone (``low = high = median``) without repeats."""
+    t = float(row["wall_time_s"])
+    times = [float(v) for v in (row.get("wall_times_s") or ()) if v is not None and math.isfinite(v) and v > 0]
+    if len(times) < 2:
+        return t, t, t
+    return t, min(min(times), t), max(max(times), t)
+
+
+def _short_count(n):
+    """``12345 -> "12k"``: a compact unknown count for a label."""
+    n = int(n)
+    for div, suffix in ((1_000_000, "M"), (1_000, "k")):
+        if n >= 10 * div:
+            return f"{n / div:.0f}{suffix}"
+        if n >= div:
+            return f"{n / div:.1f}{suffix}"
+    return str(n)
+
+
 def plot_work_precision(rows, path, *, error_label="relative error", title=None, references=(0.01, 0.001)):
     """Error against wall time, log-log, one line per (solver, method), a marker per resolution.
+
+    The marker sits at the median time of the repeats of a run, the horizontal bar spans
+    their fastest to slowest (rows with ``wall_times_s``, :func:`time_spread`); each marker
+    is labelled with its resolution and unknown count.
 
     Parameters
     ----------
     rows : iterable of dict or sequence
-        ``(solver, method, resolution, N, error, wall_time_s)`` (:func:`work_precision_rows`).
+        ``(solver, method, resolution, N, error, wall_time_s)`` and optionally
+        ``wall_times_s`` (:func:`work_precision_rows`).
     path : path-like
         PNG file to write.
     error_label : str
@@ -155,7 +181,7 @@ def plot_work_precision(rows, path, *, error_label="relative error", title=None,
     Returns
     -------
     str
-        ``path``.
+        The written file.
     """
     rows = work_precision_rows(rows)
     if not rows:
@@ -164,33 +190,39 @@ def plot_work_precision(rows, path, *, error_label="relative error", title=None,
     for row in rows:
         groups.setdefault((str(row["solver"]), str(row.get("method") or "")), []).append(row)
     by_solver = len({s for s, _ in groups}) == len(groups)  # one line per solver: colour by solver
-    with new_figure((6.6, 4.4)) as (fig, ax):
+    spread = any(time_spread(r)[1] < time_spread(r)[2] for r in rows)
+    repeats = max((len(r.get("wall_times_s") or ()) for r in rows), default=0)
+    with new_figure((7.0, 4.6)) as (fig, ax):
         for i, ((solver, method), grp) in enumerate(groups.items()):
             grp = sorted(grp, key=lambda r: r["wall_time_s"])
-            t = np.array([r["wall_time_s"] for r in grp])
+            t, lo, hi = np.array([time_spread(r) for r in grp]).T
             e = np.array([r["error"] for r in grp])
             color = color_for(solver.lower() if by_solver else (method or solver.lower()), i)
             label = solver.upper() if solver.lower() in ("bem", "fem") else solver
             label = f"{label} ({method})" if method else label
-            ax.plot(t, e, color=color, lw=1.3, label=label)
+            ax.plot(t, e, color=color, lw=1.3, label=label, zorder=2)
+            ax.errorbar(t, e, xerr=[t - lo, hi - t], fmt="none", ecolor=color, elinewidth=1.0, capsize=3,
+                        zorder=3)
             for j, r in enumerate(grp):
                 ax.plot(t[j], e[j], marker=_MARKERS[j % len(_MARKERS)], color=color, markersize=6, ls="none",
-                        markeredgecolor="white", markeredgewidth=0.6)
+                        markeredgecolor="white", markeredgewidth=0.6, zorder=4)
                 text = str(r.get("resolution") or "")
                 if r.get("N"):
-                    text = f"{text}, N={int(r['N'])}" if text else f"N={int(r['N'])}"
+                    text = f"{text}\nN = {_short_count(r['N'])}" if text else f"N = {_short_count(r['N'])}"
                 if text:
-                    ax.annotate(text, (t[j], e[j]), xytext=(5, 3), textcoords="offset points", fontsize=7,
-                                color=color)
+                    ax.annotate(text, (hi[j], e[j]), xytext=(4, 3), textcoords="offset points", fontsize=7,
+                                color=color, va="bottom", linespacing=1.0, zorder=5,
+                                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
         for ref in references:
-            ax.axhline(ref, color="#777777", lw=0.9, ls=":")
-            ax.annotate(f"{ref:.1%}".replace(".0%", "%"), (0.0, ref), xycoords=("axes fraction", "data"),
-                        xytext=(3, 2), textcoords="offset points", fontsize=8, color="#555555")
+            ax.axhline(ref, color="#777777", lw=0.9, ls=":", zorder=1)
+            ax.annotate(f"{ref:.1%}".replace(".0%", "%"), (1.0, ref), xycoords=("axes fraction", "data"),
+                        xytext=(-3, 2), textcoords="offset points", fontsize=8, color="#555555", ha="right")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.margins(x=0.2)
-        ax.set_xlabel("wall-clock time [s]")
+        ax.margins(x=0.25, y=0.12)
+        ax.set_xlabel("wall-clock time [s]" + (f" (marker: median of up to {repeats} runs; bar: fastest to slowest)"
+                                                if spread else ""))
         ax.set_ylabel(error_label)
         ax.set_title(title or "work-precision: error against run time")
-        ax.legend(loc="lower left", frameon=True, framealpha=0.9)
+        fig.legend(loc="outside lower center", ncols=min(len(groups), 3), frameon=False)
         return save_figure(fig, path)

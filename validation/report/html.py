@@ -1,6 +1,6 @@
 """Self-contained HTML5 rendering of a report.
 
-Figures are embedded as ``data:image/png;base64`` URIs and the style sheet is inline, so
+Figures are embedded as ``data:image/png;base64`` (or ``image/svg+xml``) URIs and the style sheet is inline, so
 the file opens offline and can be mailed as one file: no external link, script or font.
 """
 
@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import base64
 import html
+import os
 
 from .sections import Figure, Table
 
@@ -51,8 +52,12 @@ def _is_number(text):
     return True
 
 
+_MIME = {".png": "image/png", ".svg": "image/svg+xml"}
+
+
 def _figure(fig, number, data):
-    uri = "data:image/png;base64," + base64.b64encode(data).decode("ascii")
+    mime = _MIME.get(os.path.splitext(fig.path)[1].lower(), "image/png")
+    uri = f"data:{mime};base64," + base64.b64encode(data).decode("ascii")
     return (f'<figure>\n<img src="{uri}" alt="{html.escape(fig.alt_text)}">\n'
             f"<figcaption><b>Figure {number}.</b> {html.escape(fig.caption)}</figcaption>\n</figure>")
 
@@ -85,7 +90,7 @@ def render_html(sections, *, title, subtitle="", images, footer=""):
     subtitle : str
         Line under the heading.
     images : mapping of str to bytes
-        PNG bytes of every figure, keyed by ``Figure.path``.
+        PNG or SVG bytes of every figure, keyed by ``Figure.path``.
     footer : str
         Text of the footer (e.g. how the report was generated).
     """

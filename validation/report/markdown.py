@@ -28,7 +28,7 @@ def _table(tab, number):
     return "\n".join(lines)
 
 
-def render_markdown(sections, *, title, subtitle="", names, footer=""):
+def render_markdown(sections, *, title, subtitle="", names, footer="", vectors=()):
     """The whole report as one Markdown string.
 
     Parameters
@@ -39,6 +39,9 @@ def render_markdown(sections, *, title, subtitle="", names, footer=""):
         As for :func:`validation.report.html.render_html`.
     names : mapping of str to str
         Relative file name (``figures/x.png``) of every figure, keyed by ``Figure.path``.
+    vectors : collection of str
+        Relative names of the PDF copies written beside the PNGs (``figures/x.pdf``); the
+        caption links them.
     """
     out = [f"# {title}", ""]
     if subtitle:
@@ -53,8 +56,10 @@ def render_markdown(sections, *, title, subtitle="", names, footer=""):
         for item in sec.items:
             if isinstance(item, Figure):
                 n_fig += 1
+                pdf = names[item.path][:-4] + ".pdf"
+                link = f" (vector: [{pdf}]({pdf}))" if pdf in vectors else ""
                 out += [f"![{_cell(item.alt_text)}]({names[item.path]})", "",
-                        f"*Figure {n_fig}.* {item.caption}", ""]
+                        f"*Figure {n_fig}.* {item.caption}{link}", ""]
             elif isinstance(item, Table):
                 n_tab += 1
                 out += [_table(item, n_tab), ""]

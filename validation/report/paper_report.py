@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import logging
 import math
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -18,17 +17,19 @@ from . import figures_iterations as fit
 from . import figures_profiles as fpr
 from . import figures_sweeps as fsw
 from . import figures_validation as fva
-from .build import build_report
+from .build import Progress, draw_and_build
 from .figures_fem import plot_von_mises
-from .paper import AG_RELAXATION, solve_paper_problem
+from .paper import AG_RELAXATION, SOLVE_STAGES, solve_paper_problem
 from .sections import Figure, Section, Table, problem_section
 from .style import method_label
 
-__all__ = ["report_paper_problem", "paper_sections"]
+__all__ = ["report_paper_problem", "paper_sections", "STAGES"]
 
 log = logging.getLogger(__name__)
 
 TITLE = "contactlab: the paper's test problem - paraboloids with a nonlinear interface layer"
+#: the stages of :func:`report_paper_problem`, as reported to its ``progress``
+STAGES = (*SOLVE_STAGES, "figures", "writing")
 
 
 def _method(result):
@@ -282,11 +283,14 @@ def _validation(res, work):
     wp = fva.plot_work_precision(res.work_precision, work / "fig_work_precision.png",
                                  error_label=r"peak-pressure error $|p_{max} - p_0|\,/\,p_0$",
                                  title="Hertz problem: error against run time")
-    wp_table = Table(("solver", "method", "resolution", "N (nodes / DOFs)", "error", "time [s]"),
-                     tuple((r["solver"], r["method"], r["resolution"], r["N"], r["error"], r["wall_time_s"])
-                           for r in res.work_precision), caption="Resolution study of the smooth (Hertz) problem.")
+    wp_table = Table(("solver", "method", "resolution", "N (nodes / DOFs)", "error", "median time [s]",
+                      "fastest [s]", "slowest [s]", "runs"),
+                     tuple((r["solver"], r["method"], r["resolution"], r["N"], r["error"], *fva.time_spread(r),
+                            len(r.get("wall_times_s") or ()) or 1) for r in res.work_precision),
+                     caption="Resolution study of the smooth (Hertz) problem.")
     items += [Figure(wp, "Work-precision of the two solvers on the Hertz problem: error of the peak pressure "
-                         "against wall-clock time (2 shared cores, indicative), one marker per resolution; dotted "
+                         "against wall-clock time (2 shared cores, indicative), one marker per resolution at the "
+                         "median of its repeated runs, the bar spanning the fastest to the slowest; dotted "
                          "lines at 1 % and 0.1 %."), wp_table]
     return Section("Validation: analytic solution and FEM reference", kind="fem", items=tuple(items), text=(
         "The paper validates its solver against analytic theory and ANSYS; here the BEM is compared with "
@@ -304,7 +308,7 @@ def paper_sections(res, work):
     return sections
 
 
-def report_paper_problem(out_dir, *, quick=False, fem=True, problem=None):
+def report_paper_problem(out_dir, *, quick=False, fem=True, problem=None, fmt="png", progress=None):
     """Solve the paper's test problem and write its report to ``out_dir``.
 
     Parameters
@@ -317,15 +321,21 @@ def report_paper_problem(out_dir, *, quick=False, fem=True, problem=None):
         Include the FEM reference and the resolution study.
     problem : validation.report.paper.PaperProblem, optional
         Other parameters.
+    fmt : {"png", "svg", "pdf"}
+        Figure files (:func:`validation.report.style.figure_format`).
+    progress : callable, optional
+        ``progress(stage, done, total)`` at the start of each stage (:data:`STAGES`, the FEM
+        stage only with ``fem``) and ``progress("done", total, total)`` at the end.
 
     Returns
     -------
     validation.report.build.BuiltReport
     """
-    res = solve_paper_problem(problem, quick=quick, fem=fem)
+    stages = [s for s in STAGES if fem or s != "FEM reference"]
+    notify = Progress(stages, progress)
+    res = solve_paper_problem(problem, quick=quick, fem=fem, progress=notify)
     pb = res.problem
-    subtitle = (f"Paraboloids R = E* = P = 1, lam = {pb.lam_factor:g} C_nn; BEM lattice a_H/c = {pb.nodes_per_radius}"
-                f"{' (quick preview)' if quick else ''}; computed in {res.wall_time_s:.0f} s.")
-    with tempfile.TemporaryDirectory(prefix="contactlab-figures-") as work:
-        sections = paper_sections(res, work)
-        return build_report(sections, out_dir, title=TITLE, subtitle=subtitle)
+    subtitle = (f"Paraboloids R = E* = P = 1, lam = {pb.lam_factor:g} C_nn; BEM lattice a_H/c = "
+                f"{pb.nodes_per_radius}{' (quick preview)' if quick else ''}; computed in {res.wall_time_s:.0f} s.")
+    return draw_and_build(lambda work: paper_sections(res, work), out_dir, title=TITLE, subtitle=subtitle, fmt=fmt,
+                          notify=notify)

@@ -32,9 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from bem.checks import InputError
+from bem.checks import InputError, check_choice
 
-__all__ = ["RunResults", "Units", "load_results", "parse_units", "display_unit"]
+__all__ = ["RunResults", "Units", "load_results", "parse_units", "display_unit", "report_unit", "REPORT_UNITS",
+           "UNIT_CHOICES"]
 
 log = logging.getLogger(__name__)
 
@@ -108,6 +109,19 @@ def display_unit(unit, magnitude):
     return (prefix or unit), factor
 
 
+#: how a report draws values in an SI base unit: lengths in mm, pressures and stresses in MPa
+REPORT_UNITS = {"m": ("mm", 1e-3), "Pa": ("MPa", 1e6)}
+#: ``units`` choices of a report: the scene's units (``"auto"``: when its label names them), or
+#: lengths and pressures divided by the contact's scales
+UNIT_CHOICES = ("auto", "scene", "dimensionless")
+
+
+def report_unit(unit):
+    """``(symbol, factor)`` to draw values in ``unit`` as ``value / factor``: m as mm and Pa as MPa
+    (:data:`REPORT_UNITS`), any other unit as it is ("" when unknown)."""
+    return REPORT_UNITS.get(unit, (unit or "", 1.0))
+
+
 def parse_units(label):
     """Units named by a scene's units label.
 
@@ -144,6 +158,10 @@ class RunResults:
         ``(x, y, p)`` nodal BEM pressures [length], [pressure].
     fem_field_path : Path or None
         The FEM field file, when the FEM ran.
+    dimensionless : bool
+        Draw lengths and pressures divided by the contact's scales (Hertz's radius and peak
+        of a paraboloid, else the contact half-width and the peak pressure) instead of in the
+        scene's units (:func:`report_unit`).
     """
 
     directory: Path
@@ -152,6 +170,7 @@ class RunResults:
     units: Units = field(default_factory=lambda: parse_units(None))
     bem_field: tuple | None = None
     fem_field_path: Path | None = None
+    dimensionless: bool = False
 
     def section(self, name):
         """A table of ``scene.toml`` (empty dict when absent)."""
@@ -226,8 +245,11 @@ def _bem_field(path):
     return mesh.points[:, 0].copy(), mesh.points[:, 1].copy(), np.asarray(p, dtype=float).ravel()
 
 
-def load_results(directory):
+def load_results(directory, *, units="auto"):
     """Read a result directory of ``contactlab run`` (see the module docstring).
+
+    ``units`` (:data:`UNIT_CHOICES`) sets :attr:`RunResults.dimensionless`: ``"auto"``
+    draws in the scene's units when its units label names them, dimensionless otherwise.
 
     Raises
     ------
@@ -252,8 +274,11 @@ def load_results(directory):
         files.update({k: str(v) for k, v in data["files"].items()})
     scene = _read_scene(directory / files["scene"])
     label = data.get("units") or (scene.get("scene") or {}).get("units")
-    res = RunResults(directory=directory, data=dict(data), scene=scene, units=parse_units(label),
-                     bem_field=_bem_field(directory / files["bem_field"]))
+    parsed = parse_units(label)
+    units = check_choice("units", units, UNIT_CHOICES)
+    res = RunResults(directory=directory, data=dict(data), scene=scene, units=parsed,
+                     bem_field=_bem_field(directory / files["bem_field"]),
+                     dimensionless=units == "dimensionless" or (units == "auto" and not parsed.known))
     fem_path = directory / files["fem_field"]
     if isinstance(data.get("fem"), Mapping) and fem_path.is_file():
         res.fem_field_path = fem_path

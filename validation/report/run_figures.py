@@ -1,10 +1,12 @@
 """Figures of a run's report: axial-section profiles (against the references), contact map,
 convergence history and the FEM's von Mises field, all drawn from the result directory.
 
-Scales: a paraboloid scene records Hertz's peak ``p_H`` and radius ``a_H`` (``result["scales"]``)
-and its figures are normalised by them (paper Fig. 5). Other scenes are drawn in the scene's
-units, SI base units with a readable prefix (:func:`validation.report.results.display_unit`),
-in a window around the contact (:func:`profile_view`).
+Units: by default the figures are drawn in the scene's units, lengths in mm and pressures in MPa
+for an SI scene (:func:`validation.report.results.report_unit`), in a window around the contact
+(:func:`profile_view`). A dimensionless report (``RunResults.dimensionless``, ``contactlab report
+--units dimensionless``) divides them by the contact's scales: Hertz's peak ``p_H`` and radius
+``a_H`` of a paraboloid scene (``result["scales"]``, paper Fig. 5), else the BEM peak pressure
+``p_max`` and the contact half-width ``a_c`` along x.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .results import display_unit
+from .results import report_unit
 from .sections import Figure, fmt
 
 __all__ = ["ProfileView", "profile_view", "contact_edge", "profile_figures", "contact_map_figure",
@@ -60,15 +62,27 @@ class ProfileView:
     def axis_label(self, name):
         """Label of another length axis drawn with the same scale (e.g. ``"y"``)."""
         if self.normalised:
-            return rf"${name}\,/\,a_H$"
+            return rf"${name}\,/\,{self.x_name.split(' = ')[0]}$"
         return f"${name}$" + (f" [{self.x_name}]" if self.x_name else "")
 
 
 def scales_of(res):
-    """``(p_H, a_H)`` of the run when recorded and positive, else ``None``."""
+    """``(p0, a, p_name, a_name)`` of a dimensionless report, or ``None`` (scene units).
+
+    Hertz's peak and radius (``p_H``, ``a_H``) when the run recorded them, else the BEM peak
+    pressure and the contact radius (or half-width along x): ``p_{max}``, ``a_c``.
+    """
+    if not res.dimensionless:
+        return None
     sc = res.get("scales") or {}
     p0, a = sc.get("p_hertz"), sc.get("a_hertz")
-    return (float(p0), float(a)) if p0 and a and p0 > 0 and a > 0 else None
+    if p0 and a and p0 > 0 and a > 0:
+        return float(p0), float(a), "p_H", "a_H"
+    p0 = res.data.get("p_max")
+    a = res.data.get("contact_radius") or (res.get("contact_extent") or {}).get("x")
+    if p0 and a and p0 > 0 and a > 0:
+        return float(p0), float(a), "p_{max}", "a_c"
+    return None
 
 
 def contact_edge(curves):
@@ -97,18 +111,17 @@ def profile_view(res, curves, *, axis="x"):
     """
     edge = contact_edge(curves)
     reach = float(np.abs(np.asarray(curves[0][0], dtype=float)).max(initial=0.0)) if curves else 0.0
-    p_peak = max((float(np.max(p, initial=0.0)) for _, p in curves), default=0.0)
     scales = scales_of(res)
     if scales is not None:
-        p0, a = scales
+        p0, a, p_name, a_name = scales
         half = min(PAD * max(edge / a, 1.0), max(reach, 1.02 * edge) / a)
-        return ProfileView(a, p0, rf"${axis}\,/\,a_H$", r"contact pressure $p\,/\,p_H$",
-                           f"a_H = {fmt(a)} {res.units.of('length')}".replace(" -", ""),
-                           f"p_H = {fmt(p0)} {res.units.of('pressure')}".replace(" -", ""), (-half, half), True)
+        return ProfileView(a, p0, rf"${axis}\,/\,{a_name}$", rf"contact pressure $p\,/\,{p_name}$",
+                           f"{a_name} = {fmt(a)} {res.units.of('length')}".replace(" -", ""),
+                           f"{p_name} = {fmt(p0)} {res.units.of('pressure')}".replace(" -", ""), (-half, half), True)
     if edge <= 0:
         edge = float(max((np.abs(np.asarray(x, float)).max(initial=0.0) for x, _ in curves), default=1.0)) or 1.0
-    x_unit, xf = display_unit(res.units.length, edge)
-    p_unit, pf = display_unit(res.units.pressure, p_peak)
+    x_unit, xf = report_unit(res.units.length)
+    p_unit, pf = report_unit(res.units.pressure)
     half = min(PAD * edge, max(reach, 1.02 * edge)) / xf
     return ProfileView(xf, pf, f"${axis}$" + (f" [{x_unit}]" if x_unit else ""),
                        "contact pressure $p$" + (f" [{p_unit}]" if p_unit else ""),
@@ -200,14 +213,13 @@ def profile_figures(res, work):
         view = profile_view(res, curves, axis="r" if res.axisymmetric else axis)
         line = "the lattice row y = 0" if axis == "x" else "the line x = 0 (BEM field interpolated)"
         how = _how(res) + (" " + _fem_how(res) if fem else "")
-        scale = (f" Normalised by Hertz's peak {view.p_name} and radius {view.x_name} of the smooth problem."
-                 if view.normalised else "")
+        scale = f" {_scale_text(view)}" if view.normalised else ""
         path = work / f"profile_{axis}.png"
         if ref is None and not fem:
-            plot_pressure_profiles([("BEM", data)], path, p0=view.p_factor, a=view.x_factor, xlim=view.xlim,
-                                   labels={"x": view.x_label, "p": view.p_label},
-                                   section=("axial section $y = 0$" if axis == "x" else "section $x = 0$"),
-                                   title=f"contact pressure along {axis}")
+            path = plot_pressure_profiles([("BEM", data)], path, p0=view.p_factor, a=view.x_factor, xlim=view.xlim,
+                                          labels={"x": view.x_label, "p": view.p_label},
+                                          section=("axial section $y = 0$" if axis == "x" else "section $x = 0$"),
+                                          title=f"contact pressure along {axis}")
             figures.append(Figure(path, f"BEM contact pressure along {line}, nodal values. {how}{scale}"))
             continue
         curves = [("BEM", data[0], data[1], "bem")]
@@ -221,17 +233,26 @@ def profile_figures(res, work):
             e0 = None
         else:
             e0 = float(np.max(reference[2])) if ref is None else float(np.max(ref[1](np.abs(data[0]))))
-        err = (r"error $(p - p_{ref})\,/\,p_H$" if view.normalised
+        p_sym = view.p_name.split(" = ")[0]
+        err = (rf"error $(p - p_{{ref}})\,/\,{p_sym}$" if view.normalised
                else r"error $(p - p_{ref})\,/\,\max p_{ref}$")
-        plot_profile_comparison(curves, path, p0=view.p_factor, a=view.x_factor, reference=reference,
-                                rmax=view.xlim[1], error_scale=e0,
-                                labels={"x": view.x_label, "p": view.p_label, "err": err,
-                                        "err_of": "$p_H$" if view.normalised else r"$\max p_{ref}$"},
-                                title=f"contact pressure along {'r' if res.axisymmetric else axis} "
-                                      f"against {against}")
+        path = plot_profile_comparison(curves, path, p0=view.p_factor, a=view.x_factor, reference=reference,
+                                       rmax=view.xlim[1], error_scale=e0,
+                                       labels={"x": view.x_label, "p": view.p_label, "err": err,
+                                               "err_of": f"${p_sym}$" if view.normalised else r"$\max p_{ref}$"},
+                                       title=f"contact pressure along {'r' if res.axisymmetric else axis} "
+                                             f"against {against}")
         figures.append(Figure(path, f"Contact pressure along {line} (upper panel) and its difference to "
                                     f"{against} at each solver's nodes (lower panel). {how}{scale}"))
     return figures
+
+
+def _scale_text(view):
+    """Caption sentence naming the scales of a dimensionless figure."""
+    if view.p_name.startswith("p_H"):
+        return f"Normalised by Hertz's peak {view.p_name} and radius {view.x_name} of the smooth problem."
+    return (f"Normalised by the BEM peak pressure {view.p_name} and the contact half-width along x "
+            f"{view.x_name}.")
 
 
 def contact_map_figure(res, work):
@@ -249,11 +270,8 @@ def contact_map_figure(res, work):
     kw = dict(a=view.x_factor, labels=labels)
     ex, ey = contact_edge([(x, p)]), contact_edge([(y, p)])
     elongated = not view.normalised and min(ex, ey) > 0 and max(ex, ey) > ELONGATED * min(ex, ey)
-    if elongated:  # a roller: each axis in its own unit, the axes stretched to fill the figure
-        ux, fx = display_unit(res.units.length, ex)
-        uy, fy = display_unit(res.units.length, ey)
-        labels.update(x=f"$x$ [{ux}]" if ux else "$x$", y=f"$y$ [{uy}]" if uy else "$y$")
-        kw.update(a=fx, b=fy, aspect="auto", figsize=(8.2, 3.6))
+    if elongated:  # a roller: the axes stretched to fill the figure
+        kw.update(aspect="auto", figsize=(8.2, 3.6))
     else:  # equal axes: a figure as wide as the drawn window (the contact patch within the data)
         half = 1.3 * max(ex, ey)  # the window of figures_3d.contact_patch (margin 0.3)
         ratio = min(float(np.abs(x).max()), half) / max(min(float(np.abs(y).max()), half), 1e-300)
@@ -264,7 +282,7 @@ def contact_map_figure(res, work):
     extra = " The dotted contour is p = p_cr (rigid branch of the layer inside)." if levels else ""
     if elongated:
         extra += (f" The contact is elongated (half-widths {fmt(ex)} and {fmt(ey)} {res.units.of('length')}): "
-                  "x and y are drawn in different units, the y axis stretched.")
+                  "x and y are drawn to different scales, the y axis stretched.")
     return Figure(path, "BEM contact pressure over the contact plane, interpolated linearly on the lattice "
                         "triangles (bem_field.vtu); white: the contact boundary, midway between loaded and "
                         "unloaded nodes" + ("; dashed: the circle of equal area" if circle else "")
@@ -280,9 +298,9 @@ def convergence_figure(res, work):
         return None
     scales = scales_of(res)
     if scales is not None:
-        p0, label = scales[0], r"max. pressure $p_{max}\,/\,p_H$"
+        p0, label = scales[0], rf"max. pressure $\max\,p\,/\,{scales[2]}$"
     else:
-        unit, p0 = display_unit(res.units.pressure, float(np.max(hist["p_max"])))
+        unit, p0 = report_unit(res.units.pressure)
         label = "max. pressure $p_{max}$" + (f" [{unit}]" if unit else "")
     tol = res.bem.get("rtol") or _tolerance(res.data.get("message"))
     from .run_problem import method_text, rebuild_layer
@@ -294,6 +312,12 @@ def convergence_figure(res, work):
     return Figure(path, f"Peak pressure (upper panel) and KKT residual (lower panel, log scale) of the {n} recorded "
                         "iterates on the finest lattice (a nested solve starts there from the interpolated solution "
                         "of the coarser lattices). " + _how(res))
+
+
+def _round_up(value):
+    """``value > 0`` rounded up to two significant digits (0.57 -> 0.57, 0.571 -> 0.58)."""
+    unit = 10.0 ** (math.floor(math.log10(value)) - 1)
+    return math.ceil(value / unit * (1 - 1e-12)) * unit
 
 
 def _tolerance(message):
@@ -317,16 +341,20 @@ def von_mises_figure(res, work):
     rc = float(res.fem.get("contact_radius") or res.data.get("contact_radius") or 0.0)
     scales = scales_of(res)
     if scales is not None:
-        p0, a = scales
-        labels, l_unit, label = None, None, r"von Mises stress $\sigma_{vM}\,/\,p_H$"
+        p0, a, p_name, a_name = scales
+        labels = None if a_name == "a_H" else {k: rf"${k}\,/\,{a_name}$" for k in ("r", "z")}
+        l_unit, label = (None if a_name == "a_H" else f"${a_name}$"), rf"von Mises stress $\sigma_{{vM}}\,/\,{p_name}$"
     else:
-        l_unit, a = display_unit(res.units.length, rc or float(np.max(r)))
-        s_unit, p0 = display_unit(res.units.pressure, float(np.max(vm)))
-        labels = {"r": f"$r$ [{l_unit}]", "z": f"$z$ [{l_unit}]"}
+        l_unit, a = report_unit(res.units.length)
+        s_unit, p0 = report_unit(res.units.pressure)
+        labels = {"r": f"$r$ [{l_unit}]" if l_unit else "$r$", "z": f"$z$ [{l_unit}]" if l_unit else "$z$"}
         label = r"von Mises stress $\sigma_{vM}$" + (f" [{s_unit}]" if s_unit else "")
-    window = 3.0 * max(rc / a, 0.5) if rc > 0 else 3.0
+    if rc > 0:
+        window = 3.0 * (max(rc / a, 0.5) if scales is not None else rc / a)
+    else:
+        window = 3.0 if scales is not None else 0.5 * float(np.max(r)) / a
     path = plot_section_field(r, z, tri, vm, work / "fem_von_mises.png", a=a, scale=p0, label=label,
-                              window=math.ceil(window * 10) / 10, contact_radius=rc or None, labels=labels,
+                              window=_round_up(window), contact_radius=rc or None, labels=labels,
                               length_unit=l_unit,
                               title="FEM reference: von Mises stress in the (r, z) section")
     return Figure(path, "Von Mises stress of the FEM reference in the axial (r, z) section, mirrored about the "

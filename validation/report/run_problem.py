@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping
 
-from .results import display_unit
+from .results import display_unit, report_unit
 from .sections import Figure, Section, Table, fmt
 
 __all__ = ["problem_statement", "rebuild_layer", "method_text"]
@@ -24,6 +24,7 @@ _GAP_TEXT = {
     "crowned_roller": "crowned roller: a cylinder of effective radius R and length l along x, with an end crown",
     "flat_punch": "flat punch: a flat of radius a whose edge is rounded with the radius edge_radius",
     "table": "gap tabulated on a grid, interpolated",
+    "measured": "measured surface read from a file, interpolated onto the lattice",
     "callable": "gap given by a Python function",
 }
 _LAW_TEXT = {
@@ -128,13 +129,22 @@ def _gap_rows(res):
     gap = res.section("gap") or {"type": "not recorded"}
     kind = str(gap.get("type", "?"))
     rows = [("gap h(x, y)", _GAP_TEXT.get(kind, kind), "-")]
+
+    def unit(key):
+        if kind == "measured" and key in ("spacing", "nodata"):  # in the file's length unit
+            file_unit = gap.get("length_unit")
+            return file_unit if isinstance(file_unit, str) else res.units.of("length")
+        return res.units.of(_GAP_UNITS.get(key, "-"))
+
     for key, value in gap.items():
         if key == "type":
             continue
         if isinstance(value, (int, float)) and not isinstance(value, bool):
-            rows.append((f"gap {key}", fmt(value), res.units.of(_GAP_UNITS.get(key, "-"))))
+            rows.append((f"gap {key}", fmt(value), unit(key)))
         elif isinstance(value, str):
             rows.append((f"gap {key}", value, "-"))
+        elif isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value):
+            rows.append((f"gap {key}", ", ".join(fmt(v) for v in value), unit(key)))
         elif isinstance(value, list):
             rows.append((f"gap {key}", f"table of {len(value)} values", "-"))
     return rows
@@ -187,8 +197,8 @@ def _layer_figure(res, layer, work):
         return None
     w_top = float(np.max(layer.w(np.linspace(0.0, p_top, 200))))
     u = res.units
-    p_unit, pf = display_unit(u.pressure, p_top)
-    w_unit, wf = display_unit(u.length, w_top)
+    p_unit, pf = report_unit(u.pressure)
+    w_unit, wf = display_unit(u.length, w_top)  # closures of a few micrometres: the readable prefix
     marks = [(rf"$p_{{max}}$ (BEM) = {fmt(res.data['p_max'] / pf, 3)} {p_unit}".rstrip(), res.data["p_max"] / pf)]
     for key, name in (("p_cr", r"$p_{cr}$"), ("p_star", r"$p^*$")):
         if params.get(key):

@@ -9,19 +9,21 @@ comparison metrics only when they were recorded. Units are the scene's (``[scene
 from __future__ import annotations
 
 import logging
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
 from ..provenance import display_path
 from . import run_figures as rf
-from .build import build_report
+from .build import Progress, draw_and_build
 from .run_problem import method_text, problem_statement, rebuild_layer
 from .sections import Section, Table, fmt
 
-__all__ = ["run_sections", "report_results_dir", "results_rows", "comparison_tables"]
+__all__ = ["run_sections", "report_results_dir", "results_rows", "comparison_tables", "STAGES"]
 
 log = logging.getLogger(__name__)
+
+#: the stages of :func:`report_results_dir`, as reported to its ``progress``
+STAGES = ("reading", "figures", "writing")
 
 #: rows of the results table: (key in result.json / fem / analytic, label, unit kind)
 _QUANTITIES = (("p_max", "peak pressure p_max", "pressure"),
@@ -230,7 +232,7 @@ def run_sections(res, work):
     return sections
 
 
-def report_results_dir(directory, out_dir=None, *, title=None):
+def report_results_dir(directory, out_dir=None, *, title=None, units="auto", fmt="png", progress=None):
     """Report of a result directory; default ``out_dir`` is ``directory/report``.
 
     Parameters
@@ -241,6 +243,13 @@ def report_results_dir(directory, out_dir=None, *, title=None):
         Report directory (``report.html``, ``report.md``, ``figures/``).
     title : str, optional
         Default: the scene's title.
+    units : {"auto", "scene", "dimensionless"}
+        Axes in the scene's units (lengths in mm, pressures in MPa for SI scenes) or divided
+        by the contact's scales (:func:`validation.report.results.load_results`).
+    fmt : {"png", "svg", "pdf"}
+        Figure files (:func:`validation.report.style.figure_format`).
+    progress : callable, optional
+        ``progress(stage, done, total)`` (:class:`validation.report.build.Progress`).
 
     Returns
     -------
@@ -248,11 +257,12 @@ def report_results_dir(directory, out_dir=None, *, title=None):
     """
     from .results import load_results
 
-    res = load_results(directory)
+    notify = Progress(STAGES, progress)
+    notify("reading")
+    res = load_results(directory, units=units)
     out_dir = Path(directory) / "report" if out_dir is None else Path(out_dir)
     source = res.data.get("source")
     subtitle = f"Scene '{res.name}'" + (f" ({source})" if source else "") + \
         f"; results read from {display_path(directory)}"
-    with tempfile.TemporaryDirectory(prefix="contactlab-figures-") as work:
-        sections = run_sections(res, work)
-        return build_report(sections, out_dir, title=title or res.title, subtitle=subtitle)
+    return draw_and_build(lambda work: run_sections(res, work), out_dir, title=title or res.title,
+                          subtitle=subtitle, fmt=fmt, notify=notify)

@@ -51,12 +51,12 @@ def fmt(value, digits=4):
 
 @dataclass(frozen=True)
 class Figure:
-    """A PNG figure and its caption.
+    """A figure (PNG or SVG file) and its caption.
 
     Attributes
     ----------
     path : str
-        The PNG file (copied into the report).
+        The PNG or SVG file (copied into the report; a PDF beside a PNG is copied too).
     caption : str
         What was computed and how (method, mesh step, nodes, tolerance).
     alt : str
@@ -69,7 +69,8 @@ class Figure:
 
     def __post_init__(self):
         if not os.path.isfile(self.path):
-            raise InputError(f"Figure path = {self.path!r} is not allowed: it must be an existing PNG file.")
+            raise InputError(f"Figure path = {self.path!r} is not allowed: it must be an existing PNG file "
+                             "(or SVG file).")
 
     @property
     def alt_text(self):

@@ -9,13 +9,12 @@ coloured by status. Only the studies present in ``DIR`` get a section.
 from __future__ import annotations
 
 import json
-import tempfile
 from pathlib import Path
 
 from bem.checks import InputError
 
 from ..provenance import display_path
-from .build import build_report
+from .build import Progress, draw_and_build
 from .figures_validation import plot_work_precision
 from .sections import Figure, Section, Table, table_from_rows
 
@@ -47,16 +46,18 @@ def _error_time_sections(data, work):
         for metric, label in (("error_l2", "relative L2 error of p over the contact"),
                               ("error_peak", "relative error of the peak pressure")):
             wp = [{"solver": r["solver"], "method": _label(r), "resolution": r["resolution"], "N": r["n"],
-                   "error": r[metric], "wall_time_s": r["wall_time_s"]} for r in mine if r["converged"]]
+                   "error": r[metric], "wall_time_s": r["wall_time_s"], "wall_times_s": r.get("wall_times_s")}
+                  for r in mine if r["converged"]]
             if not wp:
                 continue
             path = plot_work_precision(wp, Path(work) / f"work_precision_{problem}_{metric}.png",
                                        error_label=label, title=f"{problem}: {label} against run time")
-            items.append(Figure(path, f"Work-precision, {problem}: {label} against the wall time "
-                                      "(median of repeats) of every converged run; one line per solver "
-                                      "and method, a marker per resolution (nodes across the contact for "
-                                      "the BEM, elements across the contact radius for the FEM); dotted "
-                                      "lines at 1 % and 0.1 %."))
+            items.append(Figure(path, f"Work-precision, {problem}: {label} against the wall time of every "
+                                      "converged run; the marker is the median of its repeats, the bar spans "
+                                      "the fastest to the slowest repeat (runs slower than the study's slow_s "
+                                      "are timed once); one line per solver and method, a marker per "
+                                      "resolution (nodes across the contact for the BEM, elements across the "
+                                      "contact radius for the FEM); dotted lines at 1 % and 0.1 %."))
         columns = ("solver", "method", "resolution", "N", "L2 error", "peak error", "time [s]", "iterations",
                    "status")
         table_rows = [(r["solver"], _label(r), r["resolution"], r["n"], r["error_l2"], r["error_peak"],
@@ -122,10 +123,16 @@ def study_sections(directory, work):
     return sections
 
 
-def report_studies_dir(directory, out_dir=None, *, title="contactlab validation studies"):
-    """Report of the study files in ``directory`` (default ``out_dir``: ``directory/report``)."""
+def report_studies_dir(directory, out_dir=None, *, title="contactlab validation studies", fmt="png", progress=None):
+    """Report of the study files in ``directory`` (default ``out_dir``: ``directory/report``).
+
+    ``fmt`` (``"png"``, ``"svg"``, ``"pdf"``) chooses the figure files
+    (:func:`validation.report.style.figure_format`); ``progress(stage, done, total)`` hears
+    the stages (:class:`validation.report.build.Progress`).
+    """
+    from .run_report import STAGES
+
     out_dir = Path(directory) / "report" if out_dir is None else Path(out_dir)
-    with tempfile.TemporaryDirectory(prefix="contactlab-figures-") as work:
-        sections = study_sections(directory, work)
-        return build_report(sections, out_dir, title=title,
-                            subtitle=f"Studies read from {display_path(directory)}")
+    return draw_and_build(lambda work: study_sections(directory, work), out_dir, title=title,
+                          subtitle=f"Studies read from {display_path(directory)}", fmt=fmt,
+                          notify=Progress(STAGES[1:], progress))

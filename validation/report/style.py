@@ -2,8 +2,8 @@
 
 Every 2-D figure is a bare :class:`matplotlib.figure.Figure` drawn with the Agg
 canvas (no ``pyplot``, so no global state and no GUI backend is ever touched)
-and saved by :func:`save_figure` through :func:`bem.files.atomic_path` (a temporary file
-in the target directory, then ``os.replace``-d), so a reader never sees a half-written PNG.
+and saved by :func:`save_figure`: rendered to a temporary file in the target
+directory, then ``os.replace``-d, so a reader never sees a half-written PNG.
 
 Colours are fixed per layer law, per method and per solver so that a law keeps
 its colour from one figure of a report to the next.
@@ -12,15 +12,20 @@ its colour from one figure of a report to the next.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 
+from bem.checks import check_choice
 from bem.files import atomic_path
 
-__all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS", "color_for",
-           "new_figure",
-           "save_figure", "atomic_path", "METHOD_LABELS", "method_label"]
+__all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "FORMATS", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS",
+           "color_for", "new_figure", "figure_format", "save_figure", "vector_copy", "METHOD_LABELS",
+           "method_label"]
 
-DPI = 120  #: resolution of every PNG [dots per inch]
+DPI = 300  #: resolution of every PNG (and of the rasterised colour fields of SVG/PDF) [dots per inch]
+#: figure file formats: PNG only, SVG only (vector, shown by browsers), or PDF (vector) beside a PNG
+FORMATS = ("png", "svg", "pdf")
+_FORMAT = contextvars.ContextVar("contactlab_figure_format", default="png")
 
 #: colour of each layer law (``Layer.law``; ``"smooth"`` for no layer)
 LAW_COLORS = {
@@ -67,6 +72,8 @@ _RC = {
     "figure.dpi": DPI,
     "savefig.dpi": DPI,
     "mathtext.fontset": "dejavusans",
+    "pdf.fonttype": 42,
+    "svg.hashsalt": "contactlab",
 }
 
 
@@ -127,24 +134,62 @@ def new_figure(figsize=(6.4, 4.0), **subplots):
         yield fig, axes
 
 
-def save_figure(fig, path, *, colors=256):
-    """Write ``fig`` as a PNG to ``path`` atomically; returns ``path`` (a string).
+@contextlib.contextmanager
+def figure_format(fmt):
+    """Within the block, :func:`save_figure` writes ``fmt`` (one of :data:`FORMATS`).
 
-    The RGBA rendering is reduced to an adaptive palette of ``colors`` colours (lossless
-    for line plots, invisible banding for colour maps), which makes the files about three
-    times smaller; ``colors=None`` keeps full RGB.
+    ``"png"``: a PNG at :data:`DPI`; ``"svg"``: an SVG instead (vector text and lines,
+    colour fields rasterised at :data:`DPI`); ``"pdf"``: a PDF (idem) and the PNG beside it,
+    which HTML and Markdown show.
+    """
+    token = _FORMAT.set(check_choice("format", fmt, FORMATS))
+    try:
+        yield fmt
+    finally:
+        _FORMAT.reset(token)
+
+
+def vector_copy(path):
+    """The PDF written beside the PNG ``path`` in ``"pdf"`` format, or ``None``."""
+    root, ext = os.path.splitext(os.fspath(path))
+    pdf = root + ".pdf"
+    return pdf if ext.lower() == ".png" and os.path.isfile(pdf) else None
+
+
+def _save_vector(fig, path, fmt):
+    with atomic_path(path, suffix=f".{fmt}") as tmp:
+        fig.savefig(tmp, format=fmt, dpi=DPI, facecolor="white",
+                    metadata={"Date": None} if fmt == "svg" else {"CreationDate": None})
+    return path
+
+
+def save_figure(fig, path, *, colors=256):
+    """Write ``fig`` atomically in the current :func:`figure_format`; returns the file shown in reports.
+
+    ``path`` names the PNG (``x.png``). In ``"svg"`` format ``x.svg`` is written instead
+    and returned; in ``"pdf"`` format ``x.pdf`` is written as well and ``x.png`` returned
+    (:func:`vector_copy` finds the PDF). The PNG's RGBA rendering is reduced to an adaptive
+    palette of ``colors`` colours (maximum coverage: no channel off by more than a few
+    levels in 255 on a colour map), which makes the files about three times smaller;
+    ``colors=None`` keeps full RGB.
     """
     import io
 
     from PIL import Image
 
+    fmt = _FORMAT.get()
     path = os.fspath(path)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI, facecolor="white")
+    root = os.path.splitext(path)[0]
+    if fmt == "svg":
+        return _save_vector(fig, root + ".svg", "svg")
+    buf = io.BytesIO()  # uncompressed: the one compression is that of the palette image below
+    fig.savefig(buf, format="png", dpi=DPI, facecolor="white", pil_kwargs={"compress_level": 0})
     buf.seek(0)
     with Image.open(buf) as img:
         rgb = img.convert("RGB")
-    out = rgb if colors is None else rgb.quantize(colors, method=Image.Quantize.MEDIANCUT)
+    out = rgb if colors is None else rgb.quantize(colors, method=Image.Quantize.MAXCOVERAGE)
     with atomic_path(path) as tmp:
-        out.save(tmp, format="PNG", optimize=True)
+        out.save(tmp, format="PNG", optimize=True, dpi=(DPI, DPI))
+    if fmt == "pdf":
+        _save_vector(fig, root + ".pdf", "pdf")
     return path

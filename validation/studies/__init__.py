@@ -48,7 +48,7 @@ def markdown_table(headers, rows):
 
 
 def timed(fn, *, repeats=3, slow_s=2.0):
-    """Run ``fn()`` and time it: ``(result, median wall time [s], runs)``.
+    """Run ``fn()`` and time it: ``(result, median wall time [s], wall times of every run [s])``.
 
     The first run decides: if it takes longer than ``slow_s`` or its result says
     ``converged = False``, it is the only run; otherwise ``repeats`` runs in all and the
@@ -61,4 +61,4 @@ def timed(fn, *, repeats=3, slow_s=2.0):
         times.append(time.perf_counter() - t0)
         if k == 0 and (times[0] > slow_s or not getattr(result, "converged", True)):
             break
-    return result, statistics.median(times), len(times)
+    return result, statistics.median(times), times

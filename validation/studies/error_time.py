@@ -70,6 +70,8 @@ class ErrorTimeRow:
         Timed runs.
     message : str
         The solver's message.
+    wall_times_s : list of float
+        Wall time of every timed run [s] (their spread is drawn in the work-precision plot).
     """
 
     problem: str
@@ -85,6 +87,7 @@ class ErrorTimeRow:
     relaxation: float | None = None
     runs: int = 1
     message: str = ""
+    wall_times_s: list = field(default_factory=list)
 
     @property
     def label(self):
@@ -228,17 +231,17 @@ def _errors(result, reference):
 
 def _bem_row(problem, method, n, reference, repeats, slow_s, relaxation=None):
     opts = {} if relaxation is None else {"relaxation": relaxation}
-    res, t, runs = timed(lambda: problem.run_bem(method, n_across=n, **opts), repeats=repeats, slow_s=slow_s)
+    res, t, times = timed(lambda: problem.run_bem(method, n_across=n, **opts), repeats=repeats, slow_s=slow_s)
     l2, peak = _errors(res, reference)
     return ErrorTimeRow(problem.name, "bem", method, n, int(res.p.size), l2, peak, t, int(res.iterations),
-                        bool(res.converged), relaxation, runs, res.message)
+                        bool(res.converged), relaxation, len(times), res.message, times)
 
 
 def _fem_row(problem, n, reference, repeats, slow_s):
-    res, t, runs = timed(lambda: problem.run_fem(n_contact=n), repeats=repeats, slow_s=slow_s)
+    res, t, times = timed(lambda: problem.run_fem(n_contact=n), repeats=repeats, slow_s=slow_s)
     l2, peak = _errors(res, reference)
     return ErrorTimeRow(problem.name, "fem", "fem", n, int(res.n_dofs), l2, peak, t, int(res.iterations),
-                        bool(res.converged), None, runs, res.reason)
+                        bool(res.converged), None, len(times), res.reason, times)
 
 
 def _richardson(coarse, mid, fine):

@@ -1,0 +1,179 @@
+"""Every figure in every file format: PNG at 300 dpi of the stated size, SVG that parses, PDF with
+its magic bytes and page size; reports embed SVG and carry the PDF beside the PNG; nothing in the
+repository imports pyvista or VTK any more."""
+
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from validation.report import figures_3d as f3d
+from validation.report import figures_iterations as fit
+from validation.report import figures_profiles as fpr
+from validation.report import figures_sweeps as fsw
+from validation.report import figures_validation as fva
+from validation.report.build import build_report
+from validation.report.figures_fem import plot_section_field
+from validation.report.sections import Figure, Section
+from validation.report.style import DPI, FORMATS, figure_format, vector_copy
+
+from .test_report_figures import A, HERTZ, P0, cases, check_png  # noqa: F401 - cases is the shared fixture
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _fem_section():
+    """A small (r, z) triangulation with a smooth field (no FEM solve needed)."""
+    r, z = np.meshgrid(np.linspace(0.0, 3.0 * A, 13), np.linspace(-3.0 * A, 3.0 * A, 25))
+    r, z = r.ravel(), z.ravel()
+    from scipy.spatial import Delaunay
+
+    tri = Delaunay(np.column_stack([r, z])).simplices
+    return r, z, tri, P0 * np.exp(-((r / A) ** 2 + (np.abs(z) / A - 0.5) ** 2))
+
+
+#: name -> (draw(cases, path), size in inches)
+FIGURES = {
+    "profiles": (lambda c, p: fpr.plot_pressure_profiles([("smooth", c["smooth"]), ("er", c["er"])], p, p0=P0, a=A,
+                                                         hertz=True), (8.2, 4.0)),
+    "layer_laws": (lambda c, p: fpr.plot_layer_laws([("er", c["er_law"])], p, p_max=P0), (6.0, 3.8)),
+    "iterations": (lambda c, p: fit.plot_iteration_profiles(c["er_vc"], p, p0=P0, a=A), (6.8, 4.0)),
+    "convergence": (lambda c, p: fit.plot_convergence([("vc", c["er_vc"])], p, p0=P0, tol=1e-8), (6.6, 5.2)),
+    "surfaces": (lambda c, p: f3d.plot_pressure_surfaces([("smooth", c["smooth"]), ("er", c["er"])], p, p0=P0, a=A,
+                                                         title="t"), (3.3 * 2 + 0.9, 2.8 + 0.35)),
+    "contact_map": (lambda c, p: f3d.plot_contact_map(c["er"], p, p0=P0, a=A, levels=[("p_cr", c["er_law"].p_cr)]),
+                    (5.4, 4.4)),
+    "sweep": (lambda c, p: fsw.plot_sweep([(0.0, *fpr.section_of(c["smooth"])), (1.0, *fpr.section_of(c["linear"]))],
+                                          p, p0=P0, a=A, name="alpha"), (6.8, 4.0)),
+    "transition": (lambda c, p: fsw.plot_transition_line([0.0, 0.5, 1.0], [1.0, 0.7, 0.0], p, a=1.0,
+                                                         r_contact=[1.0, 1.1, 1.2]), (6.0, 4.0)),
+    "sweep_scalars": (lambda c, p: fsw.plot_sweep_scalars([1.0, 2.0, 3.0], [("p [MPa]", [1.0, 2.0, 2.5]),
+                                                                            ("a [mm]", [0.1, 0.2, 0.25])], p,
+                                                          name="force [N]"), (6.4, 1.2 + 1.9 * 2)),
+    "comparison": (lambda c, p: fva.plot_profile_comparison([("BEM", *fpr.section_of(c["smooth"]), "bem")], p, p0=P0,
+                                                            a=A, reference=("Hertz", HERTZ.pressure)), (6.6, 5.4)),
+    "work_precision": (lambda c, p: fva.plot_work_precision(
+        [{"solver": "BEM", "method": "qp", "resolution": f"a/c = {m}", "N": 100 * m * m, "error": 0.3 / m ** 2,
+          "wall_time_s": 0.01 * m, "wall_times_s": [0.009 * m, 0.01 * m, 0.013 * m]} for m in (5, 10, 20)], p),
+        (7.0, 4.6)),
+    "section_field": (lambda c, p: plot_section_field(*_fem_section(), p, a=A, scale=P0, label="s",
+                                                      contact_radius=A), (5.8, 4.6)),
+}
+
+
+def _svg_size_in(root):
+    return tuple(float(root.get(k).removesuffix("pt")) / 72.0 for k in ("width", "height"))
+
+
+def _pdf_size_in(data):
+    box = re.search(rb"/MediaBox\s*\[\s*0\s+0\s+([\d.]+)\s+([\d.]+)\s*\]", data)
+    assert box, "no page size"
+    return float(box.group(1)) / 72.0, float(box.group(2)) / 72.0
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("name", list(FIGURES))
+def test_every_figure_in_every_format(cases, tmp_path, name, fmt):
+    draw, size = FIGURES[name]
+    with figure_format(fmt):
+        out = draw(cases, tmp_path / f"{name}.png")
+    out = Path(out)
+    assert out.suffix == (".svg" if fmt == "svg" else ".png") and out.is_file()
+    if fmt == "svg":
+        root = ET.parse(out).getroot()
+        assert root.tag.endswith("svg")
+        assert _svg_size_in(root) == pytest.approx(size, abs=0.01)
+        drawn = [el for el in root.iter() if el.tag.rsplit("}", 1)[-1] in ("path", "use", "image")]
+        assert len(drawn) > 20, "blank SVG"
+        assert not (tmp_path / f"{name}.png").exists()
+        return
+    img = check_png(out, size)  # 300 dpi: the pixel size of the stated inches, not blank
+    assert img.shape[:2] == (round(size[1] * 300), round(size[0] * 300)) and DPI == 300
+    assert out.stat().st_size < 1.5e6, "PNG too large"
+    if fmt == "pdf":
+        pdf = Path(vector_copy(out))
+        data = pdf.read_bytes()
+        assert data.startswith(b"%PDF-") and b"%%EOF" in data[-32:]
+        assert _pdf_size_in(data) == pytest.approx(size, abs=0.01)
+        assert 2_000 < len(data) < 3e6
+    else:
+        assert vector_copy(out) is None
+
+
+def test_colour_fields_are_rasterised_in_vector_files(cases, tmp_path):
+    """Surfaces and colour maps go into SVG/PDF as one image each; axes and text stay vector."""
+    with figure_format("svg"):
+        out = f3d.plot_pressure_surfaces([("a", cases["smooth"]), ("b", cases["er"])], tmp_path / "s.png", p0=P0, a=A)
+    root = ET.parse(out).getroot()
+    images = [el for el in root.iter() if el.tag.endswith("image")]
+    texts = [el for el in root.iter() if el.tag.endswith("path")]
+    assert len(images) == 3 and len(texts) > 50  # two surfaces and the colour bar
+    assert Path(out).stat().st_size < 2e6
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_report_carries_the_format(cases, tmp_path, fmt):
+    with figure_format(fmt):
+        paths = [FIGURES[n][0](cases, tmp_path / f"{n}.png") for n in ("profiles", "contact_map")]
+    sections = [Section("Figures", items=tuple(Figure(str(p), f"Figure {k}.") for k, p in enumerate(paths)))]
+    built = build_report(sections, tmp_path / "rep", title="T")
+    html = built.html.read_text(encoding="utf-8")
+    md = built.markdown.read_text(encoding="utf-8")
+    files = sorted(p.name for p in (built.out_dir / "figures").iterdir())
+    if fmt == "svg":
+        assert files == ["contact_map.svg", "profiles.svg"]
+        assert len(re.findall(r'src="data:image/svg\+xml;base64,', html)) == 2
+        assert "](figures/profiles.svg)" in md
+    else:
+        assert len(re.findall(r'src="data:image/png;base64,', html)) == 2
+        pngs = ["contact_map.png", "profiles.png"]
+        assert files == (sorted(pngs + ["contact_map.pdf", "profiles.pdf"]) if fmt == "pdf" else pngs)
+        assert ("(vector: [figures/profiles.pdf](figures/profiles.pdf))" in md) == (fmt == "pdf")
+    from .test_report_build import assert_valid_offline_html
+
+    assert_valid_offline_html(html)
+
+
+def test_figure_format_is_checked_and_scoped(tmp_path):
+    from bem.checks import InputError
+
+    with pytest.raises(InputError, match="format"):
+        with figure_format("jpg"):
+            pass
+    with figure_format("svg"):
+        pass
+    out = fsw.plot_transition_line([0.0, 1.0], [1.0, 0.0], tmp_path / "t.png", a=1.0)
+    assert out.endswith(".png")  # back to the default after the block
+    from validation import cli
+
+    assert cli.FORMATS == FORMATS  # the parser's copy (it imports no report code)
+
+
+def test_nothing_imports_pyvista_or_vtk():
+    pattern = re.compile(r"^\s*(?:import|from)\s+(?:pyvista|vtk|vtkmodules)\b", re.M)
+    offenders = [str(p.relative_to(ROOT)) for d in ("bem", "fem_reference", "validation", "tests", "benchmarks",
+                                                    "docs")
+                 for p in (ROOT / d).rglob("*.py") if pattern.search(p.read_text(encoding="utf-8"))]
+    offenders += [str(p.relative_to(ROOT)) for d in ("bem", "fem_reference", "validation", "tests")
+                  for p in (ROOT / d).rglob("*.py") if re.search(r"importorskip\(\s*[\"']pyvista", p.read_text())]
+    assert offenders == []
+
+
+def test_png_is_not_sheared_at_fractional_pixel_sizes(tmp_path):
+    """A figure 3.3 * 3 + 0.9 in wide (not a whole number of pixels at 300 dpi, as the 3-D panels)
+    keeps a vertical line vertical: the PNG is read with its own size, not a computed one."""
+    from validation.report.style import new_figure, save_figure
+
+    with new_figure((3.3 * 3 + 0.9, 2.8)) as (fig, ax):
+        ax.set_axis_off()
+        ax.axvline(0.5, color="black", lw=2)
+        ax.set_xlim(0, 1)
+        path = save_figure(fig, tmp_path / "v.png")
+    from PIL import Image
+
+    with Image.open(path) as im:
+        pixels = np.asarray(im.convert("L"), dtype=float)
+    dark = [int(np.argmin(row)) for row in pixels[pixels.shape[0] // 4: 3 * pixels.shape[0] // 4: 20]]
+    assert max(dark) - min(dark) <= 1

@@ -1,0 +1,86 @@
+"""`contactlab report SWEEP_DIR`: the report of a sweep directory, as `report --help` promises; and
+the stages every report build tells its progress callback."""
+
+import re
+
+import numpy as np
+import pytest
+
+from validation.report.results import load_results
+from validation.report.run_report import STAGES, report_results_dir
+from validation.report.sweep_report import is_sweep_dir, load_sweep, report_sweep_dir, sweep_sections
+from validation.runner import run_scene
+from validation.sweep import run_sweep
+
+from .conftest import cli
+from .test_report_build import assert_valid_offline_html
+from .test_report_figures import check_png
+
+FORCES = [50.0, 100.0, 200.0]
+
+
+@pytest.fixture(scope="module")
+def sweep_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep") / "elliptic-sweep"
+    run_sweep("elliptic", out, parameter="load.force", values=FORCES, workers=1, overrides=["bem.nodes_across=12"])
+    return out
+
+
+def test_report_of_a_sweep_directory_from_the_cli(sweep_dir, tmp_path):
+    assert is_sweep_dir(sweep_dir) and not is_sweep_dir(tmp_path)
+    code, out, err = cli("report", sweep_dir, "--out", tmp_path / "rep")
+    assert code == 0, err
+    assert f"report written to {tmp_path / 'rep' / 'report.html'}" in out
+    html = (tmp_path / "rep" / "report.html").read_text(encoding="utf-8")
+    assert_valid_offline_html(html)
+    assert len(re.findall(r'src="data:image/png;base64,', html)) == 2
+    md = (tmp_path / "rep" / "report.md").read_text(encoding="utf-8")
+    assert md.startswith("# Elliptic Hertz contact: sweep of load.force")
+    rows = [line for line in md.splitlines() if line.startswith("| 50 |") or line.startswith("| 100 |")
+            or line.startswith("| 200 |")]
+    assert len(rows) == 3 and all("| ok |" in r for r in rows)
+    for png in sorted((tmp_path / "rep" / "figures").glob("*.png")):
+        check_png(png)
+
+
+def test_sweep_sections_hold_every_point_in_scene_units(sweep_dir, tmp_path):
+    summary, points = load_sweep(sweep_dir)
+    assert [row["value"] for row, _ in points] == FORCES and all(res is not None for _, res in points)
+    sections = sweep_sections(summary, points, tmp_path)
+    assert [s.kind for s in sections] == ["problem", "sweeps"]
+    table = sections[1].items[0]
+    assert table.columns[:3] == ("load.force", "status", "p_max [Pa]")
+    p_max = [float(r[2]) for r in table.rows]
+    assert p_max[2] / p_max[0] == pytest.approx(4 ** (1 / 3), rel=0.03)  # Hertz: p_max ~ P^(1/3)
+    captions = [item.caption for item in sections[1].items[1:]]
+    assert len(captions) == 2 and "coloured by load.force" in captions[0]
+
+
+def test_sweep_report_dimensionless_and_svg(sweep_dir, tmp_path):
+    built = report_sweep_dir(sweep_dir, tmp_path / "rep", units="dimensionless", fmt="svg")
+    assert sorted(p.suffix for p in built.figures) == [".svg", ".svg"]
+    _summary, points = load_sweep(sweep_dir, units="dimensionless")
+    assert all(res.dimensionless for _, res in points)
+
+
+def test_sweep_dir_with_a_failed_point(sweep_dir, tmp_path):
+    import json
+    import shutil
+
+    d = tmp_path / "copy"
+    shutil.copytree(sweep_dir, d)
+    summary = json.loads((d / "summary.json").read_text())
+    summary["points"][1].update(status="error", file=None, p_max=None)
+    (d / "summary.json").write_text(json.dumps(summary))
+    sections = sweep_sections(*load_sweep(d), tmp_path / "w")
+    assert any("failed" in t and "100" in t for t in sections[1].text)
+    assert [r[1] for r in sections[1].items[0].rows] == ["ok", "error", "ok"]
+
+
+def test_report_stages_reach_the_progress_callback(tmp_path):
+    run_scene("elliptic", tmp_path / "run", overrides=["bem.nodes_across=12"])
+    calls = []
+    report_results_dir(tmp_path / "run", tmp_path / "rep", progress=lambda *a: calls.append(a))
+    assert calls == [(s, k, len(STAGES)) for k, s in enumerate(STAGES)] + [("done", len(STAGES), len(STAGES))]
+    res = load_results(tmp_path / "run")
+    assert not res.dimensionless and np.isfinite(res.data["p_max"])
