@@ -9,7 +9,7 @@ import pytest
 
 from validation.runner import execute_scene, run_scene
 from validation.scene import SceneError, load_scene
-from validation.tomlwrite import dumps
+from tomli_w import dumps
 
 from .conftest import cli
 
