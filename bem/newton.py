@@ -139,7 +139,7 @@ def _release(op, layer, h, p, u, q, delta, *, force):
     return p, u, 1
 
 
-def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, maxiter=50,
+def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, maxiter=100,
                  precondition=True, callback=None, record=False, inner_maxiter=300):
     """Newton's method with exact line search for the layered contact problem.
 
