@@ -118,13 +118,14 @@ class InfluenceOperator:
         Returns ``None`` for ``v = 0``.
         """
         n_rows, n_cols = v.shape
-        rows = np.flatnonzero(v.any(axis=1))
+        rows = np.flatnonzero(v.any(axis=1))  # NaN counts as support
         if rows.size == 0:
             return None
-        cols = np.flatnonzero(v[rows[0] : rows[-1] + 1].any(axis=0))
+        first, last = int(rows[0]), int(rows[-1])
+        cols = np.flatnonzero(v[first : last + 1].any(axis=0))
         gr, gc = -(-n_rows // _SNAP), -(-n_cols // _SNAP)
-        r0, r1 = (rows[0] - 1) // gr * gr, min(n_rows, (rows[-1] + 1 + gr) // gr * gr)
-        c0, c1 = (cols[0] - 1) // gc * gc, min(n_cols, (cols[-1] + 1 + gc) // gc * gc)
+        r0, r1 = (first - 1) // gr * gr, min(n_rows, (last + 1 + gr) // gr * gr)
+        c0, c1 = (int(cols[0]) - 1) // gc * gc, min(n_cols, (int(cols[-1]) + 1 + gc) // gc * gc)
         r0, c0 = max(r0, 0), max(c0, 0)
         ranges = []
         for s, n in zip(self._start, self._n):
