@@ -213,10 +213,10 @@ class InfluenceOperator:
     def matvec(self, p):
         """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]."""
         p = np.asarray(p, dtype=float)
-        out = np.zeros(self.lattice.shape)
         box = self._box(p)
         if box is None:
-            return out
+            return np.zeros(self.lattice.shape)
+        out = np.empty(self.lattice.shape)  # every entry is written below
         box, (shape, spectra) = self._window(box)
         self._convolve(spectra, shape, p, box, self._full(), out)
         return out
