@@ -224,7 +224,8 @@ class Lattice:
         # Gather from a copy with a border of zeros: an index clipped onto the border reads 0, so
         # points outside the lattice need no mask. Index arithmetic in float64 (exact for these
         # integers; numpy's integer clip is 10x slower than its float clip); measured 2.7e6
-        # points: 0.07 s against 0.18 s with boolean-mask sampling.
+        # points, same process, alternating: 0.17 s against 0.22-0.34 s with boolean-mask
+        # sampling. Lattice nodes of half the step go faster through :meth:`prolong`.
         n_rows, n_cols = self.shape
         padded = np.zeros((n_rows + 2, n_cols + 2))
         padded[1:-1, 1:-1] = values
