@@ -135,6 +135,61 @@ class Lattice:
             return None
         return Lattice(2 * self.step, hc, hr)
 
+    def prolong(self, values, fine):
+        """The piecewise-linear field of ``values`` at the nodes of ``fine``, with ``fine.coarsen() == self``.
+
+        Equal to ``self.interpolate(values, fine.x, fine.y) * fine.mask`` (to round-off), but
+        built row by row from the structure: a fine node is a coarse node or the midpoint of a
+        coarse edge, so it takes a coarse value or the mean of two (0 outside this lattice).
+        Measured on 1,048,703 fine nodes: 0.03 s against 0.15 s for :meth:`interpolate`.
+
+        Parameters
+        ----------
+        values : ndarray, shape :attr:`shape`
+            Nodal values of this (coarse) lattice.
+        fine : Lattice
+            The lattice of half the step whose :meth:`coarsen` is this one.
+
+        Returns
+        -------
+        ndarray, shape ``fine.shape``
+        """
+        values = np.asarray(values, dtype=float)
+        if values.shape != self.shape:
+            raise InputError(f"values has shape {values.shape} which is not allowed: it must be {self.shape}.")
+        if fine.coarsen() != self:
+            raise InputError(f"fine = {fine!r} is not allowed: its coarsen() must be this lattice ({self!r}).")
+        out = np.empty(fine.shape)
+        n_fine = fine.shape[1]
+        for r, j_f in enumerate(fine.j):
+            j_f = int(j_f)
+            i_f0 = -fine.half_cols - (j_f >> 1)  # lattice column of brick column 0 of this fine row
+            i0 = (i_f0 >> 1) - 1  # coarse columns i0 .. i0 + n cover the row and one neighbour each side
+            n = n_fine // 2 + 3
+            doubled = np.empty(2 * n)  # field at i_f = 2 i0 + k, k = 0 .. 2n-1
+            if j_f % 2 == 0:  # on coarse row j: nodes, and midpoints of horizontal edges
+                a = self._row(values, j_f >> 1, i0, n + 1)
+                doubled[0::2] = a[:-1]
+                doubled[1::2] = 0.5 * (a[:-1] + a[1:])
+            else:  # between coarse rows j and j + 1: midpoints of the e2 edges and of the diagonals
+                a = self._row(values, j_f >> 1, i0, n + 1)
+                b = self._row(values, (j_f >> 1) + 1, i0, n + 1)
+                doubled[0::2] = 0.5 * (a[:-1] + b[:-1])  # (i, j) - (i, j + 1)
+                doubled[1::2] = 0.5 * (a[1:] + b[:-1])  # (i + 1, j) - (i, j + 1)
+            out[r] = doubled[i_f0 - 2 * i0 : i_f0 - 2 * i0 + n_fine]
+        out[~fine.mask] = 0.0
+        return out
+
+    def _row(self, values, j, i0, n):
+        """Values of lattice row ``j`` at lattice columns ``i0 .. i0 + n - 1``; 0 off this lattice."""
+        row = np.zeros(n)
+        if -self.half_rows <= j <= self.half_rows:
+            q0 = i0 + self.half_cols + (j >> 1)  # brick column of lattice column i0
+            lo, hi = max(q0, 0), min(q0 + n, self.shape[1])
+            if lo < hi:
+                row[lo - q0 : hi - q0] = values[j + self.half_rows, lo:hi]
+        return row
+
     def interpolate(self, values, x, y):
         """Evaluate the piecewise-linear field ``sum values_n * pyramid_n`` at points.
 
@@ -156,30 +211,35 @@ class Lattice:
             raise InputError(f"values has shape {values.shape} which is not allowed: it must be {self.shape}.")
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         c = self.step
-        # sheared (lattice) coordinates: point = c*(s*e1 + t*e2)
+        # sheared (lattice) coordinates: point = c*(s*e1 + t*e2); cell corner (i0, j0), fractions (fs, ft)
         t = y / (c * SQRT3 / 2)
         s = x / c - t / 2
         i0, j0 = np.floor(s), np.floor(t)
         fs, ft = s - i0, t - j0
         upper = fs + ft > 1.0
-        # triangle vertices (sheared offsets) and barycentric weights
-        w_a = np.where(upper, fs + ft - 1.0, 1.0 - fs - ft)  # vertex A: (1,1) if upper else (0,0)
-        w_b = np.where(upper, 1.0 - ft, fs)  # vertex B: (1,0)
-        w_c = np.where(upper, 1.0 - fs, ft)  # vertex C: (0,1)
-        ia = i0 + np.where(upper, 1, 0)
-        ja = j0 + np.where(upper, 1, 0)
-        out = w_a * self._sample(values, ia, ja)
-        out += w_b * self._sample(values, i0 + 1, j0)
-        out += w_c * self._sample(values, i0, j0 + 1)
-        return out
-
-    def _sample(self, values, i, j):
-        """Nodal values at sheared lattice indices ``(i, j)``; 0 outside."""
-        i = i.astype(np.int64)
-        j = j.astype(np.int64)
-        r = j + self.half_rows
-        q = i + self.half_cols + np.floor_divide(j, 2)
-        inside = (r >= 0) & (r < self.shape[0]) & (q >= 0) & (q < self.shape[1])
-        out = np.zeros(i.shape)
-        out[inside] = values[r[inside], q[inside]]
+        # barycentric weights of B = (i0+1, j0) and C = (i0, j0+1); A is (i0, j0), or (i0+1, j0+1) if upper
+        w_b = np.where(upper, 1.0 - ft, fs)
+        w_c = np.where(upper, 1.0 - fs, ft)
+        w_a = np.where(upper, fs + ft - 1.0, 1.0 - fs - ft)
+        # Gather from a copy with a border of zeros: an index clipped onto the border reads 0, so
+        # points outside the lattice need no mask. Index arithmetic in float64 (exact for these
+        # integers; numpy's integer clip is 10x slower than its float clip); measured 2.7e6
+        # points, same process, alternating: 0.17 s against 0.22-0.34 s with boolean-mask
+        # sampling. Lattice nodes of half the step go faster through :meth:`prolong`.
+        n_rows, n_cols = self.shape
+        padded = np.zeros((n_rows + 2, n_cols + 2))
+        padded[1:-1, 1:-1] = values
+        flat = padded.ravel()
+        row_b = np.clip(j0 + (self.half_rows + 1), 0, n_rows + 1)  # padded row of B, and of A when lower
+        row_c = np.clip(j0 + (self.half_rows + 2), 0, n_rows + 1)  # padded row of C, and of A when upper
+        half = np.floor(j0 * 0.5)  # floor(j0 / 2): brick column of lattice column i is i + I + floor(j/2)
+        col_a = i0 + half + (self.half_cols + 1)  # padded column of A when lower
+        col_c = col_a + (j0 - 2 * half)  # floor((j0 + 1) / 2) = floor(j0 / 2) + (j0 mod 2)
+        stride = float(n_cols + 2)
+        out = np.zeros(w_a.shape)
+        for w, row, col in ((w_a, np.where(upper, row_c, row_b), np.where(upper, col_c + 1, col_a)),
+                            (w_b, row_b, col_a + 1), (w_c, row_c, col_c)):
+            np.clip(col, 0, n_cols + 1, out=col)
+            idx = row * stride + col
+            out += w * flat.take(idx.astype(np.int64))
         return out

@@ -2,27 +2,48 @@
 
 ``C[n, m] = c / (pi E*) * w_t((r_n - r_m) / c)``, with ``w_t`` the closed-form
 template of :func:`bem.template.template`. ``C`` depends only on the lattice
-offset between two nodes, so ``u = C @ p`` is a discrete (non-periodic)
+offset between two nodes, so ``u = C p`` is a discrete (non-periodic)
 convolution. In the brick storage of :class:`bem.lattice.Lattice` the offset
 also depends on the parities of the two rows, so the rows are split into their
-even and odd classes and ``u`` is a 2 x 2 block convolution
-``u_a = sum_b K_ab * p_b`` on the half-height arrays. Each block is evaluated
-exactly with real-to-complex FFTs zero-padded to at least twice the array
-size (no wrap-around), both cores used: cost ``O(N log N)``, memory ``O(N)``,
-no dense ``N x N`` matrix.
+even and odd classes (strided views, no copy) and ``u`` is a 2 x 2 block
+convolution ``u_a = sum_b K_ab * p_b`` on the half-height arrays, evaluated
+exactly with pruned real FFTs (:mod:`bem.fft`): cost ``O(N log N)``, memory
+``O(N)``, no dense ``N x N`` matrix.
+
+Support windows
+    A contact covers a fraction of the candidate region, and every vector the
+    solvers multiply (pressures, search directions, residuals) vanishes off
+    the contact. For an input supported on a box of ``B`` rows (columns) and
+    an output wanted on all ``n`` rows, a circular convolution of length
+    ``n + B - 1`` has no wrap-around, against ``2 n - 1`` for a full input.
+    :meth:`InfluenceOperator.matvec` therefore pads to the bounding box of the
+    support of ``p`` (snapped outwards to a grid of 1/16 of the region so
+    that a slowly moving contact reuses the same window) and keeps the kernel
+    spectrum of the last few windows. The product is exact for every window;
+    the window only changes the cost (issue problem, 1,048,703 nodes, contact
+    4 % of the region: 2.7x fewer FFT points per product).
 """
 
 from __future__ import annotations
 
 import math
-import os
+from collections import OrderedDict
 
 import numpy as np
 
+from . import fft
 from .checks import check_positive
 from .template import template
 
 __all__ = ["InfluenceOperator", "diagonal_coefficient"]
+
+_WINDOWS_KEPT = 3  # kernel spectra cached per operator (matvec windows, preconditioner boxes)
+_SNAP = 16  # support boxes snap to a grid of 1/_SNAP of the region
+# A cached matvec window containing the support is reused up to this size ratio (exact either
+# way; saves kernel spectra while a contact shrinks). Preconditioner boxes are not reused: a box
+# larger than the support weakens M, and the s = 0.2 power-law Newton test then stalls.
+_REUSE_UP_TO = 2.0
+_FULL_ABOVE = 0.7  # a window with more FFT points than this fraction of the full padding uses the full one
 
 
 def diagonal_coefficient(step, E_star):
@@ -34,8 +55,22 @@ def diagonal_coefficient(step, E_star):
     return check_positive("step", step) / (math.pi * check_positive("E_star", E_star)) * float(template(0.0, 0.0))
 
 
-def _workers():
-    return max(1, os.cpu_count() or 1)
+def _contains(outer, inner):
+    """Whether the box ``outer`` holds every row and column of ``inner``."""
+    def within(o, i):
+        return i[1] == 0 or (o[0] <= i[0] and i[0] + i[1] <= o[0] + o[1])
+
+    return all(within(o, i) for o, i in zip(outer[0], inner[0])) and within(outer[1], inner[1])
+
+
+def _block_product(S, V):
+    """``V_a <- sum_b S_ab V_b`` in place on a pair of spectra, two temporaries."""
+    t = S[0][1] * V[1]
+    V[1] *= S[1][1]
+    V[1] += S[1][0] * V[0]
+    V[0] *= S[0][0]
+    V[0] += t
+    return V
 
 
 class InfluenceOperator:
@@ -52,89 +87,153 @@ class InfluenceOperator:
     -----
     Pressures are brick arrays of shape ``lattice.shape`` [pressure];
     displacements come back in the same shape [length]. Masked nodes of the
-    input must be zero; they are zero on output too.
+    input must be zero; they are zero on output too. The FFTs use
+    :func:`bem.fft.threads` threads.
     """
 
     def __init__(self, lattice, E_star):
-        import scipy.fft as sfft
-
         self.lattice = lattice
         self.n_matvec = 0  # products C p so far (the work measure of ContactResult.n_matvec)
         self.E_star = check_positive("E_star", E_star)
         n_rows, n_cols = lattice.shape
-        par = lattice.parity
-        self._rows = [np.flatnonzero(par == a) for a in (0, 1)]
-        n_a = [len(r) for r in self._rows]
-        self._pad = (
-            sfft.next_fast_len(2 * max(n_a) - 1, real=True),
-            sfft.next_fast_len(2 * n_cols - 1, real=True),
-        )
-        lk, lq = self._pad
-        table = self._template_table()
-        scale = lattice.step / (math.pi * self.E_star)
-        kernel = np.zeros((2, 2, lk, lq))
-        dq = np.r_[0:n_cols, -(n_cols - 1):0]
-        for a in (0, 1):
-            for b in (0, 1):
-                dk = np.r_[0 : n_a[a], -(n_a[b] - 1) : 0]
-                dr = self._rows[a][0] - self._rows[b][0] + 2 * dk  # row offset
-                dm = 2 * dq + (a - b)  # x offset in half steps
-                n = np.abs(dr)[:, None]
-                t = (np.abs(dm)[None, :] - n % 2) // 2
-                kernel[a, b][np.ix_(dk % lk, dq % lq)] = table[n, t]
-        self._kernel_hat = sfft.rfft2(kernel * scale, workers=_workers())
-        self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
-
-    def _template_table(self):
-        """``w_t`` at every offset ``(m/2, n*sqrt(3)/2)`` with ``m = n mod 2`` (lattice units)."""
-        n_rows, n_cols = self.lattice.shape
+        self._start = tuple(0 if int(lattice.parity[0]) == a else 1 for a in (0, 1))  # first brick row of parity a
+        self._n = tuple(len(range(s, n_rows, 2)) for s in self._start)  # rows of parity a
+        # w_t at every offset (m/2, n sqrt3/2), m = n mod 2 (lattice units), times c / (pi E*)
         n = np.arange(n_rows)[:, None]
         t = np.arange(n_cols + 1)[None, :]
-        dx = (2 * t + n % 2) / 2.0
-        dy = n * (math.sqrt(3.0) / 2)
-        return template(dx, dy)
+        self._table = template((2 * t + n % 2) / 2.0, n * (math.sqrt(3.0) / 2))
+        self._table *= lattice.step / (math.pi * self.E_star)
+        self._spectra = OrderedDict()
+        self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
+
+    # -- geometry of the 2 x 2 block convolution -------------------------------------------------
+
+    def _parity_rows(self, v):
+        """Views of the even-class and odd-class rows of a brick array."""
+        return [v[s::2] for s in self._start]
+
+    def _box(self, v):
+        """Snapped bounding box of the support of ``v``: parity row ranges and a column range.
+
+        Returns ``None`` for ``v = 0``.
+        """
+        n_rows, n_cols = v.shape
+        rows = np.flatnonzero(v.any(axis=1))  # NaN counts as support
+        if rows.size == 0:
+            return None
+        first, last = int(rows[0]), int(rows[-1])
+        cols = np.flatnonzero(v[first : last + 1].any(axis=0))
+        gr, gc = -(-n_rows // _SNAP), -(-n_cols // _SNAP)
+        r0, r1 = (first - 1) // gr * gr, min(n_rows, (last + 1 + gr) // gr * gr)
+        c0, c1 = (int(cols[0]) - 1) // gc * gc, min(n_cols, (int(cols[-1]) + 1 + gc) // gc * gc)
+        r0, c0 = max(r0, 0), max(c0, 0)
+        ranges = []
+        for s, n in zip(self._start, self._n):
+            k0, k1 = min(n, max(0, -(-(r0 - s) // 2))), min(n, max(0, -(-(r1 - s) // 2)))
+            ranges.append((k0, k1 - k0))
+        return tuple(ranges), (c0, c1 - c0)
+
+    def _full(self):
+        return tuple((0, n) for n in self._n), (0, self.lattice.shape[1])
+
+    def _kernel_spectra(self, out_box, in_box):
+        """Spectra ``S_ab`` of the blocks mapping ``in_box`` data to ``out_box`` values.
+
+        A box is ``((k0_even, rows_even), (k0_odd, rows_odd)), (q0, cols)`` in parity
+        row and column indices. The input block sits at the origin of the padded
+        array and the kernel is stored shifted so that the output lands at the
+        origin too; the padding ``out + in - 1`` per axis leaves no wrap-around.
+        Returns the padded shape and the spectra divided by the padded size.
+        """
+        (o_rows, (oq, nq)), (i_rows, (iq, bq)) = out_box, in_box
+        lk = fft.fast_length(max(o[1] for o in o_rows) + max(i[1] for i in i_rows) - 1, real=False)
+        lq = fft.fast_length(nq + bq - 1, real=True)
+        f = np.r_[0:nq, -(bq - 1) : 0]  # circular column positions
+        dq = f + oq - iq  # column offset output - input
+        kernels = np.zeros((2, 2, lk, lq))
+        for a in (0, 1):
+            for b in (0, 1):
+                (oa, na), (ib, nb) = o_rows[a], i_rows[b]
+                e = np.r_[0:na, -(nb - 1) : 0]
+                dr = self._start[a] - self._start[b] + 2 * (e + oa - ib)  # brick row offset
+                t = (np.abs(2 * dq + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
+                block = self._table.take(np.abs(dr), axis=0).take(t, axis=1)  # rows e, columns f
+                for rows, src_r in ((slice(0, na), slice(0, na)), (slice(lk - nb + 1, lk), slice(na, None))):
+                    for cols, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq + 1, lq), slice(nq, None))):
+                        kernels[a, b, rows, cols] = block[src_r, src_c]
+        kernels /= lk * lq
+        return (lk, lq), fft.forward(kernels, (lk, lq))
+
+    def _cached(self, key, build):
+        if key in self._spectra:
+            self._spectra.move_to_end(key)
+            return self._spectra[key]
+        value = build()
+        self._spectra[key] = value
+        while len(self._spectra) > _WINDOWS_KEPT:
+            self._spectra.popitem(last=False)
+        return value
+
+    def _reuse(self, kind, box, size):
+        """A cached box of this kind that contains ``box`` at most ``_REUSE_UP_TO`` times its size."""
+        best = None
+        for key in self._spectra:
+            if key[0] == kind and _contains(key[1], box) and size(key[1]) <= _REUSE_UP_TO * size(box):
+                best = key[1] if best is None or size(key[1]) < size(best) else best
+        return best
+
+    def _window(self, box):
+        """Kernel spectra for input on ``box`` (or a cached window containing it), output everywhere."""
+        full, n_cols = self._full(), self.lattice.shape[1]
+
+        def size(b):  # padded FFT points, up to the fast-length rounding
+            return (max(self._n) + max(r[1] for r in b[0])) * (n_cols + b[1][1])
+
+        if size(box) > _FULL_ABOVE * size(full):
+            box = full
+        box = self._reuse("C", box, size) or box
+        return box, self._cached(("C", box), lambda: self._kernel_spectra(full, box))
+
+    def _convolve(self, spectra, shape, v, in_box, out_box, out):
+        """``out[out_box] = sum_b S_ab v_b[in_box]``; other entries of ``out`` are left alone."""
+        (i_rows, (iq, bq)), (o_rows, (oq, nq)) = in_box, out_box
+        data = np.zeros((2, max(r[1] for r in i_rows), bq))
+        for b, vb in enumerate(self._parity_rows(v)):
+            k0, nb = i_rows[b]
+            data[b, :nb] = vb[k0 : k0 + nb, iq : iq + bq]
+        V = _block_product(spectra, fft.forward(data, shape))
+        res = fft.inverse(V, shape, (max(r[1] for r in o_rows), nq))
+        for a, oa in enumerate(self._parity_rows(out)):
+            k0, na = o_rows[a]
+            oa[k0 : k0 + na, oq : oq + nq] = res[a, :na]
+        out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
+
+    # -- public products ---------------------------------------------------------------------------
 
     def matvec(self, p):
         """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]."""
         self.n_matvec += 1
-        return self._block_convolve(self._kernel_hat, np.asarray(p, dtype=float))
+        p = np.asarray(p, dtype=float)
+        box = self._box(p)
+        if box is None:
+            return np.zeros(self.lattice.shape)
+        out = np.empty(self.lattice.shape)  # every entry is written below
+        box, (shape, spectra) = self._window(box)
+        self._convolve(spectra, shape, p, box, self._full(), out)
+        return out
 
     __call__ = matvec
 
-    def _block_convolve(self, spectrum, v):
-        """Apply a 2 x 2 block convolution given by its spectrum to a brick array.
-
-        Pruned transforms: the real FFT along x runs only over the rows that
-        hold data (forward) or are kept (inverse); the complex FFT along y
-        does the zero padding.
-        """
-        import scipy.fft as sfft
-
-        lk, lq = self._pad
-        n_rows = [len(r) for r in self._rows]
-        workers = _workers()
-        v_hat = [
-            sfft.fft(sfft.rfft(v[self._rows[b]], n=lq, axis=1, workers=workers), n=lk, axis=0,
-                     overwrite_x=True, workers=workers)
-            for b in (0, 1)
-        ]
-        out = np.empty(self.lattice.shape)
-        n_cols = out.shape[1]
-        for a in (0, 1):
-            acc = spectrum[a, 0] * v_hat[0]
-            acc += spectrum[a, 1] * v_hat[1]
-            col = sfft.ifft(acc, axis=0, overwrite_x=True, workers=workers)[: n_rows[a]]
-            out[self._rows[a]] = sfft.irfft(col, n=lq, axis=1, workers=workers)[:, :n_cols]
-        out[~self.lattice.mask] = 0.0
-        return out
-
-    def preconditioner(self, lam=0.0, floor=0.5):
+    def preconditioner(self, lam=0.0, floor=0.5, box="support"):
         """FFT preconditioner ``z ~ (C + lam I)^-1 r`` for the conjugate gradients.
 
         The inverse of the 2 x 2 block symbol of the zero-padded (circulant)
-        embedding of ``C + lam I``. Truncating the ``1/r`` kernel at the
-        padding edge makes a few symbol eigenvalues small or negative; they are
-        raised to ``floor * C_nn + lam`` so that ``M`` stays positive definite.
+        embedding of ``C + lam I`` over the snapped bounding box of the support
+        of ``r`` (Vollebregt 2014: the solvers apply it to residuals that vanish
+        off the contact, and mask its output to the contact). Truncating the
+        ``1/r`` kernel at the padding edge makes a few symbol eigenvalues small
+        or negative; they are raised to ``floor * C_nn + lam`` so that ``M``
+        stays positive definite.
 
         Parameters
         ----------
@@ -142,33 +241,60 @@ class InfluenceOperator:
             Uniform layer compliance [length/pressure] added on the diagonal.
         floor : float
             Eigenvalue floor as a fraction of the diagonal coefficient ``C_nn``.
+        box : {"support", "full"}
+            ``"support"``: the embedding over the snapped bounding box of the
+            support of each ``r``, 0 outside it; for all ``r`` with one box it
+            is one symmetric positive definite operator. ``"full"``: over the
+            whole candidate region, one SPD operator for every ``r``. Measured on
+            the issue problem (1,048,703 nodes, contact 4 % of the region): same
+            15 iterations, Hertz solve 1.30 s against 2.06 s with ``"full"``.
 
         Returns
         -------
         callable
             ``M(r)`` on brick arrays.
         """
-        K = self._kernel_hat
-        A, D, B = K[0, 0].real + lam, K[1, 1].real + lam, K[0, 1]
+        from .checks import check_choice
+
+        full = check_choice("box", box, ("support", "full")) == "full"
+        symbols = {}
+
+        def apply(r):
+            r = np.asarray(r, dtype=float)
+            out = np.zeros(self.lattice.shape)
+            box = self._box(r)
+            if box is None:
+                return out
+            if full:
+                box = self._full()
+            if box not in symbols:
+                shape, K = self._cached(("M", box), lambda: self._kernel_spectra(box, box))
+                symbols.clear()  # one box at a time: the contact moves rarely
+                symbols[box] = shape, self._inverse_symbol(K, shape, lam, floor)
+            shape, spectra = symbols[box]
+            self._convolve(spectra, shape, r, box, box, out)
+            return out
+
+        return apply
+
+    def _inverse_symbol(self, K, shape, lam, floor):
+        """Spectra of ``(K + lam)^-1`` for a symmetric 2 x 2 block symbol (eigenvalues floored)."""
+        lam_hat = lam / (shape[0] * shape[1])  # spectra carry the 1/(Lk Lq) of the inverse FFT
+        A, D, B = K[0, 0].real + lam_hat, K[1, 1].real + lam_hat, K[0, 1]
         m = (A + D) / 2
         d = np.sqrt(((A - D) / 2) ** 2 + np.abs(B) ** 2)
-        low = floor * self.diagonal + lam
+        low = (floor * self.diagonal + lam) / (shape[0] * shape[1])
         inv_hi = 1.0 / np.maximum(m + d, low)
         inv_lo = 1.0 / np.maximum(m - d, low)
         # H^-1 = P+/l+ + P-/l-,  P+ = (H - (m - d) I) / (2 d),  P- = I - P+
         with np.errstate(divide="ignore", invalid="ignore"):
             safe = d > 1e-14 * np.abs(m)
             half = np.where(safe, 0.5 / np.where(safe, d, 1.0), 0.0)
-        pa = np.where(safe, (A - m + d) * half, 0.5)
-        pd = np.where(safe, (D - m + d) * half, 0.5)
-        pb = B * half
         diff = inv_hi - inv_lo
-        spectrum = np.empty_like(K)
-        spectrum[0, 0] = inv_lo + pa * diff
-        spectrum[1, 1] = inv_lo + pd * diff
-        spectrum[0, 1] = pb * diff
-        spectrum[1, 0] = np.conj(pb) * diff
-        return lambda r: self._block_convolve(spectrum, r)
+        pb = B * half * diff
+        scale = 1.0 / (shape[0] * shape[1]) ** 2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
+        return ((inv_lo + np.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale), \
+            (np.conj(pb) * scale, (inv_lo + np.where(safe, (D - m + d) * half, 0.5) * diff) * scale)
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""
@@ -197,4 +323,3 @@ class InfluenceOperator:
             raise MemoryError(f"dense C for {x.size} nodes would need {8 * x.size**2 / 1e9:.1f} GB")
         scale = self.lattice.step / (math.pi * self.E_star)
         return scale * template(x[:, None] - x[None, :], y[:, None] - y[None, :])
-

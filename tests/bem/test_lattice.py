@@ -67,3 +67,14 @@ def test_coarse_nodes_are_fine_nodes():
 def test_bad_lattice_input_is_refused(step, extent, name):
     with pytest.raises(InputError, match=name):
         Lattice.from_extent(step, extent)
+
+
+@pytest.mark.parametrize("step, extent", [(0.1, 1.0), (0.05, (1.0, 0.7)), (0.037, (0.61, 0.83)), (0.02, 0.5)])
+def test_prolong_is_interpolation_onto_the_fine_nodes(step, extent):
+    fine = Lattice.from_extent(step, extent)
+    coarse = fine.coarsen()
+    values = np.random.default_rng(3).random(coarse.shape) * coarse.mask
+    expected = coarse.interpolate(values, fine.x, fine.y) * fine.mask
+    np.testing.assert_allclose(coarse.prolong(values, fine), expected, rtol=0, atol=1e-14)
+    with pytest.raises(InputError, match="fine"):
+        fine.prolong(np.zeros(fine.shape), coarse)

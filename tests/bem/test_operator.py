@@ -47,21 +47,47 @@ def test_linear_operator_wraps_the_same_product():
     np.testing.assert_allclose(op.as_linear_operator() @ v, op.dense() @ v, rtol=1e-12)
 
 
+def _columns(M, lat, vectors):
+    return np.array([M(v)[lat.mask] for v in vectors]).T
+
+
 def test_preconditioner_is_symmetric_positive_definite():
     lat = Lattice.from_extent(0.2, 1.0)
     op = InfluenceOperator(lat, 1.0)
-    M = op.preconditioner(lam=0.1)
-    n = lat.n_nodes
-    cols = []
-    for k in range(n):
-        e = np.zeros(n)
-        e[k] = 1.0
-        grid = np.zeros(lat.shape)
-        grid[lat.mask] = e
-        cols.append(M(grid)[lat.mask])
-    Mm = np.array(cols).T
+    M = op.preconditioner(lam=0.1, box="full")
+    units = []
+    for k in range(lat.n_nodes):
+        grid = np.zeros(lat.n_nodes)
+        grid[k] = 1.0
+        units.append(np.zeros(lat.shape))
+        units[-1][lat.mask] = grid
+    Mm = _columns(M, lat, units)
     np.testing.assert_allclose(Mm, Mm.T, atol=1e-12 * np.abs(Mm).max())
     assert np.linalg.eigvalsh((Mm + Mm.T) / 2).min() > 0
+
+
+def test_support_preconditioner_is_one_spd_operator_per_box():
+    """Vectors whose supports share a bounding box see one SPD operator."""
+    lat = Lattice.from_extent(0.05, 1.0)
+    op = InfluenceOperator(lat, 1.0)
+    M = op.preconditioner(lam=0.1)
+    inside = np.zeros(lat.shape, dtype=bool)
+    inside[10:17, 12:19] = True
+    inside &= lat.mask
+    corners = np.zeros(lat.shape)
+    corners[10, 12] = corners[16, 18] = 1.0  # pins the bounding box of every vector below
+    base = M(corners)
+    cols = []
+    for r, q in zip(*np.nonzero(inside)):
+        v = corners.copy()
+        v[r, q] += 1.0
+        cols.append((M(v) - base)[inside])
+    Mb = np.array(cols).T
+    np.testing.assert_allclose(Mb, Mb.T, atol=1e-12 * np.abs(Mb).max())
+    assert np.linalg.eigvalsh((Mb + Mb.T) / 2).min() > 0
+    full = op.preconditioner(lam=0.1, box="full")(corners)
+    assert np.abs(base - full)[inside].max() < 0.5 * np.abs(full[inside]).max()  # same operator, smaller embedding
+    assert np.all(M(np.zeros(lat.shape)) == 0)
 
 
 def test_matvec_does_not_modify_input():

@@ -1,0 +1,160 @@
+"""FFT back end of the influence operator: thread count, fast sizes, pruned padded transforms.
+
+Thread count
+    :func:`threads` is the number of CPUs this process may run on,
+    ``len(os.sched_getaffinity(0))`` (``os.cpu_count()`` where the platform has
+    no affinity call), so a job confined by ``taskset``, cgroups or a batch
+    system does not oversubscribe its cores. Override it with the environment
+    variable ``CONTACTLAB_THREADS`` (read at every call) or with
+    :func:`set_threads` (takes precedence; ``set_threads(None)`` undoes it).
+
+Back end
+    ``scipy.fft`` (pocketfft), chosen by measurement (``benchmarks/fft_floor.py`` and the
+    same pair at the operator's shapes; 2-core machine, load average 0.4-1.2, medians):
+
+    =========================  ==========  ===============  ==============================
+    transform                  pocketfft   FFTW_ESTIMATE    FFTW_MEASURE (planning)
+    =========================  ==========  ===============  ==============================
+    pair 2048^2 (floor, 1e6)   45 ms       --               25 ms (10 s)
+    pair 1024^2                14 ms       --               7.4 ms
+    operator 2 x 1080 x 1875   44 ms (*)   79 ms            89 ms (8-20 s)
+    operator 2 x 648 x 1125    16 ms (*)   45 ms            8 ms (0.5-5 s)
+    =========================  ==========  ===============  ==============================
+
+    (*) pruned as below. pyFFTW 0.15 wins only with ``FFTW_MEASURE`` plans, whose
+    planning takes longer than a whole solve, per shape (every support window has
+    its own); with ``FFTW_ESTIMATE`` it is 1.8-2.8x slower than pocketfft, which
+    plans in microseconds and caches its plans.
+
+Pruned transforms
+    :func:`forward` and :func:`inverse` are the two halves of a zero-padded
+    (non-periodic) convolution of a batch of real 2-D arrays. The real FFT
+    along the last axis runs only over the rows that hold data (forward) or
+    are kept (inverse); the complex FFT along the first data axis does the
+    zero padding. Against a plain ``rfft2``/``irfft2`` pair of the padded
+    size this skips the transforms of the zero rows (about 25 % of the work
+    when the data fill half the padded rows).
+"""
+
+from __future__ import annotations
+
+import os
+
+import scipy.fft as _sfft
+
+__all__ = ["threads", "set_threads", "fast_length", "forward", "inverse"]
+
+_ENV = "CONTACTLAB_THREADS"
+_override = None
+
+
+def _available_cpus():
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # macOS, Windows: no affinity call
+        return os.cpu_count() or 1
+
+
+def threads():
+    """Number of threads the FFTs use.
+
+    Returns
+    -------
+    int
+        :func:`set_threads` value if set, else ``CONTACTLAB_THREADS`` if set to
+        a positive integer, else the number of CPUs in this process's affinity
+        mask (``os.cpu_count()`` without one); at least 1.
+    """
+    if _override is not None:
+        return _override
+    env = os.environ.get(_ENV, "").strip()
+    if env:
+        try:
+            value = int(env)
+        except ValueError:
+            value = 0
+        if value > 0:
+            return value
+    return max(1, _available_cpus())
+
+
+def set_threads(n):
+    """Fix the FFT thread count for this process (``None``: back to the automatic rule).
+
+    Parameters
+    ----------
+    n : int or None
+        Threads, >= 1, or ``None``.
+
+    Returns
+    -------
+    int or None
+        The previous override, so that a caller can restore it.
+    """
+    global _override
+    if n is not None:
+        from .checks import fail
+
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            fail("n", n, "an integer >= 1 or None")
+    previous, _override = _override, n
+    return previous
+
+
+def fast_length(n, real):
+    """Smallest length ``>= n`` that the back end transforms fast.
+
+    Parameters
+    ----------
+    n : int
+        Minimum length (no wrap-around of the padded convolution).
+    real : bool
+        ``True`` for the axis of the real-to-complex transform (pocketfft's real
+        transforms take 2-3-5 factors), ``False`` for a complex one (up to 11).
+    """
+    return _sfft.next_fast_len(int(n), real=real)
+
+
+def forward(x, shape):
+    """Spectrum of a batch of real arrays zero-padded to ``shape``.
+
+    Parameters
+    ----------
+    x : ndarray, shape ``(..., rows, cols)``, float64
+        Data; ``rows <= shape[0]``, ``cols <= shape[1]``. Not modified.
+    shape : (int, int)
+        Padded size ``(Lk, Lq)``.
+
+    Returns
+    -------
+    ndarray, shape ``(..., Lk, Lq // 2 + 1)``, complex128
+        Unnormalised 2-D DFT of the padded arrays.
+    """
+    lk, lq = shape
+    workers = threads()
+    rows = _sfft.rfft(x, n=lq, axis=-1, workers=workers)
+    return _sfft.fft(rows, n=lk, axis=-2, overwrite_x=True, workers=workers)
+
+
+def inverse(spectrum, shape, keep):
+    """Inverse of :func:`forward`, without the ``1 / (Lk Lq)`` factor, cropped.
+
+    Parameters
+    ----------
+    spectrum : ndarray, shape ``(..., Lk, Lq // 2 + 1)``, complex128
+        Overwritten.
+    shape : (int, int)
+        Padded size ``(Lk, Lq)``.
+    keep : (int, int)
+        Rows and columns kept from the origin.
+
+    Returns
+    -------
+    ndarray, shape ``(..., keep[0], keep[1])``
+        A view into a fresh array; the caller scales it.
+    """
+    lq = shape[1]
+    workers = threads()
+    cols = _sfft.ifft(spectrum, axis=-2, norm="forward", overwrite_x=True, workers=workers)
+    out = _sfft.irfft(cols[..., : keep[0], :], n=lq, axis=-1, norm="forward", workers=workers)
+    return out[..., : keep[1]]
