@@ -14,6 +14,7 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [analytic] only when wanted: kind = "hertz" | "hertz_elliptic" | "rigid_layer"
     [sweep]    only when wanted: parameter, values
     [report]   only when wanted: sections, format
+    [stress]   only when wanted: depths ("auto" or a list [m]), n_depths, max_depth, bodies
 
 :func:`load_scene` validates the WHOLE scene (every point of its sweep included) before any
 work: unknown keys, wrong types, out-of-range values, missing keys and impossible combinations
@@ -36,7 +37,7 @@ from .paper import ALIASES, EXCLUSIVE
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
            "apply_overrides", "parse_override", "SECTIONS"]
 
-SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report")
+SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report", "stress")
 _REQUIRED = ("scene", "bodies", "gap", "load")
 _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
 
@@ -63,6 +64,7 @@ class Scene:
     sweep: dict | None = None
     report: dict | None = None
     overrides: tuple = field(default=())
+    stress: dict | None = None
 
     @property
     def axisymmetric(self):
@@ -181,7 +183,7 @@ def _validate(raw, source, overrides):
         fem=sec.fem_options(raw.get("fem"), shape, body["materials"]),
         analytic=sec.analytic(raw.get("analytic"), shape, layer_spec),
         sweep=sec.sweep_spec(raw.get("sweep"), SECTIONS), report=sec.report(raw.get("report")),
-        overrides=tuple(overrides),
+        overrides=tuple(overrides), stress=sec.stress_options(raw.get("stress"), body["materials"]),
     )
 
 

@@ -2,8 +2,9 @@
 
 Only the sections the results support: the problem statement (from ``scene.toml``), the
 results table, the pressure profiles against the FEM and the closed form when they ran,
-the contact map, the convergence history, the FEM reference only when the FEM ran and the
-comparison metrics only when they were recorded. Units are the scene's (``[scene] units``).
+the contact map, the convergence history, the FEM reference only when the FEM ran, the
+subsurface stresses only when the scene asked for them and the comparison metrics only when
+they were recorded. Units are the scene's (``[scene] units``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from pathlib import Path
 from . import run_figures as rf
 from .build import build_report
 from .run_problem import method_text, problem_statement, rebuild_layer
+from .run_stress import stress_section
 from .sections import Section, Table, fmt
 
 __all__ = ["run_sections", "report_results_dir", "results_rows", "comparison_tables"]
@@ -221,6 +223,9 @@ def run_sections(res, work):
         sections.append(conv)
     if res.fem is not None:
         sections.append(_fem(res, work))
+    stress = stress_section(res, work)
+    if stress is not None:
+        sections.append(stress)
     comparison = res.get("comparison")
     if comparison:
         tables = comparison_tables(comparison, res.units)
