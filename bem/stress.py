@@ -301,8 +301,8 @@ def subsurface_stress(result, z, *, nu, x=None, y=None):
     point-load (Boussinesq) stresses convolved with a lattice stencil plus a near-field
     correction integrated semi-analytically (module docstring and :mod:`bem.boussinesq`);
     one FFT convolution per depth and stress component, ``O(N log N)``. Body frame: ``z``
-    points into the body; for the upper body of a scene the shear stresses ``xz``, ``yz`` change
-    sign in the global frame.
+    points into the body; in a frame whose z axis points up into the upper body, the lower
+    body's shear stresses ``xz`` and ``yz`` change sign.
     """
     t0 = time.perf_counter()
     if not isinstance(result, ContactResult):
