@@ -51,6 +51,17 @@ _MARGIN = 4  # rows and columns the stencil reaches
 _PARALLEL_NODES = 50_000  # lattices from this size compute their depths in parallel threads
 
 
+def _deviator_angle(s):
+    """Mean stress ``q``, ``p = sqrt(J2 / 3)`` and the Lode-type angle ``phi`` in [0, pi/3] of Voigt tensors."""
+    xx, yy, zz, yz, xz, xy = (s[..., k] for k in range(6))
+    q = (xx + yy + zz) / 3.0
+    a, b, c = xx - q, yy - q, zz - q
+    p = np.sqrt((a * a + b * b + c * c + 2.0 * (yz * yz + xz * xz + xy * xy)) / 6.0)
+    safe = np.where(p > 0, p, 1.0)
+    det = (a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz)) / safe**3
+    return q, p, np.arccos(np.clip(0.5 * det, -1.0, 1.0)) / 3.0
+
+
 def principal_stresses(sigma):
     """Principal stresses of Voigt tensors, largest first (closed-form roots of the characteristic cubic).
 
@@ -64,15 +75,7 @@ def principal_stresses(sigma):
     ndarray, shape (..., 3)
         ``s1 >= s2 >= s3`` [pressure].
     """
-    s = np.asarray(sigma, dtype=float)
-    xx, yy, zz, yz, xz, xy = (s[..., k] for k in range(6))
-    q = (xx + yy + zz) / 3.0
-    off = yz * yz + xz * xz + xy * xy
-    a, b, c = xx - q, yy - q, zz - q
-    p = np.sqrt((a * a + b * b + c * c + 2.0 * off) / 6.0)
-    safe = np.where(p > 0, p, 1.0)
-    det = (a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz)) / safe**3
-    phi = np.arccos(np.clip(0.5 * det, -1.0, 1.0)) / 3.0
+    q, p, phi = _deviator_angle(np.asarray(sigma, dtype=float))
     s1 = q + 2.0 * p * np.cos(phi)
     s3 = q + 2.0 * p * np.cos(phi + 2.0 * math.pi / 3.0)
     s2 = np.clip(3.0 * q - s1 - s3, s3, s1)  # s3 <= s2 <= s1 up to rounding
@@ -84,9 +87,14 @@ def _von_mises(s, axis=-1):
     return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2) + 3.0 * (yz * yz + xz * xz + xy * xy))
 
 
-def _tresca(s):
-    pr = principal_stresses(s)
-    return 0.5 * (pr[..., 0] - pr[..., 2])
+def _tresca(s, block=1 << 15):
+    """``(s1 - s3) / 2 = sqrt(3) p sin(phi + pi/3)`` of Voigt tensors ``s`` (..., 6), in cache-sized blocks."""
+    flat = s.reshape(-1, 6)
+    out = np.empty(flat.shape[0])
+    for start in range(0, flat.shape[0], block):
+        _, p, phi = _deviator_angle(flat[start: start + block])
+        out[start: start + block] = math.sqrt(3.0) * p * np.sin(phi + math.pi / 3.0)
+    return out.reshape(s.shape[:-1])
 
 
 def _peak(field, z):
@@ -170,7 +178,7 @@ class SubsurfaceStress:
     @cached_property
     def tresca(self):
         """Maximum shear stress ``(s1 - s3) / 2`` [pressure], shape (n_z, M) (computed on first use)."""
-        return _tresca(self.sigma)
+        return np.stack([_tresca(layer) for layer in self.sigma])
 
     def principal(self):
         """Principal stresses, largest first [pressure], shape (n_z, M, 3)."""
