@@ -152,6 +152,8 @@ class SubsurfaceStress:
         values are interpolated linearly between the nodes of each depth.
     wall_time_s : float
         Time of the computation [s].
+    meta : dict
+        ``step`` (lattice step [length]) and ``n_nodes`` (candidate nodes) of the solution.
 
     Notes
     -----
@@ -226,8 +228,8 @@ def _check_points(lattice, x, y):
     bad = np.flatnonzero((np.abs(x) > ex) | (np.abs(y) > ey))
     if bad.size:
         i = int(bad[0])
-        raise InputError(f"x[{i}], y[{i}] = ({x[i]!r}, {y[i]!r}) is not allowed: the points must lie in the "
-                         f"candidate region |x| <= {ex:.6g}, |y| <= {ey:.6g}.")
+        raise InputError(f"x[{i}], y[{i}] = ({float(x[i])!r}, {float(y[i])!r}) is not allowed: the points must "
+                         f"lie in the candidate region |x| <= {ex:.6g}, |y| <= {ey:.6g}.")
     return x, y
 
 

@@ -33,7 +33,7 @@ def solutions():
                     step=fem.contact_radius / 25, extent=1.3 * fem.contact_radius)
     assert res.converged
     depths = np.linspace(0.0, 1.5, 31) * A_H
-    stresses = {"body1": bem.subsurface_stress(res, depths, nu=NU1), "body2": bem.subsurface_stress(res, depths, nu=NU2)}
+    stresses = {name: bem.subsurface_stress(res, depths, nu=nu) for name, nu in (("body1", NU1), ("body2", NU2))}
     return res, fem, stresses, fem_body_stresses(fem)
 
 

@@ -94,7 +94,8 @@ def _run_rows(res):
             rows.append((label, fmt(b[key], 3), "-"))
     times = res.get("wall_time_s") or {}
     for key, label in (("layer_reference", "wall time: reference solve of the layer"), ("bem", "wall time: BEM"),
-                       ("fem", "wall time: FEM"), ("total", "wall time: whole run")):
+                       ("fem", "wall time: FEM"), ("stress", "wall time: subsurface stresses"),
+                       ("total", "wall time: whole run")):
         if _num(times.get(key)):
             rows.append((label, fmt(times[key], 3), "s"))
     return tuple(rows)

@@ -139,9 +139,9 @@ def stress_section(res, work):
         Figure(profiles, "Von Mises stress (solid) and maximum shear (dotted) on the axis against the depth; "
                          "circles: the maxima over the whole field." + (" Crosses: FEM axis nodes." if any(
                              b.get("fem") for b in bodies.values()) else "") + " " + how)]
-    text = ("The contact pressure matters for the strength of the parts through the stresses it causes below "
-            "the surface: yielding starts where the von Mises stress (or the maximum shear) is largest, below "
-            "the surface for a smooth contact.",)
+    text = "The contact pressure matters for the strength of the parts through the stresses it causes below " \
+           "the surface: yielding starts where the von Mises stress (or the maximum shear) is largest, below " \
+           "the surface for a smooth contact."
     if math.isfinite(float(block.get("wall_time_s") or 0.0)):
-        text += (f"Computed in {fmt(float(block['wall_time_s']), 3)} s.",)
-    return Section("Subsurface stresses", kind="results", text=text, items=tuple(items))
+        text += f" Computed in {fmt(float(block['wall_time_s']), 3)} s."
+    return Section("Subsurface stresses", kind="results", text=(text,), items=tuple(items))
