@@ -21,6 +21,10 @@ steps and only at depths below 16 steps. ``K`` agrees with adaptive
 quadrature of the point-load stresses over the pyramid to 1e-8 of the local stress at every
 depth ``z >= 0`` (tests/bem/test_stress.py); below one step the zero-offset term of ``G``
 (which grows like ``1/z^2``) is moved into ``C`` so that nothing large cancels in the FFTs.
+
+References: K. L. Johnson, *Contact Mechanics*, Cambridge 1985, doi:10.1017/CBO9781139171731
+(point load, sec. 3.2; Hertz's subsurface stresses, eq. 3.45); A. E. H. Love, Phil. Trans. R.
+Soc. A 228 (1929) 377, doi:10.1098/rsta.1929.0009.
 """
 
 from __future__ import annotations
@@ -134,7 +138,8 @@ class SubsurfaceStress:
         Depths below the surface [length], as given.
     sigma : ndarray, shape (n_z, M, 6)
         Stress tensor [pressure], Voigt order :data:`VOIGT` (``xx, yy, zz, yz, xz, xy``), tension
-        positive (compression negative), in the body's frame: ``z`` points into the body.
+        positive (compression negative), in the body's frame: ``z`` points into the body. A view
+        of component-major storage: ``sigma[..., k]`` is contiguous.
     von_mises : ndarray, shape (n_z, M)
         ``sqrt(3 J2)`` [pressure].
     nu : float
