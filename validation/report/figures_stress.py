@@ -16,6 +16,13 @@ from .style import color_for, new_figure, save_figure
 __all__ = ["plot_stress_section", "plot_depth_profiles"]
 
 
+def _checked(a, scale, items, name, what):
+    """``(a, scale)`` checked positive; ``items`` must not be empty."""
+    if not items:
+        raise InputError(f"{name} = [] is not allowed: give at least one {what}.")
+    return check_positive("a", a), check_positive("scale", scale)
+
+
 def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, fem=None, labels=None,
                         title=None):
     """Von Mises stress in the x-z section through the axis, body 1 above and body 2 below the interface.
@@ -45,9 +52,7 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
     str
         ``path``.
     """
-    a, scale = check_positive("a", a), check_positive("scale", scale)
-    if not panels:
-        raise InputError("panels = [] is not allowed: give at least one body's section.")
+    a, scale = _checked(a, scale, panels, "panels", "body's section")
     vmax = max(float(np.max(v)) for _, _, _, v in panels) / scale
     levels = np.linspace(0.0, vmax, 11)[1:-1]
     labels = {"x": r"$x\,/\,a_H$", "z": r"$z\,/\,a_H$", **(labels or {})}
@@ -118,9 +123,7 @@ def plot_depth_profiles(curves, path, *, a, scale, stress_label, depth_label=r"d
     str
         ``path``.
     """
-    a, scale = check_positive("a", a), check_positive("scale", scale)
-    if not curves:
-        raise InputError("curves = [] is not allowed: give at least one profile.")
+    a, scale = _checked(a, scale, curves, "curves", "profile")
     with new_figure((5.6, 4.4)) as (fig, ax):
         for i, c in enumerate(curves):
             ax.plot(np.asarray(c["values"]) / scale, np.asarray(c["z"]) / a, label=c["label"],
