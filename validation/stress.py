@@ -12,8 +12,10 @@ are taken from its recovered nodal stresses (:func:`fem_body_stresses`) and comp
 Depth of a maximum, FEM against BEM: the von Mises stress is flat around its maximum (it
 changes by about 1.6 % over +-0.1 a for Hertz), so the depth of the largest nodal value of the
 FEM moves with the node-to-node scatter of the recovered stresses. Both depths are therefore
-taken the same way: a least-squares parabola through the axis values within 4 % of the
-largest one (:func:`peak_fit`), the BEM evaluated at the FEM's axis nodes.
+taken the same way, on the axis: a least-squares parabola through the axis values within 4 %
+of the largest one (:func:`peak_fit`), the BEM evaluated at the FEM's axis nodes. Where the
+largest value lies off the axis (a flat punch: under its edge) only the values are compared
+with the body's maximum; the depths are those of the axis maximum.
 """
 
 from __future__ import annotations
@@ -139,8 +141,10 @@ def compare_with_fem(res, st, fem_body):
     """Maxima of one body, BEM against FEM.
 
     Values: the largest BEM von Mises stress and maximum shear (all nodes, all depths) and the
-    largest FEM nodal values. Depths: :func:`peak_fit` of the axis profiles, the BEM evaluated at
-    the FEM's axis nodes (module docstring).
+    largest FEM nodal values. Depths: of the maximum of von Mises on the axis, by :func:`peak_fit`
+    of the axis profiles, the BEM evaluated at the FEM's axis nodes (module docstring); that is
+    the depth of the largest value where ``on_axis`` (the BEM's largest value lies within one
+    lattice step of the axis), else that of the axis only.
     """
     on_axis = (fem_body["r"] <= 1e-12 * max(1.0, float(fem_body["r"].max()))) & (fem_body["depth"] >= 0)
     order = np.argsort(fem_body["depth"][on_axis])
@@ -154,13 +158,14 @@ def compare_with_fem(res, st, fem_body):
     out = {
         "max_von_mises": float(fem_body["von_mises"].max()),
         "max_tresca": float(fem_body["max_shear"].max()),
-        "depth_of_max": fit_fem[1],
-        "bem_depth_of_max": fit_bem[1],
+        "on_axis": bool(math.hypot(*st.location_of_max[:2]) <= res.step),
+        "axis_depth_of_max": fit_fem[1],
+        "bem_axis_depth_of_max": fit_bem[1],
         "axis": {"z": depth, "von_mises": vm_fem},
     }
     out["max_von_mises_rel"] = st.max_von_mises / out["max_von_mises"] - 1.0
     out["max_tresca_rel"] = st.max_tresca / out["max_tresca"] - 1.0
-    out["depth_of_max_rel"] = fit_bem[1] / fit_fem[1] - 1.0
+    out["axis_depth_of_max_rel"] = fit_bem[1] / fit_fem[1] - 1.0
     return out
 
 
