@@ -85,7 +85,13 @@ def point_load_stress(x, y, z, nu):
     ndarray, shape (..., 6)
         ``xx, yy, zz, yz, xz, xy`` [1/length^2] for a unit force.
     """
+    return np.moveaxis(_point_load_components(x, y, z, nu), 0, -1)
+
+
+def _point_load_components(x, y, z, nu):
+    """:func:`point_load_stress` with the components first: shape (6, ...), contiguous."""
     x, y, z = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float), np.asarray(z, float))
+    out = np.empty((6,) + x.shape)
     r2 = x * x + y * y
     rho2 = r2 + z * z
     rho = np.sqrt(rho2)
@@ -96,7 +102,13 @@ def point_load_stress(x, y, z, nu):
     b = (k * (2.0 * rho + z) * inv3 / (rho + z) ** 2 - 3.0 * z * inv5) / (2.0 * math.pi)
     d = 0.5 * (x * x - y * y) * b
     shear = -3.0 * z * z * inv5 / (2.0 * math.pi)
-    return np.stack([s + d, s - d, shear * z, shear * y, shear * x, b * x * y], axis=-1)
+    np.add(s, d, out=out[0, ...])
+    np.subtract(s, d, out=out[1, ...])
+    np.multiply(shear, z, out=out[2, ...])
+    np.multiply(shear, y, out=out[3, ...])
+    np.multiply(shear, x, out=out[4, ...])
+    np.multiply(b * x, y, out=out[5, ...])
+    return out
 
 
 def _radial(R, z):
@@ -302,10 +314,11 @@ def point_load_quadrants(offsets, z, nu, spike):
     out = []
     for ox, oy in offsets:
         with np.errstate(divide="ignore", invalid="ignore"):
-            g = VOLUME * point_load_stress(ox, oy, z, nu)
+            g = _point_load_components(ox, oy, z, nu)
+        g *= VOLUME
         if spike:
-            g[(ox == 0) & (oy == 0)] = 0.0
-        out.append(np.moveaxis(g, -1, 0))
+            g[:, (ox == 0) & (oy == 0)] = 0.0
+        out.append(g)
     return out
 
 
