@@ -3,7 +3,8 @@
 Boundary elements on the elastic half-space with piecewise-linear (pyramid)
 pressure on a regular triangular lattice, closed-form influence coefficients,
 FFT-fast products, and Kalker's variational principle generalised to a
-nonlinear interface layer (paper sections 4-5, docs/method.md).
+nonlinear interface layer (paper sections 4-5, docs/method.md); the stresses below the
+surface under the computed pressure (:func:`subsurface_stress`).
 """
 
 from . import checks, gaps, layers
@@ -13,7 +14,9 @@ from .materials import effective_modulus
 from .operator import InfluenceOperator, diagonal_coefficient
 from .result import ContactResult
 from .solve import METHODS, solve
+from .stress import SubsurfaceStress, subsurface_stress
 from .template import template
 
-__all__ = ["solve", "template", "Lattice", "InfluenceOperator", "ContactResult", "METHODS",
-           "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient", "effective_modulus", "gaps", "layers"]
+__all__ = ["solve", "subsurface_stress", "SubsurfaceStress", "template", "Lattice", "InfluenceOperator",
+           "ContactResult", "METHODS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
+           "effective_modulus", "gaps", "layers"]

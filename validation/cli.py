@@ -32,8 +32,8 @@ triangular lattice, an axisymmetric finite-element (FEM) reference, closed-form 
 
 A SCENE is a TOML file, or the name of a built-in scene (see `contactlab scenes`). It says
 what the bodies, gap, layer and load are and what to run: the BEM always; the FEM reference,
-a closed-form comparison, a sweep or a report only when it has a [fem], [analytic], [sweep]
-or [report] section.
+a closed-form comparison, a sweep, the subsurface stresses or a report only when it has a
+[fem], [analytic], [sweep], [stress] or [report] section.
 
 Units: every number is in the scene's own consistent units, stated in its [scene] units
 label. The built-in scenes use SI: lengths in m, moduli and pressures in Pa, forces in N
@@ -63,7 +63,7 @@ examples:
 
 result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
 iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.toml (the
-effective scene, re-runnable), bem_field.vtu and fem_field.vtu (open in ParaView).
+effective scene, re-runnable), bem_field.vtu, fem_field.vtu and stress_field.vtu (open in ParaView).
 Written whole or not at all. Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
 scene is listed), or an unknown option.
 """
@@ -199,6 +199,10 @@ def _summary(result, out_dir):
                  f"KKT residual {result['kkt_residual']:.2e})")
     times = ", ".join(f"{k} {v:.2f} s" for k, v in t.items() if v is not None)
     lines.append(f"time       {times}")
+    for name, body in (result.get("stress") or {}).get("bodies", {}).items():
+        x, y, z = body["location_of_max"]
+        lines.append(f"stress     {name}: max von Mises {body['max_von_mises']:.6g} {Pa} at depth {z:.6g} {L} "
+                     f"(x {x:.3g}, y {y:.3g}), max shear {body['max_tresca']:.6g} {Pa}")
     for msg in result["messages"]:
         lines.append(f"note       {msg}")
     if out_dir is not None:
@@ -258,7 +262,7 @@ def _cmd_check(args):
     from .scene import load_scene
 
     scene = load_scene(args.scene, overrides=args.overrides)
-    parts = ["bem"] + [k for k in ("fem", "analytic", "sweep", "report") if getattr(scene, k) is not None]
+    parts = ["bem"] + [k for k in ("fem", "analytic", "sweep", "stress", "report") if getattr(scene, k) is not None]
     b = scene.bem
     print(f"{scene.name}: OK ({', '.join(parts)}); lattice step {b['step']:.4g}, region "
           f"{b['extent'][0]:.4g} x {b['extent'][1]:.4g}, {b['n_nodes']} nodes   [units {scene.units}]")

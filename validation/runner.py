@@ -1,4 +1,4 @@
-"""Run a scene: the BEM always, the FEM reference, closed form and comparisons only when named.
+"""Run a scene: the BEM always; the FEM reference, closed form, comparisons, stresses only when named.
 
 :func:`run_scene` returns the JSON-ready result dict and, given ``out_dir``, writes it whole or
 not at all (:mod:`validation.output`) with the BEM nodal field and, when the FEM ran, its
@@ -30,7 +30,7 @@ log = logging.getLogger(__name__)
 
 #: Names of the files of a result directory.
 FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_field.vtu",
-         "fem_field": "fem_field.vtu"}
+         "fem_field": "fem_field.vtu", "stress_field": "stress_field.vtu"}
 _GROW, _MAX_GROW = 1.5, 3  # automatic region: enlarge x1.5, at most 3 times
 
 
@@ -44,6 +44,7 @@ class RunOutcome:
     fem: object = None
     analytic: object = None
     layer: object = None
+    stress: object = None
 
 
 def _notify(progress, stage, status, **info):
@@ -62,6 +63,8 @@ def planned_stages(scene, *, write=False):
         stages.append("fem")
     if scene.fem is not None or scene.analytic is not None:
         stages.append("compare")
+    if scene.stress is not None:
+        stages.append("stress")
     if write:
         stages.append("write")
     return stages
@@ -207,10 +210,23 @@ def execute_scene(scene, *, progress=None, overrides=None):
         _notify(progress, "compare", "start")
         metrics = _compare(res, fem, ref, messages)
         _notify(progress, "compare", "done")
+    stress = None
+    if scene.stress is not None:
+        from .stress import run_stress
+
+        _notify(progress, "stress", "start")
+        stress = run_stress(scene, res, fem)
+        times["stress"] = stress.wall_time_s
+        _notify(progress, "stress", "done")
     times["total"] = time.perf_counter() - t0
     result = build_result(scene, res, layer_info, fem=fem, analytic=ref, metrics=metrics, times=times,
                           messages=messages, extent=solve.extent)
-    return RunOutcome(scene=scene, result=result, bem=res, fem=fem, analytic=ref, layer=layer)
+    if stress is not None:
+        from .output import to_jsonable
+        from .stress import stress_summary
+
+        result["stress"] = to_jsonable(stress_summary(stress))
+    return RunOutcome(scene=scene, result=result, bem=res, fem=fem, analytic=ref, layer=layer, stress=stress)
 
 
 def write_outputs(outcome, out_dir, *, progress=None):
@@ -220,11 +236,17 @@ def write_outputs(outcome, out_dir, *, progress=None):
     files = {"result": FILES["result"], "scene": FILES["scene"], "bem_field": FILES["bem_field"]}
     if outcome.fem is not None:
         files["fem_field"] = FILES["fem_field"]
+    if outcome.stress is not None:
+        files["stress_field"] = FILES["stress_field"]
     outcome.result["files"] = dict(files)
     with atomic_directory(out_dir) as tmp:
         write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
         if outcome.fem is not None:
             outcome.fem.write(tmp / files["fem_field"])
+        if outcome.stress is not None:
+            from .stress_output import write_stress_field
+
+            write_stress_field(tmp / files["stress_field"], res, outcome.stress)
         write_text(tmp / files["scene"], tomli_w.dumps(scene.raw))
         atomic_write_json(tmp / files["result"], outcome.result)
     _notify(progress, "write", "done")
@@ -240,7 +262,8 @@ def run_scene(scene, out_dir=None, *, progress=None, overrides=None):
         A validated scene, a built-in name, a TOML path or a scene dict.
     out_dir : path-like, optional
         Result directory: ``result.json``, ``scene.toml`` (the effective scene, re-runnable),
-        ``bem_field.vtu`` and, with an FEM reference, ``fem_field.vtu``. Written atomically:
+        ``bem_field.vtu``, with an FEM reference ``fem_field.vtu``, with a ``[stress]`` section
+        ``stress_field.vtu`` (:mod:`validation.stress_output`). Written atomically:
         an existing result directory is replaced only when the run succeeded.
     progress : callable, optional
         See :func:`execute_scene`.

@@ -15,6 +15,7 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [analytic] only when wanted: kind = "hertz" | "hertz_elliptic" | "rigid_layer"
     [sweep]    only when wanted: parameter, values
     [report]   only when wanted: sections, format
+    [stress]   only when wanted: depths ("auto" or a list [m]), n_depths, max_depth, bodies
 
 :func:`load_scene` validates the WHOLE scene (every point of its sweep included) before any
 work: unknown keys, wrong types, out-of-range values, missing keys and impossible combinations
@@ -40,7 +41,7 @@ from .provenance import display_path
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
            "apply_overrides", "parse_override", "SECTIONS"]
 
-SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report")
+SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report", "stress")
 _REQUIRED = ("scene", "bodies", "gap", "load")
 _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
 
@@ -67,6 +68,7 @@ class Scene:
     sweep: dict | None = None
     report: dict | None = None
     overrides: tuple = field(default=())
+    stress: dict | None = None
 
     @property
     def axisymmetric(self):
@@ -212,13 +214,14 @@ def _validate(raw, source, overrides):
     analytic = check(lambda g, ls: sec.analytic(raw.get("analytic"), g[1], ls), shape, layer_spec)
     sweep = check(sec.sweep_spec, raw.get("sweep"), SECTIONS)
     report = check(sec.report, raw.get("report"))
+    stress = check(lambda b: sec.stress_options(raw.get("stress"), b["materials"]), body)
     if check.errors:
         raise SceneError.of(check.errors)
     return Scene(
         name=meta["name"], title=meta["title"], description=meta["description"], units=meta["units"],
         source=source, raw=raw, E_star=body["E_star"], materials=body["materials"], gap=shape[1],
         gap_spec=shape[0], layer_spec=layer_spec, load=load, bem=bem, fem=fem, analytic=analytic, sweep=sweep,
-        report=report, overrides=tuple(overrides),
+        report=report, overrides=tuple(overrides), stress=stress,
     )
 
 

@@ -24,12 +24,13 @@ from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
 from .sizing import DOMAIN_MARGIN, MAX_NODES, check_estimate, inner_domain, node_count
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "bem_options", "fem_options", "analytic",
-           "report", "sweep_spec", "scene_keys", "KEYS", "REPORT_SECTIONS", "ANALYTIC_KINDS", "DEFAULT_UNITS"]
+           "report", "sweep_spec", "stress_options", "scene_keys", "KEYS", "REPORT_SECTIONS", "ANALYTIC_KINDS",
+           "DEFAULT_UNITS"]
 
 DEFAULT_UNITS = "SI (m, Pa, N)"
 #: Section names the report builder knows (validation only; the builder lives in validation.report).
 REPORT_SECTIONS = ("summary", "scene", "profile", "pressure_map", "comparison", "convergence", "layer_law",
-                   "fem_field", "sweep", "timings")
+                   "fem_field", "sweep", "timings", "stress")
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
@@ -42,9 +43,12 @@ _FEM_KEYS = ("n_contact", "extent_factor", "fine_radius", "growth", "penalty", "
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
 KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *_BODY_KEYS),
         "load": ("force", "approach"), "bem": _BEM_KEYS, "fem": _FEM_KEYS, "analytic": ("kind",),
-        "sweep": ("parameter", "values"), "report": ("sections", "format")}
+        "sweep": ("parameter", "values"), "report": ("sections", "format"),
+        "stress": ("depths", "n_depths", "max_depth", "bodies")}
 GAP_TYPES = {cls.type_name: cls for cls in (gaps.Paraboloid, gaps.EllipticParaboloid, gaps.CrownedRoller,
                                             gaps.FlatPunch, gaps.Callable, gaps.Table)}
+_STRESS_KEYS = KEYS["stress"]
+STRESS_BODIES = ("body1", "body2")
 DEFAULT_NODES_ACROSS = 40
 DEFAULT_EXTENT_FACTOR = 1.5
 
@@ -365,3 +369,41 @@ def sweep_spec(d, known_sections):
     if len(set(map(repr, values))) != len(values):
         raise ck.SceneError(f"sweep.values = {values!r} is not allowed: the values must be distinct.")
     return {"parameter": param, "key": key, "values": list(values)}
+
+
+def stress_options(d, materials):
+    """``[stress]``: ``depths`` (``"auto"`` or a list [m]), ``n_depths`` and ``max_depth`` (with
+    ``"auto"``: that many depths from 0 down to ``max_depth`` contact half-widths), ``bodies``."""
+    if d is None:
+        return None
+    ck.table("stress", d)
+    ck.unknown_keys("stress", d, _STRESS_KEYS)
+    if materials is None:
+        raise ck.SceneError("stress = {...} is not allowed with bodies.E_star: the stresses depend on each body's "
+                            "Poisson ratio; give bodies.E1, nu1, E2, nu2.")
+    depths = d.get("depths", "auto")
+    out = {"depths": depths}
+    if depths == "auto":
+        out["n_depths"] = ck.integer("stress.n_depths", d.get("n_depths", 32), 2, 1000)
+        out["max_depth"] = ck.in_range("stress.max_depth", d.get("max_depth", 3.0), 0.0, 50.0, low_open=True)
+    else:
+        for key in ("n_depths", "max_depth"):
+            if key in d:
+                raise ck.SceneError(f"stress.{key} = {d[key]!r} is not allowed with a list of stress.depths: it sets "
+                                    'the depths of depths = "auto" only.')
+        if not isinstance(depths, list) or not depths or len(depths) > 1000:
+            raise ck.SceneError(f"stress.depths = {depths!r} is not allowed: it must be \"auto\" or a list of 1 to "
+                                "1000 depths below the surface [m], e.g. [0.0, 1e-4, 2e-4].")
+        out["depths"] = [ck.nonnegative(f"stress.depths[{i}]", v) for i, v in enumerate(depths)]
+        if len(set(out["depths"])) != len(depths):
+            raise ck.SceneError(f"stress.depths = {depths!r} is not allowed: the depths must be distinct.")
+    bodies = d.get("bodies", list(STRESS_BODIES))
+    if not isinstance(bodies, list) or not bodies:
+        raise ck.SceneError(f"stress.bodies = {bodies!r} is not allowed: it must be a non-empty list of "
+                            f"{', '.join(map(repr, STRESS_BODIES))} (body1: E1, nu1; body2: E2, nu2).")
+    for i, name in enumerate(bodies):
+        ck.choice(f"stress.bodies[{i}]", name, STRESS_BODIES)
+    if len(set(bodies)) != len(bodies):
+        raise ck.SceneError(f"stress.bodies = {bodies!r} is not allowed: name each body once.")
+    out["bodies"] = list(bodies)
+    return out

@@ -36,8 +36,8 @@ def report(paper, tmp_path_factory):
 def test_paper_report_files(report):
     text = report.html.read_text(encoding="utf-8")
     assert_valid_offline_html(text)
-    assert len(report.figures) == 18
-    assert len(re.findall(r'src="data:image/png;base64,', text)) == 18
+    assert len(report.figures) == 19
+    assert len(re.findall(r'src="data:image/png;base64,', text)) == 19
     for path in report.figures:
         assert path.read_bytes().startswith(PNG_MAGIC)
         check_png(path)
@@ -57,7 +57,7 @@ def test_paper_report_without_fem_has_no_fem_section(paper, tmp_path):
     built = build_report(paper_sections(bem_only, tmp_path / "w"), tmp_path / "out", title=TITLE)
     text = built.html.read_text(encoding="utf-8")
     assert "kind-fem" not in text and "FEM reference" not in text
-    assert len(built.figures) == 12
+    assert len(built.figures) == 13
 
 
 def test_paper_trends(paper):
@@ -168,3 +168,18 @@ def test_paper_report_tells_its_stages(paper, monkeypatch, tmp_path):
                                           progress=lambda *a: calls.append(a))
         n = len(stages)
         assert calls == [(s, k, n) for k, s in enumerate(stages)] + [("done", n, n)]
+
+
+def test_paper_stresses_every_layer_lowers_the_subsurface_maximum(paper):
+    """Smooth: Hertz's 0.62 p0 at 0.48 a_H; every law of Fig. 5 lowers the maximum at the same force."""
+    pb, st = paper.problem, paper.stress
+    assert set(st) == set(paper.laws)
+    smooth = st["smooth"]
+    assert smooth.max_von_mises / pb.p0 == pytest.approx(0.620, rel=0.01)
+    assert smooth.depth_of_max / pb.a == pytest.approx(0.481, abs=0.02)
+    for label, s in st.items():
+        if label != "smooth":
+            assert s.max_von_mises < smooth.max_von_mises, label
+    # the linear and root layers flatten the pressure most: the maximum moves deeper
+    assert st["linear Winkler"].depth_of_max > smooth.depth_of_max
+    assert st["root"].depth_of_max > smooth.depth_of_max

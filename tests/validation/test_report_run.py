@@ -159,12 +159,13 @@ def test_sections_follow_the_data(reports):
         assert (kinds[name][-1] == "validation") == bool(rep["res"].data.get("comparison")), name
         if kinds[name][-1] == "validation":
             kinds[name].pop()
-    assert kinds["hertz"] == ["problem", "results", "iterations", "fem"]
+    assert kinds["hertz"] == ["problem", "results", "iterations", "fem", "results"]  # [stress]: last "results"
     assert kinds["paper_elastic_rigid"] == ["problem", "results", "iterations", "fem"]
     assert kinds["elliptic"] == kinds["roller"] == ["problem", "results", "iterations"]
     names = {name: sorted(p.name for p in rep["built"].figures) for name, rep in reports.items()}
-    assert names["hertz"] == ["contact_map.png", "convergence.png", "fem_von_mises.png", "profile_x.png"]
-    assert names["paper_elastic_rigid"] == sorted(names["hertz"] + ["layer_law.png"])
+    base = ["contact_map.png", "convergence.png", "fem_von_mises.png", "profile_x.png"]
+    assert names["hertz"] == sorted(base + ["stress_profiles.png", "stress_section.png"])
+    assert names["paper_elastic_rigid"] == sorted(base + ["layer_law.png"])
     assert names["elliptic"] == names["roller"] == ["contact_map.png", "convergence.png", "profile_x.png",
                                                     "profile_y.png"]
 

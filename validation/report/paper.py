@@ -14,7 +14,8 @@ Two paraboloids in normalised units ``R = E* = P = 1`` (Hertz: ``a_H = (3PR/4E*)
 - bilinear: slope ``lam`` up to ``p_star = alpha_a p_max^lambda``, slope
   ``lam2 = lam tan(alpha_c)`` beyond (``alpha_c -> 0``: elastic-rigid; ``pi/4``: linear).
 
-Everything is solved with :func:`bem.solve`; the FEM reference with
+Everything is solved with :func:`bem.solve`, the subsurface stresses of every law with
+:func:`bem.subsurface_stress` (both bodies alike, ``nu = 0.3``); the FEM reference with
 :func:`fem_reference.solve` (two equal bodies, ``nu = 0.3``, ``E = 2 (1 - nu^2) E*``).
 """
 
@@ -32,7 +33,8 @@ import bem
 from validation.analytic import hertz_sphere
 from validation.paper import paper_law
 
-__all__ = ["PaperProblem", "PaperResults", "solve_paper_problem", "AG_RELAXATION", "SOLVE_STAGES"]
+__all__ = ["PaperProblem", "PaperResults", "solve_paper_problem", "AG_RELAXATION", "SOLVE_STAGES",
+           "STRESS_DEPTHS"]
 
 log = logging.getLogger(__name__)
 
@@ -40,6 +42,8 @@ log = logging.getLogger(__name__)
 AG_RELAXATION = 0.08
 #: timed runs per point of the resolution study (median and spread drawn); one for runs slower than WP_SLOW_S [s]
 WP_REPEATS, WP_SLOW_S = 3, 2.0
+#: depths of the subsurface stresses of the laws [a_H]
+STRESS_DEPTHS = np.linspace(0.0, 3.0, 61)
 
 
 @dataclass(frozen=True)
@@ -171,6 +175,9 @@ class PaperResults:
         One row per (law, method): ``law, method, status, iterations, p_max, kkt, time``.
     fem : dict
         Label -> ``(bem_result, fem_result)`` (empty when the FEM was not run).
+    stress : dict
+        Label -> :class:`bem.SubsurfaceStress` of the Fig. 5 case (Newton), ``nu`` of the FEM
+        bodies, depths :data:`STRESS_DEPTHS` times ``a_H``, every candidate node.
     work_precision : list of dict
         Rows ``solver, method, resolution, N, error, wall_time_s`` (median) and ``wall_times_s``
         (every repeat) of the Hertz study.
@@ -189,6 +196,7 @@ class PaperResults:
     stability: list = field(default_factory=list)
     fem: dict = field(default_factory=dict)
     work_precision: list = field(default_factory=list)
+    stress: dict = field(default_factory=dict)
     wall_time_s: float = 0.0
 
     @property
@@ -318,6 +326,7 @@ def solve_paper_problem(problem=None, *, quick=False, fem=True, progress=None):
     for label in ("elastic-rigid", "root", "bilinear"):
         res.base[label] = pb.solve(res.laws[label])
     res.base["bilinear, variable compliance"] = pb.solve(res.laws["bilinear"], method="variable_compliance")
+    res.stress = {label: bem.subsurface_stress(res.base[label], STRESS_DEPTHS * pb.a, nu=pb.nu) for label in res.laws}
     notify(SOLVE_STAGES[1])
     _sweeps(pb, res, quick)
     notify(SOLVE_STAGES[2])

@@ -20,6 +20,7 @@ from . import figures_validation as fva
 from .build import Progress, draw_and_build
 from .figures_fem import plot_von_mises
 from .paper import AG_RELAXATION, SOLVE_STAGES, solve_paper_problem
+from .paper_stress import stress_section
 from .sections import Figure, Section, Table, problem_section
 from .style import method_label
 
@@ -301,8 +302,11 @@ def _validation(res, work):
 def paper_sections(res, work):
     """The report sections of solved :class:`validation.report.paper.PaperResults`; figures go to ``work``."""
     work = Path(work)
-    sections = [_problem(res, work), _distributions(res, work), _iterations(res, work), _sweeps(res, work),
-                _stability(res)]
+    sections = [_problem(res, work), _distributions(res, work)]
+    stress = stress_section(res, work)
+    if stress is not None:
+        sections.append(stress)
+    sections += [_iterations(res, work), _sweeps(res, work), _stability(res)]
     if res.fem:
         sections.append(_validation(res, work))
     return sections

@@ -2,8 +2,9 @@
 
 Only the sections the results support: the problem statement (from ``scene.toml``), the
 results table, the pressure profiles against the FEM and the closed form when they ran,
-the contact map, the convergence history, the FEM reference only when the FEM ran and the
-comparison metrics only when they were recorded. Units are the scene's (``[scene] units``).
+the contact map, the convergence history, the FEM reference only when the FEM ran, the
+subsurface stresses only when the scene asked for them and the comparison metrics only when
+they were recorded. Units are the scene's (``[scene] units``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from ..provenance import display_path
 from . import run_figures as rf
 from .build import Progress, draw_and_build
 from .run_problem import method_text, problem_statement, rebuild_layer
+from .run_stress import stress_section
 from .sections import Section, Table, fmt
 
 __all__ = ["run_sections", "report_results_dir", "results_rows", "comparison_tables", "STAGES"]
@@ -95,7 +97,8 @@ def _run_rows(res):
             rows.append((label, fmt(b[key], 3), "-"))
     times = res.get("wall_time_s") or {}
     for key, label in (("layer_reference", "wall time: reference solve of the layer"), ("bem", "wall time: BEM"),
-                       ("fem", "wall time: FEM"), ("total", "wall time: whole run")):
+                       ("fem", "wall time: FEM"), ("stress", "wall time: subsurface stresses"),
+                       ("total", "wall time: whole run")):
         if _num(times.get(key)):
             rows.append((label, fmt(times[key], 3), "s"))
     return tuple(rows)
@@ -224,6 +227,9 @@ def run_sections(res, work):
         sections.append(conv)
     if res.fem is not None:
         sections.append(_fem(res, work))
+    stress = stress_section(res, work)
+    if stress is not None:
+        sections.append(stress)
     comparison = res.get("comparison")
     if comparison:
         tables = comparison_tables(comparison, res.units)
