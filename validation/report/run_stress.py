@@ -29,7 +29,7 @@ def _view(res, bodies):
     """``(a, scale, length name, stress name, normalised)``."""
     scales = scales_of(res)
     if scales is not None:
-        return scales[1], scales[0], "a_H", "p_H", True
+        return scales[1], scales[0], scales[3], scales[2], True
     peak = max(float(b["max_von_mises"]) for b in bodies.values())
     depth = max(float(np.max(b["axis"]["z"])) for b in bodies.values())
     l_unit, a = display_unit(res.units.length, depth)
@@ -39,9 +39,10 @@ def _view(res, bodies):
 
 def _hertz_axis(res, z, nu):
     """Hertz's von Mises stress on the axis (Johnson 1985, eq. 3.45) [pressure], or None."""
-    if (res.get("analytic") or {}).get("kind") != "hertz" or scales_of(res) is None:
+    sc = res.get("scales") or {}
+    p0, a = sc.get("p_hertz"), sc.get("a_hertz")
+    if (res.get("analytic") or {}).get("kind") != "hertz" or not (p0 and a):
         return None
-    p0, a = scales_of(res)
     zeta = np.maximum(np.asarray(z, dtype=float) / a, 1e-12)
     s_z = -1.0 / (1.0 + zeta**2)
     s_r = -(1.0 + nu) * (1.0 - zeta * np.arctan(1.0 / zeta)) + 0.5 / (1.0 + zeta**2)
