@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Regenerate every report the repository keeps (about 8 minutes on 2 cores):
+# Regenerate every report the repository keeps (about 15 minutes on 2 cores):
 #   reports/paper/        the paper's test problem (Fig. 4-11 analogues, validation)
 #   reports/hertz/        the built-in Hertz scene: BEM + FEM + closed form
-#   reports/studies/      raw study output (error_time.*, stability.*)
-#   reports/validation/   the report of the two studies (work-precision plots, stability table)
+#   reports/studies/      raw study output (error_time.*, stability.*, robustness.*)
+#   reports/validation/   the report of the studies (work-precision plots, stability and robustness tables)
 # Usage, from the repository root:  bash docs/regenerate_reports.sh
 # Every path given is relative: the reports name their sources relative to the working
 # directory and record the command in their footer, so nothing kept names a machine path.
@@ -14,6 +14,7 @@ contactlab --no-progress report hertz --out build/hertz   # build/ is not kept (
 rm -rf reports/hertz && cp -r build/hertz/report reports/hertz
 contactlab --no-progress study error-time --out reports/studies
 contactlab --no-progress study stability --out reports/studies
+contactlab --no-progress study robustness --out reports/studies
 contactlab --no-progress report reports/studies --out reports/validation
 if grep -rlE --include="*.md" --include="*.json" "(/tmp/|/home/|/root/|/work/|/Users/)" reports/; then
     echo "regenerate_reports.sh: the files above name machine paths" >&2

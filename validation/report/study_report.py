@@ -20,7 +20,7 @@ from .sections import Figure, Section, Table, table_from_rows
 
 __all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "report_studies_dir"]
 
-STUDY_FILES = ("error_time.json", "stability.json")
+STUDY_FILES = ("error_time.json", "stability.json", "robustness.json")
 
 
 def is_study_dir(directory):
@@ -108,6 +108,19 @@ def _stability_sections(data):
     return [Section("Stability", "stability", text, (summary, detail))]
 
 
+def _robustness_sections(data):
+    from validation.studies import robustness as rb
+
+    rows = rb.rows_from_json(data)
+    tables = [Table(*map(tuple, (h, [tuple(r) for r in b])), caption=cap) for (h, b), cap in (
+        (rb.summary_table(rows), "Outcomes per method and control over the whole grid; a converged answer is "
+                                 "checked against the KKT conditions with the dense influence matrix."),
+        *[(rb.matrix_table(rows, m), f"{m}: converged out of all (E*, control) per exponent s (rows) and "
+                                     "compliance k (columns).") for m in rb.LAYER_METHODS],
+        (rb.failure_table(rows), "Every outcome that is not converged."))]
+    return [Section("Robustness of the layer methods", "stability", [rb.SETTING], tuple(tables))]
+
+
 def study_sections(directory, work):
     """Sections for the study files present in ``directory``."""
     directory = Path(directory)
@@ -118,6 +131,9 @@ def study_sections(directory, work):
     path = directory / "stability.json"
     if path.is_file():
         sections += _stability_sections(json.loads(path.read_text()))
+    path = directory / "robustness.json"
+    if path.is_file():
+        sections += _robustness_sections(json.loads(path.read_text()))
     if not sections:
         raise InputError(f"directory = {str(directory)!r} is not allowed: it holds none of {list(STUDY_FILES)}.")
     return sections

@@ -30,7 +30,8 @@ import numpy as np
 
 from . import fmt, markdown_table, write_json, write_text
 
-__all__ = ["RobustnessRow", "run_robustness", "summary_markdown", "main", "EXPONENTS", "COMPLIANCES", "MODULI"]
+__all__ = ["RobustnessRow", "run_robustness", "summary_markdown", "summary_table", "matrix_table", "failure_table",
+           "rows_from_json", "main", "EXPONENTS", "COMPLIANCES", "MODULI"]
 
 log = logging.getLogger(__name__)
 
@@ -156,13 +157,8 @@ def _counts(rows, key):
     return out
 
 
-def summary_markdown(rows):
-    """Markdown: counts and times per method and control, the map of outcomes over (s, k), the failures."""
-    lines = ["# Robustness of the layer methods", "",
-             f"Paraboloid R = 1, P = 1, power layer `w = lam p^s`; {NODES_ACROSS} nodes across the contact; "
-             f"rtol = {RTOL:g}; KKT of eq. 14 checked with the dense influence matrix. `k`: the layer's secant "
-             "compliance at the Hertz mean pressure over the elastic compliance of the contact; E* relative "
-             "to P/R^2.", "", "## Outcomes per method and control", ""]
+def summary_table(rows):
+    """``(headers, body)``: outcomes, times and the worst dense KKT residual per method and control."""
     body = []
     for (method, control), c in sorted(_counts(rows, lambda r: (r.method, r.control)).items()):
         times = [r.wall_time_s for r in rows if r.method == method and r.control == control]
@@ -171,32 +167,55 @@ def summary_markdown(rows):
         body.append([method, control, c["converged"], c["reported failure"], c["wrong"],
                      fmt(float(np.median(times)), ".3f"), fmt(max(times), ".3f"),
                      fmt(max(kkts), ".1e") if kkts else "-"])
-    lines += [markdown_table(["method", "control", "converged", "reported failure", "wrong", "median time [s]",
-                              "max time [s]", "worst dense KKT when converged"], body), ""]
-    lines += ["## Converged out of all (E*, control) per exponent s and compliance k", ""]
+    return (["method", "control", "converged", "reported failure", "wrong", "median time [s]", "max time [s]",
+             "worst dense KKT when converged"], body)
+
+
+def matrix_table(rows, method):
+    """``(headers, body)``: converged out of all (E*, control) per exponent ``s`` (rows) and ``k`` (columns)."""
+    sel = [r for r in rows if r.method == method]
     ks = sorted({r.k for r in rows})
+    body = []
+    for s in sorted({r.s for r in sel}):
+        cells = []
+        for k in ks:
+            cell = [r for r in sel if r.s == s and r.k == k]
+            n_wrong = sum(r.status == "wrong" for r in cell)
+            cells.append(f"{sum(r.status == 'converged' for r in cell)}/{len(cell)}"
+                         + (f" ({n_wrong} wrong)" if n_wrong else ""))
+        body.append([fmt(s, "g")] + cells)
+    return ["s \\ k"] + [fmt(k, "g") for k in ks], body
+
+
+def failure_table(rows):
+    """``(headers, body)``: every outcome that is not converged."""
+    return (["method", "control", "s", "k", "E*", "status", "dense KKT", "message"],
+            [[r.method, r.control, fmt(r.s, "g"), fmt(r.k, "g"), fmt(r.E_star, "g"), r.status, fmt(r.kkt_dense, ".1e"),
+              r.message[:110]] for r in rows if r.status != "converged"])
+
+
+SETTING = (f"Paraboloid R = 1, P = 1, power layer `w = lam p^s`; {NODES_ACROSS} nodes across the contact; "
+           f"rtol = {RTOL:g}; KKT of eq. 14 checked with the dense influence matrix. `k`: the layer's secant "
+           "compliance at the Hertz mean pressure over the elastic compliance of the contact; E* relative to P/R^2.")
+
+
+def summary_markdown(rows):
+    """Markdown: counts and times per method and control, the map of outcomes over (s, k), the failures."""
+    lines = ["# Robustness of the layer methods", "", SETTING, "", "## Outcomes per method and control", "",
+             markdown_table(*summary_table(rows)), "",
+             "## Converged out of all (E*, control) per exponent s and compliance k", ""]
     for method in LAYER_METHODS:
-        sel = [r for r in rows if r.method == method]
-        if not sel:
-            continue
-        lines += [f"### {method}", ""]
-        body = []
-        for s in sorted({r.s for r in sel}):
-            cells = []
-            for k in ks:
-                cell = [r for r in sel if r.s == s and r.k == k]
-                n_ok = sum(r.status == "converged" for r in cell)
-                n_wrong = sum(r.status == "wrong" for r in cell)
-                cells.append(f"{n_ok}/{len(cell)}" + (f" ({n_wrong} wrong)" if n_wrong else ""))
-            body.append([fmt(s, "g")] + cells)
-        lines += [markdown_table(["s \\ k"] + [fmt(k, "g") for k in ks], body), ""]
-    bad = [r for r in rows if r.status != "converged"]
-    if bad:
-        lines += ["## Every outcome that is not converged", ""]
-        lines += [markdown_table(["method", "control", "s", "k", "E*", "status", "dense KKT", "message"],
-                                 [[r.method, r.control, fmt(r.s, "g"), fmt(r.k, "g"), fmt(r.E_star, "g"), r.status,
-                                   fmt(r.kkt_dense, ".1e"), r.message[:110]] for r in bad]), ""]
+        if any(r.method == method for r in rows):
+            lines += [f"### {method}", "", markdown_table(*matrix_table(rows, method)), ""]
+    if any(r.status != "converged" for r in rows):
+        lines += ["## Every outcome that is not converged", "", markdown_table(*failure_table(rows)), ""]
     return "\n".join(lines)
+
+
+def rows_from_json(data):
+    """:class:`RobustnessRow` objects from the content of ``robustness.json``."""
+    return [RobustnessRow(**{**d, "kkt_dense": None if d["kkt_dense"] is None else float(d["kkt_dense"])})
+            for d in data]
 
 
 def _json_row(row):
