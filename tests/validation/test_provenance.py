@@ -121,8 +121,6 @@ def test_reports_name_no_machine_path(elliptic_dir, tmp_path, monkeypatch):
     assert "Studies read from studies" in _text(studies.markdown)
 
 
-@pytest.mark.xfail(strict=True, reason="reports/hertz and reports/validation were built before this change and name "
-                   "/tmp and /work paths: regenerate them (bash docs/regenerate_reports.sh), then delete this marker")
 def test_kept_reports_name_no_machine_path():
     kept = [p for p in (ROOT / "reports").rglob("*") if p.suffix in (".md", ".html", ".json")]
     assert kept
