@@ -26,7 +26,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from bem.checks import InputError, fail, check_callable, check_choice, check_finite_array, check_positive
+from bem.checks import InputError, fail, check_callable, check_choice, check_positive
 
 __all__ = ["Gap", "Paraboloid", "EllipticParaboloid", "CrownedRoller", "FlatPunch", "Callable",
            "Table", "gap_from_dict", "lundberg_coefficient"]

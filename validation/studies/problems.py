@@ -12,7 +12,6 @@ peak, ``w(p0) / p0``, to the elastic compliance over the contact, ``C_el = delta
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
