@@ -5,7 +5,7 @@ one body (its own Poisson ratio; for dissimilar bodies call it once per body) un
 piecewise-linear BEM pressure ``sum_m p_m pyr_m``, frictionless: ``sigma(r_n, z) = sum_m p_m
 K(r_n - r_m, z)`` with ``K`` the stress influence of one pyramid at depth ``z``
 (:mod:`bem.boussinesq`), a discrete convolution on the lattice done by zero-padded FFTs
-(:class:`bem.operator.SymmetricKernelConvolution`), ``O(N log N)`` per depth, no matrix.
+(:class:`bem.kernel_convolution.SymmetricKernelConvolution`), ``O(N log N)`` per depth, no matrix.
 
 Why a closed-form kernel in real space and not Fourier transfer functions: the Boussinesq
 transfer functions give the stresses of a *periodic* pressure; the influence of the periodic
@@ -41,7 +41,7 @@ import numpy as np
 
 from . import boussinesq as bq
 from .checks import InputError, check_finite_array, check_range
-from .operator import SymmetricKernelConvolution
+from .kernel_convolution import SymmetricKernelConvolution
 from .result import ContactResult
 
 __all__ = ["subsurface_stress", "SubsurfaceStress", "VOIGT", "principal_stresses"]

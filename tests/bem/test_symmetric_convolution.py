@@ -1,4 +1,4 @@
-"""bem.operator.SymmetricKernelConvolution against the dense double sum (any parity, any input box)."""
+"""bem.kernel_convolution.SymmetricKernelConvolution against the dense double sum (any parity, any input box)."""
 
 import math
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from bem.lattice import Lattice
-from bem.operator import SymmetricKernelConvolution
+from bem.kernel_convolution import SymmetricKernelConvolution
 
 
 def kernel(x, y, odd_x, odd_y):
