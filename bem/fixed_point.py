@@ -61,11 +61,9 @@ class _Tracker:
         if record:
             self.hist["p"] = []
         self.growing = 0
-        self.applies = 0
         self.best, self.since_best = np.inf, 0
 
     def count_inner(self, sub):
-        self.applies += sub.applies
         if not sub.converged:
             self.hist["inner_missed"] += 1
             self.hist["inner_worst"] = max(self.hist["inner_worst"], float(sub.kkt_residual))
@@ -106,8 +104,7 @@ class _Tracker:
         if not converged:
             log.debug("%s: %s", name, message)
         return QPSolution(p=p, approach=delta, iterations=len(self.hist["residual"]), converged=converged,
-                          message=message, kkt_residual=float(kkt), displacement=u, history=self.hist,
-                          applies=self.applies)
+                          message=message, kkt_residual=float(kkt), displacement=u, history=self.hist)
 
 
 def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, eps_h=None,

@@ -35,7 +35,6 @@ class QPSolution:
     kkt_residual: float
     displacement: np.ndarray
     history: dict = field(default_factory=dict)
-    applies: int = 0
 
 
 def _initial(op, h, lam, force, approach, x0):
@@ -133,7 +132,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         return full
 
     u = apply(p)
-    applies, stale = 1, 0
+    stale = 0
     t = np.zeros(lat.shape)
     gz_old, restart = 1.0, True
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
@@ -171,7 +170,6 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             kkt = np.inf
         if kkt <= rtol and stale:
             u, stale = apply(p), 0  # confirm on an exact product
-            applies += 1
             continue
         changes = int(np.count_nonzero(contact != prev_contact))
         prev_contact = contact
@@ -201,7 +199,6 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 # oblique projection onto sum z = 0: z - M1 (1.z) / (1.M1), M1 cached per contact set
                 if m_one is None or changes:
                     m_one = preconditioner(contact.astype(float)).flat[idx]
-                    applies += 1
                 z -= m_one * (z.sum() / m_one.sum())
         gz = float(np.sum(g_c * z))
         beta = 0.0 if restart else gz / gz_old
@@ -211,7 +208,6 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         t = spread(idx, t_c)
         gz_old = gz
         r = apply(t)
-        applies += 1
         r_c = r.flat[idx]
         if force is not None:
             r_c -= r_c.mean()
@@ -245,7 +241,6 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             p_new.flat[overlap[~contact.flat[overlap]]] *= s  # a clipped contact node may re-enter
         if clipped.any() or restart or stale >= _RECOMPUTE_EVERY:
             u, stale = apply(p_new), 0
-            applies += 1
         else:
             r *= tau
             u -= r
@@ -260,8 +255,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     if not converged:
         log.debug("Kalker QP: %s", message)
     return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
-                      message=message, kkt_residual=float(kkt), displacement=u, history=hist,
-                      applies=applies)
+                      message=message, kkt_residual=float(kkt), displacement=u, history=hist)
 
 
 def compliance_preconditioner(op, D, contact, threshold=4.0):

@@ -122,21 +122,21 @@ def _release(op, layer, h, p, u, q, delta, *, force):
     approached geometrically by damped steps (``p -> (1 - t) p``), where ``w'`` grows
     without bound: it never reaches 0, and its gap stays violated. The projected move
     to 0 is tried once per step and kept when the functional decreases; it costs one
-    product with ``C``. Returns ``(p, u, n_products)``.
+    product with ``C``. Returns ``(p, u)``.
     """
     mask = op.lattice.mask
     out = mask & (q == 0) & (p > 0)
     if not out.any():
-        return p, u, 0
+        return p, u
     trial = np.where(out, 0.0, p)
     if force is not None and trial.sum() <= 0:
-        return p, u, 0
+        return p, u
     trial = _scaled(trial, force, op.lattice.node_area)
     dp = trial - p
     c_dp = op.matvec(dp)
     if _energy_change(layer, p, dp, u, c_dp, h, delta, mask) < 0:
-        return trial, u + c_dp, 1
-    return p, u, 1
+        return trial, u + c_dp
+    return p, u
 
 
 def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, maxiter=100,
@@ -187,7 +187,6 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     """
     mask = op.lattice.mask
     h = np.where(mask, h, 0.0)
-    applies = 0
     if x0 is None:
         # smooth-body solution, then one secant (variable compliance) step: a start
         # that is fair for stiff and for layer-dominated problems alike
@@ -198,13 +197,12 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         if np.isfinite(lam) and lam > 0:
             start = solve_qp(op, h, force=force, approach=approach, lam=lam, rtol=1e-3,
                              preconditioner=op.preconditioner(lam=lam) if precondition else None)
-        p, applies = start.p, start.applies
+        p = start.p
     else:
         p = np.where(mask, np.maximum(x0, 0.0), 0.0)
         if force is not None:
             p *= force / op.lattice.node_area / p.sum()
     u = op.matvec(p)
-    applies += 1
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "step": [], "inner_iterations": [],
             "inner_missed": 0, "inner_worst": 0.0}
     if record:
@@ -215,7 +213,6 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach)
         if kkt <= rtol and not exact:  # confirm on an exact product before stopping
             u, exact = op.matvec(p), True
-            applies += 1
             gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach)
         contact = p > 0
         hist["residual"].append(kkt)
@@ -240,7 +237,6 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         inner = max(rtol / 3, min(1e-2, 0.1 * kkt**1.5))
         sub = solve_qp(op, b, force=force, approach=approach, lam=D, x0=p, rtol=inner, maxiter=inner_maxiter,
                        preconditioner=compliance_preconditioner(op, D, contact) if precondition else None)
-        applies += sub.applies
         _count_inner(hist, sub)
         d = sub.p - p
         cd = (sub.displacement - D * sub.p) - u
@@ -252,7 +248,6 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             sub = solve_qp(op, b, force=force, approach=approach, lam=D, x0=p, rtol=max(rtol / 3, 1e-3 * kkt),
                            maxiter=4 * inner_maxiter, scale=scale,
                            preconditioner=compliance_preconditioner(op, D, contact) if precondition else None)
-            applies += sub.applies
             _count_inner(hist, sub)
             d = sub.p - p
             cd = (sub.displacement - D * sub.p) - u
@@ -266,7 +261,6 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             for t_try in (1.0, 0.5, 0.25, 0.125):
                 trial = _scaled(np.maximum(p + t_try * d, 0.0), force, op.lattice.node_area)
                 u_trial = op.matvec(trial)
-                applies += 1
                 if layered_state(op, h, layer, trial, u_trial, force=force, approach=approach)[2] < kkt:
                     judged = t_try
                     break
@@ -280,14 +274,13 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         else:
             p = _scaled(np.maximum(p + t * d, 0.0), force, op.lattice.node_area)
             u, exact = u + t * cd, False
-        p, u, released = _release(op, layer, h, p, u, sub.p, delta, force=force)
-        applies += released
+        p, u = _release(op, layer, h, p, u, sub.p, delta, force=force)
         if callback is not None:
             callback(k + 1, p)
     if not converged:
         log.debug("Newton: %s", message)
     out = QPSolution(p=p, approach=delta, iterations=len(hist["step"]), converged=converged, message=message,
-                     kkt_residual=float(kkt), displacement=u, history=hist, applies=applies)
+                     kkt_residual=float(kkt), displacement=u, history=hist)
     if force is not None and not converged and np.isfinite(delta) and delta > 0:
         out = _force_by_approach(op, h, layer, force, out, rtol=rtol, maxiter=maxiter, precondition=precondition,
                                  inner_maxiter=inner_maxiter)
@@ -345,5 +338,4 @@ def _force_by_approach(op, h, layer, force, failed, *, rtol, **kw):
     message = (f"KKT residual {kkt:.2e} {'<=' if converged else '>'} rtol {rtol:.1e}: force control by "
                f"{len(solved)} approach-controlled solves ({steps} Newton steps) after '{failed.message}'")
     return QPSolution(p=sol.p, approach=delta_f, iterations=failed.iterations + steps, converged=converged,
-                      message=message, kkt_residual=float(kkt), displacement=u, history=hist,
-                      applies=failed.applies + sum(s.applies for s in solved.values()) + 1)
+                      message=message, kkt_residual=float(kkt), displacement=u, history=hist)
