@@ -26,6 +26,7 @@ __all__ = [
     "check_callable",
     "check_int",
     "check_bool",
+    "check_load",
 ]
 
 
@@ -117,3 +118,16 @@ def check_bool(name, value):
     if not isinstance(value, (bool, np.bool_)):
         fail(name, value, "True or False")
     return bool(value)
+
+
+def check_load(force, approach):
+    """Return ``(force, approach)`` with exactly one given, as a float ``> 0``, the other ``None``.
+
+    Force control gives the total force ``P`` [force], approach control the approach
+    ``delta`` [length].
+    """
+    if (force is None) == (approach is None):
+        fail("(force, approach)", (force, approach), "exactly one given (force control or approach control)")
+    if force is not None:
+        return check_positive("force", force), None
+    return None, check_positive("approach", approach)

@@ -98,8 +98,8 @@ class ContactResult:
         out[self.lattice.mask] = self.p if values is None else values
         return out
 
-    def pressure_at(self, x, y):
-        """The piecewise-linear pressure field at arbitrary points [pressure]."""
+    def pressure(self, x, y=0.0):
+        """The piecewise-linear pressure field at arbitrary points ``(x, y)`` [pressure]."""
         return self.lattice.interpolate(self.grid(), x, y)
 
     def summary(self):

@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from .checks import check_bool, check_callable, check_choice, check_int, check_positive, check_range
+from .checks import check_bool, check_callable, check_choice, check_int, check_load, check_positive, check_range
 from .errors import InputError, RegionTooSmallError
 from .kkt import kkt_residual
 from .lattice import Lattice
@@ -33,14 +33,6 @@ def _modulus(E_star, E1, nu1, E2, nu2):
     if not all(given):
         raise InputError("E_star = None is not allowed without all of E1, nu1, E2, nu2: give E_star or all four.")
     return effective_modulus(E1, nu1, E2, nu2)
-
-
-def _load(force, approach):
-    if (force is None) == (approach is None):
-        raise InputError(f"force = {force!r}, approach = {approach!r} is not allowed: give exactly one of them.")
-    if force is not None:
-        return check_positive("force", force), None
-    return None, float(check_positive("approach", approach))
 
 
 def _levels(lattice, nested):
@@ -205,7 +197,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     t_start = time.perf_counter()
     check_callable("gap", gap)
     E_star = _modulus(E_star, E1, nu1, E2, nu2)
-    force, approach = _load(force, approach)
+    force, approach = check_load(force, approach)
     check_choice("method", method, METHODS)
     rtol = check_positive("rtol", rtol)
     if maxiter is not None:

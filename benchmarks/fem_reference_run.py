@@ -24,7 +24,7 @@ def hertz(force, radius, Es):
 
 def report(label, res, exact=None):
     t = res.timings
-    print(f"\n{label}: converged={res.converged} ({res.reason}), Newton steps={res.iterations}")
+    print(f"\n{label}: converged={res.converged} ({res.message}), Newton steps={res.iterations}")
     print(f"  DOFs={res.n_dofs}  triangles={res.n_elements}  interface pairs={res.n_interface_nodes}  "
           f"elements across contact={res.n_elements_across_contact:.1f}")
     print(f"  time [s]: mesh={t['mesh']:.2f} assembly={t['assembly']:.2f} solve={t['solve']:.2f} "

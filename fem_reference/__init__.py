@@ -8,10 +8,8 @@ problem (:mod:`fem_reference.newton`), and the fields written for ParaView with 
 (:mod:`fem_reference.fields`). Heavy packages are imported inside the functions.
 """
 
-from .estimate import estimate_contact_radius, hertz_radius, layer_radius
 from .mesh import AxiMesh, build_mesh
 from .result import FemResult
 from .solve import solve
 
-__all__ = ["solve", "FemResult", "build_mesh", "AxiMesh", "estimate_contact_radius", "hertz_radius",
-           "layer_radius"]
+__all__ = ["solve", "FemResult", "build_mesh", "AxiMesh"]

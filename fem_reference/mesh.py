@@ -255,7 +255,7 @@ def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, grow
     Parameters
     ----------
     a_est : float
-        Expected contact radius [length] (see :func:`fem_reference.estimate_contact_radius`).
+        Expected contact radius [length] (see :func:`bem.reference.estimate_contact_radius`).
     n_contact : int
         Elements across ``a_est`` in the contact zone: ``h_fine = a_est / n_contact``.
     extent_factor : float

@@ -54,7 +54,7 @@ class InterfaceSolution:
         Approach [length] (the ``delta`` of ``C``'s frame; see :func:`solve_interface`).
     converged : bool
         Whether the stopping rule was met.
-    reason : str
+    message : str
         Why the iteration stopped.
     iterations : int
         Newton steps taken.
@@ -67,7 +67,7 @@ class InterfaceSolution:
     p: np.ndarray
     delta: float
     converged: bool
-    reason: str
+    message: str
     iterations: int
     history: dict = field(default_factory=dict)
 
@@ -110,7 +110,7 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
         cho = cho_factor(C)
     except LinAlgError:
         return InterfaceSolution(g=g, p=law.pressure(g), delta=delta, converged=False, iterations=0,
-                                 reason="interface compliance is not positive definite (mesh too coarse "
+                                 message="interface compliance is not positive definite (mesh too coarse "
                                         "for the truncation correction?)", history=history)
 
     def residuals(g, delta):
@@ -124,7 +124,7 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
         value = 0.5 * d @ cho_solve(cho, d) + float(np.sum(A * law.potential(g)))
         return value - force * delta if force_control else value
 
-    converged, reason, k = False, f"maxiter = {maxiter} Newton steps reached", 0
+    converged, message, k = False, f"maxiter = {maxiter} Newton steps reached", 0
     p, F1, F2 = residuals(g, delta)
     for k in range(maxiter + 1):
         scale = max(abs(delta), float(np.abs(delta - h - g).max()), np.finfo(float).tiny)
@@ -134,10 +134,10 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
         history["force_residual"].append(res_f)
         history["n_contact"].append(int(np.count_nonzero(g > 0)))
         if not (np.isfinite(res) and np.isfinite(res_f)):
-            reason = "non-finite residual"
+            message = "non-finite residual"
             break
         if res <= rtol and res_f <= rtol:
-            converged, reason = True, "stopping rule met"
+            converged, message = True, "stopping rule met"
             break
         if k == maxiter:
             break
@@ -150,7 +150,7 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
         try:
             dx = solve(J, rhs, check_finite=True)
         except (LinAlgError, ValueError) as exc:
-            reason = f"singular Newton matrix ({exc}); no node in contact?"
+            message = f"singular Newton matrix ({exc}); no node in contact?"
             break
         dg, dd = (dx[:n], float(dx[n])) if force_control else (dx, 0.0)
         grad_g = cho_solve(cho, F1)
@@ -165,11 +165,11 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
             if t < _MIN_STEP:
                 break
         if t < _MIN_STEP:
-            reason = "line search failed (no descent along the Newton direction)"
+            message = "line search failed (no descent along the Newton direction)"
             break
         g, delta = g + t * dg, delta + t * dd
         history["step"].append(t)
         p, F1, F2 = residuals(g, delta)
-    log.debug("interface Newton: %s after %d steps, residual %.3g", reason, k, history["residual"][-1])
-    return InterfaceSolution(g=g, p=law.pressure(g), delta=float(delta), converged=converged, reason=reason,
+    log.debug("interface Newton: %s after %d steps, residual %.3g", message, k, history["residual"][-1])
+    return InterfaceSolution(g=g, p=law.pressure(g), delta=float(delta), converged=converged, message=message,
                              iterations=k, history=history)

@@ -79,7 +79,7 @@ class FemResult:
         Edge of the loaded zone [length], see :func:`contact_radius`.
     converged : bool
         Whether Newton's stopping rule was met (and the contact stays inside the domain).
-    reason : str
+    message : str
         Why the solve stopped.
     iterations : int
         Newton steps (last mesh).
@@ -123,7 +123,7 @@ class FemResult:
     p_max: float
     contact_radius: float
     converged: bool
-    reason: str
+    message: str
     iterations: int
     timings: dict
     n_dofs: int
@@ -143,15 +143,14 @@ class FemResult:
         """Total wall-clock time of the solve [s] (the BEM result's name)."""
         return float(self.timings["total"])
 
+    def pressure(self, x, y=0.0):
+        """The interface pressure at ``r = hypot(x, y)`` [pressure], linear between the nodes, 0 beyond."""
+        return np.interp(np.hypot(x, y), self.r, self.p, right=0.0)
+
     @property
     def residual(self):
         """Final relative Newton residual ``max|F1| / scale`` (:mod:`fem_reference.newton`)."""
         return float(self.history["residual"][-1]) if self.history.get("residual") else float("inf")
-
-    @property
-    def message(self):
-        """Alias of ``reason`` (the BEM result's name)."""
-        return self.reason
 
     def write(self, path):
         """Write displacements, stresses and contact pressure to a ``.vtu`` file, atomically.
@@ -167,7 +166,7 @@ class FemResult:
         return {
             "p_max": float(self.p_max), "force": float(self.force), "approach": float(self.approach),
             "contact_radius": float(self.contact_radius), "converged": bool(self.converged),
-            "reason": self.reason, "iterations": int(self.iterations), "n_dofs": int(self.n_dofs),
+            "message": self.message, "iterations": int(self.iterations), "n_dofs": int(self.n_dofs),
             "n_elements": int(self.n_elements),
             "n_elements_across_contact": float(self.n_elements_across_contact),
             "timings": {k: float(v) for k, v in self.timings.items()},

@@ -30,8 +30,8 @@ import numpy as np
 
 from bem.checks import InputError, check_callable, check_positive
 from bem.materials import effective_modulus
+from bem.reference import estimate_contact_radius
 
-from .estimate import estimate_contact_radius
 from .interface import InterfaceLaw
 from .mesh import build_mesh
 from .model import AxiModel, check_materials
@@ -128,7 +128,7 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
         Interface law ``w(p)``; ``None`` for smooth bodies (pure penalty).
     a_est : float, optional
         Expected contact radius [length] that sizes the mesh; default
-        :func:`fem_reference.estimate_contact_radius`.
+        :func:`bem.reference.estimate_contact_radius`.
     n_contact, extent_factor, fine_radius, growth : optional
         Mesh options of :func:`fem_reference.build_mesh` (elements across ``a_est``, domain
         size and fine-zone radius in units of ``a_est``, size grading).
@@ -154,7 +154,7 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     Returns
     -------
     FemResult
-        ``converged = False`` with a ``reason`` when the stopping rule was not met or the
+        ``converged = False`` with a ``message`` when the stopping rule was not met or the
         contact reaches the outer boundary; the fields are then the last finite iterate.
     """
     t_start = time.perf_counter()
@@ -207,9 +207,9 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     u = model.displacement(A * sol.p, delta_far)
     reaction = model.reaction_force(u)
     timings = dict(timings, mesh=mesh_time, recover=time.perf_counter() - t0)
-    converged, reason = sol.converged, sol.reason
+    converged, message = sol.converged, sol.message
     if p[-1] > 0:
-        converged, reason = False, "the contact reaches the outer boundary r = R: increase extent_factor"
+        converged, message = False, "the contact reaches the outer boundary r = R: increase extent_factor"
     g = sol.g[A > 0]  # the axis node (ring area 0) carries no force: its closure is free
     if layer is None:
         penetration = float(max(g.max(), 0.0))
@@ -225,7 +225,7 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     result = FemResult(
         r=model.r.copy(), p=p, closure=sol.g.copy(), gap=h, approach=float(sol.delta), force=force,
         force_reaction=reaction, p_max=float(p.max()), contact_radius=a_c, converged=converged,
-        reason=reason, iterations=sol.iterations, timings=timings, n_dofs=model.n_dofs,
+        message=message, iterations=sol.iterations, timings=timings, n_dofs=model.n_dofs,
         n_elements=amesh.n_elements, n_interface_nodes=int(model.r.size),
         n_elements_across_contact=float(np.interp(a_c, corner_r, np.arange(corner_r.size))),
         penalty={"factor": penalty, "stiffness": law.k_pen, "max_penetration": penetration,
@@ -237,7 +237,7 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
         E_star=E_star, history=sol.history, model=model, displacement=u,
     )
     if not converged:
-        log.warning("FEM reference did not converge: %s", reason)
+        log.warning("FEM reference did not converge: %s", message)
     if out is not None:
         result.write(out)
     return result

@@ -25,7 +25,7 @@ def test_hertz_example_matches_the_closed_form(capsys):
     errors = out["errors"]
     assert out["result"].converged
     assert abs(errors["p_max"]) < 2e-4 and abs(errors["approach"]) < 2e-4
-    assert abs(errors["contact_radius"]) < 2 * out["result"].step / out["hertz"].a  # within two steps
+    assert abs(errors["contact_radius"]) < 2 * out["result"].step / out["hertz"].contact_radius  # within two steps
     assert "relative errors" in capsys.readouterr().out
 
 

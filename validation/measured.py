@@ -67,7 +67,8 @@ class MeasuredSurface:
 
     Not a gap yet: :func:`measured_region` turns it into a :class:`bem.gaps.Table` over the
     candidate region once the region is known. It has what sizing the region needs:
-    ``domain`` (the data's bounding box), ``is_axisymmetric`` (False) and ``type_name``.
+    ``domain`` (the data's bounding box), ``is_axisymmetric`` (False), ``type_name`` and
+    :meth:`expected_semi_axes` (none).
     """
 
     type_name = "measured"
@@ -77,6 +78,10 @@ class MeasuredSurface:
         self.x, self.y, self.z = x, y, z
         self.kind, self.method, self.file = kind, method, file
         self.domain = ((float(x[0]), float(x[-1])), (float(y[0]), float(y[-1])))
+
+    def expected_semi_axes(self, **_):
+        """No estimate of the contact size: the scene gives ``bem.step`` and ``bem.extent``."""
+        return None
 
     def __call__(self, x, y):  # pragma: no cover - only the region's Table is ever evaluated
         raise TypeError("a MeasuredSurface is evaluated through measured_region(surface, extent)")

@@ -6,9 +6,12 @@ Three kinds of pressure source are compared:
   nodes carrying the same quadrature weight ``sqrt(3)/2 c^2`` (eq. 9);
 - an FEM reference result (:class:`fem_reference.FemResult`): the axisymmetric profile
   ``p(r)`` at the interface nodes, linear between them;
-- a closed form of :mod:`validation.analytic` (:class:`~validation.analytic.HertzSphere`,
-  :class:`~validation.analytic.RigidLayerParaboloid`, the non-axisymmetric
-  :class:`~validation.analytic.HertzElliptic`).
+- a closed form of :mod:`bem.reference` (:class:`~bem.reference.HertzSphere`,
+  :class:`~bem.reference.RigidLayerParaboloid`, the non-axisymmetric
+  :class:`~bem.reference.HertzElliptic`).
+
+All three share the names ``pressure(x, y)``, ``p_max``, ``contact_radius``, ``approach`` and
+``force``, so each is compared the same way.
 
 Relative L2 error of a candidate ``a`` against a reference ``b`` at the candidate's nodes
 ``n`` with quadrature weights ``A_n``::
@@ -32,7 +35,6 @@ from bem.checks import InputError, check_finite_array, check_positive
 from bem.result import ContactResult
 from fem_reference.result import FemResult
 
-from .analytic import HertzElliptic, HertzSphere, RigidLayerParaboloid
 
 __all__ = ["RadialProfile", "radial_profile", "ring_weights", "relative_l2", "pair_metrics", "compare",
            "PAIR_KEYS"]
@@ -147,44 +149,19 @@ def relative_l2(p, p_ref, weights=None):
     return math.sqrt(float(np.sum(w * (p - p_ref) ** 2)) / den) if den > 0 else None
 
 
-@dataclass(frozen=True)
-class _Source:
-    """A pressure source reduced to what the metrics need."""
-
-    pressure: object  # (x, y) -> p
-    p_max: float
-    contact_radius: float
-    approach: float
-    force: float
-    axisymmetric: bool  # may be compared with the axisymmetric FEM (a BEM field is sampled at (r, 0))
-
-
 def _check_bem(result):
     if not isinstance(result, ContactResult):
         raise InputError(f"result = {type(result).__name__} is not allowed: it must be a bem.ContactResult.")
 
 
-def _source(name, obj):
-    """Wrap a BEM result, an FEM result or a closed form."""
-    if isinstance(obj, ContactResult):
-        return _Source(obj.pressure_at, obj.p_max, obj.contact_radius, obj.approach, obj.force, True)
-    if isinstance(obj, FemResult):
-        r, p = obj.r, obj.p
-
-        def fem_pressure(x, y):
-            return np.interp(np.hypot(x, y), r, p, right=0.0)
-
-        return _Source(fem_pressure, obj.p_max, obj.contact_radius, obj.approach, obj.force, True)
-    if isinstance(obj, (HertzSphere, RigidLayerParaboloid)):
-        radius = obj.a if isinstance(obj, HertzSphere) else obj.contact_radius
-        p_max = obj.p0 if isinstance(obj, HertzSphere) else obj.p_max
-        return _Source(lambda x, y: obj.pressure(np.hypot(x, y)), p_max, radius, obj.delta, obj.force, True)
-    if isinstance(obj, HertzElliptic):
-        return _Source(obj.pressure, obj.p0, math.sqrt(obj.a * obj.b), obj.delta, obj.force, obj.a == obj.b)
-    raise InputError(
-        f"{name} = {type(obj).__name__} is not allowed: it must be a bem.ContactResult, a "
-        "fem_reference.FemResult or a validation.analytic HertzSphere / RigidLayerParaboloid / HertzElliptic."
-    )
+def _check_source(name, obj):
+    """Every result and closed form shares the names read here (``bem.reference``)."""
+    if not all(hasattr(obj, k) for k in ("pressure", "p_max", "contact_radius", "approach", "force")):
+        raise InputError(
+            f"{name} = {type(obj).__name__} is not allowed: it must be a bem.ContactResult, a "
+            "fem_reference.FemResult or a bem.reference closed form (pressure, p_max, contact_radius, "
+            "approach, force).")
+    return obj
 
 
 def _nodes(obj):
@@ -215,10 +192,10 @@ def pair_metrics(candidate, reference):
         ``approach_rel`` and total force ``force_rel``; ``n_points``: nodes in the union
         of the contact zones. ``None`` marks an undefined value (reference 0).
     """
-    a, b = _source("candidate", candidate), _source("reference", reference)
+    a, b = _check_source("candidate", candidate), _check_source("reference", reference)
     if not isinstance(candidate, (ContactResult, FemResult)):
         raise InputError(f"candidate = {type(candidate).__name__} is not allowed: it must be a BEM or FEM result.")
-    if isinstance(candidate, FemResult) and not b.axisymmetric:
+    if isinstance(candidate, FemResult) and not getattr(b, "is_axisymmetric", True):
         raise InputError("reference = non-axisymmetric is not allowed with an FEM candidate: the FEM is axisymmetric.")
     x, y, p, w = _nodes(candidate)
     p_ref = np.asarray(b.pressure(x, y), dtype=float)
@@ -269,12 +246,14 @@ def compare(bem_result, *, fem=None, analytic=None, force=None):
     _check_bem(bem_result)
     if fem is not None and not isinstance(fem, FemResult):
         raise InputError(f"fem = {type(fem).__name__} is not allowed: it must be a fem_reference.FemResult or None.")
+    if analytic is not None:
+        _check_source("analytic", analytic)
     out = {}
     if fem is not None:
         out["bem_vs_fem"] = pair_metrics(bem_result, fem)
     if analytic is not None:
         out["bem_vs_analytic"] = pair_metrics(bem_result, analytic)
-        if fem is not None and _source("analytic", analytic).axisymmetric:
+        if fem is not None and analytic.is_axisymmetric:
             out["fem_vs_analytic"] = pair_metrics(fem, analytic)
     target = force if force is not None else (None if analytic is None else analytic.force)
     if target is not None:

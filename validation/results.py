@@ -10,7 +10,6 @@ result (:mod:`validation.provenance`).
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -39,7 +38,7 @@ def axial_profile(res):
     p = res.grid()[row]
     closure = res.grid(res.closure)[row]
     y = lat.y[:, 0]
-    p_y = res.pressure_at(np.zeros_like(y), y)
+    p_y = res.pressure(np.zeros_like(y), y)
     return {"x": x, "p": p, "closure": closure, "y_axis": {"y": y, "p": p_y}}
 
 
@@ -56,15 +55,13 @@ def _history(res):
 
 
 def _analytic_summary(kind, ref):
-    """Scalars of the closed-form reference (HertzSphere, HertzElliptic, RigidLayerParaboloid)."""
-    out = {"kind": kind, "force": ref.force, "approach": ref.delta}
-    if kind == "hertz":
-        out.update(p_max=ref.p0, contact_radius=ref.a, contact_area=math.pi * ref.a**2)
-    elif kind == "hertz_elliptic":
-        out.update(p_max=ref.p0, a=ref.a, b=ref.b, contact_area=math.pi * ref.a * ref.b)
+    """Scalars of the closed-form reference (:mod:`bem.reference`, shared names)."""
+    out = {"kind": kind, "force": ref.force, "approach": ref.approach, "p_max": ref.p_max,
+           "contact_area": ref.contact_area}
+    if kind == "hertz_elliptic":
+        out.update(a=ref.a, b=ref.b)
     else:
-        out.update(p_max=ref.p_max, contact_radius=ref.contact_radius,
-                   contact_area=math.pi * ref.contact_radius**2)
+        out["contact_radius"] = ref.contact_radius
     return out
 
 
@@ -72,10 +69,10 @@ def _scales(scene):
     """Hertz's peak, radius and approach of the gap's paraboloid (no layer): Fig. 5's scale."""
     if scene.gap.type_name != "paraboloid":
         return None
-    from .analytic import hertz_sphere
+    from bem.reference import hertz_sphere
 
     hz = hertz_sphere(scene.gap.R, scene.E_star, **scene.load)
-    return {"p_hertz": hz.p0, "a_hertz": hz.a, "approach_hertz": hz.delta, "force_hertz": hz.force}
+    return {"p_hertz": hz.p_max, "a_hertz": hz.contact_radius, "approach_hertz": hz.approach, "force_hertz": hz.force}
 
 
 def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=None, times, messages, extent):

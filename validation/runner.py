@@ -121,7 +121,7 @@ class _BemRunner:
 
 
 def _analytic(scene, layer):
-    from . import analytic as an
+    from bem import reference as an
 
     kind = scene.analytic["kind"]
     g, load = scene.gap, scene.load
@@ -203,7 +203,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
         times["fem"] = fem.wall_time_s
         _notify(progress, "fem", "done", converged=fem.converged)
         if not fem.converged:
-            messages.append(f"FEM did not converge: {fem.reason}")
+            messages.append(f"FEM did not converge: {fem.message}")
     if scene.analytic is not None:
         ref = _analytic(scene, layer)
     if fem is not None or ref is not None:

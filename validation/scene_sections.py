@@ -45,8 +45,7 @@ KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star",
         "load": ("force", "approach"), "bem": _BEM_KEYS, "fem": _FEM_KEYS, "analytic": ("kind",),
         "sweep": ("parameter", "values"), "report": ("sections", "format"),
         "stress": ("depths", "n_depths", "max_depth", "bodies")}
-GAP_TYPES = {cls.type_name: cls for cls in (gaps.Paraboloid, gaps.EllipticParaboloid, gaps.CrownedRoller,
-                                            gaps.FlatPunch, gaps.Callable, gaps.Table)}
+GAP_TYPES = gaps.GAPS
 _STRESS_KEYS = KEYS["stress"]
 STRESS_BODIES = ("body1", "body2")
 DEFAULT_NODES_ACROSS = 40

@@ -5,9 +5,9 @@ expected contact: ``bem.nodes_across`` nodes across its smaller diameter and
 ``bem.extent_factor`` times its semi-axes. The expected semi-axes ``(ax, ay)`` are closed-form
 estimates:
 
-- axisymmetric gaps: :func:`fem_reference.estimate_contact_radius` (Hertz radius of the gap,
+- axisymmetric gaps: :func:`bem.reference.estimate_contact_radius` (Hertz radius of the gap,
   combined with the layer-alone radius when there is a layer);
-- elliptic paraboloid: Hertz's ellipse (:func:`validation.analytic.hertz_elliptic`), scaled by
+- elliptic paraboloid: Hertz's ellipse (:func:`bem.reference.hertz_elliptic`), scaled by
   the layer's widening of the paraboloid of the same mean radius ``sqrt(Rx Ry)``;
 - crowned roller (axis along x): ``ax = l/2``; ``ay`` the Hertz line-contact half-width
   ``b = sqrt(4 P R / (pi l E*))`` (Johnson 1985, ISBN 978-0-521-34796-9, sec. 4.3, load per
@@ -23,10 +23,7 @@ from __future__ import annotations
 import math
 
 from bem.checks import InputError
-from bem.gaps import CrownedRoller, EllipticParaboloid, Paraboloid
 from bem.lattice import SQRT3
-
-from .analytic import hertz_elliptic
 
 __all__ = ["expected_semi_axes", "inner_domain", "node_count", "MAX_NODES"]
 
@@ -36,38 +33,16 @@ MAX_NODES = 4_000_000
 DOMAIN_MARGIN = 1e-3
 
 
-def _radius(gap, E_star, force, approach, layer):
-    from fem_reference.estimate import estimate_contact_radius
-
-    return estimate_contact_radius(gap, E_star=E_star, force=force, approach=approach, layer=layer)
-
-
 def expected_semi_axes(gap, *, E_star, force=None, approach=None, layer=None):
-    """Expected contact semi-axes ``(ax, ay)`` [length], or ``None`` without an estimate.
+    """Expected contact semi-axes ``(ax, ay)`` [length], or ``None`` without an estimate
+    (:meth:`bem.gaps.Gap.expected_semi_axes`).
 
     Raises
     ------
     bem.InputError
         The estimate failed (e.g. a gap that does not grow with the radius).
     """
-    if gap.is_axisymmetric:
-        a = _radius(gap, E_star, force, approach, layer)
-        return a, a
-    if isinstance(gap, EllipticParaboloid):
-        hz = hertz_elliptic(gap.Rx, gap.Ry, E_star, force=force, approach=approach)
-        widen = 1.0
-        if layer is not None:
-            eq = Paraboloid(math.sqrt(gap.Rx * gap.Ry))
-            widen = _radius(eq, E_star, force, approach, layer) / _radius(eq, E_star, force, approach, None)
-        return hz.a * widen, hz.b * widen
-    if isinstance(gap, CrownedRoller):
-        half = gap.length / 2
-        if force is not None:
-            b = math.sqrt(4.0 * force * gap.R / (math.pi * gap.length * E_star))
-        else:
-            b = math.sqrt(gap.R * approach)
-        return half, b
-    return None
+    return gap.expected_semi_axes(E_star=E_star, force=force, approach=approach, layer=layer)
 
 
 def inner_domain(gap):

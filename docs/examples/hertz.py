@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import bem
 from bem.gaps import Paraboloid
-from validation.analytic import hertz_sphere
+from bem.reference import hertz_sphere
 
 
 def main():
@@ -23,12 +23,12 @@ def main():
     hz = hertz_sphere(R, E_star, force=P)          # closed form: p0 [Pa], a [m], delta [m]
 
     # 60 lattice nodes across the contact diameter, candidate region 1.5 contact radii wide
-    res = bem.solve(Paraboloid(R), E_star=E_star, force=P, step=2 * hz.a / 60, extent=1.5 * hz.a)
-    errors = {"p_max": res.p_max / hz.p0 - 1, "approach": res.approach / hz.delta - 1,
-              "contact_radius": res.contact_radius / hz.a - 1}
-    print(f"p_max {res.p_max / 1e9:.4f} GPa (Hertz {hz.p0 / 1e9:.4f} GPa), contact radius "
-          f"{res.contact_radius * 1e6:.1f} um (Hertz {hz.a * 1e6:.1f} um), approach "
-          f"{res.approach * 1e6:.4f} um (Hertz {hz.delta * 1e6:.4f} um); converged {res.converged} "
+    res = bem.solve(Paraboloid(R), E_star=E_star, force=P, step=2 * hz.contact_radius / 60, extent=1.5 * hz.contact_radius)
+    errors = {"p_max": res.p_max / hz.p_max - 1, "approach": res.approach / hz.approach - 1,
+              "contact_radius": res.contact_radius / hz.contact_radius - 1}
+    print(f"p_max {res.p_max / 1e9:.4f} GPa (Hertz {hz.p_max / 1e9:.4f} GPa), contact radius "
+          f"{res.contact_radius * 1e6:.1f} um (Hertz {hz.contact_radius * 1e6:.1f} um), approach "
+          f"{res.approach * 1e6:.4f} um (Hertz {hz.approach * 1e6:.4f} um); converged {res.converged} "
           f"in {res.iterations} iterations")
     print("relative errors: " + ", ".join(f"{k} {v:+.1e}" for k, v in errors.items()))
     return {"result": res, "hertz": hz, "errors": errors}

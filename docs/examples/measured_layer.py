@@ -18,7 +18,7 @@ import numpy as np
 import bem
 from bem.gaps import Paraboloid
 from bem.layers import Tabulated
-from validation.analytic import hertz_sphere
+from bem.reference import hertz_sphere
 
 #: pressure [Pa] and closure [m] pairs of the rough layer
 PAIRS_P = [0.0, 5e6, 1e7, 2.5e7, 5e7, 1e8, 2e8, 4e8, 8e8, 1.6e9, 3.2e9]
@@ -31,7 +31,7 @@ def main():
     R, E, nu, P = 0.01, 210e9, 0.3, 100.0          # m, Pa, -, N
     E_star = bem.effective_modulus(E, nu, E, nu)   # Pa
     layer = Tabulated(PAIRS_P, PAIRS_W)            # w(p) [m] from p [Pa]
-    a = hertz_sphere(R, E_star, force=P).a         # m, contact radius without the layer
+    a = hertz_sphere(R, E_star, force=P).contact_radius         # m, contact radius without the layer
     options = dict(E_star=E_star, force=P, step=a / 20, extent=2.5 * a)
     rough = bem.solve(Paraboloid(R), layer=layer, **options)
     smooth = bem.solve(Paraboloid(R), **options)

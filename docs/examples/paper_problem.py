@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import bem
 from bem.gaps import Paraboloid
-from validation.analytic import hertz_sphere
+from bem.reference import hertz_sphere
 from validation.paper import c_nn, paper_law
 
 
@@ -23,11 +23,11 @@ def main(nodes_per_radius=12):
     """Solve the smooth, linear, elastic-rigid and root cases; return the peaks over Hertz's p0."""
     R = E_star = P = 1.0
     hz = hertz_sphere(R, E_star, force=P)                    # p0, a of the smooth contact
-    step = hz.a / nodes_per_radius                           # lattice step c
+    step = hz.contact_radius / nodes_per_radius                           # lattice step c
     lam = 10 * c_nn(step, E_star)                            # the paper's lam = 10 C_nn
 
     def solve(layer, method="newton"):
-        return bem.solve(Paraboloid(R), E_star=E_star, force=P, step=step, extent=1.8 * hz.a, layer=layer,
+        return bem.solve(Paraboloid(R), E_star=E_star, force=P, step=step, extent=1.8 * hz.contact_radius, layer=layer,
                          method=method)
 
     linear = solve(paper_law("linear", lam))
@@ -36,10 +36,10 @@ def main(nodes_per_radius=12):
                "elastic_rigid": solve(paper_law("elastic_rigid", lam, p_lambda, alpha_a=0.5)),
                "root": solve(paper_law("root", lam, p_lambda))}
     root_vc = solve(paper_law("root", lam, p_lambda), method="variable_compliance")
-    peaks = {name: res.p_max / hz.p0 for name, res in results.items()}
+    peaks = {name: res.p_max / hz.p_max for name, res in results.items()}
     agreement = abs(root_vc.p_max / results["root"].p_max - 1)
     for name, res in results.items():
-        print(f"{name:14s} p_max / p0 = {peaks[name]:.4f}, contact radius / a = {res.contact_radius / hz.a:.3f}, "
+        print(f"{name:14s} p_max / p0 = {peaks[name]:.4f}, contact radius / a = {res.contact_radius / hz.contact_radius:.3f}, "
               f"converged {res.converged} ({res.iterations} iterations)")
     print(f"alpha_b = p_max^root / p_max^lambda = {results['root'].p_max / p_lambda:.4f}; variable compliance "
           f"method: {root_vc.iterations} iterations, peak within {agreement:.1e} of Newton's")

@@ -15,7 +15,7 @@ import numpy as np
 
 import bem
 from bem.gaps import Callable
-from validation.analytic import hertz_sphere
+from bem.reference import hertz_sphere
 
 R = 0.01             # m, ball radius (on a flat)
 WAVE_LENGTH = 1e-4   # m, period of the waviness along x
@@ -31,7 +31,7 @@ def main():
     """Solve the wavy ball and the smooth one; return both results and the peak ratio."""
     E, nu, P = 210e9, 0.3, 100.0                   # Pa, -, N: steel on steel, 100 N
     E_star = bem.effective_modulus(E, nu, E, nu)   # Pa
-    a = hertz_sphere(R, E_star, force=P).a         # m, the smooth ball's contact radius
+    a = hertz_sphere(R, E_star, force=P).contact_radius         # m, the smooth ball's contact radius
     options = dict(E_star=E_star, force=P, step=a / 40, extent=1.6 * a)
     wavy = bem.solve(Callable(wavy_ball, scale=a), **options)
     smooth = bem.solve(Callable(lambda x, y: (x**2 + y**2) / (2 * R), scale=a), **options)

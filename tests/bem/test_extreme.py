@@ -27,7 +27,7 @@ def _contact_radius(name):
     layer = CASES[name][0]
     a = A_H
     if isinstance(layer, layers.Power):
-        from validation.analytic import rigid_layer_paraboloid
+        from bem.reference import rigid_layer_paraboloid
 
         a = max(a, rigid_layer_paraboloid(layer, R, force=FORCE).contact_radius)
     elif isinstance(layer, layers.Linear):

@@ -8,7 +8,7 @@ import pytest
 import bem
 from bem import layers
 from bem.gaps import Paraboloid
-from validation.analytic import rigid_layer_paraboloid
+from bem.reference import rigid_layer_paraboloid
 
 from .conftest import C_NN, P0_HERTZ, paper_laws
 

@@ -11,7 +11,7 @@ import pytest
 import bem
 from bem import layers
 from bem.gaps import Paraboloid
-from validation.analytic import rigid_layer_paraboloid
+from bem.reference import rigid_layer_paraboloid
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 

@@ -22,7 +22,7 @@ def test_hertz_peak_radius_approach(gap, same, lower):
         res = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, **COARSE)
         Es = e_star(E, NU, E_SOFT, NU_SOFT)
     a, p0, delta = hertz(P, R, Es)
-    assert res.converged, res.reason
+    assert res.converged, res.message
     assert res.p_max == pytest.approx(p0, rel=0.02)
     assert res.contact_radius == pytest.approx(a, rel=0.02)
     assert res.approach == pytest.approx(delta, rel=0.02)
@@ -100,5 +100,5 @@ def test_contact_reaching_the_outer_boundary_is_not_an_answer(gap, hertz_same):
     a = hertz_same[0]
     res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=a / 25, n_contact=3, extent_factor=20.0,
                    remesh=False)
-    assert not res.converged and "outer boundary" in res.reason
+    assert not res.converged and "outer boundary" in res.message
     assert np.all(np.isfinite(res.p))

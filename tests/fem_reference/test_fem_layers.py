@@ -21,7 +21,7 @@ def test_layer_dominated_limit(gap, kind):
     inverse = (lambda g: g / soft) if kind == "linear" else (lambda g: (g / DELTA) ** 2 * p_ref)
     res = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, approach=DELTA, layer=layer,
                    n_contact=8, extent_factor=30.0)
-    assert res.converged, res.reason
+    assert res.converged, res.message
     expected = inverse(np.clip(DELTA - res.r**2 / (2 * R), 0, None))
     np.testing.assert_allclose(res.p, expected, atol=5e-3 * expected.max())
     assert res.contact_radius == pytest.approx(A_REF, rel=5e-3)
@@ -40,7 +40,7 @@ def test_nonlinear_laws_satisfy_the_contact_conditions(gap, name):
              "bilinear": Bilinear(lam, 0.1 * lam, 0.5 * p_ref)}[name]
     res = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=layer, n_contact=8,
                    extent_factor=30.0)
-    assert res.converged, res.reason
+    assert res.converged, res.message
     assert res.force == pytest.approx(P, rel=1e-8)
     assert np.all(np.isfinite(res.p)) and np.all(res.p >= 0)
     on = (res.p > 0) & (res.r > 0)

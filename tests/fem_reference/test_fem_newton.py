@@ -58,7 +58,7 @@ def test_not_converged_is_reported_with_a_finite_state(system):
     C, A, h = system
     sol = solve_interface(C, A, h, InterfaceLaw(Root(0.5), 1e8), force=0.05, delta0=0.9, maxiter=1,
                           rtol=1e-14)
-    assert not sol.converged and "maxiter" in sol.reason
+    assert not sol.converged and "maxiter" in sol.message
     assert np.all(np.isfinite(sol.p)) and np.isfinite(sol.delta)
     assert len(sol.history["residual"]) == 2
 
@@ -67,5 +67,5 @@ def test_indefinite_compliance_is_reported(system):
     C, A, h = system
     bad = C - 10.0 * np.eye(h.size)
     sol = solve_interface(bad, A, h, InterfaceLaw(Linear(0.3), 1e8), approach=0.2)
-    assert not sol.converged and "positive definite" in sol.reason
+    assert not sol.converged and "positive definite" in sol.message
     assert np.all(np.isfinite(sol.p))

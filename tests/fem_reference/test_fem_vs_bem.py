@@ -28,7 +28,7 @@ def test_fem_matches_bem(gap, name):
     layer = CASES[name]
     fem = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=layer, n_contact=12,
                    extent_factor=30.0)
-    assert fem.converged, fem.reason
+    assert fem.converged, fem.message
     ref = bem.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=layer,
                     step=fem.contact_radius / 25, extent=1.3 * fem.contact_radius)
     assert ref.converged

@@ -12,7 +12,7 @@ import bem
 from bem.checks import InputError
 from bem.gaps import EllipticParaboloid, Paraboloid
 from fem_reference.result import FemResult
-from validation.analytic import hertz_elliptic, hertz_sphere
+from bem.reference import hertz_elliptic, hertz_sphere
 from validation.metrics import PAIR_KEYS, compare, pair_metrics, radial_profile, relative_l2, ring_weights
 
 H = hertz_sphere(1.0, 1.0, force=1.0)
@@ -22,7 +22,7 @@ EPS = 0.01
 @pytest.fixture(scope="module")
 def base():
     """A real BEM result on a lattice of 20 steps across the Hertz contact."""
-    return bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.a / 20, extent=1.4 * H.a)
+    return bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.contact_radius / 20, extent=1.4 * H.contact_radius)
 
 
 def _with_p(res, p, **kw):
@@ -35,8 +35,8 @@ def _with_p(res, p, **kw):
 
 def _fem(r, p, **kw):
     """A FemResult holding the profile ``p(r)``."""
-    fields = dict(r=r, p=p, closure=np.zeros_like(r), gap=r**2 / 2, approach=H.delta, force=H.force,
-                  force_reaction=H.force, p_max=float(p.max()), contact_radius=H.a, converged=True, reason="",
+    fields = dict(r=r, p=p, closure=np.zeros_like(r), gap=r**2 / 2, approach=H.approach, force=H.force,
+                  force_reaction=H.force, p_max=float(p.max()), contact_radius=H.contact_radius, converged=True, message="",
                   iterations=1, timings={"total": 0.0}, n_dofs=0, n_elements=0, n_interface_nodes=r.size,
                   n_elements_across_contact=0.0, penalty={}, truncation={}, mesh={}, E_star=1.0)
     fields.update(kw)
@@ -49,7 +49,7 @@ def _radius(res):
 
 def test_scaled_hertz_field_has_the_scale_as_l2_error(base):
     p_exact = H.pressure(_radius(base))
-    fake = _with_p(base, (1 + EPS) * p_exact, approach=1.02 * H.delta)
+    fake = _with_p(base, (1 + EPS) * p_exact, approach=1.02 * H.approach)
     m = compare(fake, analytic=H)["bem_vs_analytic"]
     assert m["l2_rel"] == pytest.approx(EPS, rel=1e-10)
     assert m["max_rel"] == pytest.approx(EPS, rel=1e-10)
@@ -57,28 +57,28 @@ def test_scaled_hertz_field_has_the_scale_as_l2_error(base):
     assert m["approach_rel"] == pytest.approx(0.02, rel=1e-10)
     n_in = np.count_nonzero(p_exact > 0)
     assert m["n_points"] == n_in
-    assert m["contact_radius_rel"] == pytest.approx(math.sqrt(n_in * base.lattice.node_area / math.pi) / H.a - 1)
+    assert m["contact_radius_rel"] == pytest.approx(math.sqrt(n_in * base.lattice.node_area / math.pi) / H.contact_radius - 1)
 
 
 def test_local_bump_and_pressure_outside_the_contact_count_in_the_union(base):
     r = _radius(base)
     p_exact = H.pressure(r)
-    inner = r < H.a / 2
-    outer = (r > 1.1 * H.a) & (r < 1.3 * H.a)
-    q = 0.05 * H.p0
+    inner = r < H.contact_radius / 2
+    outer = (r > 1.1 * H.contact_radius) & (r < 1.3 * H.contact_radius)
+    q = 0.05 * H.p_max
     p = p_exact + q * inner + q * outer
     m = compare(_with_p(base, p), analytic=H)["bem_vs_analytic"]
     expected = q * math.sqrt(inner.sum() + outer.sum()) / math.sqrt(np.sum(p_exact**2))
     assert m["l2_rel"] == pytest.approx(expected, rel=1e-10)
-    assert m["max_rel"] == pytest.approx(q / H.p0, rel=1e-10)
+    assert m["max_rel"] == pytest.approx(q / H.p_max, rel=1e-10)
     assert m["n_points"] == np.count_nonzero(p_exact > 0) + outer.sum()
 
 
 def test_bem_against_fem_profile_interpolated_in_r(base):
-    r_fem = np.sort(np.append(np.linspace(0.0, 3.0, 61), H.a))  # a node at the kink r = a
-    cone = np.maximum(1.0 - r_fem / H.a, 0.0)
-    fem = _fem(r_fem, cone, approach=0.5, force=2.0, contact_radius=H.a)
-    p_bem = (1 + EPS) * np.maximum(1.0 - _radius(base) / H.a, 0.0)
+    r_fem = np.sort(np.append(np.linspace(0.0, 3.0, 61), H.contact_radius))  # a node at the kink r = a
+    cone = np.maximum(1.0 - r_fem / H.contact_radius, 0.0)
+    fem = _fem(r_fem, cone, approach=0.5, force=2.0, contact_radius=H.contact_radius)
+    p_bem = (1 + EPS) * np.maximum(1.0 - _radius(base) / H.contact_radius, 0.0)
     fake = _with_p(base, p_bem, approach=0.55)
     out = compare(fake, fem=fem, force=2.0)
     m = out["bem_vs_fem"]
@@ -144,7 +144,7 @@ def test_small_bem_solve_against_hertz_and_fem(base):
 def test_finer_lattice_is_closer_to_hertz():
     errs = []
     for n in (10, 40):
-        res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.a / n, extent=1.3 * H.a)
+        res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.contact_radius / n, extent=1.3 * H.contact_radius)
         errs.append(compare(res, analytic=H)["bem_vs_analytic"])
     assert errs[1]["l2_rel"] < 0.6 * errs[0]["l2_rel"]
     assert abs(errs[1]["peak_rel"]) < 0.2 * abs(errs[0]["peak_rel"])
@@ -171,11 +171,11 @@ def test_radial_profile_of_a_known_field(base):
 
 
 def test_radial_profile_of_a_solve_follows_hertz():
-    res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.a / 40, extent=1.3 * H.a)
+    res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.contact_radius / 40, extent=1.3 * H.contact_radius)
     prof = radial_profile(res)
-    inside = prof.r_bin < 0.9 * H.a
-    assert np.max(np.abs(prof.p_bin[inside] - H.pressure(prof.r_bin[inside]))) < 0.02 * H.p0
-    outside = prof.r_bin > 1.1 * H.a
+    inside = prof.r_bin < 0.9 * H.contact_radius
+    assert np.max(np.abs(prof.p_bin[inside] - H.pressure(prof.r_bin[inside]))) < 0.02 * H.p_max
+    outside = prof.r_bin > 1.1 * H.contact_radius
     assert np.all(prof.p_bin[outside] == 0)
 
 

@@ -10,7 +10,7 @@ import pytest
 
 import bem
 from bem.checks import InputError
-from validation.analytic import hertz_sphere
+from bem.reference import hertz_sphere
 from validation.report import figures_3d as f3d
 from validation.report import figures_iterations as fit
 from validation.report import figures_profiles as fpr
@@ -20,7 +20,7 @@ from bem.files import atomic_path
 from validation.report.style import DPI, save_figure
 
 HERTZ = hertz_sphere(R=1.0, E_star=1.0, force=1.0)
-A, P0 = HERTZ.a, HERTZ.p0
+A, P0 = HERTZ.contact_radius, HERTZ.p_max
 STEP = A / 6
 LAM = 10 * bem.diagonal_coefficient(STEP, 1.0)
 

@@ -28,7 +28,7 @@ def solutions():
     layer = Root(A_H / ES * math.sqrt(P0))  # closes like the bodies themselves near the peak
     fem = fr.solve(Paraboloid(R), E1=E1, nu1=NU1, E2=E2, nu2=NU2, force=P, layer=layer, n_contact=16,
                    extent_factor=30.0)
-    assert fem.converged, fem.reason
+    assert fem.converged, fem.message
     res = bem.solve(Paraboloid(R), E1=E1, nu1=NU1, E2=E2, nu2=NU2, force=P, layer=layer,
                     step=fem.contact_radius / 25, extent=1.3 * fem.contact_radius)
     assert res.converged

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import bem
-from validation.analytic import hertz_sphere
+from bem.reference import hertz_sphere
 from validation.paper import paper_law
 
 __all__ = ["PaperProblem", "PaperResults", "solve_paper_problem", "AG_RELAXATION", "SOLVE_STAGES",
@@ -90,16 +90,16 @@ class PaperProblem:
 
     @property
     def hertz(self):
-        """Hertz solution of the smooth problem (:func:`validation.analytic.hertz_sphere`)."""
+        """Hertz solution of the smooth problem (:func:`bem.reference.hertz_sphere`)."""
         return hertz_sphere(R=self.R, E_star=self.E_star, force=self.force)
 
     @property
     def a(self):
-        return self.hertz.a
+        return self.hertz.contact_radius
 
     @property
     def p0(self):
-        return self.hertz.p0
+        return self.hertz.p_max
 
     @property
     def step(self):

@@ -55,7 +55,7 @@ def _how(result, pb):
 
 def _row(label, r, pb):
     status = "converged" if r.converged else "not converged"
-    return (label, _method(r), r.p_max / pb.p0, r.contact_radius / pb.a, r.approach / pb.hertz.delta,
+    return (label, _method(r), r.p_max / pb.p0, r.contact_radius / pb.a, r.approach / pb.hertz.approach,
             r.iterations, r.kkt_residual, r.wall_time_s, status)
 
 
@@ -74,7 +74,7 @@ def _problem(res, work):
         "Two elastic paraboloids (effective radius R) pressed together by the force P, with a thin interface "
         "layer between them whose closure w(p) depends nonlinearly on the contact pressure p (paper section 6, "
         "Fig. 4). Normalised units: R = E* = P = 1, so the smooth (Hertz) contact has radius "
-        f"a_H = {pb.a:.4f}, peak pressure p0 = {pb.p0:.4f} and approach delta_H = {pb.hertz.delta:.4f}; all "
+        f"a_H = {pb.a:.4f}, peak pressure p0 = {pb.p0:.4f} and approach delta_H = {pb.hertz.approach:.4f}; all "
         "pressures below are divided by p0 and all lengths by a_H.",
         f"The linear (Winkler) layer has lam = {pb.lam_factor:g} C_nn = {pb.lam:.4f}, where C_nn = c/(pi E*) "
         f"w_t(0,0) = {pb.C_nn:.5f} is the diagonal influence coefficient (eq. 6) of the lattice step "
@@ -269,7 +269,7 @@ def _validation(res, work):
     for label, (b, f) in res.fem.items():
         rows.append((label, b.p_max / pb.p0, f.p_max / pb.p0, f"{(b.p_max - f.p_max) / f.p_max:+.2%}",
                      b.contact_radius / pb.a,
-                     f.contact_radius / pb.a, b.approach / pb.hertz.delta, f.approach / pb.hertz.delta,
+                     f.contact_radius / pb.a, b.approach / pb.hertz.approach, f.approach / pb.hertz.approach,
                      b.wall_time_s, f.wall_time_s, "converged" if (b.converged and f.converged) else "failed"))
     table = Table(("case", "BEM p_max / p0", "FEM p_max / p0", "rel. difference", "BEM r_c / a_H", "FEM r_c / a_H",
                    "BEM delta / delta_H", "FEM delta / delta_H", "BEM time [s]", "FEM time [s]", "status"),

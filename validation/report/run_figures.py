@@ -131,7 +131,7 @@ def profile_view(res, curves, *, axis="x"):
 def _reference(res, axis):
     """``(label, p(s))`` of the closed form along ``axis`` (x or y through the centre), or None."""
     from . import run_problem
-    from .. import analytic as an
+    from bem import reference as an
 
     ref = res.get("analytic")
     if not ref:

@@ -144,7 +144,7 @@ def _fem(res, work):
     mesh, penalty, trunc = (fem.get(k) if isinstance(fem.get(k), Mapping) else {}
                             for k in ("mesh", "penalty", "truncation"))
     rows = [("status", "converged" if fem.get("converged") else "not converged", "-"),
-            ("stopping reason", str(fem.get("reason", "-")), "-"),
+            ("stopping reason", str(fem.get("message", "-")), "-"),
             ("contact iterations", fmt(fem.get("iterations")), "-"),
             ("degrees of freedom", fmt(fem.get("n_dofs")), "-"),
             ("elements", fmt(fem.get("n_elements")), "-"),

@@ -241,14 +241,14 @@ def _fem_row(problem, n, reference, repeats, slow_s):
     res, t, times = timed(lambda: problem.run_fem(n_contact=n), repeats=repeats, slow_s=slow_s)
     l2, peak = _errors(res, reference)
     return ErrorTimeRow(problem.name, "fem", "fem", n, int(res.n_dofs), l2, peak, t, int(res.iterations),
-                        bool(res.converged), None, len(times), res.reason, times)
+                        bool(res.converged), None, len(times), res.message, times)
 
 
 def _richardson(coarse, mid, fine):
     """Order and error estimate of ``fine`` from three BEM levels of halving steps."""
     p1, p2, p4 = coarse.p_max, mid.p_max, fine.p_max
-    e12 = relative_l2(coarse.p, mid.pressure_at(coarse.x, coarse.y))
-    e24 = relative_l2(mid.p, fine.pressure_at(mid.x, mid.y))
+    e12 = relative_l2(coarse.p, mid.pressure(coarse.x, coarse.y))
+    e24 = relative_l2(mid.p, fine.pressure(mid.x, mid.y))
 
     def estimate(d1, d2):
         if not (d1 > 0 and d2 > 0) or d1 <= d2:

@@ -24,7 +24,7 @@ from bem.checks import check_choice
 from bem.gaps import Paraboloid
 from bem.materials import effective_modulus
 
-from ..analytic import hertz_sphere, rigid_layer_paraboloid
+from bem.reference import estimate_contact_radius, hertz_sphere, rigid_layer_paraboloid
 
 __all__ = ["Problem", "ERROR_TIME_PROBLEMS", "get_problem", "power_layer", "stability_cases", "body_modulus"]
 
@@ -128,10 +128,10 @@ class Problem:
         """Contact radius [length]: Hertz's without a layer; with one, the largest loaded node
         radius of a Newton solve at step ``a1 / 20`` in ``|x|, |y| <= 1.5 a1``, where ``a1`` is
         that radius, plus one step, on a coarse pass (step ``a_est / 8``, region ``3 a_est``,
-        ``a_est`` from :func:`fem_reference.estimate_contact_radius`)."""
+        ``a_est`` from :func:`bem.reference.estimate_contact_radius`)."""
         if self.layer is None:
-            return self.hertz.a
-        a = fem_reference.estimate_contact_radius(self.gap, E_star=self.E_star, force=self.force, layer=self.layer)
+            return self.hertz.contact_radius
+        a = estimate_contact_radius(self.gap, E_star=self.E_star, force=self.force, layer=self.layer)
         a1 = self._loaded_radius(step=a / 8, extent=3 * a) + a / 8
         return self._loaded_radius(step=a1 / 20, extent=1.5 * a1)
 
@@ -159,7 +159,7 @@ class Problem:
 
 def _hertz_scales():
     H = hertz_sphere(1.0, 1.0, force=1.0)
-    return H.p0, H.delta / H.p0
+    return H.p_max, H.approach / H.p_max
 
 
 def power_layer(k, s):

@@ -72,7 +72,7 @@ def _layer(s, k, E_star):
 
 def _contact_radius(layer, E_star):
     """The larger of the Hertz and the layer-only contact radius (the softer mechanism wins)."""
-    from validation.analytic import rigid_layer_paraboloid
+    from bem.reference import rigid_layer_paraboloid
 
     return max((3 / (4 * E_star)) ** (1 / 3), rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius)
 
@@ -130,7 +130,7 @@ def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODUL
     """
     from tqdm import tqdm
 
-    from validation.analytic import rigid_layer_paraboloid
+    from bem.reference import rigid_layer_paraboloid
 
     points = list(itertools.product(exponents, compliances, moduli))
     rows = []
@@ -140,7 +140,7 @@ def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODUL
         approach = None
         for control in ("force", "approach"):
             if control == "approach" and approach is None:
-                approach = rigid_layer_paraboloid(layer, 1.0, force=1.0).delta
+                approach = rigid_layer_paraboloid(layer, 1.0, force=1.0).approach
             load = {"force": 1.0} if control == "force" else {"approach": approach}
             for method in methods:
                 row, res = _row(s, k, E_star, control, method, layer, load, a)

@@ -229,7 +229,7 @@ def _row(case, solver, method, outcome, reference):
     error = _error(result, ref) if (ref is not None and finite) else None
     status, why = classify(result, converged=bool(result.converged), error=error, tolerance=tol)
     kkt = result.residual if is_fem else result.kkt_residual
-    message = result.reason if is_fem else result.message
+    message = result.message if is_fem else result.message
     return StabilityRow(case.name, solver, method, status, float(kkt) if math.isfinite(kkt) else None, error,
                         ref_name, tol, int(result.iterations), seconds, f"{why}; {message}")
 

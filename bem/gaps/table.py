@@ -1,15 +1,11 @@
-"""Gridded gap table (a measured surface) interpolated onto the lattice.
-
-Part of :mod:`bem.gaps` (re-exported there); kept in its own module for size.
-"""
+"""Gridded gap table (a measured surface) interpolated onto the lattice."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from bem.checks import InputError, fail, check_choice, check_finite_array
-
-from .gaps import Gap
+from ..checks import InputError, check_choice, check_finite_array, fail
+from .base import Gap
 
 __all__ = ["Table"]
 

@@ -4,9 +4,9 @@ import math
 
 import numpy as np
 import pytest
-from .fem_cases import E, NU, P, R, e_star, hertz
+from tests.fem_reference.fem_cases import E, NU, P, R, e_star, hertz
 
-import fem_reference as fr
+import bem.reference as fr
 from bem.checks import InputError
 from bem.gaps import Paraboloid
 from bem.layers import Linear

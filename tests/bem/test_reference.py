@@ -9,7 +9,7 @@ from scipy.integrate import quad
 from scipy.special import ellipe, ellipk
 
 from bem.checks import InputError
-from validation.analytic import (
+from bem.reference import (
     hertz_elliptic,
     hertz_sphere,
     rigid_layer_force,
@@ -59,36 +59,36 @@ def _integral_over_ellipse(fun, a, b, n_phi=256):
 def test_hertz_sphere_worked_example():
     # R = 10 mm, E* = 115 GPa, P = 100 N: a^3 = 3*100*0.01/(4*1.15e11) = 6.5217e-12 m^3
     h = hertz_sphere(0.01, E_STAR, force=100.0)
-    assert h.a == pytest.approx(6.521739130434783e-12 ** (1 / 3), rel=1e-14)
-    assert h.p0 == pytest.approx(3 * 100.0 / (2 * math.pi * h.a**2), rel=1e-14)
-    assert h.delta == pytest.approx(h.a**2 / 0.01, rel=1e-14)
+    assert h.contact_radius == pytest.approx(6.521739130434783e-12 ** (1 / 3), rel=1e-14)
+    assert h.p_max == pytest.approx(3 * 100.0 / (2 * math.pi * h.contact_radius**2), rel=1e-14)
+    assert h.approach == pytest.approx(h.contact_radius**2 / 0.01, rel=1e-14)
 
 
 def test_hertz_sphere_force_and_approach_control_agree():
     f = hertz_sphere(0.02, 2.0e9, force=7.0)
-    d = hertz_sphere(0.02, 2.0e9, approach=f.delta)
-    for name in ("a", "p0", "delta", "force"):
+    d = hertz_sphere(0.02, 2.0e9, approach=f.approach)
+    for name in ("contact_radius", "p_max", "approach", "force"):
         assert getattr(d, name) == pytest.approx(getattr(f, name), rel=1e-13)
 
 
 def test_hertz_sphere_pressure_integrates_to_force():
     h = hertz_sphere(0.01, E_STAR, force=100.0)
-    force, _ = quad(lambda r: 2 * np.pi * r * h.pressure(r), 0, h.a, epsabs=0, epsrel=1e-13)
+    force, _ = quad(lambda r: 2 * np.pi * r * h.pressure(r), 0, h.contact_radius, epsabs=0, epsrel=1e-13)
     assert force == pytest.approx(100.0, rel=1e-10)
-    assert h.pressure(0.0) == h.p0 and h.pressure(1.0001 * h.a) == 0.0
+    assert h.pressure(0.0) == h.p_max and h.pressure(1.0001 * h.contact_radius) == 0.0
 
 
 def test_hertz_sphere_displacement_is_boussinesq_and_closes_the_gap():
     h = hertz_sphere(0.01, E_STAR, force=100.0)
     press = lambda x, y: h.pressure(np.hypot(x, y))
-    for r in (0.0, 0.3 * h.a, 0.8 * h.a):
-        u = _u_inside(press, h.a, h.a, r, 0.0)
-        assert u == pytest.approx(h.delta - r * r / (2 * h.R), rel=1e-9)
+    for r in (0.0, 0.3 * h.contact_radius, 0.8 * h.contact_radius):
+        u = _u_inside(press, h.contact_radius, h.contact_radius, r, 0.0)
+        assert u == pytest.approx(h.approach - r * r / (2 * h.R), rel=1e-9)
         assert h.displacement(r) == pytest.approx(u, rel=1e-9)
-    for r in (1.5 * h.a, 3.0 * h.a):  # outside: smooth kernel, quadrature over the disc
-        u = _integral_over_ellipse(lambda x, y: press(x, y) / np.hypot(x - r, y), h.a, h.a) / (np.pi * E_STAR)
+    for r in (1.5 * h.contact_radius, 3.0 * h.contact_radius):  # outside: smooth kernel, quadrature over the disc
+        u = _integral_over_ellipse(lambda x, y: press(x, y) / np.hypot(x - r, y), h.contact_radius, h.contact_radius) / (np.pi * E_STAR)
         assert h.displacement(r) == pytest.approx(u, rel=1e-7)
-    assert h.displacement(10 * h.a) == pytest.approx(100.0 / (np.pi * E_STAR * 10 * h.a), rel=2e-3)
+    assert h.displacement(10 * h.contact_radius) == pytest.approx(100.0 / (np.pi * E_STAR * 10 * h.contact_radius), rel=2e-3)
 
 
 # ---------------------------------------------------------------- Hertz elliptic
@@ -103,7 +103,7 @@ def test_hertz_elliptic_satisfies_contact_conditions_by_quadrature(Rx, Ry):
     for fx, fy in [(0, 0), (0.5, 0), (0, 0.5), (0.4, -0.6), (-0.7, 0.2), (0.1, 0.9)]:
         x0, y0 = fx * sol.a, fy * sol.b
         u = _u_inside(sol.pressure, sol.a, sol.b, x0, y0)
-        assert u == pytest.approx(sol.delta - gap(x0, y0), rel=1e-9)
+        assert u == pytest.approx(sol.approach - gap(x0, y0), rel=1e-9)
     assert _integral_over_ellipse(sol.pressure, sol.a, sol.b) == pytest.approx(P, rel=1e-10)
 
 
@@ -112,7 +112,7 @@ def test_hertz_elliptic_orientation_and_swap():
     assert sol.a > sol.b  # longer axis along the larger radius (x)
     swapped = hertz_elliptic(0.01, 0.05, E_STAR, force=10.0)
     assert (swapped.a, swapped.b) == pytest.approx((sol.b, sol.a), rel=1e-14)
-    assert swapped.delta == pytest.approx(sol.delta, rel=1e-14)
+    assert swapped.approach == pytest.approx(sol.approach, rel=1e-14)
     assert sol.eccentricity == pytest.approx(math.sqrt(1 - (sol.b / sol.a) ** 2), rel=1e-12)
 
 
@@ -125,7 +125,7 @@ def test_eccentricity_equation_in_legendre_form(m):
     # the K/E form itself loses ~eps/m absolute to cancellation in K - E
     assert sol.eccentricity**2 == pytest.approx(m, rel=1e-10, abs=1e-15 / m)
     # delta = p0 b K / E*, with b the minor semi-axis (Johnson 1985 sec. 3.6)
-    assert sol.delta == pytest.approx(sol.p0 * sol.b * K / E_STAR, rel=1e-10)
+    assert sol.approach == pytest.approx(sol.p_max * sol.b * K / E_STAR, rel=1e-10)
 
 
 def test_hertz_elliptic_circular_limit():
@@ -133,18 +133,18 @@ def test_hertz_elliptic_circular_limit():
     for Rx in (0.01, 0.01 * (1 + 1e-9)):
         e = hertz_elliptic(Rx, 0.01, E_STAR, force=100.0)
         for name in ("a", "b"):
-            assert getattr(e, name) == pytest.approx(s.a, rel=1e-8)
-        assert (e.p0, e.delta) == pytest.approx((s.p0, s.delta), rel=1e-8)
+            assert getattr(e, name) == pytest.approx(s.contact_radius, rel=1e-8)
+        assert (e.p_max, e.approach) == pytest.approx((s.p_max, s.approach), rel=1e-8)
 
 
 def test_hertz_elliptic_approach_control_and_inputs_unmodified():
     f = hertz_elliptic(0.2, 0.01, E_STAR, force=40.0)
-    d = hertz_elliptic(0.2, 0.01, E_STAR, approach=f.delta)
-    for name in ("a", "b", "p0", "force"):
+    d = hertz_elliptic(0.2, 0.01, E_STAR, approach=f.approach)
+    for name in ("a", "b", "p_max", "force"):
         assert getattr(d, name) == pytest.approx(getattr(f, name), rel=1e-12)
     x, y = np.array([0.0, f.a, 2 * f.a]), np.array([0.0, 0.0, 0.0])
     x0 = x.copy()
-    np.testing.assert_allclose(f.pressure(x, y), [f.p0, 0.0, 0.0], atol=1e-9 * f.p0)
+    np.testing.assert_allclose(f.pressure(x, y), [f.p_max, 0.0, 0.0], atol=1e-9 * f.p_max)
     np.testing.assert_array_equal(x, x0)
 
 
@@ -224,7 +224,7 @@ def test_rigid_layer_paraboloid_fields_and_force_control():
     assert sol.p_max == pytest.approx((2e-6 / 3e-9) ** (1 / 0.6), rel=1e-14)
     assert sol.pressure(sol.contact_radius * 1.001) == 0.0
     back = rigid_layer_paraboloid("power", 0.01, force=sol.force, lam=3e-9, s=0.6)
-    assert back.delta == pytest.approx(2e-6, rel=1e-13)
+    assert back.approach == pytest.approx(2e-6, rel=1e-13)
 
 
 @pytest.mark.parametrize("layer, s", [(_PowerStub(3e-9, 0.4), 0.4), (_LinearStub(3e-9), 1.0), (Root(3e-9), 0.5)])
