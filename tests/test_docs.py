@@ -1,7 +1,7 @@
 """The documentation: self-contained, and tested against the code so that it cannot drift.
 
 - ``docs/scenes.md`` has a row for every key of the scene schema in code
-  (:func:`validation.scene_sections.scene_keys`) and no other, with the defaults of the code;
+  (:func:`validation.scene.schema.scene_keys`) and no other, with the defaults of the code;
 - ``docs/results.md`` has a row for every field of real ``result.json`` files;
 - ``docs/method.md`` names only code that exists;
 - the README's quick start runs, its links resolve inside the repository, and nothing a user
@@ -22,11 +22,11 @@ import yaml
 
 import bem
 import fem_reference
-from validation import scene_sections as ss
-from validation.runner import run_scene
+from validation.scene import schema as ss
+from validation.run import run_scene
 from validation.scene import SECTIONS
-from validation.sizing import MAX_NODES
-from validation.sweep import SUMMARY_COLUMNS
+from validation.scene.sizing import MAX_NODES
+from validation.run.sweep import SUMMARY_COLUMNS
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"

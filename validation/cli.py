@@ -17,9 +17,9 @@ from pathlib import Path
 
 from bem.checks import InputError
 
-from .paper import CalibrationError
+from .scene.paper import CalibrationError
 
-from .output import OutputError
+from .io import OutputError
 
 __all__ = ["main", "build_parser"]
 
@@ -232,8 +232,8 @@ class _StageBar:
 
 
 def _cmd_run(args):
-    from .runner import execute_scene, planned_stages, write_outputs
-    from .scene import load_scene
+    from .run.runner import execute_scene, planned_stages, write_outputs
+    from .scene.load import load_scene
 
     scene = load_scene(args.scene, overrides=args.overrides)
     out_dir = Path(args.out) if args.out else Path("results") / scene.name
@@ -248,7 +248,7 @@ def _cmd_run(args):
 
 
 def _cmd_scenes(args):
-    from .scene import builtin_scenes
+    from .scene.load import builtin_scenes
 
     scenes = builtin_scenes()
     width = max(map(len, scenes))
@@ -259,7 +259,7 @@ def _cmd_scenes(args):
 
 
 def _cmd_check(args):
-    from .scene import load_scene
+    from .scene.load import load_scene
 
     scene = load_scene(args.scene, overrides=args.overrides)
     parts = ["bem"] + [k for k in ("fem", "analytic", "sweep", "stress", "report") if getattr(scene, k) is not None]
@@ -272,8 +272,8 @@ def _cmd_check(args):
 def _cmd_sweep(args):
     from tqdm import tqdm
 
-    from .scene import load_scene
-    from .sweep import parse_values, run_sweep, sweep_points
+    from .scene.load import load_scene
+    from .run.sweep import parse_values, run_sweep, sweep_points
 
     values = parse_values(args.values) if args.values is not None else None
     if (args.param is None) != (values is None):

@@ -2,7 +2,7 @@
 
 A scene's numbers are in one consistent set of units that its label names, e.g.
 ``"SI (m, Pa, N)"`` or ``"mm, MPa, N"``. :func:`parse_units` reads the label once, when the
-scene is loaded (:class:`validation.scene.Scene` keeps the :class:`Units`); the result file
+scene is loaded (:class:`validation.scene.load.Scene` keeps the :class:`Units`); the result file
 records the symbols (``result.json["unit_symbols"]``), and the reports and the command line
 read them from there.
 """

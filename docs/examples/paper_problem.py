@@ -16,7 +16,7 @@ from __future__ import annotations
 import bem
 from bem.gaps import Paraboloid
 from bem.reference import hertz_sphere
-from validation.paper import c_nn, paper_law
+from validation.scene.paper import c_nn, paper_law
 
 
 def main(nodes_per_radius=12):

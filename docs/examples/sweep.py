@@ -1,6 +1,6 @@
 """A sweep: the peak pressure of a steel ball on a flat for several loads, with resumable storage.
 
-:func:`validation.sweep.run_sweep` runs one scene for each value of a parameter (here
+:func:`validation.run.sweep.run_sweep` runs one scene for each value of a parameter (here
 ``load.force``), saves each finished point as it comes (``points/point-NNN.json``; a rerun
 reuses them) and writes ``summary.json`` and ``summary.csv``. The same from the command line::
 
@@ -16,7 +16,7 @@ from __future__ import annotations
 import sys
 import tempfile
 
-from validation.sweep import run_sweep
+from validation.run.sweep import run_sweep
 
 #: the scene as a dict (the same keys as a TOML scene file, docs/scenes.md)
 SCENE = {

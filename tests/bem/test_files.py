@@ -108,7 +108,7 @@ def test_lattice_triangles_are_exactly_the_lattice_cells():
 
 
 def test_one_writer_of_files_in_the_packages():
-    """Temporary-file-and-rename appears only in bem.files (files) and validation.output (directories);
+    """Temporary-file-and-rename appears only in bem.files (files) and validation.io (directories);
     meshio writes only in bem.files."""
     pattern = re.compile(r"\bos\.replace\(|\bos\.rename\(|\bmkstemp\(|\bmkdtemp\(|\bmeshio\.write\(")
     found = {}
@@ -117,5 +117,5 @@ def test_one_writer_of_files_in_the_packages():
             hits = pattern.findall(path.read_text(encoding="utf-8"))
             if hits:
                 found[str(path.relative_to(ROOT))] = sorted(set(hits))
-    assert set(found) == {"bem/files.py", "validation/output.py"}, found
-    assert "meshio.write(" not in found["validation/output.py"]
+    assert set(found) == {"bem/files.py", "validation/io.py"}, found
+    assert "meshio.write(" not in found["validation/io.py"]

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from validation.runner import execute_scene, run_scene
+from validation.run import execute_scene, run_scene
 from validation.scene import SceneError, load_scene
 from tomli_w import dumps
 

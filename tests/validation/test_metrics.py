@@ -1,4 +1,4 @@
-"""validation.metrics on constructed fields with known answers, and on small real solves."""
+"""validation.compare on constructed fields with known answers, and on small real solves."""
 
 import copy
 import dataclasses
@@ -13,7 +13,7 @@ from bem.checks import InputError
 from bem.gaps import EllipticParaboloid, Paraboloid
 from fem_reference.result import FemResult
 from bem.reference import hertz_elliptic, hertz_sphere
-from validation.metrics import PAIR_KEYS, compare, pair_metrics, radial_profile, relative_l2, ring_weights
+from validation.compare import PAIR_KEYS, compare, pair_metrics, radial_profile, relative_l2, ring_weights
 
 H = hertz_sphere(1.0, 1.0, force=1.0)
 EPS = 0.01

@@ -16,7 +16,7 @@ from validation.report.build import build_report
 from validation.report.run_report import report_results_dir
 from validation.report.sections import Section
 from validation.report.study_report import report_studies_dir
-from validation.runner import run_scene
+from validation.run import run_scene
 
 from .test_report_studies import _write as write_studies
 

@@ -20,7 +20,7 @@ from validation.report.results import display_unit, load_results, parse_units, r
 from validation.report.run_figures import profile_view
 from validation.report.run_report import run_sections
 from validation.report.sections import Figure, Table
-from validation.runner import run_scene
+from validation.run import run_scene
 from validation.scene import builtin_path
 
 from .conftest import e_star, hertz

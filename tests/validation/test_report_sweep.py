@@ -9,8 +9,8 @@ import pytest
 from validation.report.results import load_results
 from validation.report.run_report import STAGES, report_results_dir
 from validation.report.sweep_report import is_sweep_dir, load_sweep, report_sweep_dir, sweep_sections
-from validation.runner import run_scene
-from validation.sweep import run_sweep
+from validation.run import run_scene
+from validation.run.sweep import run_sweep
 
 from .conftest import cli
 from .test_report_build import assert_valid_offline_html

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from validation.runner import run_scene
+from validation.run import run_scene
 
 RIGID_LAYER = {
     "scene": {"name": "rigid_layer"},

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from validation.results import CONTRACT_KEYS
+from validation.run.result import CONTRACT_KEYS
 
 from .conftest import SMALL, STEEL_E, STEEL_NU, e_star, hertz
 

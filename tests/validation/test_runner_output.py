@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import validation.runner as runner
+import validation.run.runner as runner
 from bem.files import lattice_triangles
-from validation.output import OutputError, atomic_directory, atomic_write_json
-from validation.runner import execute_scene, run_scene
+from validation.io import OutputError, atomic_directory, atomic_write_json
+from validation.run import execute_scene, run_scene
 from validation.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -175,7 +175,7 @@ def test_bem_only_runs_import_no_heavy_package(tmp_path):
     (tmp_path / "root_bem_only.toml").write_text(scene)
     code = textwrap.dedent(f"""
         import sys
-        from validation.runner import run_scene
+        from validation.run import run_scene
         from validation.cli import main
         run_scene("roller", {str(tmp_path / 'a')!r}, overrides=["bem.nodes_across=12"])
         run_scene({str(tmp_path / 'root_bem_only.toml')!r}, {str(tmp_path / 'b')!r},

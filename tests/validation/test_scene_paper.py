@@ -7,8 +7,8 @@ import pytest
 
 import bem
 from bem.layers import Bilinear, ElasticRigid, Linear, Root
-from validation.paper import c_nn, check_layer, resolve_layer
-from validation.runner import run_scene
+from validation.scene.paper import c_nn, check_layer, resolve_layer
+from validation.run import run_scene
 
 from .conftest import STEEL_E, STEEL_NU, e_star
 

@@ -6,7 +6,8 @@ from importlib import resources
 import pytest
 
 import bem
-from validation import paper, runner
+from validation.run import runner
+from validation.scene import paper
 from validation.scene import SceneError, load_scene
 
 from .conftest import cli

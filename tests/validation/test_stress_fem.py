@@ -13,7 +13,7 @@ import bem
 import fem_reference as fr
 from bem.gaps import Paraboloid
 from bem.layers import Root
-from validation.stress import compare_with_fem, fem_body_stresses, peak_fit
+from validation.run.stress import compare_with_fem, fem_body_stresses, peak_fit
 
 from .conftest import e_star, hertz
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import bem
-from validation.runner import execute_scene, planned_stages, run_scene, write_outputs
+from validation.run import execute_scene, planned_stages, run_scene, write_outputs
 from validation.scene import SceneError, load_scene
 
 from .conftest import cli
@@ -115,7 +115,7 @@ def test_result_json_holds_the_maxima_per_body(stress_run):
 def test_stress_field_file_reads_back_with_meshio(stress_run):
     import meshio
 
-    from validation.stress_output import volume_grid
+    from validation.io import volume_grid
 
     outcome, out = stress_run
     mesh = meshio.read(out / "stress_field.vtu")

@@ -8,11 +8,11 @@ import types
 import pytest
 
 import bem
-import validation.runner as runner
+import validation.run.runner as runner
 from validation.extras import MissingExtraError
-from validation.runner import run_scene
+from validation.run import run_scene
 from validation.scene import SceneError
-from validation.sweep import parse_values, run_sweep, sweep_points
+from validation.run.sweep import parse_values, run_sweep, sweep_points
 
 from .conftest import cli
 

@@ -3,7 +3,7 @@
 ``out_dir/report.html`` (self-contained), ``out_dir/report.md`` and ``out_dir/figures/`` (the
 PNG or SVG of every figure, and the PDF beside a PNG drawn in ``"pdf"`` format) are first written into a fresh temporary directory beside ``out_dir``; only when all of
 them are complete is that directory renamed onto ``out_dir`` (a previous report there is
-moved aside first and deleted afterwards: :func:`validation.output.atomic_directory`). An
+moved aside first and deleted afterwards: :func:`validation.io.atomic_directory`). An
 interrupted build leaves the previous report, or nothing, never a mixture.
 """
 
@@ -16,7 +16,7 @@ from pathlib import Path
 
 from bem.checks import InputError
 
-from ..output import atomic_directory
+from ..io import atomic_directory
 from ..provenance import report_footer
 from .html import render_html
 from .markdown import render_markdown

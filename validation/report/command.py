@@ -122,7 +122,7 @@ def build_from_args(args, progress=None):
 
     if kind == "results":
         return report_results_dir(target, out, units=units, fmt=fmt, progress=progress)
-    from validation.runner import run_scene
+    from validation.run import run_scene
 
     base = Path(out) if out is not None else Path("results") / Path(target).stem
     if progress is not None:

@@ -31,7 +31,7 @@ import numpy as np
 
 import bem
 from bem.reference import hertz_sphere
-from validation.paper import paper_law
+from validation.scene.paper import paper_law
 
 __all__ = ["PaperProblem", "PaperResults", "solve_paper_problem", "AG_RELAXATION", "SOLVE_STAGES",
            "STRESS_DEPTHS"]

@@ -1,10 +1,10 @@
-"""Reading a result directory written by ``contactlab run`` (:func:`validation.runner.run_scene`).
+"""Reading a result directory written by ``contactlab run`` (:func:`validation.run.runner.run_scene`).
 
-What is read (the names are those of :data:`validation.runner.FILES`, taken from
+What is read (the names are those of :data:`validation.run.runner.FILES`, taken from
 ``result.json["files"]`` when present):
 
 ``result.json`` (required)
-    The run's result dict (:func:`validation.results.build_result`, schema
+    The run's result dict (:func:`validation.run.result.build_result`, schema
     ``contactlab.result/1``): top-level BEM scalars ``p_max``, ``force``, ``approach``,
     ``contact_area``, ``contact_radius`` (axisymmetric scenes), ``contact_extent``,
     ``iterations``, ``converged``, ``kkt_residual``, ``message``, ``messages``,

@@ -1,4 +1,4 @@
-"""The report of a result directory written by ``contactlab run`` (:func:`validation.runner.run_scene`).
+"""The report of a result directory written by ``contactlab run`` (:func:`validation.run.runner.run_scene`).
 
 Only the sections the results support: the problem statement (from ``scene.toml``), the
 results table, the pressure profiles against the FEM and the closed form when they ran,

@@ -1,6 +1,6 @@
 """The "Subsurface stresses" section of a run's report (scenes with a ``[stress]`` section).
 
-Drawn from ``result.json["stress"]`` (:func:`validation.stress.stress_summary`): the maxima per
+Drawn from ``result.json["stress"]`` (:func:`validation.run.stress.stress_summary`): the maxima per
 body, the x-z section map of the von Mises stress with the contact, the depth profiles on the
 axis, and, when the FEM reference ran, its recovered stresses overlaid (``fem_field.vtu``) and
 the comparison of the maxima.

@@ -1,4 +1,4 @@
-"""Report of a sweep directory written by ``contactlab sweep`` (:func:`validation.sweep.run_sweep`).
+"""Report of a sweep directory written by ``contactlab sweep`` (:func:`validation.run.sweep.run_sweep`).
 
 Reads ``summary.json`` (the table of points) and ``points/point-NNN.json`` (each point's scene
 and full result, the axial section included) and builds: the problem statement of the first

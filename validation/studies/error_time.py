@@ -4,7 +4,7 @@ For each problem (:mod:`validation.studies.problems`: ``"hertz"`` and ``"paper-r
 every applicable solver runs on a ladder of resolutions: the BEM at ``n`` lattice steps
 across the contact diameter (10, 20, 40, 80, 160; a method stops climbing after a run longer
 than ``time_budget_s``), the FEM at ``n_contact`` elements across the contact radius
-(4, 8, 16, 32). Errors (:func:`validation.metrics.pair_metrics` at the solver's own nodes):
+(4, 8, 16, 32). Errors (:func:`validation.compare.pair_metrics` at the solver's own nodes):
 
 - ``error_l2``: relative L2 error of the pressure over the contact;
 - ``error_peak``: ``|p_max / p_max,ref - 1|``.
@@ -28,8 +28,12 @@ from dataclasses import asdict, dataclass, field
 
 from bem.checks import InputError, check_choice, check_positive
 
-from ..metrics import pair_metrics, relative_l2
-from . import fmt, markdown_table, timed, write_json, write_text
+from ..compare import pair_metrics, relative_l2
+from . import fmt
+from . import markdown_table
+from . import timed
+from . import write_json
+from . import write_text
 from .problems import ERROR_TIME_PROBLEMS, get_problem
 
 __all__ = ["ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "LADDERS", "TARGETS"]

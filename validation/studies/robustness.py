@@ -28,7 +28,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from . import fmt, markdown_table, write_json, write_text
+from . import fmt
+from . import markdown_table
+from . import write_json
+from . import write_text
 
 __all__ = ["RobustnessRow", "run_robustness", "summary_markdown", "summary_table", "matrix_table", "failure_table",
            "rows_from_json", "main", "EXPONENTS", "COMPLIANCES", "MODULI"]

@@ -17,7 +17,7 @@ Every outcome gets one status:
 - ``"wrong"``: a NaN or inf anywhere in the returned result, or ``converged = True`` with an
   error against the reference above the tolerance.
 
-``error_vs_reference = max(l2_rel, |peak_rel|)`` (:func:`validation.metrics.pair_metrics`).
+``error_vs_reference = max(l2_rel, |peak_rel|)`` (:func:`validation.compare.pair_metrics`).
 References and tolerances:
 
 - paper methods and Kalker's QP: Newton at the same resolution, :data:`METHOD_TOL`
@@ -41,8 +41,11 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..metrics import pair_metrics
-from . import fmt, markdown_table, write_json, write_text
+from ..compare import pair_metrics
+from . import fmt
+from . import markdown_table
+from . import write_json
+from . import write_text
 from .problems import stability_cases
 
 __all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main",

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .provenance import provenance
+from ..provenance import provenance
 
 __all__ = ["build_result", "axial_profile", "SCHEMA", "CONTRACT_KEYS"]
 
@@ -113,6 +113,6 @@ def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=Non
     if scene.report is not None:
         out["report"] = scene.report
     out["provenance"] = provenance()
-    from .output import to_jsonable
+    from ..io import to_jsonable
 
     return to_jsonable(out)

@@ -31,12 +31,12 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from . import scene_sections as sec
-from ._checks import SceneError
-from .extras import require as require_extra
+from . import schema as sec
+from .checks import SceneError
+from ..extras import require as require_extra
 from .measured import measured_region
 from .paper import ALIASES, EXCLUSIVE
-from .provenance import display_path
+from ..provenance import display_path
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
            "apply_overrides", "parse_override", "SECTIONS"]

@@ -49,7 +49,7 @@ import numpy as np
 
 from bem.gaps import Table
 
-from . import _checks as ck
+from . import checks as ck
 
 __all__ = ["MeasuredSurface", "RegionTable", "measured_gap", "measured_region", "read_surface", "KEYS", "FORMATS",
            "LENGTH_UNITS"]

@@ -32,7 +32,7 @@ import math
 from bem.operator import diagonal_coefficient
 from bem.layers import LAWS, Bilinear, ElasticRigid, Linear, Root, from_dict
 
-from ._checks import SceneError, in_range, positive, scene_errors, string, table, unknown_keys
+from .checks import SceneError, in_range, positive, scene_errors, string, table, unknown_keys
 
 __all__ = ["CalibrationError", "c_nn", "check_layer", "resolve_layer", "PAPER_LAWS", "PAPER_KEYS", "EXCLUSIVE", "ALIASES"]
 

@@ -1,7 +1,7 @@
 """Run a scene: the BEM always; the FEM reference, closed form, comparisons, stresses only when named.
 
 :func:`run_scene` returns the JSON-ready result dict and, given ``out_dir``, writes it whole or
-not at all (:mod:`validation.output`) with the BEM nodal field and, when the FEM ran, its
+not at all (:mod:`validation.io`) with the BEM nodal field and, when the FEM ran, its
 field (ParaView ``.vtu``, both by :func:`bem.files.write_vtu`). gmsh and scikit-fem (the
 ``[fem]`` extra) are imported only by the FEM reference, so a BEM-only scene never loads them.
 """
@@ -17,12 +17,13 @@ import tomli_w
 import bem
 from bem.files import write_result_vtu, write_text
 
-from . import paper
-from .output import atomic_directory, atomic_write_json
-from .results import build_result
-from .scene import Scene, load_scene
-from .scene_sections import SOLVER_KEYS
-from .sizing import DOMAIN_MARGIN, inner_domain
+from ..scene import paper
+from ..compare import compare
+from ..io import atomic_directory, atomic_write_json
+from .result import build_result
+from ..scene.load import Scene, load_scene
+from ..scene.schema import SOLVER_KEYS
+from ..scene.sizing import DOMAIN_MARGIN, inner_domain
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES"]
 
@@ -133,19 +134,6 @@ def _analytic(scene, layer):
     return an.rigid_layer_paraboloid(layer, g.R, **load)
 
 
-def _compare(bem_result, fem, analytic, messages):
-    try:
-        from .metrics import compare
-    except ModuleNotFoundError as exc:
-        if exc.name not in ("validation.metrics", __package__ + ".metrics"):
-            raise
-        msg = "comparison skipped: validation.metrics is not available"
-        log.warning(msg)
-        messages.append(msg)
-        return None
-    return compare(bem_result, fem=fem, analytic=analytic)
-
-
 def _fem(scene, layer):
     import fem_reference
 
@@ -166,7 +154,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
         ``progress(stage, status, info)``: ``stage`` in :func:`planned_stages`, ``status`` one
         of ``"start"``, ``"iteration"`` (BEM, ``info["iteration"]``), ``"done"``.
     overrides : dict or list of str, optional
-        Dotted-key overrides (:func:`validation.scene.apply_overrides`), validated first.
+        Dotted-key overrides (:func:`validation.scene.load.apply_overrides`), validated first.
     """
     t0 = time.perf_counter()
     if not isinstance(scene, Scene) or overrides:
@@ -208,7 +196,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
         ref = _analytic(scene, layer)
     if fem is not None or ref is not None:
         _notify(progress, "compare", "start")
-        metrics = _compare(res, fem, ref, messages)
+        metrics = compare(res, fem=fem, analytic=ref)
         _notify(progress, "compare", "done")
     stress = None
     if scene.stress is not None:
@@ -222,7 +210,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
     result = build_result(scene, res, layer_info, fem=fem, analytic=ref, metrics=metrics, times=times,
                           messages=messages, extent=solve.extent)
     if stress is not None:
-        from .output import to_jsonable
+        from ..io import to_jsonable
         from .stress import stress_summary
 
         result["stress"] = to_jsonable(stress_summary(stress))
@@ -244,7 +232,7 @@ def write_outputs(outcome, out_dir, *, progress=None):
         if outcome.fem is not None:
             outcome.fem.write(tmp / files["fem_field"])
         if outcome.stress is not None:
-            from .stress_output import write_stress_field
+            from ..io import write_stress_field
 
             write_stress_field(tmp / files["stress_field"], res, outcome.stress)
         write_text(tmp / files["scene"], tomli_w.dumps(scene.raw))
@@ -263,7 +251,7 @@ def run_scene(scene, out_dir=None, *, progress=None, overrides=None):
     out_dir : path-like, optional
         Result directory: ``result.json``, ``scene.toml`` (the effective scene, re-runnable),
         ``bem_field.vtu``, with an FEM reference ``fem_field.vtu``, with a ``[stress]`` section
-        ``stress_field.vtu`` (:mod:`validation.stress_output`). Written atomically:
+        ``stress_field.vtu`` (:mod:`validation.io`). Written atomically:
         an existing result directory is replaced only when the run succeeded.
     progress : callable, optional
         See :func:`execute_scene`.

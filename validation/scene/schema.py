@@ -1,7 +1,7 @@
 """Validators of the sections of a scene file (one function per section).
 
 Each takes the raw TOML table (and what earlier sections produced) and returns the
-normalised section, raising :class:`validation._checks.SceneError` that names the dotted key.
+normalised section, raising :class:`validation.scene.checks.SceneError` that names the dotted key.
 Nothing here solves anything: the whole scene is checked before any work.
 """
 
@@ -17,7 +17,7 @@ from bem.lattice import Lattice
 from bem.layers import LAWS, Linear, from_dict
 from bem.materials import effective_modulus
 
-from . import _checks as ck
+from . import checks as ck
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
 from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
@@ -61,7 +61,7 @@ def scene_keys():
         ``{section: {variant: keys}}``. Variant ``""`` holds the keys of every table of the
         section; ``[gap]`` has one more variant per gap type (its parameters, from the
         :mod:`bem.gaps` constructors), ``[layer]`` one per law (its :mod:`bem.layers`
-        parameters, and the paper's keys for the four paper laws, :mod:`validation.paper`).
+        parameters, and the paper's keys for the four paper laws, :mod:`validation.scene.paper`).
     """
     out = {name: {"": keys} for name, keys in KEYS.items()}
     out["gap"] = {"": ("type",), **{kind: tuple(p for p in inspect.signature(cls.__init__).parameters if p != "self")
@@ -113,9 +113,9 @@ def gap(d, E_star, *, units=DEFAULT_UNITS):
     """``[gap]``: ``type`` and the parameters of the :mod:`bem.gaps` shape; returns (spec, Gap).
 
     A log-crowned roller given by ``design_force`` takes ``E_star`` from ``[bodies]`` when the
-    gap table leaves it out. ``type = "measured"`` reads a file (:mod:`validation.measured`;
+    gap table leaves it out. ``type = "measured"`` reads a file (:mod:`validation.scene.measured`;
     ``units`` is the scene's units label) and returns a
-    :class:`validation.measured.MeasuredSurface`, which the scene turns into a gap table
+    :class:`validation.scene.measured.MeasuredSurface`, which the scene turns into a gap table
     over the candidate region.
     """
     ck.table("gap", d)
@@ -147,7 +147,7 @@ def load(d):
 
 
 def layer(d):
-    """``[layer]``: see :func:`validation.paper.check_layer`; absent or ``law = "none"``: no layer."""
+    """``[layer]``: see :func:`validation.scene.paper.check_layer`; absent or ``law = "none"``: no layer."""
     return check_layer(d, "layer")
 
 

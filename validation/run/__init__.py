@@ -1,0 +1,12 @@
+"""Running scenes: the runner, the result dictionary, the stresses and sweeps.
+
+- :mod:`validation.run.runner`: :func:`run_scene` / :func:`execute_scene`, the one place that
+  solves a scene (BEM always; FEM, closed form, comparison, stresses when named);
+- :mod:`validation.run.result`: the content of ``result.json``;
+- :mod:`validation.run.stress`: the ``[stress]`` part of a run;
+- :mod:`validation.run.sweep`: one scene over a list of values of a parameter.
+"""
+
+from .runner import FILES, RunOutcome, execute_scene, planned_stages, run_scene, write_outputs
+
+__all__ = ["run_scene", "execute_scene", "write_outputs", "planned_stages", "RunOutcome", "FILES"]
