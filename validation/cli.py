@@ -11,7 +11,6 @@ import contextlib
 import importlib
 import logging
 import os
-import re
 import sys
 from pathlib import Path
 
@@ -167,14 +166,14 @@ def build_parser():
     return parser
 
 
-def _units(label):
-    """``(length, pressure, force)`` unit names from a label like ``"SI (m, Pa, N)"``."""
-    m = re.search(r"\(([^,()]+),\s*([^,()]+),\s*([^,()]+)\)", label or "")
-    return tuple(s.strip() for s in m.groups()) if m else ("", "", "")
+def _units(result):
+    """``(length, pressure, force)`` unit symbols of a result ("" where unknown)."""
+    symbols = result.get("unit_symbols") or {}
+    return tuple(symbols.get(k, "") for k in ("length", "pressure", "force"))
 
 
 def _summary(result, out_dir):
-    L, Pa, N = _units(result["units"])
+    L, Pa, N = _units(result)
     t = result["wall_time_s"]
     lines = [f"scene      {result['scene']}: {result['title']}   [units {result['units']}]"]
     p_line = f"p_max      {result['p_max']:.6g} {Pa}"
@@ -265,7 +264,7 @@ def _cmd_check(args):
     parts = ["bem"] + [k for k in ("fem", "analytic", "sweep", "stress", "report") if getattr(scene, k) is not None]
     b = scene.bem
     print(f"{scene.name}: OK ({', '.join(parts)}); lattice step {b['step']:.4g}, region "
-          f"{b['extent'][0]:.4g} x {b['extent'][1]:.4g}, {b['n_nodes']} nodes   [units {scene.units}]")
+          f"{b['extent'][0]:.4g} x {b['extent'][1]:.4g}, {b['n_nodes']} nodes   [units {scene.units.label}]")
     return 0
 
 

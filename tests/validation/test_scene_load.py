@@ -26,7 +26,7 @@ def test_builtin_scenes_listed_with_descriptions():
 def test_builtin_scene_loads_and_names_itself(name):
     scene = load_scene(name)
     assert scene.name == name
-    assert scene.units == "SI (m, Pa, N)"
+    assert scene.units.label == "SI (m, Pa, N)" and scene.units.as_dict() == {"length": "m", "pressure": "Pa", "force": "N"}
     assert scene.source == f"builtin:{name}"
     assert load_scene(builtin_path(name)).raw == scene.raw  # by path, the same scene
 

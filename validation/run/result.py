@@ -54,14 +54,18 @@ def _history(res):
     return out
 
 
-def _analytic_summary(kind, ref):
-    """Scalars of the closed-form reference (:mod:`bem.reference`, shared names)."""
+def _analytic_summary(kind, ref, lattice):
+    """Scalars of the closed-form reference (:mod:`bem.reference`, shared names), and its pressure
+    along the x and y axes over the candidate region (801 points each), which the reports draw."""
     out = {"kind": kind, "force": ref.force, "approach": ref.approach, "p_max": ref.p_max,
            "contact_area": ref.contact_area}
     if kind == "hertz_elliptic":
         out.update(a=ref.a, b=ref.b)
     else:
         out["contact_radius"] = ref.contact_radius
+    x = np.linspace(lattice.x.min(), lattice.x.max(), 801)
+    y = np.linspace(lattice.y.min(), lattice.y.max(), 801)
+    out["profile"] = {"x": x, "p": ref.pressure(x, 0.0), "y": y, "p_y": ref.pressure(0.0, y)}
     return out
 
 
@@ -83,7 +87,8 @@ def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=Non
     loaded = res.p > 0
     out = {
         "schema": SCHEMA,
-        "scene": scene.name, "title": scene.title, "units": scene.units, "source": scene.source,
+        "scene": scene.name, "title": scene.title, "units": scene.units.label,
+        "unit_symbols": scene.units.as_dict(), "source": scene.source,
         "overrides": list(scene.overrides), "method": res.method,
         "p_max": res.p_max, "force": res.force, "approach": res.approach, "contact_area": res.contact_area,
     }
@@ -103,7 +108,7 @@ def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=Non
         out["fem"] = fem.summary()
         out["fem_profile"] = {"r": fem.r, "p": fem.p}
     if analytic is not None:
-        out["analytic"] = _analytic_summary(scene.analytic["kind"], analytic)
+        out["analytic"] = _analytic_summary(scene.analytic["kind"], analytic, res.lattice)
     if metrics is not None:
         out["comparison"] = metrics
     scales = _scales(scene)

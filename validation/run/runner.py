@@ -79,12 +79,11 @@ class _BemRunner:
         opts = scene.bem
         self.extent = tuple(opts["extent"])
         self.kw = dict(E_star=scene.E_star, force=scene.load["force"], approach=scene.load["approach"],
-                       step=opts["step"], method=opts["method"])
-        self.kw.update({k: opts[k] for k in SOLVER_KEYS[1:] if k in opts})
-        if calibration:  # the robust solver with its defaults, whatever the scene's method
-            self.kw["method"] = "newton"
-            for key in ("maxiter", "relaxation", "eps_h", "eps_p"):
-                self.kw.pop(key, None)
+                       step=opts["step"], method="newton" if calibration else opts["method"])
+        # the calibration solves with the robust solver and its defaults, whatever the scene's method:
+        # only the tolerance and the lattice options carry over
+        keys = ("rtol", "precondition", "nested") if calibration else SOLVER_KEYS[1:]
+        self.kw.update({k: opts[k] for k in keys if k in opts})
         self.solves = 0
 
     def __call__(self, layer, callback=None):

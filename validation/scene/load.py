@@ -37,6 +37,7 @@ from ..extras import require as require_extra
 from .measured import measured_region
 from .paper import ALIASES, EXCLUSIVE
 from ..provenance import display_path
+from ..units import Units
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
            "apply_overrides", "parse_override", "SECTIONS"]
@@ -53,7 +54,7 @@ class Scene:
     name: str
     title: str
     description: str
-    units: str
+    units: Units
     source: str
     raw: dict
     E_star: float

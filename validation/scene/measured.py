@@ -49,6 +49,7 @@ import numpy as np
 
 from bem.gaps import Table
 
+from ..units import METRES
 from . import checks as ck
 
 __all__ = ["MeasuredSurface", "RegionTable", "measured_gap", "measured_region", "read_surface", "KEYS", "FORMATS",
@@ -56,8 +57,8 @@ __all__ = ["MeasuredSurface", "RegionTable", "measured_gap", "measured_region", 
 
 KEYS = ("type", "file", "format", "kind", "length_unit", "spacing", "center", "method", "nodata")
 FORMATS = {".npy": "npy", ".csv": "grid", ".txt": "grid", ".dat": "grid", ".asc": "asc", ".xyz": "xyz"}
-#: metres per unit of the length units a scene or file may name
-LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "nm": 1e-9}
+#: metres per unit of the length units a measured file may name
+LENGTH_UNITS = {k: METRES[k] for k in ("m", "mm", "um", "µm", "nm")}
 _MIN_POINTS = 4  # of the scattered points of an xyz file
 _UNIFORM = 1e-6  # relative tolerance of "evenly spaced"
 
@@ -91,19 +92,7 @@ def _fail(key, value, rule):
     raise ck.SceneError(f"gap.{key} = {value!r} is not allowed: {rule}.")
 
 
-def _scene_metres(units_label):
-    """Metres per length unit of the scene's units label (``None`` when it names none)."""
-    label = str(units_label or "")
-    if re.match(r"^\s*SI\b", label) and not re.search(r"\(", label):
-        return 1.0
-    inner = re.search(r"\(([^)]*)\)", label)
-    for token in re.split(r"[\s,;/]+", inner.group(1) if inner else label):
-        if token in LENGTH_UNITS:
-            return LENGTH_UNITS[token]
-    return None
-
-
-def _factor(d, units_label):
+def _factor(d, units):
     """Scene length units per length unit of the file (``gap.length_unit``)."""
     value = d.get("length_unit")
     if value is None:
@@ -113,9 +102,10 @@ def _factor(d, units_label):
     if not isinstance(value, str) or value not in LENGTH_UNITS:
         _fail("length_unit", value, f"it must be one of {', '.join(map(repr, LENGTH_UNITS))} or a positive "
                                     "factor from the file's numbers to the scene's length unit")
-    scene = _scene_metres(units_label)
+    scene = None if units is None else units.metres
     if scene is None:
-        _fail("length_unit", value, f"the scene's units label {units_label!r} names no length unit (m, mm, um, "
+        label = None if units is None else units.label
+        _fail("length_unit", value, f"the scene's units label {label!r} names no length unit (m, mm, um, "
                                     "nm) to convert to; give the factor as a number instead")
     return LENGTH_UNITS[value] / scene
 
@@ -231,7 +221,7 @@ def read_surface(d, *, units=None):
     """Read the file of a ``[gap] type = "measured"`` table: ``(x, y, z, fmt)`` in scene units.
 
     ``z[i, j]`` is the value at ``(x[i], y[j])`` (NaN: no data), ``x`` and ``y`` increasing,
-    before ``center`` is applied. ``units`` is the scene's units label (for ``length_unit``).
+    before ``center`` is applied. ``units`` is the scene's :class:`validation.units.Units` (for ``length_unit``).
 
     Raises
     ------

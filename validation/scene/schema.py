@@ -16,18 +16,20 @@ from bem.gaps import gap_from_dict
 from bem.lattice import Lattice
 from bem.layers import LAWS, Linear, from_dict
 from bem.materials import effective_modulus
+from bem.solve import OPTIONS as SOLVER_OPTIONS
 
 from . import checks as ck
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
 from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
+from ..units import DEFAULT_LABEL as DEFAULT_UNITS
+from ..units import parse_units
 from .sizing import DOMAIN_MARGIN, MAX_NODES, check_estimate, inner_domain, node_count
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "bem_options", "fem_options", "analytic",
            "report", "sweep_spec", "stress_options", "scene_keys", "KEYS", "REPORT_SECTIONS", "ANALYTIC_KINDS",
            "DEFAULT_UNITS"]
 
-DEFAULT_UNITS = "SI (m, Pa, N)"
 #: Section names the report builder knows (validation only; the builder lives in validation.report).
 REPORT_SECTIONS = ("summary", "scene", "profile", "pressure_map", "comparison", "convergence", "layer_law",
                    "fem_field", "sweep", "timings", "stress")
@@ -35,8 +37,8 @@ ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
 #: solver options a scene may set: the common ones and each solver's own (bem.solve.OPTIONS)
-SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested", "relaxation", "eps_h", "eps_p",
-               "inner_maxiter")
+SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested") + tuple(
+    sorted({k for keys in SOLVER_OPTIONS.values() for k in keys}))
 _BEM_KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
 _FEM_KEYS = ("n_contact", "extent_factor", "fine_radius", "growth", "penalty", "rtol", "maxiter", "remesh",
              "truncation_correction")
@@ -89,6 +91,7 @@ def scene_meta(d):
     for key in ("title", "description", "units"):
         if key in d:
             out[key] = ck.string(f"scene.{key}", d[key])
+    out["units"] = parse_units(out["units"])
     return out
 
 
@@ -109,7 +112,7 @@ def bodies(d):
     return {"E_star": E_star, "materials": {k: float(d[k]) for k in _BODY_KEYS}}
 
 
-def gap(d, E_star, *, units=DEFAULT_UNITS):
+def gap(d, E_star, *, units=None):
     """``[gap]``: ``type`` and the parameters of the :mod:`bem.gaps` shape; returns (spec, Gap).
 
     A log-crowned roller given by ``design_force`` takes ``E_star`` from ``[bodies]`` when the
