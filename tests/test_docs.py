@@ -25,6 +25,7 @@ import fem_reference
 from validation.scene import schema as ss
 from validation.run import run_scene
 from validation.scene import SECTIONS
+from validation.scene import sizing
 from validation.scene.sizing import MAX_NODES
 from validation.run.sweep import SUMMARY_COLUMNS
 
@@ -99,8 +100,8 @@ def test_scenes_doc_defaults_are_the_code_defaults():
     solve = inspect.signature(bem.solve).parameters
     for key in ("method", "rtol", "precondition"):
         assert _default(doc["bem"][""][key]) == solve[key].default, key
-    assert _default(doc["bem"][""]["nodes_across"]) == ss.DEFAULT_NODES_ACROSS
-    assert _default(doc["bem"][""]["extent_factor"]) == ss.DEFAULT_EXTENT_FACTOR
+    assert _default(doc["bem"][""]["nodes_across"]) == sizing.DEFAULT_NODES_ACROSS
+    assert _default(doc["bem"][""]["extent_factor"]) == sizing.DEFAULT_EXTENT_FACTOR
     assert _default(doc["scene"][""]["units"]) == ss.DEFAULT_UNITS
     assert f"{MAX_NODES / 1e6:g} million nodes" in (DOCS / "scenes.md").read_text()
     assert checked > 10

@@ -178,16 +178,22 @@ def layer_radius(gap, layer, *, force=None, approach=None):
         return 1.0 if not math.isfinite(value) else value / force - 1.0
 
     top = float(h.h[-1]) if h.h.size else 0.0
-    levels = h.h[(h.h > 0) & (h.h < top)][::_PER_OCTAVE]  # one level per octave of radius
-    if levels.size == 0:
+    if top <= 0:
         raise InputError("a_est could not be estimated from the gap: it is flat. Pass a_est explicitly.")
+    # bracket the approach by doubling or halving from 1 length unit, within the sampled gap
+    delta = min(1.0, 0.5 * top)
     with np.errstate(over="ignore", invalid="ignore"):
-        signs = np.array([excess(d) >= 0 for d in levels])
-    k = int(np.argmax(signs))
-    if not signs[k] or k == 0:
-        raise InputError("a_est could not be estimated from the gap: the layer alone carries no force at any "
-                         "approach the sampled gap reaches. Pass a_est explicitly.")
-    lo, hi = float(levels[k - 1]), float(levels[k])
+        f = excess(delta)
+        for _ in range(800):
+            other = 0.5 * delta if f >= 0 else min(2.0 * delta, top)
+            g = excess(other) if other != delta else f
+            if (g >= 0) != (f >= 0):
+                break
+            if other == delta:
+                raise InputError("a_est could not be estimated from the gap: the layer alone carries the force "
+                                 "at no approach the sampled gap reaches. Pass a_est explicitly.")
+            delta, f = other, g
+    lo, hi = sorted((delta, other))
     delta = brentq(excess, lo, hi, xtol=1e-14 * hi, rtol=1e-12)
     if not math.isfinite(_layer_force(h, layer, delta * (1.0 - 1e-9))):
         return None

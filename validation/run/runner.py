@@ -22,7 +22,7 @@ from ..compare import compare
 from ..io import atomic_directory, atomic_write_json
 from .result import build_result
 from ..scene.load import Scene, load_scene
-from ..scene.schema import SOLVER_KEYS
+from ..scene.sizing import SOLVER_KEYS
 from ..scene.sizing import DOMAIN_MARGIN, inner_domain
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES"]
@@ -164,7 +164,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
         _notify(progress, "layer", "start")
     t = time.perf_counter()
     layer, layer_info = paper.resolve_layer(scene.layer_spec, step=scene.bem["step"], E_star=scene.E_star,
-                                            solve=calibrate)
+                                            solve=calibrate, layer=scene.layer)
     if calibrate.solves:
         times["layer_reference"] = time.perf_counter() - t
         solve.extent = calibrate.extent

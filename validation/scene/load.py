@@ -31,13 +31,14 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from . import schema as sec
-from .checks import SceneError
 from ..extras import require as require_extra
-from .measured import measured_region
-from .paper import ALIASES, EXCLUSIVE
 from ..provenance import display_path
 from ..units import Units
+from . import schema as sec
+from .checks import SceneError
+from .measured import measured_region
+from .paper import ALIASES, EXCLUSIVE
+from .sizing import bem_options
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
            "apply_overrides", "parse_override", "SECTIONS"]
@@ -49,7 +50,13 @@ _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
 
 @dataclass(frozen=True)
 class Scene:
-    """A validated scene. ``raw`` is the TOML content (overrides applied), re-loadable as is."""
+    """A validated scene. ``raw`` is the TOML content (overrides applied), re-loadable as is.
+
+    ``units`` is the parsed ``[scene] units`` label; ``gap`` the :mod:`bem.gaps` shape;
+    ``layer_spec`` the validated ``[layer]`` and ``layer`` the law built from it once (``None``
+    without a layer, or for a law of the paper's parameters, which the runner resolves);
+    ``bem`` the solver options with the resolved lattice (:func:`validation.scene.sizing.bem_options`).
+    """
 
     name: str
     title: str
@@ -62,6 +69,7 @@ class Scene:
     gap: object
     gap_spec: dict
     layer_spec: dict | None
+    layer: object
     load: dict
     bem: dict
     fem: dict | None = None
@@ -207,12 +215,11 @@ def _validate(raw, source, overrides):
     body = check(sec.bodies, section["bodies"])
     load = check(sec.load, section["load"])
     shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"]), section["gap"], body, meta)
-    layer_spec = check(sec.layer, raw.get("layer"))
-    bem = check(lambda g, ls, b, ld: sec.bem_options(raw.get("bem"), g[1], ls, b["E_star"], ld),
-                shape, layer_spec, body, load)
+    layer = check(sec.layer, raw.get("layer"))
+    bem = check(lambda g, la, b, ld: bem_options(raw.get("bem"), g[1], *la, b["E_star"], ld), shape, layer, body, load)
     shape = check(lambda g, b: (g[0], measured_region(g[1], b["extent"])), shape, bem)
     fem = check(lambda g, b: sec.fem_options(raw.get("fem"), g[1], b["materials"]), shape, body)
-    analytic = check(lambda g, ls: sec.analytic(raw.get("analytic"), g[1], ls), shape, layer_spec)
+    analytic = check(lambda g, la: sec.analytic(raw.get("analytic"), g[1], la[0]), shape, layer)
     sweep = check(sec.sweep_spec, raw.get("sweep"), SECTIONS)
     report = check(sec.report, raw.get("report"))
     stress = check(lambda b: sec.stress_options(raw.get("stress"), b["materials"]), body)
@@ -221,7 +228,7 @@ def _validate(raw, source, overrides):
     return Scene(
         name=meta["name"], title=meta["title"], description=meta["description"], units=meta["units"],
         source=source, raw=raw, E_star=body["E_star"], materials=body["materials"], gap=shape[1],
-        gap_spec=shape[0], layer_spec=layer_spec, load=load, bem=bem, fem=fem, analytic=analytic, sweep=sweep,
+        gap_spec=shape[0], layer_spec=layer[0], layer=layer[1], load=load, bem=bem, fem=fem, analytic=analytic, sweep=sweep,
         report=report, overrides=tuple(overrides), stress=stress,
     )
 

@@ -32,9 +32,10 @@ import math
 from bem.operator import diagonal_coefficient
 from bem.layers import LAWS, Bilinear, ElasticRigid, Linear, Root, from_dict
 
-from .checks import SceneError, in_range, positive, scene_errors, string, table, unknown_keys
+from .checks import SceneError, in_range, positive, string, table, unknown_keys
 
-__all__ = ["CalibrationError", "c_nn", "check_layer", "resolve_layer", "PAPER_LAWS", "PAPER_KEYS", "EXCLUSIVE", "ALIASES"]
+__all__ = ["CalibrationError", "c_nn", "check_layer", "resolve_layer", "is_paper_law", "PAPER_LAWS", "PAPER_KEYS",
+           "EXCLUSIVE", "ALIASES"]
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +61,11 @@ _ALPHA_B_XTOL = 1e-5  # relative tolerance on lam_r when targeting alpha_b
 
 
 c_nn = diagonal_coefficient  # ``C_nn = c / (pi E*) w_t(0, 0)``, defined once in bem.operator
+
+
+def is_paper_law(spec):
+    """Whether a validated ``[layer]`` spec is given by the paper's parameters (resolved by solves)."""
+    return spec is not None and spec["law"] in PAPER_LAWS and any(k in spec for k in PAPER_KEYS)
 
 
 def _check_paper_values(path, d):
@@ -109,9 +115,9 @@ def choice_law(path, d, *, allow_none=True):
 def check_layer(d, path="layer"):
     """Validate a ``[layer]`` table; returns the spec dict, or ``None`` for no layer.
 
-    Direct parameters are those of :mod:`bem.layers` (``from_dict``); the four paper laws
-    also take the paper's parameters (module docstring): each constructor parameter from
-    exactly one of its direct or paper key.
+    Direct parameters are those of :mod:`bem.layers` (``from_dict``, which checks their values
+    when the scene builds the law, once); the four paper laws also take the paper's parameters
+    (module docstring): each constructor parameter from exactly one of its direct or paper key.
     """
     if d is None:
         return None
@@ -125,8 +131,6 @@ def check_layer(d, path="layer"):
         return None
     if law not in PAPER_LAWS or not any(k in d for k in PAPER_KEYS):
         _check_law_keys(path, d)
-        with scene_errors(f"{path}."):
-            from_dict(d)  # value checks (monotone table, callables, ...)
         return dict(d)
     params = PAPER_LAWS[law]
     allowed = ["law"] + [k for pair in params.values() for k in pair] + (["alpha_b"] if law == "root" else [])
@@ -201,8 +205,8 @@ def paper_law(law, lam, p_lambda=None, *, alpha_a=None, alpha_c=None, p_cr=None,
     raise SceneError(f"layer.law = {law!r} is not allowed: it must be one of {sorted(PAPER_LAWS)}.")
 
 
-def resolve_layer(spec, *, step, E_star, solve):
-    """Build the layer law of a validated spec, solving the linear reference first if needed.
+def resolve_layer(spec, *, step, E_star, solve, layer=None):
+    """The layer law of a validated spec, solving the linear reference first if needed.
 
     Parameters
     ----------
@@ -214,6 +218,8 @@ def resolve_layer(spec, *, step, E_star, solve):
         Effective modulus [pressure].
     solve : callable
         ``solve(layer) -> bem.ContactResult`` of the scene's problem with that layer.
+    layer : bem.layers.Layer, optional
+        The law the scene already built from a spec of direct parameters (used as it is).
 
     Returns
     -------
@@ -228,8 +234,8 @@ def resolve_layer(spec, *, step, E_star, solve):
         return None, {"law": "none", "parameters": None}
     law = spec["law"]
     info = {"law": law}
-    if law not in PAPER_LAWS or not any(k in spec for k in PAPER_KEYS):
-        layer = from_dict(spec)
+    if not is_paper_law(spec):
+        layer = from_dict(spec) if layer is None else layer
         return layer, dict(info, parameters=layer.to_dict())
     cnn = c_nn(step, E_star)
     direct = PAPER_LAWS[law][next(iter(PAPER_LAWS[law]))][0]  # lam or lam1

@@ -11,22 +11,20 @@ import inspect
 import math
 import re
 
-from bem import METHODS, InputError, gaps
+from bem import gaps
 from bem.gaps import gap_from_dict
-from bem.lattice import Lattice
-from bem.layers import LAWS, Linear, from_dict
+from bem.layers import LAWS, from_dict
 from bem.materials import effective_modulus
-from bem.solve import OPTIONS as SOLVER_OPTIONS
 
 from . import checks as ck
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
-from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
 from ..units import DEFAULT_LABEL as DEFAULT_UNITS
 from ..units import parse_units
-from .sizing import DOMAIN_MARGIN, MAX_NODES, check_estimate, inner_domain, node_count
+from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law
+from .sizing import KEYS as BEM_KEYS
 
-__all__ = ["scene_meta", "bodies", "gap", "load", "layer", "bem_options", "fem_options", "analytic",
+__all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic",
            "report", "sweep_spec", "stress_options", "scene_keys", "KEYS", "REPORT_SECTIONS", "ANALYTIC_KINDS",
            "DEFAULT_UNITS"]
 
@@ -36,22 +34,16 @@ REPORT_SECTIONS = ("summary", "scene", "profile", "pressure_map", "comparison", 
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
-#: solver options a scene may set: the common ones and each solver's own (bem.solve.OPTIONS)
-SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested") + tuple(
-    sorted({k for keys in SOLVER_OPTIONS.values() for k in keys}))
-_BEM_KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
 _FEM_KEYS = ("n_contact", "extent_factor", "fine_radius", "growth", "penalty", "rtol", "maxiter", "remesh",
              "truncation_correction")
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
 KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *_BODY_KEYS),
-        "load": ("force", "approach"), "bem": _BEM_KEYS, "fem": _FEM_KEYS, "analytic": ("kind",),
+        "load": ("force", "approach"), "bem": BEM_KEYS, "fem": _FEM_KEYS, "analytic": ("kind",),
         "sweep": ("parameter", "values"), "report": ("sections", "format"),
         "stress": ("depths", "n_depths", "max_depth", "bodies")}
 GAP_TYPES = gaps.GAPS
 _STRESS_KEYS = KEYS["stress"]
 STRESS_BODIES = ("body1", "body2")
-DEFAULT_NODES_ACROSS = 40
-DEFAULT_EXTENT_FACTOR = 1.5
 
 
 def scene_keys():
@@ -150,117 +142,17 @@ def load(d):
 
 
 def layer(d):
-    """``[layer]``: see :func:`validation.scene.paper.check_layer`; absent or ``law = "none"``: no layer."""
-    return check_layer(d, "layer")
+    """``[layer]``: ``(spec, law)``; see :func:`validation.scene.paper.check_layer`.
 
-
-def _sizing_layer(spec, step, E_star):
-    """A layer object that sizes the region (paper laws: their linear reference)."""
-    if spec is None:
-        return None
-    law = spec["law"]
-    if law in PAPER_LAWS and any(k in spec for k in PAPER_KEYS):
-        direct = next(iter(PAPER_LAWS[law].values()))[0]
-        return Linear(spec[direct] if direct in spec else spec["lam_over_cnn"] * c_nn(step, E_star))
-    return from_dict(spec)
-
-
-def _estimate(shape, layer_spec, E_star, load_, step, n_across):
-    """Expected semi-axes; with ``lam_over_cnn`` and an automatic step, iterate step <-> layer."""
-    kw = dict(E_star=E_star, force=load_["force"], approach=load_["approach"])
-    with ck.scene_errors():
-        axes = check_estimate(shape, layer=None, **kw)
-    if axes is None or layer_spec is None:
-        return axes
-    s = step if step is not None else 2 * min(axes) / n_across
-    for _ in range(30):
-        with ck.scene_errors():
-            axes = check_estimate(shape, layer=_sizing_layer(layer_spec, s, E_star), **kw)
-        if step is not None:
-            break
-        s_new = 2 * min(axes) / n_across
-        if abs(s_new / s - 1.0) < 1e-9:
-            break
-        s = s_new
-    return axes
-
-
-def _solver_options(d, method, layer_spec):
-    """The options of the solver that will run, checked by the BEM itself (one rule, one message)."""
-    from bem.solve import check_options, solver_for
-
-    kind = None if layer_spec is None else ("linear" if layer_spec["law"] == "linear" else "nonlinear")
-    if method == "kalker" and kind == "nonlinear":
-        raise ck.SceneError(f"bem.method = 'kalker' is not allowed with layer.law = {layer_spec['law']!r}: "
-                            "Kalker's QP solves smooth bodies and linear layers; use 'newton'.")
-    own = {k: d[k] for k in SOLVER_KEYS[5:] if k in d}
-    try:
-        return check_options(method, solver_for(method, kind), own)
-    except InputError as exc:
-        raise ck.SceneError(f"bem.{exc}") from None
-
-
-def bem_options(d, shape, layer_spec, E_star, load_):
-    """``[bem]``: lattice (``step`` | ``nodes_across``, ``extent`` | ``extent_factor``) and solver options.
-
-    Returns the options with the resolved ``step`` [m], ``extent`` ``(ex, ey)`` [m],
-    ``expected`` semi-axes (or None) and ``extent_auto`` (the region may be enlarged).
+    ``law`` is the :mod:`bem.layers` object, built here once from direct parameters (which
+    checks their values); ``None`` without a layer (absent or ``law = "none"``) and for a law of
+    the paper's parameters, which the runner resolves by a solve.
     """
-    d = {} if d is None else ck.table("bem", d)
-    ck.unknown_keys("bem", d, KEYS["bem"])
-    for a, b in (("step", "nodes_across"), ("extent", "extent_factor")):
-        if a in d and b in d:
-            raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
-                                "give one of them.")
-    out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
-    if "rtol" in d:
-        out["rtol"] = ck.positive("bem.rtol", d["rtol"])
-    if "maxiter" in d:
-        out["maxiter"] = ck.integer("bem.maxiter", d["maxiter"], 1)
-    for key in ("precondition", "nested"):
-        if key in d:
-            out[key] = ck.boolean(f"bem.{key}", d[key])
-    out.update(_solver_options(d, out["method"], layer_spec))
-    step = ck.positive("bem.step", d["step"]) if "step" in d else None
-    n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
-    axes = _estimate(shape, layer_spec, E_star, load_, step, n_across)
-    if axes is None and ("step" not in d or "extent" not in d):
-        raise ck.SceneError(f"bem.step and bem.extent are missing: a {shape.type_name!r} gap has no estimate "
-                            "of the contact size, so give the lattice step [m] and the region half-width [m].")
-    if step is None:
-        step = 2 * min(axes) / n_across
-    elif axes is not None and 2 * min(axes) / step < 4:
-        raise ck.SceneError(f"bem.step = {step!r} is not allowed for this load: the expected contact is only "
-                            f"{2 * min(axes):.4g} across ({2 * min(axes) / step:.1f} steps); make step smaller "
-                            "(at least 4 nodes across the contact).")
-    hx, hy = inner_domain(shape)
-    if "extent" in d:
-        ex, ey = ck.number_or_pair("bem.extent", d["extent"], ck.positive)
-        if ex >= hx or ey >= hy:
-            raise ck.SceneError(f"bem.extent = {d['extent']!r} is not allowed: the candidate region must lie "
-                                f"inside the gap's domain, |x| < {hx:.6g}, |y| < {hy:.6g}.")
-        if axes is not None and (ex < axes[0] or ey < axes[1]):
-            raise ck.SceneError(
-                f"bem.extent = {d['extent']!r} is not allowed for this load: the expected contact semi-axes "
-                f"are ({axes[0]:.4g}, {axes[1]:.4g}), beyond the region; make extent larger (or use "
-                "extent_factor) or reduce the load.")
-        auto = False
-    else:
-        fx, fy = ck.number_or_pair("bem.extent_factor", d.get("extent_factor", DEFAULT_EXTENT_FACTOR),
-                                   lambda p, v: ck.in_range(p, v, 1.0, 100.0))
-        ex = min(fx * axes[0], (1 - DOMAIN_MARGIN) * hx)
-        ey = min(fy * axes[1], (1 - DOMAIN_MARGIN) * hy)
-        auto = True
-    with ck.scene_errors():
-        Lattice.from_extent(step, (ex, ey))
-    n = node_count(step, (ex, ey))
-    if n > MAX_NODES:
-        raise ck.SceneError(f"bem.{'step' if 'step' in d else 'nodes_across'} = "
-                            f"{d.get('step', n_across)!r} is not allowed: the region would hold {n} nodes "
-                            f"(limit {MAX_NODES}); make the lattice coarser or the region smaller.")
-    out.update(step=step, extent=(ex, ey), extent_auto=auto, expected=axes,
-               nodes_across=2 * min(axes) / step if axes else None, n_nodes=n)
-    return out
+    spec = check_layer(d, "layer")
+    if spec is None or is_paper_law(spec):
+        return spec, None
+    with ck.scene_errors("layer."):
+        return spec, from_dict(spec)
 
 
 def fem_options(d, shape, materials):

@@ -1,48 +1,44 @@
-"""Size the BEM candidate region from the expected contact before any solve.
+"""The ``[bem]`` section of a scene: the solver options, and the lattice sized from the expected contact.
 
 A scene may give the lattice directly (``bem.step``, ``bem.extent``) or relative to the
 expected contact: ``bem.nodes_across`` nodes across its smaller diameter and
-``bem.extent_factor`` times its semi-axes. The expected semi-axes ``(ax, ay)`` are closed-form
-estimates:
+``bem.extent_factor`` times its semi-axes. The expected semi-axes are the gap's own estimate,
+:meth:`bem.gaps.Gap.expected_semi_axes` (closed forms of :mod:`bem.reference`; tables,
+callables and measured surfaces have none, and such a scene gives ``bem.step`` and
+``bem.extent``). With a layer given by the paper's ``lam_over_cnn`` the layer depends on the
+step and the step on the expected contact: the two are iterated to a fixed point (the gap's
+radial profile is sampled once for all of them). An estimate only sizes the region: the runner
+enlarges an automatic region when the contact reaches its border.
 
-- axisymmetric gaps: :func:`bem.reference.estimate_contact_radius` (Hertz radius of the gap,
-  combined with the layer-alone radius when there is a layer);
-- elliptic paraboloid: Hertz's ellipse (:func:`bem.reference.hertz_elliptic`), scaled by
-  the layer's widening of the paraboloid of the same mean radius ``sqrt(Rx Ry)``;
-- crowned roller (axis along x): ``ax = l/2``; ``ay`` the Hertz line-contact half-width
-  ``b = sqrt(4 P R / (pi l E*))`` (Johnson 1985, ISBN 978-0-521-34796-9, sec. 4.3, load per
-  length ``P/l``), or ``sqrt(R delta)`` under approach control (heuristic);
-- tables and callables: no estimate (the scene must give ``bem.step`` and ``bem.extent``).
-
-An estimate only sizes the region: the runner enlarges an automatic region when the contact
-reaches its border.
+The solver options are checked by the BEM itself (:func:`bem.solve.check_options`: one rule,
+one message), and the option names come from :data:`bem.solve.OPTIONS`.
 """
 
 from __future__ import annotations
 
 import math
 
-from bem.checks import InputError
-from bem.lattice import SQRT3
+from bem import METHODS, InputError
+from bem.lattice import SQRT3, Lattice
+from bem.layers import Linear
+from bem.solve import OPTIONS, check_options, solver_for
 
-__all__ = ["expected_semi_axes", "inner_domain", "node_count", "MAX_NODES"]
+from . import checks as ck
+from .paper import PAPER_LAWS, c_nn, is_paper_law
+
+__all__ = ["bem_options", "inner_domain", "node_count", "KEYS", "SOLVER_KEYS", "MAX_NODES", "DOMAIN_MARGIN",
+           "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
 
 #: Largest candidate region a scene may ask for (memory and time guard).
 MAX_NODES = 4_000_000
 #: An automatic extent stays this fraction inside a bounded gap domain.
 DOMAIN_MARGIN = 1e-3
-
-
-def expected_semi_axes(gap, *, E_star, force=None, approach=None, layer=None):
-    """Expected contact semi-axes ``(ax, ay)`` [length], or ``None`` without an estimate
-    (:meth:`bem.gaps.Gap.expected_semi_axes`).
-
-    Raises
-    ------
-    bem.InputError
-        The estimate failed (e.g. a gap that does not grow with the radius).
-    """
-    return gap.expected_semi_axes(E_star=E_star, force=force, approach=approach, layer=layer)
+DEFAULT_NODES_ACROSS = 40
+DEFAULT_EXTENT_FACTOR = 1.5
+#: solver options a scene may set: the common ones and each solver's own (bem.solve.OPTIONS)
+SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested") + tuple(
+    sorted({k for keys in OPTIONS.values() for k in keys}))
+KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
 
 
 def inner_domain(gap):
@@ -59,10 +55,124 @@ def node_count(step, extent):
     return cols * rows
 
 
-def check_estimate(gap, **kw):
-    """:func:`expected_semi_axes`, re-raising a failure as InputError with advice."""
+def _axes(gap, layer, E_star, load):
     try:
-        return expected_semi_axes(gap, **kw)
+        return gap.expected_semi_axes(E_star=E_star, force=load["force"], approach=load["approach"], layer=layer)
     except InputError as exc:
-        raise InputError(f"bem.nodes_across cannot be used: the contact size could not be estimated ({exc}); "
-                         "give bem.step and bem.extent.") from None
+        raise ck.SceneError(f"bem.nodes_across cannot be used: the contact size could not be estimated ({exc}); "
+                            "give bem.step and bem.extent.") from None
+
+
+def _expected(gap, layer_spec, layer, E_star, load, step, n_across):
+    """Expected semi-axes; with ``lam_over_cnn`` and an automatic step, iterate step <-> layer."""
+    axes = _axes(gap, None, E_star, load)
+    if axes is None or layer_spec is None:
+        return axes
+    if not is_paper_law(layer_spec):
+        return _axes(gap, layer, E_star, load)
+    direct = next(iter(PAPER_LAWS[layer_spec["law"]].values()))[0]  # lam or lam1: the linear reference
+    s = step if step is not None else 2 * min(axes) / n_across
+    for _ in range(30):
+        lam = layer_spec[direct] if direct in layer_spec else layer_spec["lam_over_cnn"] * c_nn(s, E_star)
+        axes = _axes(gap, Linear(lam), E_star, load)
+        s_new = 2 * min(axes) / n_across
+        if step is not None or abs(s_new / s - 1.0) < 1e-9:
+            break
+        s = s_new
+    return axes
+
+
+def _solver_options(d, method, layer_spec):
+    """The options of the solver that will run, checked by the BEM itself."""
+    kind = None if layer_spec is None else ("linear" if layer_spec["law"] == "linear" else "nonlinear")
+    if method == "kalker" and kind == "nonlinear":
+        raise ck.SceneError(f"bem.method = 'kalker' is not allowed with layer.law = {layer_spec['law']!r}: "
+                            "Kalker's QP solves smooth bodies and linear layers; use 'newton'.")
+    own = {k: d[k] for k in SOLVER_KEYS[5:] if k in d}
+    try:
+        return check_options(method, solver_for(method, kind), own)
+    except InputError as exc:
+        raise ck.SceneError(f"bem.{exc}") from None
+
+
+def _extent(d, gap, axes):
+    """``(ex, ey)`` [length] and whether the region is automatic (may be enlarged)."""
+    hx, hy = inner_domain(gap)
+    if "extent" not in d:
+        fx, fy = ck.number_or_pair("bem.extent_factor", d.get("extent_factor", DEFAULT_EXTENT_FACTOR),
+                                   lambda p, v: ck.in_range(p, v, 1.0, 100.0))
+        return (min(fx * axes[0], (1 - DOMAIN_MARGIN) * hx), min(fy * axes[1], (1 - DOMAIN_MARGIN) * hy)), True
+    ex, ey = ck.number_or_pair("bem.extent", d["extent"], ck.positive)
+    if ex >= hx or ey >= hy:
+        raise ck.SceneError(f"bem.extent = {d['extent']!r} is not allowed: the candidate region must lie "
+                            f"inside the gap's domain, |x| < {hx:.6g}, |y| < {hy:.6g}.")
+    if axes is not None and (ex < axes[0] or ey < axes[1]):
+        raise ck.SceneError(
+            f"bem.extent = {d['extent']!r} is not allowed for this load: the expected contact semi-axes "
+            f"are ({axes[0]:.4g}, {axes[1]:.4g}), beyond the region; make extent larger (or use "
+            "extent_factor) or reduce the load.")
+    return (ex, ey), False
+
+
+def bem_options(d, gap, layer_spec, layer, E_star, load):
+    """``[bem]``: lattice (``step`` | ``nodes_across``, ``extent`` | ``extent_factor``) and solver options.
+
+    Parameters
+    ----------
+    d : dict or None
+        The raw ``[bem]`` table.
+    gap : bem.gaps.Gap
+        The scene's gap.
+    layer_spec : dict or None
+        The validated ``[layer]``; ``layer`` the law built from it (``None`` for a law of the
+        paper's parameters, which is resolved by a solve at run time).
+    E_star : float
+        Effective modulus [pressure].
+    load : dict
+        ``{"force": ..., "approach": ...}``.
+
+    Returns
+    -------
+    dict
+        The checked solver options with the resolved ``step`` [length], ``extent`` ``(ex, ey)``
+        [length], ``expected`` semi-axes (or None), ``extent_auto`` (the region may be
+        enlarged), ``nodes_across`` and ``n_nodes``.
+    """
+    d = {} if d is None else ck.table("bem", d)
+    ck.unknown_keys("bem", d, KEYS)
+    for a, b in (("step", "nodes_across"), ("extent", "extent_factor")):
+        if a in d and b in d:
+            raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
+                                "give one of them.")
+    out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
+    if "rtol" in d:
+        out["rtol"] = ck.positive("bem.rtol", d["rtol"])
+    if "maxiter" in d:
+        out["maxiter"] = ck.integer("bem.maxiter", d["maxiter"], 1)
+    for key in ("precondition", "nested"):
+        if key in d:
+            out[key] = ck.boolean(f"bem.{key}", d[key])
+    out.update(_solver_options(d, out["method"], layer_spec))
+    step = ck.positive("bem.step", d["step"]) if "step" in d else None
+    n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
+    axes = _expected(gap, layer_spec, layer, E_star, load, step, n_across)
+    if axes is None and ("step" not in d or "extent" not in d):
+        raise ck.SceneError(f"bem.step and bem.extent are missing: a {gap.type_name!r} gap has no estimate "
+                            "of the contact size, so give the lattice step [m] and the region half-width [m].")
+    if step is None:
+        step = 2 * min(axes) / n_across
+    elif axes is not None and 2 * min(axes) / step < 4:
+        raise ck.SceneError(f"bem.step = {step!r} is not allowed for this load: the expected contact is only "
+                            f"{2 * min(axes):.4g} across ({2 * min(axes) / step:.1f} steps); make step smaller "
+                            "(at least 4 nodes across the contact).")
+    extent, auto = _extent(d, gap, axes)
+    with ck.scene_errors():
+        Lattice.from_extent(step, extent)
+    n = node_count(step, extent)
+    if n > MAX_NODES:
+        raise ck.SceneError(f"bem.{'step' if 'step' in d else 'nodes_across'} = "
+                            f"{d.get('step', n_across)!r} is not allowed: the region would hold {n} nodes "
+                            f"(limit {MAX_NODES}); make the lattice coarser or the region smaller.")
+    out.update(step=step, extent=extent, extent_auto=auto, expected=axes,
+               nodes_across=2 * min(axes) / step if axes else None, n_nodes=n)
+    return out
