@@ -170,7 +170,7 @@ def test_report_of_a_scene_applies_set(tmp_path):
 
 
 def test_quick_help_states_the_measured_time(capsys):
-    from validation import cli as cli_mod
+    from validation.cli import report as cli_mod
 
     assert main(["report", "--help"]) == 0
     text = " ".join(capsys.readouterr().out.split())
@@ -185,7 +185,7 @@ def test_parser_is_buildable_without_heavy_imports():
 def test_report_progress_bar_shows_the_stages_on_stderr(monkeypatch):
     import io
 
-    from validation import cli as cli_mod
+    from validation.cli import report as cli_mod
 
     err = io.StringIO()
     monkeypatch.setattr(sys, "stderr", err)

@@ -146,7 +146,7 @@ def test_figure_format_is_checked_and_scoped(tmp_path):
         pass
     out = fsw.plot_transition_line([0.0, 1.0], [1.0, 0.0], tmp_path / "t.png", a=1.0)
     assert out.endswith(".png")  # back to the default after the block
-    from validation import cli
+    from validation.cli import report as cli
 
     assert cli.FORMATS == FORMATS  # the parser's copy (it imports no report code)
 

@@ -1,0 +1,121 @@
+"""The ``contactlab`` command line: one module per subcommand, each with ``add_args`` and ``run``.
+
+Exit codes: 0 success; 1 a solver did not converge (results are still written, flagged
+``converged = false``); 2 bad input (scene, option or output location); 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import logging
+import sys
+
+from bem.checks import InputError
+
+from ..io import OutputError
+from ..scene.paper import CalibrationError
+from . import check, report, run, scenes, study, sweep
+
+__all__ = ["main", "build_parser"]
+
+#: the subcommands, in the order ``--help`` lists them
+COMMANDS = {"run": run, "scenes": scenes, "check": check, "sweep": sweep, "study": study, "report": report}
+
+DESCRIPTION = """\
+contactlab: frictionless normal contact of two elastic bodies with a nonlinear interface
+layer (rough surface, coating) between them. Half-space boundary elements (BEM) on a
+triangular lattice, an axisymmetric finite-element (FEM) reference, closed-form checks.
+
+A SCENE is a TOML file, or the name of a built-in scene (see `contactlab scenes`). It says
+what the bodies, gap, layer and load are and what to run: the BEM always; the FEM reference,
+a closed-form comparison, a sweep, the subsurface stresses or a report only when it has a
+[fem], [analytic], [sweep], [stress] or [report] section.
+
+Units: every number is in the scene's own consistent units, stated in its [scene] units
+label. The built-in scenes use SI: lengths in m, moduli and pressures in Pa, forces in N
+(e.g. E1 = 210e9 for steel, R = 0.01 for a 10 mm radius, force = 100.0 for 100 N).
+The paper's layer parameters are dimensionless: lam_over_cnn (compliance / C_nn),
+alpha_a = p_cr / p_max^lambda, alpha_b = p_max^root / p_max^lambda, alpha_c = arctan(lam2/lam1) [rad].
+"""
+
+EPILOG = """\
+examples:
+  contactlab scenes                                  list the built-in scenes
+  contactlab check my_scene.toml                     validate a scene, run nothing
+  contactlab run hertz                               BEM + FEM + Hertz; writes results/hertz/
+  contactlab run paper_root --out out/root           choose the result directory
+  contactlab run hertz --set bem.nodes_across=80 --set load.force=200
+                                                     override scene keys (dotted, TOML values)
+  contactlab run paper_elastic_rigid --set alpha_a=0.25
+  contactlab sweep paper_elastic_rigid --param alpha_a --values 0,0.25,0.5,0.75,1
+  contactlab sweep paper_root --param alpha_b --values 0.8:1.1:4 --workers 2
+  contactlab sweep hertz --param load.force --values 50,100,200 --scheduler tcp://10.0.0.5:8786
+  contactlab study error-time hertz                  error vs time of the BEM methods
+  contactlab study stability                         convergence of the methods across layers
+  contactlab study robustness                        every layer method over 12 decades of compliance
+  contactlab report results/hertz --out report/      figures + HTML/Markdown report
+  contactlab report results/hertz-sweep-load.force   report of a sweep directory
+  contactlab report paper --quick                    the paper's test problem, a quick preview
+
+result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
+iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.toml (the
+effective scene, re-runnable), bem_field.vtu, fem_field.vtu and stress_field.vtu (open in ParaView).
+Written whole or not at all. Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
+scene is listed), or an unknown option.
+"""
+
+
+
+def build_parser():
+    """The argparse parser of ``contactlab``: each subcommand module adds its own."""
+    fmt = argparse.RawDescriptionHelpFormatter
+    parser = argparse.ArgumentParser(prog="contactlab", description=DESCRIPTION, epilog=EPILOG, formatter_class=fmt)
+    parser.add_argument("-v", "--verbose", action="store_true", help="log progress details (INFO)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name, module in COMMANDS.items():
+        module.add_args(sub.add_parser(name, formatter_class=fmt, **module.PARSER))
+    return parser
+
+
+@contextlib.contextmanager
+def _log_to_stderr(verbose):
+    """Show the library's log records on the current stderr while a command runs."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("contactlab: %(levelname)s: %(message)s"))
+    loggers = [logging.getLogger(name) for name in ("bem", "fem_reference", "validation")]
+    saved = [(lg.level, lg.propagate) for lg in loggers]
+    for lg in loggers:
+        lg.addHandler(handler)
+        lg.setLevel(logging.INFO if verbose else logging.WARNING)
+        lg.propagate = False
+    try:
+        yield
+    finally:
+        for lg, (level, propagate) in zip(loggers, saved):
+            lg.removeHandler(handler)
+            lg.setLevel(level)
+            lg.propagate = propagate
+
+
+def main(argv=None):
+    """Entry point of the ``contactlab`` console script; returns the exit code."""
+    parser = build_parser()
+    try:  # argparse exits on --help (0) and on bad or unknown options (2): return the code instead
+        args = parser.parse_args(argv)
+    except SystemExit as exc:
+        return exc.code
+    try:
+        with _log_to_stderr(args.verbose):
+            return COMMANDS[args.command].run(args)
+    except (InputError, OutputError) as exc:
+        for message in getattr(exc, "errors", None) or (str(exc),):
+            print(f"contactlab: error: {message}", file=sys.stderr)
+        return 2
+    except CalibrationError as exc:
+        print(f"contactlab: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("contactlab: interrupted (no partial result directory was left)", file=sys.stderr)
+        return 130

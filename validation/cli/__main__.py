@@ -1,0 +1,7 @@
+"""``python -m validation.cli``: the ``contactlab`` command."""
+
+import sys
+
+from . import main
+
+sys.exit(main())

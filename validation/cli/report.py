@@ -1,0 +1,78 @@
+"""``contactlab report TARGET``: figures and an HTML/Markdown report (:mod:`validation.report`)."""
+
+from __future__ import annotations
+
+import os
+
+from .common import add_set, optional_import
+
+#: measured wall time of `contactlab report paper --quick` and of the full paper report on 2 cores shared
+#: with other jobs (load 2.3-5; CPU time 15-18 s and 36-42 s)
+QUICK_TIME, FULL_TIME = "18-26 s", "50-80 s"
+#: figure formats of `contactlab report --format` (validation.report.style.FORMATS, kept here so the
+#: parser needs no import of the report package)
+FORMATS = ("png", "svg", "pdf")
+
+
+PARSER = {"help": "figures and an HTML/Markdown report",
+          "description": "Build a report (report.html, report.md, figures/) from the paper's test\n"
+                         "problem, a scene (runs it first), a result directory of `contactlab run`, a\n"
+                         "sweep directory of `contactlab sweep` or a directory of study files.\n"
+                         "Prints where it wrote report.html; a progress bar on stderr shows the stages.",
+          "epilog": "examples:\n  contactlab report hertz                     runs it into results/hertz/\n"
+                    "  contactlab report results/hertz --out rep/\n"
+                    "  contactlab report results/paper_elastic_rigid-sweep-alpha_a      (a sweep)\n"
+                    "  contactlab report reports/studies                (study files)\n"
+                    "  contactlab report paper --quick --out /tmp/paper\n"
+                    "  contactlab report hertz --units dimensionless --format pdf"}
+
+
+def add_args(p):
+    p.add_argument("target", metavar="SCENE_OR_DIR",
+                   help="'paper', a scene (built-in name or .toml), or a result, sweep or study directory")
+    p.add_argument("--out", metavar="DIR", help="report directory (default: reports/paper for 'paper', "
+                                                "DIR/report for a directory, results/NAME/report for a scene)")
+    p.add_argument("--format", choices=FORMATS, default="png",
+                   help="figure files: png (300 dpi, default), svg (vector, shown in the HTML), or pdf "
+                        "(vector, beside a PNG for the HTML)")
+    p.add_argument("--units", choices=("scene", "dimensionless"),
+                   help="axes of a scene, result or sweep report: in the scene's units (mm and MPa for SI "
+                        "scenes; the default when the scene's units label names them) or divided by the "
+                        "contact's scales (Hertz's p_H and a_H for a paraboloid, else p_max and the contact "
+                        "half-width)")
+    p.add_argument("--quick", action="store_true",
+                   help=f"'paper' only: a coarse preview (a_H/c = 8, short sweeps): {QUICK_TIME} instead of "
+                        f"{FULL_TIME} on 2 cores")
+    add_set(p, "scene targets only: ")
+
+
+class _ReportBar:
+    """tqdm bar (stderr) over the stages of a report build."""
+
+    def __init__(self, disable):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=1, desc="report", unit="stage", disable=disable, leave=False)
+
+    def __call__(self, stage, done, total):
+        self.bar.total = total
+        self.bar.n = done
+        self.bar.set_description(stage)
+        self.bar.refresh()
+
+    def close(self):
+        self.bar.close()
+
+
+def run(args):
+    command = optional_import("validation.report.command", "the report builder")
+    if command is None:
+        return 2
+    bar = _ReportBar(args.no_progress or None)
+    try:
+        built = command.build_from_args(args, progress=bar)
+    finally:
+        bar.close()
+    print(f"report written to {built.html}")
+    print(f"  (also {built.markdown.name} and {len(built.figures)} figures in {built.out_dir / 'figures'}{os.sep})")
+    return 0

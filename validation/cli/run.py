@@ -1,0 +1,98 @@
+"""``contactlab run SCENE``: run a scene and write its result directory."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .common import add_set
+
+PARSER = {"help": "run a scene and write its result directory",
+          "description": "Run a scene: the BEM, and the FEM/closed form/comparison it names.",
+          "epilog": "examples:\n  contactlab run hertz\n  contactlab run my.toml --out out/my "
+                    "--set bem.method=\"augmented_gap\"\n  contactlab run punch --set fem.n_contact=32"}
+
+
+def add_args(p):
+    p.add_argument("scene", metavar="SCENE", help="built-in scene name or path to a .toml file")
+    p.add_argument("--out", metavar="DIR", help="result directory (default: results/<scene name>)")
+    add_set(p)
+
+
+def _units(result):
+    """``(length, pressure, force)`` unit symbols of a result ("" where unknown)."""
+    symbols = result.get("unit_symbols") or {}
+    return tuple(symbols.get(k, "") for k in ("length", "pressure", "force"))
+
+
+def _summary(result, out_dir):
+    L, Pa, N = _units(result)
+    t = result["wall_time_s"]
+    lines = [f"scene      {result['scene']}: {result['title']}   [units {result['units']}]"]
+    p_line = f"p_max      {result['p_max']:.6g} {Pa}"
+    if "fem" in result:
+        f = result["fem"]["p_max"]
+        p_line += f"   (FEM {f:.6g}, {100 * (result['p_max'] - f) / f:+.2f} %)"
+    if "analytic" in result:
+        a = result["analytic"]["p_max"]
+        p_line += f"   ({result['analytic']['kind']} {a:.6g}, {100 * (result['p_max'] - a) / a:+.2f} %)"
+    lines.append(p_line)
+    if "contact_radius" in result:
+        lines.append(f"contact    radius {result['contact_radius']:.6g} {L}, area {result['contact_area']:.6g} {L}^2")
+    else:
+        ext = result["contact_extent"]
+        lines.append(f"contact    |x| <= {ext['x']:.6g} {L}, |y| <= {ext['y']:.6g} {L}, "
+                     f"area {result['contact_area']:.6g} {L}^2")
+    lines.append(f"load       force {result['force']:.6g} {N}, approach {result['approach']:.6g} {L}")
+    if "alpha_b" in result:
+        lines.append(f"layer      alpha_b = p_max^root / p_max^lambda = {result['alpha_b']:.4f}")
+    conv = "yes" if result["converged"] else "NO"
+    lines.append(f"converged  {conv} ({result['method']}, {result['iterations']} iterations, "
+                 f"KKT residual {result['kkt_residual']:.2e})")
+    times = ", ".join(f"{k} {v:.2f} s" for k, v in t.items() if v is not None)
+    lines.append(f"time       {times}")
+    for name, body in (result.get("stress") or {}).get("bodies", {}).items():
+        x, y, z = body["location_of_max"]
+        lines.append(f"stress     {name}: max von Mises {body['max_von_mises']:.6g} {Pa} at depth {z:.6g} {L} "
+                     f"(x {x:.3g}, y {y:.3g}), max shear {body['max_tresca']:.6g} {Pa}")
+    for msg in result["messages"]:
+        lines.append(f"note       {msg}")
+    if out_dir is not None:
+        lines.append(f"files      {out_dir}/ ({', '.join(result['files'].values())})")
+    return "\n".join(lines)
+
+
+class _StageBar:
+    """tqdm bar over the run stages; BEM iterations shown as a postfix."""
+
+    def __init__(self, stages, disable):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=len(stages), desc="run", unit="stage", disable=disable, leave=False)
+
+    def __call__(self, stage, status, info):
+        if status == "start":
+            self.bar.set_description(stage)
+        elif status == "iteration":
+            self.bar.set_postfix(iteration=info["iteration"], refresh=False)
+            self.bar.refresh()
+        elif status == "done":
+            self.bar.update(1)
+
+    def close(self):
+        self.bar.close()
+
+
+def run(args):
+    from ..run import execute_scene, planned_stages, write_outputs
+    from ..scene import load_scene
+
+    scene = load_scene(args.scene, overrides=args.overrides)
+    out_dir = Path(args.out) if args.out else Path("results") / scene.name
+    bar = _StageBar(planned_stages(scene, write=True), args.no_progress or None)
+    try:
+        outcome = execute_scene(scene, progress=bar)
+        write_outputs(outcome, out_dir, progress=bar)
+    finally:
+        bar.close()
+    print(_summary(outcome.result, out_dir))
+    return 0 if outcome.result["converged"] else 1

@@ -1,0 +1,64 @@
+"""``contactlab sweep SCENE``: one scene over a list of values of a parameter (resumable, parallel)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from bem.checks import InputError
+
+from .common import add_set
+
+PARSER = {"help": "sweep one scene parameter (resumable, parallel)",
+          "description": "Run a scene for each value of one parameter. Finished points are saved "
+                         "one file each; rerunning skips them (resume).",
+          "epilog": "examples:\n  contactlab sweep paper_elastic_rigid                 (its [sweep])\n"
+                    "  contactlab sweep paper_bilinear --param alpha_c --values 0,0.4,0.8,1.2\n"
+                    "  contactlab sweep hertz --param load.force --values 50:200:4 --workers 2\n"
+                    "  contactlab sweep hertz --param load.force --values 50,100 --scheduler tcp://host:8786"}
+
+
+def add_args(p):
+    p.add_argument("scene", metavar="SCENE")
+    p.add_argument("--param", metavar="P", help="alpha_a, alpha_b, alpha_c or a dotted key (layer.lam, load.force)")
+    p.add_argument("--values", metavar="V", help="comma list 0,0.25,0.5 or start:stop:num")
+    p.add_argument("--out", metavar="DIR", help="sweep directory (default: results/<scene>-sweep-<param>)")
+    p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: all cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address (needs dask.distributed)")
+    add_set(p)
+
+
+def run(args):
+    from tqdm import tqdm
+
+    from ..run.sweep import parse_values, run_sweep, sweep_points
+    from ..scene import load_scene
+
+    values = parse_values(args.values) if args.values is not None else None
+    if (args.param is None) != (values is None):
+        raise InputError("--param and --values are not allowed alone: give both (or neither, to use the "
+                         "scene's [sweep]).")
+    scene = load_scene(args.scene, overrides=args.overrides)
+    param, _key, points = sweep_points(scene, args.param, values)
+    out = Path(args.out) if args.out else Path("results") / f"{scene.name}-sweep-{param}"
+    bar = tqdm(total=len(points), desc=f"sweep {param}", unit="point", disable=args.no_progress or None)
+
+    def progress(done, total, row):
+        bar.update(1)
+        bar.set_postfix_str(f"{param}={row['value']} {row['status']}")
+
+    try:
+        summary = run_sweep(scene, out, parameter=args.param, values=values, workers=args.workers,
+                            scheduler=args.scheduler, progress=progress)
+    finally:
+        bar.close()
+    print(f"sweep of {summary['key']} over {len(summary['points'])} values of scene {summary['scene']} "
+          f"[units {summary['units']}]")
+    print(f"{'value':>12} {'status':>14} {'p_max':>14} {'contact_r':>12} {'approach':>12}")
+    for r in summary["points"]:
+        fmt = (lambda v: f"{v:.6g}" if isinstance(v, float) else "-")
+        print(f"{r['value']!s:>12} {r['status']:>14} {fmt(r.get('p_max')):>14} "
+              f"{fmt(r.get('contact_radius')):>12} {fmt(r.get('approach')):>12}")
+    print(f"computed {len(summary['computed'])}, reused {len(summary['reused'])}, failed {len(summary['failed'])}; "
+          f"files {out}/ (summary.json, summary.csv, points/)")
+    bad = summary["failed"] or any(r["status"] != "ok" for r in summary["points"])
+    return 1 if bad else 0
