@@ -1,0 +1,86 @@
+"""The house plan (CONTRIBUTING.md): dependencies flow one way, no import cycles, small modules."""
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGES = ("bem", "fem_reference", "validation")
+#: which packages each package may import (validation -> fem_reference -> bem)
+ALLOWED = {"bem": {"bem"}, "fem_reference": {"bem", "fem_reference"},
+           "validation": {"bem", "fem_reference", "validation"}}
+MAX_LINES = 400
+
+
+def _modules():
+    """``{module name: path}`` of every module of the three packages."""
+    out = {}
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return out
+
+
+def _imports(name, path, modules, *, top_level_only):
+    """Project modules imported by the module ``name`` (relative imports resolved)."""
+    is_package = path.name == "__init__.py"
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    nodes = tree.body if top_level_only else ast.walk(tree)
+    found = set()
+    for node in nodes:
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = name.split(".") if is_package else name.split(".")[:-1]
+            if node.level:
+                base = base[: len(base) - node.level + 1]
+                module = ".".join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module
+            targets = [module] + [f"{module}.{a.name}" for a in node.names]
+        else:
+            continue
+        for target in targets:
+            while target and target not in modules:  # a name imported from a module: its module
+                target = target.rpartition(".")[0]
+            if target and target != name:
+                found.add(target)
+    return found
+
+
+def test_dependencies_flow_one_way():
+    modules = _modules()
+    wrong = sorted((name, target) for name, path in modules.items()
+                   for target in _imports(name, path, modules, top_level_only=False)
+                   if target.split(".")[0] not in ALLOWED[name.split(".")[0]])
+    assert not wrong, wrong
+
+
+def test_no_import_cycles():
+    """No cycle among the modules' top-level imports (a package importing its own submodules and a
+    submodule importing names of its package's other submodules are not cycles by themselves)."""
+    modules = _modules()
+    graph = {name: _imports(name, path, modules, top_level_only=True) for name, path in modules.items()}
+    state, cycles = {}, []
+
+    def visit(node, stack):
+        state[node] = "open"
+        stack.append(node)
+        for nxt in sorted(graph[node]):
+            if state.get(nxt) == "open" and not nxt.startswith(node + ".") and not node.startswith(nxt + "."):
+                cycles.append(stack[stack.index(nxt):] + [nxt])
+            elif nxt not in state:
+                visit(nxt, stack)
+        stack.pop()
+        state[node] = "done"
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node, [])
+    assert not cycles, cycles
+
+
+def test_no_module_over_400_lines():
+    long = {str(p.relative_to(ROOT)): n for p in _modules().values()
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_LINES}
+    assert not long, long
