@@ -35,7 +35,6 @@ from bem.checks import InputError, check_finite_array, check_positive
 from bem.result import ContactResult
 from fem_reference.result import FemResult
 
-
 __all__ = ["RadialProfile", "radial_profile", "ring_weights", "relative_l2", "pair_metrics", "compare",
            "PAIR_KEYS"]
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 from ..checks import check_positive
 from .base import AxisymmetricGap
 

@@ -13,7 +13,12 @@ Every closed form is a result with the names every solver result uses
 
 from .estimate import estimate_contact_radius, hertz_radius, layer_radius
 from .hertz import HertzElliptic, HertzSphere, hertz_elliptic, hertz_sphere
-from .layer_limit import RigidLayerParaboloid, rigid_layer_force, rigid_layer_paraboloid, rigid_layer_pressure
+from .layer_limit import (
+           RigidLayerParaboloid,
+           rigid_layer_force,
+           rigid_layer_paraboloid,
+           rigid_layer_pressure,
+)
 
 __all__ = ["HertzSphere", "HertzElliptic", "RigidLayerParaboloid", "hertz_sphere", "hertz_elliptic",
            "rigid_layer_pressure", "rigid_layer_paraboloid", "rigid_layer_force", "estimate_contact_radius",

@@ -12,8 +12,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_callable, check_choice, check_finite_array, check_load, check_nonnegative, \
-    check_positive, fail
+from ..checks import (
+    check_callable,
+    check_choice,
+    check_finite_array,
+    check_load,
+    check_nonnegative,
+    check_positive,
+    fail,
+)
 from .hertz import _ClosedForm
 
 __all__ = ["RigidLayerParaboloid", "rigid_layer_pressure", "rigid_layer_paraboloid", "rigid_layer_force"]

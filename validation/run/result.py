@@ -10,7 +10,6 @@ result (:mod:`validation.provenance`).
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from ..provenance import provenance

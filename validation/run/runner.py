@@ -17,13 +17,12 @@ import tomli_w
 import bem
 from bem.files import write_result_vtu, write_text
 
-from ..scene import paper
 from ..compare import compare
 from ..io import atomic_directory, atomic_write_json
-from .result import build_result
+from ..scene import paper
 from ..scene.load import Scene, load_scene
-from ..scene.sizing import SOLVER_KEYS
-from ..scene.sizing import DOMAIN_MARGIN, inner_domain
+from ..scene.sizing import DOMAIN_MARGIN, SOLVER_KEYS, inner_domain
+from .result import build_result
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES"]
 

@@ -28,9 +28,9 @@ from pathlib import Path
 
 from bem.files import write_text
 
-from ..scene.checks import SceneError
 from ..extras import require as require_extra
 from ..io import atomic_write_json
+from ..scene.checks import SceneError
 from ..scene.load import Scene, apply_overrides, load_scene, parse_scene
 
 __all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values"]

@@ -29,8 +29,8 @@ from __future__ import annotations
 import logging
 import math
 
-from bem.operator import diagonal_coefficient
 from bem.layers import LAWS, Bilinear, ElasticRigid, Linear, Root, from_dict
+from bem.operator import diagonal_coefficient
 
 from .checks import SceneError, in_range, positive, string, table, unknown_keys
 

@@ -16,11 +16,11 @@ from bem.gaps import gap_from_dict
 from bem.layers import LAWS, from_dict
 from bem.materials import effective_modulus
 
+from ..units import DEFAULT_LABEL as DEFAULT_UNITS
+from ..units import parse_units
 from . import checks as ck
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
-from ..units import DEFAULT_LABEL as DEFAULT_UNITS
-from ..units import parse_units
 from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law
 from .sizing import KEYS as BEM_KEYS
 
