@@ -10,13 +10,13 @@ previous result untouched. Result directories and report directories both use it
 
 The subsurface stress field as a volume file ParaView opens (``stress_field.vtu``,
 :func:`write_stress_field`) is a structured volume grid of hexahedra per body, written with
-meshio (VTK XML, zlib-compressed) and atomically (:func:`bem.files.write_vtu`, the one writer). The grid is the brick lattice of
-the candidate nodes (every ``stride``-th row and column, the stride chosen so that the file
-holds at most :data:`MAX_POINTS` points) times the depths; a cell joins two neighbouring rows,
-two neighbouring columns and two neighbouring depths (the odd rows are shifted by half a step,
-so the cells are parallelepipeds). Global frame: ``z`` points up into body 1 (the upper body,
-``z = +depth``) and down into body 2 (``z = -depth``), as in the FEM field; the lower body's
-shear stresses ``xz``, ``yz`` change sign accordingly.
+meshio (VTK XML, zlib-compressed) and atomically (:func:`bem.files.write_vtu`, the one writer).
+The grid is the brick lattice of the candidate nodes (every ``stride``-th row and column, the
+stride chosen so that the file holds at most :data:`MAX_POINTS` points) times the depths; a
+cell joins two neighbouring rows, two neighbouring columns and two neighbouring depths (the odd
+rows are shifted by half a step, so the cells are parallelepipeds). Global frame: ``z`` points
+up into body 1 (the upper body, ``z = +depth``) and down into body 2 (``z = -depth``), as in
+the FEM field; the lower body's shear stresses ``xz``, ``yz`` change sign accordingly.
 
 Point data: ``stress`` (six components in VTK's order ``xx, yy, zz, xy, yz, xz``, so that
 ParaView reads it as a symmetric tensor), ``von_mises`` and ``max_shear`` [pressure]; cell

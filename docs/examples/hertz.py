@@ -23,7 +23,8 @@ def main():
     hz = hertz_sphere(R, E_star, force=P)          # closed form: p0 [Pa], a [m], delta [m]
 
     # 60 lattice nodes across the contact diameter, candidate region 1.5 contact radii wide
-    res = bem.solve(Paraboloid(R), E_star=E_star, force=P, step=2 * hz.contact_radius / 60, extent=1.5 * hz.contact_radius)
+    a = hz.contact_radius
+    res = bem.solve(Paraboloid(R), E_star=E_star, force=P, step=2 * a / 60, extent=1.5 * a)
     errors = {"p_max": res.p_max / hz.p_max - 1, "approach": res.approach / hz.approach - 1,
               "contact_radius": res.contact_radius / hz.contact_radius - 1}
     print(f"p_max {res.p_max / 1e9:.4f} GPa (Hertz {hz.p_max / 1e9:.4f} GPa), contact radius "

@@ -39,7 +39,8 @@ def main(nodes_per_radius=12):
     peaks = {name: res.p_max / hz.p_max for name, res in results.items()}
     agreement = abs(root_vc.p_max / results["root"].p_max - 1)
     for name, res in results.items():
-        print(f"{name:14s} p_max / p0 = {peaks[name]:.4f}, contact radius / a = {res.contact_radius / hz.contact_radius:.3f}, "
+        print(f"{name:14s} p_max / p0 = {peaks[name]:.4f}, "
+              f"contact radius / a = {res.contact_radius / hz.contact_radius:.3f}, "
               f"converged {res.converged} ({res.iterations} iterations)")
     print(f"alpha_b = p_max^root / p_max^lambda = {results['root'].p_max / p_lambda:.4f}; variable compliance "
           f"method: {root_vc.iterations} iterations, peak within {agreement:.1e} of Newton's")

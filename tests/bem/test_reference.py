@@ -85,10 +85,11 @@ def test_hertz_sphere_displacement_is_boussinesq_and_closes_the_gap():
         u = _u_inside(press, h.contact_radius, h.contact_radius, r, 0.0)
         assert u == pytest.approx(h.approach - r * r / (2 * h.R), rel=1e-9)
         assert h.displacement(r) == pytest.approx(u, rel=1e-9)
-    for r in (1.5 * h.contact_radius, 3.0 * h.contact_radius):  # outside: smooth kernel, quadrature over the disc
-        u = _integral_over_ellipse(lambda x, y: press(x, y) / np.hypot(x - r, y), h.contact_radius, h.contact_radius) / (np.pi * E_STAR)
+    a = h.contact_radius
+    for r in (1.5 * a, 3.0 * a):  # outside: smooth kernel, quadrature over the disc
+        u = _integral_over_ellipse(lambda x, y: press(x, y) / np.hypot(x - r, y), a, a) / (np.pi * E_STAR)
         assert h.displacement(r) == pytest.approx(u, rel=1e-7)
-    assert h.displacement(10 * h.contact_radius) == pytest.approx(100.0 / (np.pi * E_STAR * 10 * h.contact_radius), rel=2e-3)
+    assert h.displacement(10 * a) == pytest.approx(100.0 / (np.pi * E_STAR * 10 * a), rel=2e-3)
 
 
 # ---------------------------------------------------------------- Hertz elliptic

@@ -16,13 +16,14 @@ from bem.reference import hertz_elliptic, hertz_sphere
 from validation.compare import PAIR_KEYS, compare, pair_metrics, radial_profile, relative_l2, ring_weights
 
 H = hertz_sphere(1.0, 1.0, force=1.0)
+H_A = H.contact_radius
 EPS = 0.01
 
 
 @pytest.fixture(scope="module")
 def base():
     """A real BEM result on a lattice of 20 steps across the Hertz contact."""
-    return bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.contact_radius / 20, extent=1.4 * H.contact_radius)
+    return bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H_A / 20, extent=1.4 * H_A)
 
 
 def _with_p(res, p, **kw):
@@ -36,7 +37,7 @@ def _with_p(res, p, **kw):
 def _fem(r, p, **kw):
     """A FemResult holding the profile ``p(r)``."""
     fields = dict(r=r, p=p, closure=np.zeros_like(r), gap=r**2 / 2, approach=H.approach, force=H.force,
-                  force_reaction=H.force, p_max=float(p.max()), contact_radius=H.contact_radius, converged=True, message="",
+                  force_reaction=H.force, p_max=float(p.max()), contact_radius=H_A, converged=True, message="",
                   iterations=1, timings={"total": 0.0}, n_dofs=0, n_elements=0, n_interface_nodes=r.size,
                   n_elements_across_contact=0.0, penalty={}, truncation={}, mesh={}, E_star=1.0)
     fields.update(kw)
@@ -57,14 +58,14 @@ def test_scaled_hertz_field_has_the_scale_as_l2_error(base):
     assert m["approach_rel"] == pytest.approx(0.02, rel=1e-10)
     n_in = np.count_nonzero(p_exact > 0)
     assert m["n_points"] == n_in
-    assert m["contact_radius_rel"] == pytest.approx(math.sqrt(n_in * base.lattice.node_area / math.pi) / H.contact_radius - 1)
+    assert m["contact_radius_rel"] == pytest.approx(math.sqrt(n_in * base.lattice.node_area / math.pi) / H_A - 1)
 
 
 def test_local_bump_and_pressure_outside_the_contact_count_in_the_union(base):
     r = _radius(base)
     p_exact = H.pressure(r)
-    inner = r < H.contact_radius / 2
-    outer = (r > 1.1 * H.contact_radius) & (r < 1.3 * H.contact_radius)
+    inner = r < H_A / 2
+    outer = (r > 1.1 * H_A) & (r < 1.3 * H_A)
     q = 0.05 * H.p_max
     p = p_exact + q * inner + q * outer
     m = compare(_with_p(base, p), analytic=H)["bem_vs_analytic"]
@@ -75,10 +76,10 @@ def test_local_bump_and_pressure_outside_the_contact_count_in_the_union(base):
 
 
 def test_bem_against_fem_profile_interpolated_in_r(base):
-    r_fem = np.sort(np.append(np.linspace(0.0, 3.0, 61), H.contact_radius))  # a node at the kink r = a
-    cone = np.maximum(1.0 - r_fem / H.contact_radius, 0.0)
-    fem = _fem(r_fem, cone, approach=0.5, force=2.0, contact_radius=H.contact_radius)
-    p_bem = (1 + EPS) * np.maximum(1.0 - _radius(base) / H.contact_radius, 0.0)
+    r_fem = np.sort(np.append(np.linspace(0.0, 3.0, 61), H_A))  # a node at the kink r = a
+    cone = np.maximum(1.0 - r_fem / H_A, 0.0)
+    fem = _fem(r_fem, cone, approach=0.5, force=2.0, contact_radius=H_A)
+    p_bem = (1 + EPS) * np.maximum(1.0 - _radius(base) / H_A, 0.0)
     fake = _with_p(base, p_bem, approach=0.55)
     out = compare(fake, fem=fem, force=2.0)
     m = out["bem_vs_fem"]
@@ -144,7 +145,7 @@ def test_small_bem_solve_against_hertz_and_fem(base):
 def test_finer_lattice_is_closer_to_hertz():
     errs = []
     for n in (10, 40):
-        res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.contact_radius / n, extent=1.3 * H.contact_radius)
+        res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H_A / n, extent=1.3 * H_A)
         errs.append(compare(res, analytic=H)["bem_vs_analytic"])
     assert errs[1]["l2_rel"] < 0.6 * errs[0]["l2_rel"]
     assert abs(errs[1]["peak_rel"]) < 0.2 * abs(errs[0]["peak_rel"])
@@ -171,11 +172,11 @@ def test_radial_profile_of_a_known_field(base):
 
 
 def test_radial_profile_of_a_solve_follows_hertz():
-    res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H.contact_radius / 40, extent=1.3 * H.contact_radius)
+    res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H_A / 40, extent=1.3 * H_A)
     prof = radial_profile(res)
-    inside = prof.r_bin < 0.9 * H.contact_radius
+    inside = prof.r_bin < 0.9 * H_A
     assert np.max(np.abs(prof.p_bin[inside] - H.pressure(prof.r_bin[inside]))) < 0.02 * H.p_max
-    outside = prof.r_bin > 1.1 * H.contact_radius
+    outside = prof.r_bin > 1.1 * H_A
     assert np.all(prof.p_bin[outside] == 0)
 
 

@@ -24,7 +24,8 @@ def test_check_refuses_an_option_the_solver_that_runs_does_not_take():
     assert "bem.relaxation = 0.5 is not allowed" in err and "Kalker's QP" in err
 
 
-@pytest.mark.parametrize("override, key", [("bem.eps_p=1e-8", "bem.eps_p"), ("bem.inner_maxiter=0", "bem.inner_maxiter"),
+@pytest.mark.parametrize("override, key", [("bem.eps_p=1e-8", "bem.eps_p"),
+                                           ("bem.inner_maxiter=0", "bem.inner_maxiter"),
                                            ("bem.relaxation=2.0", "bem.relaxation")])
 def test_scene_solver_options_are_checked_per_method(override, key):
     with pytest.raises(SceneError, match=key.replace(".", r"\.")):

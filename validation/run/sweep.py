@@ -267,7 +267,8 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
         if client is not None and client[1]:
             client[0].close()
     base = points[0].scene
-    meta = {"scene": base.name, "title": base.title, "units": base.units.label, "unit_symbols": base.units.as_dict(), "parameter": parameter, "key": key,
+    meta = {"scene": base.name, "title": base.title, "units": base.units.label,
+            "unit_symbols": base.units.as_dict(), "parameter": parameter, "key": key,
             "values": [p.value for p in points]}
     rows = _write_summary(out, meta, rows)
     return dict(meta, points=rows, computed=[r["index"] for r in rows if r["computed"]],

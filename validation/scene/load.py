@@ -228,8 +228,8 @@ def _validate(raw, source, overrides):
     return Scene(
         name=meta["name"], title=meta["title"], description=meta["description"], units=meta["units"],
         source=source, raw=raw, E_star=body["E_star"], materials=body["materials"], gap=shape[1],
-        gap_spec=shape[0], layer_spec=layer[0], layer=layer[1], load=load, bem=bem, fem=fem, analytic=analytic, sweep=sweep,
-        report=report, overrides=tuple(overrides), stress=stress,
+        gap_spec=shape[0], layer_spec=layer[0], layer=layer[1], load=load, bem=bem, fem=fem, analytic=analytic,
+        sweep=sweep, report=report, overrides=tuple(overrides), stress=stress,
     )
 
 
