@@ -2,7 +2,8 @@
 
 The curves come from ``result.history``: ``"p"`` (every iterate as nodal values on
 ``result.x, result.y``, kept by ``bem.solve(..., record=True)``), ``"p_max"`` and
-``"residual"`` (the KKT residual of each iterate, :func:`bem.kkt.kkt_residual`).
+``"residual"`` (the KKT residual of each iterate, :func:`bem.kkt.kkt_residual`). Each plot
+function writes one file and returns it.
 """
 
 from __future__ import annotations
@@ -11,8 +12,8 @@ import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from .figures_profiles import auto_xlim, axial_section
-from .style import color_for, method_label, new_figure, save_figure
+from ..render.style import color_for, method_label, new_figure, save_figure
+from .profiles import auto_xlim, axial_section
 
 __all__ = ["pick_iterations", "plot_iteration_profiles", "plot_convergence"]
 
@@ -38,9 +39,9 @@ def plot_iteration_profiles(result, path, *, p0, a, iterations=None, title=None,
     result : bem.ContactResult
         Solved with ``record=True``: ``result.history["p"][k-1]`` is iterate ``k``.
     path : path-like
-        PNG file to write.
+        File to write.
     p0, a : float
-        Hertz peak pressure [pressure] and contact radius [length] (the scales).
+        Pressure [pressure] and length [length] scales (Hertz's peak and radius).
     iterations : sequence of int, optional
         Iterates to draw (1-based); default :func:`pick_iterations`.
     title : str, optional
@@ -48,10 +49,6 @@ def plot_iteration_profiles(result, path, *, p0, a, iterations=None, title=None,
     xlim : (float, float), optional
         Range of ``x / a`` (default: the widest iterate with a margin).
 
-    Returns
-    -------
-    str
-        ``path``.
     """
     import matplotlib as mpl
 
@@ -116,7 +113,7 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
     runs : sequence of (str, bem.ContactResult or dict)
         Label and a result (or its ``history`` dict with ``p_max`` and ``residual``).
     path : path-like
-        PNG file to write.
+        File to write.
     p0 : float
         Scale of the maximum pressure (Hertz peak) [pressure].
     title : str, optional
@@ -125,11 +122,6 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
         Tolerance drawn as a line on the residual panel.
     p_label : str, optional
         Label of the maximum-pressure axis (default: normalised by the Hertz peak ``p0``).
-
-    Returns
-    -------
-    str
-        ``path``.
     """
     p0 = check_positive("p0", p0)
     if not runs:

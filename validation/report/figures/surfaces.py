@@ -2,7 +2,8 @@
 
 The surface is the piecewise-linear pressure on a Delaunay triangulation of the lattice
 nodes in and around the contact (the lattice is equilateral, so the triangulation is the
-lattice's own), lifted by ``p / p0`` and drawn with matplotlib's mplot3d.
+lattice's own), lifted by ``p / p0`` and drawn with matplotlib's mplot3d. Each plot function
+writes one file and returns it.
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from .style import axis_labels, new_figure, save_figure
+from ..render.style import axis_labels, new_figure, save_figure
+from .profiles import axial_section
 
 __all__ = ["contact_patch", "covered_window", "plot_pressure_surfaces", "plot_contact_map"]
 
@@ -129,7 +131,7 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
     panels : sequence of (str, data)
         Panel title and a :class:`bem.ContactResult` or ``(x, y, p)`` nodal arrays.
     path : path-like
-        PNG file to write (:func:`validation.report.style.save_figure`).
+        File to write.
     p0, a : float
         Pressure scale [pressure] and length scale [length] (Hertz peak and radius; ``1``
         and ``1`` draw the data as they are, in the units named by ``labels``).
@@ -145,16 +147,9 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
         Draw the axial section ``y = 0`` on each surface (where nodes lie on it).
     labels : dict, optional
         ``{"x", "y", "p"}`` axis and colour-bar labels, and ``"p_short"`` for the vertical
-        axis (:func:`validation.report.style.axis_labels`; default ``x / a_H``, ``p / p0``).
-
-    Returns
-    -------
-    str
-        The written file.
+        axis (:func:`validation.report.render.style.axis_labels`; default ``x / a_H``, ``p / p0``).
     """
     import matplotlib as mpl
-
-    from .figures_profiles import axial_section
 
     p0, a = check_positive("p0", p0), check_positive("a", a)
     if not panels:
@@ -204,7 +199,7 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
     result : bem.ContactResult or (x, y, p)
         Nodal pressures.
     path : path-like
-        PNG file to write.
+        File to write.
     p0, a : float
         Pressure and length scales (Hertz peak and radius).
     title : str, optional
@@ -216,7 +211,7 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
         Labelled pressure contours [pressure] (e.g. ``("p = p_cr", p_cr)``: the line between
         the rigid and elastic branches of an elastic-rigid layer).
     labels : dict, optional
-        ``{"x", "y", "p"}`` axis labels (:func:`validation.report.style.axis_labels`).
+        ``{"x", "y", "p"}`` axis labels (:func:`validation.report.render.style.axis_labels`).
     b : float, optional
         Length scale of the y axis [length] (default ``a``); with ``aspect="auto"`` an
         elongated contact (a roller) fills the axes.
@@ -224,11 +219,6 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
         Aspect of the axes in the scaled coordinates.
     figsize : (float, float)
         Figure size [inch].
-
-    Returns
-    -------
-    str
-        ``path``.
     """
     import matplotlib.tri as mtri
 

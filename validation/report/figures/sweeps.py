@@ -4,7 +4,7 @@ and the line of transition between the elastic and rigid branches of the elastic
 For the elastic-rigid law ``w = lam min(p, p_cr)`` the contact splits into region I
 (``p >= p_cr``: the layer is on its rigid branch) around the centre and region II
 (``0 < p < p_cr``: elastic branch) around it; the transition radius is where the
-axial-section pressure crosses ``p_cr``.
+axial-section pressure crosses ``p_cr``. Each plot function writes one file and returns it.
 """
 
 from __future__ import annotations
@@ -13,18 +13,10 @@ import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from .figures_profiles import auto_xlim
-from .style import new_figure, save_figure
+from ..render.style import new_figure, save_figure
+from .profiles import auto_xlim, radial
 
 __all__ = ["transition_radius", "edge_radius", "plot_sweep", "plot_transition_line", "plot_sweep_scalars"]
-
-
-def _radial(x, p):
-    """Half-profile ``x >= 0`` sorted by radius."""
-    x, p = np.asarray(x, dtype=float), np.asarray(p, dtype=float)
-    keep = x >= 0
-    order = np.argsort(x[keep], kind="stable")
-    return x[keep][order], p[keep][order]
 
 
 def transition_radius(x, p, level):
@@ -42,7 +34,7 @@ def transition_radius(x, p, level):
         The pressure of the crossing (``p_cr``) [pressure], ``> 0``.
     """
     level = check_positive("level", level)
-    r, q = _radial(x, p)
+    r, q = radial(x, p)
     above = np.nonzero(q >= level)[0]
     if above.size == 0:
         return 0.0
@@ -55,7 +47,7 @@ def transition_radius(x, p, level):
 def edge_radius(x, p):
     """Radius of the contact edge on the section: midway between the last loaded node
     and the next one [length] (0 without contact)."""
-    r, q = _radial(x, p)
+    r, q = radial(x, p)
     loaded = np.nonzero(q > 0)[0]
     if loaded.size == 0:
         return 0.0
@@ -72,7 +64,7 @@ def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=Non
     curves : sequence of (float, array_like, array_like)
         ``(alpha, x, p)``: parameter value, section abscissae [length], pressures [pressure].
     path : path-like
-        PNG file to write.
+        File to write.
     p0, a : float
         Pressure and length scales (Hertz peak and radius).
     name : str
@@ -90,11 +82,6 @@ def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=Non
     ticklabels : sequence of str, optional
         Colour-bar tick labels, one per curve (e.g. values that are not numbers, the
         curves then given their index as ``alpha``).
-
-    Returns
-    -------
-    str
-        The written file.
     """
     import matplotlib as mpl
 
@@ -143,7 +130,7 @@ def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
     r_transition : array_like
         Transition radii [length] (:func:`transition_radius`).
     path : path-like
-        PNG file to write.
+        File to write.
     a : float
         Length scale (Hertz radius) [length].
     r_contact : array_like, optional
@@ -152,11 +139,6 @@ def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
         Label of the parameter axis (mathtext).
     title : str, optional
         Axes title.
-
-    Returns
-    -------
-    str
-        ``path``.
     """
     a = check_positive("a", a)
     alpha = np.asarray(alpha, dtype=float)
@@ -196,18 +178,13 @@ def plot_sweep_scalars(values, series, path, *, name, title=None, ticklabels=Non
     series : sequence of (str, array_like)
         ``(axis label with unit, values)`` per panel; ``NaN`` marks a missing point.
     path : path-like
-        PNG file to write.
+        File to write.
     name : str
         Label of the swept parameter (mathtext allowed).
     title : str, optional
         Title of the upper panel.
     ticklabels : sequence of str, optional
         Tick labels at ``values``.
-
-    Returns
-    -------
-    str
-        The written file.
     """
     x = np.asarray(values, dtype=float)
     if not series or x.size < 1:

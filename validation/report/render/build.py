@@ -1,8 +1,9 @@
 """Write a report directory whole or not at all.
 
 ``out_dir/report.html`` (self-contained), ``out_dir/report.md`` and ``out_dir/figures/`` (the
-PNG or SVG of every figure, and the PDF beside a PNG drawn in ``"pdf"`` format) are first written into a fresh temporary directory beside ``out_dir``; only when all of
-them are complete is that directory renamed onto ``out_dir`` (a previous report there is
+PNG or SVG of every figure, and the PDF beside a PNG drawn in ``"pdf"`` format) are first
+written into a fresh temporary directory beside ``out_dir``; only when all of them are
+complete is that directory renamed onto ``out_dir`` (a previous report there is
 moved aside first and deleted afterwards: :func:`validation.io.atomic_directory`). An
 interrupted build leaves the previous report, or nothing, never a mixture.
 """
@@ -16,11 +17,11 @@ from pathlib import Path
 
 from bem.checks import InputError
 
-from ..io import atomic_directory
-from ..provenance import report_footer
+from ...io import atomic_directory
+from ...provenance import report_footer
+from .content import Figure, Section
 from .html import render_html
 from .markdown import render_markdown
-from .sections import Figure, Section
 from .style import figure_format, vector_copy
 
 __all__ = ["build_report", "BuiltReport", "REPORT_FILES", "Progress", "draw_and_build"]
@@ -73,7 +74,7 @@ def draw_and_build(make_sections, out_dir, *, title, subtitle="", fmt="png", not
     title, subtitle : str
         As for :func:`build_report`.
     fmt : {"png", "svg", "pdf"}
-        Figure files (:func:`validation.report.style.figure_format`).
+        Figure files (:func:`validation.report.render.style.figure_format`).
     notify : Progress, optional
         Told the stages ``"figures"`` and ``"writing"``, then :meth:`Progress.done`.
 
@@ -126,7 +127,7 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None):
     Parameters
     ----------
     sections : sequence of Section
-        The content (:mod:`validation.report.sections`), in order.
+        The content (:mod:`validation.report.render.content`), in order.
     out_dir : path-like
         Report directory; created, or replaced if it holds a previous report. A
         directory with other files is refused (nothing is deleted).
