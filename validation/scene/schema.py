@@ -22,6 +22,7 @@ from . import checks as ck
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
 from .paper import ALIASES, PAPER_KEYS, PAPER_LAWS, c_nn, check_layer
+from ..report.documents.sections import SECTIONS
 from ..units import DEFAULT_LABEL as DEFAULT_UNITS
 from ..units import parse_units
 from .sizing import DOMAIN_MARGIN, MAX_NODES, check_estimate, inner_domain, node_count
@@ -30,9 +31,8 @@ __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "bem_options", "fem_o
            "report", "sweep_spec", "stress_options", "scene_keys", "KEYS", "REPORT_SECTIONS", "ANALYTIC_KINDS",
            "DEFAULT_UNITS"]
 
-#: Section names the report builder knows (validation only; the builder lives in validation.report).
-REPORT_SECTIONS = ("summary", "scene", "profile", "pressure_map", "comparison", "convergence", "layer_law",
-                   "fem_field", "sweep", "timings", "stress")
+#: Section names a scene's [report] may list: those of the report's registry (validation.report.documents.sections).
+REPORT_SECTIONS = tuple(SECTIONS)
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
