@@ -126,10 +126,10 @@ def _stresses(res, work):
     path = plot_depth_profiles(curves, work / "fig_stress_profiles_laws.png", a=res.a, scale=res.p0,
                                stress_label=r"von Mises stress $\sigma_{vM}\,/\,p_0$", depth_label=r"depth $z\,/\,a_H$",
                                marks=marks, title="von Mises stress on the axis, same force, each layer law")
-    moves = [f"{way} with {', '.join(k for k, s in st.items() if k != 'smooth' and cmp(s.depth_of_max))}"
-             for way, cmp in (("deeper", lambda d: d > smooth.depth_of_max),
-                              ("towards the surface", lambda d: d < smooth.depth_of_max))
-             if any(k != "smooth" and cmp(s.depth_of_max) for k, s in st.items())]
+    deeper = [k for k, s in st.items() if s.depth_of_max > smooth.depth_of_max]
+    shallower = [k for k, s in st.items() if s.depth_of_max < smooth.depth_of_max]
+    moves = [f"{way} with {', '.join(laws)}" for way, laws in (("deeper", deeper), ("towards the surface", shallower))
+             if laws]
     summary = (f"Smooth bodies: the largest von Mises stress is {smooth.max_von_mises / res.p0:.3f} p0 at depth "
                f"{smooth.depth_of_max / res.a:.3f} a_H below the centre (Hertz: 0.620 p0 at 0.481 a_H for nu = 0.3). "
                "With the same force it is, for the laws of Fig. 5: " + "; ".join(parts) + ". "

@@ -18,9 +18,11 @@ from bem.checks import InputError
 
 from ...provenance import display_path
 from .. import figures
+from ..figures.run import stress_view
 from ..render import Progress, Section, Table, draw_and_build, fmt
 from ..render.style import method_text
 from .problem import scene_section
+from .sweep import sweep_section
 
 __all__ = ["SECTIONS", "STAGES", "run_sections", "report_results_dir", "results_rows", "comparison_tables"]
 
@@ -148,8 +150,6 @@ def fem_field(res, work):
 
 def stress(res, work):
     """The subsurface stresses of a scene with ``[stress]``: maxima per body, and against the FEM."""
-    from ..figures.run import stress_view
-
     block = res.get("stress")
     if not block or not block.get("bodies"):
         return None
@@ -226,12 +226,6 @@ def _figures_only(title, kind):
     return lambda res, work: Section(title, kind=kind)
 
 
-def _sweep(res, work):
-    from .sweep import sweep_section
-
-    return sweep_section(res, work)
-
-
 #: section name -> function(results, work) -> Section or None, in the default order of a report
 SECTIONS = {
     "scene": scene_section,
@@ -244,7 +238,7 @@ SECTIONS = {
     "fem_field": fem_field,
     "stress": stress,
     "comparison": comparison,
-    "sweep": _sweep,
+    "sweep": sweep_section,
 }
 
 

@@ -4,7 +4,7 @@ axis, and stress profiles against the depth.
 The FEM's von Mises stress is recovered by :func:`fem_reference.fields.nodal_stresses` (the
 field its ``.vtu`` file holds) and drawn on the vertex triangulation of the quadratic mesh,
 mirrored about the axis. Lengths are divided by ``a`` and stresses by ``scale`` (Hertz's radius
-and peak, or display units). Each plot function writes one file and returns it.
+and peak, or display units); other conventions: :mod:`validation.report.figures`.
 """
 
 from __future__ import annotations
@@ -40,21 +40,15 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
     triangles : array_like of int, shape (t, 3)
         Vertex triangles.
     values : array_like, shape (n,)
-        Field at the vertices (same unit as ``scale``).
-    path : path-like
-        File to write.
-    a, scale : float
-        Length scale [length] (axes in ``r / a``, ``z / a``) and field scale (colours ``values / scale``).
+        Field at the vertices (same unit as ``scale``; colours ``values / scale``).
     label : str
         Colour-bar label (mathtext), e.g. ``r"$\\sigma_{vM}\\,/\\,p_0$"``.
     window : float
         Half-width and half-height of the window in units of ``a``.
     contact_radius : float, optional
         Edge of the contact [length], marked on the interface.
-    title : str, optional
-        Axes title.
     labels : dict, optional
-        ``{"r", "z"}`` axis labels (:func:`validation.report.render.style.axis_labels`).
+        ``{"r", "z"}`` axis labels.
     length_unit : str, optional
         Unit of ``r / a`` shown with the contact radius in the legend (default: ``a_H``
         without ``labels``, nothing with them).
@@ -126,10 +120,6 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
     panels : sequence of (sign, x, z, values)
         One per body: ``sign`` +1 (drawn at ``+z``, upper body) or -1 (at ``-z``), ``x`` (n_x,)
         [length], ``z`` (n_z,) depths [length], ``values`` (n_z, n_x) in the unit of ``scale``.
-    path : path-like
-        File to write.
-    a, scale : float
-        Length and stress scales (axes in ``x / a``, colours ``values / scale``).
     label : str
         Colour-bar label (mathtext).
     contact_radius : float, optional
@@ -139,7 +129,6 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
         mirrored about the axis, are drawn over the map at the same levels (dashed).
     labels : dict, optional
         ``{"x", "z"}`` axis labels.
-    title : str, optional
     """
     if not panels:
         raise InputError("panels = [] is not allowed: give at least one body's section.")
@@ -193,15 +182,10 @@ def plot_depth_profiles(curves, path, *, a, scale, stress_label, depth_label=r"d
     curves : sequence of dict
         ``{"label", "z", "values"}`` [length], [stress] and optionally ``"key"`` (colour of a law,
         method or solver, :func:`validation.report.render.style.color_for`), ``"ls"``, ``"marker"``.
-    path : path-like
-        File to write.
-    a, scale : float
-        Depth and stress scales.
     stress_label, depth_label : str
-        Axis labels (mathtext).
+        Axis labels (mathtext); depths are divided by ``a``, stresses by ``scale``.
     marks : sequence of (depth, value, color)
         Points to mark (e.g. the maxima) [length], [stress].
-    title : str, optional
     """
     if not curves:
         raise InputError("curves = [] is not allowed: give at least one profile.")

@@ -1,4 +1,5 @@
-"""The work-precision plot of a resolution study: error against run time, one line per solver and method."""
+"""The work-precision plot of a resolution study: error against run time, one line per solver and
+method (conventions: :mod:`validation.report.figures`)."""
 
 from __future__ import annotations
 
@@ -73,15 +74,10 @@ def plot_work_precision(rows, path, *, error_label="relative error", title=None,
     rows : iterable of dict or sequence
         ``(solver, method, resolution, N, error, wall_time_s)`` and optionally
         ``wall_times_s`` (:func:`work_precision_rows`).
-    path : path-like
-        File to write.
     error_label : str
         What the error is (y-axis label).
-    title : str, optional
-        Axes title.
     references : sequence of float
         Errors drawn as horizontal reference lines (default 1 % and 0.1 %).
-    Returns the written file.
     """
     rows = work_precision_rows(rows)
     if not rows:

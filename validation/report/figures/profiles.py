@@ -3,8 +3,7 @@ of solvers against a reference with the error underneath, and the layer laws ``w
 
 The axial section is the lattice row ``y = 0`` (lattice row ``j = 0`` holds nodes at
 ``x = c i`` exactly), so the curves are the computed nodal values, not interpolations.
-Every plot function writes one file (:func:`validation.report.render.style.save_figure`) and
-returns it; ``p0`` [pressure] and ``a`` [length] are the scales the data are divided by.
+Conventions: :mod:`validation.report.figures`.
 """
 
 from __future__ import annotations
@@ -20,22 +19,8 @@ __all__ = ["axial_section", "section_of", "radial", "auto_xlim", "curve_style", 
 
 
 def axial_section(x, y, values, *, tol=None):
-    """Nodes on the line ``y = 0``, sorted by ``x``.
-
-    Parameters
-    ----------
-    x, y : array_like, shape (N,)
-        Node coordinates [length].
-    values : array_like, shape (N,)
-        Nodal values (any unit).
-    tol : float, optional
-        ``|y| <= tol`` counts as on the line [length]; default ``1e-9 max|x|``.
-
-    Returns
-    -------
-    xs, vs : ndarray
-        Abscissae [length] and values on the section, ``xs`` increasing.
-    """
+    """``(xs, vs)``: the nodes ``(x, y)`` [length] on the line ``y = 0`` (``|y| <= tol``, default
+    ``1e-9 max|x|``), sorted by ``x``, and their ``values`` (any unit)."""
     x, y, values = (np.asarray(v, dtype=float) for v in (x, y, values))
     if not (x.shape == y.shape == values.shape):
         raise InputError(f"x, y, values have shapes {x.shape}, {y.shape}, {values.shape} which is not allowed: "
@@ -98,18 +83,10 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=None, xlim=
     curves : sequence of (str, data) or (str, data, dict)
         Label and a :class:`bem.ContactResult` (or FEM result, or ``(x, p)`` arrays,
         :func:`section_of`); an optional third item overrides the matplotlib line style.
-    path : path-like
-        File to write.
-    p0, a : float
-        Pressure [pressure] and length [length] scales of the axes.
-    title : str, optional
-        Axes title.
     hertz : (array_like, array_like), optional
         Hertz's pressure ``(x, p)`` [length], [pressure], drawn as a thin grey band.
     xlim : (float, float), optional
         Range of ``x / a``; default: the widest contact with a margin (:func:`auto_xlim`).
-    labels : dict, optional
-        Axis labels ``{"x": ..., "p": ...}`` (default: normalised by the Hertz radius and peak).
     section : str, optional
         Which line the profile lies on, appended to the x label (``None``: nothing).
     """
@@ -137,31 +114,21 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=None, xlim=
 
 def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, rmax=None, labels=None,
                             error_scale=None):
-    """Radial pressure profiles of several solvers with their error against a reference.
-
-    Upper panel: ``p(r) / p0`` of every curve and of the reference. Lower panel (shared
-    ``r``): ``(p - p_ref) / error_scale`` at each curve's own nodes, the reference evaluated
-    there (a closed form, or linear interpolation of reference samples).
+    """Radial pressure profiles of several solvers (upper panel) with their error against a
+    reference, ``(p - p_ref) / error_scale`` at each curve's own nodes (lower panel).
 
     Parameters
     ----------
     curves : sequence of (str, r, p) or (str, r, p, str)
         Radial samples [length], [pressure]; only ``r >= 0`` is used. An optional 4th item
         names the solver (``"bem"``, ``"fem"``, ...) for its colour.
-    path : path-like
-        File to write.
-    p0, a : float
-        Pressure and length scales of the axes.
     reference : (str, callable) or (str, r, p), optional
-        The reference ``p_ref(r)``; without it the first curve is the reference.
-    title : str, optional
-        Upper panel title.
+        The reference ``p_ref(r)``, a closed form or samples (interpolated linearly); without
+        it the first curve is the reference.
     rmax : float, optional
         Largest ``r / a`` shown (default: the widest loaded zone of the curves plus 25 %).
     labels : dict, optional
-        ``{"x", "p", "err", "err_of"}``: labels of the abscissa, the pressure and the error,
-        and what the error is a fraction of in the legend (default: normalised by the Hertz
-        radius and peak).
+        ``{"x", "p", "err", "err_of"}``: also the error's label and what it is a fraction of.
     error_scale : float, optional
         Pressure the error is divided by [pressure] (default ``p0``).
     """
@@ -224,14 +191,10 @@ def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, mark
     ----------
     laws : sequence of (str, bem.layers.Layer or None)
         Label and law; ``None`` (smooth bodies, ``w = 0``) is drawn on the axis.
-    path : path-like
-        File to write.
     p_max : float
         Largest pressure drawn [pressure].
     p_unit, w_unit : str
         Unit labels of pressure and closure (e.g. ``"MPa"``, ``"µm"``); blank when normalised.
-    title : str, optional
-        Axes title.
     marks : sequence of (str, float)
         Labelled vertical lines at special pressures (e.g. ``("p_cr", 0.24)``) [pressure].
     """

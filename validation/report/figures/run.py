@@ -69,7 +69,7 @@ class ProfileView:
     xlim : (float, float)
         Plotted abscissa range (in units of ``x_factor``), symmetric around 0.
     normalised : bool
-        Whether the data are divided by the contact's scales (else display units).
+        Whether the data are divided by the contact's scales (:func:`scale`).
     """
 
     x_factor: float

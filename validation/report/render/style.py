@@ -88,17 +88,9 @@ NORMALISED_LABELS = {
 }
 
 
-def axis_labels(labels=None, units=None):
-    """Axis labels: :data:`NORMALISED_LABELS` updated by ``labels``; with ``units``
-    (``{"length": "mm", "pressure": "MPa"}``) the physical labels ``x [mm]``, ``p [MPa]``
-    (use then ``p0 = a = 1`` so the data are drawn as they are)."""
-    out = dict(NORMALISED_LABELS)
-    if units is not None:
-        length, pressure = units.get("length", "length"), units.get("pressure", "pressure")
-        out.update({k: f"${k}$ [{length}]" for k in ("x", "y", "r", "z")})
-        out["p"] = f"contact pressure $p$ [{pressure}]"
-    out.update(labels or {})
-    return out
+def axis_labels(labels=None):
+    """Axis labels: :data:`NORMALISED_LABELS` updated by ``labels`` (e.g. ``{"x": "$x$ [mm]"}``)."""
+    return {**NORMALISED_LABELS, **(labels or {})}
 
 
 _METHOD_TEXT = {
