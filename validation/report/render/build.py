@@ -87,7 +87,7 @@ def draw_and_build(make_sections, out_dir, *, title, subtitle="", fmt="png", not
         notify("figures")
         sections = make_sections(work)
         notify("writing")
-        built = build_report(sections, out_dir, title=title, subtitle=subtitle)
+        built = build_report(sections, out_dir, title=title, subtitle=subtitle, root=work)
     notify.done()
     return built
 
@@ -105,13 +105,16 @@ def _check_replaceable(out_dir):
         )
 
 
-def _figure_names(sections):
-    """Unique ``figures/<name>.<png|svg>`` for every figure path, in order of appearance."""
+def _figure_names(sections, root=None):
+    """Unique ``figures/<name>.<png|svg>`` for every figure path, in order of appearance; a file in a
+    folder below ``root`` is named after that folder too (``root/case/profile.png``: ``case_profile``)."""
     names, used = {}, set()
     for sec in sections:
         for item in sec.items:
             if isinstance(item, Figure) and item.path not in names:
-                stem, ext = Path(item.path).stem or "figure", Path(item.path).suffix.lower()
+                path = Path(item.path)
+                path = path.relative_to(root) if root is not None and path.is_relative_to(root) else Path(path.name)
+                stem, ext = "_".join(path.with_suffix("").parts) or "figure", path.suffix.lower()
                 name, k = stem, 1
                 while name in used:
                     k += 1
@@ -121,7 +124,7 @@ def _figure_names(sections):
     return names
 
 
-def build_report(sections, out_dir, *, title, subtitle="", footer=None):
+def build_report(sections, out_dir, *, title, subtitle="", footer=None, root=None):
     """Render ``sections`` to ``out_dir/report.html``, ``report.md`` and ``figures/``.
 
     Parameters
@@ -138,6 +141,9 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None):
     footer : str, optional
         Footer text; default :func:`validation.provenance.report_footer` (contactlab version,
         git commit, Python, numpy and scipy versions, the command line and the date).
+    root : path-like, optional
+        The folder the figures were drawn into: a figure in a folder below it is named after
+        that folder too.
 
     Returns
     -------
@@ -157,7 +163,7 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None):
     out_dir = Path(out_dir).resolve()
     if footer is None:
         footer = report_footer()
-    names = _figure_names(sections)
+    names = _figure_names(sections, root)
     images = {path: Path(path).read_bytes() for path in names}
     vectors = {names[path][:-4] + ".pdf": Path(pdf).read_bytes() for path in names
                if (pdf := vector_copy(path)) is not None}
