@@ -17,7 +17,7 @@ from pathlib import Path
 from bem.checks import InputError
 
 from ...provenance import display_path
-from .. import figures
+from ..figures import FIGURES
 from ..figures.run import stress_view
 from ..render import Progress, Section, Table, draw_and_build, fmt
 from ..render.style import method_text
@@ -250,7 +250,7 @@ def build_section(name, res, work):
     if sec is None:
         return None
     drawn = []
-    for where, draw in figures.FIGURES.values():
+    for where, draw in FIGURES.values():
         out = draw(res, work) if where == name else None
         drawn += out if isinstance(out, list) else [out] if out is not None else []
     sec = Section(sec.title, kind=sec.kind, text=sec.text, items=sec.items + tuple(drawn))
