@@ -102,3 +102,20 @@ def test_scene_schema_names_the_registered_sections():
     from validation.scene import schema
 
     assert schema.REPORT_SECTIONS == tuple(SECTIONS)
+
+
+def test_units_are_the_recorded_symbols(elliptic_dir, tmp_path):
+    """The report draws in result.json's unit_symbols; only a result written before they were recorded
+    has its units label parsed."""
+    d = _with_report(elliptic_dir, tmp_path / "symbols", None)
+    data = json.loads((d / "result.json").read_text())
+    assert data["unit_symbols"] == {"length": "m", "pressure": "Pa", "force": "N"}
+    data["units"] = "mm, MPa, N"  # a label that disagrees: the recorded symbols win
+    (d / "result.json").write_text(json.dumps(data))
+    res = load_results(d)
+    assert (res.units.length, res.units.pressure, res.units.force) == ("m", "Pa", "N")
+    del data["unit_symbols"]  # an older result: the label is all there is
+    (d / "result.json").write_text(json.dumps(data))
+    res = load_results(d)
+    assert (res.units.length, res.units.pressure, res.units.force) == ("mm", "MPa", "N")
+    assert [r[-1] for r in run_sections(res, tmp_path / "w", ["summary"])[0].items[0].rows][:2] == ["MPa", "N"]
