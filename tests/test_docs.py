@@ -106,7 +106,7 @@ def test_scenes_doc_defaults_are_the_code_defaults():
     assert f"{MAX_NODES / 1e6:g} million nodes" in (DOCS / "scenes.md").read_text()
     assert checked > 10
     sections = doc["report"][""]["sections"][4]
-    assert all(f"`{name}`" in sections for name in ss.REPORT_SECTIONS)
+    assert all(f"`{name}`" in sections for name in ss.report_sections())
     assert all(f'"{kind}"' in doc["analytic"][""]["kind"][4] for kind in ss.ANALYTIC_KINDS)
 
 

@@ -1,16 +1,17 @@
 """Generate the report of the paper's test problem (paper section 6, Fig. 4-11).
 
-Solves two paraboloids (R = E* = P = 1) with the interface laws of the paper - linear
-Winkler (lam = 10 C_nn), elastic-rigid (alpha_a = 0.5), root, bilinear (small alpha_c) -
-and smooth bodies with ``bem.solve``; runs the paper's iterative methods with their
-histories, the alpha_a / alpha_b / alpha_c sweeps, the stability table of every method,
-and the validation against Hertz and the FEM reference; then writes ``report.html``
-(self-contained), ``report.md`` and ``figures/*.png``.
+Runs the paper's test problem - two steel paraboloids, smooth and with the interface laws of
+the paper: linear Winkler (lam = 10 C_nn), elastic-rigid (alpha_a = 0.5), root, bilinear -
+as the built-in scenes ``paper_*``, run by the runner (``validation.run.execute_scene``); the
+paper's iterative methods with their histories, the alpha_a / alpha_b / alpha_c sweeps, the
+stability table of every method, the subsurface stresses and the validation against Hertz and
+the FEM reference; then writes ``report.html`` (self-contained), ``report.md`` and
+``figures/*.png``.
 
 Usage (from the repository root)::
 
     python docs/examples/paper_report.py --out reports/paper          # about a minute
-    python docs/examples/paper_report.py --out build/paper --quick    # coarse preview, ~20 s
+    python docs/examples/paper_report.py --out build/paper --quick    # coarse preview, ~30 s
 
 The same report: ``contactlab report paper --out reports/paper``.
 """
@@ -29,7 +30,7 @@ def main(argv=None):
     parser.add_argument("--no-fem", action="store_true", help="skip the FEM reference and the resolution study")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
-    for name in ("bem", "fem_reference"):
+    for name in ("bem", "fem_reference", "validation.run"):
         logging.getLogger(name).setLevel(logging.ERROR)  # expected warnings of the diverging paper method
 
     from validation.report import report_paper_problem

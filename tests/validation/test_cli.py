@@ -113,7 +113,7 @@ def test_report_dispatches_its_arguments_and_prints_where(monkeypatch, tmp_path)
     from pathlib import Path
 
     from validation.report import command
-    from validation.report.build import BuiltReport
+    from validation.report.render import BuiltReport
 
     seen = {}
 

@@ -12,10 +12,8 @@ import pytest
 import scipy
 
 from validation import provenance as pv
-from validation.report.build import build_report
-from validation.report.run_report import report_results_dir
-from validation.report.sections import Section
-from validation.report.study_report import report_studies_dir
+from validation.report import report_results_dir, report_studies_dir
+from validation.report.render import Section, build_report
 from validation.run import run_scene
 
 from .test_report_studies import _write as write_studies

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from bem.checks import InputError
-from validation.report import build as build_mod
 from validation.report import build_report, main
-from validation.report.sections import Figure, Section, Table, fmt, problem_section, status_class
+from validation.report.render import Figure, Section, Table, fmt, problem_section, status_class
+from validation.report.render import build as build_mod
 
 html5lib = pytest.importorskip("html5lib")
 
@@ -131,7 +131,7 @@ def test_status_and_format():
 
 
 def test_table_from_rows():
-    from validation.report.sections import table_from_rows
+    from validation.report.render import table_from_rows
 
     t = table_from_rows([{"case": "a", "status": "diverged", "extra": {"x": 1}}, {"case": "b", "n": 3}])
     assert t.columns == ("case", "status", "n") and t.status_column == "status"

@@ -11,13 +11,13 @@ import pytest
 import bem
 from bem.checks import InputError
 from bem.reference import hertz_sphere
-from validation.report import figures_3d as f3d
-from validation.report import figures_iterations as fit
-from validation.report import figures_profiles as fpr
-from validation.report import figures_sweeps as fsw
-from validation.report import figures_validation as fva
+from validation.report.figures import iterations as fit
+from validation.report.figures import precision as fva
+from validation.report.figures import profiles as fpr
+from validation.report.figures import surfaces as f3d
+from validation.report.figures import sweeps as fsw
 from bem.files import atomic_path
-from validation.report.style import DPI, save_figure
+from validation.report.render.style import DPI, save_figure
 
 HERTZ = hertz_sphere(R=1.0, E_star=1.0, force=1.0)
 A, P0 = HERTZ.contact_radius, HERTZ.p_max
@@ -120,7 +120,8 @@ def test_work_precision_rows_accepts_tuples_and_drops_unplottable():
 
 def test_pressure_profiles_png(cases, tmp_path):
     curves = [("smooth", cases["smooth"]), ("linear", cases["linear"]), ("elastic-rigid", cases["er"])]
-    path = fpr.plot_pressure_profiles(curves, tmp_path / "p.png", p0=P0, a=A, hertz=True)
+    s = np.linspace(-1.5 * A, 1.5 * A, 301)
+    path = fpr.plot_pressure_profiles(curves, tmp_path / "p.png", p0=P0, a=A, hertz=(s, HERTZ.pressure(s)))
     img = check_png(path, (8.2, 4.0))
     # the data matter: a different set of curves gives a different picture
     other = fpr.plot_pressure_profiles(curves[:1], tmp_path / "q.png", p0=P0, a=A)
@@ -213,10 +214,10 @@ def test_profile_comparison_png(cases, tmp_path):
     s = cases["smooth"]
     x, p = fpr.section_of(s)
     curves = [("BEM", x, p, "bem"), ("shifted", x, 0.98 * p, "fem")]
-    check_png(fva.plot_profile_comparison(curves, tmp_path / "cmp.png", p0=P0, a=A,
+    check_png(fpr.plot_profile_comparison(curves, tmp_path / "cmp.png", p0=P0, a=A,
                                           reference=("Hertz", HERTZ.pressure)), (6.6, 5.4))
     # reference given as samples (no callable)
-    check_png(fva.plot_profile_comparison(curves, tmp_path / "cmp2.png", p0=P0, a=A))
+    check_png(fpr.plot_profile_comparison(curves, tmp_path / "cmp2.png", p0=P0, a=A))
 
 
 def test_work_precision_png(tmp_path):
@@ -236,7 +237,7 @@ def test_work_precision_png(tmp_path):
 
 
 def test_von_mises_png(tmp_path):
-    from validation.report.figures_fem import plot_von_mises, von_mises_of
+    from validation.report.figures.fields import plot_section_field, von_mises_of
 
     import fem_reference
 
@@ -248,7 +249,8 @@ def test_von_mises_png(tmp_path):
     k = int(np.argmax(vm))
     assert vm[k] / P0 == pytest.approx(0.62, abs=0.03)
     assert abs(z[k]) / A == pytest.approx(0.48, abs=0.12) and r[k] / A < 0.25
-    check_png(plot_von_mises(fem, tmp_path / "vm.png", a=A, p0=P0), (5.8, 4.6))
+    check_png(plot_section_field(r, z, tri, vm, tmp_path / "vm.png", a=A, scale=P0, label="von Mises",
+                                 contact_radius=fem.contact_radius), (5.8, 4.6))
 
 
 # ---------------------------------------------------------------- inputs untouched, atomic writes
@@ -260,7 +262,7 @@ def test_figures_do_not_modify_inputs(cases, tmp_path):
     hist = [h.copy() for h in r.history["p"]]
     fsw.plot_sweep([(0.5, x, p)], tmp_path / "a.png", p0=P0, a=A, name="a")
     fsw.transition_radius(x, p, 0.1)
-    fva.plot_profile_comparison([("c", x, p)], tmp_path / "b.png", p0=P0, a=A, reference=("h", HERTZ.pressure))
+    fpr.plot_profile_comparison([("c", x, p)], tmp_path / "b.png", p0=P0, a=A, reference=("h", HERTZ.pressure))
     fit.plot_iteration_profiles(r, tmp_path / "c.png", p0=P0, a=A)
     np.testing.assert_array_equal(x, x0)
     np.testing.assert_array_equal(p, p0)

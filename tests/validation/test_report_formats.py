@@ -9,19 +9,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from validation.report import figures_3d as f3d
-from validation.report import figures_iterations as fit
-from validation.report import figures_profiles as fpr
-from validation.report import figures_sweeps as fsw
-from validation.report import figures_validation as fva
-from validation.report.build import build_report
-from validation.report.figures_fem import plot_section_field
-from validation.report.sections import Figure, Section
-from validation.report.style import DPI, FORMATS, figure_format, vector_copy
+from validation.report.figures import iterations as fit
+from validation.report.figures import precision as fva
+from validation.report.figures import profiles as fpr
+from validation.report.figures import surfaces as f3d
+from validation.report.figures import sweeps as fsw
+from validation.report.figures.fields import plot_section_field
+from validation.report.render import Figure, Section, build_report
+from validation.report.render.style import DPI, FORMATS, figure_format, vector_copy
 
 from .test_report_figures import A, HERTZ, P0, cases, check_png  # noqa: F401 - cases is the shared fixture
 
 ROOT = Path(__file__).resolve().parents[2]
+HERTZ_X = np.linspace(-1.5 * A, 1.5 * A, 301)
 
 
 def _fem_section():
@@ -37,7 +37,7 @@ def _fem_section():
 #: name -> (draw(cases, path), size in inches)
 FIGURES = {
     "profiles": (lambda c, p: fpr.plot_pressure_profiles([("smooth", c["smooth"]), ("er", c["er"])], p, p0=P0, a=A,
-                                                         hertz=True), (8.2, 4.0)),
+                                                         hertz=(HERTZ_X, HERTZ.pressure(HERTZ_X))), (8.2, 4.0)),
     "layer_laws": (lambda c, p: fpr.plot_layer_laws([("er", c["er_law"])], p, p_max=P0), (6.0, 3.8)),
     "iterations": (lambda c, p: fit.plot_iteration_profiles(c["er_vc"], p, p0=P0, a=A), (6.8, 4.0)),
     "convergence": (lambda c, p: fit.plot_convergence([("vc", c["er_vc"])], p, p0=P0, tol=1e-8), (6.6, 5.2)),
@@ -52,7 +52,7 @@ FIGURES = {
     "sweep_scalars": (lambda c, p: fsw.plot_sweep_scalars([1.0, 2.0, 3.0], [("p [MPa]", [1.0, 2.0, 2.5]),
                                                                             ("a [mm]", [0.1, 0.2, 0.25])], p,
                                                           name="force [N]"), (6.4, 1.2 + 1.9 * 2)),
-    "comparison": (lambda c, p: fva.plot_profile_comparison([("BEM", *fpr.section_of(c["smooth"]), "bem")], p, p0=P0,
+    "comparison": (lambda c, p: fpr.plot_profile_comparison([("BEM", *fpr.section_of(c["smooth"]), "bem")], p, p0=P0,
                                                             a=A, reference=("Hertz", HERTZ.pressure)), (6.6, 5.4)),
     "work_precision": (lambda c, p: fva.plot_work_precision(
         [{"solver": "BEM", "method": "qp", "resolution": f"a/c = {m}", "N": 100 * m * m, "error": 0.3 / m ** 2,
@@ -164,7 +164,7 @@ def test_nothing_imports_pyvista_or_vtk():
 def test_png_is_not_sheared_at_fractional_pixel_sizes(tmp_path):
     """A figure 3.3 * 3 + 0.9 in wide (not a whole number of pixels at 300 dpi, as the 3-D panels)
     keeps a vertical line vertical: the PNG is read with its own size, not a computed one."""
-    from validation.report.style import new_figure, save_figure
+    from validation.report.render.style import new_figure, save_figure
 
     with new_figure((3.3 * 3 + 0.9, 2.8)) as (fig, ax):
         ax.set_axis_off()

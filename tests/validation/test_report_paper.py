@@ -1,5 +1,5 @@
 """The paper report (quick version): every figure, valid offline HTML, and the trends the paper
-describes (section 6) checked on the solved cases."""
+describes (section 6) checked on the cases, run as scenes by the runner."""
 
 import logging
 import math
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from validation.report import command
-from validation.report.build import build_report
-from validation.report.paper import solve_paper_problem
-from validation.report.paper_report import TITLE, paper_sections
+from validation.report.documents.paper import TITLE, paper_sections
+from validation.report.documents.paper_runs import run_paper_problem
+from validation.report.render import build_report
 
 from .test_report_build import PNG_MAGIC, assert_valid_offline_html
 from .test_report_figures import check_png
@@ -23,7 +23,7 @@ STAGES_SEEN = []
 
 @pytest.fixture(scope="module")
 def paper():
-    return solve_paper_problem(quick=True, progress=STAGES_SEEN.append)
+    return run_paper_problem(quick=True, progress=STAGES_SEEN.append)
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +53,7 @@ def test_paper_report_files(report):
 def test_paper_report_without_fem_has_no_fem_section(paper, tmp_path):
     import dataclasses
 
-    bem_only = dataclasses.replace(paper, fem={}, work_precision=[])
+    bem_only = dataclasses.replace(paper, validation={}, work_precision=[])
     built = build_report(paper_sections(bem_only, tmp_path / "w"), tmp_path / "out", title=TITLE)
     text = built.html.read_text(encoding="utf-8")
     assert "kind-fem" not in text and "FEM reference" not in text
@@ -64,16 +64,16 @@ def test_paper_trends(paper):
     """Section 6 of the paper: alpha_a moves the distribution from smooth to linear, region I
     shrinks as alpha_a grows, the root law lowers the peak as it softens, alpha_c -> 0 is the
     elastic-rigid law and alpha_c growing lowers the peak."""
-    from validation.report import figures_profiles as fpr
-    from validation.report import figures_sweeps as fsw
+    from validation.report.figures import profiles as fpr
+    from validation.report.figures import sweeps as fsw
 
-    p_lin, p0 = paper.p_lin, paper.problem.p0
+    p_lin, p0 = paper.p_lin, paper.p0
     alphas = [al for al, _ in paper.sweep_a]
     assert alphas[0] == 0.0 and alphas[-1] == 1.0
     peaks = [r.p_max for _, r in paper.sweep_a]
     assert np.all(np.diff(peaks) < 0) and peaks[0] == pytest.approx(paper.base["smooth"].p_max)
     r_tr = [fsw.transition_radius(*fpr.section_of(r), al * p_lin) for al, r in paper.sweep_a[1:]]
-    assert np.all(np.diff(r_tr) < 0) and r_tr[-1] < 0.2 * paper.problem.a
+    assert np.all(np.diff(r_tr) < 0) and r_tr[-1] < 0.2 * paper.a
     radii = [r.contact_radius for _, r in paper.sweep_a]
     assert np.all(np.diff(radii) >= 0)
     ab = [ab for _, ab, _ in paper.sweep_b]
@@ -115,7 +115,7 @@ def test_main_dispatches_paper(monkeypatch, tmp_path):
 
         return Built()
 
-    monkeypatch.setattr("validation.report.paper_report.report_paper_problem", fake)
+    monkeypatch.setattr("validation.report.documents.paper.report_paper_problem", fake)
     assert command.main(Namespace(target="paper", out=str(tmp_path), quick=True)) == 0
     assert command.main(Namespace(target="paper", out=None, format="pdf")) == 0
     assert calls == [(str(tmp_path), True, "png"), (str(command.DEFAULT_PAPER_OUT), False, "pdf")]
@@ -139,7 +139,7 @@ def test_example_script_passes_its_options(monkeypatch, tmp_path):
     monkeypatch.setattr("validation.report.report_paper_problem", fake)
     script = Path(__file__).parents[2] / "docs" / "examples" / "paper_report.py"
     ns = runpy.run_path(str(script), run_name="example")
-    levels = {name: logging.getLogger(name).level for name in ("bem", "fem_reference")}
+    levels = {name: logging.getLogger(name).level for name in ("bem", "fem_reference", "validation.run")}
     try:
         assert ns["main"](["--out", str(tmp_path), "--quick", "--no-fem"]) == 0
     finally:
@@ -149,18 +149,18 @@ def test_example_script_passes_its_options(monkeypatch, tmp_path):
 
 
 def test_paper_report_tells_its_stages(paper, monkeypatch, tmp_path):
-    from validation.report import paper_report
-    from validation.report.paper import SOLVE_STAGES
-    from validation.report.sections import Section
+    from validation.report.documents import paper as paper_report
+    from validation.report.documents.paper_runs import SOLVE_STAGES
+    from validation.report.render import Section
 
-    assert STAGES_SEEN == list(SOLVE_STAGES)  # the real solve, in order
+    assert STAGES_SEEN == list(SOLVE_STAGES)  # the real runs, in order
 
-    def fake_solve(problem, *, quick, fem, progress):
+    def fake_solve(*, quick, fem, progress):
         for stage in SOLVE_STAGES[:3 + fem]:
             progress(stage)
         return paper
 
-    monkeypatch.setattr(paper_report, "solve_paper_problem", fake_solve)
+    monkeypatch.setattr(paper_report, "run_paper_problem", fake_solve)
     monkeypatch.setattr(paper_report, "paper_sections", lambda res, work: [Section("x", text="y")])
     for fem, stages in ((True, paper_report.STAGES), (False, [s for s in paper_report.STAGES if "FEM" not in s])):
         calls = []
@@ -172,11 +172,11 @@ def test_paper_report_tells_its_stages(paper, monkeypatch, tmp_path):
 
 def test_paper_stresses_every_layer_lowers_the_subsurface_maximum(paper):
     """Smooth: Hertz's 0.62 p0 at 0.48 a_H; every law of Fig. 5 lowers the maximum at the same force."""
-    pb, st = paper.problem, paper.stress
+    st = paper.stress
     assert set(st) == set(paper.laws)
     smooth = st["smooth"]
-    assert smooth.max_von_mises / pb.p0 == pytest.approx(0.620, rel=0.01)
-    assert smooth.depth_of_max / pb.a == pytest.approx(0.481, abs=0.02)
+    assert smooth.max_von_mises / paper.p0 == pytest.approx(0.620, rel=0.01)
+    assert smooth.depth_of_max / paper.a == pytest.approx(0.481, abs=0.02)
     for label, s in st.items():
         if label != "smooth":
             assert s.max_von_mises < smooth.max_von_mises, label

@@ -1,7 +1,8 @@
-"""Reports of REAL result directories: built-in scenes run by validation.runner.run_scene at small
-settings, then reported. Checks: the scene's title and units, tables without raw containers,
-profile windows that hold the contact, an FEM section only when the FEM ran, comparison metrics
-when recorded, valid self-contained HTML, inputs untouched."""
+"""Reports of REAL result directories: built-in scenes run by validation.run.run_scene at small
+settings, then reported with every section of SECTIONS. Checks: the scene's title and units, tables
+without raw containers, profile windows that hold the contact, an FEM section only when the FEM
+ran, comparison metrics when recorded, valid self-contained HTML, inputs untouched. (The scene's
+[report] sections and new sections and figures: test_report_sections.py.)"""
 
 import copy
 import json
@@ -14,14 +15,15 @@ import numpy as np
 import pytest
 from tomli_w import dumps
 
-from validation.report import main, report_results_dir
-from validation.report.build import build_report
-from validation.report.results import display_unit, load_results, parse_units, report_unit
-from validation.report.run_figures import profile_view
-from validation.report.run_report import run_sections
-from validation.report.sections import Figure, Table
+from validation.report import SECTIONS, main, report_results_dir
+from validation.report.documents.results import load_results
+from validation.report.documents.sections import run_sections
+from validation.report.figures.run import profile_view
+from validation.report.render import Figure, Table, build_report
+from validation.report.render.style import display_unit, report_unit
 from validation.run import run_scene
 from validation.scene import builtin_path
+from validation.units import parse_units
 
 from .conftest import e_star, hertz
 from .test_report_build import assert_valid_offline_html
@@ -49,7 +51,7 @@ def reports(tmp_path_factory):
         res = load_results(root / name)
         work = root / f"{name}-figures"
         work.mkdir()
-        sections = run_sections(res, work)
+        sections = run_sections(res, work, SECTIONS)
         built = build_report(sections, root / f"{name}-report", title=res.title)
         out[name] = {"dir": root / name, "res": res, "sections": sections, "built": built,
                      "scene": _scene_file(name)}
@@ -105,11 +107,13 @@ def test_problem_statement_of_the_layer_scene(reports):
     p_cr = rep["res"].data["layer"]["parameters"]["p_cr"]
     assert float(rows["layer p_cr"][0]) == pytest.approx(p_cr, rel=1e-3) and rows["layer p_cr"][1] == "Pa"
     assert rows["layer lam"][1] == "m/Pa"
-    figures = [i for i in problem.items if isinstance(i, Figure)]
-    assert len(figures) == 1 and "w(p)" in figures[0].caption
+    assert not [i for i in problem.items if isinstance(i, Figure)]
+    figures = [i for s in rep["sections"] if s.title == "Interface layer law" for i in s.items]
+    assert len(figures) == 1 and isinstance(figures[0], Figure) and "w(p)" in figures[0].caption
     # smooth scene: a row saying so, no law figure
     hertz_problem = reports["hertz"]["sections"][0]
-    assert not [i for i in hertz_problem.items if isinstance(i, Figure)]
+    assert not [i for s in reports["hertz"]["sections"] for i in s.items
+                if isinstance(i, Figure) and "w(p)" in i.caption]
     assert _row(hertz_problem.items[0], "interface layer")[1].startswith("none")
 
 
@@ -154,14 +158,20 @@ def test_profile_window_holds_the_contact_in_scene_units(reports):
 
 
 def test_sections_follow_the_data(reports):
-    kinds = {name: [s.kind for s in rep["sections"]] for name, rep in reports.items()}
+    titles = {name: [s.title for s in rep["sections"]] for name, rep in reports.items()}
     for name, rep in reports.items():  # comparison metrics exactly when the run recorded them
-        assert (kinds[name][-1] == "validation") == bool(rep["res"].data.get("comparison")), name
-        if kinds[name][-1] == "validation":
-            kinds[name].pop()
-    assert kinds["hertz"] == ["problem", "results", "iterations", "fem", "results"]  # [stress]: last "results"
-    assert kinds["paper_elastic_rigid"] == ["problem", "results", "iterations", "fem"]
-    assert kinds["elliptic"] == kinds["roller"] == ["problem", "results", "iterations"]
+        assert (titles[name][-1] == "Comparison metrics") == bool(rep["res"].data.get("comparison")), name
+        assert rep["sections"][-1].kind == "validation" or titles[name][-1] != "Comparison metrics"
+        if titles[name][-1] == "Comparison metrics":
+            titles[name].pop()
+    every = ["Problem statement", "Results", "Solver and timings", "Pressure profiles",
+             "Pressure over the contact plane", "Convergence of the BEM"]
+    assert titles["hertz"] == every + ["FEM reference", "Subsurface stresses"]  # FEM and [stress]
+    assert titles["paper_elastic_rigid"] == every[:1] + ["Interface layer law"] + every[1:] + ["FEM reference"]
+    assert titles["elliptic"] == titles["roller"] == every
+    kinds = {s.title: s.kind for rep in reports.values() for s in rep["sections"]}
+    assert (kinds["Problem statement"], kinds["Interface layer law"], kinds["Convergence of the BEM"],
+            kinds["FEM reference"]) == ("problem", "problem", "iterations", "fem")
     names = {name: sorted(p.name for p in rep["built"].figures) for name, rep in reports.items()}
     base = ["contact_map.png", "convergence.png", "fem_von_mises.png", "profile_x.png"]
     assert names["hertz"] == sorted(base + ["stress_profiles.png", "stress_section.png"])
@@ -200,7 +210,7 @@ def test_fem_section_and_columns(reports):
     assert float(ratio[1]) == pytest.approx(data["p_max"] / p_h, rel=1e-3)
     assert float(ratio[3]) == pytest.approx(1.0, rel=1e-3)  # the closed form is Hertz
     assert float(_row(table, "delta / delta_H (Hertz approach)")[3]) == pytest.approx(1.0, rel=1e-3)
-    run_rows = {r[0]: r[1] for r in next(s for s in rep["sections"] if s.title == "Results").items[1].rows}
+    run_rows = {r[0]: r[1] for r in next(s for s in rep["sections"] if s.title == "Solver and timings").items[0].rows}
     assert run_rows["iterations (finest lattice)"] == str(data["iterations"])
     assert float(run_rows["lattice step c"]) == pytest.approx(data["bem"]["step"], rel=1e-3)
 
@@ -261,7 +271,7 @@ def test_units_parsing_and_display():
 def test_report_does_not_modify_the_results(reports, tmp_path):
     res = reports["paper_elastic_rigid"]["res"]
     before = copy.deepcopy(res.data), copy.deepcopy(res.scene), [a.copy() for a in res.bem_field]
-    run_sections(res, tmp_path)
+    run_sections(res, tmp_path, SECTIONS)
     assert res.data == before[0] and res.scene == before[1]
     assert all(np.array_equal(a, b) for a, b in zip(res.bem_field, before[2]))
     files = sorted(p.name for p in reports["paper_elastic_rigid"]["dir"].iterdir())

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bem.checks import InputError
-from validation.report.study_report import report_studies_dir
+from validation.report.documents.studies import report_studies_dir
 
 
 def _rows():

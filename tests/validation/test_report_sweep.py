@@ -6,9 +6,9 @@ import re
 import numpy as np
 import pytest
 
-from validation.report.results import load_results
-from validation.report.run_report import STAGES, report_results_dir
-from validation.report.sweep_report import is_sweep_dir, load_sweep, report_sweep_dir, sweep_sections
+from validation.report.documents.results import load_results
+from validation.report.documents.sections import STAGES, report_results_dir
+from validation.report.documents.sweep import is_sweep_dir, load_sweep, report_sweep_dir, sweep_sections
 from validation.run import run_scene
 from validation.run.sweep import run_sweep
 

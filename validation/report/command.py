@@ -32,8 +32,8 @@ def target_kind(target):
     """
     from validation.scene import builtin_scenes
 
-    from .study_report import is_study_dir
-    from .sweep_report import is_sweep_dir
+    from .documents.studies import is_study_dir
+    from .documents.sweep import is_sweep_dir
 
     path = Path(target)
     if target == "paper":
@@ -72,9 +72,9 @@ def build_from_args(args, progress=None):
         ``target``: ``"paper"`` (solve the paper's test problem and report it), a built-in
         scene name or a scene TOML file (run it, with ``overrides``, into ``OUT/result``,
         report into ``OUT/report``, ``OUT`` defaulting to ``results/NAME``), a results
-        directory holding ``result.json`` (:mod:`validation.report.results`), a sweep
-        directory (:mod:`validation.report.sweep_report`) or a directory of study files
-        (``error_time.json``, ``stability.json``: :mod:`validation.report.study_report`);
+        directory holding ``result.json`` (:mod:`validation.report.documents.results`), a sweep
+        directory (:mod:`validation.report.documents.sweep`) or a directory of study files
+        (``error_time.json``, ``stability.json``: :mod:`validation.report.documents.studies`);
         ``out`` (optional): the report directory (default ``reports/paper`` for ``paper``,
         ``TARGET/report`` for a directory); ``quick`` (bool, paper only): coarse preview;
         ``units`` (``"auto"``, ``"scene"``, ``"dimensionless"``; scenes, results and sweeps);
@@ -82,11 +82,11 @@ def build_from_args(args, progress=None):
         ``"svg"``, ``"pdf"``): the figure files.
     progress : callable, optional
         ``progress(stage, done, total)`` at the start of each stage and at the end
-        (:class:`validation.report.build.Progress`).
+        (:class:`validation.report.render.Progress`).
 
     Returns
     -------
-    validation.report.build.BuiltReport
+    validation.report.render.BuiltReport
 
     Raises
     ------
@@ -106,19 +106,19 @@ def build_from_args(args, progress=None):
     require_extra("report", "contactlab report (figures)")
     if kind == "paper":
         require_extra("fem", "contactlab report paper (the FEM validation)")
-        from .paper_report import report_paper_problem
+        from .documents.paper import report_paper_problem
 
         return report_paper_problem(DEFAULT_PAPER_OUT if out is None else out,
                                     quick=bool(getattr(args, "quick", False)), fmt=fmt, progress=progress)
     if kind == "studies":
-        from .study_report import report_studies_dir
+        from .documents.studies import report_studies_dir
 
         return report_studies_dir(target, out, fmt=fmt, progress=progress)
     if kind == "sweep":
-        from .sweep_report import report_sweep_dir
+        from .documents.sweep import report_sweep_dir
 
         return report_sweep_dir(target, out, units=units, fmt=fmt, progress=progress)
-    from .run_report import report_results_dir
+    from .documents.sections import report_results_dir
 
     if kind == "results":
         return report_results_dir(target, out, units=units, fmt=fmt, progress=progress)

@@ -25,12 +25,9 @@ from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law
 from .sizing import KEYS as BEM_KEYS
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic",
-           "report", "sweep_spec", "stress_options", "scene_keys", "KEYS", "REPORT_SECTIONS", "ANALYTIC_KINDS",
+           "report", "sweep_spec", "stress_options", "scene_keys", "KEYS", "report_sections", "ANALYTIC_KINDS",
            "DEFAULT_UNITS"]
 
-#: Section names the report builder knows (validation only; the builder lives in validation.report).
-REPORT_SECTIONS = ("summary", "scene", "profile", "pressure_map", "comparison", "convergence", "layer_law",
-                   "fem_field", "sweep", "timings", "stress")
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 _BODY_KEYS = ("E1", "nu1", "E2", "nu2")
@@ -44,6 +41,14 @@ KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star",
 GAP_TYPES = gaps.GAPS
 _STRESS_KEYS = KEYS["stress"]
 STRESS_BODIES = ("body1", "body2")
+
+
+def report_sections():
+    """The names a scene's ``[report] sections`` may list: the keys of the report's registry
+    (:data:`validation.report.documents.sections.SECTIONS`), read when a ``[report]`` is checked."""
+    from ..report.documents.sections import SECTIONS
+
+    return tuple(SECTIONS)
 
 
 def scene_keys():
@@ -234,7 +239,7 @@ def report(d):
         raise ck.SceneError(f"report.sections = {sections!r} is not allowed: it must be a non-empty list of "
                             "section names, e.g. [\"summary\", \"profile\"].")
     for i, name in enumerate(sections):
-        ck.choice(f"report.sections[{i}]", name, REPORT_SECTIONS)
+        ck.choice(f"report.sections[{i}]", name, report_sections())
     out["sections"] = list(sections)
     return out
 

@@ -3,6 +3,7 @@
 The curves come from ``result.history``: ``"p"`` (every iterate as nodal values on
 ``result.x, result.y``, kept by ``bem.solve(..., record=True)``), ``"p_max"`` and
 ``"residual"`` (the KKT residual of each iterate, :func:`bem.kkt.kkt_residual`).
+Conventions: :mod:`validation.report.figures`.
 """
 
 from __future__ import annotations
@@ -11,51 +12,33 @@ import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from .figures_profiles import auto_xlim, axial_section
-from .style import color_for, method_label, new_figure, save_figure
+from ..render.style import color_for, method_label, new_figure, save_figure
+from .profiles import section_of
+from .sweeps import plot_sweep
 
 __all__ = ["pick_iterations", "plot_iteration_profiles", "plot_convergence"]
 
 
 def pick_iterations(n, most=10):
-    """At most ``most`` iteration numbers out of ``1..n``: all when few, else log-spaced.
-
-    Always holds 1 and ``n``. Returns a sorted int array.
-    """
+    """At most ``most`` iteration numbers out of ``1..n`` (sorted ints): all when few, else
+    log-spaced; always 1 and ``n``."""
     if n < 1:
         return np.zeros(0, dtype=int)
-    if n <= most:
-        return np.arange(1, n + 1)
-    ks = np.unique(np.round(np.geomspace(1, n, most)).astype(int))
-    return ks
+    return np.arange(1, n + 1) if n <= most else np.unique(np.round(np.geomspace(1, n, most)).astype(int))
 
 
 def plot_iteration_profiles(result, path, *, p0, a, iterations=None, title=None, xlim=None):
-    """Axial-section pressure of the iterates ``k = 1..K``, coloured by ``k`` (Fig. 6, 10).
+    """Axial-section pressure of the iterates ``k = 1..K``, coloured by ``k``, and the final state (Fig. 6, 10).
 
     Parameters
     ----------
     result : bem.ContactResult
         Solved with ``record=True``: ``result.history["p"][k-1]`` is iterate ``k``.
-    path : path-like
-        PNG file to write.
-    p0, a : float
-        Hertz peak pressure [pressure] and contact radius [length] (the scales).
     iterations : sequence of int, optional
         Iterates to draw (1-based); default :func:`pick_iterations`.
-    title : str, optional
-        Axes title.
     xlim : (float, float), optional
         Range of ``x / a`` (default: the widest iterate with a margin).
-
-    Returns
-    -------
-    str
-        ``path``.
     """
-    import matplotlib as mpl
-
-    p0, a = check_positive("p0", p0), check_positive("a", a)
     iterates = result.history.get("p") if isinstance(result.history, dict) else None
     if not iterates:
         raise InputError("result.history['p'] is missing or empty: solve with bem.solve(..., record=True).")
@@ -63,40 +46,11 @@ def plot_iteration_profiles(result, path, *, p0, a, iterations=None, title=None,
     ks = pick_iterations(n) if iterations is None else np.asarray(sorted(set(iterations)), dtype=int)
     if ks.size == 0 or ks.min() < 1 or ks.max() > n:
         raise InputError(f"iterations = {list(ks)} is not allowed: they must lie in 1..{n}.")
-    cmap = mpl.colormaps["viridis"]
-    norm = mpl.colors.LogNorm(1, n) if n > 20 else mpl.colors.Normalize(1, max(n, 2))
-    sections = {k: axial_section(result.x, result.y, iterates[k - 1]) for k in ks}
-    with new_figure((6.8, 4.0)) as (fig, ax):
-        for k in ks:
-            x, p = sections[k]
-            ax.plot(x / a, p / p0, color=cmap(norm(k)), lw=1.3, marker=".", markersize=3)
-        x, p = axial_section(result.x, result.y, result.p)
-        state = "converged" if result.converged else "NOT converged"
-        ax.plot(x / a, p / p0, color="black", lw=1.0, ls="--", label=f"final ({state}, k = {result.iterations})")
-        sm = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
-        bar = fig.colorbar(sm, ax=ax, pad=0.01)
-        bar.set_label("iteration $k$")
-        ax.set_xlim(*(xlim or auto_xlim([*sections.values(), (x, p)], a)))
-        ax.set_ylim(bottom=0.0)
-        ax.set_xlabel(r"$x\,/\,a_H$  (axial section $y = 0$)")
-        ax.set_ylabel(r"contact pressure $p\,/\,p_0$")
-        ax.set_title(title or f"iterates of the {method_label(result.method)}")
-        ax.legend(loc="upper right", frameon=False)
-        return save_figure(fig, path)
-
-
-def _markevery(n):
-    """Markers on every iterate for short runs; on about 30 log-spaced iterates otherwise."""
-    if n <= 30:
-        return None
-    return sorted(set(np.round(np.geomspace(1, n, 30)).astype(int) - 1))
-
-
-def _history(run):
-    hist = run.history if hasattr(run, "history") else run
-    if not isinstance(hist, dict) or not hist.get("p_max"):
-        raise InputError("a run without history['p_max'] is not allowed: every run needs its iteration history.")
-    return hist
+    final = (f"final ({'converged' if result.converged else 'NOT converged'}, k = {result.iterations})",
+             *section_of(result), {"color": "black", "lw": 1.0, "ls": "--"})
+    return plot_sweep([(k, *section_of(result, iterates[k - 1])) for k in ks], path, p0=p0, a=a,
+                      name="iteration $k$", cmap="viridis", log=n > 20, xlim=xlim, extra=[final],
+                      title=title or f"iterates of the {method_label(result.method)}")
 
 
 def _integer_ticks(axis):
@@ -115,40 +69,30 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
     ----------
     runs : sequence of (str, bem.ContactResult or dict)
         Label and a result (or its ``history`` dict with ``p_max`` and ``residual``).
-    path : path-like
-        PNG file to write.
     p0 : float
-        Scale of the maximum pressure (Hertz peak) [pressure].
-    title : str, optional
-        Title of the upper panel.
+        Scale of the maximum pressure [pressure].
     tol : float, optional
         Tolerance drawn as a line on the residual panel.
     p_label : str, optional
         Label of the maximum-pressure axis (default: normalised by the Hertz peak ``p0``).
-
-    Returns
-    -------
-    str
-        ``path``.
     """
     p0 = check_positive("p0", p0)
     if not runs:
         raise InputError("runs = [] is not allowed: give at least one (label, result) pair.")
     with new_figure((6.6, 5.2), nrows=2, sharex=True, gridspec_kw={"height_ratios": [3, 2]}) as (fig, (top, bot)):
         for i, (label, run) in enumerate(runs):
-            hist = _history(run)
-            key = getattr(run, "method", None)
-            color = color_for(key, i)
-            pm = np.asarray(hist["p_max"], dtype=float)
-            k = np.arange(1, pm.size + 1)
-            if getattr(run, "converged", True) is False:
-                label = f"{label} - not converged"
-            marks = dict(marker="o", markersize=3, markevery=_markevery(pm.size))
-            top.plot(k, pm / p0, color=color, label=label, **marks)
-            res = np.asarray(hist.get("residual", []), dtype=float)
-            if res.size:
-                good = np.isfinite(res) & (res > 0)
-                bot.semilogy(np.arange(1, res.size + 1)[good], res[good], color=color, **marks)
+            hist = run.history if hasattr(run, "history") else run
+            if not isinstance(hist, dict) or not hist.get("p_max"):
+                raise InputError("a run without history['p_max'] is not allowed: every run needs its iteration "
+                                 "history.")
+            pm, res = np.asarray(hist["p_max"], dtype=float), np.asarray(hist.get("residual", []), dtype=float)
+            every = None if pm.size <= 30 else sorted(set(np.round(np.geomspace(1, pm.size, 30)).astype(int) - 1))
+            style = dict(color=color_for(getattr(run, "method", None), i), marker="o", markersize=3, markevery=every)
+            late = " - not converged" if getattr(run, "converged", True) is False else ""
+            top.plot(np.arange(1, pm.size + 1), pm / p0, label=label + late, **style)
+            good = np.isfinite(res) & (res > 0)
+            if good.any():
+                bot.semilogy(np.arange(1, res.size + 1)[good], res[good], **style)
         if tol is not None:
             bot.axhline(tol, color="#666666", ls=":", lw=1.0)
             bot.annotate(f"tolerance {tol:.0e}", (0.0, tol), xycoords=("axes fraction", "data"),

@@ -1,8 +1,9 @@
 """Write a report directory whole or not at all.
 
 ``out_dir/report.html`` (self-contained), ``out_dir/report.md`` and ``out_dir/figures/`` (the
-PNG or SVG of every figure, and the PDF beside a PNG drawn in ``"pdf"`` format) are first written into a fresh temporary directory beside ``out_dir``; only when all of
-them are complete is that directory renamed onto ``out_dir`` (a previous report there is
+PNG or SVG of every figure, and the PDF beside a PNG drawn in ``"pdf"`` format) are first
+written into a fresh temporary directory beside ``out_dir``; only when all of them are
+complete is that directory renamed onto ``out_dir`` (a previous report there is
 moved aside first and deleted afterwards: :func:`validation.io.atomic_directory`). An
 interrupted build leaves the previous report, or nothing, never a mixture.
 """
@@ -16,11 +17,11 @@ from pathlib import Path
 
 from bem.checks import InputError
 
-from ..io import atomic_directory
-from ..provenance import report_footer
+from ...io import atomic_directory
+from ...provenance import report_footer
+from .content import Figure, Section
 from .html import render_html
 from .markdown import render_markdown
-from .sections import Figure, Section
 from .style import figure_format, vector_copy
 
 __all__ = ["build_report", "BuiltReport", "REPORT_FILES", "Progress", "draw_and_build"]
@@ -73,7 +74,7 @@ def draw_and_build(make_sections, out_dir, *, title, subtitle="", fmt="png", not
     title, subtitle : str
         As for :func:`build_report`.
     fmt : {"png", "svg", "pdf"}
-        Figure files (:func:`validation.report.style.figure_format`).
+        Figure files (:func:`validation.report.render.style.figure_format`).
     notify : Progress, optional
         Told the stages ``"figures"`` and ``"writing"``, then :meth:`Progress.done`.
 
@@ -86,7 +87,7 @@ def draw_and_build(make_sections, out_dir, *, title, subtitle="", fmt="png", not
         notify("figures")
         sections = make_sections(work)
         notify("writing")
-        built = build_report(sections, out_dir, title=title, subtitle=subtitle)
+        built = build_report(sections, out_dir, title=title, subtitle=subtitle, root=work)
     notify.done()
     return built
 
@@ -104,13 +105,16 @@ def _check_replaceable(out_dir):
         )
 
 
-def _figure_names(sections):
-    """Unique ``figures/<name>.<png|svg>`` for every figure path, in order of appearance."""
+def _figure_names(sections, root=None):
+    """Unique ``figures/<name>.<png|svg>`` for every figure path, in order of appearance; a file in a
+    folder below ``root`` is named after that folder too (``root/case/profile.png``: ``case_profile``)."""
     names, used = {}, set()
     for sec in sections:
         for item in sec.items:
             if isinstance(item, Figure) and item.path not in names:
-                stem, ext = Path(item.path).stem or "figure", Path(item.path).suffix.lower()
+                path = Path(item.path)
+                path = path.relative_to(root) if root is not None and path.is_relative_to(root) else Path(path.name)
+                stem, ext = "_".join(path.with_suffix("").parts) or "figure", path.suffix.lower()
                 name, k = stem, 1
                 while name in used:
                     k += 1
@@ -120,13 +124,13 @@ def _figure_names(sections):
     return names
 
 
-def build_report(sections, out_dir, *, title, subtitle="", footer=None):
+def build_report(sections, out_dir, *, title, subtitle="", footer=None, root=None):
     """Render ``sections`` to ``out_dir/report.html``, ``report.md`` and ``figures/``.
 
     Parameters
     ----------
     sections : sequence of Section
-        The content (:mod:`validation.report.sections`), in order.
+        The content (:mod:`validation.report.render.content`), in order.
     out_dir : path-like
         Report directory; created, or replaced if it holds a previous report. A
         directory with other files is refused (nothing is deleted).
@@ -137,6 +141,9 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None):
     footer : str, optional
         Footer text; default :func:`validation.provenance.report_footer` (contactlab version,
         git commit, Python, numpy and scipy versions, the command line and the date).
+    root : path-like, optional
+        The folder the figures were drawn into: a figure in a folder below it is named after
+        that folder too.
 
     Returns
     -------
@@ -156,7 +163,7 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None):
     out_dir = Path(out_dir).resolve()
     if footer is None:
         footer = report_footer()
-    names = _figure_names(sections)
+    names = _figure_names(sections, root)
     images = {path: Path(path).read_bytes() for path in names}
     vectors = {names[path][:-4] + ".pdf": Path(pdf).read_bytes() for path in names
                if (pdf := vector_copy(path)) is not None}

@@ -1,10 +1,10 @@
-"""Parameter sweeps of the layer law (paper Fig. 5, 7, 9): families of axial-section curves
-and the line of transition between the elastic and rigid branches of the elastic-rigid law.
+"""Families of axial-section curves (paper Fig. 5, 6, 9, 10), the transition line of the
+elastic-rigid law (Fig. 7) and scalar results against a swept value.
 
 For the elastic-rigid law ``w = lam min(p, p_cr)`` the contact splits into region I
 (``p >= p_cr``: the layer is on its rigid branch) around the centre and region II
 (``0 < p < p_cr``: elastic branch) around it; the transition radius is where the
-axial-section pressure crosses ``p_cr``.
+axial-section pressure crosses ``p_cr``. Conventions: :mod:`validation.report.figures`.
 """
 
 from __future__ import annotations
@@ -13,36 +13,21 @@ import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from .figures_profiles import auto_xlim
-from .style import new_figure, save_figure
+from ..render.style import new_figure, save_figure
+from .profiles import auto_xlim, radial
 
 __all__ = ["transition_radius", "edge_radius", "plot_sweep", "plot_transition_line", "plot_sweep_scalars"]
 
 
-def _radial(x, p):
-    """Half-profile ``x >= 0`` sorted by radius."""
-    x, p = np.asarray(x, dtype=float), np.asarray(p, dtype=float)
-    keep = x >= 0
-    order = np.argsort(x[keep], kind="stable")
-    return x[keep][order], p[keep][order]
-
-
 def transition_radius(x, p, level):
-    """Outermost radius where the section pressure falls through ``level`` [length].
+    """Outermost radius where the section pressure ``p(x)`` [pressure] falls through ``level`` [length].
 
-    Scans the half-profile ``x >= 0`` outwards from the last node with ``p >= level``
-    and interpolates linearly to the crossing with the next node. Returns 0 when no
-    node reaches ``level`` (no rigid region, region I is empty).
-
-    Parameters
-    ----------
-    x, p : array_like
-        Axial section (any order; only ``x >= 0`` is used) [length], [pressure].
-    level : float
-        The pressure of the crossing (``p_cr``) [pressure], ``> 0``.
+    Scans the half-profile ``x >= 0`` outwards from the last node with ``p >= level > 0`` and
+    interpolates linearly to the crossing with the next node; 0 when no node reaches ``level``
+    (region I is empty).
     """
     level = check_positive("level", level)
-    r, q = _radial(x, p)
+    r, q = radial(x, p)
     above = np.nonzero(q >= level)[0]
     if above.size == 0:
         return 0.0
@@ -53,9 +38,9 @@ def transition_radius(x, p, level):
 
 
 def edge_radius(x, p):
-    """Radius of the contact edge on the section: midway between the last loaded node
-    and the next one [length] (0 without contact)."""
-    r, q = _radial(x, p)
+    """Radius of the contact edge on the section: midway between the last loaded node and the
+    next one [length] (0 without contact)."""
+    r, q = radial(x, p)
     loaded = np.nonzero(q > 0)[0]
     if loaded.size == 0:
         return 0.0
@@ -64,37 +49,26 @@ def edge_radius(x, p):
 
 
 def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=None, extra=(), labels=None,
-               ticklabels=None):
-    """A family of axial-section curves coloured by the swept parameter (paper Fig. 5, 9).
+               ticklabels=None, log=False):
+    """A family of axial-section curves coloured by a parameter, with its colour bar.
 
     Parameters
     ----------
     curves : sequence of (float, array_like, array_like)
         ``(alpha, x, p)``: parameter value, section abscissae [length], pressures [pressure].
-    path : path-like
-        PNG file to write.
-    p0, a : float
-        Pressure and length scales (Hertz peak and radius).
     name : str
-        Parameter name for the colour bar, mathtext allowed (e.g. ``r"$\\alpha_a$"``).
-    title : str, optional
-        Axes title.
+        Parameter name for the colour bar (mathtext, e.g. ``r"$\\alpha_a$"``).
     cmap : str
-        Matplotlib colormap.
+        Matplotlib colormap (its lower 90 % is used).
     xlim : (float, float), optional
         Range of ``x / a`` (default: the widest contact with a margin).
-    extra : sequence of (str, array_like, array_like, dict)
-        Reference curves ``(label, x, p, style)`` drawn on top (e.g. the limits).
-    labels : dict, optional
-        ``{"x", "p"}`` axis labels (default ``x / a_H`` on the axial section, ``p / p0``).
+    extra : sequence of (str, x, p, dict)
+        Reference curves ``(label, x, p, style)`` drawn on top, with a legend.
     ticklabels : sequence of str, optional
-        Colour-bar tick labels, one per curve (e.g. values that are not numbers, the
-        curves then given their index as ``alpha``).
-
-    Returns
-    -------
-    str
-        The written file.
+        Colour-bar tick labels, one per curve (values that are not numbers: the curves then
+        carry their index as ``alpha``).
+    log : bool
+        Logarithmic colour scale (``alpha > 0``).
     """
     import matplotlib as mpl
 
@@ -103,25 +77,23 @@ def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=Non
         raise InputError("curves = [] is not allowed: give at least one (alpha, x, p) triple.")
     alphas = np.array([float(c[0]) for c in curves])
     lo, hi = float(alphas.min()), float(alphas.max())
-    norm = mpl.colors.Normalize(lo, hi if hi > lo else lo + 1.0)
+    norm = (mpl.colors.LogNorm if log else mpl.colors.Normalize)(lo, hi if hi > lo else lo + 1.0)
     colors = mpl.colormaps[cmap]
+    sections = [(np.asarray(x, dtype=float), np.asarray(p, dtype=float)) for _, x, p in curves]
+    lab = {"x": r"$x\,/\,a_H$", "p": r"contact pressure $p\,/\,p_0$", **(labels or {})}
     with new_figure((6.8, 4.0)) as (fig, ax):
-        for alpha, x, p in curves:
-            x, p = np.asarray(x, dtype=float), np.asarray(p, dtype=float)
+        for alpha, (x, p) in zip(alphas, sections):
             ax.plot(x / a, p / p0, color=colors(0.9 * norm(alpha)), lw=1.4)
         for label, x, p, style in extra:
             ax.plot(np.asarray(x) / a, np.asarray(p) / p0, label=label, **{"lw": 1.2, **style})
-        sm = mpl.cm.ScalarMappable(norm=mpl.colors.Normalize(lo, hi if hi > lo else lo + 1.0),
-                                   cmap=mpl.colors.ListedColormap(colors(np.linspace(0, 0.9, 256))))
-        bar = fig.colorbar(sm, ax=ax, pad=0.01)
+        bar = fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=mpl.colors.ListedColormap(
+            colors(np.linspace(0, 0.9, 256)))), ax=ax, pad=0.01)
         bar.set_label(name)
         if len(alphas) <= 12:
             bar.set_ticks(alphas)
             bar.set_ticklabels(list(ticklabels) if ticklabels is not None else [f"{v:.3g}" for v in alphas])
-        sections = [(np.asarray(c[1], dtype=float), np.asarray(c[2], dtype=float)) for c in curves]
         ax.set_xlim(*(xlim or auto_xlim(sections, a)))
         ax.set_ylim(bottom=0.0)
-        lab = {"x": r"$x\,/\,a_H$", "p": r"contact pressure $p\,/\,p_0$", **(labels or {})}
         ax.set_xlabel(lab["x"] + "  (axial section $y = 0$)")
         ax.set_ylabel(lab["p"])
         if title:
@@ -133,8 +105,8 @@ def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=Non
 
 def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
                          name=r"$\alpha_a = p_{cr}\,/\,p_{max}^{\lambda}$", title=None):
-    """Radius of the transition between the rigid and elastic branches against the
-    threshold parameter (paper Fig. 7), with regions I and II shaded.
+    """Radius of the transition between the rigid and elastic branches against the threshold
+    parameter (paper Fig. 7), with regions I and II shaded.
 
     Parameters
     ----------
@@ -142,21 +114,10 @@ def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
         Values of the parameter (``alpha_a = p_cr / p_max^lambda``).
     r_transition : array_like
         Transition radii [length] (:func:`transition_radius`).
-    path : path-like
-        PNG file to write.
-    a : float
-        Length scale (Hertz radius) [length].
     r_contact : array_like, optional
         Contact radii [length]; region II lies between the two lines.
     name : str
         Label of the parameter axis (mathtext).
-    title : str, optional
-        Axes title.
-
-    Returns
-    -------
-    str
-        ``path``.
     """
     a = check_positive("a", a)
     alpha = np.asarray(alpha, dtype=float)
@@ -174,9 +135,7 @@ def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
             ax.fill_between(alpha, rt, rc, color="#1f77b4", alpha=0.15, lw=0,
                             label="II: elastic branch, $0 < p < p_{cr}$")
             ax.plot(alpha, rc, color="#1f77b4", marker="s", markersize=3.5, label="contact edge")
-            ax.set_ylim(0.0, 1.08 * float(rc.max()))
-        else:
-            ax.set_ylim(bottom=0.0)
+        ax.set_ylim(0.0, 1.08 * float(rc.max()) if r_contact is not None else None)
         ax.set_xlim(float(alpha.min()), float(alpha.max()))
         ax.set_xlabel(name)
         ax.set_ylabel(r"radius $r\,/\,a_H$")
@@ -195,19 +154,10 @@ def plot_sweep_scalars(values, series, path, *, name, title=None, ticklabels=Non
         The swept values (numbers; give ``ticklabels`` for values that are not).
     series : sequence of (str, array_like)
         ``(axis label with unit, values)`` per panel; ``NaN`` marks a missing point.
-    path : path-like
-        PNG file to write.
     name : str
         Label of the swept parameter (mathtext allowed).
-    title : str, optional
-        Title of the upper panel.
     ticklabels : sequence of str, optional
         Tick labels at ``values``.
-
-    Returns
-    -------
-    str
-        The written file.
     """
     x = np.asarray(values, dtype=float)
     if not series or x.size < 1:
@@ -220,10 +170,9 @@ def plot_sweep_scalars(values, series, path, *, name, title=None, ticklabels=Non
                                  f"values, {x.shape}.")
             ax.plot(x, y, marker="o", markersize=4, color="#1f77b4")
             ax.set_ylabel(label)
-        bottom = axes[-1, 0]
-        bottom.set_xlabel(name)
+        axes[-1, 0].set_xlabel(name)
         if ticklabels is not None:
-            bottom.set_xticks(x, list(ticklabels))
+            axes[-1, 0].set_xticks(x, list(ticklabels))
         if title:
             axes[0, 0].set_title(title)
         return save_figure(fig, path)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .sections import Figure, Table
+from .content import Figure, Table
 
 __all__ = ["render_markdown"]
 
@@ -36,7 +36,7 @@ def render_markdown(sections, *, title, subtitle="", names, footer="", vectors=(
     sections : sequence of Section
         Content in order.
     title, subtitle, footer : str
-        As for :func:`validation.report.html.render_html`.
+        As for :func:`validation.report.render.html.render_html`.
     names : mapping of str to str
         Relative file name (``figures/x.png``) of every figure, keyed by ``Figure.path``.
     vectors : collection of str

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import math
 import os
 
 from bem.checks import check_choice
@@ -20,7 +21,7 @@ from bem.files import atomic_path
 
 __all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "FORMATS", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS",
            "color_for", "new_figure", "figure_format", "save_figure", "vector_copy", "METHOD_LABELS",
-           "method_label"]
+           "method_label", "method_text", "display_unit", "report_unit", "REPORT_UNITS"]
 
 DPI = 300  #: resolution of every PNG (and of the rasterised colour fields of SVG/PDF) [dots per inch]
 #: figure file formats: PNG only, SVG only (vector, shown by browsers), or PDF (vector) beside a PNG
@@ -87,22 +88,59 @@ NORMALISED_LABELS = {
 }
 
 
-def axis_labels(labels=None, units=None):
-    """Axis labels: :data:`NORMALISED_LABELS` updated by ``labels``; with ``units``
-    (``{"length": "mm", "pressure": "MPa"}``) the physical labels ``x [mm]``, ``p [MPa]``
-    (use then ``p0 = a = 1`` so the data are drawn as they are)."""
-    out = dict(NORMALISED_LABELS)
-    if units is not None:
-        length, pressure = units.get("length", "length"), units.get("pressure", "pressure")
-        out.update({k: f"${k}$ [{length}]" for k in ("x", "y", "r", "z")})
-        out["p"] = f"contact pressure $p$ [{pressure}]"
-    out.update(labels or {})
-    return out
+def axis_labels(labels=None):
+    """Axis labels: :data:`NORMALISED_LABELS` updated by ``labels`` (e.g. ``{"x": "$x$ [mm]"}``)."""
+    return {**NORMALISED_LABELS, **(labels or {})}
+
+
+_METHOD_TEXT = {
+    "newton": "direct minimisation of the generalised Kalker functional with the layer's energy",
+    "augmented_gap": "the paper's fixed-point iteration on the gap augmented by the layer closure",
+    "variable_compliance": "the paper's fixed-point iteration with a pressure-dependent layer compliance",
+}
+
+
+_PREFIXES = {"m": (("", 1.0), ("mm", 1e-3), ("µm", 1e-6), ("nm", 1e-9)),
+             "Pa": (("GPa", 1e9), ("MPa", 1e6), ("kPa", 1e3), ("", 1.0)),
+             "N": (("MN", 1e6), ("kN", 1e3), ("", 1.0), ("mN", 1e-3))}
+#: how a report draws values in an SI base unit: lengths in mm, pressures and stresses in MPa
+REPORT_UNITS = {"m": ("mm", 1e-3), "Pa": ("MPa", 1e6)}
+
+
+def display_unit(unit, magnitude):
+    """``(symbol, factor)`` to draw values of size ``magnitude`` [unit] as ``value / factor``.
+
+    SI base units (m, Pa, N) get the prefix that puts ``magnitude`` in [1, 1000)
+    (e.g. 1.9e-4 m -> ("µm", 1e-6)); any other unit is kept (factor 1, "" when unknown).
+    """
+    if unit not in _PREFIXES or not (magnitude > 0 and math.isfinite(magnitude)):
+        return (unit or ""), 1.0
+    prefix, factor = next((c for c in _PREFIXES[unit] if magnitude >= c[1]), _PREFIXES[unit][-1])
+    return (prefix or unit), factor
+
+
+def report_unit(unit):
+    """``(symbol, factor)`` to draw values in ``unit`` as ``value / factor``: m as mm and Pa as MPa
+    (:data:`REPORT_UNITS`), any other unit as it is ("" when unknown)."""
+    return REPORT_UNITS.get(unit, (unit or "", 1.0))
 
 
 def method_label(method):
     """Readable name of a BEM method (the key itself when unknown)."""
     return METHOD_LABELS.get(method, str(method))
+
+
+def method_text(method, law, *, short=False):
+    """What the BEM solved, in words: Kalker's QP for quadratic problems (no layer or a linear
+    one: ``law`` in None, "none", "linear"), whatever was asked, else the named method."""
+    if method in ("newton", "kalker") and law in (None, "none", "linear"):
+        if short:
+            return "Kalker QP (eq. 11, projected conjugate gradients)"
+        return ("Kalker's quadratic programme (eq. 11), solved by projected conjugate gradients "
+                "(the functional is quadratic without a layer or with a linear one)")
+    if short or method not in _METHOD_TEXT:
+        return method_label(method)
+    return f"{method_label(method)}: {_METHOD_TEXT[method]}"
 
 
 def color_for(key, index=0):

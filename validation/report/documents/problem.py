@@ -1,22 +1,18 @@
-"""The problem statement of a run's report: gap, materials, layer law (with its w(p) plot), load, units.
+"""The problem statement of a run's report (the section ``scene``): gap, materials, layer law, load, units.
 
 Everything is read from the effective scene (``scene.toml``) and the run's ``result.json``: the
-layer drawn is the one the solver used (``result["layer"]["parameters"]``, rebuilt with
-:func:`bem.layers.from_dict`), with the paper's relative parameters (``lam_over_cnn``,
-``alpha_a``, ...) shown next to the values they resolved to.
+layer is the one the solver used (``result["layer"]["parameters"]``), with the paper's relative
+parameters (``lam_over_cnn``, ``alpha_a``, ...) shown next to the values they resolved to.
 """
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Mapping
 
-from .results import display_unit, report_unit
-from .sections import Figure, Section, Table, fmt
+from ..render.content import Section, Table, fmt
+from ..render.style import method_text
 
-__all__ = ["problem_statement", "rebuild_layer", "method_text"]
-
-log = logging.getLogger(__name__)
+__all__ = ["scene_section"]
 
 _GAP_TEXT = {
     "paraboloid": "paraboloid h = r^2 / (2 R) (two spheres of effective radius R, 1/R = 1/R1 + 1/R2)",
@@ -37,11 +33,6 @@ _LAW_TEXT = {
     "series": "two layers in series: w = w1(p) + w2(p)",
     "custom": "user-defined layer law",
 }
-_METHOD_TEXT = {
-    "newton": "direct minimisation of the generalised Kalker functional with the layer's energy",
-    "augmented_gap": "the paper's fixed-point iteration on the gap augmented by the layer closure",
-    "variable_compliance": "the paper's fixed-point iteration with a pressure-dependent layer compliance",
-}
 _GAP_UNITS = {"R": "length", "Rx": "length", "Ry": "length", "length": "length", "a": "length",
               "edge_radius": "length", "crown_radius": "length", "design_force": "force", "A": "length",
               "scale": "length"}
@@ -52,36 +43,6 @@ _PAPER_ROWS = (("c_nn", "C_nn = c w_t(0,0) / (pi E*), diagonal influence coeffic
                ("alpha_a", "alpha_a = p_cr / p_max^lambda (paper parameter)", "-"),
                ("alpha_c", "alpha_c = arctan(lam2 / lam1) (paper parameter)", "rad"),
                ("alpha_b", "alpha_b = p_max / p_max^lambda", "-"))
-
-
-def rebuild_layer(res):
-    """The :class:`bem.layers.Layer` the run used, or ``None`` (smooth bodies or not rebuildable)."""
-    from bem.layers import from_dict
-
-    params = (res.get("layer") or {}).get("parameters")
-    if not isinstance(params, Mapping):
-        params = res.section("layer") if res.section("layer").get("law") not in (None, "none") else None
-    if not params:
-        return None
-    try:
-        return from_dict(dict(params))
-    except (ValueError, TypeError, KeyError) as exc:
-        log.warning("the layer of the run cannot be rebuilt (%s): no w(p) plot", exc)
-        return None
-
-
-def method_text(method, law, *, short=False):
-    """What the BEM solved, in words: the QP for quadratic problems, else the named method."""
-    from .style import method_label
-
-    if method in ("newton", "kalker") and law in (None, "none", "linear"):
-        if short:
-            return "Kalker QP (eq. 11, projected conjugate gradients)"
-        return ("Kalker's quadratic programme (eq. 11), solved by projected conjugate gradients "
-                "(the functional is quadratic without a layer or with a linear one)")
-    if short or method not in _METHOD_TEXT:
-        return method_label(method)
-    return f"{method_label(method)}: {_METHOD_TEXT[method]}"
 
 
 def _param_unit(law, key, params, units):
@@ -95,7 +56,7 @@ def _param_unit(law, key, params, units):
     return "-"
 
 
-def _layer_rows(res, layer):
+def _layer_rows(res):
     """Rows of the layer: its law, the parameters used, and the paper's relative ones."""
     info = res.get("layer") or {}
     params = info.get("parameters") if isinstance(info.get("parameters"), Mapping) else {}
@@ -174,66 +135,19 @@ def _load_rows(res):
     return []
 
 
-class _Scaled:
-    """A layer drawn in display units: ``w(p) = layer.w(p * pf) / wf``."""
-
-    def __init__(self, layer, pf, wf):
-        self.layer, self.pf, self.wf, self.law = layer, pf, wf, layer.law
-
-    def w(self, p):
-        return self.layer.w(p * self.pf) / self.wf
-
-
-def _layer_figure(res, layer, work):
-    """The w(p) plot of the layer over ``0 .. 1.25 max(p_max, p_cr, ...)`` with the BEM peak marked."""
-    import numpy as np
-
-    from .figures_profiles import plot_layer_laws
-
-    params = layer.to_dict()
-    p_top = 1.25 * max(float(res.data.get("p_max") or 0.0), *(float(params.get(k) or 0.0)
-                                                             for k in ("p_cr", "p_star")))
-    if p_top <= 0:
-        return None
-    w_top = float(np.max(layer.w(np.linspace(0.0, p_top, 200))))
-    u = res.units
-    p_unit, pf = report_unit(u.pressure)
-    w_unit, wf = display_unit(u.length, w_top)  # closures of a few micrometres: the readable prefix
-    marks = [(rf"$p_{{max}}$ (BEM) = {fmt(res.data['p_max'] / pf, 3)} {p_unit}".rstrip(), res.data["p_max"] / pf)]
-    for key, name in (("p_cr", r"$p_{cr}$"), ("p_star", r"$p^*$")):
-        if params.get(key):
-            marks.append((f"{name} = {fmt(params[key] / pf, 3)} {p_unit}".rstrip(), params[key] / pf))
-    path = plot_layer_laws([(params["law"].replace("_", "-"), _Scaled(layer, pf, wf))], work / "layer_law.png",
-                           p_max=p_top / pf, p_unit=p_unit, w_unit=w_unit, marks=marks,
-                           title="interface layer law: closure $w(p)$ under the pressure $p$")
-    return Figure(path, f"The layer law w(p) used by the solver ({_LAW_TEXT.get(params['law'], params['law'])}), "
-                        "rebuilt from the run's result with bem.layers.from_dict and evaluated at 200 pressures "
-                        "from 0 to 1.25 times the largest of the computed peak pressure and the law's kink "
-                        "pressures (marked).")
-
-
-def problem_statement(res, work):
-    """The problem-statement :class:`Section` of a run (figures written to ``work``)."""
-    meta = res.section("scene")
-    text = []
-    if meta.get("description"):
-        text.append(str(meta["description"]))
-    layer = rebuild_layer(res)
-    law = getattr(layer, "law", None)
+def scene_section(res, work):
+    """The problem statement: the effective scene's inputs (``work``: unused, no figure)."""
+    meta, law, u = res.section("scene"), getattr(res.layer, "law", None), res.units
+    text = [str(meta["description"])] if meta.get("description") else []
     text.append("Frictionless normal contact of two elastic half-spaces whose surfaces are separated by the "
                 "initial gap h(x, y)" + (", with an interface layer between them whose closure w(p) depends "
                                          "on the contact pressure p." if law else " (no interface layer).")
                 + f" Solved by the BEM: {method_text(res.data.get('method'), law)}.")
     if res.data.get("overrides"):
         text.append("Scene overrides of this run: " + ", ".join(map(str, res.data["overrides"])) + ".")
-    u = res.units
     text.append(f"Units: {u.label}" + (f" - lengths in {u.length}, pressures and moduli in {u.pressure}, forces in "
                                        f"{u.force}, areas in {u.of('area')}." if u.known else "."))
-    rows = _gap_rows(res) + _material_rows(res) + _layer_rows(res, layer) + _load_rows(res)
-    items = [Table(("quantity", "value", "unit"), tuple(rows),
-                   caption="Input data of the problem, from the effective scene (scene.toml) of the run.")]
-    if layer is not None:
-        fig = _layer_figure(res, layer, work)
-        if fig is not None:
-            items.append(fig)
-    return Section("Problem statement", kind="problem", text=tuple(text), items=tuple(items))
+    rows = _gap_rows(res) + _material_rows(res) + _layer_rows(res) + _load_rows(res)
+    return Section("Problem statement", kind="problem", text=tuple(text), items=(
+        Table(("quantity", "value", "unit"), tuple(rows),
+              caption="Input data of the problem, from the effective scene (scene.toml) of the run."),))

@@ -1,8 +1,8 @@
 """The content of a report: sections holding paragraphs, figures and tables.
 
-A report is a list of :class:`Section`; :func:`validation.report.build.build_report` renders
-it to HTML and Markdown. Sections are plain data, so a scene, a study or a script builds
-exactly the sections its results support (no FEM section without an FEM result).
+A report is a list of :class:`Section`; :func:`validation.report.render.build_report` renders
+it to HTML and Markdown. Sections are plain data, so a document builds exactly the sections
+its results support (no FEM section without an FEM result).
 """
 
 from __future__ import annotations
@@ -15,8 +15,7 @@ from dataclasses import dataclass, field
 
 from bem.checks import InputError
 
-__all__ = ["Figure", "Table", "Section", "KINDS", "status_class", "fmt", "problem_section", "results_table",
-           "quantity_rows", "table_from_rows"]
+__all__ = ["Figure", "Table", "Section", "KINDS", "status_class", "fmt", "problem_section", "table_from_rows"]
 
 #: kinds of section; ``"fem"`` marks anything that needs an FEM result
 KINDS = ("problem", "results", "iterations", "sweeps", "validation", "fem", "stability", "notes")
@@ -51,7 +50,7 @@ def fmt(value, digits=4):
 
 @dataclass(frozen=True)
 class Figure:
-    """A figure (PNG or SVG file) and its caption.
+    """A figure file and its caption.
 
     Attributes
     ----------
@@ -80,7 +79,7 @@ class Figure:
 
 @dataclass(frozen=True)
 class Table:
-    """A table of already-formatted cells (use :func:`fmt`).
+    """A table; cells are formatted with :func:`fmt`.
 
     Attributes
     ----------
@@ -153,14 +152,6 @@ class Section:
         return "-".join(part for part in slug.split("-") if part)
 
 
-def quantity_rows(values, units):
-    """``(quantity, value, unit)`` rows from a mapping of result scalars.
-
-    ``units`` maps a scalar name to its unit string; names missing there get ``"-"``.
-    """
-    return [(name, fmt(v) if not isinstance(v, str) else v, units.get(name, "-")) for name, v in values.items()]
-
-
 def table_from_rows(rows, *, columns=None, caption="", status="status", max_columns=12):
     """A :class:`Table` from row dicts (e.g. a stability study), coloured by ``status``.
 
@@ -184,56 +175,41 @@ def table_from_rows(rows, *, columns=None, caption="", status="status", max_colu
                  status_column=status if status in columns else None)
 
 
-def results_table(rows, *, caption="Key results."):
-    """A three-column table ``quantity | value | unit``."""
-    return Table(("quantity", "value", "unit"), tuple(tuple(r) for r in rows), caption=caption)
-
-
 def _params(obj):
     if obj is None:
         return "none (smooth bodies)"
-    d = obj.to_dict() if hasattr(obj, "to_dict") else dict(obj) if isinstance(obj, Mapping) else {"value": obj}
+    d = obj.to_dict() if hasattr(obj, "to_dict") else dict(obj)
     kind = d.get("type", d.get("law", ""))
     rest = ", ".join(f"{k} = {fmt(v)}" for k, v in d.items() if k not in ("type", "law") and not isinstance(v, list))
     return f"{kind}: {rest}" if kind else rest
 
 
 def problem_section(*, gap, materials, load, units, layers=(), figure=None, text=(), title="Problem statement"):
-    """The problem statement: gap, materials, layer law(s) with their figure, load, units.
+    """The problem statement of several layer laws on one gap: gap, materials, laws, load, units.
 
     Parameters
     ----------
     gap : bem.gaps.Gap or dict
         The initial gap ``h(x, y)``.
     materials : dict
-        ``{"E_star": ...}`` or ``{"E1", "nu1", "E2", "nu2"}`` (any of them).
+        ``{"E_star": ...}`` or ``{"E1", "nu1", "E2", "nu2"}`` (any of them) [pressure].
     load : dict
-        ``{"force": P}`` or ``{"approach": delta}``.
-    units : dict or str
-        ``{"length": ..., "pressure": ..., "force": ...}`` (the unit column of the table), or
-        one sentence describing them (e.g. ``"normalised: R = E* = P = 1"``; the unit column
-        then shows "-").
+        ``{"force": P}`` [force] or ``{"approach": delta}`` [length].
+    units : dict
+        ``{"length": ..., "pressure": ..., "force": ...}``: the unit column of the table.
     layers : sequence of (str, bem.layers.Layer or None)
         The layer law(s) studied.
     figure : Figure, optional
-        The ``w(p)`` plot (:func:`validation.report.figures_profiles.plot_layer_laws`).
+        The ``w(p)`` plot (:func:`validation.report.figures.profiles.plot_layer_laws`).
     text : sequence of str
         Paragraphs before the table.
     """
-    u = units if isinstance(units, Mapping) else {}
-    rows = [("gap h(x, y)", _params(gap), u.get("length", "-"))]
-    for key, value in materials.items():
-        unit = "-" if key.startswith("nu") else u.get("pressure", "-")
-        rows.append((f"material {key}", fmt(value), unit))
-    for key, value in load.items():
-        rows.append((f"load: {key}", fmt(value), u.get("force" if key == "force" else "length", "-")))
-    for label, layer in layers:
-        rows.append((f"layer: {label}", _params(layer),
-                     f"w in {u.get('length', 'length units')}, p in {u.get('pressure', 'pressure units')}"))
+    rows = [("gap h(x, y)", _params(gap), units.get("length", "-"))]
+    rows += [(f"material {k}", fmt(v), "-" if k.startswith("nu") else units.get("pressure", "-"))
+             for k, v in materials.items()]
+    rows += [(f"load: {k}", fmt(v), units.get("force" if k == "force" else "length", "-")) for k, v in load.items()]
+    rows += [(f"layer: {label}", _params(layer), f"w in {units.get('length', 'length units')}, p in "
+              f"{units.get('pressure', 'pressure units')}") for label, layer in layers]
     table = Table(("quantity", "value", "unit"), tuple(rows), caption="Input data of the problem.")
-    items = (table,) + ((figure,) if figure is not None else ())
-    if not isinstance(units, Mapping):
-        text = tuple(text) + (f"Units: {units}.",)
-    else:
-        text = tuple(text) + ("Units: " + ", ".join(f"{k} [{v}]" for k, v in units.items()) + ".",)
-    return Section(title, kind="problem", text=text, items=items)
+    text = tuple(text) + ("Units: " + ", ".join(f"{k} [{v}]" for k, v in units.items()) + ".",)
+    return Section(title, kind="problem", text=text, items=(table,) + ((figure,) if figure is not None else ()))

@@ -2,7 +2,8 @@
 
 The surface is the piecewise-linear pressure on a Delaunay triangulation of the lattice
 nodes in and around the contact (the lattice is equilateral, so the triangulation is the
-lattice's own), lifted by ``p / p0`` and drawn with matplotlib's mplot3d.
+lattice's own), lifted by ``p / p0`` and drawn with matplotlib's mplot3d. Conventions:
+:mod:`validation.report.figures`.
 """
 
 from __future__ import annotations
@@ -13,44 +14,28 @@ import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from .style import axis_labels, new_figure, save_figure
+from ..render.style import axis_labels, new_figure, save_figure
+from .profiles import axial_section
 
 __all__ = ["contact_patch", "covered_window", "plot_pressure_surfaces", "plot_contact_map"]
 
 
 def _nodal(data):
-    if isinstance(data, (tuple, list)):
-        x, y, p = (np.asarray(v, dtype=float) for v in data)
-    else:
-        x, y, p = (np.asarray(v, dtype=float) for v in (data.x, data.y, data.p))
-    return x, y, p
+    """``(x, y, p)`` of a :class:`bem.ContactResult` or of nodal arrays."""
+    return tuple(np.asarray(v, dtype=float) for v in (data if isinstance(data, (tuple, list)) else
+                                                       (data.x, data.y, data.p)))
 
 
 def contact_patch(x, y, p, *, margin=0.25):
-    """Nodes of the contact and a margin around it, and their Delaunay triangles.
-
-    Parameters
-    ----------
-    x, y, p : ndarray, shape (N,)
-        Nodes [length] and pressures.
-    margin : float
-        Margin around the bounding box of the loaded nodes, as a fraction of its
-        half-size.
-
-    Returns
-    -------
-    xs, ys, ps : ndarray, shape (M,)
-        The selected nodes and pressures.
-    triangles : ndarray of int, shape (T, 3)
-        Triangles (indices into the selection).
-    """
+    """``(xs, ys, ps, triangles)``: the nodes ``(x, y)`` [length] of the contact (``p > 0``) and a
+    ``margin`` around its bounding box (a fraction of its half-size), their pressures and their
+    Delaunay triangles (indices into the selection, shape (T, 3))."""
     from scipy.spatial import Delaunay
 
     loaded = p > 0
     if not loaded.any():
         raise InputError("p has no positive value: there is no contact to draw.")
-    half = max(np.abs(x[loaded]).max(), np.abs(y[loaded]).max())
-    half = half * (1.0 + margin)
+    half = max(np.abs(x[loaded]).max(), np.abs(y[loaded]).max()) * (1.0 + margin)
     keep = (np.abs(x) <= half) & (np.abs(y) <= half)
     xs, ys, ps = x[keep], y[keep], p[keep]
     tri = Delaunay(np.column_stack([xs, ys]))
@@ -90,21 +75,13 @@ def _locator(bins):
 
 
 def covered_window(x, y):
-    """The largest axis-parallel rectangle that the triangulation of lattice nodes covers [length].
+    """``(x0, x1), (y0, y1)``: the largest axis-parallel rectangle that the triangulation of the
+    lattice nodes ``(x, y)`` covers [length].
 
     The rows of the equilateral lattice are shifted by half a step in turn, so the nodes of a
     square patch end alternately half a step short at the left and right; their triangles
     leave notches there and at the corners. The window runs from the largest row start to the
     smallest row end, and from the lowest to the highest row.
-
-    Parameters
-    ----------
-    x, y : ndarray, shape (N,)
-        Node coordinates [length].
-
-    Returns
-    -------
-    (x0, x1), (y0, y1) : tuple of float
     """
     _, row = np.unique(np.round(y / max(float(np.ptp(y)), 1e-300) * 1e6), return_inverse=True)
     row_min = np.full(row.max() + 1, np.inf)
@@ -128,33 +105,18 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
     ----------
     panels : sequence of (str, data)
         Panel title and a :class:`bem.ContactResult` or ``(x, y, p)`` nodal arrays.
-    path : path-like
-        PNG file to write (:func:`validation.report.style.save_figure`).
-    p0, a : float
-        Pressure scale [pressure] and length scale [length] (Hertz peak and radius; ``1``
-        and ``1`` draw the data as they are, in the units named by ``labels``).
     height : float
         Drawn height of the highest peak relative to the width of the patch.
     columns : int, optional
         Panels per row (default: all in one row up to 3, then rows of 3; 2 x 2 for 4).
     panel_inches : (float, float)
         Size of one panel [inch].
-    title : str, optional
-        Figure title.
     section : bool
         Draw the axial section ``y = 0`` on each surface (where nodes lie on it).
     labels : dict, optional
-        ``{"x", "y", "p"}`` axis and colour-bar labels, and ``"p_short"`` for the vertical
-        axis (:func:`validation.report.style.axis_labels`; default ``x / a_H``, ``p / p0``).
-
-    Returns
-    -------
-    str
-        The written file.
+        ``{"x", "y", "p"}`` and ``"p_short"`` for the vertical axis.
     """
     import matplotlib as mpl
-
-    from .figures_profiles import axial_section
 
     p0, a = check_positive("p0", p0), check_positive("a", a)
     if not panels:
@@ -179,10 +141,9 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
             sec = axial_section(xs, ys, ps) if section and on_axis.sum() > 1 else None
             _surface_panel(ax, xs, ys, ps, tri, p0=p0, a=a, height=height, vmax=vmax, section=sec, lab=lab)
             ax.set_title(label, fontsize=9.5, pad=-6)
-        sm = mpl.cm.ScalarMappable(norm=mpl.colors.Normalize(0.0, vmax), cmap="viridis")
         cax = fig.add_subplot(grid[:, ncol])
-        bar = fig.colorbar(sm, cax=cax)
-        bar.set_label(lab["p"])
+        fig.colorbar(mpl.cm.ScalarMappable(norm=mpl.colors.Normalize(0.0, vmax), cmap="viridis"),
+                     cax=cax).set_label(lab["p"])
         box = cax.get_position()
         cax.set_position([box.x0, box.y0 + 0.1 * box.height, box.width, 0.8 * box.height])
         if title:
@@ -190,8 +151,8 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
         return save_figure(fig, path)
 
 
-def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(), labels=None, b=None,
-                     aspect="equal", figsize=(5.4, 4.4)):
+def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(), labels=None, aspect="equal",
+                     figsize=(5.4, 4.4)):
     """Map of the contact pressure ``p / p0`` over the plane with the contact boundary.
 
     The boundary is drawn midway between the loaded nodes (``p > 0``) and their unloaded
@@ -203,40 +164,22 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
     ----------
     result : bem.ContactResult or (x, y, p)
         Nodal pressures.
-    path : path-like
-        PNG file to write.
-    p0, a : float
-        Pressure and length scales (Hertz peak and radius).
-    title : str, optional
-        Axes title.
     circle : float, optional
         Radius of the equal-area circle [length]; default from the loaded node count
         and the lattice node area when ``result`` is a ContactResult.
     levels : sequence of (str, float)
         Labelled pressure contours [pressure] (e.g. ``("p = p_cr", p_cr)``: the line between
         the rigid and elastic branches of an elastic-rigid layer).
-    labels : dict, optional
-        ``{"x", "y", "p"}`` axis labels (:func:`validation.report.style.axis_labels`).
-    b : float, optional
-        Length scale of the y axis [length] (default ``a``); with ``aspect="auto"`` an
-        elongated contact (a roller) fills the axes.
     aspect : {"equal", "auto"} or float
-        Aspect of the axes in the scaled coordinates.
+        Aspect of the axes (``"auto"``: an elongated contact, a roller, fills them).
     figsize : (float, float)
         Figure size [inch].
-
-    Returns
-    -------
-    str
-        ``path``.
     """
     import matplotlib.tri as mtri
 
     p0, a = check_positive("p0", p0), check_positive("a", a)
-    b = a if b is None else check_positive("b", b)
-    x, y, p = _nodal(result)
-    xs, ys, ps, tri = contact_patch(x, y, p, margin=0.3)
-    triang = mtri.Triangulation(xs / a, ys / b, tri)
+    xs, ys, ps, tri = contact_patch(*_nodal(result), margin=0.3)
+    triang = mtri.Triangulation(xs / a, ys / a, tri)
     if circle is None and hasattr(result, "contact_radius"):
         circle = result.contact_radius
     with new_figure(figsize) as (fig, ax):
@@ -253,15 +196,14 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
             ax.plot([], [], color=color, lw=1.3, ls=":", label=label)
         if circle:
             t = np.linspace(0.0, 2.0 * np.pi, 361)
-            ax.plot(circle / a * np.cos(t), circle / b * np.sin(t), color="#ff7f0e", ls="--", lw=1.2,
+            ax.plot(circle / a * np.cos(t), circle / a * np.sin(t), color="#ff7f0e", ls="--", lw=1.2,
                     label=r"equal-area circle $r = \sqrt{A/\pi}$")
-        bar = fig.colorbar(pc, ax=ax, pad=0.01)
         lab = axis_labels(labels)
-        bar.set_label(lab["p"])
+        fig.colorbar(pc, ax=ax, pad=0.01).set_label(lab["p"])
         ax.set_aspect(aspect)
         (x0, x1), (y0, y1) = covered_window(xs, ys)
         ax.set_xlim(x0 / a, x1 / a)
-        ax.set_ylim(y0 / b, y1 / b)
+        ax.set_ylim(y0 / a, y1 / a)
         ax.grid(False)
         ax.set_xlabel(lab["x"])
         ax.set_ylabel(lab["y"])

@@ -1,22 +1,20 @@
-"""Report of the validation studies: error against run time, and stability.
+"""Report of the validation studies: error against run time, stability and robustness.
 
-Reads what ``contactlab study error-time --out DIR`` and ``contactlab study stability
---out DIR`` write (``error_time.json``, ``stability.json``) and builds a report with the
-work-precision plot per problem, the "first to reach" table and the stability table
-coloured by status. Only the studies present in ``DIR`` get a section.
+Reads what ``contactlab study error-time|stability|robustness --out DIR`` write
+(``error_time.json``, ``stability.json``, ``robustness.json``) and builds a report with the
+work-precision plot per problem, the "first to reach" table, the stability table coloured by
+status and the robustness tables. Only the studies present in ``DIR`` get a section.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from bem.checks import InputError
 
-from ..provenance import display_path
-from .build import Progress, draw_and_build
-from .figures_validation import plot_work_precision
-from .sections import Figure, Section, Table, table_from_rows
+from ...provenance import display_path
+from ..render import Figure, Progress, Section, Table, draw_and_build, table_from_rows
+from .results import read_json
 
 __all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "report_studies_dir"]
 
@@ -36,6 +34,8 @@ def _label(row):
 
 
 def _error_time_sections(data, work):
+    from ..figures.precision import plot_work_precision
+
     rows = data.get("rows", [])
     sections = []
     for problem in dict.fromkeys(r["problem"] for r in rows):
@@ -125,15 +125,10 @@ def study_sections(directory, work):
     """Sections for the study files present in ``directory``."""
     directory = Path(directory)
     sections = []
-    path = directory / "error_time.json"
-    if path.is_file():
-        sections += _error_time_sections(json.loads(path.read_text()), work)
-    path = directory / "stability.json"
-    if path.is_file():
-        sections += _stability_sections(json.loads(path.read_text()))
-    path = directory / "robustness.json"
-    if path.is_file():
-        sections += _robustness_sections(json.loads(path.read_text()))
+    for name, make in zip(STUDY_FILES, (lambda d: _error_time_sections(d, work), _stability_sections,
+                                        _robustness_sections)):
+        if (directory / name).is_file():
+            sections += make(read_json(directory / name))
     if not sections:
         raise InputError(f"directory = {str(directory)!r} is not allowed: it holds none of {list(STUDY_FILES)}.")
     return sections
@@ -143,10 +138,10 @@ def report_studies_dir(directory, out_dir=None, *, title="contactlab validation 
     """Report of the study files in ``directory`` (default ``out_dir``: ``directory/report``).
 
     ``fmt`` (``"png"``, ``"svg"``, ``"pdf"``) chooses the figure files
-    (:func:`validation.report.style.figure_format`); ``progress(stage, done, total)`` hears
-    the stages (:class:`validation.report.build.Progress`).
+    (:func:`validation.report.render.style.figure_format`); ``progress(stage, done, total)``
+    hears the stages (:class:`validation.report.render.Progress`).
     """
-    from .run_report import STAGES
+    from .sections import STAGES
 
     out_dir = Path(directory) / "report" if out_dir is None else Path(out_dir)
     return draw_and_build(lambda work: study_sections(directory, work), out_dir, title=title,

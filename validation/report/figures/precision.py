@@ -1,5 +1,5 @@
-"""Validation figures: solver profiles against a reference with the error underneath, and the
-work-precision plot (error against run time) of a resolution study."""
+"""The work-precision plot of a resolution study: error against run time, one line per solver and
+method (conventions: :mod:`validation.report.figures`)."""
 
 from __future__ import annotations
 
@@ -8,111 +8,16 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from bem.checks import InputError, check_positive
+from bem.checks import InputError
 
-from .style import SOLVER_COLORS, color_for, new_figure, save_figure
+from ..render.style import color_for, new_figure, save_figure
 
-__all__ = ["plot_profile_comparison", "plot_work_precision", "WP_FIELDS", "work_precision_rows", "time_spread"]
+__all__ = ["plot_work_precision", "WP_FIELDS", "work_precision_rows", "time_spread"]
 
 #: fields of one row of a resolution study
 WP_FIELDS = ("solver", "method", "resolution", "N", "error", "wall_time_s")
 
 _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
-
-
-def _radial(r, p):
-    r, p = np.asarray(r, dtype=float), np.asarray(p, dtype=float)
-    keep = r >= 0
-    order = np.argsort(r[keep], kind="stable")
-    return r[keep][order], p[keep][order]
-
-
-def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, rmax=None, labels=None,
-                            error_scale=None):
-    """Radial pressure profiles of several solvers with their error against a reference.
-
-    Upper panel: ``p(r) / p0`` of every curve (and of the reference). Lower panel
-    (shared ``r``): ``(p - p_ref) / p0`` at each curve's own nodes, the reference
-    evaluated there (closed form, or linear interpolation of reference samples).
-
-    Parameters
-    ----------
-    curves : sequence of (str, array_like, array_like) or (str, r, p, str)
-        ``(label, r, p)`` radial samples [length], [pressure]; only ``r >= 0`` is used.
-        An optional 4th item names the solver (``"bem"``, ``"fem"``, ...) for its colour.
-    path : path-like
-        PNG file to write.
-    p0, a : float
-        Pressure and length scales (Hertz peak and radius).
-    reference : (str, callable) or (str, r, p), optional
-        The reference profile ``p_ref(r)``; without it the first curve is the reference.
-    title : str, optional
-        Upper panel title.
-    rmax : float, optional
-        Largest ``r / a`` shown (default: the widest loaded zone of the curves plus 25 %).
-    labels : dict, optional
-        ``{"x", "p", "err", "err_of"}``: axis labels of the abscissa, the pressure and the
-        error, and what the error is a fraction of in the legend (default: normalised by
-        the Hertz radius and peak, error in units of ``p0``).
-    error_scale : float, optional
-        Pressure the error is divided by [pressure] (default ``p0``).
-
-    Returns
-    -------
-    str
-        ``path``.
-    """
-    p0, a = check_positive("p0", p0), check_positive("a", a)
-    e0 = p0 if error_scale is None else check_positive("error_scale", error_scale)
-    lab = {"x": r"radius $r\,/\,a_H$", "p": r"contact pressure $p\,/\,p_0$",
-           "err": r"error $(p - p_{ref})\,/\,p_0$", "err_of": "$p_0$", **(labels or {})}
-    if not curves:
-        raise InputError("curves = [] is not allowed: give at least one (label, r, p) curve.")
-    curves = list(curves)
-    if reference is None:
-        first = curves.pop(0)
-        reference = (first[0], first[1], first[2])
-    ref_label = reference[0]
-    if rmax is None:
-        reach = [float(np.max(np.abs(np.asarray(c[1], dtype=float))[np.asarray(c[2]) > 0], initial=0.0))
-                 for c in curves]
-        rmax = max(1.25 * max(reach, default=0.0) / a, 1.2)
-    if callable(reference[1]):
-        ref_fn = reference[1]
-        rr = np.linspace(0.0, rmax * a, 800)
-        ref_r, ref_p = rr, np.asarray(ref_fn(rr), dtype=float)
-    else:
-        ref_r, ref_p = _radial(reference[1], reference[2])
-
-        def ref_fn(r):
-            return np.interp(r, ref_r, ref_p, right=0.0)
-
-    with new_figure((6.6, 5.4), nrows=2, sharex=True, gridspec_kw={"height_ratios": [3, 2]}) as (fig, (top, bot)):
-        top.plot(ref_r / a, ref_p / p0, color=SOLVER_COLORS["analytic"], lw=1.3, ls="--", label=ref_label, zorder=4)
-        bot.axhline(0.0, color=SOLVER_COLORS["analytic"], lw=1.0, ls="--")
-        worst = 0.0
-        for i, item in enumerate(curves):
-            label, r, p = item[0], item[1], item[2]
-            color = color_for(item[3] if len(item) > 3 else None, i + 1)
-            r, p = _radial(r, p)
-            err = (p - ref_fn(r)) / e0
-            shown = r <= rmax * a
-            worst = max(worst, float(np.abs(err[shown]).max(initial=0.0)))
-            marker = dict(marker="o", markersize=3) if r.size <= 80 else {}
-            top.plot(r / a, p / p0, color=color, label=label, lw=1.5, **marker)
-            bot.plot(r[shown] / a, err[shown], color=color, lw=1.2, **marker,
-                     label=f"{label}: max |error| {np.abs(err[shown]).max(initial=0.0):.2%} of {lab['err_of']}")
-        top.set_xlim(0.0, rmax)
-        top.set_ylim(bottom=0.0)
-        top.set_ylabel(lab["p"])
-        top.set_title(title or f"pressure profiles against {ref_label}")
-        top.legend(loc="upper right", frameon=False)
-        bot.set_xlabel(lab["x"])
-        bot.set_ylabel(lab["err"])
-        if worst > 0:
-            bot.set_ylim(-1.15 * worst, 1.15 * worst)
-        bot.legend(loc="lower left", frameon=False, fontsize=7.5)
-        return save_figure(fig, path)
 
 
 def work_precision_rows(rows):
@@ -169,19 +74,10 @@ def plot_work_precision(rows, path, *, error_label="relative error", title=None,
     rows : iterable of dict or sequence
         ``(solver, method, resolution, N, error, wall_time_s)`` and optionally
         ``wall_times_s`` (:func:`work_precision_rows`).
-    path : path-like
-        PNG file to write.
     error_label : str
         What the error is (y-axis label).
-    title : str, optional
-        Axes title.
     references : sequence of float
         Errors drawn as horizontal reference lines (default 1 % and 0.1 %).
-
-    Returns
-    -------
-    str
-        The written file.
     """
     rows = work_precision_rows(rows)
     if not rows:

@@ -10,7 +10,7 @@ import base64
 import html
 import os
 
-from .sections import Figure, Table
+from .content import Figure, Table
 
 __all__ = ["render_html", "CSS"]
 

@@ -1,0 +1,230 @@
+"""The results a report is drawn from: a result directory of ``contactlab run``, or a run in memory.
+
+What is read (names from ``result.json["files"]``, :data:`validation.run.runner.FILES`):
+
+``result.json`` (required)
+    The run's result (:func:`validation.run.result.build_result`, docs/results.md): the BEM
+    scalars, ``bem``, ``layer``, ``profile``, ``scales``, ``unit_symbols``, and only when they
+    ran ``fem`` / ``fem_profile``, ``analytic`` (with its ``profile``), ``comparison``,
+    ``stress``; ``report`` when the scene had a ``[report]``.
+``scene.toml``
+    The effective scene (overrides applied): bodies, gap, layer, load, options.
+``bem_field.vtu``, ``fem_field.vtu``
+    The BEM nodal pressure ``p`` and the FEM's (r, z) von Mises field.
+
+Units are the symbols the run recorded (``unit_symbols``); a result written before they were
+recorded has its units label read by :func:`validation.units.parse_units`.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import logging
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bem.checks import InputError, check_choice
+
+from ...units import Units, parse_units
+
+__all__ = ["RunResults", "load_results", "results_of", "units_of", "read_json", "UNIT_CHOICES"]
+
+log = logging.getLogger(__name__)
+
+_FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_field.vtu", "fem_field": "fem_field.vtu"}
+#: ``units`` choices of a report: the scene's units (``"auto"``: when they are known), or
+#: lengths and pressures divided by the contact's scales
+UNIT_CHOICES = ("auto", "scene", "dimensionless")
+def units_of(data, label=None):
+    """The :class:`validation.units.Units` of a result: its ``unit_symbols``, else its units label parsed."""
+    label = data.get("units") or label
+    if isinstance(data.get("unit_symbols"), Mapping):
+        return Units.from_dict(label, data["unit_symbols"])
+    return parse_units(label)
+
+
+@dataclass
+class RunResults:
+    """The results of one run, as a report reads them.
+
+    Attributes
+    ----------
+    directory : Path
+    data : dict
+        ``result.json``.
+    scene : dict
+        ``scene.toml`` (empty when missing).
+    units : validation.units.Units
+    bem_field : tuple of ndarray or None
+        ``(x, y, p)``: nodal BEM pressures [length], [pressure].
+    fem_field : tuple of ndarray or None
+        ``(r, z, triangles, von_mises)`` of the FEM reference [length], [pressure], when it ran.
+    dimensionless : bool
+        Draw lengths and pressures divided by the contact's scales (:meth:`scales`) instead of
+        in the scene's units (:func:`validation.report.render.style.report_unit`).
+    """
+
+    directory: Path
+    data: dict
+    scene: dict = field(default_factory=dict)
+    units: Units = field(default_factory=lambda: parse_units(None))
+    bem_field: tuple | None = None
+    fem_field: tuple | None = None
+    dimensionless: bool = False
+
+    def section(self, name):
+        """A table of ``scene.toml`` (empty dict when absent)."""
+        value = self.scene.get(name)
+        return value if isinstance(value, Mapping) else {}
+
+    def get(self, key, default=None):
+        """A top-level entry of ``result.json`` that is a dict (``default`` otherwise)."""
+        value = self.data.get(key)
+        return value if isinstance(value, Mapping) else default
+
+    @property
+    def name(self):
+        return str(self.data.get("scene") or self.section("scene").get("name") or self.directory.name)
+
+    @property
+    def title(self):
+        return str(self.data.get("title") or self.section("scene").get("title") or self.name)
+
+    @property
+    def bem(self):
+        return self.get("bem", {})
+
+    @property
+    def fem(self):
+        """The FEM summary, or ``None`` when the FEM did not run."""
+        return self.get("fem")
+
+    @property
+    def axisymmetric(self):
+        """Axisymmetric scenes record ``contact_radius``."""
+        return self.data.get("contact_radius") is not None
+
+    @functools.cached_property
+    def layer(self):
+        """The :class:`bem.layers.Layer` the run used, or ``None`` (smooth bodies or not rebuildable)."""
+        from bem.layers import from_dict
+
+        params = (self.get("layer") or {}).get("parameters")
+        if not isinstance(params, Mapping):
+            params = self.section("layer") if self.section("layer").get("law") not in (None, "none") else None
+        try:
+            return from_dict(dict(params)) if params else None
+        except (ValueError, TypeError, KeyError) as exc:
+            log.warning("the layer of the run cannot be rebuilt (%s): no w(p) plot", exc)
+            return None
+
+    def scales(self):
+        """``(p0, a, p_name, a_name)`` of a dimensionless report, or ``None`` (scene units).
+
+        Hertz's peak and radius (``p_H``, ``a_H``) when the run recorded them, else the BEM peak
+        pressure and the contact radius (or half-width along x): ``p_{max}``, ``a_c``.
+        """
+        if not self.dimensionless:
+            return None
+        sc = self.get("scales") or {}
+        p0, a = sc.get("p_hertz"), sc.get("a_hertz")
+        if p0 and a and p0 > 0 and a > 0:
+            return float(p0), float(a), "p_H", "a_H"
+        p0 = self.data.get("p_max")
+        a = self.data.get("contact_radius") or (self.get("contact_extent") or {}).get("x")
+        return (float(p0), float(a), "p_{max}", "a_c") if p0 and a and p0 > 0 and a > 0 else None
+
+
+def read_json(path):
+    """The JSON content of ``path``; InputError when it cannot be read."""
+    try:
+        return json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path} is not allowed: it must be a readable JSON file ({exc}).") from None
+
+
+def _read_scene(path):
+    try:
+        with path.open("rb") as fh:
+            return tomllib.load(fh)
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        log.warning("%s cannot be read (%s): the problem statement is built from result.json alone", path, exc)
+        return {}
+
+
+def _field(path, read):
+    """``read(path)``, or None when the file is missing or unreadable (a report without that figure)."""
+    if not path.is_file():
+        return None
+    try:
+        return read(path)
+    except Exception as exc:  # noqa: BLE001 - any reader error means "no field"
+        log.warning("skipping %s: it cannot be read (%s)", path, exc)
+        return None
+
+
+def _bem_field(path):
+    import meshio
+
+    mesh = meshio.read(path)
+    p = np.asarray(mesh.point_data["p"], dtype=float).ravel()
+    if p.size != mesh.points.shape[0]:
+        raise ValueError("it has no nodal pressure 'p'")
+    return mesh.points[:, 0].copy(), mesh.points[:, 1].copy(), p
+
+
+def _dimensionless(units, parsed):
+    return check_choice("units", units, UNIT_CHOICES) == "dimensionless" or (units == "auto" and not parsed.known)
+
+
+def load_results(directory, *, units="auto"):
+    """Read a result directory of ``contactlab run`` (see the module docstring).
+
+    ``units`` (:data:`UNIT_CHOICES`) sets :attr:`RunResults.dimensionless`: ``"auto"`` draws
+    in the scene's units when they are known, dimensionless otherwise.
+
+    Raises
+    ------
+    bem.InputError
+        ``directory`` is not a directory or has no readable ``result.json`` holding an object.
+    """
+    from ..figures.fields import section_field_from_vtu
+
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise InputError(f"directory = {str(directory)!r} is not allowed: it must be a result directory.")
+    main = directory / _FILES["result"]
+    if not main.is_file():
+        raise InputError(f"directory = {str(directory)!r} is not allowed: it has no result.json "
+                         "(run the scene first: contactlab run SCENE --out DIR).")
+    data = read_json(main)
+    if not isinstance(data, Mapping):
+        raise InputError(f"{main} is not allowed: it must hold a JSON object.")
+    if not str(data.get("schema", "")).startswith("contactlab.result/"):
+        log.warning("%s has schema %r: it was not written by contactlab run; parts may be missing",
+                    main, data.get("schema"))
+    files = {**_FILES, **{k: str(v) for k, v in (data.get("files") or {}).items()}}
+    scene = _read_scene(directory / files["scene"])
+    parsed = units_of(data, (scene.get("scene") or {}).get("units"))
+    fem = _field(directory / files["fem_field"], section_field_from_vtu) if isinstance(data.get("fem"), Mapping) \
+        else None
+    return RunResults(directory=directory, data=dict(data), scene=scene, units=parsed,
+                      bem_field=_field(directory / files["bem_field"], _bem_field), fem_field=fem,
+                      dimensionless=_dimensionless(units, parsed))
+
+
+def results_of(outcome, *, units="auto", directory="."):
+    """The :class:`RunResults` of a run in memory (:class:`validation.run.RunOutcome`), as
+    :func:`load_results` would read them once written."""
+    from ..figures.fields import von_mises_of
+
+    res = outcome.bem
+    return RunResults(directory=Path(directory), data=outcome.result, scene=outcome.scene.raw,
+                      units=outcome.scene.units, bem_field=(res.x, res.y, res.p),
+                      fem_field=None if outcome.fem is None else von_mises_of(outcome.fem),
+                      dimensionless=_dimensionless(units, outcome.scene.units))

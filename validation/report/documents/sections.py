@@ -1,0 +1,303 @@
+"""The report of a result directory written by ``contactlab run``: :data:`SECTIONS`, one function per section.
+
+:data:`SECTIONS` maps the names a scene's ``[report] sections`` may list to
+``function(results, work) -> Section or None`` (``None``: the results do not support the
+section; ``work``: the folder figure files go to). The figures :data:`validation.report.figures.FIGURES`
+registers for a section follow its tables; a section left without text and items is dropped.
+A report contains the sections ``result.json["report"]["sections"]`` lists (the scene's
+``[report]``), in that order; without it, every section the results support, in the order of
+:data:`SECTIONS`. A new section is one function and one line in :data:`SECTIONS`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+from bem.checks import InputError
+
+from ...provenance import display_path
+from ..figures import FIGURES
+from ..figures.run import stress_view
+from ..render import Progress, Section, Table, draw_and_build, fmt
+from ..render.style import method_text
+from .problem import scene_section
+from .sweep import sweep_section
+
+__all__ = ["SECTIONS", "STAGES", "run_sections", "report_results_dir", "results_rows", "comparison_tables"]
+
+#: the stages of :func:`report_results_dir`, as reported to its ``progress``
+STAGES = ("reading", "figures", "writing")
+
+#: rows of the results table: (key in result.json / fem / analytic, label, unit kind)
+_QUANTITIES = (("p_max", "peak pressure p_max", "pressure"), ("force", "total force P", "force"),
+               ("approach", "approach delta", "length"), ("contact_area", "contact area A", "area"),
+               ("contact_radius", "contact radius r_c", "length"))
+#: ratio rows: (key, label, key in result["scales"])
+_RATIOS = (("p_max", "p_max / p_H (Hertz peak)", "p_hertz"), ("contact_radius", "r_c / a_H (Hertz radius)", "a_hertz"),
+           ("approach", "delta / delta_H (Hertz approach)", "approach_hertz"))
+_BEM_COUNTS = (("n_nodes", "candidate nodes"), ("n_contact", "nodes in contact"),
+               ("nodes_across_contact", "nodes across the contact, 2 sqrt(A / pi) / c"))
+_TIMES = (("layer_reference", "reference solve of the layer"), ("bem", "BEM"), ("fem", "FEM"),
+          ("stress", "subsurface stresses"), ("total", "whole run"))
+_FEM_TIMES = (("mesh", "mesh generation"), ("assembly", "assembly"), ("factorize", "factorisation"),
+              ("compliance", "contact-node compliance"), ("newton", "contact iterations"),
+              ("recover", "stress recovery"), ("total", "total"))
+_METRICS = {"l2_rel": "relative L2 error of p", "max_rel": "max |p - p_ref| / max p_ref",
+            "peak_rel": "peak pressure (a - b) / b", "contact_radius_rel": "contact radius (a - b) / b",
+            "approach_rel": "approach (a - b) / b", "force_rel": "force (a - b) / b",
+            "n_points": "nodes compared (union of contacts)"}
+
+
+def _num(value):
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _timed(times, names, prefix="wall time: "):
+    """``(label, seconds, "s")`` rows of the numeric entries of ``times``."""
+    times = times if isinstance(times, Mapping) else {}
+    return [(prefix + label, fmt(times[key], 3), "s") for key, label in names if _num(times.get(key))]
+
+
+def results_rows(res):
+    """``(columns, rows)`` of the results table: one column per solver that ran, then the unit."""
+    parts = [("BEM", res.data)] + ([("FEM", res.fem)] if res.fem is not None else []) + (
+        [("closed form", res.get("analytic"))] if res.get("analytic") else [])
+
+    def cells(key, scale=1.0):
+        return [fmt(p.get(key) / scale) if _num(p.get(key)) else "-" for _, p in parts]
+
+    rows = [(label, *cells(key), res.units.of(kind)) for key, label, kind in _QUANTITIES
+            if any(_num(p.get(key)) for _, p in parts)]
+    ext = res.get("contact_extent")
+    if ext and not res.axisymmetric:
+        ref = res.get("analytic") or {}
+        closed = {"closed form": f"{fmt(ref.get('a'))}, {fmt(ref.get('b'))}"} if _num(ref.get("a")) else {}
+        rows.append(("contact half-widths along x, y", f"{fmt(ext.get('x'))}, {fmt(ext.get('y'))}",
+                     *(closed.get(name, "-") for name, _ in parts[1:]), res.units.of("length")))
+    scales = res.get("scales") or {}
+    rows += [(label, *cells(key, scales[skey]), "-") for key, label, skey in _RATIOS
+             if _num(scales.get(skey)) and scales[skey] > 0]
+    if _num(res.data.get("alpha_b")):
+        rows.append(("alpha_b = p_max / p_max^lambda", fmt(res.data["alpha_b"]), *("-" for _ in parts[1:]), "-"))
+    return ("quantity", *(name for name, _ in parts), "unit"), tuple(rows)
+
+
+def summary(res, work):
+    """The key results of every solver that ran, and their ratios to Hertz's."""
+    columns, rows = results_rows(res)
+    text = [f"Computed: {', '.join(columns[1:-1])}. "
+            + ("The run converged." if res.data.get("converged") else "The run did NOT converge.")]
+    if res.data.get("messages"):
+        text.append("Run messages: " + "; ".join(map(str, res.data["messages"])) + ".")
+    caption = "Key results in the scene's units."
+    if res.axisymmetric:
+        caption += " BEM: r_c = sqrt(A / pi), A = loaded node count times the node area" + (
+            "; FEM: edge of the loaded zone, interpolated between the interface nodes." if res.fem is not None else ".")
+    else:
+        caption += " Half-widths: the farthest loaded node along each axis."
+    if res.get("scales"):
+        caption += (" Ratios: to Hertz's peak, radius and approach of the smooth paraboloid at the same load "
+                    "(the scale of the figures).")
+    return Section("Results", kind="results", text=tuple(text), items=(Table(columns, rows, caption=caption),))
+
+
+def timings(res, work):
+    """How the BEM ran: method, lattice, iterations, residual, wall times."""
+    d, b, u = res.data, res.bem, res.units
+    rows = [("method", method_text(d.get("method"), getattr(res.layer, "law", None)), "-"),
+            ("status", "converged" if d.get("converged") else "not converged", "-"),
+            ("solver message", str(d.get("message", "-")), "-"),
+            ("iterations (finest lattice)", fmt(d.get("iterations")), "-"),
+            ("KKT residual", fmt(d.get("kkt_residual")), "-")]
+    if _num(b.get("step")):
+        rows.append(("lattice step c", fmt(b["step"]), u.of("length")))
+    if isinstance(b.get("extent"), list) and len(b["extent"]) == 2:
+        rows.append(("candidate region |x| <= X, |y| <= Y (X, Y)", ", ".join(map(fmt, b["extent"])), u.of("length")))
+    rows += [(label, fmt(b[key], 3), "-") for key, label in _BEM_COUNTS if _num(b.get(key))]
+    rows += _timed(res.get("wall_time_s"), _TIMES)
+    return Section("Solver and timings", kind="results", items=(
+        Table(("quantity", "value", "unit"), tuple(rows), caption="How the BEM solution was computed."),))
+
+
+def fem_field(res, work):
+    """The FEM reference: mesh, solver and time split (its von Mises field is a figure)."""
+    fem, u = res.fem, res.units
+    if fem is None:
+        return None
+    mesh, penalty, trunc = ((fem.get(k) if isinstance(fem.get(k), Mapping) else {})
+                            for k in ("mesh", "penalty", "truncation"))
+    rows = [("status", "converged" if fem.get("converged") else "not converged", "-"),
+            ("stopping reason", str(fem.get("message", "-")), "-"),
+            ("contact iterations", fmt(fem.get("iterations")), "-"),
+            ("degrees of freedom", fmt(fem.get("n_dofs")), "-"),
+            ("elements", fmt(fem.get("n_elements")), "-"),
+            ("elements across the contact radius", fmt(fem.get("n_elements_across_contact"), 3), "-")]
+    if _num(mesh.get("h_fine")):
+        rows.append(("element size at the contact", fmt(mesh["h_fine"]), u.of("length")))
+    if _num(mesh.get("extent_factor")):
+        rows.append(("mesh half-size / estimated contact radius", fmt(mesh["extent_factor"]), "-"))
+    if _num(penalty.get("relative_penetration")):
+        rows.append(("penalty: largest penetration / approach", fmt(penalty["relative_penetration"]), "-"))
+    if "applied" in trunc:
+        rows.append(("far-field (truncation) correction applied", fmt(bool(trunc["applied"])), "-"))
+    rows += _timed(fem.get("timings"), _FEM_TIMES)
+    return Section("FEM reference", kind="fem", items=(Table(
+        ("quantity", "value", "unit"), tuple(rows),
+        caption="FEM reference (fem_reference, axisymmetric, quadratic triangles): mesh, solver and time split. "
+                "Its pressure, force, approach and radius are in the results table."),))
+
+
+def stress(res, work):
+    """The subsurface stresses of a scene with ``[stress]``: maxima per body, and against the FEM."""
+    block = res.get("stress")
+    if not block or not block.get("bodies"):
+        return None
+    a, s, l_name, s_name, _ = stress_view(res)
+    rows = [(name, fmt(b["nu"]), fmt(b["max_von_mises"] / s), fmt(b["depth_of_max"] / a),
+             f"{fmt(b['location_of_max'][0] / a)}, {fmt(b['location_of_max'][1] / a)}", fmt(b["max_tresca"] / s),
+             fmt(b["depth_of_max_tresca"] / a)) for name, b in block["bodies"].items()]
+    items = [Table(("body", "nu", f"max von Mises / {s_name}", f"its depth / {l_name}", f"at x, y / {l_name}",
+                    f"max shear / {s_name}", f"its depth / {l_name}"), tuple(rows),
+                   caption="Largest von Mises stress and largest maximum shear (s1 - s3)/2 of each body over all "
+                           "candidate nodes and depths, refined in depth by a parabola through the largest sample and "
+                           f"its neighbours. Units: {s_name} = {fmt(s)} {res.units.of('pressure')}, {l_name} = "
+                           f"{fmt(a)} {res.units.of('length')}.")]
+    fem_rows = [(name, fmt(f["max_von_mises"] / s), f"{100 * f['max_von_mises_rel']:+.2f} %", fmt(f["max_tresca"] / s),
+                 f"{100 * f['max_tresca_rel']:+.2f} %", fmt(f["axis_depth_of_max"] / a),
+                 fmt(f["bem_axis_depth_of_max"] / a), f"{100 * f['axis_depth_of_max_rel']:+.2f} %",
+                 "yes" if f["on_axis"] else "no")
+                for name, b in block["bodies"].items() if (f := b.get("fem"))]
+    if fem_rows:
+        items.append(Table(
+            ("body", f"FEM max von Mises / {s_name}", "BEM - FEM", f"FEM max shear / {s_name}", "BEM - FEM",
+             f"FEM depth of the axis max / {l_name}", f"BEM depth of the axis max / {l_name}", "BEM - FEM",
+             "largest value on the axis"), tuple(fem_rows),
+            caption="BEM against the FEM reference: largest values over the body (FEM: recovered nodal stresses), "
+                    "relative differences (BEM - FEM) / FEM. Depth of the largest von Mises stress on the axis from "
+                    "a least-squares parabola through the axis values within 4 % of the largest, the BEM evaluated "
+                    "at the FEM's axis nodes (the maximum is flat, so the depth of the largest nodal value alone "
+                    "scatters with the nodes); it is the depth of the body's largest value where the last column "
+                    "says yes."))
+    text = ("The contact pressure matters for the strength of the parts through the stresses it causes below the "
+            "surface: yielding starts where the von Mises stress (or the maximum shear) is largest, below the "
+            "surface for a smooth contact.")
+    if _num(block.get("wall_time_s")):
+        text += f" Computed in {fmt(float(block['wall_time_s']), 3)} s."
+    return Section("Subsurface stresses", kind="results", text=(text,), items=tuple(items))
+
+
+def _metric_cell(key, value):
+    if not _num(value):
+        return "-" if value is None else str(value)
+    return str(value) if key == "n_points" or isinstance(value, int) else f"{100.0 * value:.3g} %"
+
+
+def comparison_tables(comparison, units):
+    """Tables of ``result["comparison"]``: one column per compared pair (per cent), then the force balance."""
+    names = {"bem": "BEM", "fem": "FEM", "analytic": "closed form"}
+    pairs = {k: v for k, v in comparison.items() if isinstance(v, Mapping) and k != "force_balance"}
+    tables = []
+    if pairs:
+        keys = dict.fromkeys(k for v in pairs.values() for k, x in v.items() if not isinstance(x, (Mapping, list)))
+        tables.append(Table(
+            ("metric", *(" vs ".join(names.get(p, p.replace("_", " ")) for p in k.split("_vs_")) for k in pairs)),
+            tuple((_METRICS.get(k, k), *(_metric_cell(k, v.get(k)) for v in pairs.values())) for k in keys),
+            caption="Comparison metrics of the run (candidate vs reference at the candidate's nodes; signed "
+                    "differences are (candidate - reference) / reference)."))
+    balance = comparison.get("force_balance") if isinstance(comparison.get("force_balance"), Mapping) else {}
+    rows = [("target force P", fmt(v), units.of("force")) if k == "target" else
+            (f"force balance |F - P| / P ({k.upper()})", _metric_cell(k, v), "-")
+            for k, v in balance.items() if _num(v)]
+    rows += [(k, _metric_cell(k, v), "-") for k, v in comparison.items() if _num(v)]
+    if rows:
+        tables.append(Table(("quantity", "value", "unit"), tuple(rows), caption="Force balance of the solvers."))
+    return tables
+
+
+def comparison(res, work):
+    """The comparison metrics the run recorded (BEM against the FEM and the closed form)."""
+    tables = comparison_tables(res.get("comparison") or {}, res.units)
+    return Section("Comparison metrics", kind="validation", items=tuple(tables)) if tables else None
+
+
+def _figures_only(title, kind):
+    """A section that holds only its figures (dropped when none can be drawn)."""
+    return lambda res, work: Section(title, kind=kind)
+
+
+#: section name -> function(results, work) -> Section or None, in the default order of a report
+SECTIONS = {
+    "scene": scene_section,
+    "layer_law": _figures_only("Interface layer law", "problem"),
+    "summary": summary,
+    "timings": timings,
+    "profile": _figures_only("Pressure profiles", "results"),
+    "pressure_map": _figures_only("Pressure over the contact plane", "results"),
+    "convergence": _figures_only("Convergence of the BEM", "iterations"),
+    "fem_field": fem_field,
+    "stress": stress,
+    "comparison": comparison,
+    "sweep": sweep_section,
+}
+
+
+def build_section(name, res, work):
+    """Section ``name`` of :data:`SECTIONS` with the figures registered for it, or None."""
+    if name not in SECTIONS:
+        raise InputError(f"section = {name!r} is not allowed: it must be one of {list(SECTIONS)}.")
+    sec = SECTIONS[name](res, work)
+    if sec is None:
+        return None
+    drawn = []
+    for where, draw in FIGURES.values():
+        out = draw(res, work) if where == name else None
+        drawn += out if isinstance(out, list) else [out] if out is not None else []
+    sec = Section(sec.title, kind=sec.kind, text=sec.text, items=sec.items + tuple(drawn))
+    return sec if sec.items or sec.text else None
+
+
+def run_sections(res, work, names=None):
+    """The sections of a run's report; figures go to ``work``.
+
+    ``names``: the sections to build, in order; default: those of ``result.json["report"]``
+    (the scene's ``[report] sections``) when present, else every name of :data:`SECTIONS`.
+    """
+    if names is None:
+        names = (res.get("report") or {}).get("sections") or tuple(SECTIONS)
+    return [sec for name in names if (sec := build_section(name, res, Path(work))) is not None]
+
+
+def report_results_dir(directory, out_dir=None, *, title=None, units="auto", fmt="png", progress=None):
+    """Report of a result directory (:func:`run_sections`); default ``out_dir``: ``directory/report``.
+
+    Parameters
+    ----------
+    directory : path-like
+        Written by ``contactlab run`` (``result.json``, ``scene.toml``, fields).
+    out_dir : path-like, optional
+        Report directory (``report.html``, ``report.md``, ``figures/``).
+    title : str, optional
+        Default: the scene's title.
+    units : {"auto", "scene", "dimensionless"}
+        Axes in the scene's units (lengths in mm, pressures in MPa for SI scenes) or divided
+        by the contact's scales (:func:`validation.report.documents.results.load_results`).
+    fmt : {"png", "svg", "pdf"}
+        Figure files (:func:`validation.report.render.style.figure_format`).
+    progress : callable, optional
+        ``progress(stage, done, total)`` (:class:`validation.report.render.Progress`).
+
+    Returns
+    -------
+    validation.report.render.BuiltReport
+    """
+    from .results import load_results
+
+    notify = Progress(STAGES, progress)
+    notify("reading")
+    res = load_results(directory, units=units)
+    source = res.data.get("source")
+    subtitle = (f"Scene '{res.name}'" + (f" ({source})" if source else "")
+                + f"; results read from {display_path(directory)}")
+    return draw_and_build(lambda work: run_sections(res, work), Path(directory) / "report" if out_dir is None
+                          else out_dir, title=title or res.title, subtitle=subtitle, fmt=fmt, notify=notify)

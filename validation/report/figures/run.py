@@ -1,0 +1,379 @@
+"""The figures of a run's report, drawn from its results (:class:`validation.report.documents.results.RunResults`).
+
+Each figure function takes ``(res, work)`` (the results and the folder its files go to) and
+returns a :class:`validation.report.render.Figure`, a list of them, or ``None`` when the results
+cannot support it; :data:`validation.report.figures.FIGURES` registers them.
+
+Units: the scene's, lengths in mm and pressures in MPa for an SI scene
+(:func:`validation.report.render.style.report_unit`), in a window around the contact
+(:func:`profile_view`); a dimensionless report (``contactlab report --units dimensionless``)
+divides by the contact's scales (:meth:`RunResults.scales`: Hertz's ``p_H``, ``a_H`` of a
+paraboloid, else the BEM peak ``p_max`` and the contact half-width ``a_c``).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..render.content import Figure, fmt
+from ..render.style import display_unit, method_text, report_unit
+
+__all__ = ["scale", "axis_label", "Scaled", "ProfileView", "profile_view", "contact_edge", "how", "layer_law", "profiles",
+           "pressure_map", "convergence", "fem_von_mises", "stress_view", "stress_figures"]
+
+#: margin of a profile's window beyond the contact edge
+PAD = 1.3
+#: a contact whose half-widths differ by more than this factor is mapped with unequal axes
+ELONGATED = 4.0
+_REFERENCE = {"hertz": "Hertz (closed form)", "hertz_elliptic": "Hertz ellipse (closed form)",
+              "rigid_layer": "rigid bodies on the layer (closed form)"}
+
+
+def scale(res, kind, magnitude=None):
+    """``(factor, name, normalised)``: a ``kind`` (``"length"`` or ``"pressure"``) quantity is drawn
+    as ``value / factor``; ``name`` is the symbol of the scale (dimensionless: ``"a_H"``,
+    ``"p_H"``, ...) or the unit drawn in (``"mm"``; with ``magnitude``, the SI prefix that puts
+    it in [1, 1000), :func:`display_unit`)."""
+    scales = res.scales()
+    if scales is not None:
+        return (scales[1], scales[3], True) if kind == "length" else (scales[0], scales[2], True)
+    unit = getattr(res.units, kind)
+    name, factor = report_unit(unit) if magnitude is None else display_unit(unit, magnitude)
+    return factor, name, False
+
+
+def axis_label(symbol, sc, what=""):
+    """Axis label of ``symbol`` drawn with the scale ``sc`` (:func:`scale`): ``what $x\\,/\\,a_H$`` or ``what $x$ [mm]``."""
+    _, name, normalised = sc
+    if normalised:
+        return rf"{what}${symbol}\,/\,{name}$"
+    return f"{what}${symbol}$" + (f" [{name}]" if name else "")
+
+
+@dataclass(frozen=True)
+class ProfileView:
+    """How a profile is drawn: plotted value = data / factor.
+
+    Attributes
+    ----------
+    x_factor, p_factor : float
+        Length [length] and pressure [pressure] scales.
+    x_label, p_label : str
+        Axis labels (mathtext).
+    x_name, p_name : str
+        Normalised: the scales for captions (``"a_H = 0.0001866 m"``); else the display units.
+    xlim : (float, float)
+        Plotted abscissa range (in units of ``x_factor``), symmetric around 0.
+    normalised : bool
+        Whether the data are divided by the contact's scales (:func:`scale`).
+    """
+
+    x_factor: float
+    p_factor: float
+    x_label: str
+    p_label: str
+    x_name: str
+    p_name: str
+    xlim: tuple
+    normalised: bool
+
+
+def contact_edge(curves):
+    """Largest ``|x|`` of a loaded point (``p > 0``) over ``(x, p)`` curves [length]; 0 if none."""
+    reach = [float(np.abs(np.asarray(x, float))[np.asarray(p, float) > 0].max(initial=0.0)) for x, p in curves]
+    return max(reach, default=0.0)
+
+
+def profile_view(res, curves, *, axis="x"):
+    """Scales, labels and window of a profile along ``axis`` holding every loaded point of ``curves``.
+
+    ``curves`` are the ``(x, p)`` data to be drawn [length], [pressure]. The window is
+    ``(-h, h)``, ``h = PAD e`` with ``e`` the contact edge (:func:`contact_edge`), at least the
+    length scale when normalised, but not beyond the first curve's data when that still shows
+    the edge (``h >= 1.02 e``).
+    """
+    edge = contact_edge(curves)
+    reach = float(np.abs(np.asarray(curves[0][0], dtype=float)).max(initial=0.0)) if curves else 0.0
+    (xf, xn, normalised), (pf, pn, _) = scale(res, "length"), scale(res, "pressure")
+    if normalised:
+        half = min(PAD * max(edge / xf, 1.0), max(reach, 1.02 * edge) / xf)
+        xn, pn = (f"{n} = {fmt(f)} {res.units.of(k)}".replace(" -", "") for n, f, k in
+                  ((xn, xf, "length"), (pn, pf, "pressure")))
+    else:
+        edge = edge or float(max((np.abs(np.asarray(x, float)).max(initial=0.0) for x, _ in curves), default=1.0)) \
+            or 1.0
+        half = min(PAD * edge, max(reach, 1.02 * edge)) / xf
+    return ProfileView(xf, pf, axis_label(axis, scale(res, "length")),
+                       axis_label("p", scale(res, "pressure"), "contact pressure "), xn, pn, (-half, half), normalised)
+
+
+def _tolerance(res):
+    """The KKT tolerance of the run: ``bem.rtol``, or the one quoted in its message (``... rtol 1.0e-10``)."""
+    m = re.search(r"rtol\s+([0-9.eE+-]+)", str(res.data.get("message") or ""))
+    try:
+        return res.bem.get("rtol") or (float(m.group(1)) if m else None)
+    except ValueError:
+        return None
+
+
+def how(res):
+    """One sentence: how the BEM solution was computed."""
+    b, tol = res.bem, _tolerance(res)
+    text = (f"BEM: {method_text(res.data.get('method'), getattr(res.layer, 'law', None), short=True)}; lattice step "
+            f"c = {fmt(b.get('step'))} {res.units.of('length')}, {b.get('n_nodes', '?')} candidate nodes, "
+            f"{b.get('n_contact', '?')} in contact")
+    if b.get("nodes_across_contact"):
+        text += f" ({b['nodes_across_contact']:.0f} across the contact)"
+    return text + f"; KKT residual {fmt(res.data.get('kkt_residual'))}" + (f" (tolerance {fmt(tol)})." if tol else ".")
+
+
+def _fem_how(res):
+    fem = res.fem
+    return (f"FEM: axisymmetric quadratic triangles, {fmt(fem.get('n_elements_across_contact'), 3)} elements "
+            f"across the contact radius (h = {fmt((fem.get('mesh') or {}).get('h_fine'))} {res.units.of('length')} "
+            f"there), {fem.get('n_dofs', '?')} DOFs, interface nodal pressures.")
+
+
+class Scaled:
+    """A layer drawn in display units: ``w(p) = layer.w(p * pf) / wf``."""
+
+    def __init__(self, layer, pf, wf):
+        self.layer, self.pf, self.wf, self.law = layer, pf, wf, layer.law
+
+    def w(self, p):
+        return self.layer.w(p * self.pf) / self.wf
+
+
+def layer_law(res, work):
+    """The layer law w(p) the solver used over ``0 .. 1.25 max(p_max, p_cr, p_star)``, its kinks marked."""
+    from .profiles import plot_layer_laws
+
+    if res.layer is None:
+        return None
+    params = res.layer.to_dict()
+    p_top = 1.25 * max(float(res.data.get("p_max") or 0.0), *(float(params.get(k) or 0.0) for k in ("p_cr", "p_star")))
+    if p_top <= 0:
+        return None
+    p_unit, pf = report_unit(res.units.pressure)
+    w_unit, wf = display_unit(res.units.length, float(np.max(res.layer.w(np.linspace(0.0, p_top, 200)))))
+    marks = [(rf"$p_{{max}}$ (BEM) = {fmt(res.data['p_max'] / pf, 3)} {p_unit}".rstrip(), res.data["p_max"] / pf)]
+    marks += [(f"{name} = {fmt(params[key] / pf, 3)} {p_unit}".rstrip(), params[key] / pf)
+              for key, name in (("p_cr", r"$p_{cr}$"), ("p_star", r"$p^*$")) if params.get(key)]
+    path = plot_layer_laws([(params["law"].replace("_", "-"), Scaled(res.layer, pf, wf))], work / "layer_law.png",
+                           p_max=p_top / pf, p_unit=p_unit, w_unit=w_unit, marks=marks,
+                           title="interface layer law: closure $w(p)$ under the pressure $p$")
+    return Figure(path, f"The layer law w(p) used by the solver ({params['law']}), rebuilt from the run's result with "
+                        "bem.layers.from_dict and evaluated at 200 pressures from 0 to 1.25 times the largest of the "
+                        "computed peak pressure and the law's kink pressures (marked).")
+
+
+def _reference(res, axis):
+    """``(label, s, p)``: the closed form's pressure along ``axis`` as the run recorded it, or None."""
+    ref = res.get("analytic") or {}
+    prof = ref.get("profile") or {}
+    s, p = (prof.get("x"), prof.get("p")) if axis == "x" else (prof.get("y"), prof.get("p_y"))
+    if not s or not p:
+        return None
+    return _REFERENCE.get(ref.get("kind"), "closed form"), np.asarray(s, float), np.asarray(p, float)
+
+
+def profiles(res, work):
+    """Pressure along x (and along y for non-axisymmetric scenes), against the references."""
+    from .profiles import plot_pressure_profiles, plot_profile_comparison
+
+    figures, fem = [], res.get("fem_profile") if res.axisymmetric else None
+    prof = res.get("profile") or {}
+    for axis in ("x",) if res.axisymmetric else ("x", "y"):
+        line = prof if axis == "x" else prof.get("y_axis") or {}
+        if not line.get(axis) or not line.get("p") or not np.any(np.asarray(line["p"]) > 0):
+            continue
+        data = np.asarray(line[axis], dtype=float), np.asarray(line["p"], dtype=float)
+        ref = _reference(res, axis)
+        curves = [data] + ([(np.asarray(fem["r"], float), np.asarray(fem["p"], float))] if fem else [])
+        view = profile_view(res, curves, axis="r" if res.axisymmetric else axis)
+        where = "the lattice row y = 0" if axis == "x" else "the line x = 0 (BEM field interpolated)"
+        text = how(res) + (" " + _fem_how(res) if fem else "") + (f" {_scale_text(view)}" if view.normalised else "")
+        path, labels = work / f"profile_{axis}.png", {"x": view.x_label, "p": view.p_label}
+        if ref is None and not fem:
+            path = plot_pressure_profiles([("BEM", data)], path, p0=view.p_factor, a=view.x_factor, xlim=view.xlim,
+                                          labels=labels, title=f"contact pressure along {axis}",
+                                          section="axial section $y = 0$" if axis == "x" else "section $x = 0$")
+            figures.append(Figure(path, f"BEM contact pressure along {where}, nodal values. {text}"))
+            continue
+        solvers = [("BEM", *data, "bem")] + ([("FEM", fem["r"], fem["p"], "fem")] if fem and ref else [])
+        reference = ref or ("FEM reference", fem["r"], fem["p"])
+        against = ref[0] if ref else "the FEM reference"
+        p_sym = view.p_name.split(" = ")[0]
+        labels.update(err=rf"error $(p - p_{{ref}})\,/\,{p_sym}$" if view.normalised
+                      else r"error $(p - p_{ref})\,/\,\max p_{ref}$",
+                      err_of=f"${p_sym}$" if view.normalised else r"$\max p_{ref}$")
+        e0 = None if view.normalised else float(np.max(reference[2]))
+        path = plot_profile_comparison(solvers, path, p0=view.p_factor, a=view.x_factor, reference=reference,
+                                       rmax=view.xlim[1], error_scale=e0, labels=labels,
+                                       title=f"contact pressure along {'r' if res.axisymmetric else axis} "
+                                             f"against {against}")
+        figures.append(Figure(path, f"Contact pressure along {where} (upper panel) and its difference to {against} "
+                                    f"at each solver's nodes (lower panel). {text}"))
+    return figures
+
+
+def _scale_text(view):
+    """Caption sentence naming the scales of a dimensionless figure."""
+    if view.p_name.startswith("p_H"):
+        return f"Normalised by Hertz's peak {view.p_name} and radius {view.x_name} of the smooth problem."
+    return f"Normalised by the BEM peak pressure {view.p_name} and the contact half-width along x {view.x_name}."
+
+
+def pressure_map(res, work):
+    """The BEM pressure over the plane with the contact boundary, or None without a field."""
+    from .surfaces import plot_contact_map
+
+    if res.bem_field is None or not np.any(res.bem_field[2] > 0):
+        return None
+    x, y, p = res.bem_field
+    view = profile_view(res, [(np.hypot(x, y) if res.axisymmetric else np.maximum(abs(x), abs(y)), p)])
+    labels = {"x": axis_label("x", scale(res, "length")), "y": axis_label("y", scale(res, "length")),
+              "p": view.p_label}
+    p_cr = ((res.get("layer") or {}).get("parameters") or {}).get("p_cr")
+    levels = [(r"$p = p_{cr}$", p_cr)] if p_cr else []
+    circle = res.data.get("contact_radius") if res.axisymmetric else None
+    kw = dict(a=view.x_factor, labels=labels)
+    ex, ey = contact_edge([(x, p)]), contact_edge([(y, p)])
+    elongated = not view.normalised and min(ex, ey) > 0 and max(ex, ey) > ELONGATED * min(ex, ey)
+    if elongated:  # a roller: the axes stretched to fill the figure
+        kw.update(aspect="auto", figsize=(8.2, 3.6))
+    else:  # equal axes: a figure as wide as the drawn window (the contact patch within the data)
+        half = 1.3 * max(ex, ey)  # the window of surfaces.contact_patch (margin 0.3)
+        ratio = min(float(np.abs(x).max()), half) / max(min(float(np.abs(y).max()), half), 1e-300)
+        if ratio > 1.3:
+            kw["figsize"] = (min(8.6, 1.6 + 2.4 * ratio), 4.4)
+    path = plot_contact_map((x, y, p), work / "contact_map.png", p0=view.p_factor, circle=circle, levels=levels,
+                            title="BEM contact pressure over the plane", **kw)
+    extra = " The dotted contour is p = p_cr (rigid branch of the layer inside)." if levels else ""
+    if elongated:
+        extra += (f" The contact is elongated (half-widths {fmt(ex)} and {fmt(ey)} {res.units.of('length')}): "
+                  "x and y are drawn to different scales, the y axis stretched.")
+    return Figure(path, "BEM contact pressure over the contact plane, interpolated linearly on the lattice "
+                        "triangles (bem_field.vtu); white: the contact boundary, midway between loaded and "
+                        "unloaded nodes" + ("; dashed: the circle of equal area" if circle else "")
+                  + f".{extra} {how(res)}")
+
+
+def convergence(res, work):
+    """Peak pressure and KKT residual per iteration, or None without a history."""
+    from .iterations import plot_convergence
+
+    hist = res.bem.get("history") or {}
+    if not hist.get("p_max"):
+        return None
+    sc = scale(res, "pressure")
+    name = method_text(res.data.get("method"), getattr(res.layer, "law", None), short=True)
+    path = plot_convergence([(f"BEM: {name}", hist)], work / "convergence.png", p0=sc[0], tol=_tolerance(res),
+                            p_label=axis_label(r"\max\,p" if sc[2] else "p_{max}", sc, "max. pressure "),
+                            title="BEM iterations: peak pressure and KKT residual")
+    return Figure(path, f"Peak pressure (upper panel) and KKT residual (lower panel, log scale) of the "
+                        f"{len(hist['p_max'])} recorded iterates on the finest lattice (a nested solve starts there "
+                        "from the interpolated solution of the coarser lattices). " + how(res))
+
+
+def _round_up(value):
+    """``value > 0`` rounded up to two significant digits (0.57 -> 0.57, 0.571 -> 0.58)."""
+    unit = 10.0 ** (math.floor(math.log10(value)) - 1)
+    return math.ceil(value / unit * (1 - 1e-12)) * unit
+
+
+def fem_von_mises(res, work):
+    """Von Mises stress of the FEM reference in the (r, z) section, or None without its field."""
+    from .fields import plot_section_field
+
+    if res.fem_field is None:
+        return None
+    r, z, tri, vm = res.fem_field
+    rc = float(res.fem.get("contact_radius") or res.data.get("contact_radius") or 0.0)
+    (a, l_name, normalised), (p0, s_name, _) = scale(res, "length"), scale(res, "pressure")
+    hertz = normalised and l_name == "a_H"  # the figure's default labels
+    labels = None if hertz else {k: axis_label(k, (a, l_name, normalised)) for k in ("r", "z")}
+    if rc > 0:
+        window = 3.0 * (max(rc / a, 0.5) if normalised else rc / a)
+    else:
+        window = 3.0 if normalised else 0.5 * float(np.max(r)) / a
+    path = plot_section_field(r, z, tri, vm, work / "fem_von_mises.png", a=a, scale=p0,
+                              label=axis_label(r"\sigma_{vM}", (p0, s_name, normalised), "von Mises stress "),
+                              window=_round_up(window), contact_radius=rc or None, labels=labels,
+                              length_unit=None if hertz else (f"${l_name}$" if normalised else l_name),
+                              title="FEM reference: von Mises stress in the (r, z) section")
+    return Figure(path, "Von Mises stress of the FEM reference in the axial (r, z) section, mirrored about the "
+                        "axis, from the stresses recovered at the mesh nodes (fem_field.vtu); the thick line "
+                        "marks the contact. " + _fem_how(res))
+
+
+def stress_view(res):
+    """``(a, scale, length name, stress name, normalised)`` of the ``stress`` block's figures and tables."""
+    bodies = res.get("stress")["bodies"]
+    a, l_name, normalised = scale(res, "length", max(float(np.max(b["axis"]["z"])) for b in bodies.values()))
+    s, s_name, _ = scale(res, "pressure", max(float(b["max_von_mises"]) for b in bodies.values()))
+    return a, s, l_name, s_name, normalised
+
+
+def _hertz_axis(res, z, nu):
+    """Hertz's von Mises stress on the axis (Johnson 1985, eq. 3.45) [pressure], or None."""
+    sc = res.get("scales") or {}
+    p0, a = sc.get("p_hertz"), sc.get("a_hertz")
+    if (res.get("analytic") or {}).get("kind") != "hertz" or not (p0 and a):
+        return None
+    zeta = np.maximum(np.asarray(z, dtype=float) / a, 1e-12)
+    s_r = -(1.0 + nu) * (1.0 - zeta * np.arctan(1.0 / zeta)) + 0.5 / (1.0 + zeta**2)
+    return p0 * np.abs(-1.0 / (1.0 + zeta**2) - s_r)
+
+
+def stress_figures(res, work):
+    """The x-z section map of the von Mises stress and the stresses on the axis, or None without stresses."""
+    from .fields import plot_depth_profiles, plot_stress_section
+
+    block = res.get("stress")
+    if not block or not block.get("bodies"):
+        return None
+    bodies = block["bodies"]
+    a, s, l_name, s_name, normalised = stress_view(res)
+    z_label, s_label = axis_label("z", (a, l_name, normalised)), axis_label(r"\sigma", (s, s_name, normalised))
+    panels = [({"body1": 1.0, "body2": -1.0}[name], b["section"]["x"], b["section"]["z"], b["section"]["von_mises"])
+              for name, b in bodies.items()]
+    section = plot_stress_section(panels, work / "stress_section.png", a=a, scale=s,
+                                  label="von Mises " + s_label.replace(r"\sigma", r"\sigma_{vM}"),
+                                  contact_radius=res.data.get("contact_radius"), fem=res.fem_field,
+                                  labels={"x": axis_label("x", (a, l_name, normalised)), "z": z_label},
+                                  title="von Mises stress in the section y = 0")
+    curves, marks = [], []
+    for i, (name, b) in enumerate(bodies.items()):
+        ax, key = b["axis"], ("bem", "fem")[i % 2] if i else "bem"
+        curves += [{"label": f"{name} (nu = {fmt(b['nu'])}): von Mises", "z": ax["z"], "values": ax["von_mises"],
+                    "key": key, "ls": "-"},
+                   {"label": f"{name}: max shear", "z": ax["z"], "values": ax["tresca"], "key": key, "ls": ":"}]
+        marks.append((b["depth_of_max"], b["max_von_mises"], "black"))
+        if b.get("fem"):
+            curves.append({"label": f"{name}: FEM von Mises", "z": b["fem"]["axis"]["z"],
+                           "values": b["fem"]["axis"]["von_mises"], "key": "analytic", "ls": "none", "marker": "x"})
+        depths = np.linspace(0.0, float(np.max(ax["z"])), 200)
+        hertz = _hertz_axis(res, depths, float(b["nu"])) if i == 0 else None
+        if hertz is not None:
+            curves.append({"label": f"Hertz, Johnson eq. 3.45 (nu = {fmt(b['nu'])})", "z": depths, "values": hertz,
+                           "key": "smooth", "ls": "--"})
+    profiles_ = plot_depth_profiles(curves, work / "stress_profiles.png", a=a, scale=s, stress_label=s_label,
+                                    depth_label=z_label.replace("$z", "depth $z"), marks=marks,
+                                    title="stresses on the axis x = y = 0")
+    depths = np.asarray(block["depths"], dtype=float)
+    text = (f"{depths.size} depths from {fmt(depths.min())} to {fmt(depths.max())} {res.units.of('length')}"
+            f" (down to {fmt(depths.max() / block['scale'])} contact half-widths), every candidate node; "
+            "bem.subsurface_stress: the BEM pressure (pyramids on the lattice) convolved with the stresses "
+            "under one pyramid, frictionless, each body with its own Poisson ratio.")
+    overlay = " Dashed: the FEM reference's von Mises stress at the same levels." if res.fem_field is not None else ""
+    crosses = " Crosses: FEM axis nodes." if any(b.get("fem") for b in bodies.values()) else ""
+    return [Figure(section, "Von Mises stress of the BEM solution in the x-z section through the axis (lattice row "
+                            "y = 0), body 1 above and body 2 below the interface; the thick line marks the contact."
+                   + overlay + " " + text),
+            Figure(profiles_, "Von Mises stress (solid) and maximum shear (dotted) on the axis against the depth; "
+                              "circles: the maxima over the whole field." + crosses + " " + text)]
