@@ -40,12 +40,12 @@ def _headings(built):
 
 
 def test_report_sections_are_exactly_the_scenes(elliptic_dir, tmp_path):
-    # the built-in scene asks for ["summary", "profile", "pressure_map", "comparison"]
+    # the built-in scene asks for ["scene", "summary", "profile", "pressure_map", "comparison", "convergence"]
     assert json.loads((elliptic_dir / "result.json").read_text())["report"]["sections"] == [
-        "summary", "profile", "pressure_map", "comparison"]
+        "scene", "summary", "profile", "pressure_map", "comparison", "convergence"]
     built = report_results_dir(elliptic_dir, tmp_path / "builtin")
-    assert _headings(built) == ["Results", "Pressure profiles", "Pressure over the contact plane",
-                                "Comparison metrics"]
+    assert _headings(built) == ["Problem statement", "Results", "Pressure profiles", "Pressure over the contact plane",
+                                "Comparison metrics", "Convergence of the BEM"]
     d = _with_report(elliptic_dir, tmp_path / "two", {"sections": ["summary", "profile"], "format": "html"})
     built = report_results_dir(d, tmp_path / "two-report")
     assert_valid_offline_html(built.html.read_text(encoding="utf-8"))
