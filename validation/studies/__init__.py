@@ -1,14 +1,16 @@
-"""Studies over the solvers: error against run time, and stability on stiff and extreme cases.
+"""Studies over the solvers; every problem is a scene run by :func:`validation.run.execute_scene`.
 
+- :mod:`validation.studies.problems`: the problems, as scene dicts (docs/scenes.md).
 - :mod:`validation.studies.error_time`: pressure error against wall time over a ladder of
   resolutions for every BEM method and the FEM reference (:class:`ErrorTimeStudy`).
 - :mod:`validation.studies.stability`: every method on stiff and extreme cases, each outcome
-  classified ``converged`` / ``reported failure`` / ``wrong`` (:class:`StabilityStudy`);
-  a wrong answer or a NaN raises :class:`StabilityFailure`.
-- :mod:`validation.studies.problems`: the problems both studies run.
+  classified; a wrong answer or a NaN raises :class:`StabilityFailure`.
+- :mod:`validation.studies.robustness`: the layer methods over 12 decades of layer compliance,
+  every converged answer checked against the KKT conditions with the dense influence matrix.
 
-Each module has ``main(args)`` for the command line (``contactlab study error-time`` and
-``contactlab study stability``).
+Each has ``main(args)`` for ``contactlab study error-time | stability | robustness``. This
+module holds what they share: running a scene (:func:`attempt`, :func:`timed`), classifying an
+outcome (:func:`classify`) and writing tables and files.
 """
 
 from __future__ import annotations
@@ -18,9 +20,76 @@ import math
 import statistics
 import time
 
+import numpy as np
+
 from bem.files import write_text
 
-__all__ = ["write_text", "write_json", "markdown_table", "fmt", "timed"]
+from ..run import execute_scene
+from ..scene import load_scene
+
+__all__ = ["attempt", "timed", "classify", "finite", "write_json", "write_text", "markdown_table", "fmt",
+           "STATUSES"]
+
+#: outcome statuses: converged (and agreeing with the reference), the solver's own failure, wrong
+STATUSES = ("converged", "reported failure", "wrong")
+#: errors a run may raise to report a failure (anything else is a bug and propagates)
+_REPORTED = (ValueError, ArithmeticError, RuntimeError)
+
+
+def attempt(scene, overrides=None):
+    """Run a scene: ``(RunOutcome or None, wall time [s], "" or "<Error>: <message>")``.
+
+    The scene is validated first: a bad scene is a bug of the study and propagates. An error
+    of the run itself (a solver that refuses with a message) is a reported failure.
+    """
+    scene = load_scene(scene, overrides=overrides)
+    t0 = time.perf_counter()
+    try:
+        return execute_scene(scene), time.perf_counter() - t0, ""
+    except _REPORTED as exc:
+        return None, time.perf_counter() - t0, f"{type(exc).__name__}: {exc}"
+
+
+def timed(scene, part="bem", *, overrides=None, repeats=3, slow_s=2.0):
+    """Run a scene ``repeats`` times and time one part: ``(outcome, median [s], times [s])``.
+
+    The times are the runner's (``outcome.result["wall_time_s"][part]``, ``part`` ``"bem"``
+    or ``"fem"``, meshing included). The first run decides: if it takes longer than
+    ``slow_s`` [s] or that part did not converge, it is the only run (the solvers are
+    deterministic, so the last outcome stands for all).
+    """
+    scene = load_scene(scene, overrides=overrides)
+    times = []
+    for k in range(max(1, repeats)):
+        outcome = execute_scene(scene)
+        times.append(outcome.result["wall_time_s"][part])
+        if k == 0 and (times[0] > slow_s or not getattr(outcome, part).converged):
+            break
+    return outcome, statistics.median(times), times
+
+
+def finite(result):
+    """Whether every pressure and scalar of a BEM or FEM result is finite."""
+    values = (result.p_max, result.force, result.approach)
+    return bool(np.all(np.isfinite(result.p)) and all(math.isfinite(float(v)) for v in values))
+
+
+def classify(result, *, converged, error, tolerance):
+    """Status of one outcome (one of :data:`STATUSES`) and the reason.
+
+    ``"wrong"``: a NaN or inf in ``result`` or in ``error``, or ``converged`` with ``error``
+    above ``tolerance``; ``"reported failure"``: ``result`` is ``None`` (the run raised) or
+    not ``converged``; else ``"converged"`` (``error`` ``None``: no reference to check).
+    """
+    if result is None:
+        return "reported failure", "raised"
+    if not finite(result) or (error is not None and not math.isfinite(error)):
+        return "wrong", "NaN or inf in the result"
+    if not converged:
+        return "reported failure", "not converged"
+    if error is not None and error > tolerance:
+        return "wrong", f"called converged but off the reference by {error:.2e} > {tolerance:.1e}"
+    return "converged", "agrees with the reference" if error is not None else "no reference: KKT only"
 
 
 def write_json(path, data):
@@ -45,20 +114,3 @@ def markdown_table(headers, rows):
         return "| " + " | ".join(str(c).replace("|", "\\|").replace("\n", " ") for c in cells) + " |"
 
     return "\n".join([line(headers), "|" + "|".join("---" for _ in headers) + "|"] + [line(r) for r in rows])
-
-
-def timed(fn, *, repeats=3, slow_s=2.0):
-    """Run ``fn()`` and time it: ``(result, median wall time [s], wall times of every run [s])``.
-
-    The first run decides: if it takes longer than ``slow_s`` or its result says
-    ``converged = False``, it is the only run; otherwise ``repeats`` runs in all and the
-    median of their times is returned (with the last result; the solvers are deterministic).
-    """
-    times, result = [], None
-    for k in range(max(1, repeats)):
-        t0 = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - t0)
-        if k == 0 and (times[0] > slow_s or not getattr(result, "converged", True)):
-            break
-    return result, statistics.median(times), times

@@ -1,19 +1,21 @@
 """Pressure error against wall time for every BEM method and the FEM reference.
 
-For each problem (:mod:`validation.studies.problems`: ``"hertz"`` and ``"paper-root"``)
-every applicable solver runs on a ladder of resolutions: the BEM at ``n`` lattice steps
-across the contact diameter (10, 20, 40, 80, 160; a method stops climbing after a run longer
-than ``time_budget_s``), the FEM at ``n_contact`` elements across the contact radius
-(4, 8, 16, 32). Errors (:func:`validation.compare.pair_metrics` at the solver's own nodes):
+For each problem (:mod:`validation.studies.problems`: the scenes ``"hertz"`` and
+``"paper-root"``, run by :func:`validation.run.execute_scene`) every applicable solver runs on
+a ladder of resolutions: the BEM at ``n`` lattice steps across the expected contact diameter
+(``bem.nodes_across`` 10, 20, 40, 80, 160; a method stops climbing after a run longer than
+``time_budget_s``), the FEM at ``fem.n_contact`` elements across the contact radius (4, 8, 16,
+32). Errors (:func:`validation.compare.pair_metrics` at the solver's own nodes):
 
 - ``error_l2``: relative L2 error of the pressure over the contact;
 - ``error_peak``: ``|p_max / p_max,ref - 1|``.
 
-References: Hertz's closed form for ``"hertz"``; for a problem without a closed form, the BEM
-Newton solution at 4 x the finest ladder resolution, whose own error is estimated by
-Richardson's rule from the finest ladder level and 2 x and 4 x it (``references`` in the
-result). Wall time: median of ``repeats`` runs (one run when the first takes more than
-``slow_s`` or fails), measured around the whole call (FEM: meshing included).
+References: the run's closed form for ``"hertz"`` (Hertz, ``outcome.analytic``); for a problem
+without one, the BEM Newton solution at 4 x the finest ladder resolution, whose own error is
+estimated by Richardson's rule from the finest ladder level and 2 x and 4 x it
+(``references`` in the result). Wall time: the runner's time of the solver
+(``result["wall_time_s"]``; FEM: meshing included), median of ``repeats`` runs (one run when
+the first takes more than ``slow_s`` or fails).
 
 The augmented gap method is tried with the relaxations ``relaxations`` in turn at each level
 until one converges; every attempt is a row. After a level where none converged, the finer
@@ -22,23 +24,17 @@ levels run only the first (the paper's ``omega = 1``), and its failure is record
 
 from __future__ import annotations
 
-import logging
 import math
 from dataclasses import asdict, dataclass, field
 
 from bem.checks import InputError, check_choice, check_positive
 
 from ..compare import pair_metrics, relative_l2
-from . import fmt
-from . import markdown_table
-from . import timed
-from . import write_json
-from . import write_text
-from .problems import ERROR_TIME_PROBLEMS, get_problem
+from ..run import execute_scene
+from . import fmt, markdown_table, timed, write_json, write_text
+from .problems import ERROR_TIME_PROBLEMS, get_problem, methods
 
 __all__ = ["ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "LADDERS", "TARGETS"]
-
-log = logging.getLogger(__name__)
 
 #: resolution ladders: BEM steps across the contact diameter, FEM elements across the radius
 LADDERS = {"full": {"bem": (10, 20, 40, 80, 160), "fem": (4, 8, 16, 32)},
@@ -233,19 +229,14 @@ def _errors(result, reference):
     return m["l2_rel"], None if m["peak_rel"] is None else abs(m["peak_rel"])
 
 
-def _bem_row(problem, method, n, reference, repeats, slow_s, relaxation=None):
-    opts = {} if relaxation is None else {"relaxation": relaxation}
-    res, t, times = timed(lambda: problem.run_bem(method, n_across=n, **opts), repeats=repeats, slow_s=slow_s)
-    l2, peak = _errors(res, reference)
-    return ErrorTimeRow(problem.name, "bem", method, n, int(res.p.size), l2, peak, t, int(res.iterations),
-                        bool(res.converged), relaxation, len(times), res.message, times)
-
-
-def _fem_row(problem, n, reference, repeats, slow_s):
-    res, t, times = timed(lambda: problem.run_fem(n_contact=n), repeats=repeats, slow_s=slow_s)
-    l2, peak = _errors(res, reference)
-    return ErrorTimeRow(problem.name, "fem", "fem", n, int(res.n_dofs), l2, peak, t, int(res.iterations),
-                        bool(res.converged), None, len(times), res.message, times)
+def _row(name, part, method, n, overrides, reference, problem, opts, relaxation=None):
+    """One timed row: ``problem`` with ``overrides`` (``reference`` ``None``: the run's closed form)."""
+    outcome, t, times = timed(problem, part, overrides=overrides, repeats=opts["repeats"], slow_s=opts["slow_s"])
+    res = getattr(outcome, part)
+    l2, peak = _errors(res, outcome.analytic if reference is None else reference)
+    size = res.p.size if part == "bem" else res.n_dofs
+    return ErrorTimeRow(name, part, method if part == "bem" else "fem", n, int(size), l2, peak, t,
+                        int(res.iterations), bool(res.converged), relaxation, len(times), res.message, times)
 
 
 def _richardson(coarse, mid, fine):
@@ -267,11 +258,11 @@ def _richardson(coarse, mid, fine):
 
 
 def _reference(problem, finest, bar):
-    """The reference of ``problem`` and its description (dict)."""
-    if problem.analytic == "hertz" and problem.layer is None:
-        return problem.hertz, {"kind": "analytic", "title": problem.title,
-                               "description": "Hertz's closed form (exact for this problem)"}
-    levels = [problem.run_bem("newton", n_across=k * finest) for k in (1, 2, 4)]
+    """The reference of ``problem`` (``None``: the closed form of each run) and its description (dict)."""
+    title = problem["scene"]["description"]
+    if "analytic" in problem:
+        return None, {"kind": "analytic", "title": title, "description": "Hertz's closed form (exact for this problem)"}
+    levels = [execute_scene(problem, overrides={"bem.nodes_across": k * finest}).bem for k in (1, 2, 4)]
     bar.update(3)
     ref = levels[-1]
     check = _richardson(*levels)
@@ -279,15 +270,17 @@ def _reference(problem, finest, bar):
             f"{ref.kkt_residual:.1e}); Richardson from {finest}/{2 * finest}/{4 * finest}: peak order "
             f"{fmt(check['order_peak'], '.2f')}, estimated reference error peak {fmt(check['error_peak_estimate'])}, "
             f"L2 order {fmt(check['order_l2'], '.2f')}, estimated reference error L2 {fmt(check['error_l2_estimate'])}")
-    return ref, {"kind": "bem-newton", "title": problem.title, "description": desc, "resolution": 4 * finest,
+    return ref, {"kind": "bem-newton", "title": title, "description": desc, "resolution": 4 * finest,
                  "n": int(ref.p.size), "converged": bool(ref.converged), **check}
 
 
 def _bem_method(study, problem, method, ladder, reference, opts, bar):
+    name = problem["scene"]["title"]
     relaxations = opts["relaxations"] if method == "augmented_gap" else (None,)
     for i, n in enumerate(ladder):
         for omega in relaxations:
-            row = _bem_row(problem, method, n, reference, opts["repeats"], opts["slow_s"], omega)
+            over = {"bem.nodes_across": n, "bem.method": method, **({} if omega is None else {"bem.relaxation": omega})}
+            row = _row(name, "bem", method, n, over, reference, problem, opts, omega)
             study.rows.append(row)
             bar.update(1)
             if row.converged:
@@ -295,10 +288,14 @@ def _bem_method(study, problem, method, ladder, reference, opts, bar):
         else:
             relaxations = relaxations[:1]
         if row.wall_time_s > opts["time_budget_s"] and i + 1 < len(ladder):
-            study.notes.append(f"{problem.name}: {method} took {row.wall_time_s:.3g} s at {n} steps across "
+            study.notes.append(f"{name}: {method} took {row.wall_time_s:.3g} s at {n} steps across "
                                f"(> budget {opts['time_budget_s']:g} s); finer levels skipped")
             bar.update(len(ladder) - i - 1)
             return
+
+
+def _methods(problem):
+    return ("kalker",) if "layer" not in problem else methods(problem)
 
 
 def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=None, repeats=3, slow_s=2.0,
@@ -307,8 +304,9 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
 
     Parameters
     ----------
-    problems : list of Problem or str, optional
-        Default: all of :data:`validation.studies.problems.ERROR_TIME_PROBLEMS`.
+    problems : list of dict or str, optional
+        Scene dicts or built-in problem names; default all of
+        :data:`validation.studies.problems.ERROR_TIME_PROBLEMS`.
     quick : bool
         Use the short ladders of :data:`LADDERS` (for tests).
     bem_ladder, fem_ladder : sequence of int, optional
@@ -343,26 +341,24 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
             "relaxations": relaxations}
     study = ErrorTimeStudy(settings={"mode": mode, "bem_ladder": list(bem_ladder), "fem_ladder": list(fem_ladder),
                                      **opts, "relaxations": list(relaxations)})
-    total = sum(3 * (p.layer is not None) + len(fem_ladder) + len(bem_ladder) * (
+    total = sum(3 * ("analytic" not in p) + len(fem_ladder) + len(bem_ladder) * (
         len(_methods(p)) + ("augmented_gap" in _methods(p)) * (len(relaxations) - 1)) for p in problems)
     with tqdm(total=total, desc="error-time", unit="run", disable=not progress) as bar:
         for problem in problems:
-            reference, study.references[problem.name] = _reference(problem, max(bem_ladder), bar)
-            if problem.layer is None:
-                study.notes.append(f"{problem.name}: without a layer every BEM method is Kalker's QP "
+            name = problem["scene"]["title"]
+            reference, study.references[name] = _reference(problem, max(bem_ladder), bar)
+            if "layer" not in problem:
+                study.notes.append(f"{name}: without a layer every BEM method is Kalker's QP "
                                    "(bem.solve dispatches them to it), so only 'kalker' is run")
             for method in _methods(problem):
                 _bem_method(study, problem, method, bem_ladder, reference, opts, bar)
-            for n in fem_ladder:
-                study.rows.append(_fem_row(problem, n, reference, opts["repeats"], opts["slow_s"]))
+            for n in fem_ladder:  # the run's BEM part on the coarsest lattice: only the FEM is timed
+                over = {"fem.n_contact": n, "bem.nodes_across": min(bem_ladder)}
+                study.rows.append(_row(name, "fem", "fem", n, over, reference, problem, opts))
                 bar.update(1)
         bar.total = bar.n  # relaxations not tried (after failures) were counted in the estimate
         bar.refresh()
     return study
-
-
-def _methods(problem):
-    return ("kalker",) if problem.layer is None else problem.methods
 
 
 def main(args):
@@ -377,11 +373,11 @@ def main(args):
     from ..extras import require
 
     require("fem", "contactlab study error-time (the FEM reference)")
-
     scene = getattr(args, "scene", None)
     problems = None if scene is None else [get_problem(str(scene))]
     out = Path(getattr(args, "out", None) or ".")
-    study = run_error_time(problems, quick=bool(getattr(args, "quick", False)), progress=True)
+    study = run_error_time(problems, quick=bool(getattr(args, "quick", False)),
+                           progress=not getattr(args, "no_progress", False))
     study.to_json(out / "error_time.json")
     text = study.markdown()
     write_text(out / "error_time.md", text)

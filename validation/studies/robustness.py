@@ -8,8 +8,11 @@ approach that force gives (approach control), with a power layer ``w = lam p^s``
   ``w(p_m) / p_m``, is ``k`` times the elastic compliance of the contact ``a_H^2 / (R p_0)``
   (12 decades, from a layer far stiffer than the bodies to a layer far softer),
 - ``E*`` in :data:`MODULI` (``1e-3 .. 1e12`` relative to ``P / R^2``),
-- each layer method of :func:`bem.solve` (Newton, variable compliance, augmented gap) and both
-  controls, on a lattice of :data:`NODES_ACROSS` nodes across the contact diameter.
+- each layer method (Newton, variable compliance, augmented gap) and both controls, on a lattice
+  of :data:`NODES_ACROSS` steps across the expected contact diameter (``bem.nodes_across``).
+
+Each point is a scene run by :func:`validation.run.execute_scene` (the region grown when the
+contact reaches it); the dense KKT check is done on the outcome.
 
 Each outcome gets one status: ``"converged"`` (the solver says so and the KKT residual of
 eq. 14 recomputed with the dense influence matrix, independently of the FFT path, is at most
@@ -20,23 +23,17 @@ or ``"wrong"`` (``converged = True`` with the dense KKT residual above ``2 rtol`
 from __future__ import annotations
 
 import itertools
-import logging
 import math
-import time
 from collections import Counter
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from . import fmt
-from . import markdown_table
-from . import write_json
-from . import write_text
+from ..scene import load_scene
+from . import attempt, classify, finite, fmt, markdown_table, write_json, write_text
 
 __all__ = ["RobustnessRow", "run_robustness", "summary_markdown", "summary_table", "matrix_table", "failure_table",
            "rows_from_json", "main", "EXPONENTS", "COMPLIANCES", "MODULI"]
-
-log = logging.getLogger(__name__)
 
 EXPONENTS = (0.05, 0.2, 0.5, 1.0, 2.0, 3.0, 10.0)
 COMPLIANCES = (1e-6, 1e-3, 1.0, 1e3, 1e6)
@@ -63,93 +60,67 @@ class RobustnessRow:
     message: str
 
 
-def _layer(s, k, E_star):
-    """``Power(lam, s)`` whose secant at the Hertz mean pressure is ``k`` elastic compliances."""
-    from bem.layers import Power
-
+def _scene(s, k, E_star):
+    """Scene dict of one grid point: ``Power(lam, s)`` whose secant at the Hertz mean pressure is
+    ``k`` elastic compliances, under ``P = 1`` (force control)."""
     a = (3 / (4 * E_star)) ** (1 / 3)  # Hertz, R = P = 1
     p0 = 3 / (2 * math.pi * a * a)
-    p_m = 2 * p0 / 3
-    return Power(k * (a * a / p0) * p_m ** (1 - s), s)
+    lam = k * (a * a / p0) * (2 * p0 / 3) ** (1 - s)
+    return {"scene": {"name": "robustness", "units": "normalised: R = P = 1"}, "bodies": {"E_star": E_star},
+            "gap": {"type": "paraboloid", "R": 1.0}, "layer": {"law": "power", "lam": lam, "s": s},
+            "load": {"force": 1.0}, "bem": {"nodes_across": NODES_ACROSS, "extent_factor": 1.5, "rtol": RTOL}}
 
 
-def _contact_radius(layer, E_star):
-    """The larger of the Hertz and the layer-only contact radius (the softer mechanism wins)."""
-    from bem.reference import rigid_layer_paraboloid
-
-    return max((3 / (4 * E_star)) ** (1 / 3), rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius)
-
-
-def _dense_kkt(res, layer):
+def _dense_kkt(outcome):
+    """KKT residual of eq. 14 of a run's BEM state, with the dense influence matrix (not the FFT path)."""
     import bem
 
-    C = bem.InfluenceOperator(res.lattice, res.E_star).dense()
-    total = C @ res.p + layer.w(res.p)
-    g = total + 0.5 * (res.x ** 2 + res.y ** 2) - res.approach
+    res = outcome.bem
+    total = bem.InfluenceOperator(res.lattice, res.E_star).dense() @ res.p + outcome.layer.w(res.p)
+    g = total + outcome.scene.gap(res.x, res.y) - res.approach
     return float(bem.kkt.kkt_residual(res.p, g, displacement_scale=float(np.abs(total).max()),
                                       force=None, node_area=res.lattice.node_area))
 
 
-def _solve(layer, E_star, load, method, a):
-    import bem
-    from bem.gaps import Paraboloid
-
-    extent = 1.5 * a
-    for _ in range(4):
-        try:
-            return bem.solve(Paraboloid(1.0), E_star=E_star, step=2 * a / NODES_ACROSS, extent=extent,
-                             layer=layer, method=method, rtol=RTOL, **load)
-        except bem.RegionTooSmallError:
-            extent *= 1.5
-    raise RuntimeError(f"the contact kept reaching the border of the region (extent {extent:.3g})")
-
-
-def _row(s, k, E_star, control, method, layer, load, a):
-    t0 = time.perf_counter()
-    try:
-        res = _solve(layer, E_star, load, method, a)
-    except (ValueError, ArithmeticError, RuntimeError) as exc:
-        return RobustnessRow(s, k, E_star, control, method, "reported failure", False, None, 0,
-                             time.perf_counter() - t0, f"{type(exc).__name__}: {exc}"), None
-    elapsed = time.perf_counter() - t0
-    finite = bool(np.all(np.isfinite(res.p))) and math.isfinite(res.approach)
-    kkt = _dense_kkt(res, layer) if finite else math.inf
-    if not finite:
-        status = "wrong"
-    elif res.converged:
-        status = "converged" if kkt <= 2 * RTOL else "wrong"
-    else:
-        status = "reported failure"
-    return RobustnessRow(s, k, E_star, control, method, status, bool(res.converged), kkt, int(res.iterations),
-                         elapsed, res.message), res
+def _row(point, control, method, run):
+    outcome, seconds, raised = run
+    if outcome is None:
+        return RobustnessRow(*point, control, method, "reported failure", False, None, 0, seconds, raised)
+    res = outcome.bem
+    kkt = _dense_kkt(outcome) if finite(res) else math.inf
+    status, _ = classify(res, converged=res.converged, error=kkt if res.converged else None, tolerance=2 * RTOL)
+    return RobustnessRow(*point, control, method, status, bool(res.converged), kkt, int(res.iterations),
+                         outcome.result["wall_time_s"]["bem"], res.message)
 
 
 def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODULI, methods=LAYER_METHODS,
                    progress=False):
     """Run the grid; returns the list of :class:`RobustnessRow`.
 
-    Approach control uses the approach of the force-controlled Newton solve of the same point
+    Every run of a point is its scene with overrides, on the lattice step of the force-controlled
+    scene. Approach control uses the approach of the force-controlled Newton run of the same point
     (the same discrete problem), or, if that failed, the layer-only closed form.
     """
     from tqdm import tqdm
 
+    from bem.layers import Power
     from bem.reference import rigid_layer_paraboloid
 
-    points = list(itertools.product(exponents, compliances, moduli))
     rows = []
-    for s, k, E_star in tqdm(points, disable=not progress, desc="robustness", unit="point"):
-        layer = _layer(s, k, E_star)
-        a = _contact_radius(layer, E_star)
+    for point in tqdm(list(itertools.product(exponents, compliances, moduli)), disable=not progress,
+                      desc="robustness", unit="point"):
+        scene = load_scene(_scene(*point))
         approach = None
         for control in ("force", "approach"):
             if control == "approach" and approach is None:
+                layer = Power(scene.layer_spec["lam"], scene.layer_spec["s"])
                 approach = rigid_layer_paraboloid(layer, 1.0, force=1.0).approach
-            load = {"force": 1.0} if control == "force" else {"approach": approach}
+            load = {} if control == "force" else {"load.approach": approach, "bem.step": scene.bem["step"]}
             for method in methods:
-                row, res = _row(s, k, E_star, control, method, layer, load, a)
-                rows.append(row)
-                if control == "force" and method == "newton" and res is not None and res.converged:
-                    approach = res.approach
+                run = attempt(scene, {"bem.method": method, **load})
+                rows.append(_row(point, control, method, run))
+                if control == "force" and method == "newton" and run[0] is not None and run[0].bem.converged:
+                    approach = run[0].bem.approach
     return rows
 
 
@@ -241,7 +212,7 @@ def main(args):
     kw = {}
     if getattr(args, "quick", False):
         kw = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
-    rows = run_robustness(progress=True, **kw)
+    rows = run_robustness(progress=not getattr(args, "no_progress", False), **kw)
     text = summary_markdown(rows)
     write_text(out / "robustness.md", text + "\n")
     write_json(out / "robustness.json", [_json_row(r) for r in rows])

@@ -1,13 +1,13 @@
 """Stability study: every method on stiff and extreme cases, every outcome classified.
 
-Cases (:func:`validation.studies.problems.stability_cases`): layer compliance over six
-decades (``1e-3 .. 1e3`` times the elastic compliance over the contact), power laws
-``s = 0.2 .. 3``, an elastic-rigid layer with a tiny ``p_cr``, a contact of a few nodes, a
-contact filling most of the candidate region, very dissimilar moduli (``E1/E2 = 1e3``,
+Cases (:func:`validation.studies.problems.stability_cases`, scenes run by the runner): layer
+compliance over six decades (``1e-3 .. 1e3`` times the elastic compliance over the contact),
+power laws ``s = 0.2 .. 3``, an elastic-rigid layer with a tiny ``p_cr``, a contact of a few
+nodes, a contact filling most of the candidate region, very dissimilar moduli (``E1/E2 = 1e3``,
 ``nu2 = 0.49``) and nearly incompressible bodies in the FEM (``nu = 0.49, 0.499``).
 
-Each case runs every BEM method that applies, and the FEM where the case marks it relevant.
-Every outcome gets one status:
+Each case runs every BEM method that applies, and the FEM where the case has ``[fem]`` (in the
+Newton run). Every outcome gets one status (:func:`validation.studies.classify`):
 
 - ``"converged"``: the solver says converged, every value is finite, and it agrees with the
   reference within the tolerance (or no reference exists: then its KKT residual is the only
@@ -22,8 +22,9 @@ References and tolerances:
 
 - paper methods and Kalker's QP: Newton at the same resolution, :data:`METHOD_TOL`
   (the same discrete problem, solved to a KKT residual of ``1e-10``);
-- Newton: the case's closed form (Hertz, or a layer limit) with the case's tolerance, else
-  the FEM with :data:`FEM_TOL` when the FEM runs, else none;
+- Newton: the case's closed form (``outcome.analytic``: Hertz, or a layer limit) with
+  :data:`~validation.studies.problems.LIMIT_TOL`, else the FEM with :data:`FEM_TOL` when the
+  FEM runs, else none;
 - FEM: Hertz for smooth bodies, else BEM Newton, with :data:`FEM_TOL` (two different
   discretisations: 25 BEM steps across the diameter, 16 FEM elements across the radius).
 
@@ -33,33 +34,23 @@ References and tolerances:
 
 from __future__ import annotations
 
-import logging
 import math
-import time
 from collections import Counter
 from dataclasses import asdict, dataclass, field
 
-import numpy as np
+from bem.reference import hertz_sphere
 
 from ..compare import pair_metrics
-from . import fmt
-from . import markdown_table
-from . import write_json
-from . import write_text
-from .problems import stability_cases
+from . import STATUSES, attempt, classify, finite, fmt, markdown_table, write_json, write_text
+from .problems import LIMIT_TOL, methods, stability_cases
 
 __all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main",
            "METHOD_TOL", "FEM_TOL", "STATUSES"]
 
-log = logging.getLogger(__name__)
-
-STATUSES = ("converged", "reported failure", "wrong")
 #: agreement required of a method with Newton on the same lattice
 METHOD_TOL = 1e-6
 #: agreement required between the FEM and the BEM (or Hertz)
 FEM_TOL = 0.05
-#: errors a solver may raise to report a failure (anything else is a bug and propagates)
-_REPORTED = (ValueError, ArithmeticError, RuntimeError)
 
 
 class StabilityFailure(RuntimeError):
@@ -83,18 +74,15 @@ class StabilityRow:
     status : str
         One of :data:`STATUSES` (module docstring).
     kkt_residual : float or None
-        BEM: :func:`bem.kkt.kkt_residual` of the returned state; FEM: final relative Newton
-        residual; ``None`` when the solver raised.
-    error_vs_reference : float or None
-        ``max(l2_rel, |peak_rel|)`` against ``reference``.
-    reference : str
-        What the result was compared with (``"-"`` for nothing).
-    tolerance : float or None
-        The tolerance of that comparison.
+        BEM: the KKT residual of the returned state; FEM: final relative Newton residual;
+        ``None`` when the run raised.
+    error_vs_reference, tolerance : float or None
+        ``max(l2_rel, |peak_rel|)`` against ``reference`` (``"-"``: nothing), and its tolerance.
     iterations : int
     wall_time_s : float
+        The solver's wall time [s] (of the whole run when it raised).
     message : str
-        The solver's message (and why the status was given).
+        Why the status was given, and the solver's message.
     """
 
     case: str
@@ -123,35 +111,31 @@ class StabilityStudy:
 
     def check(self):
         """Raise :class:`StabilityFailure` if any outcome is wrong; else return ``self``."""
-        bad = self.wrong()
-        if bad:
-            raise StabilityFailure(bad, self)
+        if self.wrong():
+            raise StabilityFailure(self.wrong(), self)
         return self
 
     def counts(self):
-        """``{method: {status: count}}`` over all cases."""
+        """``{"solver method": {status: count}}`` over all cases."""
         out = {}
         for r in self.rows:
             out.setdefault(f"{r.solver} {r.method}", Counter())[r.status] += 1
         return {k: {s: v.get(s, 0) for s in STATUSES} for k, v in out.items()}
 
-    def table_markdown(self):
-        """Markdown table of all rows."""
-        head = ["case", "solver", "method", "status", "KKT residual", "error vs reference", "reference",
-                "iterations", "wall time [s]", "message"]
-        body = [[r.case, r.solver, r.method, r.status, fmt(r.kkt_residual, ".1e"), fmt(r.error_vs_reference),
-                 r.reference, r.iterations, fmt(r.wall_time_s, ".3g"), _short(r.message)] for r in self.rows]
-        return markdown_table(head, body)
-
     def markdown(self):
         """The study as markdown: a per-method summary, then the full table."""
         summary = markdown_table(["solver / method"] + list(STATUSES),
                                  [[k] + [v[s] for s in STATUSES] for k, v in self.counts().items()])
+        table = markdown_table(
+            ["case", "solver", "method", "status", "KKT residual", "error vs reference", "reference", "iterations",
+             "wall time [s]", "message"],
+            [[r.case, r.solver, r.method, r.status, fmt(r.kkt_residual, ".1e"), fmt(r.error_vs_reference),
+              r.reference, r.iterations, fmt(r.wall_time_s, ".3g"), _short(r.message)] for r in self.rows])
         return "\n".join([
             "## Stability on stiff and extreme cases", "",
             f"Tolerances: paper methods and QP against Newton on the same lattice {METHOD_TOL:g}; FEM against "
             f"Hertz or BEM Newton {FEM_TOL:g}; Newton against the case's closed form at the case's tolerance.",
-            "", summary, "", self.table_markdown(), ""])
+            "", summary, "", table, ""])
 
     def to_dict(self):
         """JSON-ready dict."""
@@ -168,101 +152,62 @@ def _short(message, n=110):
     return message if len(message) <= n else message[: n - 3] + "..."
 
 
-def _finite(result):
-    """Whether every pressure and scalar of a BEM or FEM result is finite."""
-    values = [result.p_max, result.force, result.approach]
-    return bool(np.all(np.isfinite(result.p)) and all(math.isfinite(float(v)) for v in values))
+def _part(run, part):
+    """``(solver result or None, wall time [s], why it raised)`` of the ``"bem"`` or ``"fem"`` part of a run."""
+    outcome, seconds, raised = run
+    if outcome is None:
+        return None, seconds, f"raised {raised}"
+    return getattr(outcome, part), outcome.result["wall_time_s"][part], ""
 
 
-def classify(result, *, converged, error, tolerance):
-    """Status of one outcome (module docstring) and the reason.
-
-    Parameters
-    ----------
-    result : bem.ContactResult or fem_reference.FemResult or None
-        ``None`` when the solver raised (a reported failure).
-    converged : bool
-        The solver's verdict.
-    error : float or None
-        Error against the reference (``None``: no reference).
-    tolerance : float or None
-        Allowed error.
-
-    Returns
-    -------
-    (str, str)
-        Status and a short reason.
-    """
-    if result is None:
-        return "reported failure", "raised"
-    if not _finite(result) or (error is not None and not math.isfinite(error)):
-        return "wrong", "NaN or inf in the result"
-    if not converged:
-        return "reported failure", "not converged"
-    if error is not None and error > tolerance:
-        return "wrong", f"called converged but off the reference by {error:.2e} > {tolerance:.1e}"
-    return "converged", "agrees with the reference" if error is not None else "no reference: KKT only"
+def _good(part):
+    return part[0] is not None and bool(part[0].converged) and finite(part[0])
 
 
-def _error(result, reference):
-    m = pair_metrics(result, reference)
-    if m["l2_rel"] is None or m["peak_rel"] is None:
-        return math.inf
-    return max(m["l2_rel"], abs(m["peak_rel"]))
+def _closed(case, limit, run):
+    """``(name, closed form, tolerance)`` of a case's ``limit``, or ``None``: the run's ``[analytic]``,
+    or Hertz's solution of the run's bodies, gap and load (the limit of a stiff layer)."""
+    outcome = run[0]
+    if limit is None or outcome is None:
+        return None
+    scene = outcome.scene
+    ref = outcome.analytic or hertz_sphere(scene.gap.R, scene.E_star, **scene.load)
+    return (f"{limit} limit" if "layer" in case else "Hertz"), ref, LIMIT_TOL[limit]
 
 
-def _attempt(fn):
-    """``(result, seconds, exception message or "")``."""
-    t0 = time.perf_counter()
-    try:
-        return fn(), time.perf_counter() - t0, ""
-    except _REPORTED as exc:  # a solver that refuses with a message has reported its failure
-        return None, time.perf_counter() - t0, f"raised {type(exc).__name__}: {exc}"
-
-
-def _row(case, solver, method, outcome, reference):
-    """Build a row from ``(result, seconds, raised)`` and ``(name, object, tol)`` or ``None``."""
-    result, seconds, raised = outcome
+def _row(case, solver, method, part, reference):
+    """Row of one solver result ``(result, seconds, raised)`` against ``(name, object, tol)`` or ``None``."""
+    result, seconds, raised = part
     ref_name, ref, tol = reference if reference is not None else ("-", None, None)
+    name = case["scene"]["title"]
     if result is None:
-        return StabilityRow(case.name, solver, method, "reported failure", None, None, ref_name, tol, 0, seconds,
-                            raised)
-    is_fem = solver == "fem"
-    finite = _finite(result)
-    error = _error(result, ref) if (ref is not None and finite) else None
+        return StabilityRow(name, solver, method, "reported failure", None, None, ref_name, tol, 0, seconds, raised)
+    error = None
+    if ref is not None and finite(result):
+        m = pair_metrics(result, ref)
+        error = math.inf if None in (m["l2_rel"], m["peak_rel"]) else max(m["l2_rel"], abs(m["peak_rel"]))
     status, why = classify(result, converged=bool(result.converged), error=error, tolerance=tol)
-    kkt = result.residual if is_fem else result.kkt_residual
-    message = result.message if is_fem else result.message
-    return StabilityRow(case.name, solver, method, status, float(kkt) if math.isfinite(kkt) else None, error,
-                        ref_name, tol, int(result.iterations), seconds, f"{why}; {message}")
+    kkt = result.residual if solver == "fem" else result.kkt_residual
+    return StabilityRow(name, solver, method, status, float(kkt) if math.isfinite(kkt) else None, error, ref_name,
+                        tol, int(result.iterations), seconds, f"{why}; {result.message}")
 
 
-def _good(outcome):
-    result = outcome[0]
-    return result is not None and bool(result.converged) and _finite(result)
-
-
-def _run_case(case):
-    rows = []
-    newton = _attempt(lambda: case.run_bem("newton"))
-    fem = _attempt(case.run_fem) if case.fem else None
-    analytic = case.reference_solution()
-    closed = None if analytic is None else (f"{case.analytic} limit" if case.layer is not None else "Hertz",
-                                            analytic, case.analytic_tol)
-    if closed is not None:
-        newton_ref = closed
-    elif fem is not None and _good(fem):
-        newton_ref = ("FEM", fem[0], FEM_TOL)
-    else:
-        newton_ref = None
-    rows.append(_row(case, "bem", "newton", newton, newton_ref))
-    same = ("Newton, same lattice", newton[0], METHOD_TOL) if _good(newton) else closed
-    for method in case.methods:
-        if method != "newton":
-            rows.append(_row(case, "bem", method, _attempt(lambda m=method: case.run_bem(m)), same))
+def _run_case(case, limit):
+    bem_only = {k: v for k, v in case.items() if k != "fem"}
+    first = attempt(case)  # Newton, with the FEM when the case has [fem]
+    fem = _part(first, "fem") if "fem" in case else None
+    if first[0] is None and fem is not None:  # the run raised: run Newton alone to tell whose error it was
+        first = attempt(bem_only)
+    newton, closed = _part(first, "bem"), _closed(case, limit, first)
+    rows = [_row(case, "bem", "newton", newton,
+                 closed or (("FEM", fem[0], FEM_TOL) if fem is not None and _good(fem) else None))]
+    for method in methods(case)[1:]:
+        run = attempt(bem_only, {"bem.method": method})
+        same = ("Newton, same lattice", newton[0], METHOD_TOL) if _good(newton) else _closed(case, limit, run)
+        rows.append(_row(case, "bem", method, _part(run, "bem"), same))
     if fem is not None:
-        if case.layer is None and case.analytic == "hertz":
-            fem_ref = ("Hertz", analytic, FEM_TOL)
+        if "layer" not in case and closed is not None:
+            fem_ref = ("Hertz", closed[1], FEM_TOL)
         elif _good(newton):
             fem_ref = ("BEM Newton", newton[0], FEM_TOL)
         else:
@@ -276,8 +221,9 @@ def run_stability(cases=None, *, quick=False, check=True, progress=False):
 
     Parameters
     ----------
-    cases : list of Problem, optional
-        Default :func:`validation.studies.problems.stability_cases` (``quick``: the subset).
+    cases : list of (dict, str or None), optional
+        Scene dicts and their closed-form limits; default
+        :func:`validation.studies.problems.stability_cases` (``quick``: the subset).
     quick : bool
         The representative subset of cases (for tests).
     check : bool
@@ -298,12 +244,10 @@ def run_stability(cases=None, *, quick=False, check=True, progress=False):
 
     cases = stability_cases(quick) if cases is None else list(cases)
     study = StabilityStudy(settings={"mode": "quick" if quick else "full", "method_tol": METHOD_TOL,
-                                     "fem_tol": FEM_TOL, "cases": [c.name for c in cases]})
-    for case in tqdm(cases, desc="stability", unit="case", disable=not progress):
-        study.rows += _run_case(case)
-    if check:
-        study.check()
-    return study
+                                     "fem_tol": FEM_TOL, "cases": [c["scene"]["title"] for c, _ in cases]})
+    for case, limit in tqdm(cases, desc="stability", unit="case", disable=not progress):
+        study.rows += _run_case(case, limit)
+    return study.check() if check else study
 
 
 def main(args):
@@ -318,9 +262,9 @@ def main(args):
     from ..extras import require
 
     require("fem", "contactlab study stability (the FEM cases)")
-
     out = Path(getattr(args, "out", None) or ".")
-    study = run_stability(quick=bool(getattr(args, "quick", False)), check=False, progress=True)
+    study = run_stability(quick=bool(getattr(args, "quick", False)), check=False,
+                          progress=not getattr(args, "no_progress", False))
     study.to_json(out / "stability.json")
     text = study.markdown()
     write_text(out / "stability.md", text)
