@@ -1,16 +1,16 @@
 """Studies over the solvers; every problem is a scene run by :func:`validation.run.execute_scene`.
 
-- :mod:`validation.studies.problems`: the problems, as scene dicts (docs/scenes.md).
-- :mod:`validation.studies.error_time`: pressure error against wall time over a ladder of
-  resolutions for every BEM method and the FEM reference (:class:`ErrorTimeStudy`).
-- :mod:`validation.studies.stability`: every method on stiff and extreme cases, each outcome
-  classified; a wrong answer or a NaN raises :class:`StabilityFailure`.
-- :mod:`validation.studies.robustness`: the layer methods over 12 decades of layer compliance,
+- :mod:`~validation.studies.problems`: the problems, as scene dicts (docs/scenes.md);
+- :mod:`~validation.studies.error_time`: pressure error against wall time over a ladder of
+  resolutions for every BEM method and the FEM reference;
+- :mod:`~validation.studies.stability`: every method on stiff and extreme cases; a wrong answer
+  or a NaN raises ``StabilityFailure``;
+- :mod:`~validation.studies.robustness`: the layer methods over 12 decades of layer compliance,
   every converged answer checked against the KKT conditions with the dense influence matrix.
 
-Each has ``main(args)`` for ``contactlab study error-time | stability | robustness``. This
-module holds what they share: running a scene (:func:`attempt`, :func:`timed`), classifying an
-outcome (:func:`classify`) and writing tables and files.
+Each has ``main(args)`` for ``contactlab study error-time | stability | robustness``. This module
+holds what they share: running a scene (:func:`attempt`, :func:`timed`), the status of an outcome
+(:func:`classify`) and the files (:func:`save`).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import json
 import math
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -27,10 +28,9 @@ from bem.files import write_text
 from ..run import execute_scene
 from ..scene import load_scene
 
-__all__ = ["attempt", "timed", "classify", "finite", "write_json", "write_text", "markdown_table", "fmt",
-           "STATUSES"]
+__all__ = ["attempt", "timed", "classify", "finite", "save", "write_json", "markdown_table", "fmt", "STATUSES"]
 
-#: outcome statuses: converged (and agreeing with the reference), the solver's own failure, wrong
+#: status of an outcome (:func:`classify`)
 STATUSES = ("converged", "reported failure", "wrong")
 #: errors a run may raise to report a failure (anything else is a bug and propagates)
 _REPORTED = (ValueError, ArithmeticError, RuntimeError)
@@ -39,8 +39,8 @@ _REPORTED = (ValueError, ArithmeticError, RuntimeError)
 def attempt(scene, overrides=None):
     """Run a scene: ``(RunOutcome or None, wall time [s], "" or "<Error>: <message>")``.
 
-    The scene is validated first: a bad scene is a bug of the study and propagates. An error
-    of the run itself (a solver that refuses with a message) is a reported failure.
+    The scene is validated first (a bad scene is a bug of the study and propagates); an error of
+    the run itself (a solver that refuses with a message) is returned as a reported failure.
     """
     scene = load_scene(scene, overrides=overrides)
     t0 = time.perf_counter()
@@ -51,12 +51,10 @@ def attempt(scene, overrides=None):
 
 
 def timed(scene, part="bem", *, overrides=None, repeats=3, slow_s=2.0):
-    """Run a scene ``repeats`` times and time one part: ``(outcome, median [s], times [s])``.
+    """Run a scene up to ``repeats`` times: ``(last outcome, median wall time [s], every wall time [s])``.
 
-    The times are the runner's (``outcome.result["wall_time_s"][part]``, ``part`` ``"bem"``
-    or ``"fem"``, meshing included). The first run decides: if it takes longer than
-    ``slow_s`` [s] or that part did not converge, it is the only run (the solvers are
-    deterministic, so the last outcome stands for all).
+    The times are the runner's for ``part`` (``"bem"`` or ``"fem"``, meshing included). When the
+    first run takes longer than ``slow_s`` [s] or that part did not converge, it is the only one.
     """
     scene = load_scene(scene, overrides=overrides)
     times = []
@@ -75,11 +73,11 @@ def finite(result):
 
 
 def classify(result, *, converged, error, tolerance):
-    """Status of one outcome (one of :data:`STATUSES`) and the reason.
+    """Status of one outcome and the reason: ``(status, why)``.
 
-    ``"wrong"``: a NaN or inf in ``result`` or in ``error``, or ``converged`` with ``error``
-    above ``tolerance``; ``"reported failure"``: ``result`` is ``None`` (the run raised) or
-    not ``converged``; else ``"converged"`` (``error`` ``None``: no reference to check).
+    ``"wrong"``: a NaN or inf in ``result`` or ``error``, or ``converged`` with ``error`` above
+    ``tolerance``; ``"reported failure"``: no ``result`` (the run raised) or not ``converged``;
+    else ``"converged"`` (with ``error`` ``None`` there was no reference to check).
     """
     if result is None:
         return "reported failure", "raised"
@@ -95,6 +93,14 @@ def classify(result, *, converged, error, tolerance):
 def write_json(path, data):
     """Write ``data`` as indented JSON, whole or not at all (``NaN``/``inf`` refused: JSON has none)."""
     return write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
+
+
+def save(args, stem, data, text):
+    """Write ``<stem>.json`` and ``<stem>.md`` to ``args.out`` (default: the current directory); returns ``text``."""
+    out = Path(getattr(args, "out", None) or ".")
+    write_json(out / f"{stem}.json", data)
+    write_text(out / f"{stem}.md", text)
+    return text
 
 
 def fmt(value, spec=".2e"):
