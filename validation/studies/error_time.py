@@ -138,13 +138,14 @@ class ErrorTimeStudy:
                 "converged"]
         for name in self.problems:
             ref = self.references.get(name, {})
-            body = [[r.solver, r.label, r.resolution, r.n, fmt(r.error_l2), fmt(r.error_peak), fmt(r.wall_time_s, ".3g"),
-                     r.iterations, fmt(r.converged)] for r in self.rows if r.problem == name]
+            body = [[r.solver, r.label, r.resolution, r.n, fmt(r.error_l2), fmt(r.error_peak),
+                     fmt(r.wall_time_s, ".3g"), r.iterations, fmt(r.converged)] for r in self.rows if r.problem == name]
             out += [f"### {name}", "", ref.get("title", ""), "", f"Reference: {ref.get('description', '-')}", "",
                     markdown_table(head, body), ""]
-        firsts = [[name, f"{m.replace('error_', '')} <= {tol:.1%}"] + (
-            ["none reached it", "-", "-"] if r is None else [f"{r.solver} {r.label}", r.resolution,
-                                                           fmt(r.wall_time_s, ".3g")]) for name, m, tol, r in self._firsts()]
+        firsts = [[name, f"{m.replace('error_', '')} <= {tol:.1%}"]
+                  + (["none reached it", "-", "-"] if r is None
+                     else [f"{r.solver} {r.label}", r.resolution, fmt(r.wall_time_s, ".3g")])
+                  for name, m, tol, r in self._firsts()]
         out += ["### First to reach the error target", "", "The fastest converged run whose error is at most the "
                 "target and stays so at every finer converged level of its solver and method.", "",
                 markdown_table(["problem", "target", "first", "resolution", "wall time [s]"], firsts)]
@@ -206,8 +207,11 @@ def _climb(study, problem, method, ladder, reference, opts):
     relaxations = opts["relaxations"] if method == "augmented_gap" else (None,)
     for i, n in enumerate(ladder):
         for omega in relaxations:
-            over = ({"fem.n_contact": n, "bem.nodes_across": opts["coarsest"]} if part == "fem" else
-                    {"bem.nodes_across": n, "bem.method": method, **({} if omega is None else {"bem.relaxation": omega})})
+            if part == "fem":
+                over = {"fem.n_contact": n, "bem.nodes_across": opts["coarsest"]}
+            else:
+                over = {"bem.nodes_across": n, "bem.method": method}
+                over.update({} if omega is None else {"bem.relaxation": omega})
             outcome, t, times = timed(problem, part, overrides=over, repeats=opts["repeats"], slow_s=opts["slow_s"])
             res = getattr(outcome, part)
             m = pair_metrics(res, outcome.analytic if reference is None else reference)

@@ -123,8 +123,8 @@ def summary_table(rows):
         sel = [r for r in rows if r.method == method and r.control == control]
         times = [r.wall_time_s for r in sel]
         kkts = [r.kkt_dense for r in sel if r.converged and r.kkt_dense is not None]
-        body.append([method, control, c["converged"], c["reported failure"], c["wrong"],
-                     fmt(float(np.median(times)), ".3f"), fmt(max(times), ".3f"), fmt(max(kkts), ".1e") if kkts else "-"])
+        body.append([method, control, c["converged"], c["reported failure"], c["wrong"], fmt(float(np.median(times)),
+                     ".3f"), fmt(max(times), ".3f"), fmt(max(kkts), ".1e") if kkts else "-"])
     return (["method", "control", "converged", "reported failure", "wrong", "median time [s]", "max time [s]",
              "worst dense KKT when converged"], body)
 
