@@ -188,8 +188,10 @@ def _richardson(coarse, mid, fine):
 def _reference(problem, finest):
     """The reference of ``problem`` (``None``: each run's closed form) and its description (dict)."""
     title = problem["scene"]["description"]
-    if "analytic" in problem:
-        return None, {"kind": "analytic", "title": title, "description": "Hertz's closed form (exact for this problem)"}
+    kind = problem.get("analytic", {}).get("kind")
+    if kind is not None:
+        desc = "Hertz's closed form (exact for this problem)" if kind == "hertz" else f"the closed form {kind!r}"
+        return None, {"kind": "analytic", "title": title, "description": desc}
     levels = [execute_scene(problem, overrides={"bem.nodes_across": k * finest}).bem for k in (1, 2, 4)]
     ref, check = levels[-1], _richardson(*levels)
     desc = (f"BEM Newton at {4 * finest} steps across the contact ({ref.p.size} nodes, KKT residual "
