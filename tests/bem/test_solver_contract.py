@@ -160,10 +160,10 @@ def test_newton_force_control_with_an_extreme_concave_layer(k):
 
     Newton under force control stalls there; the force is then found as the root of P(delta)
     over approach-controlled solves (which converge)."""
-    from validation.studies.robustness import _contact_radius, _layer
-
-    layer = _layer(0.05, k, 1.0)
-    a = _contact_radius(layer, 1.0)
+    a_H = 0.75 ** (1 / 3)  # Hertz, R = E* = P = 1; the layer's secant at his mean pressure is k a_H^2 / p0
+    p0 = 3 / (2 * math.pi * a_H * a_H)
+    layer = layers.Power(k * (a_H * a_H / p0) * (2 * p0 / 3) ** (1 - 0.05), 0.05)
+    a = max(a_H, rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius)
     res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * a / 16, extent=1.5 * a, layer=layer)
     assert res.converged, res.message
     assert _dense_kkt(res, layer) <= 1.01e-10

@@ -13,7 +13,8 @@ from bem.checks import InputError
 from bem.reference import hertz_sphere
 from validation.studies import error_time, stability
 from validation.studies.error_time import ErrorTimeRow, ErrorTimeStudy, run_error_time
-from validation.studies.problems import get_problem, stability_cases
+from validation.run import execute_scene
+from validation.studies.problems import get_problem, methods, stability_cases
 from validation.studies.stability import STATUSES, StabilityFailure, classify, run_stability
 
 LADDER = error_time.LADDERS["quick"]
@@ -136,11 +137,11 @@ def test_error_time_json_and_main(et, tmp_path, capsys):
 
 def test_stability_quick_has_no_nan_and_no_wrong_answer(st):
     assert st.wrong() == [] and st.check() is st
-    names = [c.name for c in stability_cases(quick=True)]
-    for case in stability_cases(quick=True):
-        rows = [r for r in st.rows if r.case == case.name]
-        assert {r.method for r in rows if r.solver == "bem"} == set(case.methods)
-        assert any(r.solver == "fem" for r in rows) == case.fem
+    names = [c["scene"]["title"] for c, _ in stability_cases(quick=True)]
+    for case, _ in stability_cases(quick=True):
+        rows = [r for r in st.rows if r.case == case["scene"]["title"]]
+        assert {r.method for r in rows if r.solver == "bem"} == set(methods(case))
+        assert any(r.solver == "fem" for r in rows) == ("fem" in case)
     assert {r.case for r in st.rows} == set(names)
     for r in st.rows:
         assert r.status in STATUSES
@@ -160,7 +161,7 @@ def test_stability_quick_has_no_nan_and_no_wrong_answer(st):
 
 
 def test_classify_rules():
-    res = get_problem("hertz").run_bem("kalker", n_across=10)
+    res = execute_scene(get_problem("hertz"), overrides={"bem.method": "kalker", "bem.nodes_across": 10}).bem
     assert classify(res, converged=True, error=1e-9, tolerance=1e-6)[0] == "converged"
     assert classify(res, converged=True, error=None, tolerance=None)[0] == "converged"
     assert classify(res, converged=True, error=1e-3, tolerance=1e-6)[0] == "wrong"
@@ -172,7 +173,7 @@ def test_classify_rules():
 
 
 def _case():
-    return next(c for c in stability_cases(quick=True) if c.name == "linear k=1000")
+    return next(c for c in stability_cases(quick=True) if c[0]["scene"]["title"] == "linear k=1000")
 
 
 def test_a_wrong_result_called_converged_makes_the_study_raise(monkeypatch):

@@ -1,14 +1,16 @@
-"""Studies over the solvers: error against run time, and stability on stiff and extreme cases.
+"""Studies over the solvers; every problem is a scene run by :func:`validation.run.execute_scene`.
 
-- :mod:`validation.studies.error_time`: pressure error against wall time over a ladder of
-  resolutions for every BEM method and the FEM reference (:class:`ErrorTimeStudy`).
-- :mod:`validation.studies.stability`: every method on stiff and extreme cases, each outcome
-  classified ``converged`` / ``reported failure`` / ``wrong`` (:class:`StabilityStudy`);
-  a wrong answer or a NaN raises :class:`StabilityFailure`.
-- :mod:`validation.studies.problems`: the problems both studies run.
+- :mod:`~validation.studies.problems`: the problems, as scene dicts (docs/scenes.md);
+- :mod:`~validation.studies.error_time`: pressure error against wall time over a ladder of
+  resolutions for every BEM method and the FEM reference;
+- :mod:`~validation.studies.stability`: every method on stiff and extreme cases; a wrong answer
+  or a NaN raises ``StabilityFailure``;
+- :mod:`~validation.studies.robustness`: the layer methods over 12 decades of layer compliance,
+  every converged answer checked against the KKT conditions with the dense influence matrix.
 
-Each module has ``main(args)`` for the command line (``contactlab study error-time`` and
-``contactlab study stability``).
+Each has ``main(args)`` for ``contactlab study error-time | stability | robustness``. This module
+holds what they share: running a scene (:func:`attempt`, :func:`timed`), the status of an outcome
+(:func:`classify`) and the files (:func:`save`).
 """
 
 from __future__ import annotations
@@ -17,15 +19,88 @@ import json
 import math
 import statistics
 import time
+from pathlib import Path
+
+import numpy as np
 
 from bem.files import write_text
 
-__all__ = ["write_text", "write_json", "markdown_table", "fmt", "timed"]
+from ..run import execute_scene
+from ..scene import load_scene
+
+__all__ = ["attempt", "timed", "classify", "finite", "save", "write_json", "markdown_table", "fmt", "STATUSES"]
+
+#: status of an outcome (:func:`classify`)
+STATUSES = ("converged", "reported failure", "wrong")
+#: errors a run may raise to report a failure (anything else is a bug and propagates)
+_REPORTED = (ValueError, ArithmeticError, RuntimeError)
+
+
+def attempt(scene, overrides=None):
+    """Run a scene: ``(RunOutcome or None, wall time [s], "" or "<Error>: <message>")``.
+
+    The scene is validated first (a bad scene is a bug of the study and propagates); an error of
+    the run itself (a solver that refuses with a message) is returned as a reported failure.
+    """
+    scene = load_scene(scene, overrides=overrides)
+    t0 = time.perf_counter()
+    try:
+        return execute_scene(scene), time.perf_counter() - t0, ""
+    except _REPORTED as exc:
+        return None, time.perf_counter() - t0, f"{type(exc).__name__}: {exc}"
+
+
+def timed(scene, part="bem", *, overrides=None, repeats=3, slow_s=2.0):
+    """Run a scene up to ``repeats`` times: ``(last outcome, median wall time [s], every wall time [s])``.
+
+    The times are the runner's for ``part`` (``"bem"`` or ``"fem"``, meshing included). When the
+    first run takes longer than ``slow_s`` [s] or that part did not converge, it is the only one.
+    """
+    scene = load_scene(scene, overrides=overrides)
+    times = []
+    for k in range(max(1, repeats)):
+        outcome = execute_scene(scene)
+        times.append(outcome.result["wall_time_s"][part])
+        if k == 0 and (times[0] > slow_s or not getattr(outcome, part).converged):
+            break
+    return outcome, statistics.median(times), times
+
+
+def finite(result):
+    """Whether every pressure and scalar of a BEM or FEM result is finite."""
+    values = (result.p_max, result.force, result.approach)
+    return bool(np.all(np.isfinite(result.p)) and all(math.isfinite(float(v)) for v in values))
+
+
+def classify(result, *, converged, error, tolerance):
+    """Status of one outcome and the reason: ``(status, why)``.
+
+    ``"wrong"``: a NaN or inf in ``result`` or ``error``, or ``converged`` with ``error`` above
+    ``tolerance``; ``"reported failure"``: no ``result`` (the run raised) or not ``converged``;
+    else ``"converged"`` (with ``error`` ``None`` there was no reference to check).
+    """
+    if result is None:
+        return "reported failure", "raised"
+    if not finite(result) or (error is not None and not math.isfinite(error)):
+        return "wrong", "NaN or inf in the result"
+    if not converged:
+        return "reported failure", "not converged"
+    if error is not None and error > tolerance:
+        return "wrong", f"called converged but off the reference by {error:.2e} > {tolerance:.1e}"
+    return "converged", "agrees with the reference" if error is not None else "no reference: KKT only"
 
 
 def write_json(path, data):
     """Write ``data`` as indented JSON, whole or not at all (``NaN``/``inf`` refused: JSON has none)."""
     return write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
+
+
+def save(args, stem, data, text):
+    """Write ``<stem>.json`` and ``<stem>.md`` to ``args.out`` (default: the current directory); returns ``text``."""
+    out = Path(getattr(args, "out", None) or ".")
+    write_json(out / f"{stem}.json", data)
+    write_text(out / f"{stem}.md", text)
+    return text
 
 
 def fmt(value, spec=".2e"):
@@ -45,20 +120,3 @@ def markdown_table(headers, rows):
         return "| " + " | ".join(str(c).replace("|", "\\|").replace("\n", " ") for c in cells) + " |"
 
     return "\n".join([line(headers), "|" + "|".join("---" for _ in headers) + "|"] + [line(r) for r in rows])
-
-
-def timed(fn, *, repeats=3, slow_s=2.0):
-    """Run ``fn()`` and time it: ``(result, median wall time [s], wall times of every run [s])``.
-
-    The first run decides: if it takes longer than ``slow_s`` or its result says
-    ``converged = False``, it is the only run; otherwise ``repeats`` runs in all and the
-    median of their times is returned (with the last result; the solvers are deterministic).
-    """
-    times, result = [], None
-    for k in range(max(1, repeats)):
-        t0 = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - t0)
-        if k == 0 and (times[0] > slow_s or not getattr(result, "converged", True)):
-            break
-    return result, statistics.median(times), times

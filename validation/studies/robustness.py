@@ -1,42 +1,36 @@
 """Robustness grid: every layer method over 12 decades of layer compliance, exponents and moduli.
 
 Problem: a paraboloid (``R = 1``) on a flat under force ``P = 1`` (force control) or under the
-approach that force gives (approach control), with a power layer ``w = lam p^s``. The grid:
+approach that force gives (approach control), with a power layer ``w = lam p^s``, for ``s`` in
+:data:`EXPONENTS` (0.05 .. 10), ``k`` in :data:`COMPLIANCES` (the layer's secant compliance at
+the Hertz mean pressure, ``w(p_m) / p_m``, over the elastic compliance of the contact
+``a_H^2 / (R p_0)``: from a layer far stiffer than the bodies to one far softer), ``E*`` in
+:data:`MODULI` (``1e-3 .. 1e12`` relative to ``P / R^2``), each layer method and both controls,
+at :data:`NODES_ACROSS` steps across the expected contact diameter. Each point is a scene
+(:func:`validation.studies.problems.robustness_scene`, run by :func:`validation.run.execute_scene`;
+the region grows when the contact reaches it).
 
-- ``s`` in :data:`EXPONENTS` (0.05 .. 10),
-- ``k`` in :data:`COMPLIANCES`: the layer's secant compliance at the mean contact pressure,
-  ``w(p_m) / p_m``, is ``k`` times the elastic compliance of the contact ``a_H^2 / (R p_0)``
-  (12 decades, from a layer far stiffer than the bodies to a layer far softer),
-- ``E*`` in :data:`MODULI` (``1e-3 .. 1e12`` relative to ``P / R^2``),
-- each layer method of :func:`bem.solve` (Newton, variable compliance, augmented gap) and both
-  controls, on a lattice of :data:`NODES_ACROSS` nodes across the contact diameter.
-
-Each outcome gets one status: ``"converged"`` (the solver says so and the KKT residual of
-eq. 14 recomputed with the dense influence matrix, independently of the FFT path, is at most
-``2 rtol``), ``"reported failure"`` (``converged = False`` with a message, every value finite)
-or ``"wrong"`` (``converged = True`` with the dense KKT residual above ``2 rtol``, or a NaN).
+Status (:func:`validation.studies.classify`): ``"converged"`` when the solver says so and the
+KKT residual of eq. 14, recomputed with the dense influence matrix (independently of the FFT
+path), is at most ``2 rtol``; ``"reported failure"`` (not converged, with a message, every
+value finite); ``"wrong"`` (called converged with a larger dense KKT residual, or a NaN).
 """
 
 from __future__ import annotations
 
 import itertools
-import logging
 import math
-import time
 from collections import Counter
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from . import fmt
-from . import markdown_table
-from . import write_json
-from . import write_text
+from ..scene import load_scene
+from . import attempt, classify, finite, fmt, markdown_table, save
+from .problems import robustness_scene
 
 __all__ = ["RobustnessRow", "run_robustness", "summary_markdown", "summary_table", "matrix_table", "failure_table",
-           "rows_from_json", "main", "EXPONENTS", "COMPLIANCES", "MODULI"]
-
-log = logging.getLogger(__name__)
+           "rows_from_json", "main", "EXPONENTS", "COMPLIANCES", "MODULI", "LAYER_METHODS", "SETTING"]
 
 EXPONENTS = (0.05, 0.2, 0.5, 1.0, 2.0, 3.0, 10.0)
 COMPLIANCES = (1e-6, 1e-3, 1.0, 1e3, 1e6)
@@ -44,6 +38,9 @@ MODULI = (1e-3, 1.0, 1e3, 1e6, 1e12)
 LAYER_METHODS = ("newton", "variable_compliance", "augmented_gap")
 NODES_ACROSS = 16
 RTOL = 1e-10
+SETTING = (f"Paraboloid R = 1, P = 1, power layer `w = lam p^s`; {NODES_ACROSS} nodes across the contact; "
+           f"rtol = {RTOL:g}; KKT of eq. 14 checked with the dense influence matrix. `k`: the layer's secant "
+           "compliance at the Hertz mean pressure over the elastic compliance of the contact; E* relative to P/R^2.")
 
 
 @dataclass
@@ -63,113 +60,71 @@ class RobustnessRow:
     message: str
 
 
-def _layer(s, k, E_star):
-    """``Power(lam, s)`` whose secant at the Hertz mean pressure is ``k`` elastic compliances."""
-    from bem.layers import Power
-
-    a = (3 / (4 * E_star)) ** (1 / 3)  # Hertz, R = P = 1
-    p0 = 3 / (2 * math.pi * a * a)
-    p_m = 2 * p0 / 3
-    return Power(k * (a * a / p0) * p_m ** (1 - s), s)
-
-
-def _contact_radius(layer, E_star):
-    """The larger of the Hertz and the layer-only contact radius (the softer mechanism wins)."""
-    from bem.reference import rigid_layer_paraboloid
-
-    return max((3 / (4 * E_star)) ** (1 / 3), rigid_layer_paraboloid(layer, 1.0, force=1.0).contact_radius)
-
-
-def _dense_kkt(res, layer):
+def _dense_kkt(outcome):
+    """KKT residual of eq. 14 of a run's BEM answer, with the dense influence matrix."""
     import bem
 
-    C = bem.InfluenceOperator(res.lattice, res.E_star).dense()
-    total = C @ res.p + layer.w(res.p)
-    g = total + 0.5 * (res.x ** 2 + res.y ** 2) - res.approach
-    return float(bem.kkt.kkt_residual(res.p, g, displacement_scale=float(np.abs(total).max()),
-                                      force=None, node_area=res.lattice.node_area))
+    res = outcome.bem
+    total = bem.InfluenceOperator(res.lattice, res.E_star).dense() @ res.p + outcome.layer.w(res.p)
+    g = total + outcome.scene.gap(res.x, res.y) - res.approach
+    return float(bem.kkt.kkt_residual(res.p, g, displacement_scale=float(np.abs(total).max()), force=None,
+                                      node_area=res.lattice.node_area))
 
 
-def _solve(layer, E_star, load, method, a):
-    import bem
-    from bem.gaps import Paraboloid
-
-    extent = 1.5 * a
-    for _ in range(4):
-        try:
-            return bem.solve(Paraboloid(1.0), E_star=E_star, step=2 * a / NODES_ACROSS, extent=extent,
-                             layer=layer, method=method, rtol=RTOL, **load)
-        except bem.RegionTooSmallError:
-            extent *= 1.5
-    raise RuntimeError(f"the contact kept reaching the border of the region (extent {extent:.3g})")
-
-
-def _row(s, k, E_star, control, method, layer, load, a):
-    t0 = time.perf_counter()
-    try:
-        res = _solve(layer, E_star, load, method, a)
-    except (ValueError, ArithmeticError, RuntimeError) as exc:
-        return RobustnessRow(s, k, E_star, control, method, "reported failure", False, None, 0,
-                             time.perf_counter() - t0, f"{type(exc).__name__}: {exc}"), None
-    elapsed = time.perf_counter() - t0
-    finite = bool(np.all(np.isfinite(res.p))) and math.isfinite(res.approach)
-    kkt = _dense_kkt(res, layer) if finite else math.inf
-    if not finite:
-        status = "wrong"
-    elif res.converged:
-        status = "converged" if kkt <= 2 * RTOL else "wrong"
-    else:
-        status = "reported failure"
-    return RobustnessRow(s, k, E_star, control, method, status, bool(res.converged), kkt, int(res.iterations),
-                         elapsed, res.message), res
+def _row(point, control, method, run):
+    outcome, seconds, raised = run
+    if outcome is None:
+        return RobustnessRow(*point, control, method, "reported failure", False, None, 0, seconds, raised)
+    res = outcome.bem
+    kkt = _dense_kkt(outcome) if finite(res) else math.inf
+    status, _ = classify(res, converged=res.converged, error=kkt if res.converged else None, tolerance=2 * RTOL)
+    return RobustnessRow(*point, control, method, status, bool(res.converged), kkt, int(res.iterations),
+                         outcome.result["wall_time_s"]["bem"], res.message)
 
 
 def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODULI, methods=LAYER_METHODS,
                    progress=False):
     """Run the grid; returns the list of :class:`RobustnessRow`.
 
-    Approach control uses the approach of the force-controlled Newton solve of the same point
-    (the same discrete problem), or, if that failed, the layer-only closed form.
+    Every run of a point has the lattice step of its force-controlled scene; approach control
+    uses the approach of the force-controlled Newton run (the same discrete problem), or, if that
+    failed, the layer-only closed form.
     """
     from tqdm import tqdm
 
+    from bem.layers import Power
     from bem.reference import rigid_layer_paraboloid
 
-    points = list(itertools.product(exponents, compliances, moduli))
     rows = []
-    for s, k, E_star in tqdm(points, disable=not progress, desc="robustness", unit="point"):
-        layer = _layer(s, k, E_star)
-        a = _contact_radius(layer, E_star)
+    for point in tqdm(list(itertools.product(exponents, compliances, moduli)), disable=not progress,
+                      desc="robustness", unit="point"):
+        scene = load_scene(robustness_scene(*point, nodes_across=NODES_ACROSS, extent_factor=1.5, rtol=RTOL))
         approach = None
         for control in ("force", "approach"):
             if control == "approach" and approach is None:
+                layer = Power(scene.layer_spec["lam"], scene.layer_spec["s"])
                 approach = rigid_layer_paraboloid(layer, 1.0, force=1.0).approach
-            load = {"force": 1.0} if control == "force" else {"approach": approach}
+            load = {} if control == "force" else {"load.approach": approach, "bem.step": scene.bem["step"]}
             for method in methods:
-                row, res = _row(s, k, E_star, control, method, layer, load, a)
-                rows.append(row)
-                if control == "force" and method == "newton" and res is not None and res.converged:
-                    approach = res.approach
+                run = attempt(scene, {"bem.method": method, **load})
+                rows.append(_row(point, control, method, run))
+                if control == "force" and method == "newton" and run[0] is not None and run[0].bem.converged:
+                    approach = run[0].bem.approach
     return rows
-
-
-def _counts(rows, key):
-    out = {}
-    for r in rows:
-        out.setdefault(key(r), Counter())[r.status] += 1
-    return out
 
 
 def summary_table(rows):
     """``(headers, body)``: outcomes, times and the worst dense KKT residual per method and control."""
+    counts = {}
+    for r in rows:
+        counts.setdefault((r.method, r.control), Counter())[r.status] += 1
     body = []
-    for (method, control), c in sorted(_counts(rows, lambda r: (r.method, r.control)).items()):
-        times = [r.wall_time_s for r in rows if r.method == method and r.control == control]
-        kkts = [r.kkt_dense for r in rows if r.method == method and r.control == control and r.converged
-                and r.kkt_dense is not None]
-        body.append([method, control, c["converged"], c["reported failure"], c["wrong"],
-                     fmt(float(np.median(times)), ".3f"), fmt(max(times), ".3f"),
-                     fmt(max(kkts), ".1e") if kkts else "-"])
+    for (method, control), c in sorted(counts.items()):
+        sel = [r for r in rows if r.method == method and r.control == control]
+        times = [r.wall_time_s for r in sel]
+        kkts = [r.kkt_dense for r in sel if r.converged and r.kkt_dense is not None]
+        body.append([method, control, c["converged"], c["reported failure"], c["wrong"], fmt(float(np.median(times)),
+                     ".3f"), fmt(max(times), ".3f"), fmt(max(kkts), ".1e") if kkts else "-"])
     return (["method", "control", "converged", "reported failure", "wrong", "median time [s]", "max time [s]",
              "worst dense KKT when converged"], body)
 
@@ -180,13 +135,9 @@ def matrix_table(rows, method):
     ks = sorted({r.k for r in rows})
     body = []
     for s in sorted({r.s for r in sel}):
-        cells = []
-        for k in ks:
-            cell = [r for r in sel if r.s == s and r.k == k]
-            n_wrong = sum(r.status == "wrong" for r in cell)
-            cells.append(f"{sum(r.status == 'converged' for r in cell)}/{len(cell)}"
-                         + (f" ({n_wrong} wrong)" if n_wrong else ""))
-        body.append([fmt(s, "g")] + cells)
+        cells = [[r.status for r in sel if r.s == s and r.k == k] for k in ks]
+        body.append([fmt(s, "g")] + [f"{c.count('converged')}/{len(c)}" + (
+            f" ({c.count('wrong')} wrong)" if "wrong" in c else "") for c in cells])
     return ["s \\ k"] + [fmt(k, "g") for k in ks], body
 
 
@@ -197,19 +148,13 @@ def failure_table(rows):
               r.message[:110]] for r in rows if r.status != "converged"])
 
 
-SETTING = (f"Paraboloid R = 1, P = 1, power layer `w = lam p^s`; {NODES_ACROSS} nodes across the contact; "
-           f"rtol = {RTOL:g}; KKT of eq. 14 checked with the dense influence matrix. `k`: the layer's secant "
-           "compliance at the Hertz mean pressure over the elastic compliance of the contact; E* relative to P/R^2.")
-
-
 def summary_markdown(rows):
     """Markdown: counts and times per method and control, the map of outcomes over (s, k), the failures."""
     lines = ["# Robustness of the layer methods", "", SETTING, "", "## Outcomes per method and control", "",
              markdown_table(*summary_table(rows)), "",
              "## Converged out of all (E*, control) per exponent s and compliance k", ""]
-    for method in LAYER_METHODS:
-        if any(r.method == method for r in rows):
-            lines += [f"### {method}", "", markdown_table(*matrix_table(rows, method)), ""]
+    for method in (m for m in LAYER_METHODS if any(r.method == m for r in rows)):
+        lines += [f"### {method}", "", markdown_table(*matrix_table(rows, method)), ""]
     if any(r.status != "converged" for r in rows):
         lines += ["## Every outcome that is not converged", "", markdown_table(*failure_table(rows)), ""]
     return "\n".join(lines)
@@ -230,20 +175,11 @@ def _json_row(row):
 
 
 def main(args):
-    """Command-line entry: ``contactlab study robustness [--out DIR] [--quick]``.
-
-    Writes ``robustness.json`` and ``robustness.md``; prints the summary. Returns 1 if any
-    outcome is wrong, else 0.
-    """
-    from pathlib import Path
-
-    out = Path(getattr(args, "out", None) or ".")
-    kw = {}
-    if getattr(args, "quick", False):
-        kw = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
-    rows = run_robustness(progress=True, **kw)
-    text = summary_markdown(rows)
-    write_text(out / "robustness.md", text + "\n")
-    write_json(out / "robustness.json", [_json_row(r) for r in rows])
-    print(text)
+    """``contactlab study robustness [--out DIR] [--quick]``: writes ``robustness.json`` and ``robustness.md``
+    to ``args.out`` (default: the current directory) and prints the markdown. Returns 1 if any outcome is
+    wrong, else 0."""
+    quick = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
+    rows = run_robustness(progress=not getattr(args, "no_progress", False),
+                          **(quick if getattr(args, "quick", False) else {}))
+    print(save(args, "robustness", [_json_row(r) for r in rows], summary_markdown(rows) + "\n"), end="")
     return 1 if any(r.status == "wrong" for r in rows) else 0

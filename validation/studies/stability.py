@@ -1,65 +1,46 @@
 """Stability study: every method on stiff and extreme cases, every outcome classified.
 
-Cases (:func:`validation.studies.problems.stability_cases`): layer compliance over six
-decades (``1e-3 .. 1e3`` times the elastic compliance over the contact), power laws
-``s = 0.2 .. 3``, an elastic-rigid layer with a tiny ``p_cr``, a contact of a few nodes, a
-contact filling most of the candidate region, very dissimilar moduli (``E1/E2 = 1e3``,
-``nu2 = 0.49``) and nearly incompressible bodies in the FEM (``nu = 0.49, 0.499``).
+Cases (:func:`validation.studies.problems.stability_cases`): layer compliance over six decades
+(``1e-3 .. 1e3`` times the elastic compliance over the contact), power laws ``s = 0.2 .. 3``, an
+elastic-rigid layer with a tiny ``p_cr``, a contact of a few nodes, a contact filling most of the
+candidate region, very dissimilar moduli (``E1/E2 = 1e3``, ``nu2 = 0.49``) and nearly
+incompressible bodies in the FEM (``nu = 0.49, 0.499``). Each case runs every BEM method that
+applies, and the FEM where the case has ``[fem]`` (in the Newton run); each outcome gets a status
+of :func:`validation.studies.classify` against its reference, by
+``error_vs_reference = max(l2_rel, |peak_rel|)`` (:func:`validation.compare.pair_metrics`):
 
-Each case runs every BEM method that applies, and the FEM where the case marks it relevant.
-Every outcome gets one status:
+- paper methods and Kalker's QP: Newton at the same resolution, :data:`METHOD_TOL` (the same
+  discrete problem, solved to a KKT residual of ``1e-10``);
+- Newton: the case's closed-form limit (Hertz, or the rigid-body layer) with
+  :data:`~validation.studies.problems.LIMIT_TOL`, else the FEM with :data:`FEM_TOL` when it runs;
+- FEM: Hertz for smooth bodies, else BEM Newton on a lattice 4 x finer than the case's, with
+  :data:`FEM_TOL` (at the case's 25 steps across the diameter the BEM's own interpolation error
+  at a steep contact edge dominates the difference: 6.0 % against the FEM for ``s = 3``, 0.4 %
+  at 100 steps, where the FEM has 16 elements across the radius).
 
-- ``"converged"``: the solver says converged, every value is finite, and it agrees with the
-  reference within the tolerance (or no reference exists: then its KKT residual is the only
-  check, and ``error_vs_reference`` is ``None``);
-- ``"reported failure"``: the solver says it did not converge (``converged = False`` with a
-  message) or raised an error with a message; every returned value finite;
-- ``"wrong"``: a NaN or inf anywhere in the returned result, or ``converged = True`` with an
-  error against the reference above the tolerance.
-
-``error_vs_reference = max(l2_rel, |peak_rel|)`` (:func:`validation.compare.pair_metrics`).
-References and tolerances:
-
-- paper methods and Kalker's QP: Newton at the same resolution, :data:`METHOD_TOL`
-  (the same discrete problem, solved to a KKT residual of ``1e-10``);
-- Newton: the case's closed form (Hertz, or a layer limit) with the case's tolerance, else
-  the FEM with :data:`FEM_TOL` when the FEM runs, else none;
-- FEM: Hertz for smooth bodies, else BEM Newton, with :data:`FEM_TOL` (two different
-  discretisations: 25 BEM steps across the diameter, 16 FEM elements across the radius).
-
-:meth:`StabilityStudy.check` (called by :func:`run_stability` unless ``check=False``) raises
-:class:`StabilityFailure` listing every wrong outcome.
+Without a reference a converged answer is checked by its KKT residual only. A NaN or a wrong
+answer called converged makes :meth:`StabilityStudy.check` raise :class:`StabilityFailure`.
 """
 
 from __future__ import annotations
 
-import logging
 import math
-import time
 from collections import Counter
 from dataclasses import asdict, dataclass, field
 
-import numpy as np
+from bem.reference import hertz_sphere
 
 from ..compare import pair_metrics
-from . import fmt
-from . import markdown_table
-from . import write_json
-from . import write_text
-from .problems import stability_cases
+from . import STATUSES, attempt, classify, finite, fmt, markdown_table, save
+from .problems import LIMIT_TOL, methods, stability_cases
 
 __all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main",
            "METHOD_TOL", "FEM_TOL", "STATUSES"]
 
-log = logging.getLogger(__name__)
-
-STATUSES = ("converged", "reported failure", "wrong")
 #: agreement required of a method with Newton on the same lattice
 METHOD_TOL = 1e-6
 #: agreement required between the FEM and the BEM (or Hertz)
 FEM_TOL = 0.05
-#: errors a solver may raise to report a failure (anything else is a bug and propagates)
-_REPORTED = (ValueError, ArithmeticError, RuntimeError)
 
 
 class StabilityFailure(RuntimeError):
@@ -74,27 +55,12 @@ class StabilityFailure(RuntimeError):
 
 @dataclass
 class StabilityRow:
-    """One solver on one case.
+    """One solver (``"bem"`` or ``"fem"``) and method (``"fem"`` for the FEM) on one case.
 
-    Attributes
-    ----------
-    case, solver, method : str
-        Case name; ``"bem"`` or ``"fem"``; the method (``"fem"`` for the FEM).
-    status : str
-        One of :data:`STATUSES` (module docstring).
-    kkt_residual : float or None
-        BEM: :func:`bem.kkt.kkt_residual` of the returned state; FEM: final relative Newton
-        residual; ``None`` when the solver raised.
-    error_vs_reference : float or None
-        ``max(l2_rel, |peak_rel|)`` against ``reference``.
-    reference : str
-        What the result was compared with (``"-"`` for nothing).
-    tolerance : float or None
-        The tolerance of that comparison.
-    iterations : int
-    wall_time_s : float
-    message : str
-        The solver's message (and why the status was given).
+    ``kkt_residual``: BEM KKT residual, FEM final relative Newton residual (``None`` when the run
+    raised); ``error_vs_reference`` against ``reference`` (``"-"``: none) with ``tolerance``;
+    ``wall_time_s`` [s]: the solver's (the whole run's when it raised); ``message``: why the
+    status, and the solver's message.
     """
 
     case: str
@@ -123,44 +89,35 @@ class StabilityStudy:
 
     def check(self):
         """Raise :class:`StabilityFailure` if any outcome is wrong; else return ``self``."""
-        bad = self.wrong()
-        if bad:
-            raise StabilityFailure(bad, self)
+        if self.wrong():
+            raise StabilityFailure(self.wrong(), self)
         return self
 
     def counts(self):
-        """``{method: {status: count}}`` over all cases."""
+        """``{"solver method": {status: count}}`` over all cases."""
         out = {}
         for r in self.rows:
             out.setdefault(f"{r.solver} {r.method}", Counter())[r.status] += 1
         return {k: {s: v.get(s, 0) for s in STATUSES} for k, v in out.items()}
 
-    def table_markdown(self):
-        """Markdown table of all rows."""
-        head = ["case", "solver", "method", "status", "KKT residual", "error vs reference", "reference",
-                "iterations", "wall time [s]", "message"]
+    def markdown(self):
+        """The study as markdown: a per-method summary, then every row."""
+        head = ["case", "solver", "method", "status", "KKT residual", "error vs reference", "reference", "iterations",
+                "wall time [s]", "message"]
         body = [[r.case, r.solver, r.method, r.status, fmt(r.kkt_residual, ".1e"), fmt(r.error_vs_reference),
                  r.reference, r.iterations, fmt(r.wall_time_s, ".3g"), _short(r.message)] for r in self.rows]
-        return markdown_table(head, body)
-
-    def markdown(self):
-        """The study as markdown: a per-method summary, then the full table."""
-        summary = markdown_table(["solver / method"] + list(STATUSES),
-                                 [[k] + [v[s] for s in STATUSES] for k, v in self.counts().items()])
         return "\n".join([
             "## Stability on stiff and extreme cases", "",
             f"Tolerances: paper methods and QP against Newton on the same lattice {METHOD_TOL:g}; FEM against "
-            f"Hertz or BEM Newton {FEM_TOL:g}; Newton against the case's closed form at the case's tolerance.",
-            "", summary, "", self.table_markdown(), ""])
+            f"Hertz or BEM Newton on a 4x finer lattice {FEM_TOL:g}; Newton against the case's closed form at the "
+            "case's tolerance.", "",
+            markdown_table(["solver / method", *STATUSES], [[k, *v.values()] for k, v in self.counts().items()]),
+            "", markdown_table(head, body), ""])
 
     def to_dict(self):
         """JSON-ready dict."""
         return {"study": "stability", "settings": self.settings, "counts": self.counts(),
                 "rows": [asdict(r) for r in self.rows]}
-
-    def to_json(self, path):
-        """Write :meth:`to_dict` to ``path`` atomically. Returns the path."""
-        return write_json(path, self.to_dict())
 
 
 def _short(message, n=110):
@@ -168,105 +125,71 @@ def _short(message, n=110):
     return message if len(message) <= n else message[: n - 3] + "..."
 
 
-def _finite(result):
-    """Whether every pressure and scalar of a BEM or FEM result is finite."""
-    values = [result.p_max, result.force, result.approach]
-    return bool(np.all(np.isfinite(result.p)) and all(math.isfinite(float(v)) for v in values))
+def _part(run, part):
+    """``(result or None, wall time [s], why it raised)`` of the ``"bem"`` or ``"fem"`` part of an attempt."""
+    outcome, seconds, raised = run
+    if outcome is None:
+        return None, seconds, f"raised {raised}"
+    return getattr(outcome, part), outcome.result["wall_time_s"][part], ""
 
 
-def classify(result, *, converged, error, tolerance):
-    """Status of one outcome (module docstring) and the reason.
+def _good(part):
+    return part[0] is not None and bool(part[0].converged) and finite(part[0])
 
-    Parameters
-    ----------
-    result : bem.ContactResult or fem_reference.FemResult or None
-        ``None`` when the solver raised (a reported failure).
-    converged : bool
-        The solver's verdict.
-    error : float or None
-        Error against the reference (``None``: no reference).
-    tolerance : float or None
-        Allowed error.
 
-    Returns
-    -------
-    (str, str)
-        Status and a short reason.
-    """
+def _closed(case, limit, run):
+    """``(name, closed form, tolerance)`` of the case's ``limit`` or ``None``: the run's ``[analytic]``,
+    else Hertz's solution of the run's bodies, gap and load (the limit of a stiff layer)."""
+    outcome = run[0]
+    if limit is None or outcome is None:
+        return None
+    scene = outcome.scene
+    ref = outcome.analytic or hertz_sphere(scene.gap.R, scene.E_star, **scene.load)
+    return (f"{limit} limit" if "layer" in case else "Hertz"), ref, LIMIT_TOL[limit]
+
+
+def _row(case, solver, method, part, reference):
+    """The row of ``part`` (:func:`_part`) against ``reference`` ``(name, object, tolerance)`` or ``None``."""
+    result, seconds, raised = part
+    ref_name, ref, tol = reference or ("-", None, None)
+    row = dict(case=case["scene"]["title"], solver=solver, method=method, reference=ref_name, tolerance=tol)
     if result is None:
-        return "reported failure", "raised"
-    if not _finite(result) or (error is not None and not math.isfinite(error)):
-        return "wrong", "NaN or inf in the result"
-    if not converged:
-        return "reported failure", "not converged"
-    if error is not None and error > tolerance:
-        return "wrong", f"called converged but off the reference by {error:.2e} > {tolerance:.1e}"
-    return "converged", "agrees with the reference" if error is not None else "no reference: KKT only"
-
-
-def _error(result, reference):
-    m = pair_metrics(result, reference)
-    if m["l2_rel"] is None or m["peak_rel"] is None:
-        return math.inf
-    return max(m["l2_rel"], abs(m["peak_rel"]))
-
-
-def _attempt(fn):
-    """``(result, seconds, exception message or "")``."""
-    t0 = time.perf_counter()
-    try:
-        return fn(), time.perf_counter() - t0, ""
-    except _REPORTED as exc:  # a solver that refuses with a message has reported its failure
-        return None, time.perf_counter() - t0, f"raised {type(exc).__name__}: {exc}"
-
-
-def _row(case, solver, method, outcome, reference):
-    """Build a row from ``(result, seconds, raised)`` and ``(name, object, tol)`` or ``None``."""
-    result, seconds, raised = outcome
-    ref_name, ref, tol = reference if reference is not None else ("-", None, None)
-    if result is None:
-        return StabilityRow(case.name, solver, method, "reported failure", None, None, ref_name, tol, 0, seconds,
-                            raised)
-    is_fem = solver == "fem"
-    finite = _finite(result)
-    error = _error(result, ref) if (ref is not None and finite) else None
+        return StabilityRow(**row, status="reported failure", kkt_residual=None, error_vs_reference=None,
+                            iterations=0, wall_time_s=seconds, message=raised)
+    error = None
+    if ref is not None and finite(result):
+        m = pair_metrics(result, ref)
+        error = math.inf if None in (m["l2_rel"], m["peak_rel"]) else max(m["l2_rel"], abs(m["peak_rel"]))
     status, why = classify(result, converged=bool(result.converged), error=error, tolerance=tol)
-    kkt = result.residual if is_fem else result.kkt_residual
-    message = result.message if is_fem else result.message
-    return StabilityRow(case.name, solver, method, status, float(kkt) if math.isfinite(kkt) else None, error,
-                        ref_name, tol, int(result.iterations), seconds, f"{why}; {message}")
+    kkt = float(result.residual if solver == "fem" else result.kkt_residual)
+    return StabilityRow(**row, status=status, kkt_residual=kkt if math.isfinite(kkt) else None,
+                        error_vs_reference=error, iterations=int(result.iterations), wall_time_s=seconds,
+                        message=f"{why}; {result.message}")
 
 
-def _good(outcome):
-    result = outcome[0]
-    return result is not None and bool(result.converged) and _finite(result)
-
-
-def _run_case(case):
-    rows = []
-    newton = _attempt(lambda: case.run_bem("newton"))
-    fem = _attempt(case.run_fem) if case.fem else None
-    analytic = case.reference_solution()
-    closed = None if analytic is None else (f"{case.analytic} limit" if case.layer is not None else "Hertz",
-                                            analytic, case.analytic_tol)
-    if closed is not None:
-        newton_ref = closed
-    elif fem is not None and _good(fem):
-        newton_ref = ("FEM", fem[0], FEM_TOL)
-    else:
-        newton_ref = None
-    rows.append(_row(case, "bem", "newton", newton, newton_ref))
-    same = ("Newton, same lattice", newton[0], METHOD_TOL) if _good(newton) else closed
-    for method in case.methods:
-        if method != "newton":
-            rows.append(_row(case, "bem", method, _attempt(lambda m=method: case.run_bem(m)), same))
+def _run_case(case, limit):
+    bem_only = {k: v for k, v in case.items() if k != "fem"}
+    first = attempt(case)  # Newton, and the FEM when the case has [fem]
+    fem = _part(first, "fem") if "fem" in case else None
+    if first[0] is None and fem is not None:  # it raised: Newton alone tells whose error it was
+        first = attempt(bem_only)
+    newton, closed = _part(first, "bem"), _closed(case, limit, first)
+    fem_ok = fem is not None and _good(fem)
+    rows = [_row(case, "bem", "newton", newton, closed or (("FEM", fem[0], FEM_TOL) if fem_ok else None))]
+    for method in methods(case)[1:]:
+        run = attempt(bem_only, {"bem.method": method})
+        same = ("Newton, same lattice", newton[0], METHOD_TOL) if _good(newton) else _closed(case, limit, run)
+        rows.append(_row(case, "bem", method, _part(run, "bem"), same))
     if fem is not None:
-        if case.layer is None and case.analytic == "hertz":
-            fem_ref = ("Hertz", analytic, FEM_TOL)
-        elif _good(newton):
-            fem_ref = ("BEM Newton", newton[0], FEM_TOL)
+        fine = (None,)
+        if "layer" in case and newton[0] is not None:  # Newton on a 4x finer lattice (module docstring)
+            fine = _part(attempt(bem_only, {"bem.step": newton[0].step / 4}), "bem")
+        if "layer" not in case and closed is not None:
+            fem_ref = ("Hertz", closed[1], FEM_TOL)
+        elif _good(fine):
+            fem_ref = ("BEM Newton, 4x finer", fine[0], FEM_TOL)
         else:
-            fem_ref = None if closed is None else (closed[0], closed[1], max(FEM_TOL, closed[2]))
+            fem_ref = closed and (closed[0], closed[1], max(FEM_TOL, closed[2]))
         rows.append(_row(case, "fem", "fem", fem, fem_ref))
     return rows
 
@@ -276,54 +199,39 @@ def run_stability(cases=None, *, quick=False, check=True, progress=False):
 
     Parameters
     ----------
-    cases : list of Problem, optional
-        Default :func:`validation.studies.problems.stability_cases` (``quick``: the subset).
+    cases : list of (dict, str or None), optional
+        Scene dicts and their closed-form limits; default :func:`~validation.studies.problems.stability_cases`.
     quick : bool
-        The representative subset of cases (for tests).
+        The representative subset of the default cases (for tests).
     check : bool
-        Raise :class:`StabilityFailure` when any outcome is wrong.
+        Raise :class:`StabilityFailure` when any outcome is wrong (a NaN anywhere, or a wrong answer
+        called converged).
     progress : bool
         Show a tqdm progress bar (stderr).
 
     Returns
     -------
     StabilityStudy
-
-    Raises
-    ------
-    StabilityFailure
-        With ``check``: a NaN anywhere, or a wrong answer called converged.
     """
     from tqdm import tqdm
 
     cases = stability_cases(quick) if cases is None else list(cases)
     study = StabilityStudy(settings={"mode": "quick" if quick else "full", "method_tol": METHOD_TOL,
-                                     "fem_tol": FEM_TOL, "cases": [c.name for c in cases]})
-    for case in tqdm(cases, desc="stability", unit="case", disable=not progress):
-        study.rows += _run_case(case)
-    if check:
-        study.check()
-    return study
+                                     "fem_tol": FEM_TOL, "cases": [c["scene"]["title"] for c, _ in cases]})
+    for case, limit in tqdm(cases, desc="stability", unit="case", disable=not progress):
+        study.rows += _run_case(case, limit)
+    return study.check() if check else study
 
 
 def main(args):
-    """Command-line entry: ``contactlab study stability [--out DIR] [--quick]``.
-
-    Writes ``stability.json`` and ``stability.md`` to ``args.out`` (default the current
-    directory), prints the markdown, then raises :class:`StabilityFailure` if any outcome is
-    wrong. Returns 0.
-    """
-    from pathlib import Path
-
+    """``contactlab study stability [--out DIR] [--quick]``: writes ``stability.json`` and ``stability.md``
+    to ``args.out`` (default: the current directory), prints the markdown, then raises
+    :class:`StabilityFailure` if any outcome is wrong. Returns 0."""
     from ..extras import require
 
     require("fem", "contactlab study stability (the FEM cases)")
-
-    out = Path(getattr(args, "out", None) or ".")
-    study = run_stability(quick=bool(getattr(args, "quick", False)), check=False, progress=True)
-    study.to_json(out / "stability.json")
-    text = study.markdown()
-    write_text(out / "stability.md", text)
-    print(text)
+    study = run_stability(quick=bool(getattr(args, "quick", False)), check=False,
+                          progress=not getattr(args, "no_progress", False))
+    print(save(args, "stability", study.to_dict(), study.markdown()))
     study.check()
     return 0
