@@ -75,9 +75,11 @@ def _line_search(layer, p, d, u, cd, h, delta, mask):
     """
     sel = mask & (d != 0)
     ps, ds, us, cds, hs = p[sel], d[sel], u[sel], cd[sel], h[sel]
+    # np.vdot, not np.dot: on 86,000 nodes np.dot (threaded OpenBLAS, 2 cores) took 1.2 ms idle
+    # and up to 7.8 ms with the other core busy, np.vdot 0.015-0.025 ms
 
     def slope(t):
-        return float(np.dot(ds, us + t * cds + layer.w(np.maximum(ps + t * ds, 0.0)) + hs - delta))
+        return float(np.vdot(ds, us + t * cds + layer.w(np.maximum(ps + t * ds, 0.0)) + hs - delta))
 
     s0, s1 = slope(0.0), slope(1.0)
     if s0 >= 0:
@@ -95,7 +97,7 @@ def _energy_change(layer, p, delta_p, u, c_dp, h, delta, mask):
     itself are still measured with their sign.
     """
     dp, pp = delta_p[mask], p[mask]
-    lin = float(np.dot(dp, u[mask] + h[mask] - delta)) + 0.5 * float(np.dot(dp, c_dp[mask]))
+    lin = float(np.vdot(dp, u[mask] + h[mask] - delta)) + 0.5 * float(np.vdot(dp, c_dp[mask]))
     small = np.abs(dp) < 1e-4 * pp
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         taylor = layer.w(pp) * dp + 0.5 * np.asarray(layer.dw(pp), dtype=float) * dp * dp
