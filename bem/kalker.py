@@ -59,7 +59,7 @@ def _initial(op, h, lam, force, approach, x0):
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, preconditioner=None, callback=None, scale=None):
+             maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
 
     Parameters
@@ -89,6 +89,16 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         Displacement scale of the KKT residual [length]; default
         ``max |C p + lam p|``. A caller whose ``lam`` is a model curvature (Newton)
         passes the scale of the problem it linearises.
+    u0 : ndarray, optional
+        ``C x0`` (brick array) where the caller has it, e.g. updated incrementally:
+        spares the first product. The iterate starts from ``x0`` as given (under force
+        control it must carry the force), and the stopping check is then confirmed on an
+        exact product as after any incremental update.
+    confirm : bool
+        Confirm the stopping check on an exactly recomputed ``C p`` (default). A caller
+        that re-checks the solution itself (Newton's inner solves) passes False and gets
+        the solution of the incrementally updated products, which differ from the exact
+        ones by round-off only.
 
     Returns
     -------
@@ -102,8 +112,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     with ``g = C p + lam p + h - delta`` (and ``|a sum p - P| <= rtol P`` under
     force control, which the rescaling keeps to round-off), i.e.
-    :func:`bem.kkt.kkt_residual` ``<= rtol``; the check always uses an exactly
-    recomputed ``C p``.
+    :func:`bem.kkt.kkt_residual` ``<= rtol``; the check uses an exactly
+    recomputed ``C p`` unless ``confirm`` is False.
     """
     lat = op.lattice
     mask = lat.mask
@@ -114,10 +124,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     if maxiter is None:
         maxiter = max(200, int(10 * np.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
-    p = np.where(mask, _initial(op, h, lam, force, approach, x0), 0.0)
-    if target is not None:
-        p = p if p.sum() > 0 else mask.astype(float)
-        p *= target / p.sum()
+    if u0 is None or x0 is None:
+        p = np.where(mask, _initial(op, h, lam, force, approach, x0), 0.0)
+        if target is not None:
+            p = p if p.sum() > 0 else mask.astype(float)
+            p *= target / p.sum()
+        u0 = None
+    else:  # the caller's iterate and its product, as they are
+        p = np.where(mask, x0, 0.0)
     off = np.flatnonzero(~mask)  # the few masked nodes (last node of the odd rows)
 
     def apply(v):
@@ -131,8 +145,11 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         full.flat[idx] = values
         return full
 
-    u = apply(p)
-    stale = 0
+    if u0 is None:
+        u, stale = apply(p), 0
+    else:  # from the caller: C x0 (+ lam x0), to be confirmed like an incremental update
+        u, stale = np.where(mask, u0, 0.0), 1
+        u += lam * p
     t = np.zeros(lat.shape)
     gz_old, restart = 1.0, True
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
@@ -168,7 +185,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             kkt = float(np.max([kkt, abs(a * p.flat[idx].sum() - force) / force]))
         if not np.isfinite(kkt):
             kkt = np.inf
-        if kkt <= rtol and stale:
+        if kkt <= rtol and stale and confirm:
             u, stale = apply(p), 0  # confirm on an exact product
             continue
         changes = int(np.count_nonzero(contact != prev_contact))
