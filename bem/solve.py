@@ -157,9 +157,11 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         Initial nodal pressures on the candidate nodes, shape ``(N,)``.
     nested : bool, optional
         Start from the solution on successively coarser lattices (step ``2c``,
-        ``4c``, ...) interpolated onto the finer one; each finer level is solved on
-        the window of the nodes whose gap can close at the approach of the coarser
-        one (checked afterwards, see ``_candidate_window``). Default: on for
+        ``4c``, ...) interpolated onto the finer one. Each finer level is solved on
+        the rectangular window of the nodes whose initial gap is below the approach
+        (of the coarser level, with a margin): the others cannot close. Its solution
+        is checked against the final approach, and the level solved again on the whole
+        lattice if a node outside the window could close. Default: on for
         ``"newton"`` and the QP, off for the paper's methods so that their
         iteration histories start as in the paper.
     precondition : bool
@@ -350,6 +352,8 @@ def _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window)
         sol = _embedded(_run(solver, op, h[window.index], layer, precondition, kw_w, options), window)
         if _clear_outside(lat, window, h, sol.approach):
             return sol, ops
+        # rare: the approach grew past the margin. The full lattice starts from the window's
+        # solution; the result reports that solve's iterations.
         log.debug("candidate window too small (approach %.6g): solving on the full lattice", sol.approach)
         kw = dict(kw, x0=sol.p)
     op = InfluenceOperator(lat, E_star)

@@ -82,3 +82,27 @@ def test_recorded_iterates_are_on_the_full_lattice():
     assert len(res.history["p"]) == res.iterations + 1  # Newton records its start and every step
     assert all(p.shape == res.p.shape for p in res.history["p"])
     np.testing.assert_allclose(res.history["p"][-1], res.p)
+
+
+@pytest.mark.parametrize("layer", [None, layers.Power(0.02, 0.3)])
+def test_window_off_centre_with_an_offset_gap(monkeypatch, layer):
+    """A sphere off the centre of an elongated region, the gap offset by a constant."""
+
+    def gap(x, y):
+        return 0.01 + ((x - 0.17) ** 2 + (y + 0.05) ** 2) / 2.0
+
+    kw = dict(E_star=1.0, force=1e-3, step=0.003, extent=(0.45, 0.25), layer=layer)
+    windowed = bem.solve(gap, **kw)
+    monkeypatch.setattr(solve_module, "_WINDOW_UP_TO", 0.0)
+    full = bem.solve(gap, **kw)
+    assert windowed.converged and windowed.kkt_residual <= 1e-10
+    assert np.abs(windowed.p - full.p).max() <= 1e-8 * full.p.max()
+
+
+def test_qp_window_fallback(monkeypatch):
+    monkeypatch.setattr(solve_module, "_WINDOW_MARGIN", -0.6)
+    small = bem.solve(Paraboloid(1.0), E_star=1.0, force=1e-3, step=0.003, extent=0.3)
+    monkeypatch.setattr(solve_module, "_WINDOW_UP_TO", 0.0)
+    full = bem.solve(Paraboloid(1.0), E_star=1.0, force=1e-3, step=0.003, extent=0.3)
+    assert small.converged and small.kkt_residual <= 1e-10
+    assert np.abs(small.p - full.p).max() <= 1e-8 * full.p.max()
