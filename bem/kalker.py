@@ -59,7 +59,7 @@ def _initial(op, h, lam, force, approach, x0):
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, preconditioner=None, callback=None, scale=None):
+             maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
 
     Parameters
@@ -89,6 +89,16 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         Displacement scale of the KKT residual [length]; default
         ``max |C p + lam p|``. A caller whose ``lam`` is a model curvature (Newton)
         passes the scale of the problem it linearises.
+    u0 : ndarray, optional
+        ``C x0`` (brick array) where the caller has it, e.g. updated incrementally:
+        spares the first product. The iterate starts from ``x0`` as given (under force
+        control it must carry the force), and the stopping check is then confirmed on an
+        exact product as after any incremental update.
+    confirm : bool
+        Confirm the stopping check on an exactly recomputed ``C p`` (default). A caller
+        that re-checks the solution itself (Newton's inner solves) passes False and gets
+        the solution of the incrementally updated products, which differ from the exact
+        ones by round-off only.
 
     Returns
     -------
@@ -102,8 +112,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     with ``g = C p + lam p + h - delta`` (and ``|a sum p - P| <= rtol P`` under
     force control, which the rescaling keeps to round-off), i.e.
-    :func:`bem.kkt.kkt_residual` ``<= rtol``; the check always uses an exactly
-    recomputed ``C p``.
+    :func:`bem.kkt.kkt_residual` ``<= rtol``; the check uses an exactly
+    recomputed ``C p`` unless ``confirm`` is False.
     """
     lat = op.lattice
     mask = lat.mask
@@ -114,10 +124,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     if maxiter is None:
         maxiter = max(200, int(10 * np.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
-    p = np.where(mask, _initial(op, h, lam, force, approach, x0), 0.0)
-    if target is not None:
-        p = p if p.sum() > 0 else mask.astype(float)
-        p *= target / p.sum()
+    if u0 is None or x0 is None:
+        p = np.where(mask, _initial(op, h, lam, force, approach, x0), 0.0)
+        if target is not None:
+            p = p if p.sum() > 0 else mask.astype(float)
+            p *= target / p.sum()
+        u0 = None
+    else:  # the caller's iterate and its product, as they are
+        p = np.where(mask, x0, 0.0)
     off = np.flatnonzero(~mask)  # the few masked nodes (last node of the odd rows)
 
     def apply(v):
@@ -128,11 +142,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     def spread(idx, values):  # brick array holding values at the flat indices idx, 0 elsewhere
         full = np.zeros(lat.shape)
-        full.flat[idx] = values
+        full.reshape(-1)[idx] = values
         return full
 
-    u = apply(p)
-    stale = 0
+    if u0 is None:
+        u, stale = apply(p), 0
+    else:  # from the caller: C x0 (+ lam x0), to be confirmed like an incremental update
+        u, stale = np.where(mask, u0, 0.0), 1
+        u += lam * p
     t = np.zeros(lat.shape)
     gz_old, restart = 1.0, True
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
@@ -148,33 +165,37 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     # The conjugate-gradient vectors live on the contact set: they are kept compact, at the
     # flat indices idx of the contact nodes, and spread to brick arrays only for the FFT
     # products; full-array work is left to the gap, the KKT check, the overlap search and the
-    # displacement update.
+    # displacement update. Gathers and scatters go through flat views (x.reshape(-1)[idx], every
+    # array here is C-contiguous): 0.1-0.3 ms on 86,000 of 170,000 nodes against 0.9-1.9 ms
+    # through x.flat[idx].
     for k in range(1, maxiter + 1):
         contact = p > 0
         idx = np.flatnonzero(contact)
-        if force is not None:
-            delta = float(np.mean(u.flat[idx] + h.flat[idx]))
+        pf = p.reshape(-1)
         g = u + h
+        gf = g.reshape(-1)
+        if force is not None:
+            delta = float(np.mean(gf[idx]))
         g -= delta
-        g.flat[off] = 0.0
+        gf[off] = 0.0
         scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
-        g_c = g.flat[idx]
+        g_c = gf[idx]
         # kkt_residual(p[mask], g[mask], ...) without the copies: p = g = 0 off the mask, p >= 0,
         # and max(max_contact |g|, max_free (-g)+) = max(max_contact |g|, (-min g)+) because
         # contact nodes have -g <= max_contact |g|
         parts = [np.abs(g_c).max(initial=0.0), -g.min(), 0.0]  # NaN propagates through np.max
         kkt = float(np.max(parts)) / (scale if scale > 0 else float(np.abs(g).max()) or 1.0)
         if force is not None:
-            kkt = float(np.max([kkt, abs(a * p.flat[idx].sum() - force) / force]))
+            kkt = float(np.max([kkt, abs(a * pf[idx].sum() - force) / force]))
         if not np.isfinite(kkt):
             kkt = np.inf
-        if kkt <= rtol and stale:
+        if kkt <= rtol and stale and confirm:
             u, stale = apply(p), 0  # confirm on an exact product
             continue
         changes = int(np.count_nonzero(contact != prev_contact))
         prev_contact = contact
         hist["residual"].append(kkt)
-        hist["p_max"].append(float(p.flat[idx].max(initial=0.0)))
+        hist["p_max"].append(float(pf[idx].max(initial=0.0)))
         hist["n_contact"].append(int(idx.size))
         hist["changes"].append(changes)
         if not np.isfinite(kkt):
@@ -192,23 +213,23 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             if force is not None:
                 z -= z.mean()
         else:
-            z = preconditioner(spread(idx, g_c)).flat[idx]
+            z = preconditioner(spread(idx, g_c)).reshape(-1)[idx]
             if force is not None and not oblique:
                 z -= z.mean()
             elif force is not None:
                 # oblique projection onto sum z = 0: z - M1 (1.z) / (1.M1), M1 cached per contact set
                 if m_one is None or changes:
-                    m_one = preconditioner(contact.astype(float)).flat[idx]
+                    m_one = preconditioner(contact.astype(float)).reshape(-1)[idx]
                 z -= m_one * (z.sum() / m_one.sum())
         gz = float(np.sum(g_c * z))
         beta = 0.0 if restart else gz / gz_old
-        t_c = z + beta * t.flat[idx]
+        t_c = z + beta * t.reshape(-1)[idx]
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (t_c.sum() / m_one.sum()) if oblique and m_one is not None else t_c.mean()
         t = spread(idx, t_c)
         gz_old = gz
         r = apply(t)
-        r_c = r.flat[idx]
+        r_c = r.reshape(-1)[idx]
         if force is not None:
             r_c -= r_c.mean()
         tt = float(np.sum(t_c * r_c))
@@ -221,24 +242,28 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             break
         else:
             tau = gz / tt
-        p_c = p.flat[idx] - tau * t_c
+        p_c = pf[idx] - tau * t_c
         clipped = p_c < 0
         p_c[clipped] = 0.0
         p_new = spread(idx, p_c)
         # re-entering nodes (p_new = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi
         # estimate -g / (C_nn + lam) so that a node with a large layer compliance cannot overshoot
+        new_f = p_new.reshape(-1)
         low = np.flatnonzero(g < 0)
-        overlap = low[p_new.flat[low] == 0]  # off-mask nodes have g = 0
+        overlap = low[new_f[low] == 0]  # off-mask nodes have g = 0
         if overlap.size:
-            lam_o = lam.flat[overlap] if per_node else lam
+            lam_o = lam.reshape(-1)[overlap] if per_node else lam
             jacobi = 1.0 / (op.diagonal + lam_o)
-            p_new.flat[overlap] = -g.flat[overlap] * (np.minimum(tau, jacobi) if tau > 0 else jacobi)
+            new_f[overlap] = -gf[overlap] * (np.minimum(tau, jacobi) if tau > 0 else jacobi)
         restart = bool(overlap.size)
         s = 1.0
         if target is not None:
             s = target / float(p_new.sum())  # the full sum: Newton's round-off floor depends on it
-            p_new.flat[idx] *= s
-            p_new.flat[overlap[~contact.flat[overlap]]] *= s  # a clipped contact node may re-enter
+            if np.isfinite(s):
+                p_new *= s  # nonzero only at the contact and the overlap: the same as scaling those
+            else:
+                new_f[idx] *= s
+                new_f[overlap[~contact.reshape(-1)[overlap]]] *= s  # a clipped contact node may re-enter
         if clipped.any() or restart or stale >= _RECOMPUTE_EVERY:
             u, stale = apply(p_new), 0
         else:

@@ -22,7 +22,7 @@ import numpy as np
 
 from .checks import InputError, check_positive
 
-__all__ = ["Lattice", "SQRT3"]
+__all__ = ["Lattice", "LatticeWindow", "SQRT3"]
 
 SQRT3 = math.sqrt(3.0)
 
@@ -123,6 +123,18 @@ class Lattice:
     def n_nodes(self):
         """Number of candidate nodes."""
         return int(self.mask.sum())
+
+    def window(self, rows, cols):
+        """The block ``rows x cols`` (two ``(start, stop)`` ranges) of the brick array: a :class:`LatticeWindow`.
+
+        At least two rows, so that both row parities are present.
+        """
+        (r0, r1), (c0, c1) = rows, cols
+        n_rows, n_cols = self.shape
+        if not (0 <= r0 and r0 + 2 <= r1 <= n_rows and 0 <= c0 < c1 <= n_cols):
+            raise InputError(f"rows = {rows!r}, cols = {cols!r} is not allowed: they must be ranges within the "
+                             f"brick array of shape {self.shape}, at least 2 rows (one of each parity).")
+        return LatticeWindow(self, (int(r0), int(r1)), (int(c0), int(c1)))
 
     def coarsen(self):
         """The lattice of step ``2c`` whose nodes are every other node of this one.
@@ -242,4 +254,80 @@ class Lattice:
             np.clip(col, 0, n_cols + 1, out=col)
             idx = row * stride + col
             out += w * flat.take(idx.astype(np.int64))
+        return out
+
+
+@dataclass(frozen=True)
+class LatticeWindow:
+    """A rectangular block of rows and columns of a :class:`Lattice`'s brick array.
+
+    ``C`` depends only on the offset between two nodes, so the influence operator of the
+    nodes in a window is the operator of a lattice of the window's shape whose first row
+    has the window's parity: :class:`bem.operator.InfluenceOperator` takes a window
+    wherever it takes a lattice, and so do the solvers. :func:`bem.solve` runs them on the
+    window of the nodes whose gap can close (see there); arrays of the window are
+    brick arrays of :attr:`shape`, :meth:`embed` puts them back on the parent.
+
+    Parameters
+    ----------
+    parent : Lattice
+        The full lattice.
+    rows, cols : (int, int)
+        Brick rows ``start .. stop - 1`` and columns ``start .. stop - 1`` of the parent.
+    """
+
+    parent: Lattice
+    rows: tuple
+    cols: tuple
+
+    @property
+    def index(self):
+        """The window as an index into a parent brick array."""
+        return slice(*self.rows), slice(*self.cols)
+
+    @property
+    def step(self):
+        return self.parent.step
+
+    @property
+    def shape(self):
+        return (self.rows[1] - self.rows[0], self.cols[1] - self.cols[0])
+
+    @property
+    def node_area(self):
+        return self.parent.node_area
+
+    @cached_property
+    def j(self):
+        return self.parent.j[slice(*self.rows)]
+
+    @cached_property
+    def parity(self):
+        return self.parent.parity[slice(*self.rows)]
+
+    @cached_property
+    def x(self):
+        return self.parent.x[self.index].copy()
+
+    @cached_property
+    def y(self):
+        return self.parent.y[self.index].copy()
+
+    @cached_property
+    def mask(self):
+        return self.parent.mask[self.index].copy()
+
+    @cached_property
+    def border(self):
+        """Nodes of the parent's border inside the window (not the window's own edge)."""
+        return self.parent.border[self.index].copy()
+
+    @property
+    def n_nodes(self):
+        return int(self.mask.sum())
+
+    def embed(self, values):
+        """A parent brick array holding ``values`` (shape :attr:`shape`) in the window, 0 elsewhere."""
+        out = np.zeros(self.parent.shape)
+        out[self.index] = values
         return out

@@ -78,8 +78,8 @@ class InfluenceOperator:
 
     Parameters
     ----------
-    lattice : Lattice
-        The candidate region.
+    lattice : Lattice or bem.lattice.LatticeWindow
+        The candidate region, or a window of it (the operator of the nodes in the window).
     E_star : float
         Effective modulus ``E*`` [pressure], ``1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2``.
 
@@ -98,6 +98,8 @@ class InfluenceOperator:
         n_rows, n_cols = lattice.shape
         self._start = tuple(0 if int(lattice.parity[0]) == a else 1 for a in (0, 1))  # first brick row of parity a
         self._n = tuple(len(range(s, n_rows, 2)) for s in self._start)  # rows of parity a
+        # the last node of the odd rows lies outside the region (a window off the right edge has none)
+        self._masked_last = not bool(lattice.mask[:, -1].all())
         # w_t at every offset (m/2, n sqrt3/2), m = n mod 2 (lattice units), times c / (pi E*)
         n = np.arange(n_rows)[:, None]
         t = np.arange(n_cols + 1)[None, :]
@@ -206,7 +208,8 @@ class InfluenceOperator:
         for a, oa in enumerate(self._parity_rows(out)):
             k0, na = o_rows[a]
             oa[k0 : k0 + na, oq : oq + nq] = res[a, :na]
-        out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
+        if self._masked_last:
+            out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 
     # -- public products ---------------------------------------------------------------------------
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from .checks import check_bool, check_callable, check_choice, check_int, check_load, check_positive, check_range
 from .errors import InputError, RegionTooSmallError
+from .kalker import QPSolution
 from .kkt import kkt_residual
 from .lattice import Lattice
 from .materials import effective_modulus
@@ -148,7 +149,11 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         Initial nodal pressures on the candidate nodes, shape ``(N,)``.
     nested : bool, optional
         Start from the solution on successively coarser lattices (step ``2c``,
-        ``4c``, ...) interpolated onto the finer one. Default: on for
+        ``4c``, ...) interpolated onto the finer one. Each finer level is solved on
+        the rectangular window of the nodes whose initial gap is below the approach
+        (of the coarser level, with a margin): the others cannot close. Its solution
+        is checked against the final approach, and the level solved again on the whole
+        lattice if a node outside the window could close. Default: on for
         ``"newton"`` and the QP, off for the paper's methods so that their
         iteration histories start as in the paper.
     precondition : bool
@@ -222,20 +227,24 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         guess[lattice.mask] = x0
         nested = False
     levels = _levels(lattice, nested)
+    delta = approach  # the approach, or under force control its estimate from the coarser level
     for level, lat in enumerate(levels):
         finest = level == len(levels) - 1
-        op = InfluenceOperator(lat, E_star)
         h = _gap_values(gap, lat)
         kw = dict(force=force, approach=approach, x0=guess, rtol=rtol if finest else max(rtol, 1e-6),
                   callback=callback if finest else None)
         if maxiter is not None:
             kw["maxiter"] = maxiter
-        sol = _run(solver, op, h, layer, precondition, kw, options)
+        window = _candidate_window(lat, h, delta) if nested else None
+        sol, ops = _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window)
+        delta = sol.approach
         if not finest:
             guess = _prolong(lat, sol.p, levels[level + 1])
     _check_border(lattice, sol.p, extent)
+    op = ops[-1] if ops[-1].lattice is lattice else InfluenceOperator(lattice, E_star)
     closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
-    result = _result(lattice, op, h, sol, closure, E_star, layer, solver, force, t_start)
+    result = _result(lattice, op, h, sol, closure, E_star, layer, solver, force, t_start,
+                     n_matvec=sum(o.n_matvec for o in ops if o is not op))
     if not result.converged:
         log.warning("%s: %s%s", solver, result.message, _inner_summary(sol.history))
     return result
@@ -262,6 +271,86 @@ def _run(solver, op, h, layer, precondition, kw, options):
     run = {"newton": solve_newton, "augmented_gap": solve_augmented_gap,
            "variable_compliance": solve_variable_compliance}[solver]
     return run(op, h, layer=layer, precondition=precondition, **kw, **options)
+
+
+# Candidate windows. C p >= 0 and w(p) >= 0 for p >= 0, so the deformed gap of a node is
+# g_n >= h_n - delta: a node with h_n >= delta carries no pressure at the solution, whatever the
+# others do. Nested iteration knows delta (the approach, or under force control its value on the
+# coarser level), and each finer level is solved on the window of the brick array that holds
+# the nodes with h_n < delta + _WINDOW_MARGIN (delta - min h), padded by _WINDOW_PAD nodes; the
+# window's solution is the full one when every node outside it has h_n >= delta of that
+# solution, which is checked (otherwise the level is solved again on the full lattice from the
+# window's solution). Measured on the issue problem (1,048,703 nodes, root layer; the window
+# holds 16 % of them), same process, alternating, load 1.1: 1.23 s against 2.89 s on the full
+# lattice; Hertz 0.88 s against 1.18 s. The full lattice still gets one product, for the result.
+_WINDOW_MARGIN = 0.25
+_WINDOW_PAD = 2
+_WINDOW_UP_TO = 0.6  # a window with more than this fraction of the brick array is not worth it
+
+
+def _candidate_window(lat, h, delta):
+    """The window of ``lat`` holding the nodes whose gap may close near the approach ``delta``, or None."""
+    if delta is None or not np.isfinite(delta):
+        return None
+    mask = lat.mask
+    h_min = float(np.min(h, where=mask, initial=np.inf))
+    if not delta > h_min:
+        return None
+    near = mask & (h < delta + _WINDOW_MARGIN * (delta - h_min))
+    rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
+    (n_rows, n_cols), pad = lat.shape, _WINDOW_PAD
+    r0, r1 = max(int(rows[0]) - pad, 0), min(int(rows[-1]) + 1 + pad, n_rows)
+    c0, c1 = max(int(cols[0]) - pad, 0), min(int(cols[-1]) + 1 + pad, n_cols)
+    if r1 - r0 < 4 or (r1 - r0) * (c1 - c0) > _WINDOW_UP_TO * n_rows * n_cols:
+        return None
+    return lat.window((r0, r1), (c0, c1))
+
+
+def _clear_outside(lat, window, h, delta):
+    """Whether every node of ``lat`` outside ``window`` has ``h >= delta`` (then ``g >= 0`` there at ``p = 0``)."""
+    outside = lat.mask.copy()
+    outside[window.index] = False
+    return bool(np.isfinite(delta)) and float(np.min(h, where=outside, initial=np.inf)) >= delta
+
+
+def _embedded(sol, window):
+    """A window's solution as one of its parent lattice (``displacement`` is not carried over)."""
+    hist = dict(sol.history)
+    if "p" in hist:  # recorded iterates: candidate nodes of the window -> of the parent
+        full = np.zeros(window.shape)
+        parent = window.parent
+
+        def lift(v):
+            full[window.mask] = v
+            return window.embed(full)[parent.mask]
+
+        hist["p"] = [lift(v) for v in hist["p"]]
+    return QPSolution(p=window.embed(sol.p), approach=sol.approach, iterations=sol.iterations,
+                      converged=sol.converged, message=sol.message, kkt_residual=sol.kkt_residual,
+                      displacement=None, history=hist)
+
+
+def _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window):
+    """Solve one lattice level, on ``window`` where given; returns the solution and the operators used."""
+    ops = []
+    if window is not None:
+        op = InfluenceOperator(window, E_star)
+        ops.append(op)
+        kw_w = dict(kw, x0=None if kw["x0"] is None else kw["x0"][window.index])
+        if kw["callback"] is not None:
+            kw_w["callback"] = lambda k, p, cb=kw["callback"]: cb(k, window.embed(p))
+        if solver == "kalker" and "maxiter" not in kw:  # the QP's default limit of the full lattice
+            kw_w["maxiter"] = max(200, int(10 * np.sqrt(lat.n_nodes)))
+        sol = _embedded(_run(solver, op, h[window.index], layer, precondition, kw_w, options), window)
+        if _clear_outside(lat, window, h, sol.approach):
+            return sol, ops
+        # rare: the approach grew past the margin. The full lattice starts from the window's
+        # solution; the result reports that solve's iterations.
+        log.debug("candidate window too small (approach %.6g): solving on the full lattice", sol.approach)
+        kw = dict(kw, x0=sol.p)
+    op = InfluenceOperator(lat, E_star)
+    ops.append(op)
+    return _run(solver, op, h, layer, precondition, kw, options), ops
 
 
 def _prolong(coarse, p, fine):
@@ -307,7 +396,7 @@ def _check_border(lattice, p, extent):
         )
 
 
-def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start):
+def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start, n_matvec=0):
     mask = lattice.mask
     p = sol.p
     u = op.matvec(p)
@@ -324,5 +413,5 @@ def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start)
         contact_area=float(a * np.count_nonzero(p[mask] > 0)), converged=bool(sol.converged),
         message=sol.message, iterations=int(sol.iterations), kkt_residual=float(kkt), method=method,
         wall_time_s=time.perf_counter() - t_start, lattice=lattice, E_star=E_star,
-        history=sol.history, layer=layer, n_matvec=op.n_matvec,
+        history=sol.history, layer=layer, n_matvec=n_matvec + op.n_matvec,
     )

@@ -1,0 +1,108 @@
+"""Nested levels solved on the window of the nodes whose gap can close (bem.lattice.LatticeWindow)."""
+
+import importlib
+
+import numpy as np
+import pytest
+
+import bem
+from bem import layers
+from bem.gaps import Paraboloid
+from bem.lattice import Lattice
+from bem.operator import InfluenceOperator
+
+solve_module = importlib.import_module("bem.solve")
+
+
+@pytest.mark.parametrize("rows, cols", [((3, 20), (5, 30)), ((4, 21), (6, 41)), ((0, 35), (0, 41)), ((1, 3), (0, 3)),
+                                        ((5, 35), (1, 41))])
+def test_window_operator_is_the_parent_operator_on_the_window(rows, cols):
+    lat = Lattice.from_extent(0.1, (2.0, 1.7))
+    win = lat.window(rows, cols)
+    op, op_w = InfluenceOperator(lat, 2.0), InfluenceOperator(win, 2.0)
+    p = np.random.default_rng(3).random(win.shape) * win.mask
+    ref = op.matvec(win.embed(p))[win.index]
+    got = op_w.matvec(p)
+    assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
+    assert np.abs(op_w.dense() @ p[win.mask] - got[win.mask]).max() <= 1e-13 * np.abs(ref).max()
+    assert not got[~win.mask].any()
+
+
+def test_window_refuses_a_block_outside_the_lattice():
+    lat = Lattice.from_extent(0.1, 1.0)
+    with pytest.raises(bem.InputError, match="rows = "):
+        lat.window((0, 1), (0, 5))
+    with pytest.raises(bem.InputError, match="rows = "):
+        lat.window((0, 5), (0, lat.shape[1] + 1))
+
+
+def _root(**kw):
+    return bem.solve(Paraboloid(1.0), E_star=1.0, force=1e-3, step=0.003, extent=0.3, layer=layers.Root(0.04),
+                     **kw)
+
+
+@pytest.mark.parametrize("control", ["force", "approach"])
+@pytest.mark.parametrize("layer", [None, layers.Root(0.04)])
+def test_window_gives_the_full_lattice_solution(monkeypatch, control, layer):
+    load = {"force": 1e-3} if control == "force" else {"approach": 0.012}
+    kw = dict(E_star=1.0, step=0.003, extent=0.3, layer=layer, **load)
+    windowed = bem.solve(Paraboloid(1.0), **kw)
+    monkeypatch.setattr(solve_module, "_WINDOW_UP_TO", 0.0)  # no window
+    full = bem.solve(Paraboloid(1.0), **kw)
+    assert windowed.converged and full.converged
+    assert windowed.kkt_residual <= 1e-10 and windowed.p.shape == full.p.shape
+    assert np.abs(windowed.p - full.p).max() <= 1e-8 * full.p.max()
+    assert windowed.approach == pytest.approx(full.approach, rel=1e-9)
+
+
+def test_window_is_used_and_its_solution_checked_outside(monkeypatch):
+    used, calls = [], []
+    run = solve_module._run
+
+    def spy(solver, op, *args):
+        used.append(op.lattice)
+        return run(solver, op, *args)
+
+    monkeypatch.setattr(solve_module, "_run", spy)
+    res = _root(callback=lambda k, p: calls.append(p.shape))
+    assert res.converged
+    assert type(used[-1]).__name__ == "LatticeWindow" and used[-1].n_nodes < 0.5 * res.p.size
+    assert set(calls) == {res.lattice.shape}  # the callback sees the full lattice
+    # a window that misses nodes of the contact is detected, and the level solved on the full lattice
+    used.clear()
+    monkeypatch.setattr(solve_module, "_WINDOW_MARGIN", -0.6)
+    small = _root()
+    assert small.converged and small.kkt_residual <= 1e-10
+    assert type(used[-1]).__name__ == "Lattice" and type(used[-2]).__name__ == "LatticeWindow"
+    assert np.abs(small.p - res.p).max() <= 1e-8 * res.p.max()
+
+
+def test_recorded_iterates_are_on_the_full_lattice():
+    res = _root(record=True)
+    assert len(res.history["p"]) == res.iterations + 1  # Newton records its start and every step
+    assert all(p.shape == res.p.shape for p in res.history["p"])
+    np.testing.assert_allclose(res.history["p"][-1], res.p)
+
+
+@pytest.mark.parametrize("layer", [None, layers.Power(0.02, 0.3)])
+def test_window_off_centre_with_an_offset_gap(monkeypatch, layer):
+    """A sphere off the centre of an elongated region, the gap offset by a constant."""
+
+    def gap(x, y):
+        return 0.01 + ((x - 0.17) ** 2 + (y + 0.05) ** 2) / 2.0
+
+    kw = dict(E_star=1.0, force=1e-3, step=0.003, extent=(0.45, 0.25), layer=layer)
+    windowed = bem.solve(gap, **kw)
+    monkeypatch.setattr(solve_module, "_WINDOW_UP_TO", 0.0)
+    full = bem.solve(gap, **kw)
+    assert windowed.converged and windowed.kkt_residual <= 1e-10
+    assert np.abs(windowed.p - full.p).max() <= 1e-8 * full.p.max()
+
+
+def test_qp_window_fallback(monkeypatch):
+    monkeypatch.setattr(solve_module, "_WINDOW_MARGIN", -0.6)
+    small = bem.solve(Paraboloid(1.0), E_star=1.0, force=1e-3, step=0.003, extent=0.3)
+    monkeypatch.setattr(solve_module, "_WINDOW_UP_TO", 0.0)
+    full = bem.solve(Paraboloid(1.0), E_star=1.0, force=1e-3, step=0.003, extent=0.3)
+    assert small.converged and small.kkt_residual <= 1e-10
+    assert np.abs(small.p - full.p).max() <= 1e-8 * full.p.max()
