@@ -13,10 +13,11 @@ from .lattice import Lattice
 from .materials import effective_modulus
 from .operator import InfluenceOperator, diagonal_coefficient
 from .result import ContactResult
-from .solve import METHODS, solve
+from .options import METHODS, OPTIONS
+from .solve import solve
 from .stress import SubsurfaceStress, subsurface_stress
 from .template import template
 
 __all__ = ["solve", "subsurface_stress", "SubsurfaceStress", "template", "Lattice", "InfluenceOperator",
-           "ContactResult", "METHODS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
+           "ContactResult", "METHODS", "OPTIONS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
            "effective_modulus", "gaps", "layers"]

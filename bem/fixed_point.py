@@ -245,7 +245,7 @@ def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=Non
         if not np.all(np.isfinite(p_new)):
             reason = f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
             break
-        u = sub.displacement - lam * p_new
+        u = sub.displacement
         inc_p = 1.0 if p is None else _increment(p_new, p)
         same_set = p is not None and np.array_equal(p_new > 0, contact)
         p = p_new

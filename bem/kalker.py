@@ -25,7 +25,11 @@ _RECOMPUTE_EVERY = 20  # exact C p every so many incremental updates
 
 @dataclass
 class QPSolution:
-    """Outcome of :func:`solve_qp` (brick arrays on the operator's lattice)."""
+    """Outcome of :func:`solve_qp` and of every solver built on it (brick arrays on the operator's lattice).
+
+    ``displacement`` is the elastic closure ``C p`` [length], the same for every solver (the
+    layer's closure ``lam p`` or ``w(p)`` is not in it); ``None`` where a solver did not keep it.
+    """
 
     p: np.ndarray
     approach: float
@@ -279,8 +283,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
     if not converged:
         log.debug("Kalker QP: %s", message)
+    elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
-                      message=message, kkt_residual=float(kkt), displacement=u, history=hist)
+                      message=message, kkt_residual=float(kkt), displacement=elastic, history=hist)
 
 
 def compliance_preconditioner(op, D, contact, threshold=4.0):

@@ -270,7 +270,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
                        u0=u, confirm=False)
         _count_inner(hist, sub)
         d = sub.p - p
-        cd = (sub.displacement - D * sub.p) - u
+        cd = sub.displacement - u
         t = _line_search(layer, p, d, u, cd, h, delta, mask)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
             scale = float(np.abs(u + np.where(mask, layer.w(p), 0.0)).max())
@@ -282,7 +282,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
                            u0=u, confirm=False)
             _count_inner(hist, sub)
             d = sub.p - p
-            cd = (sub.displacement - D * sub.p) - u
+            cd = sub.displacement - u
             t = _line_search(layer, p, d, u, cd, h, delta, mask)
         judged = None
         if t == 0.0:

@@ -212,3 +212,19 @@ def test_a_failed_run_logs_one_warning(caplog):
     warnings = [r for r in caplog.records if r.levelno >= logging.WARNING]
     assert len(warnings) == 1 and res.message in warnings[0].getMessage()
     assert math.isfinite(res.kkt_residual)
+
+
+# --- one meaning per name: a solver's displacement is C p, whatever the layer ------------------
+
+@pytest.mark.parametrize("lam", [0.0, 0.3, "per node"])
+def test_the_qp_displacement_is_the_elastic_closure(lam):
+    """QPSolution.displacement = C p (was (C + lam) p for the QP and C p for Newton)."""
+    from bem.kalker import solve_qp
+
+    lattice = bem.Lattice.from_extent(0.1, 1.2)
+    op = bem.InfluenceOperator(lattice, 1.0)
+    if lam == "per node":
+        lam = np.where(lattice.mask, 0.1 + 0.05 * np.hypot(lattice.x, lattice.y), 0.0)
+    sol = solve_qp(op, Paraboloid(1.0)(lattice.x, lattice.y), force=1.0, lam=lam, rtol=1e-10)
+    assert sol.converged
+    np.testing.assert_allclose(sol.displacement, op.matvec(sol.p), rtol=0, atol=1e-12 * np.abs(sol.displacement).max())

@@ -10,8 +10,8 @@ step and the step on the expected contact: the two are iterated to a fixed point
 radial profile is sampled once for all of them). An estimate only sizes the region: the runner
 enlarges an automatic region when the contact reaches its border.
 
-The solver options are checked by the BEM itself (:func:`bem.solve.check_options`: one rule,
-one message), and the option names come from :data:`bem.solve.OPTIONS`.
+The solver options are checked by the BEM itself (:func:`bem.options.check_options`: one rule,
+one message), and the option names come from :data:`bem.options.OPTIONS`.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import math
 from bem import METHODS, InputError
 from bem.lattice import SQRT3, Lattice
 from bem.layers import Linear
-from bem.solve import OPTIONS, check_options, solver_for
+from bem.options import OPTIONS, check_options, solver_for
 
 from . import checks as ck
 from .paper import PAPER_LAWS, c_nn, is_paper_law
@@ -35,7 +35,7 @@ MAX_NODES = 4_000_000
 DOMAIN_MARGIN = 1e-3
 DEFAULT_NODES_ACROSS = 40
 DEFAULT_EXTENT_FACTOR = 1.5
-#: solver options a scene may set: the common ones and each solver's own (bem.solve.OPTIONS)
+#: solver options a scene may set: the common ones and each solver's own (bem.options.OPTIONS)
 SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested") + tuple(
     sorted({k for keys in OPTIONS.values() for k in keys}))
 KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
