@@ -179,7 +179,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
     _notify(progress, "bem", "done", converged=res.converged)
     if not res.converged:
         messages.append(f"BEM did not converge: {res.message}")
-        log.warning("BEM did not converge: %s", res.message)
+        log.info("BEM did not converge: %s", res.message)  # bem.solve has logged its warning
     if "p_max_lambda" in layer_info and scene.layer_spec["law"] == "root":
         layer_info["alpha_b"] = res.p_max / layer_info["p_max_lambda"]
     fem = ref = metrics = None
