@@ -14,7 +14,7 @@ from .kkt import kkt_residual
 from .lattice import Lattice
 from .materials import effective_modulus
 from .operator import InfluenceOperator
-from .options import METHODS, OPTIONS, check_options, solver_for
+from .options import METHODS, check_options, solver_for
 from .result import ContactResult
 
 __all__ = ["solve"]
