@@ -40,6 +40,9 @@ class Gap:
     """
 
     type_name = ""
+    #: the kind of quantity of each constructor argument ("length", "force", "pressure"); the
+    #: reports print its unit from the scene's units (an argument not named here has none)
+    units = {}
     is_axisymmetric = False
     domain = _UNBOUNDED
 
@@ -63,8 +66,8 @@ class Gap:
 
     @classmethod
     def describe(cls):
-        """One line saying what the shape is (the first line of the class docstring)."""
-        return (cls.__doc__ or cls.__name__).strip().splitlines()[0].rstrip(".")
+        """One line saying what the shape is: the first line of the class docstring, without markup."""
+        return (cls.__doc__ or cls.__name__).strip().splitlines()[0].rstrip(".").replace("``", "")
 
     def expected_semi_axes(self, *, E_star, force=None, approach=None, layer=None):
         """Expected contact semi-axes ``(ax, ay)`` [length] before any solve, or ``None``.

@@ -49,6 +49,7 @@ class Callable(Gap):
     """
 
     type_name = "callable"
+    units = {"scale": "length"}
 
     def __init__(self, function, *, scale=1.0):
         if isinstance(function, str):

@@ -23,6 +23,7 @@ class EllipticParaboloid(Gap):
     """
 
     type_name = "elliptic_paraboloid"
+    units = {"Rx": "length", "Ry": "length"}
 
     def __init__(self, Rx, Ry):
         self.Rx = check_positive("Rx", Rx)

@@ -19,6 +19,7 @@ class Paraboloid(AxisymmetricGap):
     """
 
     type_name = "paraboloid"
+    units = {"R": "length"}
 
     def __init__(self, R):
         self.R = check_positive("R", R)

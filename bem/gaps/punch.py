@@ -26,6 +26,7 @@ class FlatPunch(AxisymmetricGap):
     """
 
     type_name = "flat_punch"
+    units = {"a": "length", "edge_radius": "length"}
 
     def __init__(self, a, edge_radius):
         self.a = check_positive("a", a)

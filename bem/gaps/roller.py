@@ -70,6 +70,8 @@ class CrownedRoller(Gap):
     """
 
     type_name = "crowned_roller"
+    units = {"length": "length", "R": "length", "A": "length", "crown_radius": "length",
+             "design_force": "force", "E_star": "pressure"}
     CROWN_KEYS = {"log": ("A", "design_force", "E_star"), "circular": ("crown_radius",), "none": ()}
 
     def __init__(self, length, R, crown="log", *, A=None, crown_radius=None,

@@ -32,6 +32,7 @@ class Table(Gap):
     """
 
     type_name = "table"
+    units = {"x": "length", "y": "length", "h": "length"}
     MIN_POINTS = {"linear": 2, "cubic": 4, "pchip": 4, "quintic": 6}
 
     def __init__(self, x, y, h, method="cubic"):

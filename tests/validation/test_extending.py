@@ -50,6 +50,11 @@ def test_a_new_gap_type_is_checked_sized_and_solved_by_the_scenes(registered, tm
     assert result["converged"] and (tmp_path / "cone" / "bem_field.vtu").is_file()
     assert result["contact_radius"] == pytest.approx(a, abs=2 * scene.bem["step"])
     assert result["approach"] == pytest.approx(math.pi * a * SLOPE / 2, rel=1e-3)  # measured 3.9e-5
+    # the report's problem statement describes the shape by its docstring, with its parameter
+    from validation.report import report_results_dir
+
+    html = report_results_dir(tmp_path / "cone", tmp_path / "report").html.read_text(encoding="utf-8")
+    assert "Rigid cone on a flat: h = slope r" in html and "slope" in html
 
 
 def test_a_new_gap_type_s_bad_input_names_its_key(registered):

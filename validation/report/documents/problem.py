@@ -9,20 +9,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from bem.gaps import GAPS
+
 from ..render.content import Section, Table, fmt
 from ..render.style import method_text
 
 __all__ = ["scene_section"]
 
-_GAP_TEXT = {
-    "paraboloid": "paraboloid h = r^2 / (2 R) (two spheres of effective radius R, 1/R = 1/R1 + 1/R2)",
-    "elliptic_paraboloid": "elliptic paraboloid h = x^2 / (2 Rx) + y^2 / (2 Ry)",
-    "crowned_roller": "crowned roller: a cylinder of effective radius R and length l along x, with an end crown",
-    "flat_punch": "flat punch: a flat of radius a whose edge is rounded with the radius edge_radius",
-    "table": "gap tabulated on a grid, interpolated",
-    "measured": "measured surface read from a file, interpolated onto the lattice",
-    "callable": "gap given by a Python function",
-}
 _LAW_TEXT = {
     "linear": "linear (Winkler) layer w = lam p",
     "elastic_rigid": "elastic-rigid layer w = lam min(p, p_cr)",
@@ -33,9 +26,7 @@ _LAW_TEXT = {
     "series": "two layers in series: w = w1(p) + w2(p)",
     "custom": "user-defined layer law",
 }
-_GAP_UNITS = {"R": "length", "Rx": "length", "Ry": "length", "length": "length", "a": "length",
-              "edge_radius": "length", "crown_radius": "length", "design_force": "force", "A": "length",
-              "scale": "length"}
+_MEASURED = "measured surface read from a file, interpolated onto the lattice"
 _PAPER_ROWS = (("c_nn", "C_nn = c w_t(0,0) / (pi E*), diagonal influence coefficient (eq. 6)", "compliance"),
                ("lam_over_cnn", "lam / C_nn (paper parameter)", "-"),
                ("lam_ref", "compliance of the linear reference layer lam_over_cnn C_nn", "compliance"),
@@ -89,13 +80,14 @@ def _layer_rows(res):
 def _gap_rows(res):
     gap = res.section("gap") or {"type": "not recorded"}
     kind = str(gap.get("type", "?"))
-    rows = [("gap h(x, y)", _GAP_TEXT.get(kind, kind), "-")]
+    shape = GAPS.get(kind)  # the shape says what it is and the kind of each parameter
+    rows = [("gap h(x, y)", _MEASURED if kind == "measured" else shape.describe() if shape else kind, "-")]
 
     def unit(key):
         if kind == "measured" and key in ("spacing", "nodata"):  # in the file's length unit
             file_unit = gap.get("length_unit")
             return file_unit if isinstance(file_unit, str) else res.units.of("length")
-        return res.units.of(_GAP_UNITS.get(key, "-"))
+        return res.units.of(shape.units.get(key, "-") if shape else "-")
 
     for key, value in gap.items():
         if key == "type":
