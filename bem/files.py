@@ -1,6 +1,6 @@
 """Writing files whole or not at all, and the one ParaView (``.vtu``) writer of the toolkit.
 
-Every file contactlab writes (result JSON, scene TOML, field ``.vtu``, gmsh ``.msh``, figure
+Every file contactlab writes (result JSON, scene TOML, field ``.vtu``, figure
 PNG, study tables) goes through :func:`atomic_path`: the content is written to a temporary
 file in the target's own directory, given the permissions of any new file (``0666`` less the
 process umask, i.e. ``0644`` under the usual umask ``022``; ``tempfile.mkstemp`` alone would
@@ -11,8 +11,9 @@ interrupt leaves the previous file, or none.
 The helpers live here, in :mod:`bem`, because the packages depend one way,
 ``validation -> fem_reference -> bem``: the lowest package is the only place both others can
 import. :func:`write_vtu` writes any mesh with point and cell data through meshio (VTK XML,
-binary, zlib-compressed); :func:`write_result_vtu` gives it the BEM lattice as triangles and
-:mod:`fem_reference.fields` its quadratic triangles, so there is one writer for both fields.
+binary, zlib-compressed); :func:`write_result_vtu` gives it the BEM lattice as triangles, :func:`write_stress_vtu` the
+lattice times the depths as hexahedra, and :mod:`fem_reference.fields` its quadratic
+triangles, so there is one writer for every field.
 """
 
 from __future__ import annotations
@@ -25,7 +26,11 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["atomic_path", "write_bytes", "write_text", "file_mode", "umask", "write_vtu", "lattice_triangles",
-           "write_result_vtu"]
+           "write_result_vtu", "write_stress_vtu", "volume_grid", "MAX_POINTS"]
+
+#: largest number of points (all bodies, all depths) of :func:`write_stress_vtu`'s volume file
+MAX_POINTS = 150_000
+_VOIGT_TO_VTK = (0, 1, 2, 5, 3, 4)  # xx, yy, zz, xy, yz, xz from xx, yy, zz, yz, xz, xy
 
 
 def umask():
@@ -200,3 +205,95 @@ def write_result_vtu(path, result, **extra):
               **extra}
     point_data = {name: np.asarray(v, dtype=np.float64).reshape(x.size) for name, v in fields.items()}
     return write_vtu(path, points, [("triangle", lattice_triangles(result.lattice))], point_data)
+
+
+def volume_grid(lattice, n_depths, n_bodies):
+    """Rows and columns of the lattice kept in the volume grid of :func:`write_stress_vtu`.
+
+    Every ``stride``-th brick row and column, the stride chosen so that the file holds at most
+    :data:`MAX_POINTS` points.
+
+    Returns
+    -------
+    (rows, cols, nodes) : ndarray, ndarray, ndarray of shape (len(rows), len(cols))
+        Brick rows and columns kept and the index of each kept node in the nodal arrays of
+        :class:`bem.ContactResult` (masked nodes are never kept: the last column of odd rows
+        lies outside the region, so the columns stop one short of it).
+    """
+    n_rows, n_cols = lattice.shape
+    per_layer = MAX_POINTS / max(1, n_depths * n_bodies)
+    stride = max(1, int(np.ceil(np.sqrt(n_rows * n_cols / per_layer))))
+    rows = np.arange(0, n_rows, stride)
+    cols = np.arange(0, n_cols - 1, stride)
+    index = np.full(lattice.shape, -1, dtype=np.int64)
+    index[lattice.mask] = np.arange(int(lattice.mask.sum()))
+    return rows, cols, index[np.ix_(rows, cols)]
+
+
+def _hexahedra(n_z, n_r, n_c, offset):
+    """Cells of a structured (depth, row, column) block of points numbered from ``offset``."""
+    k, i, j = np.meshgrid(np.arange(n_z - 1), np.arange(n_r - 1), np.arange(n_c - 1), indexing="ij")
+    base = (k * n_r + i) * n_c + j
+    layer = n_r * n_c
+    quad = [base, base + 1, base + n_c + 1, base + n_c]  # counter-clockwise seen from +z
+    cells = np.stack(quad + [q + layer for q in quad], axis=-1).reshape(-1, 8)
+    return (cells + offset).astype(np.int32)
+
+
+def write_stress_vtu(path, result, upper=None, lower=None):
+    """Write subsurface stresses as a volume of hexahedra ParaView opens, atomically (:func:`write_vtu`).
+
+    The grid is the brick lattice of the candidate nodes (:func:`volume_grid`) times the depths;
+    a cell joins two neighbouring rows, columns and depths (odd rows are shifted by half a step,
+    so the cells are parallelepipeds). Global frame, as in the FEM field: ``z`` points up into
+    the upper body (``z = +depth``) and down into the lower one (``z = -depth``), whose shear
+    stresses ``yz``, ``xz`` change sign accordingly.
+
+    Parameters
+    ----------
+    path : path-like
+        Target ``.vtu`` file.
+    result : bem.ContactResult
+        The BEM solution the stresses were computed from (its lattice and nodes).
+    upper, lower : bem.SubsurfaceStress, optional
+        Stresses of the upper body (cell data ``body = 1``) and of the lower one (``body = 2``),
+        on the candidate nodes at increasing depths [length].
+
+    Returns
+    -------
+    pathlib.Path
+
+    Notes
+    -----
+    Point data: ``stress`` (six components in VTK's order ``xx, yy, zz, xy, yz, xz``, which
+    ParaView reads as a symmetric tensor), ``von_mises`` and ``max_shear`` [pressure]; single
+    precision (a picture: the numbers of record are those of :func:`bem.subsurface_stress`).
+    """
+    from .stress import principal_stresses
+
+    bodies = [(body, sign, st) for body, sign, st in ((1, 1.0, upper), (2, -1.0, lower)) if st is not None]
+    rows, cols, nodes = volume_grid(result.lattice, max(st.z.size for *_, st in bodies), len(bodies))
+    flat = nodes.ravel()
+    points, data, cells, body_id = [], [], [], []
+    offset = 0
+    for body, sign, st in bodies:
+        # lower body (depth downwards): reverse the depth order so that every cell's first face is its lowest
+        order = np.arange(st.z.size) if sign > 0 else np.arange(st.z.size)[::-1]
+        z = sign * st.z[order]
+        x = np.broadcast_to(result.x[flat], (z.size, flat.size))
+        y = np.broadcast_to(result.y[flat], (z.size, flat.size))
+        points.append(np.stack([x, y, np.broadcast_to(z[:, None], x.shape)], axis=-1).reshape(-1, 3))
+        sigma = st.sigma[order][:, flat].reshape(-1, 6).copy()
+        if sign < 0:
+            sigma[:, 3:5] *= -1.0  # yz, xz in the global frame
+        principal = principal_stresses(sigma)
+        data.append((sigma[:, _VOIGT_TO_VTK], st.von_mises[order][:, flat].ravel(),
+                     0.5 * (principal[:, 0] - principal[:, 2])))
+        hexa = _hexahedra(z.size, rows.size, cols.size, offset)
+        cells.append(hexa)
+        body_id.append(np.full(len(hexa), body, dtype=np.int32))
+        offset += z.size * flat.size
+    return write_vtu(path, np.concatenate(points), [("hexahedron", np.concatenate(cells))],
+                     point_data={name: np.concatenate([d[k] for d in data]).astype(np.float32)
+                                 for k, name in enumerate(("stress", "von_mises", "max_shear"))},
+                     cell_data={"body": [np.concatenate(body_id)]})

@@ -1,4 +1,4 @@
-"""Nodal stress recovery and the ParaView (.vtu) file of an FEM solution.
+"""Nodal stress recovery and the field of an FEM solution as a mesh for the ParaView (.vtu) writer.
 
 Stresses (Hooke's law per body, axisymmetric)::
 
@@ -13,14 +13,12 @@ interface). ``tr(eps) = eps_rr + eps_zz + eps_tt``; tension positive.
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from bem.files import write_vtu as write_mesh_vtu
 
-__all__ = ["nodal_stresses", "write_vtu", "STRESS_NAMES"]
+__all__ = ["nodal_stresses", "body_stresses", "field_mesh", "STRESS_NAMES"]
 
 STRESS_NAMES = ("sigma_rr", "sigma_zz", "sigma_tt", "sigma_rz", "von_mises")
 
@@ -73,14 +71,42 @@ def nodal_stresses(model, u):
     return out
 
 
-def write_vtu(path, model, u, pressure):
-    """Write the whole field to ``path`` (.vtu, 6-node triangles), atomically.
+def body_stresses(model, u):
+    """Recovered nodal stresses of each body, upper first, on its own nodes.
 
     Parameters
     ----------
-    path : path-like
-        Target file, written by :func:`bem.files.write_vtu` (compressed VTK XML, whole or
-        not at all, permissions of any new file).
+    model : fem_reference.model.AxiModel
+    u : ndarray, shape (model.n_dofs,)
+        Displacement [length].
+
+    Returns
+    -------
+    list of dict
+        One dict per body (upper, lower): ``r`` and ``depth = |z|`` below the interface
+        [length], ``von_mises`` and ``max_shear = (s1 - s3) / 2`` [pressure], the principal
+        stresses being ``sigma_tt`` and those of the ``(r, z)`` block.
+    """
+    s = nodal_stresses(model, u)
+    basis = model.scalar_basis
+    r, z = basis.doflocs
+    centre = 0.5 * (s["sigma_rr"] + s["sigma_zz"])
+    radius = np.hypot(0.5 * (s["sigma_rr"] - s["sigma_zz"]), s["sigma_rz"])
+    principal = np.stack([centre + radius, centre - radius, s["sigma_tt"]])
+    shear = 0.5 * (principal.max(axis=0) - principal.min(axis=0))
+    out = []
+    for index in range(2):
+        nodes = np.unique(basis.element_dofs[:, model.amesh.body == index])
+        out.append({"r": r[nodes], "depth": np.abs(z[nodes]), "von_mises": s["von_mises"][nodes],
+                    "max_shear": shear[nodes]})
+    return out
+
+
+def field_mesh(model, u, pressure):
+    """The whole field as a mesh with point and cell data, for :func:`bem.files.write_vtu`.
+
+    Parameters
+    ----------
     model : fem_reference.model.AxiModel
         The model.
     u : ndarray
@@ -90,14 +116,11 @@ def write_vtu(path, model, u, pressure):
 
     Returns
     -------
-    str
-        ``path``.
-
-    Notes
-    -----
-    Points are ``(r, z, 0)`` [length]; point data ``displacement`` (``u_r, u_z, 0``) [length],
-    the stresses of :func:`nodal_stresses` and ``contact_pressure`` (0 off the interface)
-    [pressure]; cell data ``body`` (0 upper, 1 lower).
+    dict
+        ``points`` ``(r, z, 0)`` [length]; ``cells`` (6-node triangles); ``point_data``:
+        ``displacement`` (``u_r, u_z, 0``) [length], the stresses of :func:`nodal_stresses` and
+        ``contact_pressure`` (0 off the interface) [pressure]; ``cell_data``: ``body`` (0
+        upper, 1 lower). ``bem.files.write_vtu(path, **field_mesh(...))`` writes it.
     """
     basis = model.scalar_basis
     x = basis.doflocs
@@ -107,7 +130,6 @@ def write_vtu(path, model, u, pressure):
     p_nodes = np.zeros(x.shape[1])
     p_nodes[model.node_up] = pressure
     p_nodes[model.node_lo] = pressure
-    write_mesh_vtu(path, points, [("triangle6", np.ascontiguousarray(basis.element_dofs.T, dtype=np.int64))],
-                   point_data={"displacement": disp, **fields, "contact_pressure": p_nodes},
-                   cell_data={"body": [model.amesh.body.astype(np.int32)]})
-    return os.fspath(path)
+    return {"points": points, "cells": [("triangle6", np.ascontiguousarray(basis.element_dofs.T, dtype=np.int64))],
+            "point_data": {"displacement": disp, **fields, "contact_pressure": p_nodes},
+            "cell_data": {"body": [model.amesh.body.astype(np.int32)]}}

@@ -35,7 +35,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bem.checks import InputError, check_positive
-from bem.files import atomic_path
 
 __all__ = ["AxiMesh", "build_mesh", "BOUNDARIES"]
 
@@ -243,13 +242,7 @@ def _to_skfem(xy, parts):
     return mesh, body, np.hstack(n6_blocks), np.hstack(c6_blocks)
 
 
-def _write_msh(gmsh, path):
-    with atomic_path(path, suffix=".msh") as tmp:
-        gmsh.write(tmp)
-
-
-def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None,
-               msh_path=None):
+def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None):
     """Mesh the two bodies with gmsh and convert the mesh to scikit-fem.
 
     Parameters
@@ -266,8 +259,6 @@ def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, grow
         Slope ``dh/d(distance)`` of the linear size grading outside the fine zone [-].
     h_coarse : float, optional
         Far-field size [length]; default ``R / 8``.
-    msh_path : path-like, optional
-        Also write the gmsh mesh (``.msh``, physical groups included) there, atomically.
 
     Returns
     -------
@@ -298,8 +289,6 @@ def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, grow
         gmsh.model.mesh.generate(2)
         gmsh.model.mesh.setOrder(2)
         xy, parts = _extract(gmsh, surfaces, curves)
-        if msh_path is not None:
-            _write_msh(gmsh, msh_path)
     finally:
         gmsh.finalize()
     mesh, body, nodes6, cells6 = _to_skfem(xy, parts)

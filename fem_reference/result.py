@@ -152,14 +152,14 @@ class FemResult:
         """Final relative Newton residual ``max|F1| / scale`` (:mod:`fem_reference.newton`)."""
         return float(self.history["residual"][-1]) if self.history.get("residual") else float("inf")
 
-    def write(self, path):
-        """Write displacements, stresses and contact pressure to a ``.vtu`` file, atomically.
+    def field(self):
+        """Displacements, stresses and contact pressure as a mesh (:func:`fem_reference.fields.field_mesh`).
 
-        See :func:`fem_reference.fields.write_vtu`. Returns the path.
+        ``bem.files.write_vtu(path, **result.field())`` writes the ParaView file.
         """
-        from .fields import write_vtu
+        from .fields import field_mesh
 
-        return write_vtu(path, self.model, self.displacement, self.p)
+        return field_mesh(self.model, self.displacement, self.p)
 
     def summary(self):
         """Scalars as a JSON-ready dict."""

@@ -108,7 +108,7 @@ def _one_mesh(amesh, gap, materials, E_star, layer, penalty, force, approach, tr
 
 def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est=None, n_contact=24,
           extent_factor=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5, truncation_correction=True,
-          remesh=True, rtol=1e-9, maxiter=60, out=None, msh_path=None):
+          remesh=True, rtol=1e-9, maxiter=60):
     """Axisymmetric FEM reference solution of the layered contact of two elastic bodies.
 
     Body 1 (``E1, nu1``) is the upper body ``z >= 0``, body 2 the lower one; the interface
@@ -146,10 +146,6 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
         Newton stopping rule (:mod:`fem_reference.newton`).
     maxiter : int
         Newton-step limit.
-    out : path-like, optional
-        Write the whole field there (``.vtu``), see :meth:`FemResult.write`.
-    msh_path : path-like, optional
-        Also write the gmsh mesh (``.msh``).
 
     Returns
     -------
@@ -177,7 +173,7 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     for attempt in range(2):
         if mesh is None or remeshed:
             amesh = build_mesh(a_est, n_contact=n_contact, extent_factor=extent_factor, fine_radius=fine_radius,
-                               growth=growth, msh_path=msh_path)
+                               growth=growth)
         else:
             amesh = mesh
         mesh_time += amesh.mesh_time_s if (mesh is None or remeshed) else 0.0
@@ -195,11 +191,11 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
             continue
         break
     return _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty, E_star,
-                   layer, remeshed, amesh, out)
+                   layer, remeshed, amesh)
 
 
 def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty, E_star, layer,
-            remeshed, amesh, out):
+            remeshed, amesh):
     t0 = time.perf_counter()
     A = model.weights
     force = float(np.sum(A * sol.p))
@@ -238,6 +234,4 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     )
     if not converged:
         log.warning("FEM reference did not converge: %s", message)
-    if out is not None:
-        result.write(out)
     return result

@@ -27,7 +27,6 @@ for the FEM they are the ring areas of :func:`ring_weights`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -35,87 +34,11 @@ from bem.checks import InputError, check_finite_array, check_positive
 from bem.result import ContactResult
 from fem_reference.result import FemResult
 
-__all__ = ["RadialProfile", "radial_profile", "ring_weights", "relative_l2", "pair_metrics", "compare",
+__all__ = ["ring_weights", "relative_l2", "pair_metrics", "compare",
            "PAIR_KEYS"]
 
 #: keys of one pair of :func:`pair_metrics` / :func:`compare`
 PAIR_KEYS = ("l2_rel", "max_rel", "peak_rel", "contact_radius_rel", "approach_rel", "force_rel", "n_points")
-
-
-@dataclass(frozen=True)
-class RadialProfile:
-    """Radial pressure profile of a BEM result.
-
-    Attributes
-    ----------
-    r, p : ndarray
-        All candidate nodes sorted by radius ``r = hypot(x, y)`` [length] and their
-        pressures [pressure].
-    r_bin, p_bin : ndarray
-        Binned profile: mean radius and mean pressure of the nodes in each non-empty bin of
-        width ``bin_width`` [length], [pressure].
-    count : ndarray of int
-        Nodes per bin.
-    bin_width : float
-        Width of the radial bins [length].
-    x_section, p_section : ndarray
-        The axial section ``y = 0`` (lattice row ``j = 0``), sorted by ``x`` [length],
-        [pressure].
-    """
-
-    r: np.ndarray
-    p: np.ndarray
-    r_bin: np.ndarray
-    p_bin: np.ndarray
-    count: np.ndarray
-    bin_width: float
-    x_section: np.ndarray
-    p_section: np.ndarray
-
-    def to_dict(self):
-        """JSON-ready dict (lists of floats)."""
-        return {
-            "r": self.r.tolist(), "p": self.p.tolist(), "r_bin": self.r_bin.tolist(),
-            "p_bin": self.p_bin.tolist(), "count": self.count.tolist(), "bin_width": float(self.bin_width),
-            "x_section": self.x_section.tolist(), "p_section": self.p_section.tolist(),
-        }
-
-
-def radial_profile(result, *, n=None):
-    """Radial profile of a BEM result: sorted nodes, binned averages and the axial section.
-
-    Parameters
-    ----------
-    result : bem.ContactResult
-        The BEM solution (any gap; the profile is meaningful for axisymmetric scenes).
-    n : int, optional
-        Number of radial bins over ``[0, r_max]`` (``r_max`` the largest node radius);
-        default: bins one lattice step ``c`` wide.
-
-    Returns
-    -------
-    RadialProfile
-    """
-    _check_bem(result)
-    r = np.hypot(result.x, result.y)
-    r_max = float(r.max())
-    if n is None:
-        n = max(1, math.ceil(r_max / result.step))
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise InputError(f"n = {n!r} is not allowed: it must be an integer >= 1.")
-    width = r_max / n if r_max > 0 else 1.0
-    order = np.argsort(r, kind="stable")
-    k = np.minimum((r / width).astype(int), n - 1)
-    count = np.bincount(k, minlength=n)
-    sum_r = np.bincount(k, weights=r, minlength=n)
-    sum_p = np.bincount(k, weights=result.p, minlength=n)
-    full = count > 0
-    on_axis = np.abs(result.y) <= 1e-9 * result.step
-    xs = result.x[on_axis]
-    sec = np.argsort(xs, kind="stable")
-    return RadialProfile(r=r[order], p=result.p[order].copy(), r_bin=sum_r[full] / count[full],
-                         p_bin=sum_p[full] / count[full], count=count[full], bin_width=float(width),
-                         x_section=xs[sec], p_section=result.p[on_axis][sec])
 
 
 def ring_weights(r):

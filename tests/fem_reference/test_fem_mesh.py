@@ -84,16 +84,11 @@ def test_grading_fine_at_contact_coarse_far(coarse_mesh):
     assert abs(across - coarse_mesh.n_contact) <= 2
 
 
-def test_msh_file_has_physical_groups(tmp_path, hertz_same):
-    import meshio
-
-    path = tmp_path / "bodies.msh"
-    build_mesh(hertz_same[0], n_contact=3, extent_factor=20.0, msh_path=path)
-    m = meshio.read(path)
-    names = set(m.field_data)
-    assert {"upper", "lower", "interface", "axis", "top", "bottom", "outer"} <= names
-    assert any(block.type == "triangle6" for block in m.cells)
-    assert not [p for p in tmp_path.iterdir() if p.name != "bodies.msh"]
+def test_mesh_keeps_the_physical_groups_and_writes_no_file(tmp_path, monkeypatch, hertz_same):
+    monkeypatch.chdir(tmp_path)
+    mesh = build_mesh(hertz_same[0], n_contact=3, extent_factor=20.0)
+    assert {"upper", "lower", "interface", "axis", "top", "bottom", "outer"} <= set(mesh.physical_groups)
+    assert not list(tmp_path.iterdir())  # fem_reference returns data; writes no files
 
 
 def test_gmsh_finalized_on_error(monkeypatch):

@@ -8,6 +8,7 @@ from .fem_cases import E, NU, P
 
 import fem_reference as fr
 from bem.checks import InputError
+from bem.files import write_vtu
 from bem.layers import Linear, Root
 
 
@@ -20,7 +21,7 @@ def test_vtu_readable_with_expected_fields(result, tmp_path):
     import meshio
 
     path = tmp_path / "field.vtu"
-    assert result.write(path) == str(path)
+    assert write_vtu(path, **result.field()) == path
     m = meshio.read(path)
     assert [c.type for c in m.cells] == ["triangle6"]
     assert m.cells[0].data.shape == (result.n_elements, 6)
@@ -44,12 +45,14 @@ def test_vtu_readable_with_expected_fields(result, tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["field.vtu"]  # no temporary file left
 
 
-def test_out_argument_and_atomic_failure(gap, coarse_mesh, tmp_path, monkeypatch):
+def test_solve_writes_no_file_and_the_field_is_written_whole_or_not_at_all(gap, coarse_mesh, tmp_path,
+                                                                             monkeypatch):
     import meshio
 
-    path = tmp_path / "solve.vtu"
-    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, mesh=coarse_mesh, out=path)
-    assert path.exists() and res.converged
+    monkeypatch.chdir(tmp_path)
+    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, mesh=coarse_mesh)
+    assert res.converged and not list(tmp_path.iterdir())  # fem_reference returns data; writes no files
+    path = write_vtu(tmp_path / "solve.vtu", **res.field())
 
     def broken(*args, **kwargs):
         raise OSError("disk full")
@@ -57,9 +60,9 @@ def test_out_argument_and_atomic_failure(gap, coarse_mesh, tmp_path, monkeypatch
     monkeypatch.setattr(meshio, "write", broken)
     target = tmp_path / "never.vtu"
     with pytest.raises(OSError, match="disk full"):
-        res.write(target)
+        write_vtu(target, **res.field())
     assert not target.exists()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["solve.vtu"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
 
 
 def test_not_converged_says_so_without_nan(gap, coarse_mesh):
@@ -112,7 +115,7 @@ def test_vtu_is_compressed_with_ordinary_permissions(result, tmp_path):
 
     from ..vtu_reader import read_vtu
 
-    path = result.write(tmp_path / "f.vtu")
+    path = write_vtu(tmp_path / "f.vtu", **result.field())
     assert stat.S_IMODE(os.stat(path).st_mode) == file_mode()
     points, (conn, offsets, types), point_data, cell_data, attrs = read_vtu(path)
     assert attrs["compressor"] == "vtkZLibDataCompressor"
@@ -149,7 +152,7 @@ def test_vtk_reader_opens_the_file(result, tmp_path):
     (VTK cell type 22) and the fields, one value per point."""
     import re
 
-    path = result.write(tmp_path / "paraview.vtu")
+    path = write_vtu(tmp_path / "paraview.vtu", **result.field())
     text = Path(path).read_text()
     assert 'type="UnstructuredGrid"' in text and 'compressor="vtkZLibDataCompressor"' in text
     n_points, n_cells = map(int, re.search(r'NumberOfPoints="(\d+)" NumberOfCells="(\d+)"', text).groups())

@@ -13,7 +13,7 @@ from bem.checks import InputError
 from bem.gaps import EllipticParaboloid, Paraboloid
 from fem_reference.result import FemResult
 from bem.reference import hertz_elliptic, hertz_sphere
-from validation.compare import PAIR_KEYS, compare, pair_metrics, radial_profile, relative_l2, ring_weights
+from validation.compare import PAIR_KEYS, compare, pair_metrics, relative_l2, ring_weights
 
 H = hertz_sphere(1.0, 1.0, force=1.0)
 H_A = H.contact_radius
@@ -151,33 +151,12 @@ def test_finer_lattice_is_closer_to_hertz():
     assert abs(errs[1]["peak_rel"]) < 0.2 * abs(errs[0]["peak_rel"])
 
 
-def test_radial_profile_of_a_known_field(base):
-    r = _radius(base)
-    fake = _with_p(base, np.maximum(1.0 - r**2, 0.0) + 0.5)
-    prof = radial_profile(fake)
-    assert np.all(np.diff(prof.r) >= 0) and prof.p.size == r.size
-    assert prof.count.sum() == r.size
-    assert prof.bin_width == pytest.approx(r.max() / math.ceil(r.max() / base.step))
-    inside = prof.r_bin < 0.95 - prof.bin_width
-    # mean of 1.5 - r^2 over a bin is 1.5 - mean(r)^2 - var(r), var <= (w/2)^2
-    dev = (1.5 - prof.r_bin**2) - prof.p_bin
-    assert np.all(dev[inside] >= -1e-12) and np.all(dev[inside] <= prof.bin_width**2 / 4 + 1e-12)
-    assert np.all(np.diff(prof.x_section) > 0)
-    assert np.allclose(prof.p_section, np.maximum(1.0 - prof.x_section**2, 0.0) + 0.5)
-    assert np.allclose(np.diff(prof.x_section), base.step)
-    assert radial_profile(fake, n=7).r_bin.size <= 7
-    json.dumps(prof.to_dict(), allow_nan=False)
-    with pytest.raises(InputError, match="n = 0"):
-        radial_profile(fake, n=0)
-
-
-def test_radial_profile_of_a_solve_follows_hertz():
+def test_nodal_pressure_of_a_solve_follows_hertz():
     res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=2 * H_A / 40, extent=1.3 * H_A)
-    prof = radial_profile(res)
-    inside = prof.r_bin < 0.9 * H_A
-    assert np.max(np.abs(prof.p_bin[inside] - H.pressure(prof.r_bin[inside]))) < 0.02 * H.p_max
-    outside = prof.r_bin > 1.1 * H_A
-    assert np.all(prof.p_bin[outside] == 0)
+    r = np.hypot(res.x, res.y)
+    inside = r < 0.9 * H_A
+    assert np.max(np.abs(res.p[inside] - H.pressure(r[inside]))) < 0.02 * H.p_max
+    assert np.all(res.p[r > 1.1 * H_A] == 0)
 
 
 def test_bad_input_is_refused(base):
@@ -196,7 +175,6 @@ def test_inputs_are_not_modified(base):
     fem = _fem(np.linspace(0, 3, 31), H.pressure(np.linspace(0, 3, 31)))
     saved = copy.deepcopy((base.p, base.x, base.y, fem.r, fem.p))
     compare(base, fem=fem, analytic=H)
-    radial_profile(base)
     ring_weights(fem.r)
     for a, b in zip(saved, (base.p, base.x, base.y, fem.r, fem.p)):
         assert np.array_equal(a, b)

@@ -115,7 +115,7 @@ def test_result_json_holds_the_maxima_per_body(stress_run):
 def test_stress_field_file_reads_back_with_meshio(stress_run):
     import meshio
 
-    from validation.io import volume_grid
+    from bem.files import volume_grid
 
     outcome, out = stress_run
     mesh = meshio.read(out / "stress_field.vtu")

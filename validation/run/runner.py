@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import tomli_w
 
 import bem
-from bem.files import write_result_vtu, write_text
+from bem.files import write_result_vtu, write_stress_vtu, write_text, write_vtu
 
 from ..compare import compare
 from ..io import atomic_directory, atomic_write_json
@@ -228,11 +228,10 @@ def write_outputs(outcome, out_dir, *, progress=None):
     with atomic_directory(out_dir) as tmp:
         write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
         if outcome.fem is not None:
-            outcome.fem.write(tmp / files["fem_field"])
+            write_vtu(tmp / files["fem_field"], **outcome.fem.field())
         if outcome.stress is not None:
-            from ..io import write_stress_field
-
-            write_stress_field(tmp / files["stress_field"], res, outcome.stress)
+            write_stress_vtu(tmp / files["stress_field"], res, upper=outcome.stress.bodies.get("body1"),
+                             lower=outcome.stress.bodies.get("body2"))
         write_text(tmp / files["scene"], tomli_w.dumps(scene.raw))
         atomic_write_json(tmp / files["result"], outcome.result)
     _notify(progress, "write", "done")

@@ -32,8 +32,8 @@ from bem.stress import principal_stresses
 __all__ = ["BODIES", "StressRun", "run_stress", "stress_depths", "stress_summary", "fem_body_stresses", "peak_fit",
            "compare_with_fem", "contact_half_width"]
 
-#: body name -> (its Poisson-ratio key in [bodies], sign of its depth in the FEM's z, which points up)
-BODIES = {"body1": ("nu1", 1.0), "body2": ("nu2", -1.0)}
+#: body name (upper, lower) -> its Poisson-ratio key in [bodies]
+BODIES = {"body1": "nu1", "body2": "nu2"}
 _SECTION_POINTS = 400  # at most this many x positions of the x-z section kept in result.json
 _BAND = 0.04
 
@@ -84,7 +84,7 @@ def run_stress(scene, res, fem=None):
     t0 = time.perf_counter()
     spec = scene.stress
     depths, scale = stress_depths(spec, res)
-    bodies = {name: bem.subsurface_stress(res, depths, nu=scene.materials[BODIES[name][0]])
+    bodies = {name: bem.subsurface_stress(res, depths, nu=scene.materials[BODIES[name]])
               for name in spec["bodies"]}
     run = StressRun(bodies=bodies, depths=depths, scale=scale)
     if fem is not None:
@@ -95,28 +95,10 @@ def run_stress(scene, res, fem=None):
 
 
 def fem_body_stresses(fem):
-    """Recovered nodal stresses of each FEM body: ``name -> {r, depth, von_mises, max_shear}``.
+    """Recovered nodal stresses of each FEM body by name (:func:`fem_reference.fields.body_stresses`)."""
+    from fem_reference.fields import body_stresses
 
-    From :func:`fem_reference.fields.nodal_stresses`; ``depth = |z|`` below the interface.
-    ``max_shear = (s1 - s3) / 2`` of the principal stresses ``sigma_tt`` and those of the
-    ``(r, z)`` block.
-    """
-    from fem_reference.fields import nodal_stresses
-
-    model = fem.model
-    s = nodal_stresses(model, fem.displacement)
-    basis = model.scalar_basis
-    r, z = basis.doflocs
-    centre = 0.5 * (s["sigma_rr"] + s["sigma_zz"])
-    radius = np.hypot(0.5 * (s["sigma_rr"] - s["sigma_zz"]), s["sigma_rz"])
-    principal = np.stack([centre + radius, centre - radius, s["sigma_tt"]])
-    shear = 0.5 * (principal.max(axis=0) - principal.min(axis=0))
-    out = {}
-    for index, (name, (_, sign)) in enumerate(BODIES.items()):
-        nodes = np.unique(basis.element_dofs[:, model.amesh.body == index])
-        out[name] = {"r": r[nodes], "depth": sign * z[nodes], "von_mises": s["von_mises"][nodes],
-                     "max_shear": shear[nodes]}
-    return out
+    return dict(zip(BODIES, body_stresses(fem.model, fem.displacement)))
 
 
 def peak_fit(depth, values, band=_BAND):
