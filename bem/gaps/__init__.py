@@ -10,6 +10,10 @@ line in :data:`GAPS`; user code registers its own with :func:`register`. Scenes
 (``[gap] type = ...``), their checks, the sizing of the candidate region and the reports
 read everything else from the class: its constructor arguments, its docstring and its
 :meth:`Gap.expected_semi_axes`.
+
+Measured surfaces (:mod:`bem.gaps.measured`): :func:`read_heights` reads a height map from a
+file, and :class:`Measured` gives the gap over a candidate region as a :class:`Table` (it is
+not in :data:`GAPS`: its gap exists only over a region; see its docstring).
 """
 
 from __future__ import annotations
@@ -21,13 +25,15 @@ from ..checks import check_choice, fail
 from .base import AxisymmetricGap, Gap
 from .callable import Callable
 from .elliptic import EllipticParaboloid
+from .measured import Measured, read_heights
 from .paraboloid import Paraboloid
 from .punch import FlatPunch
 from .roller import CrownedRoller, lundberg_coefficient
 from .table import Table
 
 __all__ = ["Gap", "AxisymmetricGap", "Paraboloid", "EllipticParaboloid", "CrownedRoller", "FlatPunch",
-           "Callable", "Table", "GAPS", "register", "parameters", "gap_from_dict", "lundberg_coefficient"]
+           "Callable", "Table", "Measured", "read_heights", "GAPS", "register", "parameters", "gap_from_dict",
+           "lundberg_coefficient"]
 
 #: The registry: ``type_name`` -> class, one line per gap type.
 GAPS = {

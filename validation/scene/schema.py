@@ -115,8 +115,8 @@ def gap(d, E_star, *, units=None):
     A log-crowned roller given by ``design_force`` takes ``E_star`` from ``[bodies]`` when the
     gap table leaves it out. ``type = "measured"`` reads a file (:mod:`validation.scene.measured`;
     ``units`` is the scene's units label) and returns a
-    :class:`validation.scene.measured.MeasuredSurface`, which the scene turns into a gap table
-    over the candidate region.
+    :class:`bem.gaps.Measured`, which the scene turns into a gap table over the candidate
+    region.
     """
     ck.table("gap", d)
     kinds = (*GAP_TYPES, "measured")
