@@ -28,6 +28,8 @@ part of the grid that covers it (:meth:`bem.gaps.Measured.region`).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from bem.gaps import Measured
 
 from ..units import METRES
@@ -77,6 +79,8 @@ def measured_gap(d, *, units=None):
     """
     ck.unknown_keys("gap", d, KEYS)
     file = ck.string("gap.file", ck.require("gap", d, "file", 'give the measured surface, e.g. file = "z.npy"'))
+    if not Path(file).is_file():
+        _fail("file", file, "there is no such file (a relative name starts from the scene file's folder)")
     scale = _factor(d, units)
     with ck.scene_errors("gap."):
         surface = Measured.from_file(file, scale=scale, **{k: d[k] for k in _FILE_KEYS if k in d})
