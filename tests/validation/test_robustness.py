@@ -1,10 +1,12 @@
 """The robustness grid on its corners: nothing wrong, Newton converges, the paper's methods where they can."""
 
+import json
 import logging
 
 import pytest
 
-from validation.studies.robustness import run_robustness, summary_markdown
+from validation.report.documents.studies import study_markdown
+from validation.studies.robustness import _json_row, run_robustness
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +46,7 @@ def test_augmented_gap_fails_loudly_where_the_layer_dominates(rows):
 
 
 def test_summary_lists_every_failure(rows):
-    text = summary_markdown(rows)
+    text = study_markdown("robustness.json", json.loads(json.dumps([_json_row(r) for r in rows])))
     failures = [r for r in rows if r.status != "converged"]
-    listed = text.split("## Every outcome that is not converged")[1]
+    listed = text.split("Every outcome that is not converged.")[1]
     assert listed.count("| reported failure |") == len(failures) > 0

@@ -11,6 +11,7 @@ import pytest
 import bem
 from bem.checks import InputError
 from bem.reference import hertz_sphere
+from validation.report.documents.studies import study_markdown
 from validation.studies import error_time, stability
 from validation.studies.error_time import ErrorTimeRow, ErrorTimeStudy, run_error_time
 from validation.run import execute_scene
@@ -115,8 +116,9 @@ def test_first_to_reach_on_the_study(et):
             assert best.wall_time_s == min(r.wall_time_s for r in ok)
             kept = et.first_to_reach(tol, problem=problem)
             assert kept is None or (kept in ok and kept.wall_time_s >= best.wall_time_s)
-    text = et.markdown()
-    assert "First to reach" in text and "augmented_gap (omega=1)" in text and "variable_compliance" in text
+    text = study_markdown("error_time.json", json.loads(json.dumps(et.to_dict())))
+    assert "reaches 1 % and 0.1 % first" in text and "augmented_gap (omega=1)" in text
+    assert "variable_compliance" in text
     assert text.count("| bem | newton |") == len(LADDER["bem"])
 
 
@@ -130,7 +132,7 @@ def test_error_time_json_and_main(et, tmp_path, capsys):
     assert "| bem | kalker |" in capsys.readouterr().out
     written = json.loads((tmp_path / "cli" / "error_time.json").read_text())
     assert {r["problem"] for r in written["rows"]} == {"hertz"}
-    assert (tmp_path / "cli" / "error_time.md").read_text().startswith("## Error against run time")
+    assert (tmp_path / "cli" / "error_time.md").read_text().startswith("# Error against run time")
     with pytest.raises(InputError, match="scene"):
         error_time.main(argparse.Namespace(scene="nope", out=str(tmp_path), quick=True))
 
@@ -157,7 +159,7 @@ def test_stability_quick_has_no_nan_and_no_wrong_answer(st):
     # the augmented gap method stalls on soft layers and must say so
     assert any(r.method == "augmented_gap" and r.status == "reported failure" for r in st.rows)
     json.dumps(st.to_dict(), allow_nan=False)
-    assert "| bem newton |" in st.markdown()
+    assert "| bem newton |" in study_markdown("stability.json", json.loads(json.dumps(st.to_dict())))
 
 
 def test_classify_rules():

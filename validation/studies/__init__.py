@@ -28,7 +28,7 @@ from bem.files import write_text
 from ..run import execute_scene
 from ..scene import load_scene
 
-__all__ = ["attempt", "timed", "classify", "finite", "save", "write_json", "markdown_table", "fmt", "STATUSES"]
+__all__ = ["attempt", "timed", "classify", "finite", "save", "write_json", "fmt", "STATUSES"]
 
 #: status of an outcome (:func:`classify`)
 STATUSES = ("converged", "reported failure", "wrong")
@@ -95,10 +95,16 @@ def write_json(path, data):
     return write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
 
 
-def save(args, stem, data, text):
-    """Write ``<stem>.json`` and ``<stem>.md`` to ``args.out`` (default: the current directory); returns ``text``."""
+def save(args, stem, data):
+    """Write ``<stem>.json`` and its tables as ``<stem>.md`` to ``args.out`` (default: the current directory).
+
+    The Markdown is that of the studies report without its figures, made from the JSON as
+    written (:func:`validation.report.documents.studies.study_markdown`); returns it.
+    """
+    from ..report.documents.studies import study_markdown
+
     out = Path(getattr(args, "out", None) or ".")
-    write_json(out / f"{stem}.json", data)
+    text = study_markdown(f"{stem}.json", json.loads(write_json(out / f"{stem}.json", data).read_text()))
     write_text(out / f"{stem}.md", text)
     return text
 
@@ -112,11 +118,3 @@ def fmt(value, spec=".2e"):
     if isinstance(value, float):
         return format(value, spec) if math.isfinite(value) else str(value)
     return str(value)
-
-
-def markdown_table(headers, rows):
-    """A GitHub-flavoured markdown table of already formatted cells (``|`` escaped)."""
-    def line(cells):
-        return "| " + " | ".join(str(c).replace("|", "\\|").replace("\n", " ") for c in cells) + " |"
-
-    return "\n".join([line(headers), "|" + "|".join("---" for _ in headers) + "|"] + [line(r) for r in rows])

@@ -26,7 +26,7 @@ from bem.checks import InputError, check_choice, check_positive
 
 from ..compare import pair_metrics, relative_l2
 from ..run import execute_scene
-from . import fmt, markdown_table, save, timed, write_json
+from . import fmt, save, timed, write_json
 from .problems import ERROR_TIME_PROBLEMS, get_problem, methods
 
 __all__ = ["ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "LADDERS", "TARGETS"]
@@ -130,28 +130,6 @@ class ErrorTimeStudy:
         """``(problem, metric, tol, first row or None)`` for every target."""
         return [(name, m, tol, self.first_to_reach(tol, problem=name, metric=m))
                 for name in self.problems for m in _METRICS for tol in TARGETS]
-
-    def markdown(self):
-        """The study as markdown: per problem its reference and rows, then who reached each target first."""
-        out = ["## Error against run time", ""]
-        head = ["solver", "method", "resolution", "N", "error L2", "error peak", "wall time [s]", "iterations",
-                "converged"]
-        for name in self.problems:
-            ref = self.references.get(name, {})
-            body = [[r.solver, r.label, r.resolution, r.n, fmt(r.error_l2), fmt(r.error_peak),
-                     fmt(r.wall_time_s, ".3g"), r.iterations, fmt(r.converged)] for r in self.rows if r.problem == name]
-            out += [f"### {name}", "", ref.get("title", ""), "", f"Reference: {ref.get('description', '-')}", "",
-                    markdown_table(head, body), ""]
-        firsts = [[name, f"{m.replace('error_', '')} <= {tol:.1%}"]
-                  + (["none reached it", "-", "-"] if r is None
-                     else [f"{r.solver} {r.label}", r.resolution, fmt(r.wall_time_s, ".3g")])
-                  for name, m, tol, r in self._firsts()]
-        out += ["### First to reach the error target", "", "The fastest converged run whose error is at most the "
-                "target and stays so at every finer converged level of its solver and method.", "",
-                markdown_table(["problem", "target", "first", "resolution", "wall time [s]"], firsts)]
-        if self.notes:
-            out += ["", "Notes:", ""] + [f"- {n}" for n in self.notes]
-        return "\n".join(out) + "\n"
 
     def to_dict(self):
         """JSON-ready dict of the whole study."""
@@ -294,5 +272,5 @@ def main(args):
     scene = getattr(args, "scene", None)
     study = run_error_time(None if scene is None else [get_problem(scene)], quick=bool(getattr(args, "quick", False)),
                            progress=not getattr(args, "no_progress", False))
-    print(save(args, "error_time", study.to_dict(), study.markdown()))
+    print(save(args, "error_time", study.to_dict()))
     return 0

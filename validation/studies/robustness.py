@@ -26,10 +26,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..scene import load_scene
-from . import attempt, classify, finite, fmt, markdown_table, save
+from . import attempt, classify, finite, fmt, save
 from .problems import robustness_scene
 
-__all__ = ["RobustnessRow", "run_robustness", "summary_markdown", "summary_table", "matrix_table", "failure_table",
+__all__ = ["RobustnessRow", "run_robustness", "summary_table", "matrix_table", "failure_table",
            "rows_from_json", "main", "EXPONENTS", "COMPLIANCES", "MODULI", "LAYER_METHODS", "SETTING"]
 
 EXPONENTS = (0.05, 0.2, 0.5, 1.0, 2.0, 3.0, 10.0)
@@ -148,18 +148,6 @@ def failure_table(rows):
               r.message[:110]] for r in rows if r.status != "converged"])
 
 
-def summary_markdown(rows):
-    """Markdown: counts and times per method and control, the map of outcomes over (s, k), the failures."""
-    lines = ["# Robustness of the layer methods", "", SETTING, "", "## Outcomes per method and control", "",
-             markdown_table(*summary_table(rows)), "",
-             "## Converged out of all (E*, control) per exponent s and compliance k", ""]
-    for method in (m for m in LAYER_METHODS if any(r.method == m for r in rows)):
-        lines += [f"### {method}", "", markdown_table(*matrix_table(rows, method)), ""]
-    if any(r.status != "converged" for r in rows):
-        lines += ["## Every outcome that is not converged", "", markdown_table(*failure_table(rows)), ""]
-    return "\n".join(lines)
-
-
 def rows_from_json(data):
     """:class:`RobustnessRow` objects from the content of ``robustness.json``."""
     return [RobustnessRow(**{**d, "kkt_dense": None if d["kkt_dense"] is None else float(d["kkt_dense"])})
@@ -181,5 +169,5 @@ def main(args):
     quick = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
     rows = run_robustness(progress=not getattr(args, "no_progress", False),
                           **(quick if getattr(args, "quick", False) else {}))
-    print(save(args, "robustness", [_json_row(r) for r in rows], summary_markdown(rows) + "\n"), end="")
+    print(save(args, "robustness", [_json_row(r) for r in rows]), end="")
     return 1 if any(r.status == "wrong" for r in rows) else 0

@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass, field
 from bem.reference import hertz_sphere
 
 from ..compare import pair_metrics
-from . import STATUSES, attempt, classify, finite, fmt, markdown_table, save
+from . import STATUSES, attempt, classify, finite, fmt, save
 from .problems import LIMIT_TOL, methods, stability_cases
 
 __all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main",
@@ -100,29 +100,10 @@ class StabilityStudy:
             out.setdefault(f"{r.solver} {r.method}", Counter())[r.status] += 1
         return {k: {s: v.get(s, 0) for s in STATUSES} for k, v in out.items()}
 
-    def markdown(self):
-        """The study as markdown: a per-method summary, then every row."""
-        head = ["case", "solver", "method", "status", "KKT residual", "error vs reference", "reference", "iterations",
-                "wall time [s]", "message"]
-        body = [[r.case, r.solver, r.method, r.status, fmt(r.kkt_residual, ".1e"), fmt(r.error_vs_reference),
-                 r.reference, r.iterations, fmt(r.wall_time_s, ".3g"), _short(r.message)] for r in self.rows]
-        return "\n".join([
-            "## Stability on stiff and extreme cases", "",
-            f"Tolerances: paper methods and QP against Newton on the same lattice {METHOD_TOL:g}; FEM against "
-            f"Hertz or BEM Newton on a 4x finer lattice {FEM_TOL:g}; Newton against the case's closed form at the "
-            "case's tolerance.", "",
-            markdown_table(["solver / method", *STATUSES], [[k, *v.values()] for k, v in self.counts().items()]),
-            "", markdown_table(head, body), ""])
-
     def to_dict(self):
         """JSON-ready dict."""
         return {"study": "stability", "settings": self.settings, "counts": self.counts(),
                 "rows": [asdict(r) for r in self.rows]}
-
-
-def _short(message, n=110):
-    message = " ".join(str(message).split())
-    return message if len(message) <= n else message[: n - 3] + "..."
 
 
 def _part(run, part):
@@ -232,6 +213,6 @@ def main(args):
     require("fem", "contactlab study stability (the FEM cases)")
     study = run_stability(quick=bool(getattr(args, "quick", False)), check=False,
                           progress=not getattr(args, "no_progress", False))
-    print(save(args, "stability", study.to_dict(), study.markdown()))
+    print(save(args, "stability", study.to_dict()))
     study.check()
     return 0

@@ -16,7 +16,7 @@ from ...provenance import display_path
 from ..render import Figure, Progress, Section, Table, draw_and_build, table_from_rows
 from .results import read_json
 
-__all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "report_studies_dir"]
+__all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "study_markdown", "report_studies_dir"]
 
 STUDY_FILES = ("error_time.json", "stability.json", "robustness.json")
 
@@ -27,15 +27,11 @@ def is_study_dir(directory):
 
 
 def _label(row):
-    method = row["method"]
-    if row.get("relaxation") not in (None, 1, 1.0):
-        method = f"{method} (omega={row['relaxation']:g})"
-    return method
+    """The method with its relaxation when one was set, e.g. ``augmented_gap (omega=1)``."""
+    return row["method"] if row.get("relaxation") is None else f"{row['method']} (omega={row['relaxation']:g})"
 
 
 def _error_time_sections(data, work):
-    from ..figures.precision import plot_work_precision
-
     rows = data.get("rows", [])
     sections = []
     for problem in dict.fromkeys(r["problem"] for r in rows):
@@ -48,8 +44,10 @@ def _error_time_sections(data, work):
             wp = [{"solver": r["solver"], "method": _label(r), "resolution": r["resolution"], "N": r["n"],
                    "error": r[metric], "wall_time_s": r["wall_time_s"], "wall_times_s": r.get("wall_times_s")}
                   for r in mine if r["converged"]]
-            if not wp:
+            if not wp or work is None:
                 continue
+            from ..figures.precision import plot_work_precision
+
             path = plot_work_precision(wp, Path(work) / f"work_precision_{problem}_{metric}.png",
                                        error_label=label, title=f"{problem}: {label} against run time")
             items.append(Figure(path, f"Work-precision, {problem}: {label} against the wall time of every "
@@ -87,16 +85,11 @@ def _error_time_sections(data, work):
 
 def _stability_sections(data):
     rows = data.get("rows", [])
-    columns = [c for c in ("case", "solver", "method", "status", "kkt_residual", "error_vs_reference",
+    columns = [c for c in ("case", "solver", "method", "status", "kkt_residual", "error_vs_reference", "reference",
                            "iterations", "wall_time_s", "message") if any(c in r for r in rows)]
-    counts = {}
-    for r in rows:
-        key = (r.get("solver", ""), r.get("method", ""))
-        counts.setdefault(key, {}).setdefault(r.get("status", "?"), 0)
-        counts[key][r.get("status", "?")] += 1
     statuses = ("converged", "reported failure", "wrong")
-    summary = Table(("solver", "method") + statuses,
-                    tuple((s, m) + tuple(c.get(st, 0) for st in statuses) for (s, m), c in counts.items()),
+    summary = Table(("solver / method",) + statuses,
+                    tuple((k, *(c.get(st, 0) for st in statuses)) for k, c in data.get("counts", {}).items()),
                     caption="Outcomes per solver and method: converged (and agreeing with the reference), "
                             "reported failure (converged = false with a reason), wrong (a converged answer "
                             "that disagrees with the reference, or NaN anywhere).")
@@ -105,6 +98,11 @@ def _stability_sections(data):
             "a tiny elastic-rigid threshold, a contact of a few nodes, a contact filling the region, very "
             "dissimilar moduli, and Poisson's ratio near 0.5 in the FEM. The study raises on any NaN or "
             "wrong answer."]
+    tol = data.get("settings", {})
+    if "method_tol" in tol:
+        text.append(f"Tolerances: the paper's methods and the QP against Newton on the same lattice "
+                    f"{tol['method_tol']:g}; the FEM against Hertz or BEM Newton on a 4x finer lattice "
+                    f"{tol['fem_tol']:g}; Newton against the case's closed form at the case's tolerance.")
     return [Section("Stability", "stability", text, (summary, detail))]
 
 
@@ -121,17 +119,30 @@ def _robustness_sections(data):
     return [Section("Robustness of the layer methods", "stability", [rb.SETTING], tuple(tables))]
 
 
+_SECTIONS = dict(zip(STUDY_FILES, (_error_time_sections, lambda d, work: _stability_sections(d),
+                                   lambda d, work: _robustness_sections(d))))
+
+
 def study_sections(directory, work):
-    """Sections for the study files present in ``directory``."""
+    """Sections for the study files present in ``directory``; figures go to ``work``."""
     directory = Path(directory)
-    sections = []
-    for name, make in zip(STUDY_FILES, (lambda d: _error_time_sections(d, work), _stability_sections,
-                                        _robustness_sections)):
-        if (directory / name).is_file():
-            sections += make(read_json(directory / name))
+    sections = [sec for name, make in _SECTIONS.items() if (directory / name).is_file()
+                for sec in make(read_json(directory / name), work)]
     if not sections:
         raise InputError(f"directory = {str(directory)!r} is not allowed: it holds none of {list(STUDY_FILES)}.")
     return sections
+
+
+def study_markdown(name, data):
+    """The tables of one study as Markdown, without figures (what ``contactlab study`` prints and writes).
+
+    ``name`` is its file in :data:`STUDY_FILES` (``"stability.json"``), ``data`` that file's content.
+    """
+    from ..render.markdown import render_markdown
+
+    title = {"error_time.json": "Error against run time", "stability.json": "Stability on stiff and extreme cases",
+             "robustness.json": "Robustness of the layer methods"}[name]
+    return render_markdown(_SECTIONS[name](data, None), title=title, names={})
 
 
 def report_studies_dir(directory, out_dir=None, *, title="contactlab validation studies", fmt="png", progress=None):
