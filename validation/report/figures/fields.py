@@ -63,7 +63,7 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
         raise InputError("no triangle lies in the window: make window larger.")
     triang, vv = _mirrored(r, z, tri, values, a, scale, near)
     vmax = float(np.percentile(vv[np.unique(triang.triangles)], 99.8))
-    with new_figure((5.8, 4.6)) as (fig, ax):
+    with new_figure((5.8, 4.6), title=title) as (fig, ax):
         pc = ax.tripcolor(triang, vv, shading="gouraud", cmap="magma", vmin=0.0, vmax=vmax, rasterized=True)
         ax.tricontour(triang, vv, levels=np.linspace(0, vmax, 9)[1:-1], colors="white", linewidths=0.5, alpha=0.6)
         ax.axhline(0.0, color="#00d0ff", lw=1.0, ls="--")
@@ -81,8 +81,6 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
         lab = axis_labels(labels)
         ax.set_xlabel(lab["r"] + " (mirrored about the axis)")
         ax.set_ylabel(lab["z"] + "  (upper body $z > 0$)")
-        if title:
-            ax.set_title(title)
         return save_figure(fig, path)
 
 
@@ -135,13 +133,13 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
     a, scale = check_positive("a", a), check_positive("scale", scale)
     vmax = max(float(np.max(v)) for _, _, _, v in panels) / scale
     levels = np.linspace(0.0, vmax, 11)[1:-1]
-    labels = {"x": r"$x\,/\,a_H$", "z": r"$z\,/\,a_H$", **(labels or {})}
+    labels = axis_labels(labels)
     x_lim = max(float(np.max(np.abs(x))) for _, x, _, _ in panels) / a
     z_lim = max(float(np.max(z)) for _, _, z, _ in panels) / a
     span = z_lim * (2 if len(panels) > 1 else 1)
     height = 5.2 if len(panels) > 1 else 3.6
     width = min(9.0, max(3.8, 1.6 + (height - 0.8) * 2 * x_lim / span))
-    with new_figure((width, height)) as (fig, ax):
+    with new_figure((width, height), title=title) as (fig, ax):
         for sign, x, z, values in panels:
             xx, zz = np.meshgrid(np.asarray(x) / a, sign * np.asarray(z) / a)
             vv = np.asarray(values) / scale
@@ -168,8 +166,6 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
         ax.grid(False)
         ax.set_xlabel(labels["x"])
         ax.set_ylabel(labels["z"] + ("  (body 1 above, body 2 below)" if low < 0 < high else ""))
-        if title:
-            ax.set_title(title)
         return save_figure(fig, path)
 
 
@@ -190,7 +186,7 @@ def plot_depth_profiles(curves, path, *, a, scale, stress_label, depth_label=r"d
     if not curves:
         raise InputError("curves = [] is not allowed: give at least one profile.")
     a, scale = check_positive("a", a), check_positive("scale", scale)
-    with new_figure((5.6, 4.4)) as (fig, ax):
+    with new_figure((5.6, 4.4), title=title) as (fig, ax):
         for i, c in enumerate(curves):
             ax.plot(np.asarray(c["values"]) / scale, np.asarray(c["z"]) / a, label=c["label"],
                     color=color_for(c.get("key", ""), i), ls=c.get("ls", "-"), marker=c.get("marker"),
@@ -201,6 +197,4 @@ def plot_depth_profiles(curves, path, *, a, scale, stress_label, depth_label=r"d
         ax.set_xlabel(stress_label)
         ax.set_ylabel(depth_label)
         ax.legend(fontsize=8)
-        if title:
-            ax.set_title(title)
         return save_figure(fig, path)

@@ -79,7 +79,8 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
     p0 = check_positive("p0", p0)
     if not runs:
         raise InputError("runs = [] is not allowed: give at least one (label, result) pair.")
-    with new_figure((6.6, 5.2), nrows=2, sharex=True, gridspec_kw={"height_ratios": [3, 2]}) as (fig, (top, bot)):
+    with new_figure((6.6, 5.2), title=title or "maximum contact pressure during the iterations", nrows=2,
+                    sharex=True, gridspec_kw={"height_ratios": [3, 2]}) as (fig, (top, bot)):
         for i, (label, run) in enumerate(runs):
             hist = run.history if hasattr(run, "history") else run
             if not isinstance(hist, dict) or not hist.get("p_max"):
@@ -98,7 +99,6 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
             bot.annotate(f"tolerance {tol:.0e}", (0.0, tol), xycoords=("axes fraction", "data"),
                          xytext=(4, 3), textcoords="offset points", ha="left", fontsize=8, color="#444444")
         top.set_ylabel(p_label or r"max. pressure $p_{max}\,/\,p_0$")
-        top.set_title(title or "maximum contact pressure during the iterations")
         top.legend(frameon=False, loc="best")
         bot.set_xscale("log")
         _integer_ticks(bot.xaxis)

@@ -88,7 +88,7 @@ def plot_work_precision(rows, path, *, error_label="relative error", title=None,
     by_solver = len({s for s, _ in groups}) == len(groups)  # one line per solver: colour by solver
     spread = any(time_spread(r)[1] < time_spread(r)[2] for r in rows)
     repeats = max((len(r.get("wall_times_s") or ()) for r in rows), default=0)
-    with new_figure((7.0, 4.6)) as (fig, ax):
+    with new_figure((7.0, 4.6), title=title or "work-precision: error against run time") as (fig, ax):
         for i, ((solver, method), grp) in enumerate(groups.items()):
             grp = sorted(grp, key=lambda r: r["wall_time_s"])
             t, lo, hi = np.array([time_spread(r) for r in grp]).T
@@ -119,6 +119,5 @@ def plot_work_precision(rows, path, *, error_label="relative error", title=None,
         ax.set_xlabel("wall-clock time [s]" + (f" (marker: median of up to {repeats} runs; bar: fastest to slowest)"
                                                 if spread else ""))
         ax.set_ylabel(error_label)
-        ax.set_title(title or "work-precision: error against run time")
         fig.legend(loc="outside lower center", ncols=min(len(groups), 3), frameon=False)
         return save_figure(fig, path)

@@ -14,8 +14,8 @@ from bem.checks import InputError, check_positive
 
 from ..render.style import SOLVER_COLORS, axis_labels, color_for, new_figure, save_figure
 
-__all__ = ["axial_section", "section_of", "radial", "auto_xlim", "curve_style", "plot_pressure_profiles",
-           "plot_profile_comparison", "plot_layer_laws"]
+__all__ = ["axial_section", "section_of", "radial", "contact_edge", "auto_xlim", "curve_style",
+           "plot_pressure_profiles", "plot_profile_comparison", "plot_layer_laws"]
 
 
 def axial_section(x, y, values, *, tol=None):
@@ -58,10 +58,15 @@ def radial(x, p):
     return x[keep][order], p[keep][order]
 
 
+def contact_edge(curves):
+    """Largest ``|x|`` of a loaded point (``p > 0``) over ``(x, p)`` curves [length]; 0 if none."""
+    reach = [float(np.abs(np.asarray(x, float))[np.asarray(p, float) > 0].max(initial=0.0)) for x, p in curves]
+    return max(reach, default=0.0)
+
+
 def auto_xlim(sections, a, *, pad=1.15, least=1.3):
     """Symmetric range of ``x / a`` holding every loaded node of the ``(x, p)`` sections, with a margin."""
-    reach = [float(np.abs(x[p > 0]).max()) for x, p in sections if np.any(p > 0)]
-    half = max(max(reach, default=0.0) / a * pad, least)
+    half = max(contact_edge(sections) / a * pad, least)
     return (-half, half)
 
 
@@ -95,7 +100,7 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=None, xlim=
         raise InputError("curves = [] is not allowed: give at least one (label, result) pair.")
     sections = [section_of(item[1]) for item in curves]
     lab = axis_labels(labels)
-    with new_figure((8.2, 4.0)) as (fig, ax):
+    with new_figure((8.2, 4.0), title=title) as (fig, ax):
         if hertz is not None:
             ax.plot(np.asarray(hertz[0]) / a, np.asarray(hertz[1]) / p0, color="#999999", lw=3.5, alpha=0.45,
                     zorder=1, label="Hertz (closed form)")
@@ -106,8 +111,6 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=None, xlim=
         ax.set_ylim(bottom=0.0)
         ax.set_xlabel(lab["x"] + (f"  ({section})" if section else ""))
         ax.set_ylabel(lab["p"])
-        if title:
-            ax.set_title(title)
         fig.legend(loc="outside right upper", frameon=False)
         return save_figure(fig, path)
 
@@ -142,9 +145,7 @@ def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, 
     if reference is None:
         reference = tuple(curves.pop(0)[:3])
     if rmax is None:
-        reach = [float(np.max(np.abs(np.asarray(c[1], dtype=float))[np.asarray(c[2]) > 0], initial=0.0))
-                 for c in curves]
-        rmax = max(1.25 * max(reach, default=0.0) / a, 1.2)
+        rmax = max(1.25 * contact_edge(c[1:3] for c in curves) / a, 1.2)
     if callable(reference[1]):
         ref_fn = reference[1]
         ref_r = np.linspace(0.0, rmax * a, 800)
@@ -155,7 +156,8 @@ def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, 
         def ref_fn(r):
             return np.interp(r, ref_r, ref_p, right=0.0)
 
-    with new_figure((6.6, 5.4), nrows=2, sharex=True, gridspec_kw={"height_ratios": [3, 2]}) as (fig, (top, bot)):
+    with new_figure((6.6, 5.4), title=title or f"pressure profiles against {reference[0]}", nrows=2,
+                    sharex=True, gridspec_kw={"height_ratios": [3, 2]}) as (fig, (top, bot)):
         top.plot(ref_r / a, ref_p / p0, color=SOLVER_COLORS["analytic"], lw=1.3, ls="--", label=reference[0],
                  zorder=4)
         bot.axhline(0.0, color=SOLVER_COLORS["analytic"], lw=1.0, ls="--")
@@ -174,7 +176,6 @@ def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, 
         top.set_xlim(0.0, rmax)
         top.set_ylim(bottom=0.0)
         top.set_ylabel(lab["p"])
-        top.set_title(title or f"pressure profiles against {reference[0]}")
         top.legend(loc="upper right", frameon=False)
         bot.set_xlabel(lab["x"])
         bot.set_ylabel(lab["err"])
@@ -203,7 +204,7 @@ def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, mark
         raise InputError("laws = [] is not allowed: give at least one (label, layer) pair.")
     p = np.linspace(0.0, p_max, 600)
     w_top = 0.0
-    with new_figure((6.0, 3.8)) as (fig, ax):
+    with new_figure((6.0, 3.8), title=title) as (fig, ax):
         for i, (label, layer) in enumerate(laws):
             w = np.zeros_like(p) if layer is None else np.asarray(layer.w(p), dtype=float)
             w_top = max(w_top, float(np.max(w, initial=0.0)))
@@ -219,7 +220,5 @@ def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, mark
         ax.set_ylim(0.0, 1.15 * w_top if w_top > 0 else None)  # headroom for the labels of the marks
         ax.set_xlabel("pressure $p$" + (f" [{p_unit}]" if p_unit else ""))
         ax.set_ylabel("layer closure $w(p)$" + (f" [{w_unit}]" if w_unit else ""))
-        if title:
-            ax.set_title(title)
         ax.legend(loc="upper left", frameon=False)
         return save_figure(fig, path)

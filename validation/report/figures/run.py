@@ -21,6 +21,7 @@ import numpy as np
 
 from ..render.content import Figure, fmt
 from ..render.style import display_unit, method_text, report_unit
+from .profiles import contact_edge
 
 __all__ = ["scale", "axis_label", "Scaled", "ProfileView", "profile_view", "contact_edge", "how", "layer_law", "profiles",
            "pressure_map", "convergence", "fem_von_mises", "stress_view", "stress_figures"]
@@ -82,12 +83,6 @@ class ProfileView:
     normalised: bool
 
 
-def contact_edge(curves):
-    """Largest ``|x|`` of a loaded point (``p > 0``) over ``(x, p)`` curves [length]; 0 if none."""
-    reach = [float(np.abs(np.asarray(x, float))[np.asarray(p, float) > 0].max(initial=0.0)) for x, p in curves]
-    return max(reach, default=0.0)
-
-
 def profile_view(res, curves, *, axis="x"):
     """Scales, labels and window of a profile along ``axis`` holding every loaded point of ``curves``.
 
@@ -98,7 +93,8 @@ def profile_view(res, curves, *, axis="x"):
     """
     edge = contact_edge(curves)
     reach = float(np.abs(np.asarray(curves[0][0], dtype=float)).max(initial=0.0)) if curves else 0.0
-    (xf, xn, normalised), (pf, pn, _) = scale(res, "length"), scale(res, "pressure")
+    length, pressure = scale(res, "length"), scale(res, "pressure")
+    (xf, xn, normalised), (pf, pn, _) = length, pressure
     if normalised:
         half = min(PAD * max(edge / xf, 1.0), max(reach, 1.02 * edge) / xf)
         xn, pn = (f"{n} = {fmt(f)} {res.units.of(k)}".replace(" -", "") for n, f, k in
@@ -107,8 +103,8 @@ def profile_view(res, curves, *, axis="x"):
         edge = edge or float(max((np.abs(np.asarray(x, float)).max(initial=0.0) for x, _ in curves), default=1.0)) \
             or 1.0
         half = min(PAD * edge, max(reach, 1.02 * edge)) / xf
-    return ProfileView(xf, pf, axis_label(axis, scale(res, "length")),
-                       axis_label("p", scale(res, "pressure"), "contact pressure "), xn, pn, (-half, half), normalised)
+    return ProfileView(xf, pf, axis_label(axis, length), axis_label("p", pressure, "contact pressure "), xn, pn,
+                       (-half, half), normalised)
 
 
 def _tolerance(res):
@@ -236,8 +232,7 @@ def pressure_map(res, work):
         return None
     x, y, p = res.bem_field
     view = profile_view(res, [(np.hypot(x, y) if res.axisymmetric else np.maximum(abs(x), abs(y)), p)])
-    labels = {"x": axis_label("x", scale(res, "length")), "y": axis_label("y", scale(res, "length")),
-              "p": view.p_label}
+    labels = {"x": view.x_label, "y": axis_label("y", scale(res, "length")), "p": view.p_label}
     p_cr = ((res.get("layer") or {}).get("parameters") or {}).get("p_cr")
     levels = [(r"$p = p_{cr}$", p_cr)] if p_cr else []
     circle = res.data.get("contact_radius") if res.axisymmetric else None
@@ -339,13 +334,14 @@ def stress_figures(res, work):
         return None
     bodies = block["bodies"]
     a, s, l_name, s_name, normalised = stress_view(res)
-    z_label, s_label = axis_label("z", (a, l_name, normalised)), axis_label(r"\sigma", (s, s_name, normalised))
+    length = (a, l_name, normalised)
+    z_label, s_label = axis_label("z", length), axis_label(r"\sigma", (s, s_name, normalised))
     panels = [({"body1": 1.0, "body2": -1.0}[name], b["section"]["x"], b["section"]["z"], b["section"]["von_mises"])
               for name, b in bodies.items()]
     section = plot_stress_section(panels, work / "stress_section.png", a=a, scale=s,
                                   label="von Mises " + s_label.replace(r"\sigma", r"\sigma_{vM}"),
                                   contact_radius=res.data.get("contact_radius"), fem=res.fem_field,
-                                  labels={"x": axis_label("x", (a, l_name, normalised)), "z": z_label},
+                                  labels={"x": axis_label("x", length), "z": z_label},
                                   title="von Mises stress in the section y = 0")
     curves, marks = [], []
     for i, (name, b) in enumerate(bodies.items()):

@@ -44,8 +44,10 @@ def contact_patch(x, y, p, *, margin=0.25):
 
 def _surface_panel(ax, xs, ys, ps, tri, *, p0, a, height, vmax, section, lab):
     """One isometric pressure surface on the 3-D axes ``ax`` (orthographic view, labelled axes)."""
-    surf = ax.plot_trisurf(xs / a, ys / a, ps / p0, triangles=tri, cmap="viridis", vmin=0.0, vmax=vmax,
-                           linewidth=0.0, antialiased=False, rasterized=True, zorder=1)
+    from matplotlib.ticker import MaxNLocator
+
+    ax.plot_trisurf(xs / a, ys / a, ps / p0, triangles=tri, cmap="viridis", vmin=0.0, vmax=vmax,
+                    linewidth=0.0, antialiased=False, rasterized=True, zorder=1)
     if section is not None:
         xs0, ps0 = section
         ax.plot(xs0 / a, np.zeros_like(xs0), ps0 / p0, color="black", lw=1.2, zorder=3)
@@ -58,20 +60,13 @@ def _surface_panel(ax, xs, ys, ps, tri, *, p0, a, height, vmax, section, lab):
     ax.view_init(elev=34.0, azim=-58.0)
     ax.computed_zorder = False
     for axis, bins in ((ax.xaxis, 4), (ax.yaxis, 4), (ax.zaxis, 2)):
-        axis.set_major_locator(_locator(bins))
+        axis.set_major_locator(MaxNLocator(nbins=bins, steps=[1, 2, 2.5, 5, 10]))
         axis.pane.set_facecolor((0.96, 0.96, 0.96, 1.0))
         axis.set_tick_params(labelsize=7, pad=0)
         axis.label.set_size(8)
     ax.set_xlabel(lab["x"], labelpad=-1)
     ax.set_ylabel(lab["y"], labelpad=-1)
     ax.set_zlabel(lab["p_short"], labelpad=-3)
-    return surf
-
-
-def _locator(bins):
-    from matplotlib.ticker import MaxNLocator
-
-    return MaxNLocator(nbins=bins, steps=[1, 2, 2.5, 5, 10])
 
 
 def covered_window(x, y):
@@ -182,7 +177,7 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
     triang = mtri.Triangulation(xs / a, ys / a, tri)
     if circle is None and hasattr(result, "contact_radius"):
         circle = result.contact_radius
-    with new_figure(figsize) as (fig, ax):
+    with new_figure(figsize, title=title) as (fig, ax):
         pc = ax.tripcolor(triang, ps / p0, shading="gouraud", cmap="viridis", vmin=0.0, rasterized=True)
         loaded = (ps > 0).astype(float)
         if loaded.min() < 0.5:
@@ -207,8 +202,6 @@ def plot_contact_map(result, path, *, p0, a, title=None, circle=None, levels=(),
         ax.grid(False)
         ax.set_xlabel(lab["x"])
         ax.set_ylabel(lab["y"])
-        if title:
-            ax.set_title(title)
         leg = fig.legend(loc="outside lower center", ncols=2, fontsize=8, facecolor="#555555", framealpha=1.0)
         for text in leg.get_texts():
             text.set_color("white")

@@ -13,7 +13,7 @@ import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from ..render.style import new_figure, save_figure
+from ..render.style import axis_labels, new_figure, save_figure
 from .profiles import auto_xlim, radial
 
 __all__ = ["transition_radius", "edge_radius", "plot_sweep", "plot_transition_line", "plot_sweep_scalars"]
@@ -80,8 +80,8 @@ def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=Non
     norm = (mpl.colors.LogNorm if log else mpl.colors.Normalize)(lo, hi if hi > lo else lo + 1.0)
     colors = mpl.colormaps[cmap]
     sections = [(np.asarray(x, dtype=float), np.asarray(p, dtype=float)) for _, x, p in curves]
-    lab = {"x": r"$x\,/\,a_H$", "p": r"contact pressure $p\,/\,p_0$", **(labels or {})}
-    with new_figure((6.8, 4.0)) as (fig, ax):
+    lab = axis_labels(labels)
+    with new_figure((6.8, 4.0), title=title) as (fig, ax):
         for alpha, (x, p) in zip(alphas, sections):
             ax.plot(x / a, p / p0, color=colors(0.9 * norm(alpha)), lw=1.4)
         for label, x, p, style in extra:
@@ -96,8 +96,6 @@ def plot_sweep(curves, path, *, p0, a, name, title=None, cmap="plasma", xlim=Non
         ax.set_ylim(bottom=0.0)
         ax.set_xlabel(lab["x"] + "  (axial section $y = 0$)")
         ax.set_ylabel(lab["p"])
-        if title:
-            ax.set_title(title)
         if extra:
             ax.legend(loc="upper right", frameon=False)
         return save_figure(fig, path)
@@ -127,7 +125,7 @@ def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
                          "they must be equal, with at least 2 values.")
     order = np.argsort(alpha)
     alpha, rt = alpha[order], rt[order]
-    with new_figure((6.0, 4.0)) as (fig, ax):
+    with new_figure((6.0, 4.0), title=title) as (fig, ax):
         ax.fill_between(alpha, 0.0, rt, color="#d62728", alpha=0.18, lw=0, label="I: rigid branch, $p \\geq p_{cr}$")
         ax.plot(alpha, rt, color="#d62728", marker="o", markersize=4, label="transition line $p = p_{cr}$")
         if r_contact is not None:
@@ -139,8 +137,6 @@ def plot_transition_line(alpha, r_transition, path, *, a, r_contact=None,
         ax.set_xlim(float(alpha.min()), float(alpha.max()))
         ax.set_xlabel(name)
         ax.set_ylabel(r"radius $r\,/\,a_H$")
-        if title:
-            ax.set_title(title)
         ax.legend(loc="lower left", frameon=True, framealpha=0.85)
         return save_figure(fig, path)
 
@@ -162,7 +158,8 @@ def plot_sweep_scalars(values, series, path, *, name, title=None, ticklabels=Non
     x = np.asarray(values, dtype=float)
     if not series or x.size < 1:
         raise InputError("series = [] is not allowed: give at least one (label, values) pair.")
-    with new_figure((6.4, 1.2 + 1.9 * len(series)), nrows=len(series), sharex=True, squeeze=False) as (fig, axes):
+    with new_figure((6.4, 1.2 + 1.9 * len(series)), title=title, nrows=len(series), sharex=True,
+                    squeeze=False) as (fig, axes):
         for ax, (label, y) in zip(axes[:, 0], series):
             y = np.asarray(y, dtype=float)
             if y.shape != x.shape:
@@ -173,6 +170,4 @@ def plot_sweep_scalars(values, series, path, *, name, title=None, ticklabels=Non
         axes[-1, 0].set_xlabel(name)
         if ticklabels is not None:
             axes[-1, 0].set_xticks(x, list(ticklabels))
-        if title:
-            axes[0, 0].set_title(title)
         return save_figure(fig, path)

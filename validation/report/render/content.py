@@ -39,12 +39,12 @@ def status_class(status):
 def fmt(value, digits=4):
     """A cell of a table: floats with ``digits`` significant digits (``%g``), ints as they are,
     booleans as yes/no, ``None`` as "-"."""
-    if isinstance(value, bool) or value is None:
-        return "-" if value is None else ("yes" if value else "no")
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        return f"{value:.{digits}g}" if math.isfinite(value) else str(value)
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float) and math.isfinite(value):
+        return f"{value:.{digits}g}"
     return str(value)
 
 

@@ -63,11 +63,9 @@ def _figure(fig, number, data):
 
 
 def _table(tab, number):
-    out = ['<div class="table-wrap"><table>']
     cap = f"<b>Table {number}.</b> {html.escape(tab.caption)}" if tab.caption else f"<b>Table {number}.</b>"
-    out.append(f"<caption>{cap}</caption>")
-    out.append("<thead><tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in tab.columns) + "</tr></thead>")
-    out.append("<tbody>")
+    out = ['<div class="table-wrap"><table>', f"<caption>{cap}</caption>",
+           "<thead><tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in tab.columns) + "</tr></thead>", "<tbody>"]
     for row in tab.rows:
         cls = tab.status(row)
         attr = f' class="{cls}"' if cls != "other" else ""

@@ -14,12 +14,10 @@ def _cell(text):
 
 
 def _table(tab, number):
-    cols = list(tab.columns)
     status = tab.status_column is not None
-    lines = [f"**Table {number}.** {tab.caption}".rstrip(), ""]
-    head = cols + (["flag"] if status else [])
-    lines.append("| " + " | ".join(_cell(c) for c in head) + " |")
-    lines.append("|" + "|".join("---" for _ in head) + "|")
+    head = list(tab.columns) + (["flag"] if status else [])
+    lines = [f"**Table {number}.** {tab.caption}".rstrip(), "", "| " + " | ".join(_cell(c) for c in head) + " |",
+             "|" + "|".join("---" for _ in head) + "|"]
     for row in tab.rows:
         cells = [_cell(c) for c in row]
         if status:

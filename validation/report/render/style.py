@@ -154,11 +154,11 @@ def color_for(key, index=0):
 
 
 @contextlib.contextmanager
-def new_figure(figsize=(6.4, 4.0), **subplots):
+def new_figure(figsize=(6.4, 4.0), *, title=None, **subplots):
     """A fresh Agg figure with the report style; yields ``(fig, axes)``.
 
-    ``subplots`` are passed to :meth:`matplotlib.figure.Figure.subplots`
-    (``nrows``, ``ncols``, ``sharex``, ``gridspec_kw``, ...).
+    ``title`` (optional) is set on the first axes; ``subplots`` are passed to
+    :meth:`matplotlib.figure.Figure.subplots` (``nrows``, ``ncols``, ``sharex``, ``gridspec_kw``, ...).
     """
     import matplotlib
 
@@ -169,6 +169,8 @@ def new_figure(figsize=(6.4, 4.0), **subplots):
         fig = Figure(figsize=figsize, layout="constrained")
         FigureCanvasAgg(fig)
         axes = fig.subplots(**subplots)
+        if title:
+            fig.axes[0].set_title(title)
         yield fig, axes
 
 
