@@ -87,7 +87,7 @@ def plot_convergence(runs, path, *, p0, title=None, tol=None, p_label=None):
                 raise InputError("a run without history['p_max'] is not allowed: every run needs its iteration "
                                  "history.")
             pm, res = np.asarray(hist["p_max"], dtype=float), np.asarray(hist.get("residual", []), dtype=float)
-            every = None if pm.size <= 30 else sorted(set(np.round(np.geomspace(1, pm.size, 30)).astype(int) - 1))
+            every = None if pm.size <= 30 else (pick_iterations(pm.size, 30) - 1).tolist()  # log-spaced markers
             style = dict(color=color_for(getattr(run, "method", None), i), marker="o", markersize=3, markevery=every)
             late = " - not converged" if getattr(run, "converged", True) is False else ""
             top.plot(np.arange(1, pm.size + 1), pm / p0, label=label + late, **style)

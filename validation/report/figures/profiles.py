@@ -104,9 +104,9 @@ def plot_pressure_profiles(curves, path, *, p0, a, title=None, hertz=None, xlim=
         if hertz is not None:
             ax.plot(np.asarray(hertz[0]) / a, np.asarray(hertz[1]) / p0, color="#999999", lw=3.5, alpha=0.45,
                     zorder=1, label="Hertz (closed form)")
-        for i, item in enumerate(curves):
+        for i, (item, (x, p)) in enumerate(zip(curves, sections)):
             style = {**curve_style(item[1], i), **(item[2] if len(item) > 2 else {})}
-            ax.plot(sections[i][0] / a, sections[i][1] / p0, label=item[0], zorder=3, **style)
+            ax.plot(x / a, p / p0, label=item[0], zorder=3, **style)
         ax.set_xlim(*(xlim or auto_xlim(sections, a)))
         ax.set_ylim(bottom=0.0)
         ax.set_xlabel(lab["x"] + (f"  ({section})" if section else ""))
