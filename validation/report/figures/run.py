@@ -23,8 +23,8 @@ from ..render.content import Figure, fmt
 from ..render.style import display_unit, method_text, report_unit
 from .profiles import contact_edge
 
-__all__ = ["scale", "axis_label", "Scaled", "ProfileView", "profile_view", "contact_edge", "how", "layer_law", "profiles",
-           "pressure_map", "convergence", "fem_von_mises", "stress_view", "stress_figures"]
+__all__ = ["scale", "axis_label", "Scaled", "ProfileView", "profile_view", "contact_edge", "how", "layer_law",
+           "profiles", "pressure_map", "convergence", "fem_von_mises", "stress_view", "stress_figures"]
 
 #: margin of a profile's window beyond the contact edge
 PAD = 1.3
@@ -48,7 +48,8 @@ def scale(res, kind, magnitude=None):
 
 
 def axis_label(symbol, sc, what=""):
-    """Axis label of ``symbol`` drawn with the scale ``sc`` (:func:`scale`): ``what $x\\,/\\,a_H$`` or ``what $x$ [mm]``."""
+    """Axis label of ``symbol`` drawn with the scale ``sc`` (:func:`scale`): ``what $x\\,/\\,a_H$``
+    or ``what $x$ [mm]``."""
     _, name, normalised = sc
     if normalised:
         return rf"{what}${symbol}\,/\,{name}$"
