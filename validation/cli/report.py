@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 
-from .common import add_set, optional_import
+from .common import add_set
 
 #: measured wall time of `contactlab report paper --quick` and of the full paper report on 2 cores shared
 #: with other jobs (load 2.3-5; CPU time 15-18 s and 36-42 s)
@@ -65,9 +65,8 @@ class _ReportBar:
 
 
 def run(args):
-    command = optional_import("validation.report.command", "the report builder")
-    if command is None:
-        return 2
+    from ..report import command
+
     bar = _ReportBar(args.no_progress or None)
     try:
         built = command.build_from_args(args, progress=bar)

@@ -18,23 +18,15 @@ def add_args(p):
     add_set(p)
 
 
-def _units(result):
-    """``(length, pressure, force)`` unit symbols of a result ("" where unknown)."""
-    symbols = result.get("unit_symbols") or {}
-    return tuple(symbols.get(k, "") for k in ("length", "pressure", "force"))
-
-
 def _summary(result, out_dir):
-    L, Pa, N = _units(result)
-    t = result["wall_time_s"]
+    """The lines ``contactlab run`` prints: the result's numbers with their units, and its files."""
+    L, Pa, N = ((result.get("unit_symbols") or {}).get(k, "") for k in ("length", "pressure", "force"))
     lines = [f"scene      {result['scene']}: {result['title']}   [units {result['units']}]"]
     p_line = f"p_max      {result['p_max']:.6g} {Pa}"
-    if "fem" in result:
-        f = result["fem"]["p_max"]
-        p_line += f"   (FEM {f:.6g}, {100 * (result['p_max'] - f) / f:+.2f} %)"
-    if "analytic" in result:
-        a = result["analytic"]["p_max"]
-        p_line += f"   ({result['analytic']['kind']} {a:.6g}, {100 * (result['p_max'] - a) / a:+.2f} %)"
+    for ref in (result.get("fem"), result.get("analytic")):
+        if ref is not None:  # the closed form names its kind, the FEM summary has none
+            f = ref["p_max"]
+            p_line += f"   ({ref.get('kind', 'FEM')} {f:.6g}, {100 * (result['p_max'] - f) / f:+.2f} %)"
     lines.append(p_line)
     if "contact_radius" in result:
         lines.append(f"contact    radius {result['contact_radius']:.6g} {L}, area {result['contact_area']:.6g} {L}^2")
@@ -48,14 +40,13 @@ def _summary(result, out_dir):
     conv = "yes" if result["converged"] else "NO"
     lines.append(f"converged  {conv} ({result['method']}, {result['iterations']} iterations, "
                  f"KKT residual {result['kkt_residual']:.2e})")
-    times = ", ".join(f"{k} {v:.2f} s" for k, v in t.items() if v is not None)
+    times = ", ".join(f"{k} {v:.2f} s" for k, v in result["wall_time_s"].items() if v is not None)
     lines.append(f"time       {times}")
     for name, body in (result.get("stress") or {}).get("bodies", {}).items():
         x, y, z = body["location_of_max"]
         lines.append(f"stress     {name}: max von Mises {body['max_von_mises']:.6g} {Pa} at depth {z:.6g} {L} "
                      f"(x {x:.3g}, y {y:.3g}), max shear {body['max_tresca']:.6g} {Pa}")
-    for msg in result["messages"]:
-        lines.append(f"note       {msg}")
+    lines += [f"note       {msg}" for msg in result["messages"]]
     if out_dir is not None:
         lines.append(f"files      {out_dir}/ ({', '.join(result['files'].values())})")
     return "\n".join(lines)

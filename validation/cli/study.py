@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import optional_import
+import importlib
 
 PARSER = {"help": "error-time and stability studies",
           "description": "Studies of the methods (validation.studies) on their built-in problems "
@@ -25,8 +25,4 @@ def add_args(p):
 
 
 def run(args):
-    mod = optional_import(STUDIES[args.study], f"the {args.study} study")
-    if mod is None:
-        return 2
-    code = mod.main(args)
-    return 0 if code is None else int(code)
+    return importlib.import_module(STUDIES[args.study]).main(args)

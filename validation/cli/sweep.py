@@ -54,8 +54,8 @@ def run(args):
     print(f"sweep of {summary['key']} over {len(summary['points'])} values of scene {summary['scene']} "
           f"[units {summary['units']}]")
     print(f"{'value':>12} {'status':>14} {'p_max':>14} {'contact_r':>12} {'approach':>12}")
+    fmt = (lambda v: f"{v:.6g}" if isinstance(v, float) else "-")
     for r in summary["points"]:
-        fmt = (lambda v: f"{v:.6g}" if isinstance(v, float) else "-")
         print(f"{r['value']!s:>12} {r['status']:>14} {fmt(r.get('p_max')):>14} "
               f"{fmt(r.get('contact_radius')):>12} {fmt(r.get('approach')):>12}")
     print(f"computed {len(summary['computed'])}, reused {len(summary['reused'])}, failed {len(summary['failed'])}; "

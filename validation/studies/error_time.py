@@ -126,17 +126,15 @@ class ErrorTimeStudy:
             and (q.solver, q.method, q.relaxation) == (r.solver, r.method, r.relaxation) for q in rows))]
         return min(ok, key=lambda r: r.wall_time_s, default=None)
 
-    def _firsts(self):
-        """``(problem, metric, tol, first row or None)`` for every target."""
-        return [(name, m, tol, self.first_to_reach(tol, problem=name, metric=m))
-                for name in self.problems for m in _METRICS for tol in TARGETS]
-
     def to_dict(self):
         """JSON-ready dict of the whole study."""
-        first = {}
-        for name, m, tol, r in self._firsts():
-            first.setdefault(name, {}).setdefault(m, {})[f"{tol:g}"] = r and {
-                "solver": r.solver, "method": r.label, "resolution": r.resolution, "wall_time_s": r.wall_time_s}
+
+        def hit(r):
+            return r and {"solver": r.solver, "method": r.label, "resolution": r.resolution,
+                          "wall_time_s": r.wall_time_s}
+
+        first = {name: {m: {f"{tol:g}": hit(self.first_to_reach(tol, problem=name, metric=m)) for tol in TARGETS}
+                        for m in _METRICS} for name in self.problems}
         return {"study": "error-time", "settings": self.settings, "references": self.references,
                 "rows": [asdict(r) for r in self.rows], "first_to_reach": first, "notes": list(self.notes)}
 
@@ -270,7 +268,7 @@ def main(args):
 
     require("fem", "contactlab study error-time (the FEM reference)")
     scene = getattr(args, "scene", None)
-    study = run_error_time(None if scene is None else [get_problem(scene)], quick=bool(getattr(args, "quick", False)),
+    study = run_error_time(None if scene is None else [scene], quick=bool(getattr(args, "quick", False)),
                            progress=not getattr(args, "no_progress", False))
     print(save(args, "error_time", study.to_dict()))
     return 0

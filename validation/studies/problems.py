@@ -18,8 +18,8 @@ import re
 from bem.checks import check_choice
 from bem.reference import hertz_sphere
 
-__all__ = ["paraboloids", "power_layer", "body_modulus", "methods", "get_problem", "stability_cases",
-           "robustness_scene", "ERROR_TIME_PROBLEMS", "LIMIT_TOL"]
+__all__ = ["paraboloids", "power_layer", "methods", "get_problem", "stability_cases", "robustness_scene",
+           "ERROR_TIME_PROBLEMS", "LIMIT_TOL"]
 
 NU = 0.3
 #: relative L2 difference allowed against a closed-form limit: Hertz (smooth bodies, or a layer with
@@ -27,11 +27,6 @@ NU = 0.3
 #: rigid-body layer (k >= 1e2; measured 0.02 .. 1 % for s <= 1, 0.6 % for s = 1.5, 4.4 % for s = 3,
 #: where the layer is stiff at the low pressures of that contact and the bodies' compliance counts)
 LIMIT_TOL = {"hertz": 0.03, "rigid_layer": 0.06}
-
-
-def body_modulus(nu, E_star=1.0):
-    """Young's modulus of each of two identical bodies whose ``E*`` is ``E_star`` [pressure]."""
-    return 2.0 * (1.0 - nu * nu) * E_star
 
 
 def _hertz_scales():
@@ -60,7 +55,7 @@ def paraboloids(name, description, *, layer=None, E=None, nu=(NU, NU), E_star=No
     ``extent_factor`` and ``bem``: the ``[bem]`` table (steps across the expected contact
     diameter, region half-width over its radius, other keys).
     """
-    E = (body_modulus(nu[0]), body_modulus(nu[1])) if E is None else E
+    E = tuple(2.0 * (1.0 - n * n) for n in nu) if E is None else E  # two like bodies: E* = 1
     bodies = {"E_star": E_star} if E_star is not None else {"E1": E[0], "nu1": nu[0], "E2": E[1], "nu2": nu[1]}
     scene = {"scene": {"name": re.sub(r"[^A-Za-z0-9_.-]+", "_", name), "title": name, "description": description,
                        "units": "normalised: R = E* = P = 1" if E_star is None else "normalised: R = P = 1"},

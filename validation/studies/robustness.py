@@ -115,12 +115,12 @@ def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODUL
 
 def summary_table(rows):
     """``(headers, body)``: outcomes, times and the worst dense KKT residual per method and control."""
-    counts = {}
+    groups = {}
     for r in rows:
-        counts.setdefault((r.method, r.control), Counter())[r.status] += 1
+        groups.setdefault((r.method, r.control), []).append(r)
     body = []
-    for (method, control), c in sorted(counts.items()):
-        sel = [r for r in rows if r.method == method and r.control == control]
+    for (method, control), sel in sorted(groups.items()):
+        c = Counter(r.status for r in sel)
         times = [r.wall_time_s for r in sel]
         kkts = [r.kkt_dense for r in sel if r.converged and r.kkt_dense is not None]
         body.append([method, control, c["converged"], c["reported failure"], c["wrong"], fmt(float(np.median(times)),
