@@ -219,12 +219,9 @@ def write_outputs(outcome, out_dir, *, progress=None):
     """Write the result directory of ``outcome`` atomically (whole or not at all); returns its path."""
     _notify(progress, "write", "start")
     res, scene = outcome.bem, outcome.scene
-    files = {"result": FILES["result"], "scene": FILES["scene"], "bem_field": FILES["bem_field"]}
-    if outcome.fem is not None:
-        files["fem_field"] = FILES["fem_field"]
-    if outcome.stress is not None:
-        files["stress_field"] = FILES["stress_field"]
-    outcome.result["files"] = dict(files)
+    absent = {"fem_field": outcome.fem is None, "stress_field": outcome.stress is None}
+    files = {key: name for key, name in FILES.items() if not absent.get(key, False)}
+    outcome.result["files"] = files
     with atomic_directory(out_dir) as tmp:
         write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
         if outcome.fem is not None:

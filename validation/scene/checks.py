@@ -15,7 +15,7 @@ from bem import checks as v
 from bem.checks import InputError
 
 __all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one", "positive",
-           "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair"]
+           "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair", "options"]
 
 
 class SceneError(InputError):
@@ -134,6 +134,12 @@ def string(path, value):
 def choice(path, value, choices):
     string(path, value)
     return _wrap(v.check_choice, path, value, tuple(choices))
+
+
+def options(path, d, rules):
+    """The keys of ``rules`` that ``d`` holds, in the order of ``rules``, each checked by its
+    rule ``check(dotted key, value)``."""
+    return {key: check(f"{path}.{key}", d[key]) for key, check in rules.items() if key in d}
 
 
 def number_or_pair(path, value, check):
