@@ -156,9 +156,7 @@ def compare(bem_result, *, fem=None, analytic=None, force=None):
           (only for an axisymmetric closed form);
         - ``"force_balance"``: ``{"target": P, "bem": |F - P| / P, "fem": ...}``.
 
-        Each pair holds :data:`PAIR_KEYS`: ``l2_rel``, ``max_rel``, ``peak_rel``,
-        ``contact_radius_rel``, ``approach_rel``, ``force_rel`` (the last four signed,
-        ``(a - b) / b``), ``n_points``; ``None`` where undefined.
+        Each pair holds :data:`PAIR_KEYS` (:func:`pair_metrics`).
     """
     if not isinstance(bem_result, ContactResult):
         raise InputError(f"result = {type(bem_result).__name__} is not allowed: it must be a bem.ContactResult.")

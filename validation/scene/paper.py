@@ -193,9 +193,10 @@ def paper_law(law, lam, p_lambda=None, *, alpha_a=None, alpha_c=None, p_cr=None,
     ``p_lambda`` is ``p_max^lambda``, the peak pressure of the same problem with the
     linear layer ``lam``. Elastic-rigid: ``p_cr = alpha_a p_lambda``; bilinear:
     ``lam2 = lam tan(alpha_c)``, ``p_star = alpha_a p_lambda``; root:
-    ``lam_r = lam sqrt(p_lambda)`` (closes as the linear layer does at ``p_lambda``). Explicit ``p_cr``, ``p_star``, ``lam2`` win over
-    the alphas. A zero threshold gives no layer (``None``: the paper's ``alpha_a = 0`` is
-    the smooth contact), a bilinear law with a zero knee the linear layer ``lam2``.
+    ``lam_r = lam sqrt(p_lambda)`` (closes as the linear layer does at ``p_lambda``).
+    Explicit ``p_cr``, ``p_star``, ``lam2`` win over the alphas. A zero threshold gives no
+    layer (``None``: the paper's ``alpha_a = 0`` is the smooth contact), a bilinear law with
+    a zero knee the linear layer ``lam2``.
     """
     if law == "linear":
         return Linear(lam)

@@ -229,13 +229,8 @@ def report(d):
         return None
     _section("report", d)
     out = {"format": ck.choice("report.format", d.get("format", "html"), ("html", "markdown", "both"))}
-    sections = d.get("sections", ["summary"])
-    if not isinstance(sections, list) or not sections:
-        raise ck.SceneError(f"report.sections = {sections!r} is not allowed: it must be a non-empty list of "
-                            "section names, e.g. [\"summary\", \"profile\"].")
-    for i, name in enumerate(sections):
-        ck.choice(f"report.sections[{i}]", name, report_sections())
-    out["sections"] = list(sections)
+    out["sections"] = ck.names("report.sections", d.get("sections", ["summary"]), report_sections(),
+                               'section names, e.g. ["summary", "profile"]')
     return out
 
 
@@ -289,13 +284,9 @@ def stress_options(d, materials):
         out["depths"] = [ck.nonnegative(f"stress.depths[{i}]", v) for i, v in enumerate(depths)]
         if len(set(out["depths"])) != len(depths):
             raise ck.SceneError(f"stress.depths = {depths!r} is not allowed: the depths must be distinct.")
-    bodies = d.get("bodies", list(STRESS_BODIES))
-    if not isinstance(bodies, list) or not bodies:
-        raise ck.SceneError(f"stress.bodies = {bodies!r} is not allowed: it must be a non-empty list of "
-                            f"{', '.join(map(repr, STRESS_BODIES))} (body1: E1, nu1; body2: E2, nu2).")
-    for i, name in enumerate(bodies):
-        ck.choice(f"stress.bodies[{i}]", name, STRESS_BODIES)
+    bodies = ck.names("stress.bodies", d.get("bodies", list(STRESS_BODIES)), STRESS_BODIES,
+                      f"{', '.join(map(repr, STRESS_BODIES))} (body1: E1, nu1; body2: E2, nu2)")
     if len(set(bodies)) != len(bodies):
         raise ck.SceneError(f"stress.bodies = {bodies!r} is not allowed: name each body once.")
-    out["bodies"] = list(bodies)
+    out["bodies"] = bodies
     return out
