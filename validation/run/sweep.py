@@ -145,26 +145,22 @@ def _row(point, result, *, computed, error=None):
     return row
 
 
-def _trace(exc):
-    """The last three frames of ``exc``'s traceback, as text (a failed point's ``error``)."""
-    return "".join(traceback.format_exception(type(exc), exc, exc.__traceback__, limit=3))
-
-
 def _local_map(jobs, workers):
     """Yield ``(point, result, error)`` as local jobs finish (in-process when workers == 1)."""
     if workers == 1 or len(jobs) == 1:
         for point in jobs:
             try:
                 yield point, _solve_point(point.scene.raw, point.scene.source), None
-            except Exception as exc:  # noqa: BLE001 - a failed point is reported, the sweep goes on
-                yield point, None, _trace(exc)
+            except Exception:  # noqa: BLE001 - a failed point is reported, the sweep goes on
+                yield point, None, traceback.format_exc(limit=3)
         return
     with ProcessPoolExecutor(max_workers=workers) as pool:
         futures = {pool.submit(_solve_point, p.scene.raw, p.scene.source): p for p in jobs}
         try:
             for fut in as_completed(futures):
                 exc = fut.exception()
-                yield futures[fut], None if exc else fut.result(), None if exc is None else _trace(exc)
+                error = None if exc is None else "".join(traceback.format_exception(exc, limit=3))
+                yield futures[fut], None if exc else fut.result(), error
         except BaseException:
             for fut in futures:
                 fut.cancel()
@@ -190,7 +186,7 @@ def _dask_map(jobs, client):
     for fut in dask_completed(list(futures)):
         point = futures[fut]
         if fut.status == "error":
-            yield point, None, _trace(fut.exception())
+            yield point, None, "".join(traceback.format_exception(fut.exception(), limit=3))
         else:
             yield point, fut.result(), None
 
@@ -242,16 +238,12 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
     out = Path(out_dir)
     (out / "points").mkdir(parents=True, exist_ok=True)
     rows, jobs = [], []
-
-    def add(row):
-        rows.append(row)
-        if progress is not None:
-            progress(len(rows), len(points), row)
-
     for point in points:
         cached = _load_point(out / "points" / point.file, point.fingerprint)
         if cached is not None:
-            add(_row(point, cached["result"], computed=False))
+            rows.append(_row(point, cached["result"], computed=False))
+            if progress is not None:
+                progress(len(rows), len(points), rows[-1])
         else:
             jobs.append(point)
     log.info("sweep of %s over %d values: %d on disk, %d to run", key, len(points), len(rows), len(jobs))
@@ -267,7 +259,9 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
                     "fingerprint": point.fingerprint, "scene": point.scene.raw, "result": result})
             else:
                 log.warning("sweep point %d (%s = %r) failed:\n%s", point.index, key, point.value, error)
-            add(_row(point, result, computed=True, error=error))
+            rows.append(_row(point, result, computed=True, error=error))
+            if progress is not None:
+                progress(len(rows), len(points), rows[-1])
     finally:
         if client is not None and client[1]:
             client[0].close()
