@@ -71,11 +71,6 @@ def relative_l2(p, p_ref, weights=None):
     return math.sqrt(float(np.sum(w * (p - p_ref) ** 2)) / den) if den > 0 else None
 
 
-def _check_bem(result):
-    if not isinstance(result, ContactResult):
-        raise InputError(f"result = {type(result).__name__} is not allowed: it must be a bem.ContactResult.")
-
-
 def _check_source(name, obj):
     """Every result and closed form shares the names read here (``bem.reference``)."""
     if not all(hasattr(obj, k) for k in ("pressure", "p_max", "contact_radius", "approach", "force")):
@@ -161,11 +156,10 @@ def compare(bem_result, *, fem=None, analytic=None, force=None):
           (only for an axisymmetric closed form);
         - ``"force_balance"``: ``{"target": P, "bem": |F - P| / P, "fem": ...}``.
 
-        Each pair holds :data:`PAIR_KEYS`: ``l2_rel``, ``max_rel``, ``peak_rel``,
-        ``contact_radius_rel``, ``approach_rel``, ``force_rel`` (the last four signed,
-        ``(a - b) / b``), ``n_points``; ``None`` where undefined.
+        Each pair holds :data:`PAIR_KEYS` (:func:`pair_metrics`).
     """
-    _check_bem(bem_result)
+    if not isinstance(bem_result, ContactResult):
+        raise InputError(f"result = {type(bem_result).__name__} is not allowed: it must be a bem.ContactResult.")
     if fem is not None and not isinstance(fem, FemResult):
         raise InputError(f"fem = {type(fem).__name__} is not allowed: it must be a fem_reference.FemResult or None.")
     if analytic is not None:

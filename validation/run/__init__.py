@@ -7,13 +7,6 @@
 - :mod:`validation.run.sweep`: one scene over a list of values of a parameter.
 """
 
-from .runner import (
-    FILES,
-    RunOutcome,
-    execute_scene,
-    planned_stages,
-    run_scene,
-    write_outputs,
-)
+from .runner import FILES, RunOutcome, execute_scene, planned_stages, run_scene, write_outputs
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "planned_stages", "RunOutcome", "FILES"]

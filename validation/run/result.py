@@ -83,7 +83,6 @@ def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=Non
     converged = bool(res.converged) and (fem is None or bool(fem.converged))
     bem_part = dict(res.summary(), E_star=scene.E_star, extent=list(extent), n_nodes=int(res.p.size),
                     nodes_across_contact=(2 * res.contact_radius / res.step), history=_history(res))
-    loaded = res.p > 0
     out = {
         "schema": SCHEMA,
         "scene": scene.name, "title": scene.title, "units": scene.units.label,
@@ -94,11 +93,11 @@ def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=Non
     if scene.axisymmetric:
         out["contact_radius"] = res.contact_radius
     out.update({
-        "contact_extent": {"x": float(np.abs(res.x[loaded]).max()) if loaded.any() else 0.0,
-                           "y": float(np.abs(res.y[loaded]).max()) if loaded.any() else 0.0},
+        "contact_extent": {axis: float(np.abs(coord[res.p > 0]).max(initial=0.0))
+                           for axis, coord in (("x", res.x), ("y", res.y))},
         "iterations": res.iterations, "converged": converged, "kkt_residual": res.kkt_residual,
         "message": res.message, "messages": list(messages),
-        "wall_time_s": {k: v for k, v in times.items()},
+        "wall_time_s": dict(times),
         "bem": bem_part, "layer": layer_info,
     })
     if "alpha_b" in layer_info:

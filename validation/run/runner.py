@@ -54,20 +54,11 @@ def _notify(progress, stage, status, **info):
 
 def planned_stages(scene, *, write=False):
     """Stage names :func:`run_scene` will report for ``scene`` (for progress bars)."""
-    stages = []
     spec = scene.layer_spec
-    if spec is not None and ("alpha_a" in spec or (spec["law"] == "root" and "lam_over_cnn" in spec)):
-        stages.append("layer")
-    stages.append("bem")
-    if scene.fem is not None:
-        stages.append("fem")
-    if scene.fem is not None or scene.analytic is not None:
-        stages.append("compare")
-    if scene.stress is not None:
-        stages.append("stress")
-    if write:
-        stages.append("write")
-    return stages
+    wanted = {"layer": spec is not None and ("alpha_a" in spec or (spec["law"] == "root" and "lam_over_cnn" in spec)),
+              "bem": True, "fem": scene.fem is not None, "compare": scene.fem is not None or scene.analytic is not None,
+              "stress": scene.stress is not None, "write": write}
+    return [stage for stage, on in wanted.items() if on]
 
 
 class _BemRunner:
@@ -77,8 +68,8 @@ class _BemRunner:
         self.scene, self.messages, self.calibration = scene, messages, calibration
         opts = scene.bem
         self.extent = tuple(opts["extent"])
-        self.kw = dict(E_star=scene.E_star, force=scene.load["force"], approach=scene.load["approach"],
-                       step=opts["step"], method="newton" if calibration else opts["method"])
+        self.kw = dict(E_star=scene.E_star, **scene.load, step=opts["step"],
+                       method="newton" if calibration else opts["method"])
         # the calibration solves with the robust solver and its defaults, whatever the scene's method:
         # only the tolerance and the lattice options carry over
         keys = ("rtol", "precondition", "nested") if calibration else SOLVER_KEYS[1:]
@@ -103,7 +94,7 @@ class _BemRunner:
                     raise
                 hx, hy = inner_domain(self.scene.gap)
                 limit = ((1 - DOMAIN_MARGIN) * hx, (1 - DOMAIN_MARGIN) * hy)
-                grown = (min(_GROW * self.extent[0], limit[0]), min(_GROW * self.extent[1], limit[1]))
+                grown = tuple(min(_GROW * e, lim) for e, lim in zip(self.extent, limit))
                 if attempt == _MAX_GROW or grown == self.extent:
                     if any(e >= lim for e, lim in zip(self.extent, limit)):
                         raise bem.RegionTooSmallError(
@@ -130,15 +121,6 @@ def _analytic(scene, layer):
     if kind == "hertz_elliptic":
         return an.hertz_elliptic(rx, ry, scene.E_star, **load)
     return an.rigid_layer_paraboloid(layer, g.R, **load)
-
-
-def _fem(scene, layer):
-    import fem_reference
-
-    m = scene.materials
-    return fem_reference.solve(scene.gap, E1=m["E1"], nu1=m["nu1"], E2=m["E2"], nu2=m["nu2"],
-                               force=scene.load["force"], approach=scene.load["approach"], layer=layer,
-                               **scene.fem)
 
 
 def execute_scene(scene, *, progress=None, overrides=None):
@@ -184,8 +166,10 @@ def execute_scene(scene, *, progress=None, overrides=None):
         layer_info["alpha_b"] = res.p_max / layer_info["p_max_lambda"]
     fem = ref = metrics = None
     if scene.fem is not None:
+        import fem_reference
+
         _notify(progress, "fem", "start")
-        fem = _fem(scene, layer)
+        fem = fem_reference.solve(scene.gap, **scene.materials, **scene.load, layer=layer, **scene.fem)
         times["fem"] = fem.wall_time_s
         _notify(progress, "fem", "done", converged=fem.converged)
         if not fem.converged:
@@ -219,12 +203,9 @@ def write_outputs(outcome, out_dir, *, progress=None):
     """Write the result directory of ``outcome`` atomically (whole or not at all); returns its path."""
     _notify(progress, "write", "start")
     res, scene = outcome.bem, outcome.scene
-    files = {"result": FILES["result"], "scene": FILES["scene"], "bem_field": FILES["bem_field"]}
-    if outcome.fem is not None:
-        files["fem_field"] = FILES["fem_field"]
-    if outcome.stress is not None:
-        files["stress_field"] = FILES["stress_field"]
-    outcome.result["files"] = dict(files)
+    absent = {"fem_field": outcome.fem is None, "stress_field": outcome.stress is None}
+    files = {key: name for key, name in FILES.items() if not absent.get(key, False)}
+    outcome.result["files"] = files
     with atomic_directory(out_dir) as tmp:
         write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
         if outcome.fem is not None:

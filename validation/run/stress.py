@@ -29,7 +29,7 @@ import numpy as np
 import bem
 from bem.stress import principal_stresses
 
-__all__ = ["BODIES", "StressRun", "run_stress", "stress_depths", "stress_summary", "fem_body_stresses", "peak_fit",
+__all__ = ["BODIES", "StressRun", "run_stress", "stress_summary", "fem_body_stresses", "peak_fit",
            "compare_with_fem", "contact_half_width"]
 
 #: body name (upper, lower) -> its Poisson-ratio key in [bodies]
@@ -71,19 +71,15 @@ def contact_half_width(res):
     return max(min(extent, res.contact_radius), res.step)
 
 
-def stress_depths(spec, res):
-    """``(depths, scale)``: the scene's depths [length], increasing, and the contact half-width."""
-    scale = contact_half_width(res)
-    if spec["depths"] == "auto":
-        return np.linspace(0.0, spec["max_depth"] * scale, spec["n_depths"]), scale
-    return np.unique(np.asarray(spec["depths"], dtype=float)), scale
-
-
 def run_stress(scene, res, fem=None):
     """Stresses of the scene's bodies under the BEM pressure ``res``; compared with ``fem`` when given."""
     t0 = time.perf_counter()
     spec = scene.stress
-    depths, scale = stress_depths(spec, res)
+    scale = contact_half_width(res)
+    if spec["depths"] == "auto":
+        depths = np.linspace(0.0, spec["max_depth"] * scale, spec["n_depths"])
+    else:
+        depths = np.unique(np.asarray(spec["depths"], dtype=float))
     bodies = {name: bem.subsurface_stress(res, depths, nu=scene.materials[BODIES[name]])
               for name in spec["bodies"]}
     run = StressRun(bodies=bodies, depths=depths, scale=scale)

@@ -186,8 +186,7 @@ def _dask_map(jobs, client):
     for fut in dask_completed(list(futures)):
         point = futures[fut]
         if fut.status == "error":
-            exc = fut.exception()
-            yield point, None, "".join(traceback.format_exception(type(exc), exc, exc.__traceback__, limit=3))
+            yield point, None, "".join(traceback.format_exception(fut.exception(), limit=3))
         else:
             yield point, fut.result(), None
 

@@ -9,16 +9,8 @@
 """
 
 from .checks import SceneError
-from .load import (
-                   SECTIONS,
-                   Scene,
-                   apply_overrides,
-                   builtin_path,
-                   builtin_scenes,
-                   load_scene,
-                   parse_override,
-                   parse_scene,
-)
+from .load import (SECTIONS, Scene, apply_overrides, builtin_path, builtin_scenes, load_scene, parse_override,
+                   parse_scene)
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
            "apply_overrides", "parse_override", "SECTIONS"]

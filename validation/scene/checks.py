@@ -15,7 +15,8 @@ from bem import checks as v
 from bem.checks import InputError
 
 __all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one", "positive",
-           "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair"]
+           "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair", "options",
+           "names"]
 
 
 class SceneError(InputError):
@@ -134,6 +135,21 @@ def string(path, value):
 def choice(path, value, choices):
     string(path, value)
     return _wrap(v.check_choice, path, value, tuple(choices))
+
+
+def options(path, d, rules):
+    """The keys of ``rules`` that ``d`` holds, in the order of ``rules``, each checked by its
+    rule ``check(dotted key, value)``."""
+    return {key: check(f"{path}.{key}", d[key]) for key, check in rules.items() if key in d}
+
+
+def names(path, value, choices, rule):
+    """A non-empty list of names, each one of ``choices``; ``rule`` says what the list holds."""
+    if not isinstance(value, list) or not value:
+        raise SceneError(f"{path} = {value!r} is not allowed: it must be a non-empty list of {rule}.")
+    for i, name in enumerate(value):
+        choice(f"{path}[{i}]", name, choices)
+    return list(value)
 
 
 def number_or_pair(path, value, check):

@@ -37,7 +37,9 @@ from ..units import Units
 from . import schema as sec
 from .checks import SceneError
 from .measured import measured_region
-from .paper import ALIASES, EXCLUSIVE
+from .paper import ALIASES
+from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
+from .sizing import EXCLUSIVE as BEM_EXCLUSIVE
 from .sizing import bem_options
 
 __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
@@ -45,7 +47,9 @@ __all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes",
 
 SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report", "stress")
 _REQUIRED = ("scene", "bodies", "gap", "load")
-_BODY_KEYS = ("E1", "nu1", "E2", "nu2")
+#: section -> groups of keys that replace each other (a ``--set`` of one drops the others)
+_EXCLUSIVE = {"bem": BEM_EXCLUSIVE, "load": (("force", "approach"),), "layer": LAYER_EXCLUSIVE,
+              "bodies": tuple(("E_star", key) for key in sec.BODY_KEYS)}
 
 
 @dataclass(frozen=True)
@@ -123,15 +127,7 @@ def parse_override(text):
 
 def _exclusive_partners(section, key):
     """Keys of ``section`` that a new value of ``key`` replaces."""
-    groups = {"bem": (("step", "nodes_across"), ("extent", "extent_factor")),
-              "load": (("force", "approach"),), "layer": EXCLUSIVE}
-    drop = set()
-    for group in groups.get(section, ()):
-        if key in group:
-            drop.update(k for k in group if k != key)
-    if section == "bodies":
-        drop.update(_BODY_KEYS if key == "E_star" else ("E_star",) if key in _BODY_KEYS else ())
-    return drop
+    return {other for group in _EXCLUSIVE.get(section, ()) if key in group for other in group if other != key}
 
 
 def apply_overrides(raw, overrides):
@@ -165,7 +161,7 @@ def apply_overrides(raw, overrides):
                 raise SceneError(f"--set {key!r} is not allowed: {part} is not a table in this scene.")
             node = child
         if len(parts) == 2:
-            for other in _exclusive_partners(parts[0], parts[1]):
+            for other in _exclusive_partners(*parts):
                 node.pop(other, None)
             if parts == ["layer", "law"] and value == "none":
                 node.clear()

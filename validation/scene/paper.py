@@ -34,8 +34,8 @@ from bem.operator import diagonal_coefficient
 
 from .checks import SceneError, in_range, positive, string, table, unknown_keys
 
-__all__ = ["CalibrationError", "c_nn", "check_layer", "resolve_layer", "is_paper_law", "PAPER_LAWS", "PAPER_KEYS",
-           "EXCLUSIVE", "ALIASES"]
+__all__ = ["CalibrationError", "c_nn", "check_layer", "resolve_layer", "is_paper_law", "paper_keys",
+           "reference_compliance", "PAPER_LAWS", "PAPER_KEYS", "EXCLUSIVE", "ALIASES"]
 
 log = logging.getLogger(__name__)
 
@@ -66,6 +66,17 @@ c_nn = diagonal_coefficient  # ``C_nn = c / (pi E*) w_t(0, 0)``, defined once in
 def is_paper_law(spec):
     """Whether a validated ``[layer]`` spec is given by the paper's parameters (resolved by solves)."""
     return spec is not None and spec["law"] in PAPER_LAWS and any(k in spec for k in PAPER_KEYS)
+
+
+def paper_keys(law):
+    """The keys of a paper law's table besides ``law``: each parameter's direct and paper key."""
+    return [k for pair in PAPER_LAWS[law].values() for k in pair] + (["alpha_b"] if law == "root" else [])
+
+
+def reference_compliance(spec, step, E_star):
+    """Compliance of the linear reference layer [length/pressure]: ``lam`` (``lam1``) or ``lam_over_cnn C_nn``."""
+    direct = PAPER_LAWS[spec["law"]][next(iter(PAPER_LAWS[spec["law"]]))][0]  # lam or lam1
+    return spec[direct] if direct in spec else spec["lam_over_cnn"] * c_nn(step, E_star)
 
 
 def _check_paper_values(path, d):
@@ -101,14 +112,13 @@ def _check_law_keys(path, d):
 
 def choice_law(path, d, *, allow_none=True):
     """The ``law`` key of a layer table, checked against the known laws."""
+    choices = (("none",) if allow_none else ()) + tuple(LAWS)
+    known = ", ".join(map(repr, choices))
     if "law" not in d:
-        raise SceneError(f"{path}.law is missing: give one of " + ", ".join(
-            repr(k) for k in (("none",) if allow_none else ()) + tuple(LAWS)) + ".")
+        raise SceneError(f"{path}.law is missing: give one of {known}.")
     law = string(f"{path}.law", d["law"])
-    known = (("none",) if allow_none else ()) + tuple(LAWS)
-    if law not in known:
-        raise SceneError(f"{path}.law = {law!r} is not allowed: it must be one of "
-                         + ", ".join(repr(k) for k in known) + ".")
+    if law not in choices:
+        raise SceneError(f"{path}.law = {law!r} is not allowed: it must be one of {known}.")
     return law
 
 
@@ -132,10 +142,8 @@ def check_layer(d, path="layer"):
     if law not in PAPER_LAWS or not any(k in d for k in PAPER_KEYS):
         _check_law_keys(path, d)
         return dict(d)
-    params = PAPER_LAWS[law]
-    allowed = ["law"] + [k for pair in params.values() for k in pair] + (["alpha_b"] if law == "root" else [])
-    unknown_keys(path, d, allowed)
-    for param, (direct, paper) in params.items():
+    unknown_keys(path, d, ["law", *paper_keys(law)])
+    for param, (direct, paper) in PAPER_LAWS[law].items():
         present = [k for k in (direct, paper) if k in d]
         if not present:
             raise SceneError(f"{path}.{direct} or {path}.{paper} is missing: a {law!r} layer needs {param}.")
@@ -179,17 +187,16 @@ def _root_for_alpha_b(alpha_b, p_lambda, lam_r0, solve):
     return math.exp(t), len(cache)
 
 
-def paper_law(law, lam, p_lambda=None, *, alpha_a=None, alpha_c=None, p_cr=None, p_star=None, lam2=None,
-              root_factor=1.0):
+def paper_law(law, lam, p_lambda=None, *, alpha_a=None, alpha_c=None, p_cr=None, p_star=None, lam2=None):
     """A layer law of the paper's section 6 from its parameters.
 
     ``p_lambda`` is ``p_max^lambda``, the peak pressure of the same problem with the
     linear layer ``lam``. Elastic-rigid: ``p_cr = alpha_a p_lambda``; bilinear:
     ``lam2 = lam tan(alpha_c)``, ``p_star = alpha_a p_lambda``; root:
-    ``lam_r = root_factor lam sqrt(p_lambda)`` (closes as the linear layer does at
-    ``p_lambda`` for ``root_factor = 1``). Explicit ``p_cr``, ``p_star``, ``lam2`` win over
-    the alphas. A zero threshold gives no layer (``None``: the paper's ``alpha_a = 0`` is
-    the smooth contact), a bilinear law with a zero knee the linear layer ``lam2``.
+    ``lam_r = lam sqrt(p_lambda)`` (closes as the linear layer does at ``p_lambda``).
+    Explicit ``p_cr``, ``p_star``, ``lam2`` win over the alphas. A zero threshold gives no
+    layer (``None``: the paper's ``alpha_a = 0`` is the smooth contact), a bilinear law with
+    a zero knee the linear layer ``lam2``.
     """
     if law == "linear":
         return Linear(lam)
@@ -201,7 +208,7 @@ def paper_law(law, lam, p_lambda=None, *, alpha_a=None, alpha_c=None, p_cr=None,
         p_star = alpha_a * p_lambda if p_star is None else p_star
         return Bilinear(lam, lam2, p_star) if p_star > 0 else (Linear(lam2) if lam2 > 0 else None)
     if law == "root":
-        return Root(root_factor * lam * math.sqrt(p_lambda))
+        return Root(lam * math.sqrt(p_lambda))
     raise SceneError(f"layer.law = {law!r} is not allowed: it must be one of {sorted(PAPER_LAWS)}.")
 
 
@@ -238,8 +245,7 @@ def resolve_layer(spec, *, step, E_star, solve, layer=None):
         layer = from_dict(spec) if layer is None else layer
         return layer, dict(info, parameters=layer.to_dict())
     cnn = c_nn(step, E_star)
-    direct = PAPER_LAWS[law][next(iter(PAPER_LAWS[law]))][0]  # lam or lam1
-    lam_ref = spec[direct] if direct in spec else spec["lam_over_cnn"] * cnn
+    lam_ref = reference_compliance(spec, step, E_star)
     info.update(c_nn=cnn, lam_over_cnn=spec.get("lam_over_cnn", lam_ref / cnn), lam_ref=lam_ref)
     p_lambda = None
     if "alpha_a" in spec or law == "root":

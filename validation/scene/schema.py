@@ -10,6 +10,7 @@ from __future__ import annotations
 import inspect
 import math
 import re
+from functools import partial
 
 from bem import gaps
 from bem.gaps import gap_from_dict
@@ -21,26 +22,38 @@ from ..units import parse_units
 from . import checks as ck
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
-from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law
+from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law, paper_keys
 from .sizing import KEYS as BEM_KEYS
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic",
            "report", "sweep_spec", "stress_options", "scene_keys", "KEYS", "report_sections", "ANALYTIC_KINDS",
-           "DEFAULT_UNITS"]
+           "DEFAULT_UNITS", "BODY_KEYS"]
 
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
-_BODY_KEYS = ("E1", "nu1", "E2", "nu2")
-_FEM_KEYS = ("n_contact", "extent_factor", "fine_radius", "growth", "penalty", "rtol", "maxiter", "remesh",
-             "truncation_correction")
+BODY_KEYS = ("E1", "nu1", "E2", "nu2")
+#: the ``[fem]`` options and their checks, in the order they are checked
+_FEM_OPTIONS = {"n_contact": partial(ck.integer, minimum=4, maximum=400),
+                **dict.fromkeys(("extent_factor", "fine_radius", "growth", "penalty", "rtol"), ck.positive),
+                "maxiter": partial(ck.integer, minimum=1), "remesh": ck.boolean, "truncation_correction": ck.boolean}
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
-KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *_BODY_KEYS),
-        "load": ("force", "approach"), "bem": BEM_KEYS, "fem": _FEM_KEYS, "analytic": ("kind",),
+KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS),
+        "load": ("force", "approach"), "bem": BEM_KEYS, "fem": tuple(_FEM_OPTIONS), "analytic": ("kind",),
         "sweep": ("parameter", "values"), "report": ("sections", "format"),
         "stress": ("depths", "n_depths", "max_depth", "bodies")}
 GAP_TYPES = gaps.GAPS
-_STRESS_KEYS = KEYS["stress"]
 STRESS_BODIES = ("body1", "body2")
+
+
+def _section(name, d):
+    """``d`` must be a table holding only the keys of ``[name]`` (:data:`KEYS`)."""
+    ck.table(name, d)
+    ck.unknown_keys(name, d, KEYS[name])
+
+
+def _gap_parameters(cls):
+    """The constructor parameters of a :mod:`bem.gaps` shape, by name."""
+    return {name: p for name, p in inspect.signature(cls.__init__).parameters.items() if name != "self"}
 
 
 def report_sections():
@@ -63,23 +76,20 @@ def scene_keys():
         parameters, and the paper's keys for the four paper laws, :mod:`validation.scene.paper`).
     """
     out = {name: {"": keys} for name, keys in KEYS.items()}
-    out["gap"] = {"": ("type",), **{kind: tuple(p for p in inspect.signature(cls.__init__).parameters if p != "self")
-                                    for kind, cls in GAP_TYPES.items()},
+    out["gap"] = {"": ("type",), **{kind: tuple(_gap_parameters(cls)) for kind, cls in GAP_TYPES.items()},
                   "measured": tuple(k for k in MEASURED_KEYS if k != "type")}
     out["layer"] = {"": ("law",)}
     for law, cls in LAWS.items():
         keys = [*cls._required, *cls._optional]
         if law in PAPER_LAWS:
-            keys += [k for pair in PAPER_LAWS[law].values() for k in pair if k not in keys]
-            keys += ["alpha_b"] if law == "root" else []
+            keys += [k for k in paper_keys(law) if k not in keys]
         out["layer"][law] = tuple(keys)
     return out
 
 
 def scene_meta(d):
     """``[scene]``: name (required), title, description, units."""
-    ck.table("scene", d)
-    ck.unknown_keys("scene", d, KEYS["scene"])
+    _section("scene", d)
     name = ck.string("scene.name", ck.require("scene", d, "name", 'give a short name, e.g. name = "hertz"'))
     if not _NAME.match(name):
         raise ck.SceneError(f"scene.name = {name!r} is not allowed: it must be letters, digits, '_', '.', '-' "
@@ -94,19 +104,18 @@ def scene_meta(d):
 
 def bodies(d):
     """``[bodies]``: ``E_star`` alone, or ``E1, nu1, E2, nu2`` (``E = inf``: rigid body)."""
-    ck.table("bodies", d)
-    ck.unknown_keys("bodies", d, KEYS["bodies"])
+    _section("bodies", d)
     if "E_star" in d:
-        if any(k in d for k in _BODY_KEYS):
-            given = ", ".join(f"bodies.{k}" for k in _BODY_KEYS if k in d)
+        if any(k in d for k in BODY_KEYS):
+            given = ", ".join(f"bodies.{k}" for k in BODY_KEYS if k in d)
             raise ck.SceneError(f"bodies.E_star = {d['E_star']!r} is not allowed together with {given}: "
                                 "give E_star alone or all of E1, nu1, E2, nu2.")
         return {"E_star": ck.positive("bodies.E_star", d["E_star"]), "materials": None}
-    for key in _BODY_KEYS:
+    for key in BODY_KEYS:
         ck.require("bodies", d, key, "give E1, nu1, E2, nu2 [Pa, -] (or E_star alone)")
     with ck.scene_errors("bodies."):
-        E_star = effective_modulus(*(d[k] for k in _BODY_KEYS))
-    return {"E_star": E_star, "materials": {k: float(d[k]) for k in _BODY_KEYS}}
+        E_star = effective_modulus(*(d[k] for k in BODY_KEYS))
+    return {"E_star": E_star, "materials": {k: float(d[k]) for k in BODY_KEYS}}
 
 
 def gap(d, E_star, *, units=None):
@@ -124,14 +133,14 @@ def gap(d, E_star, *, units=None):
     ck.choice("gap.type", kind, kinds)
     if kind == "measured":
         return measured_gap(d, units=units)
-    allowed = ["type", *(p for p in inspect.signature(GAP_TYPES[kind].__init__).parameters if p != "self")]
-    ck.unknown_keys("gap", d, allowed)
+    params = _gap_parameters(GAP_TYPES[kind])
+    ck.unknown_keys("gap", d, ["type", *params])
     spec = dict(d)
     if kind == "crowned_roller" and "design_force" in spec and "E_star" not in spec:
         spec["E_star"] = E_star
-    for name, p in inspect.signature(GAP_TYPES[kind].__init__).parameters.items():
-        if name != "self" and p.default is inspect.Parameter.empty and name not in spec:
-            raise ck.SceneError(f"gap.{name} is missing: a {kind!r} gap needs " + ", ".join(allowed[1:]) + ".")
+    for name, p in params.items():
+        if p.default is inspect.Parameter.empty and name not in spec:
+            raise ck.SceneError(f"gap.{name} is missing: a {kind!r} gap needs " + ", ".join(params) + ".")
     with ck.scene_errors("gap."):
         shape = gap_from_dict(spec)
     return spec, shape
@@ -139,8 +148,7 @@ def gap(d, E_star, *, units=None):
 
 def load(d):
     """``[load]``: exactly one of ``force`` [N] and ``approach`` [m], > 0."""
-    ck.table("load", d)
-    ck.unknown_keys("load", d, KEYS["load"])
+    _section("load", d)
     key = ck.exactly_one("load", d, KEYS["load"], "force control: force [N]; approach control: "
                          "approach [m]")
     return {"force": None, "approach": None, key: ck.positive(f"load.{key}", d[key])}
@@ -164,8 +172,7 @@ def fem_options(d, shape, materials):
     """``[fem]``: options of :func:`fem_reference.solve`; axisymmetric gaps and E1..nu2 only."""
     if d is None:
         return None
-    ck.table("fem", d)
-    ck.unknown_keys("fem", d, KEYS["fem"])
+    _section("fem", d)
     if not shape.is_axisymmetric:
         raise ck.SceneError(f"fem = {{...}} is not allowed with gap.type = {shape.type_name!r}: the FEM "
                             "reference is axisymmetric; remove [fem] or use an axisymmetric gap.")
@@ -179,17 +186,7 @@ def fem_options(d, shape, materials):
         if materials[key] > 0.499:
             raise ck.SceneError(f"bodies.{key} = {materials[key]!r} is not allowed with [fem]: it must be "
                                 "<= 0.499 (the displacement FEM locks).")
-    out = {}
-    if "n_contact" in d:
-        out["n_contact"] = ck.integer("fem.n_contact", d["n_contact"], 4, 400)
-    for key in ("extent_factor", "fine_radius", "growth", "penalty", "rtol"):
-        if key in d:
-            out[key] = ck.positive(f"fem.{key}", d[key])
-    if "maxiter" in d:
-        out["maxiter"] = ck.integer("fem.maxiter", d["maxiter"], 1)
-    for key in ("remesh", "truncation_correction"):
-        if key in d:
-            out[key] = ck.boolean(f"fem.{key}", d[key])
+    out = ck.options("fem", d, _FEM_OPTIONS)
     extent, fine = out.get("extent", 40.0), out.get("fine_radius", 1.5)
     if extent < 4 * fine:
         raise ck.SceneError(f"fem.extent = {extent!r} is not allowed: it must be >= 4 * fem.fine_radius = "
@@ -201,8 +198,7 @@ def analytic(d, shape, layer_spec):
     """``[analytic]``: ``kind`` of the closed-form comparison and its applicability."""
     if d is None:
         return None
-    ck.table("analytic", d)
-    ck.unknown_keys("analytic", d, KEYS["analytic"])
+    _section("analytic", d)
     kind = ck.choice("analytic.kind", ck.require("analytic", d, "kind", "give one of " + ", ".join(
         map(repr, ANALYTIC_KINDS))), ANALYTIC_KINDS)
     t = shape.type_name
@@ -231,16 +227,10 @@ def report(d):
     """``[report]``: ``sections`` (names checked) and ``format``."""
     if d is None:
         return None
-    ck.table("report", d)
-    ck.unknown_keys("report", d, KEYS["report"])
+    _section("report", d)
     out = {"format": ck.choice("report.format", d.get("format", "html"), ("html", "markdown", "both"))}
-    sections = d.get("sections", ["summary"])
-    if not isinstance(sections, list) or not sections:
-        raise ck.SceneError(f"report.sections = {sections!r} is not allowed: it must be a non-empty list of "
-                            "section names, e.g. [\"summary\", \"profile\"].")
-    for i, name in enumerate(sections):
-        ck.choice(f"report.sections[{i}]", name, report_sections())
-    out["sections"] = list(sections)
+    out["sections"] = ck.names("report.sections", d.get("sections", ["summary"]), report_sections(),
+                               'section names, e.g. ["summary", "profile"]')
     return out
 
 
@@ -248,8 +238,7 @@ def sweep_spec(d, known_sections):
     """``[sweep]``: ``parameter`` (alpha_a, alpha_b, alpha_c or a dotted key) and ``values``."""
     if d is None:
         return None
-    ck.table("sweep", d)
-    ck.unknown_keys("sweep", d, KEYS["sweep"])
+    _section("sweep", d)
     param = ck.string("sweep.parameter", ck.require("sweep", d, "parameter",
                                                     "give alpha_a, alpha_b, alpha_c or a dotted key like layer.lam"))
     key = ALIASES.get(param, param)
@@ -275,8 +264,7 @@ def stress_options(d, materials):
     ``"auto"``: that many depths from 0 down to ``max_depth`` contact half-widths), ``bodies``."""
     if d is None:
         return None
-    ck.table("stress", d)
-    ck.unknown_keys("stress", d, _STRESS_KEYS)
+    _section("stress", d)
     if materials is None:
         raise ck.SceneError("stress = {...} is not allowed with bodies.E_star: the stresses depend on each body's "
                             "Poisson ratio; give bodies.E1, nu1, E2, nu2.")
@@ -296,13 +284,9 @@ def stress_options(d, materials):
         out["depths"] = [ck.nonnegative(f"stress.depths[{i}]", v) for i, v in enumerate(depths)]
         if len(set(out["depths"])) != len(depths):
             raise ck.SceneError(f"stress.depths = {depths!r} is not allowed: the depths must be distinct.")
-    bodies = d.get("bodies", list(STRESS_BODIES))
-    if not isinstance(bodies, list) or not bodies:
-        raise ck.SceneError(f"stress.bodies = {bodies!r} is not allowed: it must be a non-empty list of "
-                            f"{', '.join(map(repr, STRESS_BODIES))} (body1: E1, nu1; body2: E2, nu2).")
-    for i, name in enumerate(bodies):
-        ck.choice(f"stress.bodies[{i}]", name, STRESS_BODIES)
+    bodies = ck.names("stress.bodies", d.get("bodies", list(STRESS_BODIES)), STRESS_BODIES,
+                      f"{', '.join(map(repr, STRESS_BODIES))} (body1: E1, nu1; body2: E2, nu2)")
     if len(set(bodies)) != len(bodies):
         raise ck.SceneError(f"stress.bodies = {bodies!r} is not allowed: name each body once.")
-    out["bodies"] = list(bodies)
+    out["bodies"] = bodies
     return out

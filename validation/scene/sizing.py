@@ -17,6 +17,7 @@ one message), and the option names come from :data:`bem.options.OPTIONS`.
 from __future__ import annotations
 
 import math
+from functools import partial
 
 from bem import METHODS, InputError
 from bem.lattice import SQRT3, Lattice
@@ -24,10 +25,10 @@ from bem.layers import Linear
 from bem.options import OPTIONS, check_options, solver_for
 
 from . import checks as ck
-from .paper import PAPER_LAWS, c_nn, is_paper_law
+from .paper import is_paper_law, reference_compliance
 
-__all__ = ["bem_options", "inner_domain", "node_count", "KEYS", "SOLVER_KEYS", "MAX_NODES", "DOMAIN_MARGIN",
-           "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
+__all__ = ["bem_options", "inner_domain", "node_count", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "MAX_NODES",
+           "DOMAIN_MARGIN", "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
 
 #: Largest candidate region a scene may ask for (memory and time guard).
 MAX_NODES = 4_000_000
@@ -39,6 +40,8 @@ DEFAULT_EXTENT_FACTOR = 1.5
 SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested") + tuple(
     sorted({k for keys in OPTIONS.values() for k in keys}))
 KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
+#: pairs of lattice keys of which a scene gives one (a ``--set`` of one drops the other)
+EXCLUSIVE = (("step", "nodes_across"), ("extent", "extent_factor"))
 
 
 def inner_domain(gap):
@@ -70,11 +73,9 @@ def _expected(gap, layer_spec, layer, E_star, load, step, n_across):
         return axes
     if not is_paper_law(layer_spec):
         return _axes(gap, layer, E_star, load)
-    direct = next(iter(PAPER_LAWS[layer_spec["law"]].values()))[0]  # lam or lam1: the linear reference
     s = step if step is not None else 2 * min(axes) / n_across
     for _ in range(30):
-        lam = layer_spec[direct] if direct in layer_spec else layer_spec["lam_over_cnn"] * c_nn(s, E_star)
-        axes = _axes(gap, Linear(lam), E_star, load)
+        axes = _axes(gap, Linear(reference_compliance(layer_spec, s, E_star)), E_star, load)
         s_new = 2 * min(axes) / n_across
         if step is not None or abs(s_new / s - 1.0) < 1e-9:
             break
@@ -140,18 +141,13 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
     """
     d = {} if d is None else ck.table("bem", d)
     ck.unknown_keys("bem", d, KEYS)
-    for a, b in (("step", "nodes_across"), ("extent", "extent_factor")):
+    for a, b in EXCLUSIVE:
         if a in d and b in d:
             raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
                                 "give one of them.")
     out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
-    if "rtol" in d:
-        out["rtol"] = ck.positive("bem.rtol", d["rtol"])
-    if "maxiter" in d:
-        out["maxiter"] = ck.integer("bem.maxiter", d["maxiter"], 1)
-    for key in ("precondition", "nested"):
-        if key in d:
-            out[key] = ck.boolean(f"bem.{key}", d[key])
+    out.update(ck.options("bem", d, {"rtol": ck.positive, "maxiter": partial(ck.integer, minimum=1),
+                                     "precondition": ck.boolean, "nested": ck.boolean}))
     out.update(_solver_options(d, out["method"], layer_spec))
     step = ck.positive("bem.step", d["step"]) if "step" in d else None
     n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
