@@ -113,6 +113,8 @@ CASES = {
     "fem_with_E_star": (BASE.replace(BODIES, "\n[bodies]\nE_star = 1e11\n") + "\n[fem]\n", "fem"),
     "fem_too_few_elements": (BASE + "\n[fem]\nn_contact = 1\n", "fem.n_contact"),
     "unknown_fem_key": (BASE + "\n[fem]\nmesh_size = 1e-5\n", "fem.mesh_size"),
+    "fem_domain_inside_its_fine_zone": (BASE + "\n[fem]\nextent_factor = 5.0\nfine_radius = 1.5\n",
+                                        "fem.extent_factor"),
     "unknown_analytic_kind": (BASE + '\n[analytic]\nkind = "exact"\n', "analytic.kind"),
     "hertz_with_layer": (PAPER_ER + '\n[analytic]\nkind = "hertz"\n', "analytic.kind"),
     "hertz_on_flat_punch": (BASE.replace('type = "paraboloid"\nR = 0.01', 'type = "flat_punch"\na = 1e-4\n'

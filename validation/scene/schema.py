@@ -187,9 +187,9 @@ def fem_options(d, shape, materials):
             raise ck.SceneError(f"bodies.{key} = {materials[key]!r} is not allowed with [fem]: it must be "
                                 "<= 0.499 (the displacement FEM locks).")
     out = ck.options("fem", d, _FEM_OPTIONS)
-    extent, fine = out.get("extent", 40.0), out.get("fine_radius", 1.5)
+    extent, fine = out.get("extent_factor", 40.0), out.get("fine_radius", 1.5)
     if extent < 4 * fine:
-        raise ck.SceneError(f"fem.extent = {extent!r} is not allowed: it must be >= 4 * fem.fine_radius = "
+        raise ck.SceneError(f"fem.extent_factor = {extent!r} is not allowed: it must be >= 4 * fem.fine_radius = "
                             f"{4 * fine!r} (domain size in expected contact radii).")
     return out
 
