@@ -16,7 +16,7 @@ import numpy as np
 from ..figures import run as run_figures
 from ..render import Figure, Progress, Section, Table, draw_and_build, problem_section
 from ..render.style import display_unit, method_text, report_unit
-from .paper_runs import AG_RELAXATION, ALPHA_A_ITERATIONS, RTOL, SOLVE_STAGES, run_paper_problem
+from .paper_runs import AG_RELAXATION, ALPHA_A_ITERATIONS, RTOL, SCENES, SOLVE_STAGES, run_paper_problem
 from .results import results_of
 
 __all__ = ["report_paper_problem", "paper_sections", "STAGES", "TITLE"]
@@ -24,8 +24,8 @@ __all__ = ["report_paper_problem", "paper_sections", "STAGES", "TITLE"]
 TITLE = "contactlab: the paper's test problem - paraboloids with a nonlinear interface layer"
 #: the stages of :func:`report_paper_problem`, as reported to its ``progress``
 STAGES = (*SOLVE_STAGES, "figures", "writing")
-_KEYS = {"smooth": "smooth", "linear Winkler": "linear", "elastic-rigid": "elastic_rigid", "root": "root",
-         "bilinear": "bilinear"}
+#: case -> its key in figure names and colours (``"linear Winkler"`` -> ``"linear"``)
+_KEYS = {case: scene.removeprefix("paper_") for case, scene in SCENES.items()}
 
 
 def _method(r):
@@ -208,8 +208,10 @@ def _sweeps(res, work):
     pick = alphas if res.quick else [0.0, 0.3, 0.5, 0.7, 0.9, 1.0]
     f9 = plot_pressure_surfaces([(rf"$\alpha_a$ = {al:g}", r) for al, r in res.sweep_a
                                  if any(abs(al - q) < 1e-9 for q in pick)], work / "fig09_alpha_a_3d.png", p0=p0, a=a,
-                                title=r"elastic-rigid law: pressure over the contact as $\alpha_a$ varies (paper Fig. 9)")
-    fb = plot_sweep([(ab, *section_of(r)) for _, ab, r in res.sweep_b], work / "fig10_sweep_alpha_b.png", p0=p0, a=a,
+                                title=r"elastic-rigid law: pressure over the contact as $\alpha_a$ varies "
+                                      "(paper Fig. 9)")
+    fb = plot_sweep([(ab, *section_of(r)) for _, ab, r in res.sweep_b], work / "fig10_sweep_alpha_b.png",
+                    p0=p0, a=a,
                     name=r"$\alpha_b = p_{max}^{root} / p_{max}^{\lambda}$", cmap="viridis",
                     title=r"root law $w = \lambda_b \sqrt{p}$: varying $\lambda_b$",
                     extra=[("linear Winkler", *section_of(res.base["linear Winkler"]), {"color": "black", "ls": "--"})])
@@ -223,7 +225,8 @@ def _sweeps(res, work):
                         "interpolation between nodes; at alpha_a = 0 the whole contact is rigid) and contact radius "
                         "r_c = sqrt(A/pi).")
     t_b = Table(("lam_b / (lam sqrt(p_max^lambda))", "alpha_b", "p_max / p0", "r_c / a_H"),
-                tuple((f, ab, r.p_max / p0, r.contact_radius / a) for f, ab, r in res.sweep_b), caption="Root-law sweep.")
+                tuple((f, ab, r.p_max / p0, r.contact_radius / a) for f, ab, r in res.sweep_b),
+                caption="Root-law sweep.")
     t_c = Table(("alpha_c [rad]", "lam2 / lam1", "p_max / p0", "r_c / a_H"),
                 tuple((t, math.tan(t), r.p_max / p0, r.contact_radius / a) for t, r in res.sweep_c),
                 caption="Bilinear sweep (alpha_c = 0 is the elastic-rigid law, pi/4 the linear layer).")
@@ -253,8 +256,8 @@ def _augmented_gap_summary(res):
         return "The augmented gap method as printed in the paper (omega = 1) converges on every law tested."
     return (f"The augmented gap method as printed in the paper (omega = 1) does not converge for {len(failed)} of "
             f"{len(rows)} laws ({', '.join(failed)}; see the stability table): with lam = {res.lam_over_cnn:g} C_nn "
-            "the layer is much softer than the bodies on the scale of one node, and the fixed-point map h_bar = h + w(p_k) is "
-            "not a contraction.")
+            "the layer is much softer than the bodies on the scale of one node, and the fixed-point map "
+            "h_bar = h + w(p_k) is not a contraction.")
 
 
 def _stability(res):
@@ -341,6 +344,7 @@ def report_paper_problem(out_dir, *, quick=False, fem=True, fmt="png", progress=
     notify = Progress([s for s in STAGES if fem or s != SOLVE_STAGES[3]], progress)
     res = run_paper_problem(quick=quick, fem=fem, progress=notify)
     subtitle = (f"Steel paraboloids (built-in scenes paper_*), lam = {res.lam_over_cnn:g} C_nn; BEM lattice "
-                f"a_H/c = {res.nodes_per_radius}{' (quick preview)' if quick else ''}; computed in {res.wall_time_s:.0f} s.")
+                f"a_H/c = {res.nodes_per_radius}{' (quick preview)' if quick else ''}; "
+                f"computed in {res.wall_time_s:.0f} s.")
     return draw_and_build(lambda work: paper_sections(res, work), out_dir, title=TITLE, subtitle=subtitle, fmt=fmt,
                           notify=notify)

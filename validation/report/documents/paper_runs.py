@@ -204,30 +204,27 @@ def _methods(run, res, quick):
                                   "wall_time_s": r.wall_time_s, "message": r.message})
 
 
-def _repeat(solve, part):
-    """Runs of ``solve()`` for timing: ``WP_REPEATS``, or one when the first is slower than ``WP_SLOW_S``."""
+def _work_point(solve, part, p0, **row):
+    """Row of the resolution study: ``solve()`` WP_REPEATS times (once if slower than WP_SLOW_S), timed on ``part``."""
     runs = [solve()]
     if getattr(runs[0], part).wall_time_s <= WP_SLOW_S:
         runs += [solve() for _ in range(WP_REPEATS - 1)]
-    return runs
+    last, times = getattr(runs[-1], part), [getattr(o, part).wall_time_s for o in runs]
+    return {**row, "N": last.p.size if part == "bem" else last.n_dofs, "error": abs(last.p_max - p0) / p0,
+            "wall_time_s": statistics.median(times), "wall_times_s": times}
 
 
 def _validation(run, res, quick):
     n_fem = 8 if quick else 24
     for case in ("smooth", "linear Winkler", "elastic-rigid", "root"):
         res.validation[case] = run(case, analytic=True, fem={"n_contact": n_fem})
-    for m in (4, 8) if quick else (5, 10, 20, 40, 80):
-        runs = _repeat(lambda: run("smooth", bem__step=res.a / m, bem__nested=True), "bem")
-        times = [o.bem.wall_time_s for o in runs]
-        res.work_precision.append({"solver": "BEM", "method": "Kalker QP", "resolution": f"a/c = {m}",
-                                   "N": runs[-1].bem.p.size, "error": abs(runs[-1].bem.p_max - res.p0) / res.p0,
-                                   "wall_time_s": statistics.median(times), "wall_times_s": times})
-    for n in (4, 8) if quick else (8, 16, 32):  # the BEM of these runs on a coarse lattice: only the FEM is timed
-        runs = _repeat(lambda: run("smooth", bem__step=res.a / 4, fem={"n_contact": n}), "fem")
-        times = [o.fem.wall_time_s for o in runs]
-        res.work_precision.append({"solver": "FEM", "method": "P2 axisymmetric", "resolution": f"{n} el./a",
-                                   "N": runs[-1].fem.n_dofs, "error": abs(runs[-1].fem.p_max - res.p0) / res.p0,
-                                   "wall_time_s": statistics.median(times), "wall_times_s": times})
+    res.work_precision += [_work_point(lambda: run("smooth", bem__step=res.a / m, bem__nested=True), "bem", res.p0,
+                                       solver="BEM", method="Kalker QP", resolution=f"a/c = {m}")
+                           for m in ((4, 8) if quick else (5, 10, 20, 40, 80))]
+    # the BEM of these runs on a coarse lattice: only the FEM is timed
+    res.work_precision += [_work_point(lambda: run("smooth", bem__step=res.a / 4, fem={"n_contact": n}), "fem", res.p0,
+                                       solver="FEM", method="P2 axisymmetric", resolution=f"{n} el./a")
+                           for n in ((4, 8) if quick else (8, 16, 32))]
 
 
 def run_paper_problem(*, quick=False, fem=True, progress=None):

@@ -13,6 +13,7 @@ from bem.gaps import GAPS
 
 from ..render.content import Section, Table, fmt
 from ..render.style import method_text
+from .results import is_number
 
 __all__ = ["scene_section"]
 
@@ -34,6 +35,8 @@ _PAPER_ROWS = (("c_nn", "C_nn = c w_t(0,0) / (pi E*), diagonal influence coeffic
                ("alpha_a", "alpha_a = p_cr / p_max^lambda (paper parameter)", "-"),
                ("alpha_c", "alpha_c = arctan(lam2 / lam1) (paper parameter)", "rad"),
                ("alpha_b", "alpha_b = p_max / p_max^lambda", "-"))
+_MATERIALS = (("E1", "Young's modulus E1 (body 1)"), ("nu1", "Poisson's ratio nu1 (body 1)"),
+              ("E2", "Young's modulus E2 (body 2)"), ("nu2", "Poisson's ratio nu2 (body 2)"))
 
 
 def _param_unit(law, key, params, units):
@@ -62,7 +65,7 @@ def _layer_rows(res):
         if isinstance(value, list) and law == "tabulated":
             unit = u.of("pressure" if key == "p" else "length")
             rows.append((f"layer {key} (table)", f"{len(value)} points, {fmt(min(value))} to {fmt(max(value))}", unit))
-        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        elif is_number(value):
             rows.append((f"layer {key}", fmt(value), _param_unit(law, key, params, u)))
         elif isinstance(value, Mapping):
             rows.append((f"layer {key}", _LAW_TEXT.get(value.get("law"), str(value.get("law", "?"))), "-"))
@@ -72,7 +75,7 @@ def _layer_rows(res):
             continue  # an output unless the scene gave it (then the layer was fitted to it)
         if key == "lam_ref" and value == params.get("lam"):
             continue
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
+        if is_number(value):
             rows.append((text, fmt(value), u.of(kind) if kind not in ("-", "rad") else kind))
     return rows
 
@@ -92,7 +95,7 @@ def _gap_rows(res):
     for key, value in gap.items():
         if key == "type":
             continue
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
+        if is_number(value):
             rows.append((f"gap {key}", fmt(value), unit(key)))
         elif isinstance(value, str):
             rows.append((f"gap {key}", value, "-"))
@@ -104,13 +107,9 @@ def _gap_rows(res):
 
 
 def _material_rows(res):
-    bodies = res.section("bodies")
-    u = res.units
-    rows = []
-    for key, label in (("E1", "Young's modulus E1 (body 1)"), ("nu1", "Poisson's ratio nu1 (body 1)"),
-                       ("E2", "Young's modulus E2 (body 2)"), ("nu2", "Poisson's ratio nu2 (body 2)")):
-        if key in bodies:
-            rows.append((label, fmt(float(bodies[key])), "-" if key.startswith("nu") else u.of("pressure")))
+    bodies, u = res.section("bodies"), res.units
+    rows = [(label, fmt(float(bodies[key])), "-" if key.startswith("nu") else u.of("pressure"))
+            for key, label in _MATERIALS if key in bodies]
     e_star = res.bem.get("E_star", bodies.get("E_star"))
     if e_star is not None:
         rows.append(("effective modulus E* = 1 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)", fmt(float(e_star)),

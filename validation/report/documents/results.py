@@ -32,7 +32,8 @@ from bem.checks import InputError, check_choice
 
 from ...units import Units, parse_units
 
-__all__ = ["RunResults", "load_results", "results_of", "units_of", "read_json", "UNIT_CHOICES"]
+__all__ = ["RunResults", "load_results", "results_of", "units_of", "read_json", "is_number", "dimensionless_for",
+           "UNIT_CHOICES"]
 
 log = logging.getLogger(__name__)
 
@@ -40,6 +41,13 @@ _FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_fiel
 #: ``units`` choices of a report: the scene's units (``"auto"``: when they are known), or
 #: lengths and pressures divided by the contact's scales
 UNIT_CHOICES = ("auto", "scene", "dimensionless")
+
+
+def is_number(value):
+    """True for an int or a float of ``result.json`` (not a bool)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def units_of(data, label=None):
     """The :class:`validation.units.Units` of a result: its ``unit_symbols``, else its units label parsed."""
     label = data.get("units") or label
@@ -105,6 +113,11 @@ class RunResults:
         return self.get("fem")
 
     @property
+    def contact_size(self):
+        """The contact radius, else the half-width along x (``None`` when neither was recorded)."""
+        return self.data.get("contact_radius") or (self.get("contact_extent") or {}).get("x")
+
+    @property
     def axisymmetric(self):
         """Axisymmetric scenes record ``contact_radius``."""
         return self.data.get("contact_radius") is not None
@@ -135,8 +148,7 @@ class RunResults:
         p0, a = sc.get("p_hertz"), sc.get("a_hertz")
         if p0 and a and p0 > 0 and a > 0:
             return float(p0), float(a), "p_H", "a_H"
-        p0 = self.data.get("p_max")
-        a = self.data.get("contact_radius") or (self.get("contact_extent") or {}).get("x")
+        p0, a = self.data.get("p_max"), self.contact_size
         return (float(p0), float(a), "p_{max}", "a_c") if p0 and a and p0 > 0 and a > 0 else None
 
 
@@ -178,7 +190,8 @@ def _bem_field(path):
     return mesh.points[:, 0].copy(), mesh.points[:, 1].copy(), p
 
 
-def _dimensionless(units, parsed):
+def dimensionless_for(units, parsed):
+    """Whether a report with ``units`` (:data:`UNIT_CHOICES`) of a run in ``parsed`` units is dimensionless."""
     return check_choice("units", units, UNIT_CHOICES) == "dimensionless" or (units == "auto" and not parsed.known)
 
 
@@ -215,7 +228,7 @@ def load_results(directory, *, units="auto"):
         else None
     return RunResults(directory=directory, data=dict(data), scene=scene, units=parsed,
                       bem_field=_field(directory / files["bem_field"], _bem_field), fem_field=fem,
-                      dimensionless=_dimensionless(units, parsed))
+                      dimensionless=dimensionless_for(units, parsed))
 
 
 def results_of(outcome, *, units="auto", directory="."):
@@ -227,4 +240,4 @@ def results_of(outcome, *, units="auto", directory="."):
     return RunResults(directory=Path(directory), data=outcome.result, scene=outcome.scene.raw,
                       units=outcome.scene.units, bem_field=(res.x, res.y, res.p),
                       fem_field=None if outcome.fem is None else von_mises_of(outcome.fem),
-                      dimensionless=_dimensionless(units, outcome.scene.units))
+                      dimensionless=dimensionless_for(units, outcome.scene.units))

@@ -22,9 +22,10 @@ from ..figures.run import stress_view
 from ..render import Progress, Section, Table, draw_and_build, fmt
 from ..render.style import method_text
 from .problem import scene_section
+from .results import is_number
 from .sweep import sweep_section
 
-__all__ = ["SECTIONS", "STAGES", "run_sections", "report_results_dir", "results_rows", "comparison_tables"]
+__all__ = ["SECTIONS", "STAGES", "run_sections", "report_results_dir", "results_rows"]
 
 #: the stages of :func:`report_results_dir`, as reported to its ``progress``
 STAGES = ("reading", "figures", "writing")
@@ -49,14 +50,10 @@ _METRICS = {"l2_rel": "relative L2 error of p", "max_rel": "max |p - p_ref| / ma
             "n_points": "nodes compared (union of contacts)"}
 
 
-def _num(value):
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
 def _timed(times, names, prefix="wall time: "):
     """``(label, seconds, "s")`` rows of the numeric entries of ``times``."""
     times = times if isinstance(times, Mapping) else {}
-    return [(prefix + label, fmt(times[key], 3), "s") for key, label in names if _num(times.get(key))]
+    return [(prefix + label, fmt(times[key], 3), "s") for key, label in names if is_number(times.get(key))]
 
 
 def results_rows(res):
@@ -65,20 +62,20 @@ def results_rows(res):
         [("closed form", res.get("analytic"))] if res.get("analytic") else [])
 
     def cells(key, scale=1.0):
-        return [fmt(p.get(key) / scale) if _num(p.get(key)) else "-" for _, p in parts]
+        return [fmt(p.get(key) / scale) if is_number(p.get(key)) else "-" for _, p in parts]
 
     rows = [(label, *cells(key), res.units.of(kind)) for key, label, kind in _QUANTITIES
-            if any(_num(p.get(key)) for _, p in parts)]
+            if any(is_number(p.get(key)) for _, p in parts)]
     ext = res.get("contact_extent")
     if ext and not res.axisymmetric:
         ref = res.get("analytic") or {}
-        closed = {"closed form": f"{fmt(ref.get('a'))}, {fmt(ref.get('b'))}"} if _num(ref.get("a")) else {}
+        closed = {"closed form": f"{fmt(ref.get('a'))}, {fmt(ref.get('b'))}"} if is_number(ref.get("a")) else {}
         rows.append(("contact half-widths along x, y", f"{fmt(ext.get('x'))}, {fmt(ext.get('y'))}",
                      *(closed.get(name, "-") for name, _ in parts[1:]), res.units.of("length")))
     scales = res.get("scales") or {}
     rows += [(label, *cells(key, scales[skey]), "-") for key, label, skey in _RATIOS
-             if _num(scales.get(skey)) and scales[skey] > 0]
-    if _num(res.data.get("alpha_b")):
+             if is_number(scales.get(skey)) and scales[skey] > 0]
+    if is_number(res.data.get("alpha_b")):
         rows.append(("alpha_b = p_max / p_max^lambda", fmt(res.data["alpha_b"]), *("-" for _ in parts[1:]), "-"))
     return ("quantity", *(name for name, _ in parts), "unit"), tuple(rows)
 
@@ -110,11 +107,11 @@ def timings(res, work):
             ("solver message", str(d.get("message", "-")), "-"),
             ("iterations (finest lattice)", fmt(d.get("iterations")), "-"),
             ("KKT residual", fmt(d.get("kkt_residual")), "-")]
-    if _num(b.get("step")):
+    if is_number(b.get("step")):
         rows.append(("lattice step c", fmt(b["step"]), u.of("length")))
     if isinstance(b.get("extent"), list) and len(b["extent"]) == 2:
         rows.append(("candidate region |x| <= X, |y| <= Y (X, Y)", ", ".join(map(fmt, b["extent"])), u.of("length")))
-    rows += [(label, fmt(b[key], 3), "-") for key, label in _BEM_COUNTS if _num(b.get(key))]
+    rows += [(label, fmt(b[key], 3), "-") for key, label in _BEM_COUNTS if is_number(b.get(key))]
     rows += _timed(res.get("wall_time_s"), _TIMES)
     return Section("Solver and timings", kind="results", items=(
         Table(("quantity", "value", "unit"), tuple(rows), caption="How the BEM solution was computed."),))
@@ -133,12 +130,10 @@ def fem_field(res, work):
             ("degrees of freedom", fmt(fem.get("n_dofs")), "-"),
             ("elements", fmt(fem.get("n_elements")), "-"),
             ("elements across the contact radius", fmt(fem.get("n_elements_across_contact"), 3), "-")]
-    if _num(mesh.get("h_fine")):
-        rows.append(("element size at the contact", fmt(mesh["h_fine"]), u.of("length")))
-    if _num(mesh.get("extent_factor")):
-        rows.append(("mesh half-size / estimated contact radius", fmt(mesh["extent_factor"]), "-"))
-    if _num(penalty.get("relative_penetration")):
-        rows.append(("penalty: largest penetration / approach", fmt(penalty["relative_penetration"]), "-"))
+    optional = ((mesh, "h_fine", "element size at the contact", u.of("length")),
+                (mesh, "extent_factor", "mesh half-size / estimated contact radius", "-"),
+                (penalty, "relative_penetration", "penalty: largest penetration / approach", "-"))
+    rows += [(label, fmt(part[key]), unit) for part, key, label, unit in optional if is_number(part.get(key))]
     if "applied" in trunc:
         rows.append(("far-field (truncation) correction applied", fmt(bool(trunc["applied"])), "-"))
     rows += _timed(fem.get("timings"), _FEM_TIMES)
@@ -182,21 +177,22 @@ def stress(res, work):
     text = ("The contact pressure matters for the strength of the parts through the stresses it causes below the "
             "surface: yielding starts where the von Mises stress (or the maximum shear) is largest, below the "
             "surface for a smooth contact.")
-    if _num(block.get("wall_time_s")):
+    if is_number(block.get("wall_time_s")):
         text += f" Computed in {fmt(float(block['wall_time_s']), 3)} s."
     return Section("Subsurface stresses", kind="results", text=(text,), items=tuple(items))
 
 
 def _metric_cell(key, value):
-    if not _num(value):
+    if not is_number(value):
         return "-" if value is None else str(value)
     return str(value) if key == "n_points" or isinstance(value, int) else f"{100.0 * value:.3g} %"
 
 
-def comparison_tables(comparison, units):
-    """Tables of ``result["comparison"]``: one column per compared pair (per cent), then the force balance."""
+def comparison(res, work):
+    """The comparison metrics the run recorded: one column per compared pair (per cent), then the force balance."""
     names = {"bem": "BEM", "fem": "FEM", "analytic": "closed form"}
-    pairs = {k: v for k, v in comparison.items() if isinstance(v, Mapping) and k != "force_balance"}
+    metrics = res.get("comparison") or {}
+    pairs = {k: v for k, v in metrics.items() if isinstance(v, Mapping) and k != "force_balance"}
     tables = []
     if pairs:
         keys = dict.fromkeys(k for v in pairs.values() for k, x in v.items() if not isinstance(x, (Mapping, list)))
@@ -205,19 +201,13 @@ def comparison_tables(comparison, units):
             tuple((_METRICS.get(k, k), *(_metric_cell(k, v.get(k)) for v in pairs.values())) for k in keys),
             caption="Comparison metrics of the run (candidate vs reference at the candidate's nodes; signed "
                     "differences are (candidate - reference) / reference)."))
-    balance = comparison.get("force_balance") if isinstance(comparison.get("force_balance"), Mapping) else {}
-    rows = [("target force P", fmt(v), units.of("force")) if k == "target" else
+    balance = metrics.get("force_balance") if isinstance(metrics.get("force_balance"), Mapping) else {}
+    rows = [("target force P", fmt(v), res.units.of("force")) if k == "target" else
             (f"force balance |F - P| / P ({k.upper()})", _metric_cell(k, v), "-")
-            for k, v in balance.items() if _num(v)]
-    rows += [(k, _metric_cell(k, v), "-") for k, v in comparison.items() if _num(v)]
+            for k, v in balance.items() if is_number(v)]
+    rows += [(k, _metric_cell(k, v), "-") for k, v in metrics.items() if is_number(v)]
     if rows:
         tables.append(Table(("quantity", "value", "unit"), tuple(rows), caption="Force balance of the solvers."))
-    return tables
-
-
-def comparison(res, work):
-    """The comparison metrics the run recorded (BEM against the FEM and the closed form)."""
-    tables = comparison_tables(res.get("comparison") or {}, res.units)
     return Section("Comparison metrics", kind="validation", items=tuple(tables)) if tables else None
 
 

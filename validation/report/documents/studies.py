@@ -56,26 +56,20 @@ def _error_time_sections(data, work):
                                       "are timed once); one line per solver and method, a marker per "
                                       "resolution (nodes across the contact for the BEM, elements across the "
                                       "contact radius for the FEM); dotted lines at 1 % and 0.1 %."))
-        columns = ("solver", "method", "resolution", "N", "L2 error", "peak error", "time [s]", "iterations",
-                   "status")
-        table_rows = [(r["solver"], _label(r), r["resolution"], r["n"], r["error_l2"], r["error_peak"],
-                       r["wall_time_s"], r["iterations"], "converged" if r["converged"] else "failed")
-                      for r in mine]
-        items.append(Table(columns, tuple(table_rows), caption=f"Every run of the {problem} ladder.",
-                           status_column="status"))
+        items.append(Table(
+            ("solver", "method", "resolution", "N", "L2 error", "peak error", "time [s]", "iterations", "status"),
+            tuple((r["solver"], _label(r), r["resolution"], r["n"], r["error_l2"], r["error_peak"], r["wall_time_s"],
+                   r["iterations"], "converged" if r["converged"] else "failed") for r in mine),
+            caption=f"Every run of the {problem} ladder.", status_column="status"))
         text = [f"Reference: {ref_text}."] if ref_text else []
         sections.append(Section(f"Error against run time: {problem}", "validation", text, items))
     first = data.get("first_to_reach", {})
     if first:
-        flat = []
-        for problem, metrics in first.items():
-            for metric, targets in metrics.items():
-                for target, hit in targets.items():
-                    hit = hit or {}
-                    flat.append({"problem": problem, "error": metric.replace("error_", ""),
-                                 "target": f"{float(target):.1%}", "first": " ".join(
-                                     str(hit[k]) for k in ("solver", "method") if hit.get(k)) or "none reached it",
-                                 "resolution": hit.get("resolution", "-"), "time [s]": hit.get("wall_time_s")})
+        flat = [{"problem": problem, "error": metric.replace("error_", ""), "target": f"{float(target):.1%}",
+                 "first": " ".join(str(hit[k]) for k in ("solver", "method") if hit.get(k)) or "none reached it",
+                 "resolution": hit.get("resolution", "-"), "time [s]": hit.get("wall_time_s")}
+                for problem, metrics in first.items() for metric, targets in metrics.items()
+                for target, found in targets.items() for hit in [found or {}]]
         table = table_from_rows(flat, caption="The fastest converged run that reaches each target and stays "
                                               "below it at every finer level of the same method.", status="")
         notes = [str(n) for n in data.get("notes", [])]
@@ -83,7 +77,7 @@ def _error_time_sections(data, work):
     return sections
 
 
-def _stability_sections(data):
+def _stability_sections(data, work=None):
     rows = data.get("rows", [])
     columns = [c for c in ("case", "solver", "method", "status", "kkt_residual", "error_vs_reference", "reference",
                            "iterations", "wall_time_s", "message") if any(c in r for r in rows)]
@@ -106,7 +100,7 @@ def _stability_sections(data):
     return [Section("Stability", "stability", text, (summary, detail))]
 
 
-def _robustness_sections(data):
+def _robustness_sections(data, work=None):
     from validation.studies import robustness as rb
 
     rows = rb.rows_from_json(data)
@@ -119,8 +113,8 @@ def _robustness_sections(data):
     return [Section("Robustness of the layer methods", "stability", [rb.SETTING], tuple(tables))]
 
 
-_SECTIONS = dict(zip(STUDY_FILES, (_error_time_sections, lambda d, work: _stability_sections(d),
-                                   lambda d, work: _robustness_sections(d))))
+#: study file -> function(data, work) -> sections (``work``: the figures' folder, None for none)
+_SECTIONS = dict(zip(STUDY_FILES, (_error_time_sections, _stability_sections, _robustness_sections)))
 
 
 def study_sections(directory, work):

@@ -23,13 +23,10 @@ from ..figures.run import PAD, axis_label, contact_edge, scale
 from ..render import Figure, Progress, Section, Table, draw_and_build, fmt
 from ..render.style import report_unit
 from .problem import scene_section
-from .results import UNIT_CHOICES, RunResults, read_json, units_of
+from .results import UNIT_CHOICES, RunResults, dimensionless_for, is_number, read_json, units_of
 
-__all__ = ["Sweep", "is_sweep_dir", "load_sweep", "sweep_section", "sweep_sections", "report_sweep_dir",
-           "SWEEP_FILES"]
+__all__ = ["Sweep", "is_sweep_dir", "load_sweep", "sweep_section", "sweep_sections", "report_sweep_dir"]
 
-#: what marks a sweep directory
-SWEEP_FILES = ("summary.json", "points")
 #: unit kind of the swept scene keys (their last part); the others are dimensionless
 _KEY_KINDS = {"force": "force", "approach": "length", "R": "length", "Rx": "length", "Ry": "length",
               "length": "length", "a": "length", "edge_radius": "length", "crown_radius": "length",
@@ -53,7 +50,10 @@ def is_sweep_dir(directory):
 
 
 def load_sweep(directory, *, units="auto"):
-    """The :class:`Sweep` of a sweep directory; ``units`` as for :func:`validation.report.documents.results.load_results`."""
+    """The :class:`Sweep` of a sweep directory.
+
+    ``units``: as for :func:`validation.report.documents.results.load_results`.
+    """
     directory = Path(directory)
     if not is_sweep_dir(directory):
         raise InputError(f"directory = {str(directory)!r} is not allowed: it must be a sweep directory "
@@ -70,7 +70,7 @@ def load_sweep(directory, *, units="auto"):
             data = dict(point.get("result") or {})
             u = units_of(data, summary.get("units"))
             res = RunResults(directory=directory, data=data, scene=dict(point.get("scene") or {}), units=u,
-                             dimensionless=units == "dimensionless" or (units == "auto" and not u.known))
+                             dimensionless=dimensionless_for(units, u))
         points.append((row, res))
     return Sweep(summary, points)
 
@@ -84,7 +84,7 @@ def _table(summary, points):
     for row, res in points:
         radius = row.get("contact_radius")
         if radius is None and res is not None:
-            radius = (res.get("contact_extent") or {}).get("x")
+            radius = res.contact_size
         rows.append((fmt(row.get("value")), row.get("status", "?"), row.get("p_max"), radius, row.get("approach"),
                      row.get("iterations"), row.get("kkt_residual"), row.get("wall_time_bem")))
     return Table(columns, tuple(rows), status_column="status",
@@ -106,22 +106,21 @@ def _figures(summary, points, work):
     if not done:
         return []
     values = [row["value"] for row, _ in done]
-    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+    numeric = all(is_number(v) for v in values)
     alpha = [float(v) for v in values] if numeric else list(range(len(values)))
     ticks = None if numeric else [str(v) for v in values]
     key, first = str(summary.get("key", "value")), done[0][1]
-    (xf, *_), (pf, *_) = scale(first, "length"), scale(first, "pressure")
-    curves = []
-    for a_i, (_, res) in zip(alpha, done):  # each point divided by its own scales, drawn with the first's
-        prof = res.get("profile")
-        curves.append((a_i, np.asarray(prof["x"], float) * xf / scale(res, "length")[0],
-                       np.asarray(prof["p"], float) * pf / scale(res, "pressure")[0]))
+    x_scale, p_scale = scale(first, "length"), scale(first, "pressure")
+    xf, pf = x_scale[0], p_scale[0]
+    # each point divided by its own scales, drawn with the first's
+    curves = [(a_i, np.asarray(res.get("profile")["x"], float) * xf / scale(res, "length")[0],
+               np.asarray(res.get("profile")["p"], float) * pf / scale(res, "pressure")[0])
+              for a_i, (_, res) in zip(alpha, done)]
     u = first.units
     name = _key_label(key, u)
     edge = contact_edge([(x / xf, p) for _, x, p in curves])
     path = plot_sweep(curves, work / "sweep_profiles.png", p0=pf, a=xf, name=name, ticklabels=ticks,
-                      labels={"x": axis_label("x", scale(first, "length")),
-                              "p": axis_label("p", scale(first, "pressure"), "contact pressure ")},
+                      labels={"x": axis_label("x", x_scale), "p": axis_label("p", p_scale, "contact pressure ")},
                       cmap="viridis", xlim=(-PAD * edge, PAD * edge),
                       title=f"contact pressure on the axial section as {key} varies")
     (lu, lf), (pu, pfac) = report_unit(u.length), report_unit(u.pressure)
@@ -129,11 +128,8 @@ def _figures(summary, points, work):
     def series(get, factor):
         return np.array([get(res) / factor if get(res) is not None else math.nan for _, res in done])
 
-    def radius(r):
-        return r.data.get("contact_radius") or (r.get("contact_extent") or {}).get("x")
-
     scalars = [(f"$p_{{max}}$ [{pu}]" if pu else "$p_{max}$", series(lambda r: r.data.get("p_max"), pfac)),
-               (f"contact size [{lu}]" if lu else "contact size", series(radius, lf)),
+               (f"contact size [{lu}]" if lu else "contact size", series(lambda r: r.contact_size, lf)),
                (f"approach [{lu}]" if lu else "approach", series(lambda r: r.data.get("approach"), lf))]
     path2 = plot_sweep_scalars(alpha, scalars, work / "sweep_scalars.png", name=name, ticklabels=ticks,
                                title=f"results against {key}")
