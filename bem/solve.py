@@ -314,7 +314,8 @@ def _check_layer(layer, method):
 def _gap_values(gap, lattice):
     h = np.asarray(gap(lattice.x, lattice.y), dtype=float)
     if h.shape != lattice.shape:
-        raise InputError(f"gap returned shape {h.shape} which is not allowed: it must return the shape of x ({lattice.shape}).")
+        raise InputError(f"gap returned shape {h.shape} which is not allowed: it must return the shape of x "
+                         f"({lattice.shape}).")
     bad = lattice.mask & ~np.isfinite(h)
     if bad.any():
         r, q = np.argwhere(bad)[0]

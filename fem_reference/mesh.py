@@ -272,7 +272,8 @@ def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, grow
     fine_radius = check_positive("fine_radius", fine_radius)
     growth = check_positive("growth", growth)
     if extent_factor < 4.0 * fine_radius:
-        raise InputError(f"extent_factor = {extent_factor!r} is not allowed: it must be >= 4 * fine_radius = {4 * fine_radius!r}.")
+        raise InputError(f"extent_factor = {extent_factor!r} is not allowed: it must be >= 4 * fine_radius = "
+                         f"{4 * fine_radius!r}.")
     R = H = extent_factor * a_est
     h_fine = a_est / int(n_contact)
     h_coarse = R / 8.0 if h_coarse is None else check_positive("h_coarse", h_coarse)
