@@ -55,9 +55,13 @@ def _notify(progress, stage, status, **info):
 def planned_stages(scene, *, write=False):
     """Stage names :func:`run_scene` will report for ``scene`` (for progress bars)."""
     spec = scene.layer_spec
-    wanted = {"layer": spec is not None and ("alpha_a" in spec or (spec["law"] == "root" and "lam_over_cnn" in spec)),
-              "bem": True, "fem": scene.fem is not None, "compare": scene.fem is not None or scene.analytic is not None,
-              "stress": scene.stress is not None, "write": write}
+    calibrated = spec is not None and ("alpha_a" in spec or (spec["law"] == "root" and "lam_over_cnn" in spec))
+    wanted = {"layer": calibrated,
+              "bem": True,
+              "fem": scene.fem is not None,
+              "compare": scene.fem is not None or scene.analytic is not None,
+              "stress": scene.stress is not None,
+              "write": write}
     return [stage for stage, on in wanted.items() if on]
 
 
