@@ -29,7 +29,7 @@ from ..run import execute_scene
 from . import fmt, save, timed, write_json
 from .problems import ERROR_TIME_PROBLEMS, get_problem, methods
 
-__all__ = ["ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "LADDERS", "TARGETS"]
+__all__ = ["method_label", "ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "LADDERS", "TARGETS"]
 
 #: resolution ladders: BEM steps across the contact diameter, FEM elements across the radius
 LADDERS = {"full": {"bem": (10, 20, 40, 80, 160), "fem": (4, 8, 16, 32)},
@@ -37,6 +37,11 @@ LADDERS = {"full": {"bem": (10, 20, 40, 80, 160), "fem": (4, 8, 16, 32)},
 #: error targets of the "first to reach" summary
 TARGETS = (1e-2, 1e-3)
 _METRICS = ("error_l2", "error_peak")
+
+
+def method_label(method, relaxation=None):
+    """The method with its relaxation when one was set, e.g. ``augmented_gap (omega=1)``."""
+    return method if relaxation is None else f"{method} (omega={relaxation:g})"
 
 
 @dataclass
@@ -68,8 +73,8 @@ class ErrorTimeRow:
 
     @property
     def label(self):
-        """Method name with its relaxation, e.g. ``augmented_gap (omega=0.5)``."""
-        return self.method if self.relaxation is None else f"{self.method} (omega={self.relaxation:g})"
+        """Method name with its relaxation (:func:`method_label`)."""
+        return method_label(self.method, self.relaxation)
 
 
 @dataclass

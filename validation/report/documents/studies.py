@@ -27,8 +27,9 @@ def is_study_dir(directory):
 
 
 def _label(row):
-    """The method with its relaxation when one was set, e.g. ``augmented_gap (omega=1)``."""
-    return row["method"] if row.get("relaxation") is None else f"{row['method']} (omega={row['relaxation']:g})"
+    from validation.studies.error_time import method_label
+
+    return method_label(row["method"], row.get("relaxation"))
 
 
 def _error_time_sections(data, work):
