@@ -1,0 +1,399 @@
+"""Rough surfaces: measured topographies read from instrument files, seeded self-affine surfaces.
+
+Needs the optional package SurfaceTopography (``pip install "contactlab[rough]"``), imported
+inside the functions; without it they raise :class:`bem.InputError` naming ``contactlab[rough]``.
+It reads the instrument formats (:func:`formats`: x3p, sur, opd, datx, gwy, nc, npy, text
+matrices, x-y-z lists, ...), detrends, computes the statistics and synthesises self-affine
+surfaces. The core readers of :mod:`bem.gaps.measured` do not need it.
+
+A :class:`RoughSurface` holds ``z[i, j]`` at ``(x, y) = (i Lx/nx, j Ly/ny)`` (x first, the
+order of SurfaceTopography and of :func:`bem.gaps.measured.read_heights`), heights measured
+outwards from the body (towards the other one; summits positive), in the length unit of the
+solve after ``scale``.
+
+**The periodic cell of a measured patch.** A patch is not periodic. Its cell is the detrended
+patch (``detrend``: the plane of least rms height by default, SurfaceTopography's
+``"height"``) repeated with the period ``(Lx, Ly) = (nx dx, ny dy)``: the last column of
+nodes is followed by the first. The repetition puts a seam at the cell's edges, measured by
+
+    edge_jump = sqrt( (sum_j (z[0, j] - z[-1, j])^2 + sum_i (z[i, 0] - z[i, -1])^2) / (nx + ny) ),
+
+the rms height difference between opposite edges (on a periodic surface only the step of
+one grid spacing). When ``edge_jump > EDGE_JUMP_LIMIT * rms_height`` (:data:`EDGE_JUMP_LIMIT`
+= 0.5: uncorrelated opposite edges give about ``sqrt(2) rms_height``) a warning is logged and
+:attr:`SurfaceStats.edge_jump_large` is set: the cell's edges are a step the surface does not
+have. The statistics are those of the patch as measured (SurfaceTopography's non-periodic
+estimates), not of the cell with its seam.
+
+**Two rough surfaces.** The contact of two rough surfaces is that of their sum,
+:func:`combined`, against a flat: ``z = z1 + z2``, each measured outwards, both in the common
+``(x, y)`` frame (a map of body 2 taken face up is mirrored, one axis reversed, before adding).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ..checks import InputError, check_choice, check_finite_array, check_int, check_positive, check_range, fail
+from .lattice_heights import to_lattice
+
+__all__ = ["RoughSurface", "SurfaceStats", "read_surface", "self_affine", "from_heights", "combined", "formats",
+           "DETRENDS", "EDGE_JUMP_LIMIT", "MIN_POINTS"]
+
+log = logging.getLogger(__name__)
+
+#: the ``detrend`` modes (SurfaceTopography's): mean, plane of least rms height, plane of least
+#: rms slope, second-order polynomial of least rms height
+DETRENDS = ("center", "height", "slope", "curvature")
+#: ``edge_jump / rms_height`` above which the periodic cell of a patch is flagged (module docstring)
+EDGE_JUMP_LIMIT = 0.5
+#: fewest grid points per axis of a surface
+MIN_POINTS = 8
+
+
+def _surface_topography():
+    """The SurfaceTopography package, or the error naming the extra."""
+    try:
+        import SurfaceTopography
+    except ImportError:
+        raise InputError('rough surfaces need the optional package SurfaceTopography (not installed): install '
+                         'contactlab[rough] (pip install "contactlab[rough]").') from None
+    return SurfaceTopography
+
+
+def formats():
+    """The format names SurfaceTopography reads (the ``format`` of :func:`read_surface`)."""
+    _surface_topography()
+    from SurfaceTopography.IO import lookup_reader_by_format
+
+    return tuple(sorted(lookup_reader_by_format))
+
+
+@dataclass(frozen=True)
+class SurfaceStats:
+    """Statistics of a rough surface, for reports (:meth:`as_dict`).
+
+    Attributes
+    ----------
+    rms_height : float
+        ``Sq``, rms of ``z - mean z`` [length].
+    rms_slope : float
+        rms of ``|grad z|`` from finite differences (SurfaceTopography ``rms_gradient``) [-].
+    rms_curvature : float
+        rms of the mean curvature ``laplacian(z)/2`` (SurfaceTopography
+        ``rms_curvature_from_area``) [1/length].
+    size : (float, float)
+        ``(Lx, Ly)`` of the cell [length].
+    grid : (int, int)
+        ``(nx, ny)`` points.
+    edge_jump : float
+        rms height difference between opposite edges of the cell [length] (module docstring).
+    edge_jump_large : bool
+        ``edge_jump > EDGE_JUMP_LIMIT * rms_height``: the periodic cell has a seam.
+    periodic : bool
+        The data is one period of a periodic surface (synthetic), not a patch.
+    source : str
+        The file, or how the surface was made.
+    unit : str or None
+        The length unit the file states (before ``scale``), if any.
+    detrend : str or None
+        The ``detrend`` mode applied (:data:`DETRENDS`), ``None`` for none.
+    """
+
+    rms_height: float
+    rms_slope: float
+    rms_curvature: float
+    size: tuple
+    grid: tuple
+    edge_jump: float
+    edge_jump_large: bool
+    periodic: bool
+    source: str
+    unit: str | None = None
+    detrend: str | None = None
+
+    def as_dict(self):
+        """The fields as plain JSON values (tuples as lists)."""
+        return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}
+
+
+@dataclass(frozen=True)
+class RoughSurface:
+    """A rough surface on one periodic cell: heights, cell size and statistics.
+
+    Attributes
+    ----------
+    heights : ndarray
+        ``z[i, j]`` at ``(i Lx/nx, j Ly/ny)`` [length], shape ``(nx, ny)``, read-only.
+    size : (float, float)
+        The cell ``(Lx, Ly)`` [length].
+    stats : SurfaceStats
+        Its statistics.
+    """
+
+    heights: np.ndarray
+    size: tuple
+    stats: SurfaceStats
+
+    def topography(self):
+        """The heights as a SurfaceTopography ``Topography`` (for its other analyses)."""
+        st = _surface_topography()
+        return st.Topography(np.array(self.heights), self.size, periodic=self.stats.periodic)
+
+    def power_spectrum(self):
+        """Radially averaged PSD ``(q [1/length], C(q) [length^4])``, SurfaceTopography's
+        ``power_spectrum_from_area`` (bins without data dropped)."""
+        q, c = self.topography().power_spectrum_from_area()
+        ok = ~(np.ma.getmaskarray(q) | np.ma.getmaskarray(c)) & np.isfinite(np.ma.filled(c, np.nan))
+        return np.ma.getdata(q)[ok], np.ma.getdata(c)[ok]
+
+    def to_lattice(self, n_cols):
+        """The heights on the periodic triangular lattice, :func:`bem.rough.to_lattice`."""
+        return to_lattice(self.heights, self.size, n_cols)
+
+
+def _pair(name, value):
+    if not isinstance(value, (list, tuple, np.ndarray)) or len(value) != 2:
+        fail(name, value, "a pair (Lx, Ly) of lengths")
+    return check_positive(f"{name}[0]", value[0]), check_positive(f"{name}[1]", value[1])
+
+
+def _edge_jump(z):
+    jumps = np.concatenate([z[0, :] - z[-1, :], z[:, 0] - z[:, -1]])
+    return float(np.sqrt(np.mean(jumps**2)))
+
+
+def _surface(z, size, *, periodic, source, unit=None, detrend=None):
+    """A :class:`RoughSurface` of the finite grid ``z`` (owned), statistics by SurfaceTopography."""
+    st = _surface_topography()
+    topo = st.Topography(z, size, periodic=periodic)
+    rms_height = float(topo.rms_height_from_area())
+    jump = _edge_jump(z)
+    large = jump > EDGE_JUMP_LIMIT * rms_height
+    if large:
+        log.warning("%s: the periodic cell of this patch has an edge jump of %.4g, %.2f times its rms height %.4g "
+                    "(> %g): its repetition has a step at the cell's edges", source, jump, jump / rms_height,
+                    rms_height, EDGE_JUMP_LIMIT)
+    stats = SurfaceStats(rms_height, float(topo.rms_gradient()), float(topo.rms_curvature_from_area()),
+                         (float(size[0]), float(size[1])), tuple(int(n) for n in z.shape), jump, bool(large),
+                         bool(periodic), source, unit, detrend)
+    z.flags.writeable = False
+    return RoughSurface(z, stats.size, stats)
+
+
+def _grid_shape(name, shape):
+    if len(shape) != 2 or min(shape) < MIN_POINTS:
+        fail(name, tuple(int(n) for n in shape), f"a 2-D grid of at least {MIN_POINTS} x {MIN_POINTS} points")
+
+
+def from_heights(heights, size, *, periodic=False, detrend=None, source="heights"):
+    """A :class:`RoughSurface` from a height grid (e.g. read by :func:`bem.gaps.measured.read_heights`).
+
+    Parameters
+    ----------
+    heights : array_like
+        ``z[i, j]`` at ``(i Lx/nx, j Ly/ny)`` [length], finite, at least ``8 x 8``. Not modified.
+    size : (float, float)
+        ``(Lx, Ly) = (nx dx, ny dy)`` [length], the cell (module docstring).
+    periodic : bool
+        The grid is one period of a periodic surface (no detrending then beyond ``"center"``).
+    detrend : str or None
+        One of :data:`DETRENDS` (``"height"`` forms a measured patch's cell as :func:`read_surface`
+        does), or ``None`` to keep the heights.
+    source : str
+        What the statistics call the surface.
+    """
+    z = check_finite_array("heights", heights, ndim=2)
+    _grid_shape("heights.shape", z.shape)
+    size = _pair("size", size)
+    if detrend is not None:
+        check_choice("detrend", detrend, DETRENDS)
+    if periodic and detrend not in (None, "center"):
+        fail("detrend", detrend, "None or 'center' for a periodic surface (a plane would break its periodicity)")
+    z = np.array(z, dtype=float)
+    if detrend is not None:
+        st = _surface_topography()
+        z = np.array(st.Topography(z, size, periodic=periodic).detrend(detrend).heights(), dtype=float)
+    return _surface(z, size, periodic=bool(periodic), source=str(source), detrend=detrend)
+
+
+def read_surface(file, *, format=None, physical_sizes=None, channel=None, scale=1.0, detrend="height"):
+    """Read a measured topography with SurfaceTopography into a :class:`RoughSurface`.
+
+    Parameters
+    ----------
+    file : str or os.PathLike
+        The instrument file.
+    format : str, optional
+        One of :func:`formats`; default: detected from the file's contents.
+    physical_sizes : (float, float), optional
+        ``(Lx, Ly)`` [file length unit] when the file does not state its size (npy, plain
+        text matrices); refused when it does.
+    channel : int, optional
+        Index of the data channel (default: the file's default channel).
+    scale : float
+        [solve length per file length unit], ``> 0``: multiplies every length (sizes and heights).
+    detrend : str or None
+        One of :data:`DETRENDS` (default ``"height"``: the plane of least rms height), or
+        ``None`` to keep the heights as measured.
+
+    Returns
+    -------
+    RoughSurface
+        The detrended patch as a periodic cell, its statistics and edge jump (module
+        docstring; a large jump is logged as a warning).
+
+    Raises
+    ------
+    bem.InputError
+        No such file, a format SurfaceTopography cannot read, a line scan, points not on an
+        evenly spaced grid, missing data (NaN holes), fewer than 8 x 8 points, a missing or
+        superfluous ``physical_sizes``, a bad argument; the message starts with its name and
+        quotes nothing from the file. SurfaceTopography missing: the message names
+        ``contactlab[rough]``.
+    """
+    st = _surface_topography()
+    if not isinstance(file, (str, os.PathLike)):
+        fail("file", file, "a file name (str or os.PathLike)")
+    path = os.fspath(file)
+    if format is not None:
+        check_choice("format", format, formats())
+    if physical_sizes is not None:
+        physical_sizes = _pair("physical_sizes", physical_sizes)
+    if channel is not None:
+        channel = check_int("channel", channel, minimum=0)
+    scale = check_positive("scale", scale)
+    if detrend is not None:
+        check_choice("detrend", detrend, DETRENDS)
+    if not os.path.isfile(path):
+        fail("file", path, "an existing file" + ("" if os.path.isabs(path) else f" (relative to {os.getcwd()})"))
+
+    def refuse(rule):
+        raise InputError(f"file = {path!r} is not allowed: {rule}.")
+
+    try:  # the readers raise many kinds of errors, whose messages may quote the file: name the kind only
+        reader = st.open_topography(path, format=format)
+    except Exception as exc:
+        refuse(f"SurfaceTopography cannot read it as {format or 'any format it knows'} ({type(exc).__name__}); "
+               "give format (bem.rough.formats()) or convert the file")
+    channels = reader.channels
+    if channel is not None and channel >= len(channels):
+        fail("channel", channel, f"< {len(channels)}, the number of data channels of the file")
+    info = reader.default_channel if channel is None else channels[channel]
+    if info.dim != 2:
+        refuse(f"it holds a {info.dim}-D line scan; a 2-D height map is needed")
+    if not info.is_uniform:
+        refuse("its points are not on an evenly spaced grid (non-uniform); resample them onto a regular grid")
+    if min(info.nb_grid_pts) < MIN_POINTS:
+        refuse(f"it holds {info.nb_grid_pts[0]} x {info.nb_grid_pts[1]} points; at least {MIN_POINTS} x "
+               f"{MIN_POINTS} are needed (too small)")
+    if info.physical_sizes is None and physical_sizes is None:
+        raise InputError(f"physical_sizes is missing: file = {path!r} does not state its size; give (Lx, Ly) in "
+                         "the file's length unit.")
+    if info.physical_sizes is not None and physical_sizes is not None:
+        fail("physical_sizes", physical_sizes, f"left out: file = {path!r} states its size "
+                                               f"{tuple(float(s) for s in info.physical_sizes)}")
+    kwargs = {} if physical_sizes is None else {"physical_sizes": physical_sizes}
+    try:
+        topo = reader.topography(channel_index=info.index, **kwargs)
+    except Exception as exc:
+        refuse(f"SurfaceTopography cannot read its data ({type(exc).__name__})")
+    if topo.has_undefined_data:
+        missing = int(np.ma.getmaskarray(topo.heights()).sum())
+        refuse(f"it has {missing} points without data (NaN holes or missing data); fill or crop them first "
+               "(SurfaceTopography: interpolate_undefined_data)")
+    z = np.ma.getdata(topo.heights())
+    if not np.isfinite(z).all():
+        refuse(f"it has {int((~np.isfinite(z)).sum())} heights that are not finite (NaN or inf)")
+    size = tuple(float(s) * scale for s in topo.physical_sizes)
+    if detrend is not None:
+        z = np.ma.getdata(topo.detrend(detrend).heights())
+    return _surface(np.array(z, dtype=float) * scale, size, periodic=bool(topo.is_periodic), source=path,
+                    unit=topo.unit, detrend=detrend)
+
+
+def self_affine(grid, size, *, hurst, rms_height=None, rms_slope=None, long_cutoff=None, short_cutoff=None,
+                rolloff=1.0, seed):
+    """A seeded, periodic, self-affine surface (SurfaceTopography's ``fourier_synthesis``).
+
+    Its PSD is ``C(q) = C0 q^(-2-2H)`` between the roll-off wave number ``2 pi/long_cutoff``
+    (below it ``rolloff^2 C(q_L)``) and the cut-off ``2 pi/short_cutoff`` (above it zero),
+    with random phases and normal amplitudes from ``seed``. The realisation is scaled so that
+    its :class:`SurfaceStats` ``rms_height`` (or ``rms_slope``) is exactly the one asked for.
+
+    Parameters
+    ----------
+    grid : (int, int)
+        ``(nx, ny)`` points, each ``>= 8``.
+    size : (float, float)
+        The period ``(Lx, Ly)`` [length].
+    hurst : float
+        Hurst exponent ``H``, ``0 < H <= 1``.
+    rms_height, rms_slope : float
+        Exactly one: rms height [length] or rms slope [-], ``> 0``.
+    long_cutoff : float, optional
+        Roll-off wavelength ``lambda_L`` [length], ``> short_cutoff``; default: none (power law
+        down to the longest wavelength of the cell).
+    short_cutoff : float, optional
+        Short cut-off wavelength ``lambda_s`` [length]; default: twice the grid spacing.
+    rolloff : float
+        PSD amplitude below ``q_L`` relative to ``C(q_L)``, ``0 <= rolloff <= 1``.
+    seed : int
+        Seed of the random numbers, ``>= 0``: the same seed gives the same surface.
+    """
+    _surface_topography()
+    from SurfaceTopography.Generation import fourier_synthesis
+
+    if not isinstance(grid, (list, tuple, np.ndarray)) or len(grid) != 2:
+        fail("grid", grid, "a pair (nx, ny) of integers")
+    grid = (check_int("grid[0]", grid[0], minimum=MIN_POINTS), check_int("grid[1]", grid[1], minimum=MIN_POINTS))
+    size = _pair("size", size)
+    hurst = check_range("hurst", hurst, 0.0, 1.0, low_open=True)
+    if (rms_height is None) == (rms_slope is None):
+        fail("(rms_height, rms_slope)", (rms_height, rms_slope), "exactly one given")
+    target = check_positive("rms_height" if rms_slope is None else "rms_slope",
+                            rms_height if rms_slope is None else rms_slope)
+    if short_cutoff is not None:
+        short_cutoff = check_positive("short_cutoff", short_cutoff)
+    if long_cutoff is not None:
+        long_cutoff = check_positive("long_cutoff", long_cutoff)
+        if short_cutoff is not None and long_cutoff <= short_cutoff:
+            fail("long_cutoff", long_cutoff, f"> short_cutoff = {short_cutoff!r}")
+    rolloff = check_range("rolloff", rolloff, 0.0, 1.0)
+    seed = check_int("seed", seed, minimum=0)
+    topo = fourier_synthesis(grid, size, hurst=hurst, rms_height=1.0, short_cutoff=short_cutoff,
+                             long_cutoff=long_cutoff, rolloff=rolloff, rng=seed)
+    got = float(topo.rms_height_from_area() if rms_slope is None else topo.rms_gradient())
+    z = np.array(topo.heights(), dtype=float) * (target / got)
+    source = f"self-affine H = {hurst:g}, seed = {seed}"
+    return _surface(z, size, periodic=True, source=source, detrend=None)
+
+
+def combined(first, second):
+    """The composite surface ``z = z1 + z2`` of two rough surfaces in contact (module docstring).
+
+    Parameters
+    ----------
+    first, second : RoughSurface
+        On the same grid and cell size (relative difference ``<= 1e-9``), both in the common
+        ``(x, y)`` frame, heights measured outwards.
+
+    Returns
+    -------
+    RoughSurface
+        The sum, periodic when both are, with its own statistics and edge jump.
+    """
+    for name, s in (("first", first), ("second", second)):
+        if not isinstance(s, RoughSurface):
+            fail(name, type(s).__name__, "a RoughSurface")
+    if first.heights.shape != second.heights.shape or not np.allclose(first.size, second.size, rtol=1e-9, atol=0):
+        fail("second", f"grid {second.heights.shape}, size {second.size}",
+             f"on the grid {first.heights.shape} and size {first.size} of first (resample one of them)")
+    z = np.array(first.heights) + np.array(second.heights)
+    detrend = first.stats.detrend if first.stats.detrend == second.stats.detrend else None
+    return _surface(z, first.size, periodic=first.stats.periodic and second.stats.periodic,
+                    source=f"{first.stats.source} + {second.stats.source}", detrend=detrend)
