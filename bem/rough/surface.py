@@ -15,15 +15,22 @@ solve after ``scale``.
 patch (``detrend``: the plane of least rms height by default, SurfaceTopography's
 ``"height"``) repeated with the period ``(Lx, Ly) = (nx dx, ny dy)``: the last column of
 nodes is followed by the first. The repetition puts a seam at the cell's edges, measured by
+the rms height difference between opposite edges and by the rms difference of neighbouring
+points inside the grid, along the same directions:
 
-    edge_jump = sqrt( (sum_j (z[0, j] - z[-1, j])^2 + sum_i (z[i, 0] - z[i, -1])^2) / (nx + ny) ),
+    edge_jump^2  = ( sum_j (z[0, j] - z[-1, j])^2 + sum_i (z[i, 0] - z[i, -1])^2 ) / (nx + ny),
+    grid_step^2  = ( ny mean (z[i+1, j] - z[i, j])^2 + nx mean (z[i, j+1] - z[i, j])^2 ) / (nx + ny).
 
-the rms height difference between opposite edges (on a periodic surface only the step of
-one grid spacing). When ``edge_jump > EDGE_JUMP_LIMIT * rms_height`` (:data:`EDGE_JUMP_LIMIT`
-= 0.5: uncorrelated opposite edges give about ``sqrt(2) rms_height``) a warning is logged and
-:attr:`SurfaceStats.edge_jump_large` is set: the cell's edges are a step the surface does not
-have. The statistics are those of the patch as measured (SurfaceTopography's non-periodic
-estimates), not of the cell with its seam.
+On one period of a periodic surface the seam is an ordinary grid step, ``edge_jump ~
+grid_step``; a patch adds a step the surface does not have. The seam is flagged when its
+excess over a grid step is large against the rms height,
+
+    sqrt(max(edge_jump^2 - grid_step^2, 0)) > EDGE_JUMP_LIMIT * rms_height,
+
+:data:`EDGE_JUMP_LIMIT` = 0.5 (uncorrelated opposite edges give about ``sqrt(2) rms_height``):
+a warning is logged and :attr:`SurfaceStats.edge_jump_large` is set. The statistics are those
+of the patch as measured (SurfaceTopography's non-periodic estimates), not of the cell with
+its seam.
 
 **Two rough surfaces.** The contact of two rough surfaces is that of their sum,
 :func:`combined`, against a flat: ``z = z1 + z2``, each measured outwards, both in the common
@@ -32,8 +39,10 @@ estimates), not of the cell with its seam.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
+import warnings
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -49,7 +58,7 @@ log = logging.getLogger(__name__)
 #: the ``detrend`` modes (SurfaceTopography's): mean, plane of least rms height, plane of least
 #: rms slope, second-order polynomial of least rms height
 DETRENDS = ("center", "height", "slope", "curvature")
-#: ``edge_jump / rms_height`` above which the periodic cell of a patch is flagged (module docstring)
+#: excess of the seam over a grid step, per rms height, above which a periodic cell is flagged (module docstring)
 EDGE_JUMP_LIMIT = 0.5
 #: fewest grid points per axis of a surface
 MIN_POINTS = 8
@@ -58,7 +67,9 @@ MIN_POINTS = 8
 def _surface_topography():
     """The SurfaceTopography package, or the error naming the extra."""
     try:
-        import SurfaceTopography
+        with warnings.catch_warnings():  # its MPI layer warns that it runs serially, which is what is wanted
+            warnings.simplefilter("ignore", ImportWarning)
+            import SurfaceTopography
     except ImportError:
         raise InputError('rough surfaces need the optional package SurfaceTopography (not installed): install '
                          'contactlab[rough] (pip install "contactlab[rough]").') from None
@@ -92,8 +103,12 @@ class SurfaceStats:
         ``(nx, ny)`` points.
     edge_jump : float
         rms height difference between opposite edges of the cell [length] (module docstring).
+    grid_step : float
+        rms height difference of neighbouring grid points [length], what ``edge_jump`` is on a
+        periodic surface.
     edge_jump_large : bool
-        ``edge_jump > EDGE_JUMP_LIMIT * rms_height``: the periodic cell has a seam.
+        ``sqrt(edge_jump^2 - grid_step^2) > EDGE_JUMP_LIMIT * rms_height``: the periodic cell
+        has a seam the surface does not have.
     periodic : bool
         The data is one period of a periodic surface (synthetic), not a patch.
     source : str
@@ -110,6 +125,7 @@ class SurfaceStats:
     size: tuple
     grid: tuple
     edge_jump: float
+    grid_step: float
     edge_jump_large: bool
     periodic: bool
     source: str
@@ -163,23 +179,27 @@ def _pair(name, value):
 
 
 def _edge_jump(z):
+    """``(edge_jump, grid_step)`` of the periodic cell of ``z`` (module docstring)."""
+    nx, ny = z.shape
     jumps = np.concatenate([z[0, :] - z[-1, :], z[:, 0] - z[:, -1]])
-    return float(np.sqrt(np.mean(jumps**2)))
+    steps = (ny * np.mean(np.diff(z, axis=0) ** 2) + nx * np.mean(np.diff(z, axis=1) ** 2)) / (nx + ny)
+    return float(np.sqrt(np.mean(jumps**2))), float(np.sqrt(steps))
 
 
 def _surface(z, size, *, periodic, source, unit=None, detrend=None):
     """A :class:`RoughSurface` of the finite grid ``z`` (owned), statistics by SurfaceTopography."""
     st = _surface_topography()
     topo = st.Topography(z, size, periodic=periodic)
-    rms_height = float(topo.rms_height_from_area())
-    jump = _edge_jump(z)
-    large = jump > EDGE_JUMP_LIMIT * rms_height
+    rms_height = float(topo.Sq())
+    jump, step = _edge_jump(z)
+    excess = np.sqrt(max(jump**2 - step**2, 0.0))
+    large = excess > EDGE_JUMP_LIMIT * rms_height
     if large:
-        log.warning("%s: the periodic cell of this patch has an edge jump of %.4g, %.2f times its rms height %.4g "
-                    "(> %g): its repetition has a step at the cell's edges", source, jump, jump / rms_height,
-                    rms_height, EDGE_JUMP_LIMIT)
+        log.warning("%s: the periodic cell has an edge jump of %.4g against a grid step of %.4g, an excess of %.2f "
+                    "times its rms height %.4g (> %g): its repetition has a step at the cell's edges", source, jump,
+                    step, excess / rms_height, rms_height, EDGE_JUMP_LIMIT)
     stats = SurfaceStats(rms_height, float(topo.rms_gradient()), float(topo.rms_curvature_from_area()),
-                         (float(size[0]), float(size[1])), tuple(int(n) for n in z.shape), jump, bool(large),
+                         (float(size[0]), float(size[1])), tuple(int(n) for n in z.shape), jump, step, bool(large),
                          bool(periodic), source, unit, detrend)
     z.flags.writeable = False
     return RoughSurface(z, stats.size, stats)
@@ -219,6 +239,55 @@ def from_heights(heights, size, *, periodic=False, detrend=None, source="heights
         st = _surface_topography()
         z = np.array(st.Topography(z, size, periodic=periodic).detrend(detrend).heights(), dtype=float)
     return _surface(z, size, periodic=bool(periodic), source=str(source), detrend=detrend)
+
+
+#: loggers of readers SurfaceTopography tries while detecting a format, which log bytes of the file
+_READER_LOGGERS = ("igor2",)
+
+
+@contextlib.contextmanager
+def _quiet_readers():
+    """Keep the readers' own loggers from quoting the file (errors name the file, never its contents)."""
+    loggers = [logging.getLogger(name) for name in _READER_LOGGERS]
+    before = [lg.level for lg in loggers]
+    for lg in loggers:  # their child loggers inherit the level
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, before):
+            lg.setLevel(level)
+
+
+def _read(st, handle, path, format, physical_sizes, channel, refuse):
+    """The topography of an open file, checked before its data is read (:func:`read_surface`)."""
+    try:  # the readers raise many kinds of errors, whose messages may quote the file: name the kind only
+        reader = st.open_topography(handle, format=format)
+    except Exception as exc:
+        refuse(f"SurfaceTopography cannot read it as {format or 'any format it knows'} ({type(exc).__name__}); "
+               "give format (bem.rough.formats()) or convert the file")
+    channels = reader.channels
+    if channel is not None and channel >= len(channels):
+        fail("channel", channel, f"< {len(channels)}, the number of data channels of the file")
+    info = reader.default_channel if channel is None else channels[channel]
+    if not info.is_uniform:
+        refuse("its points are not on an evenly spaced grid (non-uniform); resample them onto a regular grid")
+    if info.dim != 2:
+        refuse(f"it holds a {info.dim}-D line scan; a 2-D height map is needed")
+    if min(info.nb_grid_pts) < MIN_POINTS:
+        refuse(f"it holds {info.nb_grid_pts[0]} x {info.nb_grid_pts[1]} points; at least {MIN_POINTS} x "
+               f"{MIN_POINTS} are needed (too small)")
+    if info.physical_sizes is None and physical_sizes is None:
+        raise InputError(f"physical_sizes is missing: file = {path!r} does not state its size; give (Lx, Ly) in "
+                         "the file's length unit.")
+    if info.physical_sizes is not None and physical_sizes is not None:
+        fail("physical_sizes", physical_sizes, f"left out: file = {path!r} states its size "
+                                               f"{tuple(float(s) for s in info.physical_sizes)}")
+    kwargs = {} if physical_sizes is None else {"physical_sizes": physical_sizes}
+    try:
+        return reader.topography(channel_index=info.index, **kwargs)
+    except Exception as exc:
+        refuse(f"SurfaceTopography cannot read its data ({type(exc).__name__})")
 
 
 def read_surface(file, *, format=None, physical_sizes=None, channel=None, scale=1.0, detrend="height"):
@@ -275,33 +344,8 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, scale=
     def refuse(rule):
         raise InputError(f"file = {path!r} is not allowed: {rule}.")
 
-    try:  # the readers raise many kinds of errors, whose messages may quote the file: name the kind only
-        reader = st.open_topography(path, format=format)
-    except Exception as exc:
-        refuse(f"SurfaceTopography cannot read it as {format or 'any format it knows'} ({type(exc).__name__}); "
-               "give format (bem.rough.formats()) or convert the file")
-    channels = reader.channels
-    if channel is not None and channel >= len(channels):
-        fail("channel", channel, f"< {len(channels)}, the number of data channels of the file")
-    info = reader.default_channel if channel is None else channels[channel]
-    if info.dim != 2:
-        refuse(f"it holds a {info.dim}-D line scan; a 2-D height map is needed")
-    if not info.is_uniform:
-        refuse("its points are not on an evenly spaced grid (non-uniform); resample them onto a regular grid")
-    if min(info.nb_grid_pts) < MIN_POINTS:
-        refuse(f"it holds {info.nb_grid_pts[0]} x {info.nb_grid_pts[1]} points; at least {MIN_POINTS} x "
-               f"{MIN_POINTS} are needed (too small)")
-    if info.physical_sizes is None and physical_sizes is None:
-        raise InputError(f"physical_sizes is missing: file = {path!r} does not state its size; give (Lx, Ly) in "
-                         "the file's length unit.")
-    if info.physical_sizes is not None and physical_sizes is not None:
-        fail("physical_sizes", physical_sizes, f"left out: file = {path!r} states its size "
-                                               f"{tuple(float(s) for s in info.physical_sizes)}")
-    kwargs = {} if physical_sizes is None else {"physical_sizes": physical_sizes}
-    try:
-        topo = reader.topography(channel_index=info.index, **kwargs)
-    except Exception as exc:
-        refuse(f"SurfaceTopography cannot read its data ({type(exc).__name__})")
+    with open(path, "rb") as handle, _quiet_readers():  # our handle: some readers leave files they open open
+        topo = _read(st, handle, path, format, physical_sizes, channel, refuse)
     if topo.has_undefined_data:
         missing = int(np.ma.getmaskarray(topo.heights()).sum())
         refuse(f"it has {missing} points without data (NaN holes or missing data); fill or crop them first "
@@ -367,7 +411,7 @@ def self_affine(grid, size, *, hurst, rms_height=None, rms_slope=None, long_cuto
     seed = check_int("seed", seed, minimum=0)
     topo = fourier_synthesis(grid, size, hurst=hurst, rms_height=1.0, short_cutoff=short_cutoff,
                              long_cutoff=long_cutoff, rolloff=rolloff, rng=seed)
-    got = float(topo.rms_height_from_area() if rms_slope is None else topo.rms_gradient())
+    got = float(topo.Sq() if rms_slope is None else topo.rms_gradient())
     z = np.array(topo.heights(), dtype=float) * (target / got)
     source = f"self-affine H = {hurst:g}, seed = {seed}"
     return _surface(z, size, periodic=True, source=source, detrend=None)
