@@ -1,4 +1,5 @@
-"""Rough surfaces (bem.rough): synthesis, files, the periodic cell, statistics, the lattice, the core without the extra."""
+"""Rough surfaces (bem.rough): synthesis, files, the periodic cell, statistics, the lattice, and the core
+install without the [rough] extra."""
 
 import importlib.util
 import logging
