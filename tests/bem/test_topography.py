@@ -4,7 +4,9 @@ install without the [rough] extra."""
 import importlib.util
 import logging
 import math
+import re
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -294,6 +296,19 @@ def test_surface_on_the_lattice_and_its_report():
     report = s.stats.as_dict()
     assert report["grid"] == [64, 64] and report["size"] == [1.0, 1.0] and report["edge_jump_large"] is False
     assert set(report) >= {"rms_height", "rms_slope", "rms_curvature", "edge_jump", "grid_step", "source"}
+
+
+@needs_extra
+def test_the_example_of_docs_rough_runs(capsys):
+    text = (Path(__file__).resolve().parents[2] / "docs" / "rough.md").read_text()
+    code = re.search(r"```python\n(.*?)```", text, re.S).group(1)
+    exec(compile(code, "docs/rough.md", "exec"), {})
+    out = capsys.readouterr().out
+    assert float(re.search(r"'rms_height': (\S+),", out).group(1)) == pytest.approx(1e-6, rel=1e-12)
+    assert "'source': 'self-affine H = 0.8, seed = 1'" in out
+    step, n_rows, shape, stretch = re.search(r"\n(\S+) (\d+) \((\d+), 96\) (\S+)\n", out).groups()
+    assert float(step) == pytest.approx(200e-6 / 96) and int(n_rows) % 2 == 0 and shape == n_rows
+    assert abs(float(stretch) - 1) <= math.sqrt(3) / (2 * 96)
 
 
 # --- the core without the extra ----------------------------------------------------------------
