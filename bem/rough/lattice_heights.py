@@ -81,6 +81,15 @@ class LatticeHeights:
     stretch_y: float
     stretch_large: bool
 
+    def gap(self):
+        """The initial gap ``h = max z - z`` against a flat [length], shape ``(n_rows, n_cols)``.
+
+        The heights are those of a surface measured outwards (summits positive); the highest
+        node touches first (``h = 0`` there), as for a measured topography over a region
+        (:class:`bem.gaps.Measured`).
+        """
+        return self.heights.max() - self.heights
+
     def positions(self):
         """Node coordinates ``(x, y)`` [length], each of shape ``(n_rows, n_cols)``."""
         r, q = np.mgrid[0:self.n_rows, 0:self.n_cols]

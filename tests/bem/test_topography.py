@@ -71,6 +71,8 @@ def test_sinusoid_is_resampled_exactly_onto_the_lattice(shape, size, n_cols, a, 
     assert np.abs(lat.heights - expected).max() < 1e-12
     assert lat.stretch_large == (abs(lat.stretch_y - 1) > rough.MAX_STRETCH)
     assert lat.stretch_large == any("stretches the data along y" in m for m in caplog.messages)
+    gap = lat.gap()  # against a flat: the highest node touches first
+    assert gap.min() == 0 and np.array_equal(gap, lat.heights.max() - lat.heights)
 
 
 def test_lattice_keeps_rms_height_and_slopes_of_a_band_limited_surface():
