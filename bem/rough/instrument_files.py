@@ -137,7 +137,11 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, scale=
     def refuse(rule):
         raise InputError(f"file = {path!r} is not allowed: {rule}.")
 
-    with open(path, "rb") as handle, _quiet_readers():  # our handle: some readers leave files they open open
+    try:
+        handle = open(path, "rb")  # our handle: some readers leave the files they open open
+    except OSError as exc:
+        refuse(f"it cannot be opened ({type(exc).__name__})")
+    with handle, _quiet_readers():
         topo = _read(st, handle, path, format, physical_sizes, channel, refuse)
     if topo.has_undefined_data:
         missing = int(np.ma.getmaskarray(topo.heights()).sum())
@@ -149,5 +153,6 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, scale=
     size = tuple(float(s) * scale for s in topo.physical_sizes)
     if detrend is not None:
         z = np.ma.getdata(topo.detrend(detrend).heights())
-    return _surface(np.array(z, dtype=float) * scale, size, periodic=bool(topo.is_periodic), source=path,
-                    unit=topo.unit, detrend=detrend)
+    periodic = bool(topo.is_periodic) and detrend in (None, "center")  # a plane taken off breaks a period
+    return _surface(np.array(z, dtype=float) * scale, size, periodic=periodic, source=path, unit=topo.unit,
+                    detrend=detrend)

@@ -265,6 +265,20 @@ def test_bad_files_stop_with_a_message_naming_the_argument(tmp_path, make, kwarg
 
 
 @needs_extra
+@pytest.mark.parametrize("kwargs, blamed", [
+    ({"heights": np.where(np.eye(8) > 0, np.nan, 0.0)}, "heights"),
+    ({"heights": np.zeros((4, 16))}, "heights.shape"),
+    ({"size": (1.0, 0.0)}, "size[1]"),
+    ({"periodic": True, "detrend": "height"}, "detrend"),
+])
+def test_from_heights_refuses_bad_arguments(kwargs, blamed):
+    args = {"heights": np.zeros((8, 8)), "size": (1.0, 1.0), **kwargs}
+    with pytest.raises(bem.InputError) as err:
+        rough.from_heights(**args)
+    assert str(err.value).startswith(blamed)
+
+
+@needs_extra
 def test_superfluous_physical_sizes_are_refused(tmp_path):
     import SurfaceTopography
 
