@@ -309,6 +309,16 @@ def test_surface_on_the_lattice_and_its_report():
     lat = s.to_lattice(64)  # the surface holds |k| <= 8: the lattice carries it whole
     assert lat.n_rows == 74 and not lat.stretch_large
     assert np.sqrt(np.mean(lat.heights**2)) == pytest.approx(s.stats.rms_height, rel=1e-12)
+    # a rough surface with power up to the grid's Nyquist wave number (measured: 2e-6 on a finer lattice)
+    rough_one = rough.self_affine((128, 128), (1.0, 1.0), hurst=0.3, rms_height=1.0, seed=5)
+    fine = rough_one.to_lattice(256)
+    assert np.sqrt(np.mean(fine.heights**2)) == pytest.approx(1.0, rel=1e-5)
+    coarse = rough_one.to_lattice(64)  # loses the power beyond its band, |kx| <= 32, |ky| <= n_rows/2
+    k0 = np.fft.fftfreq(128, 1 / 128)
+    band = (np.abs(k0)[:, None] <= 32) & (np.abs(k0)[None, :] <= coarse.n_rows / 2)
+    kept = np.fft.ifft2(np.where(band, np.fft.fft2(rough_one.heights), 0)).real
+    assert np.sqrt(np.mean(coarse.heights**2)) == pytest.approx(np.sqrt(np.mean(kept**2)), rel=1e-4)
+    assert np.sqrt(np.mean(coarse.heights**2)) < 0.995
     report = s.stats.as_dict()
     assert report["grid"] == [64, 64] and report["size"] == [1.0, 1.0] and report["edge_jump_large"] is False
     assert set(report) >= {"rms_height", "rms_slope", "rms_curvature", "edge_jump", "grid_step", "source"}
