@@ -168,7 +168,8 @@ def test_cli_sweeps_a_string_key(tmp_path):
 
 
 @pytest.mark.parametrize("text, n", [("50:100:1000000000", 1000000000), ("50:100:10001", 10001),
-                                     (",".join(str(50 + i) for i in range(100_000)), 100_000)])
+                                     (",".join(str(50 + i) for i in range(100_000)), 100_000)],
+                         ids=["range-1e9", "range-10001", "list-100000"])
 def test_too_many_values_refused_before_they_are_made(text, n):
     with pytest.raises(SceneError, match=rf"--values = .* is not allowed: it gives {n} points, more than the "
                                          r"10000 points"):

@@ -93,7 +93,7 @@ def test_nothing_listening_is_a_one_line_error(tmp_path):
     (struct.pack("Q", 24) + b"\xff" * 24, False, "is not a Dask handshake"),
     (b"\x01\x02", True, "closed the connection"),
     (b"", False, "within 0.5 s"),
-])
+], ids=["http", "bad-frames", "hangs-up", "silent"])
 def test_a_server_that_is_not_dask_is_refused_quickly(tmp_path, reply, hang_up, said):
     with _server(reply, hang_up=hang_up) as port:
         start = time.monotonic()
