@@ -185,3 +185,9 @@ def test_too_many_values_refused_before_any_point(tmp_path, monkeypatch):
     code, _out, err = cli("sweep", "elliptic", "--param", "load.force", "--values", "50:100:1000000000",
                           "--out", tmp_path)
     assert code == 2 and "--values" in err and "1000000000" in err and "10000" in err
+
+
+def test_a_hidden_unfinished_write_does_not_block_the_folder(tmp_path):
+    first = _sweep(tmp_path, [50.0])
+    (tmp_path / "points" / ".point-0123.json.tmp4567.json").write_text("{")  # a write killed half-way
+    assert _sweep(tmp_path, [50.0])["reused"] == [0] and first["computed"] == [0]

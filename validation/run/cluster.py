@@ -8,7 +8,8 @@ frames, whose content is a small table (``compression``, ``python``, ``pickle-pr
 probe reads at most :data:`HANDSHAKE_LIMIT` bytes of it and decodes it; a server that is
 silent, closes the connection, announces a longer message (a server of another protocol whose
 first bytes read as a length of exbibytes) or sends something that does not decode is refused
-with :class:`SchedulerError` before Dask would allocate or wait on it.
+with :class:`SchedulerError` before Dask would allocate or wait on it. (A scheduler logs the
+probe as a connection closed before its handshake completed, at level INFO.)
 """
 
 from __future__ import annotations

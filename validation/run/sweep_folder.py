@@ -103,7 +103,7 @@ def earlier_points(out, sweep):
     """
     found = {}
     folder = out / "points"
-    for path in sorted(folder.glob("*.json")) if folder.is_dir() else ():
+    for path in sorted(folder.glob("[!.]*.json")) if folder.is_dir() else ():  # not a hidden unfinished write
         try:
             with open(path, encoding="utf-8") as fh:
                 data = json.load(fh)
