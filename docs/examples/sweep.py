@@ -1,8 +1,9 @@
 """A sweep: the peak pressure of a steel ball on a flat for several loads, with resumable storage.
 
 :func:`validation.run.sweep.run_sweep` runs one scene for each value of a parameter (here
-``load.force``), saves each finished point as it comes (``points/point-NNN.json``; a rerun
-reuses them) and writes ``summary.json`` and ``summary.csv``. The same from the command line::
+``load.force``), saves each finished point as it comes (``points/point-*.json``, keyed by
+the point's scene; a rerun reuses them, other values extend the folder) and writes
+``summary.json`` and ``summary.csv``. The same from the command line::
 
     contactlab sweep hertz --param load.force --values 50,100,200,400
 

@@ -8,6 +8,7 @@ import types
 import pytest
 
 import bem
+import validation.run.cluster as cluster
 import validation.run.runner as runner
 from validation.extras import MissingExtraError
 from validation.run import run_scene
@@ -25,11 +26,17 @@ def _sweep(out, **kw):
     return run_sweep("elliptic", out, **kw)
 
 
+def _point(out, summary, i):
+    """The point file of row ``i`` of a summary."""
+    return out / summary["points"][i]["file"]
+
+
 def test_points_are_saved_with_profile_and_summary(tmp_path):
     summary = _sweep(tmp_path)
     assert summary["computed"] == [0, 1, 2] and summary["reused"] == [] and summary["failed"] == []
+    assert len(list((tmp_path / "points").iterdir())) == 3
     for i, force in enumerate(FORCES):
-        point = json.loads((tmp_path / "points" / f"point-{i:03d}.json").read_text())
+        point = json.loads(_point(tmp_path, summary, i).read_text())
         assert point["value"] == force and point["key"] == "load.force"
         assert point["scene"]["load"] == {"force": force}
         r = point["result"]
@@ -47,18 +54,18 @@ def test_points_are_saved_with_profile_and_summary(tmp_path):
 
 def test_sweep_resumes_recomputing_only_missing_points(tmp_path):
     first = _sweep(tmp_path)
-    kept = {i: (tmp_path / "points" / f"point-{i:03d}.json").stat().st_mtime_ns for i in (0, 2)}
-    (tmp_path / "points" / "point-001.json").unlink()
+    kept = {i: _point(tmp_path, first, i).stat().st_mtime_ns for i in (0, 2)}
+    _point(tmp_path, first, 1).unlink()
     second = _sweep(tmp_path)
-    assert second["computed"] == [1] and second["reused"] == [0, 2]
+    assert second["computed"] == [1] and second["reused"] == [0, 2] and second["kept"] == []
     for i, mtime in kept.items():
-        assert (tmp_path / "points" / f"point-{i:03d}.json").stat().st_mtime_ns == mtime
+        assert _point(tmp_path, first, i).stat().st_mtime_ns == mtime
     assert [r["p_max"] for r in second["points"]] == [r["p_max"] for r in first["points"]]
 
 
 def test_changed_scene_is_not_reused(tmp_path):
     _sweep(tmp_path)
-    again = _sweep(tmp_path, overrides=["bem.nodes_across=18"])
+    again = _sweep(tmp_path / "other", overrides=["bem.nodes_across=18"])
     assert again["computed"] == [0, 1, 2]
 
 
@@ -84,7 +91,7 @@ def test_failed_point_is_reported_and_retried(tmp_path, monkeypatch):
     summary = _sweep(tmp_path)
     assert summary["failed"] == [1]
     assert summary["points"][1]["status"] == "error" and "node crashed" in summary["points"][1]["error"]
-    assert not (tmp_path / "points" / "point-001.json").exists()
+    assert summary["points"][1]["file"] is None and len(list((tmp_path / "points").iterdir())) == 2
     monkeypatch.setattr(runner, "run_scene", real)
     assert _sweep(tmp_path)["computed"] == [1]
 
@@ -94,7 +101,7 @@ def test_paper_alpha_a_sweep_spans_smooth_to_linear(tmp_path):
     summary = run_sweep("paper_elastic_rigid", tmp_path, parameter="alpha_a", values=[0.0, 0.5, 1.0],
                         workers=1, overrides=small)
     p = [row["p_max"] for row in summary["points"]]
-    point = json.loads((tmp_path / "points" / "point-000.json").read_text())["result"]
+    point = json.loads(_point(tmp_path, summary, 0).read_text())["result"]
     smooth = bem.solve(bem.gaps.Paraboloid(0.01), E_star=point["bem"]["E_star"], force=100.0,
                        step=point["bem"]["step"], extent=point["bem"]["extent"])  # the same lattice
     linear = run_scene("paper_linear", overrides=small)
@@ -129,7 +136,7 @@ def _fake_dask(monkeypatch):
     class Client:
         made = []
 
-        def __init__(self, address):
+        def __init__(self, address, timeout=None):
             self.address, self.closed = address, False
             Client.made.append(self)
 
@@ -150,6 +157,7 @@ def _fake_dask(monkeypatch):
 
 def test_dask_path_with_a_stand_in_client(tmp_path, monkeypatch):
     client = _fake_dask(monkeypatch)
+    monkeypatch.setattr(cluster, "probe_scheduler", lambda address, timeout: None)  # no server behind it
     summary = _sweep(tmp_path, values=FORCES[:2], scheduler="tcp://scheduler:8786")
     assert summary["computed"] == [0, 1]
     assert [c.address for c in client.made] == ["tcp://scheduler:8786"] and client.made[0].closed

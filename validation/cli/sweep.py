@@ -6,24 +6,35 @@ from pathlib import Path
 
 from bem.checks import InputError
 
+from ..run.cluster import DEFAULT_TIMEOUT
+from ..scene.checks import MAX_SWEEP_POINTS
 from .common import add_set
 
 PARSER = {"help": "sweep one scene parameter (resumable, parallel)",
           "description": "Run a scene for each value of one parameter. Finished points are saved "
-                         "one file each; rerunning skips them (resume).",
+                         "one file each, keyed by the point's scene and the contents of its files; "
+                         "rerunning into the same --out skips them (resume), and other values extend "
+                         "the folder (the summary lists every point). A folder of another sweep "
+                         "(another parameter, scene or file contents) is refused: no point is "
+                         f"overwritten. At most {MAX_SWEEP_POINTS} values.",
           "epilog": "examples:\n  contactlab sweep paper_elastic_rigid                 (its [sweep])\n"
                     "  contactlab sweep paper_bilinear --param alpha_c --values 0,0.4,0.8,1.2\n"
                     "  contactlab sweep hertz --param load.force --values 50:200:4 --workers 2\n"
+                    "  contactlab sweep paper_linear --param layer.law --values linear,none\n"
                     "  contactlab sweep hertz --param load.force --values 50,100 --scheduler tcp://host:8786"}
 
 
 def add_args(p):
     p.add_argument("scene", metavar="SCENE")
     p.add_argument("--param", metavar="P", help="alpha_a, alpha_b, alpha_c or a dotted key (layer.lam, load.force)")
-    p.add_argument("--values", metavar="V", help="comma list 0,0.25,0.5 or start:stop:num")
+    p.add_argument("--values", metavar="V", help="comma list of numbers or words (0,0.25,0.5 or none,tabulated) "
+                                                 f"or start:stop:num; at most {MAX_SWEEP_POINTS} values")
     p.add_argument("--out", metavar="DIR", help="sweep directory (default: results/<scene>-sweep-<param>)")
     p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: all cores)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address (needs dask.distributed)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address host:port or tcp://host:port "
+                                                          "(needs dask.distributed)")
+    p.add_argument("--scheduler-timeout", type=float, default=DEFAULT_TIMEOUT, metavar="S",
+                   help=f"seconds allowed to reach the scheduler (default {DEFAULT_TIMEOUT:g})")
     add_set(p)
 
 
@@ -48,7 +59,7 @@ def run(args):
 
     try:
         summary = run_sweep(scene, out, parameter=args.param, values=values, workers=args.workers,
-                            scheduler=args.scheduler, progress=progress)
+                            scheduler=args.scheduler, scheduler_timeout=args.scheduler_timeout, progress=progress)
     finally:
         bar.close()
     print(f"sweep of {summary['key']} over {len(summary['points'])} values of scene {summary['scene']} "
@@ -58,7 +69,8 @@ def run(args):
     for r in summary["points"]:
         print(f"{r['value']!s:>12} {r['status']:>14} {fmt(r.get('p_max')):>14} "
               f"{fmt(r.get('contact_radius')):>12} {fmt(r.get('approach')):>12}")
-    print(f"computed {len(summary['computed'])}, reused {len(summary['reused'])}, failed {len(summary['failed'])}; "
-          f"files {out}/ (summary.json, summary.csv, points/)")
+    kept = f", {len(summary['kept'])} more from earlier runs" if summary["kept"] else ""
+    print(f"computed {len(summary['computed'])}, reused {len(summary['reused'])}, failed {len(summary['failed'])}"
+          f"{kept}; files {out}/ (summary.json, summary.csv, points/)")
     bad = summary["failed"] or any(r["status"] != "ok" for r in summary["points"])
     return 1 if bad else 0

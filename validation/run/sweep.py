@@ -1,14 +1,22 @@
-"""Parameter sweeps of a scene: one scene parameter over a list of values, resumable.
+"""Parameter sweeps of a scene: one scene parameter over a list of values, resumable and extendable.
 
 Every point is a complete scene (the base scene with ``parameter = value``) validated before
-any work. Points run in parallel on local cores (:class:`concurrent.futures.ProcessPoolExecutor`,
-``workers`` = cores by default) or on a Dask cluster when a scheduler address is given
-(``dask.distributed``, optional, imported only then). Each finished point is saved at once as
-its own JSON file (atomically), ``points/point-NNN.json``, holding the point's full result
-(``result.json`` content, the axial section profile included); a rerun skips the points
-already on disk for the same scene (``fingerprint``: SHA-256 of the point's scene), so an
-interrupted sweep resumes where it stopped. At the end a summary table is written as
-``summary.json`` and ``summary.csv``.
+any work; a sweep holds at most :data:`~validation.scene.checks.MAX_SWEEP_POINTS` values. Points
+run in parallel on local cores (:class:`concurrent.futures.ProcessPoolExecutor`, ``workers`` =
+cores by default) or on a Dask cluster when a scheduler address is given
+(:mod:`validation.run.cluster`; ``dask.distributed``, optional, imported only then).
+
+A point is keyed by its scene and the contents of the files that scene names (every key
+``file``, e.g. a measured surface's ``gap.file``: the SHA-256 of the file's bytes), its
+``fingerprint``; it is saved, once finished, as ``points/point-<fingerprint[:16]>.json``
+(atomically) holding the point's full result (``result.json`` content, the axial section
+profile included). A sweep folder holds the points of one sweep: one parameter over one base
+scene (the scene without the swept key, its files' contents included). A rerun into the same
+folder reuses the points already there and computes the others, so an interrupted sweep
+resumes where it stopped and a rerun with other values extends the folder; the summary
+(``summary.json``, ``summary.csv``) lists every point of the folder, numbers in ascending order.
+A folder holding points of another sweep (another parameter, another base scene, a changed
+file) is refused before any work: no point is ever overwritten.
 
 The paper's sweeps (section 6): ``alpha_a`` in ``[0, 1]`` (elastic-rigid, Fig. 5/9),
 ``alpha_c`` (bilinear), ``alpha_b`` (root law, Fig. 10-11).
@@ -17,21 +25,23 @@ The paper's sweeps (section 6): ``alpha_a`` in ``[0, 1]`` (elastic-rigid, Fig. 5
 from __future__ import annotations
 
 import csv
-import hashlib
 import io
 import json
 import logging
 import os
+import re
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 from bem.files import write_text
 
-from ..extras import require as require_extra
 from ..io import atomic_write_json
-from ..scene.checks import SceneError
+from ..scene.checks import SceneError, sweep_size
 from ..scene.load import Scene, apply_overrides, load_scene, parse_scene
+from ..scene.paper import ALIASES
+from .cluster import DEFAULT_TIMEOUT, dask_client, scheduler_address
+from .sweep_folder import SWEPT, earlier_points, file_digests, fingerprint, keyed, other_point
 
 __all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values"]
 
@@ -40,43 +50,98 @@ log = logging.getLogger(__name__)
 SUMMARY_COLUMNS = ("index", "value", "status", "p_max", "force", "approach", "contact_radius", "contact_area",
                    "converged", "iterations", "kkt_residual", "alpha_b", "p_max_lambda", "wall_time_bem",
                    "wall_time_fem", "computed", "file")
+_BARE_WORD = re.compile(r"^[^\s\"'\[\]{}=#,]+(\s+[^\s\"'\[\]{}=#,]+)*$")
 
 
 class SweepPoint:
-    """One point: its index, value, validated scene and file name."""
+    """One point: its index, value, validated scene, the digests of its files and its file name.
 
-    def __init__(self, index, value, scene):
-        self.index, self.value, self.scene = index, value, scene
-        text = json.dumps(scene.raw, sort_keys=True, default=str)
-        self.fingerprint = hashlib.sha256(text.encode()).hexdigest()
-        self.file = f"point-{index:03d}.json"
+    ``sweep`` is the identity of the sweep it belongs to (shared by its points): the swept
+    ``key``, the base ``scene`` (the swept key replaced by a place holder), the digests of the
+    base scene's ``files`` and their ``fingerprint``.
+    """
+
+    def __init__(self, index, value, scene, *, files=None, sweep=None):
+        self.index, self.value, self.scene, self.files, self.sweep = index, value, scene, dict(files or {}), sweep
+        self.fingerprint = fingerprint(keyed(scene.raw), self.files)
+        self.file = f"point-{self.fingerprint[:16]}.json"
+
+
+def _number(text):
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _item(text, item):
+    """One comma-separated item of ``--values``: a TOML value, else a bare word (a string)."""
+    import tomllib
+
+    item = item.strip()
+    try:
+        return tomllib.loads(f"v = {item}")["v"]
+    except tomllib.TOMLDecodeError:
+        pass
+    if not _BARE_WORD.match(item):
+        raise SceneError(f"--values {text!r} is not allowed: the item {item!r} is neither a TOML value nor a "
+                         "bare word; give comma-separated numbers or words (0,0.25,0.5 or none,tabulated) or "
+                         "start:stop:num (0:1:5).")
+    return item
 
 
 def parse_values(text):
-    """``"0,0.25,0.5"`` (TOML values) or ``"start:stop:num"`` (evenly spaced) -> list."""
+    """The values of ``--values``: a comma list or ``"start:stop:num"``; returns a list.
+
+    Items of a comma list are TOML values (``0.25``, ``"log"``, ``[1e-3, 2e-3]``) or bare words,
+    taken as strings (``none,tabulated``, ``mymodule:w``); ``start:stop:num`` gives ``num``
+    evenly spaced numbers. At most :data:`~validation.scene.checks.MAX_SWEEP_POINTS` values,
+    refused before any is made.
+    """
     import tomllib
 
     import numpy as np
 
     text = text.strip()
     parts = text.split(":")
-    if len(parts) == 3:
+    if "," not in text and (len(parts) == 3 or (len(parts) == 2 and _number(parts[0]))):
         try:
             start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
-        except ValueError:
+        except (ValueError, IndexError):
             raise SceneError(f"--values {text!r} is not allowed: start:stop:num needs two numbers and an "
                              "integer, e.g. 0:1:5.") from None
         if num < 1:
             raise SceneError(f"--values {text!r} is not allowed: num must be >= 1.")
+        sweep_size("--values", text, num)
         return [float(v) for v in np.linspace(start, stop, num)]
     try:
         values = tomllib.loads(f"v = [{text}]")["v"]
     except tomllib.TOMLDecodeError:
-        raise SceneError(f"--values {text!r} is not allowed: give comma-separated numbers (0,0.25,0.5) or "
-                         "start:stop:num (0:1:5).") from None
+        values = None
+    if values is None:
+        items = text.split(",")
+        sweep_size("--values", text, len(items))
+        values = [_item(text, item) for item in items]
     if not values:
         raise SceneError(f"--values {text!r} is not allowed: it must hold at least one value.")
+    sweep_size("--values", text, len(values))
     return values
+
+
+def _typed(raw, key, value):
+    """``value`` in the type of the base scene's value at ``key``: an integer for a float key is a
+    float, an integral float for an integer key an integer (``--values 50,100``, ``16:32:3``)."""
+    node = raw
+    for part in key.split("."):
+        node = node.get(part) if isinstance(node, dict) else None
+    if isinstance(node, bool) or isinstance(value, bool):
+        return value
+    if isinstance(node, float) and isinstance(value, int):
+        return float(value)
+    if isinstance(node, int) and isinstance(value, float) and value.is_integer():
+        return int(value)
+    return value
 
 
 def sweep_points(scene, parameter=None, values=None, *, overrides=None):
@@ -90,7 +155,8 @@ def sweep_points(scene, parameter=None, values=None, *, overrides=None):
         ``alpha_a``, ``alpha_b``, ``alpha_c`` or a dotted key (``layer.lam``, ``load.force``);
         default: the scene's ``[sweep]``.
     values : list, optional
-        The values; default: the scene's ``[sweep] values``.
+        The values (numbers or strings, each typed as the base scene's value of the key);
+        default: the scene's ``[sweep] values``.
     overrides : dict or list of str, optional
         Applied to the base scene first.
     """
@@ -101,14 +167,21 @@ def sweep_points(scene, parameter=None, values=None, *, overrides=None):
         raise SceneError(f"sweep parameter = {parameter!r}, values = {values!r} is not allowed: give both "
                          "(--param and --values), or neither to use the scene's [sweep] section.")
     raw = {k: v for k, v in base.raw.items() if k != "sweep"}
+    if isinstance(parameter, str) and isinstance(values, list | tuple):
+        values = [_typed(raw, ALIASES.get(parameter, parameter), v) for v in values]
     raw["sweep"] = {"parameter": parameter, "values": list(values)}
     checked = parse_scene(raw, source=base.source)  # checks the parameter and every value
     key = checked.sweep["key"]
     raw.pop("sweep")
+    cache = {}
+    held = apply_overrides(raw, {key: SWEPT})
+    files = file_digests(held, cache)
+    sweep = {"key": key, "scene": keyed(held), "files": files}
+    sweep["fingerprint"] = fingerprint(key, sweep["scene"], files)
     points = []
     for i, value in enumerate(checked.sweep["values"]):
         point = parse_scene(apply_overrides(raw, {key: value}), source=base.source)
-        points.append(SweepPoint(i, value, point))
+        points.append(SweepPoint(i, value, point, files=file_digests(point.raw, cache), sweep=sweep))
     return parameter, key, points
 
 
@@ -119,17 +192,15 @@ def _solve_point(raw, source):
     return run_scene(parse_scene(raw, source=source))
 
 
-def _load_point(path, fingerprint):
-    try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
-    except (OSError, ValueError):
-        return None
-    return data if data.get("fingerprint") == fingerprint else None
+def _ordered(values):
+    """Summary positions of ``values``: ascending when all are numbers, else in the given order."""
+    numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
+    order = sorted(range(len(values)), key=lambda i: values[i]) if numeric else range(len(values))
+    return {i: pos for pos, i in enumerate(order)}
 
 
-def _row(point, result, *, computed, error=None):
-    row = {"index": point.index, "value": point.value, "computed": computed, "file": f"points/{point.file}"}
+def _row(index, value, file, result, *, computed, error=None):
+    row = {"index": index, "value": value, "computed": computed, "file": f"points/{file}"}
     if error is not None:
         row.update(status="error", error=error, file=None)
         return row
@@ -167,17 +238,6 @@ def _local_map(jobs, workers):
             raise
 
 
-def _dask_client(scheduler):
-    """A ``dask.distributed.Client`` for an address (or a Client/cluster object); owned flag."""
-    if isinstance(scheduler, str):
-        require_extra("dask", f"--scheduler {scheduler!r} (a Dask cluster; without it the sweep runs on local cores)")
-    from dask import distributed
-
-    if isinstance(scheduler, distributed.Client):
-        return scheduler, False
-    return distributed.Client(scheduler), True
-
-
 def _dask_map(jobs, client):
     """Yield ``(point, result, error)`` as Dask futures finish on ``client``."""
     from dask.distributed import as_completed as dask_completed
@@ -203,50 +263,80 @@ def _write_summary(out, meta, rows):
     return rows
 
 
-def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, scheduler=None, progress=None,
-              overrides=None):
-    """Run a resumable sweep and write its point files and summary table.
+def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, scheduler=None,
+              scheduler_timeout=DEFAULT_TIMEOUT, progress=None, overrides=None):
+    """Run a resumable, extendable sweep and write its point files and summary table.
 
     Parameters
     ----------
     scene : Scene, str, path-like or dict
         The base scene.
     out_dir : path-like
-        Sweep directory: ``points/point-NNN.json``, ``summary.json``, ``summary.csv``.
+        Sweep directory: ``points/point-<fingerprint>.json``, ``summary.json``, ``summary.csv``.
+        Points already there are reused; a folder holding points of another sweep is refused.
     parameter, values : optional
         See :func:`sweep_points` (default: the scene's ``[sweep]``).
     workers : int, optional
         Local worker processes (default: the number of cores; 1 runs in this process).
     scheduler : str or dask.distributed.Client, optional
-        Dask scheduler address (``"tcp://host:8786"``): run the points on that cluster.
+        Dask scheduler address (``"tcp://host:8786"`` or ``"host:8786"``): run the points on
+        that cluster (:func:`validation.run.cluster.dask_client`).
+    scheduler_timeout : float, optional
+        Seconds allowed to reach the scheduler, > 0.
     progress : callable, optional
-        ``progress(done, total, row)`` after each point (cached points included).
+        ``progress(done, total, row)`` after each point of ``values`` (reused points included).
     overrides : dict or list of str, optional
         Applied to the base scene before sweeping.
 
     Returns
     -------
     dict
-        The summary (``summary.json``): ``scene``, ``parameter``, ``key``, ``values``, ``points``
-        (one row per point, see :data:`SUMMARY_COLUMNS`; ``computed`` says whether this run
-        computed it), ``computed``, ``reused``, ``failed`` (indices).
+        The summary (``summary.json``): ``scene``, ``parameter``, ``key``, ``values`` (every value
+        of the folder), ``points`` (one row per value, see :data:`SUMMARY_COLUMNS`; ``computed``
+        says whether this run computed it), and the indices ``computed``, ``reused`` (values of
+        this run found in the folder), ``kept`` (values of earlier runs only) and ``failed``.
+
+    Raises
+    ------
+    SceneError
+        A bad scene, parameter or value (every point is checked first).
+    validation.io.OutputError
+        ``out_dir`` holds points of another sweep.
+    validation.run.cluster.SchedulerError
+        ``scheduler`` is malformed, cannot be reached or is not a Dask scheduler.
     """
     parameter, key, points = sweep_points(scene, parameter, values, overrides=overrides)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise SceneError(f"workers = {workers!r} is not allowed: it must be an integer >= 1.")
-    client = _dask_client(scheduler) if scheduler is not None else None  # fails before any work
+    if isinstance(scheduler, str):
+        scheduler_address(scheduler)
     out = Path(out_dir)
+    earlier = earlier_points(out, points[0].sweep)
+    mine = {p.fingerprint for p in points}
+    kept = [d for fp, d in earlier.items() if fp not in mine]
+    by_value = {json.dumps(p.value): p for p in points}
+    for data in kept:
+        if json.dumps(data["value"]) in by_value:
+            other_point(out, data, by_value[json.dumps(data["value"])])
+    client = dask_client(scheduler, scheduler_timeout) if scheduler is not None else None  # before any work
+    position = _ordered([p.value for p in points] + [d["value"] for d in kept])
+    for i, point in enumerate(points):
+        point.index = position[i]
+    rows = [_row(position[len(points) + i], d["value"], d["file"], d["result"], computed=False)
+            for i, d in enumerate(kept)]
     (out / "points").mkdir(parents=True, exist_ok=True)
-    rows, jobs = [], []
+    jobs, done = [], 0
     for point in points:
-        cached = _load_point(out / "points" / point.file, point.fingerprint)
+        cached = earlier.get(point.fingerprint)
         if cached is not None:
-            rows.append(_row(point, cached["result"], computed=False))
+            rows.append(_row(point.index, point.value, cached["file"], cached["result"], computed=False))
+            done += 1
             if progress is not None:
-                progress(len(rows), len(points), rows[-1])
+                progress(done, len(points), rows[-1])
         else:
             jobs.append(point)
-    log.info("sweep of %s over %d values: %d on disk, %d to run", key, len(points), len(rows), len(jobs))
+    log.info("sweep of %s over %d values: %d on disk, %d to run, %d more from earlier runs", key, len(points),
+             len(points) - len(jobs), len(jobs), len(kept))
     try:
         if client is not None:
             results = _dask_map(jobs, client[0])
@@ -255,21 +345,25 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
         for point, result, error in results if jobs else ():
             if error is None:
                 atomic_write_json(out / "points" / point.file, {
-                    "index": point.index, "parameter": parameter, "key": key, "value": point.value,
-                    "fingerprint": point.fingerprint, "scene": point.scene.raw, "result": result})
+                    "parameter": parameter, "key": key, "value": point.value, "fingerprint": point.fingerprint,
+                    "files": point.files, "sweep": point.sweep, "scene": point.scene.raw, "result": result})
             else:
-                log.warning("sweep point %d (%s = %r) failed:\n%s", point.index, key, point.value, error)
-            rows.append(_row(point, result, computed=True, error=error))
+                log.warning("sweep point %s = %r failed:\n%s", key, point.value, error)
+            rows.append(_row(point.index, point.value, point.file, result, computed=True, error=error))
+            done += 1
             if progress is not None:
-                progress(len(rows), len(points), rows[-1])
+                progress(done, len(points), rows[-1])
     finally:
         if client is not None and client[1]:
             client[0].close()
     base = points[0].scene
     meta = {"scene": base.name, "title": base.title, "units": base.units.label,
-            "unit_symbols": base.units.as_dict(), "parameter": parameter, "key": key,
-            "values": [p.value for p in points]}
-    rows = _write_summary(out, meta, rows)
-    return dict(meta, points=rows, computed=[r["index"] for r in rows if r["computed"]],
-                reused=[r["index"] for r in rows if not r["computed"]],
+            "unit_symbols": base.units.as_dict(), "parameter": parameter, "key": key}
+    rows = _write_summary(out, dict(meta, values=[r["value"] for r in sorted(rows, key=lambda r: r["index"])]),
+                          rows)
+    fresh = {p.index for p in points}
+    return dict(meta, values=[r["value"] for r in rows], points=rows,
+                computed=[r["index"] for r in rows if r["computed"]],
+                reused=[r["index"] for r in rows if not r["computed"] and r["index"] in fresh],
+                kept=[r["index"] for r in rows if r["index"] not in fresh],
                 failed=[r["index"] for r in rows if r["status"] == "error"])

@@ -16,7 +16,10 @@ from bem.checks import InputError
 
 __all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one", "positive",
            "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair", "options",
-           "names"]
+           "names", "MAX_SWEEP_POINTS", "sweep_size"]
+
+#: the most values one sweep may hold (each is a complete run; split a larger study into several sweeps)
+MAX_SWEEP_POINTS = 10_000
 
 
 class SceneError(InputError):
@@ -160,3 +163,12 @@ def number_or_pair(path, value, check):
         return (check(f"{path}[0]", value[0]), check(f"{path}[1]", value[1]))
     x = check(path, value)
     return (x, x)
+
+
+def sweep_size(name, value, n):
+    """Refuse a sweep of ``n`` points beyond :data:`MAX_SWEEP_POINTS`; ``value`` is shown (shortened)."""
+    if n > MAX_SWEEP_POINTS:
+        shown = repr(value)
+        shown = shown if len(shown) <= 60 else shown[:57] + "..."
+        raise SceneError(f"{name} = {shown} is not allowed: it gives {n} points, more than the "
+                         f"{MAX_SWEEP_POINTS} points a sweep may hold (split it into several sweeps).")

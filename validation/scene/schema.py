@@ -249,6 +249,7 @@ def sweep_spec(d, known_sections):
     values = ck.require("sweep", d, "values", "give a list of numbers, e.g. values = [0.0, 0.5, 1.0]")
     if not isinstance(values, list) or not values:
         raise ck.SceneError(f"sweep.values = {values!r} is not allowed: it must be a non-empty list.")
+    ck.sweep_size("sweep.values", values, len(values))
     for i, value in enumerate(values):
         if isinstance(value, bool) or not isinstance(value, (int, float, str)):
             raise ck.SceneError(f"sweep.values[{i}] = {value!r} is not allowed: it must be a number or a string.")

@@ -1,6 +1,6 @@
 """Report of a sweep directory written by ``contactlab sweep`` (:func:`validation.run.sweep.run_sweep`).
 
-Reads ``summary.json`` (the table of points) and ``points/point-NNN.json`` (each point's scene
+Reads ``summary.json`` (the table of points) and ``points/point-*.json`` (each point's scene
 and full result, the axial section included) and builds: the problem statement of the first
 point, a table of every point, the axial-section pressure of every point coloured by the swept
 value, and the peak pressure, contact size and approach against that value. Units as in a run's
@@ -134,7 +134,7 @@ def _figures(summary, points, work):
     path2 = plot_sweep_scalars(alpha, scalars, work / "sweep_scalars.png", name=name, ticklabels=ticks,
                                title=f"results against {key}")
     how = (f"{len(done)} computed points of {len(points)}; BEM method {first.data.get('method', '?')}, "
-           "each point a complete run of the scene with the swept key set (points/point-NNN.json).")
+           "each point a complete run of the scene with the swept key set (points/point-*.json).")
     return [Figure(path, "Contact pressure on the axial section y = 0 of every computed point, coloured by "
                          f"{key}. " + ("Each point divided by its own scales. " if first.scales() else "") + how),
             Figure(path2, f"Peak pressure, contact size (radius sqrt(A / pi) of an axisymmetric contact, else the "
