@@ -80,7 +80,7 @@ def test_nothing_listening_is_a_one_line_error(tmp_path):
     start = time.monotonic()
     with pytest.raises(SchedulerError, match=r"--scheduler = .* cannot connect"):
         _sweep(tmp_path, f"127.0.0.1:{port}")
-    assert time.monotonic() - start < 5.0
+    assert time.monotonic() - start < 20.0  # a timeout honoured, not a speed: the unbounded connect took 31 s
     assert not (tmp_path / "points").exists()
     for address in (f"127.0.0.1:{port}", ""):
         code, out, err = cli("sweep", "elliptic", "--param", "load.force", "--values", "50", "--out", tmp_path,
@@ -99,7 +99,7 @@ def test_a_server_that_is_not_dask_is_refused_quickly(tmp_path, reply, hang_up, 
         start = time.monotonic()
         with pytest.raises(SchedulerError, match=rf"--scheduler = 'tcp://127.0.0.1:{port}' .*{said}"):
             _sweep(tmp_path, f"tcp://127.0.0.1:{port}", scheduler_timeout=0.5)
-        assert time.monotonic() - start < 5.0
+        assert time.monotonic() - start < 20.0  # a timeout honoured, not a speed: the unbounded connect took 31 s
     assert not (tmp_path / "points").exists()
 
 
