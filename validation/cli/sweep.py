@@ -6,7 +6,7 @@ from pathlib import Path
 
 from bem.checks import InputError
 
-from .common import add_set
+from .common import add_set, add_trust, trust
 
 PARSER = {"help": "sweep one scene parameter (resumable, parallel)",
           "description": "Run a scene for each value of one parameter. Finished points are saved "
@@ -24,7 +24,10 @@ def add_args(p):
     p.add_argument("--out", metavar="DIR", help="sweep directory (default: results/<scene>-sweep-<param>)")
     p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address (needs dask.distributed)")
+    p.add_argument("--no-fem", action="store_true",
+                   help="skip the scene's [fem]: no FEM reference, and no need of the fem extra (gmsh, scikit-fem)")
     add_set(p)
+    add_trust(p)
 
 
 def run(args):
@@ -37,7 +40,7 @@ def run(args):
     if (args.param is None) != (values is None):
         raise InputError("--param and --values are not allowed alone: give both (or neither, to use the "
                          "scene's [sweep]).")
-    scene = load_scene(args.scene, overrides=args.overrides)
+    scene = load_scene(args.scene, overrides=args.overrides, no_fem=args.no_fem, **trust(args))
     param, _key, points = sweep_points(scene, args.param, values)
     out = Path(args.out) if args.out else Path("results") / f"{scene.name}-sweep-{param}"
     bar = tqdm(total=len(points), desc=f"sweep {param}", unit="point", disable=args.no_progress or None)
