@@ -275,7 +275,7 @@ def test_check_lists_misspelled_keys_with_the_other_errors_and_suggests_the_key(
     ("[scene]\nname = 't'\n".encode("utf-16"), "is UTF-16 text"),
     (b"[scene]\nname = 't'\nx = " + b"[" * 5000 + b"]" * 5000 + b"\n", "more than 32 levels deep"),
     (b"[scene]\nname = 't'\nx = " + b"[" * 40 + b"]" * 40 + b"\n", "more than 32 levels deep"),
-])
+], ids=["latin-1", "utf-16", "nested-5000", "nested-40"])
 def test_files_that_are_not_utf8_toml_or_nest_too_deep_are_refused(tmp_path, content, rule):
     path = tmp_path / "bad.toml"
     path.write_bytes(content)
@@ -287,7 +287,7 @@ def test_files_that_are_not_utf8_toml_or_nest_too_deep_are_refused(tmp_path, con
 @pytest.mark.parametrize("text, key", [
     (LAYER_BASE + 'law = "power"\nlam = 1e-12\ns = 1e308\n', "layer.s = 1e+308"),
     (BASE + "\n[stress]\ndepths = [0.0, 1e308]\n", "stress.depths[1] = 1e+308"),
-])
+], ids=["power-exponent", "stress-depth"])
 def test_values_beyond_their_range_are_refused_at_load(tmp_path, text, key):
     code, out, err = cli("run", _write(tmp_path, text), "--out", tmp_path / "out")
     assert code == 2 and err.startswith(f"contactlab: error: {key} is not allowed") and out == ""

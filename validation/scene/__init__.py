@@ -1,6 +1,7 @@
 """Scenes: TOML files that describe one contact problem and what to run on it (docs/scenes.md).
 
-- :mod:`validation.scene.load`: the :class:`Scene`, loading, overrides, built-in scenes;
+- :mod:`validation.scene.load`: the :class:`Scene`, loading, overrides;
+- :mod:`validation.scene.source`: the built-in scenes, reading a scene file;
 - :mod:`validation.scene.schema`: the validator of each section;
 - :mod:`validation.scene.paper`: the paper's layer parameters (``lam_over_cnn``, ``alpha_*``);
 - :mod:`validation.scene.sizing`: the lattice and candidate region from the expected contact;

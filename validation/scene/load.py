@@ -28,20 +28,19 @@ from __future__ import annotations
 import copy
 import tomllib
 from dataclasses import dataclass, field, replace
-from importlib import resources
 from pathlib import Path
 
 from ..extras import require as require_extra
-from ..provenance import display_path
 from ..units import Units
-from . import schema as sec
 from . import checks as ck
+from . import schema as sec
 from .checks import SceneError, closest
 from .measured import measured_region
 from .paper import ALIASES
 from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
 from .sizing import EXCLUSIVE as BEM_EXCLUSIVE
 from .sizing import bem_options
+from .source import builtin_path, builtin_scenes, read_source, read_toml
 from .trust import check_code_name, code_names, refuse_code, scene_file
 
 __all__ = ["Scene", "SceneError", "load_scene", "check_scene", "parse_scene", "builtin_scenes", "builtin_path",
@@ -105,30 +104,6 @@ class Scene:
     def axisymmetric(self):
         """Whether the gap is axisymmetric (contact radius and FEM reference apply)."""
         return bool(self.gap.is_axisymmetric)
-
-
-def builtin_dir():
-    """The folder of the built-in scene files."""
-    return Path(str(resources.files("validation") / "scenes"))
-
-
-def builtin_scenes():
-    """``{name: one-line description}`` of the built-in scenes, sorted by name."""
-    out = {}
-    for path in sorted(builtin_dir().glob("*.toml")):
-        with path.open("rb") as fh:
-            meta = tomllib.load(fh).get("scene", {})
-        out[path.stem] = meta.get("description") or meta.get("title", "")
-    return out
-
-
-def builtin_path(name):
-    """Path of the built-in scene ``name``; SceneError listing the names if there is none."""
-    path = builtin_dir() / f"{name}.toml"
-    if not path.is_file():
-        raise SceneError(f"scene = {name!r} is not allowed: it must be a built-in scene name ("
-                         + ", ".join(builtin_scenes()) + ") or a path to a .toml file.")
-    return path
 
 
 def parse_override(text):
@@ -359,67 +334,6 @@ def parse_scene(raw, *, source="<dict>", overrides=None, base_dir=None, allow_co
     return scene
 
 
-#: deepest nesting of arrays and tables a scene file may hold
-MAX_DEPTH = 32
-
-
-def _depth(value):
-    """Nesting depth of lists and dicts in ``value`` (iterative: any depth)."""
-    deepest, stack = 0, [(value, 0)]
-    while stack:
-        node, depth = stack.pop()
-        deepest = max(deepest, depth)
-        if deepest > MAX_DEPTH:
-            break
-        children = node.values() if isinstance(node, dict) else node if isinstance(node, list) else ()
-        stack.extend((child, depth + 1) for child in children)
-    return deepest
-
-
-def read_toml(path):
-    """The content of a scene file: UTF-8 TOML, arrays and tables nested at most :data:`MAX_DEPTH` deep.
-
-    Raises
-    ------
-    SceneError
-        An unreadable file, another encoding than UTF-8, invalid TOML or too deep a nesting.
-    """
-    name = f"scene file {str(path)!r}"
-    try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
-        raise SceneError(f"{name} is not allowed: it cannot be read ({exc.strerror}).") from None
-    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        raise SceneError(f"{name} is not allowed: it is UTF-16 text and a TOML file is UTF-8; save it as UTF-8.")
-    try:
-        text = data.decode("utf-8").removeprefix("\ufeff")
-    except UnicodeDecodeError as exc:
-        raise SceneError(f"{name} is not allowed: it must be UTF-8 text (TOML), and byte {exc.start} "
-                         f"(0x{data[exc.start]:02x}) is not UTF-8; save it as UTF-8.") from None
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{name} is not valid TOML: {exc}.") from None
-    except RecursionError:
-        raw = None
-    if raw is None or _depth(raw) > MAX_DEPTH:
-        raise SceneError(f"{name} is not allowed: it nests arrays or tables more than {MAX_DEPTH} levels deep.")
-    return raw
-
-
-def _read(source):
-    """``(raw, label, folder)`` of a built-in name or a TOML file."""
-    path = Path(source)
-    if path.suffix == ".toml" or path.exists():
-        if not path.is_file():
-            raise SceneError(f"scene = {str(source)!r} is not allowed: there is no such file.")
-        label = display_path(path)
-    else:
-        path = builtin_path(str(source))
-        label = f"builtin:{source}"
-    return read_toml(path), label, path.parent
-
-
 def load_scene(source, *, overrides=None, allow_code=False, allow_outside_files=False, no_fem=False):
     """Load and validate a scene: a built-in name, a path to a TOML file, a dict or a Scene.
 
@@ -446,7 +360,7 @@ def load_scene(source, *, overrides=None, allow_code=False, allow_outside_files=
     kw = {"allow_code": allow_code, "allow_outside_files": allow_outside_files, "no_fem": no_fem}
     if isinstance(source, dict):
         return parse_scene(source, overrides=overrides, **kw)
-    raw, label, folder = _read(source)
+    raw, label, folder = read_source(source)
     return parse_scene(raw, source=label, overrides=overrides, base_dir=folder, **kw)
 
 
@@ -459,5 +373,5 @@ def check_scene(source, *, overrides=None, allow_outside_files=False):
     if isinstance(source, dict):
         raw, label, folder = source, "<dict>", None
     else:
-        raw, label, folder = _read(source)
+        raw, label, folder = read_source(source)
     return _parse(raw, label, overrides, folder, "form", allow_outside_files)
