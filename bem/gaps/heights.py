@@ -7,6 +7,7 @@ the argument it blames and never shows the file's content.
 
 from __future__ import annotations
 
+import itertools
 import os
 import re
 
@@ -77,19 +78,22 @@ def _not_numbers(exc):
 
 
 def _load_table(file, fmt):
-    """A 2-D table of numbers from a text file (comma- or whitespace-separated)."""
+    """A 2-D table of numbers from a text file (comma- or whitespace-separated), read line by line
+    (the peak memory is about that of the table)."""
     _check_size(file, fmt)
+    rule = f"it must be a UTF-8 text table of numbers for format = {fmt!r} (blank and # lines left out)"
     try:
         with open(file, encoding="utf-8") as fh:
-            lines = [ln for ln in fh.read().splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+            lines = (ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#"))
+            first = next(lines, None)
+            if first is None:
+                _refuse("file", file, f"{rule}: it holds none")
+            delimiter = "," if "," in first else None
+            return np.loadtxt(itertools.chain([first], lines), delimiter=delimiter, ndmin=2, dtype=float)
     except (OSError, UnicodeDecodeError) as exc:
-        _refuse("file", file, f"it must be a UTF-8 text table of numbers for format = {fmt!r} ({type(exc).__name__})")
-    delimiter = "," if lines and "," in lines[0] else None
-    try:
-        return np.loadtxt(lines, delimiter=delimiter, ndmin=2, dtype=float)
+        _refuse("file", file, f"{rule} ({type(exc).__name__})")
     except ValueError as exc:
-        _refuse("file", file, f"it must be a table of numbers for format = {fmt!r} (blank and # lines left out): "
-                              f"{_not_numbers(exc)}")
+        _refuse("file", file, f"{rule}: {_not_numbers(exc)}")
 
 
 def _load_npy(file):
