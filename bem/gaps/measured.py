@@ -53,8 +53,9 @@ CENTERS = ("grid", "minimum", "file")
 def check_within(extent, x, y, *, name="extent", data="the data"):
     """Refuse a candidate region ``|x| <= X``, ``|y| <= Y`` that reaches beyond the grid ``x``, ``y``.
 
-    The one rule of :meth:`Measured.region` and of :func:`bem.solve` with a
-    :class:`RegionTable`: data are never extended beyond where they were measured.
+    The one rule of :meth:`Measured.region`, :meth:`Measured.check_region` (a scene's
+    ``bem.extent``) and :func:`bem.solve` with a :class:`RegionTable`: data are never extended
+    beyond where they were measured.
 
     Raises
     ------
@@ -175,6 +176,11 @@ class Measured:
         """No estimate of the contact size: the candidate region is the caller's."""
         return None
 
+    def check_region(self, extent, *, name="extent"):
+        """Refuse a candidate region that reaches beyond the data (:func:`check_within`)."""
+        return check_within(extent, self.x, self.y, name=name,
+                            data="the measured data" + ("" if self.file is None else f" of {self.file}"))
+
     def _refuse(self, rule):
         if self.file is None:
             raise InputError(f"z is not allowed: {rule}.")
@@ -203,8 +209,7 @@ class Measured:
             x-y-z points) at a node of the region, too few nodes for ``method``, or negative
             values of ``kind = "gap"``.
         """
-        ex, ey = check_within(extent, self.x, self.y, name=name,
-                              data="the measured data" + ("" if self.file is None else f" of {self.file}"))
+        ex, ey = self.check_region(extent, name=name)
         need = Table.MIN_POINTS[self.method]
         (i0, i1), (j0, j1) = _cover(self.x, ex, need), _cover(self.y, ey, need)
         x, y, z = self.x[i0:i1], self.y[j0:j1], self.z[i0:i1, j0:j1]

@@ -188,9 +188,10 @@ def test_missing_data_inside_the_region_is_refused(tmp_path):
     far[:3, :] = np.nan  # outside the region: fine
     np.save(tmp_path / "far.npy", far)
     load_scene(_scene(tmp_path, {"type": "measured", "file": "far.npy", "length_unit": "um", "spacing": DX}))
-    # a region larger than the data
-    assert "bem.extent" in _bad(tmp_path, {"type": "measured", "file": "far.npy", "length_unit": "um",
-                                           "spacing": DX}, extent=5e-4)
+    # a region larger than the data: the message names the data's extent (the rule of bem.gaps.Measured)
+    msg = _bad(tmp_path, {"type": "measured", "file": "far.npy", "length_unit": "um", "spacing": DX}, extent=5e-4)
+    assert msg.startswith("bem.extent = 0.0005 is not allowed: the candidate region |x| <= 0.0005, |y| <= 0.0005 "
+                          f"must lie inside the measured data of {tmp_path / 'far.npy'}, x in [-0.0004, 0.0004]")
 
 
 def test_bad_keys_are_refused_with_the_key(tmp_path):
