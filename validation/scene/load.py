@@ -250,13 +250,13 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     meta = check(sec.scene_meta, section["scene"])
     body = check(sec.bodies, section["bodies"])
     load = check(sec.load, section["load"])
-    build = code == "import" or "gap" not in coded
-    shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"], build=build), section["gap"], body, meta)
-    if code == "refuse" and coded:
-        shape = check.FAILED if "gap" in coded else shape
-    layer = check(lambda d: sec.layer(d, build=code == "import" or "layer" not in coded), raw.get("layer"))
-    if code == "refuse" and "layer" in coded:
-        layer = check.FAILED
+    if code == "refuse":  # refused above: build nothing that imports
+        section["gap"] = check.FAILED if "gap" in coded else section["gap"]
+    layer_raw = check.FAILED if code == "refuse" and "layer" in coded else raw.get("layer")
+    build = {part: code == "import" or part not in coded for part in ("gap", "layer")}
+    shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"], build=build["gap"]),
+                  section["gap"], body, meta)
+    layer = check(lambda d: sec.layer(d, build=build["layer"]), layer_raw)
     bem = check(lambda g, la, b, ld: bem_options(raw.get("bem"), g[1], *la, b["E_star"], ld), shape, layer, body, load)
     shape = check(lambda g, b: (g[0], measured_region(g[1], b["extent"])), shape, bem)
     fem = check(lambda g, b: sec.fem_options(raw.get("fem"), g[1], b["materials"]), shape, body)

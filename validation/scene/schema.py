@@ -25,9 +25,9 @@ from .measured import measured_gap
 from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law, paper_keys
 from .sizing import KEYS as BEM_KEYS
 
-__all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic",
-           "report", "sweep_spec", "stress_options", "stress_depth_bound", "scene_keys", "KEYS", "report_sections", "ANALYTIC_KINDS",
-           "DEFAULT_UNITS", "BODY_KEYS"]
+__all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic", "report", "sweep_spec",
+           "stress_options", "stress_depth_bound", "scene_keys", "KEYS", "report_sections", "ANALYTIC_KINDS",
+           "DEFAULT_UNITS", "BODY_KEYS", "Unimported"]
 
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
