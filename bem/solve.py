@@ -67,7 +67,9 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     step : float
         Lattice step ``c`` [length].
     extent : float or (float, float)
-        Half-width of the rectangular candidate region [length].
+        Half-width of the rectangular candidate region [length]. A gap with a
+        ``check_region(extent)`` method (a measured surface's table,
+        :meth:`bem.gaps.Measured.region`) refuses a region beyond its data.
     layer : bem.layers.Layer, optional
         Interface layer law ``w(p)``; ``None`` for smooth bodies.
     method : {"newton", "augmented_gap", "variable_compliance", "kalker"}
@@ -153,6 +155,8 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     if callback is not None:
         check_callable("callback", callback)
     lattice = Lattice.from_extent(step, extent)
+    if hasattr(gap, "check_region"):  # a gap known on a bounded region only (bem.gaps.RegionTable)
+        gap.check_region(extent)
     _check_layer(layer, method)
     solver = solver_for(method, layer)
     options = check_options(method, solver, options)

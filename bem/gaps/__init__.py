@@ -25,6 +25,7 @@ from ..checks import check_choice, fail
 from .base import AxisymmetricGap, Gap
 from .callable import Callable
 from .elliptic import EllipticParaboloid
+from .heights import MAX_FILE_BYTES, MAX_GRID_VALUES
 from .measured import Measured, read_heights
 from .paraboloid import Paraboloid
 from .punch import FlatPunch
@@ -32,8 +33,8 @@ from .roller import CrownedRoller, lundberg_coefficient
 from .table import Table
 
 __all__ = ["Gap", "AxisymmetricGap", "Paraboloid", "EllipticParaboloid", "CrownedRoller", "FlatPunch",
-           "Callable", "Table", "Measured", "read_heights", "GAPS", "register", "parameters", "gap_from_dict",
-           "lundberg_coefficient"]
+           "Callable", "Table", "Measured", "read_heights", "MAX_FILE_BYTES", "MAX_GRID_VALUES", "GAPS", "register",
+           "parameters", "gap_from_dict", "lundberg_coefficient"]
 
 #: The registry: ``type_name`` -> class, one line per gap type.
 GAPS = {

@@ -35,213 +35,40 @@ point at the origin).
 from __future__ import annotations
 
 import os
-import re
 
 import numpy as np
 
 from ..checks import InputError, check_choice, check_positive, fail
+from .heights import (EXTENSIONS, FORMATS, MAX_FILE_BYTES, MAX_GRID_VALUES, _positive_pair, _refuse, file_format,
+                      read_heights)
 from .table import Table, _axis
 
-__all__ = ["Measured", "RegionTable", "read_heights", "file_format", "EXTENSIONS", "FORMATS", "KINDS", "CENTERS"]
+__all__ = ["Measured", "RegionTable", "read_heights", "file_format", "EXTENSIONS", "FORMATS", "KINDS", "CENTERS",
+           "MAX_FILE_BYTES", "MAX_GRID_VALUES"]
 
-#: the format of a file by its extension
-EXTENSIONS = {".npy": "npy", ".csv": "grid", ".txt": "grid", ".dat": "grid", ".asc": "asc", ".xyz": "xyz"}
-FORMATS = ("asc", "grid", "npy", "xyz")
 KINDS = ("gap", "topography")
 CENTERS = ("grid", "minimum", "file")
-_MIN_POINTS = 4  # of the scattered points of an xyz file
-_UNIFORM = 1e-6  # relative tolerance of "evenly spaced"
 
 
-def _refuse(name, value, rule):
-    raise InputError(f"{name} = {value!r} is not allowed: {rule}.")
+def check_within(extent, x, y, *, name="extent", data="the data"):
+    """Refuse a candidate region ``|x| <= X``, ``|y| <= Y`` that reaches beyond the grid ``x``, ``y``.
 
-
-def _positive_pair(name, value):
-    """``(a, b)`` from a number (``a = b``) or a pair, each a finite real ``> 0``."""
-    if isinstance(value, (list, tuple, np.ndarray)):
-        if len(value) != 2:
-            fail(name, value, "a number or a pair of numbers")
-        return check_positive(f"{name}[0]", value[0]), check_positive(f"{name}[1]", value[1])
-    a = check_positive(name, value)
-    return a, a
-
-
-def file_format(file, format=None):
-    """The format of ``file``: ``format`` when given (checked), else from its extension (:data:`EXTENSIONS`)."""
-    if not isinstance(file, (str, os.PathLike)):
-        fail("file", file, "a file name (str or os.PathLike)")
-    suffix = os.path.splitext(os.fspath(file))[1].lower()
-    if format is None:
-        format = EXTENSIONS.get(suffix)
-        if format is None:
-            _refuse("file", os.fspath(file), f"its extension {suffix!r} does not tell the format; give format = "
-                                             f"one of {list(FORMATS)}")
-    return check_choice("format", format, FORMATS)
-
-
-def _load_table(file, fmt):
-    """A 2-D table of numbers from a text file (comma- or whitespace-separated)."""
-    try:
-        with open(file, encoding="utf-8") as fh:
-            lines = [ln for ln in fh.read().splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-        delimiter = "," if lines and "," in lines[0] else None
-        return np.loadtxt(lines, delimiter=delimiter, ndmin=2, dtype=float)
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        _refuse("file", file, f"it must be a table of numbers for format = {fmt!r} ({exc})")
-
-
-def _read_grid(file, fmt, spacing):
-    """``(x, y, z)`` of an npy or grid file: rows along y, steps ``spacing = (dx, dy)``."""
-    if fmt == "npy":
-        try:
-            z = np.load(file, allow_pickle=False)
-        except (OSError, ValueError) as exc:
-            _refuse("file", file, f"it must be a .npy file of numbers ({exc})")
-    else:
-        z = _load_table(file, fmt)
-    if z.ndim != 2 or min(z.shape) < 2 or z.dtype.kind not in "biuf":
-        _refuse("file", file, f"it must hold a 2-D array of numbers of at least 2 x 2 values, it has shape "
-                              f"{z.shape} and dtype {z.dtype} (wrong shape)")
-    z = np.array(z, dtype=float).T  # rows run along y
-    return spacing[0] * np.arange(z.shape[0]), spacing[1] * np.arange(z.shape[1]), z
-
-
-def _read_asc(file):
-    """``(x, y, z)`` of an ESRI ASCII grid, cell centres, rows turned to increasing y."""
-    header, rows = {}, []
-    try:
-        with open(file, encoding="utf-8") as fh:
-            for line in fh:
-                parts = line.split()
-                if not parts:
-                    continue
-                if len(parts) == 2 and re.match(r"^[A-Za-z_]+$", parts[0]) and not rows:
-                    header[parts[0].lower()] = float(parts[1])
-                else:
-                    rows.append([float(v) for v in parts])
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        _refuse("file", file, f"it must be an ESRI ASCII grid ({exc})")
-    need = [k for k in ("ncols", "nrows", "cellsize") if k not in header]
-    if need or not any(k in header for k in ("xllcorner", "xllcenter")):
-        _refuse("file", file, f"an ESRI ASCII grid needs the header keys ncols, nrows, xllcorner (or xllcenter), "
-                              f"yllcorner (or yllcenter), cellsize; missing {need or ['xllcorner']}")
-    nx, ny, c = int(header["ncols"]), int(header["nrows"]), header["cellsize"]
-    if len(rows) != ny or any(len(r) != nx for r in rows):
-        _refuse("file", file, f"its header says nrows = {ny}, ncols = {nx} but the data has {len(rows)} rows of "
-                              f"{sorted({len(r) for r in rows})} values (wrong shape)")
-    z = np.array(rows[::-1], dtype=float)  # first row is the northernmost
-    if "nodata_value" in header:
-        z[z == header["nodata_value"]] = np.nan
-    x0 = header.get("xllcenter", header.get("xllcorner", 0.0)) + (0.0 if "xllcenter" in header else 0.5 * c)
-    y0 = header.get("yllcenter", header.get("yllcorner", 0.0)) + (0.0 if "yllcenter" in header else 0.5 * c)
-    return x0 + c * np.arange(nx), y0 + c * np.arange(ny), z.T
-
-
-def _grid_of_points(x, y, z, file):
-    """``(xs, ys, Z)`` when the points form a complete grid (each node once), else ``None``."""
-    xs, ix = np.unique(x, return_inverse=True)
-    ys, iy = np.unique(y, return_inverse=True)
-    if xs.size * ys.size != x.size or xs.size < 2 or ys.size < 2:
-        return None
-    grid = np.full((xs.size, ys.size), np.nan)
-    seen = np.zeros(grid.shape, dtype=bool)
-    seen[ix, iy] = True
-    if not seen.all():
-        return None
-    grid[ix, iy] = z
-    for name, axis in (("x", xs), ("y", ys)):
-        step = np.diff(axis)
-        if np.abs(step - step.mean()).max() > _UNIFORM * step.mean():
-            _refuse("file", file, f"its points lie on a grid whose {name} step varies from {step.min():.6g} to "
-                                  f"{step.max():.6g} (not evenly spaced: coordinates rounded in the export?); "
-                                  "give spacing to interpolate the points onto an even grid instead")
-    return xs, ys, grid
-
-
-def _read_xyz(file, spacing):
-    """``(x, y, z)`` of an x-y-z point list: its own grid, or the points resampled (module docstring)."""
-    pts = _load_table(file, "xyz")
-    if pts.shape[1] != 3:
-        _refuse("file", file, f"an x-y-z point list needs 3 columns, it has {pts.shape[1]} (wrong shape)")
-    pts = pts[np.isfinite(pts[:, :2]).all(axis=1)]
-    if pts.shape[0] < _MIN_POINTS:
-        _refuse("file", file, f"an x-y-z point list needs at least {_MIN_POINTS} points, it has "
-                              f"{pts.shape[0]} (too few points)")
-    x, y, z = pts.T
-    if spacing is None:
-        grid = _grid_of_points(x, y, z, file)
-        if grid is not None:
-            return grid
-    from scipy.interpolate import LinearNDInterpolator
-    from scipy.spatial import QhullError, cKDTree
-
-    ok = np.isfinite(z)
-    try:
-        interp = LinearNDInterpolator(np.column_stack([x[ok], y[ok]]), z[ok])
-    except (QhullError, ValueError) as exc:
-        _refuse("file", file, f"its points must span an area (too few points, or all on one line: {exc})")
-    if spacing is None:
-        dist, _ = cKDTree(np.column_stack([x, y])).query(np.column_stack([x, y]), k=2)
-        spacing = (float(np.median(dist[:, 1])),) * 2
-    xs = np.arange(x.min(), x.max() + 1e-9 * spacing[0], spacing[0])
-    ys = np.arange(y.min(), y.max() + 1e-9 * spacing[1], spacing[1])
-    gx, gy = np.meshgrid(xs, ys, indexing="ij")
-    return xs, ys, interp(gx, gy)
-
-
-def read_heights(file, *, format=None, spacing=None, nodata=None):
-    """Read a height map (or a gap) from a file: ``(x, y, z)`` in the file's length unit.
-
-    Parameters
-    ----------
-    file : str or os.PathLike
-        The file (a relative name starts from the current directory).
-    format : {"npy", "grid", "asc", "xyz"}, optional
-        Default: from the extension (:data:`EXTENSIONS`); see the module docstring.
-    spacing : float or (float, float), optional
-        Grid step ``(dx, dy)`` [file length unit], ``> 0``; one number when ``dx = dy``.
-        Required for npy and grid files, refused for asc (it has ``cellsize``); for xyz the
-        step of the grid the points are interpolated onto.
-    nodata : float, optional
-        Value marking missing points (``.asc`` files also use their ``NODATA_value``).
-
-    Returns
-    -------
-    x, y : ndarray
-        Increasing grid coordinates [file length unit], as the file places them.
-    z : ndarray
-        ``z[i, j]`` at ``(x[i], y[j])`` [file length unit], NaN where there is no data.
+    The one rule of :meth:`Measured.region`, :meth:`Measured.check_region` (a scene's
+    ``bem.extent``) and :func:`bem.solve` with a :class:`RegionTable`: data are never extended
+    beyond where they were measured.
 
     Raises
     ------
     bem.InputError
-        Missing or unreadable file, wrong shape, too few points, a grid that is not evenly
-        spaced, no finite value, or a bad argument; the message starts with its name.
+        ``{name} = extent is not allowed``, naming the data's extent.
     """
-    fmt = file_format(file, format)
-    file = os.fspath(file)
-    if not os.path.isfile(file):
-        _refuse("file", file, "there is no such file" + ("" if os.path.isabs(file) else f" in {os.getcwd()}"))
-    if spacing is None and fmt in ("npy", "grid"):
-        raise InputError(f"spacing is missing: a {fmt!r} file holds heights only; give the grid step (dx, dy) "
-                         "(or one number) in the file's length unit.")
-    if spacing is not None and fmt == "asc":
-        _refuse("spacing", spacing, "an ESRI grid states its own step (cellsize); leave spacing out")
-    spacing = None if spacing is None else _positive_pair("spacing", spacing)
-    if nodata is not None and (isinstance(nodata, bool) or not isinstance(nodata, (int, float, np.number))):
-        fail("nodata", nodata, "a number (the value that marks a missing point)")
-    if fmt == "asc":
-        x, y, z = _read_asc(file)
-    elif fmt == "xyz":
-        x, y, z = _read_xyz(file, spacing)
-    else:
-        x, y, z = _read_grid(file, fmt, spacing)
-    if nodata is not None:
-        z[z == nodata] = np.nan
-    if not np.isfinite(z).any():
-        _refuse("file", file, "it holds no finite value")
-    return x, y, z
+    ex, ey = _positive_pair(name, extent)
+    tol = 1e-9
+    if -ex < x[0] - tol * ex or ex > x[-1] + tol * ex or -ey < y[0] - tol * ey or ey > y[-1] + tol * ey:
+        _refuse(name, extent, f"the candidate region |x| <= {ex:.6g}, |y| <= {ey:.6g} must lie inside {data}, "
+                              f"x in [{x[0]:.6g}, {x[-1]:.6g}], y in [{y[0]:.6g}, {y[-1]:.6g}] (data are not "
+                              "extended beyond where they were measured); make it smaller")
+    return ex, ey
 
 
 class RegionTable(Table):
@@ -250,12 +77,17 @@ class RegionTable(Table):
 
     The lattice evaluates the gap at every node of its brick array, including the masked node
     half a step beyond the region at the end of each odd row (a coarser step in nested solves);
-    those values are never used. Every candidate node is inside (:meth:`Measured.region`).
+    those values are never used. Every candidate node is inside: :meth:`Measured.region` makes
+    it so, and :func:`bem.solve` calls :meth:`check_region` with its ``extent``.
     """
 
     def _inside(self, name, v, other):
         axis = self.x if name == "x" else self.y
         return np.clip(v, axis[0], axis[-1])
+
+    def check_region(self, extent, *, name="extent"):
+        """Refuse a candidate region beyond the table's grid (:func:`check_within`)."""
+        check_within(extent, self.x, self.y, name=name, data="the measured data of this gap table")
 
 
 def _cover(axis, half, need):
@@ -344,6 +176,11 @@ class Measured:
         """No estimate of the contact size: the candidate region is the caller's."""
         return None
 
+    def check_region(self, extent, *, name="extent"):
+        """Refuse a candidate region that reaches beyond the data (:func:`check_within`)."""
+        return check_within(extent, self.x, self.y, name=name,
+                            data="the measured data" + ("" if self.file is None else f" of {self.file}"))
+
     def _refuse(self, rule):
         if self.file is None:
             raise InputError(f"z is not allowed: {rule}.")
@@ -368,10 +205,11 @@ class Measured:
         Raises
         ------
         bem.InputError
-            Missing data (NaN, NODATA, outside the hull of x-y-z points) at a node of the
-            region, too few nodes for ``method``, or negative values of ``kind = "gap"``.
+            A region reaching beyond the data, missing data (NaN, NODATA, outside the hull of
+            x-y-z points) at a node of the region, too few nodes for ``method``, or negative
+            values of ``kind = "gap"``.
         """
-        ex, ey = _positive_pair(name, extent)
+        ex, ey = self.check_region(extent, name=name)
         need = Table.MIN_POINTS[self.method]
         (i0, i1), (j0, j1) = _cover(self.x, ex, need), _cover(self.y, ey, need)
         x, y, z = self.x[i0:i1], self.y[j0:j1], self.z[i0:i1, j0:j1]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_nonnegative, check_positive
+from ..checks import check_nonnegative, check_positive, check_range
 from ._common import LawBase, as_closure, as_pressure, out
 
 __all__ = ["Linear", "Power", "Root", "Bilinear", "ElasticRigid"]
@@ -67,7 +67,7 @@ class Power(LawBase):
     lam : float
         Coefficient [length/pressure**s], ``> 0``.
     s : float
-        Exponent [-], ``> 0`` (``s < 1``: stiffening, typical of roughness).
+        Exponent [-], in ``(0, MAX_EXPONENT]`` (``s < 1``: stiffening, typical of roughness).
 
     Notes
     -----
@@ -78,10 +78,13 @@ class Power(LawBase):
 
     law = "power"
     _required = ("lam", "s")
+    #: largest exponent ``s``: larger ones describe no interface layer, and ``p**s`` overflows
+    #: for pressures in Pa once ``s`` exceeds about 34
+    MAX_EXPONENT = 10.0
 
     def __init__(self, lam, s):
         self.lam = check_positive("lam", lam)
-        self.s = check_positive("s", s)
+        self.s = check_range("s", s, 0.0, self.MAX_EXPONENT, low_open=True)
 
     def _params(self):
         return {"lam": self.lam, "s": self.s}

@@ -91,7 +91,11 @@ def test_measured_does_not_modify_its_arrays():
     copies = [a.copy() for a in (x, y, z)]
     for center in ("grid", "minimum", "file"):
         gap = Measured(x, y, z, center=center, kind="topography")
-        gap.region(0.5)
+        if all(lo <= -0.5 and hi >= 0.5 for lo, hi in gap.domain):
+            gap.region(0.5)
+        else:  # the origin is near an edge of the data: no region |x|, |y| <= 0.5 inside them
+            with pytest.raises(InputError, match="must lie inside the measured data"):
+                gap.region(0.5)
         for a, b in zip((x, y, z), copies):
             np.testing.assert_array_equal(a, b)
     assert Measured(x, y, z, center="file").x[0] == x[0]
@@ -127,3 +131,76 @@ def test_errors_name_the_argument(tmp_path):
         Measured(x, y, z - 1.0).region(0.3)
     with pytest.raises(InputError, match=r"^z.shape = \(25, 21\) is not allowed"):
         Measured(x, y, z.T)
+
+
+def test_files_that_are_not_height_maps_say_what_they_are(tmp_path):
+    (tmp_path / "empty.npy").write_bytes(b"")
+    (tmp_path / "zeros.npy").write_bytes(bytes(4096))
+    np.save(tmp_path / "full.npy", np.ones((30, 40)))
+    (tmp_path / "cut.npy").write_bytes((tmp_path / "full.npy").read_bytes()[:-100])
+    np.save(tmp_path / "flat.npy", np.ones(0))
+    for name in ("empty", "zeros"):
+        with pytest.raises(InputError, match=rf"^file = .*{name}.npy' is not allowed: it is not a valid .npy file: it "
+                                             "does not start with the .npy header"):
+            read_heights(tmp_path / f"{name}.npy", spacing=1.0)
+    with pytest.raises(InputError, match=r"cut.npy' is not allowed: it is not a valid .npy file: .*shorter"):
+        read_heights(tmp_path / "cut.npy", spacing=1.0)
+    with pytest.raises(InputError, match=r"flat.npy' is not allowed: .*2-D array .* shape \(0,\)"):
+        read_heights(tmp_path / "flat.npy", spacing=1.0)
+
+
+def test_asc_cellsize_must_be_positive(tmp_path):
+    head = "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize {}\n1 2 3\n4 5 6\n"
+    for cellsize in ("0", "-1", "nan"):
+        (tmp_path / "s.asc").write_text(head.format(cellsize))
+        with pytest.raises(InputError, match=r"^file = .*s.asc' is not allowed: its header has cellsize = "):
+            read_heights(tmp_path / "s.asc")
+
+
+def test_large_files_and_grids_are_refused_before_they_are_read(tmp_path, monkeypatch):
+    rng = np.random.default_rng(3)
+    pts = rng.uniform(0.0, 1.0, (50, 3))
+    np.savetxt(tmp_path / "p.xyz", pts)
+    # 1e6 x 1e6 nodes: refused by the size the step implies, before any grid is allocated
+    with pytest.raises(InputError, match=r"^spacing = \(1e-06, 1e-06\) is not allowed: .* more than 67108864"):
+        read_heights(tmp_path / "p.xyz", spacing=1e-6)
+    size = (tmp_path / "p.xyz").stat().st_size
+    monkeypatch.setattr("bem.gaps.heights.MAX_FILE_BYTES", size - 1)
+    monkeypatch.setattr("builtins.open", None)  # the file is refused by its size, never opened
+    with pytest.raises(InputError, match=rf"^file = .*p.xyz' is not allowed: it holds {size} bytes, more than"):
+        read_heights(tmp_path / "p.xyz")
+    monkeypatch.undo()
+    monkeypatch.setattr("bem.gaps.heights.MAX_GRID_VALUES", 30 * 40 - 1)
+    np.save(tmp_path / "full.npy", np.ones((30, 40)))
+    with pytest.raises(InputError, match=r"full.npy' is not allowed: its array of shape \(30, 40\) holds more"):
+        read_heights(tmp_path / "full.npy", spacing=1.0)
+
+
+def test_errors_never_show_the_files_content(tmp_path):
+    (tmp_path / "secret.csv").write_text("1,2,3\n4,root:x:0:0,6\n")
+    (tmp_path / "secret.asc").write_text("ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\nroot:x 3\n")
+    for name, kw, where in (("secret.csv", {"spacing": 1.0}, "data row 2, column 2"),
+                            ("secret.csv", {"format": "xyz"}, "data row 2, column 2"),
+                            ("secret.asc", {}, "line 7")):
+        with pytest.raises(InputError) as info:
+            read_heights(tmp_path / name, **kw)
+        assert where in str(info.value) and "root" not in str(info.value).replace(str(tmp_path), "")
+
+
+def test_a_region_beyond_the_data_is_refused_naming_the_data_extent():
+    x, y, z = _grid()  # x in [-1, 1], y in [-1.2, 1.2]
+    gap = Measured(x, y, z)
+    with pytest.raises(InputError, match=r"^extent = 1.5 is not allowed: the candidate region \|x\| <= 1.5, "
+                                         r"\|y\| <= 1.5 must lie inside the measured data, x in \[-1, 1\], "
+                                         r"y in \[-1.2, 1.2\]"):
+        gap.region(1.5)
+    with pytest.raises(InputError, match=r"^X = \(0.5, 1.3\) is not allowed: .* y in \[-1.2, 1.2\]"):
+        gap.region((0.5, 1.3), name="X")
+    table = gap.region(1.0)  # the whole data: allowed
+    import bem
+
+    kw = dict(E_star=1.0, force=1e-3, step=0.05)
+    with pytest.raises(InputError, match=r"^extent = 2.0 is not allowed: .*measured data of this gap table, x in "
+                                         r"\[-1, 1\]"):
+        bem.solve(table, extent=2.0, **kw)
+    assert bem.solve(gap.region(0.5), extent=0.5, **kw).converged

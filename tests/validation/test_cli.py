@@ -196,3 +196,48 @@ def test_report_progress_bar_shows_the_stages_on_stderr(monkeypatch):
     bar.close()
     text = err.getvalue()
     assert "layer laws" in text and "parameter sweeps" in text and "2/3" in text
+
+
+@pytest.fixture
+def core_install(monkeypatch):
+    """gmsh and scikit-fem missing, as in a core install (validation.extras.missing answers so)."""
+    from validation import extras
+
+    real = extras.missing
+    monkeypatch.setattr(extras, "missing", lambda extra: [("gmsh", "not installed"), ("skfem", "not installed")]
+                        if extra == "fem" else real(extra))
+    monkeypatch.setitem(sys.modules, "skfem", None)  # an import of the FEM would fail
+    monkeypatch.setitem(sys.modules, "gmsh", None)
+
+
+def test_no_fem_runs_a_builtin_scene_on_a_core_install(tmp_path, core_install):
+    small = ["--set", "bem.nodes_across=16"]
+    code, out, err = cli("run", "hertz", "--out", tmp_path / "fem", *small)
+    assert code == 2 and "install contactlab[fem]" in err and not (tmp_path / "fem").exists()
+    code, out, err = cli("run", "hertz", "--no-fem", "--out", tmp_path / "r", *small)
+    assert code == 0, err
+    result = json.loads((tmp_path / "r" / "result.json").read_text())
+    assert result["converged"] and "fem" not in result and result["analytic"]["kind"] == "hertz"
+    assert "FEM reference skipped" in out and "FEM reference skipped" in " ".join(result["messages"])
+    assert "[fem]" not in (tmp_path / "r" / "scene.toml").read_text()
+    code, out, err = cli("sweep", "hertz", "--no-fem", "--param", "load.force", "--values", "50,100",
+                         "--workers", "1", "--out", tmp_path / "s", *small)
+    assert code == 0, err
+    code, out, err = cli("check", "hertz")
+    assert code == 2 and "--no-fem" in err
+
+
+def test_run_summary_prints_any_value_of_a_result():
+    from validation.cli.run import _summary
+
+    result = {"scene": "s", "title": "t", "units": "SI", "unit_symbols": {"length": "m", "pressure": "Pa",
+                                                                          "force": "N"},
+              "p_max": None, "fem": {"p_max": 0.0}, "analytic": {"kind": "hertz", "p_max": None},
+              "contact_radius": None, "contact_area": 1e308, "force": 100.0, "approach": None,
+              "alpha_b": None, "converged": False, "method": "newton", "iterations": 3, "kkt_residual": None,
+              "wall_time_s": {"bem": 0.5, "fem": None}, "messages": ["BEM did not converge"],
+              "stress": {"bodies": {"body1": {"location_of_max": [0.0, 0.0, 1e308], "max_von_mises": None,
+                                              "max_tresca": None}}}, "files": {"result": "result.json"}}
+    text = _summary(result, "out")
+    assert "p_max      - Pa   (FEM 0)   (hertz -)" in text and "approach - m" in text
+    assert "area 1e+308 m^2" in text and "at depth 1e+308 m" in text and "KKT residual -" in text

@@ -119,8 +119,8 @@ def test_relative_file_follows_the_scene_and_the_result_reloads(tmp_path, monkey
     run_scene(str(scene), tmp_path / "out")
     saved = (tmp_path / "out" / "scene.toml").read_text()
     assert str(tmp_path / "data" / "surface.npy") in saved  # absolute in the effective scene
-    monkeypatch.chdir(tmp_path / "out")
-    again = execute_scene("scene.toml").bem
+    monkeypatch.chdir(tmp_path / "out")  # the file lies outside the effective scene's folder: opt in
+    again = execute_scene(load_scene("scene.toml", allow_outside_files=True)).bem
     _assert_same(again, paraboloid)
     result = json.loads((tmp_path / "out" / "result.json").read_text())
     assert result["converged"]
@@ -146,7 +146,7 @@ def test_bad_files_are_refused_with_the_key(tmp_path):
     assert msg.startswith(f"gap.file = {str(tmp_path / 'none.npy')!r}") and "no such file" in msg  # where it looked
     # unreadable: not an npy, and text that is not numbers
     (tmp_path / "junk.npy").write_bytes(b"\x00\x01 not numpy at all")
-    assert "gap.file" in _bad(tmp_path, {**ok, "file": "junk.npy"}) and ".npy file of numbers" in \
+    assert "gap.file" in _bad(tmp_path, {**ok, "file": "junk.npy"}) and "not a valid .npy file" in \
         _bad(tmp_path, {**ok, "file": "junk.npy"})
     (tmp_path / "words.csv").write_text("1,2,3\n4,five,6\n7,8,9\n")
     assert "table of numbers" in _bad(tmp_path, {**ok, "file": "words.csv"})
@@ -188,9 +188,10 @@ def test_missing_data_inside_the_region_is_refused(tmp_path):
     far[:3, :] = np.nan  # outside the region: fine
     np.save(tmp_path / "far.npy", far)
     load_scene(_scene(tmp_path, {"type": "measured", "file": "far.npy", "length_unit": "um", "spacing": DX}))
-    # a region larger than the data
-    assert "bem.extent" in _bad(tmp_path, {"type": "measured", "file": "far.npy", "length_unit": "um",
-                                           "spacing": DX}, extent=5e-4)
+    # a region larger than the data: the message names the data's extent (the rule of bem.gaps.Measured)
+    msg = _bad(tmp_path, {"type": "measured", "file": "far.npy", "length_unit": "um", "spacing": DX}, extent=5e-4)
+    assert msg.startswith("bem.extent = 0.0005 is not allowed: the candidate region |x| <= 0.0005, |y| <= 0.0005 "
+                          f"must lie inside the measured data of {tmp_path / 'far.npy'}, x in [-0.0004, 0.0004]")
 
 
 def test_bad_keys_are_refused_with_the_key(tmp_path):

@@ -250,3 +250,45 @@ def test_errors_of_dependent_sections_are_not_repeated(tmp_path):
         load_scene(_write(tmp_path, text))
     keys = sorted(e.split()[0] for e in info.value.errors)
     assert keys == ["bodies.E1", "report.format", "solver"]
+
+
+def test_check_lists_misspelled_keys_with_the_other_errors_and_suggests_the_key(tmp_path):
+    """Misspelled keys of sections that wait for a failed one ([bem], [fem], [stress] need
+    [bodies]) are listed in the same pass, each with the closest known key."""
+    text = (BASE.replace("nu1 = 0.3", "nu1 = 0.7").replace("force = 100.0", "force = -5.0")
+            .replace("nodes_across = 16", "nodes_acros = 16\nextent_factr = 2.0")
+            + "\n[fem]\nn_contct = 8\n\n[stress]\ndepht = [0.0]\n\n[reprot]\nformat = 'html'\n")
+    path = _write(tmp_path, text)
+    code, out, err = cli("check", path)
+    lines = err.strip().splitlines()
+    assert code == 2 and out == ""
+    expected = {"bodies.nu1": "", "load.force": "", "bem.nodes_acros": "Did you mean 'nodes_across'?",
+                "bem.extent_factr": "Did you mean 'extent_factor'?", "fem.n_contct": "Did you mean 'n_contact'?",
+                "stress.depht": "Did you mean 'depths'?", "reprot": "Did you mean 'report'?"}
+    assert sorted(line.split()[2] for line in lines) == sorted(expected)
+    for line in lines:
+        assert line.endswith(expected[line.split()[2]])
+
+
+@pytest.mark.parametrize("content, rule", [
+    ("[scene]\nname = 'caf\u00e9'\n".encode("latin-1"), "must be UTF-8 text"),
+    ("[scene]\nname = 't'\n".encode("utf-16"), "is UTF-16 text"),
+    (b"[scene]\nname = 't'\nx = " + b"[" * 5000 + b"]" * 5000 + b"\n", "more than 32 levels deep"),
+    (b"[scene]\nname = 't'\nx = " + b"[" * 40 + b"]" * 40 + b"\n", "more than 32 levels deep"),
+], ids=["latin-1", "utf-16", "nested-5000", "nested-40"])
+def test_files_that_are_not_utf8_toml_or_nest_too_deep_are_refused(tmp_path, content, rule):
+    path = tmp_path / "bad.toml"
+    path.write_bytes(content)
+    code, out, err = cli("check", path)
+    assert code == 2 and out == "" and err.startswith(f"contactlab: error: scene file {str(path)!r} is not")
+    assert rule in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("text, key", [
+    (LAYER_BASE + 'law = "power"\nlam = 1e-12\ns = 1e308\n', "layer.s = 1e+308"),
+    (BASE + "\n[stress]\ndepths = [0.0, 1e308]\n", "stress.depths[1] = 1e+308"),
+], ids=["power-exponent", "stress-depth"])
+def test_values_beyond_their_range_are_refused_at_load(tmp_path, text, key):
+    code, out, err = cli("run", _write(tmp_path, text), "--out", tmp_path / "out")
+    assert code == 2 and err.startswith(f"contactlab: error: {key} is not allowed") and out == ""
+    assert not (tmp_path / "out").exists()

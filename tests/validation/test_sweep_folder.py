@@ -14,7 +14,7 @@ import validation.run.runner as runner
 from validation.io import OutputError
 from validation.run import run_scene
 from validation.run.sweep import parse_values, run_sweep, sweep_points
-from validation.scene import SceneError
+from validation.scene import SceneError, load_scene
 
 from .conftest import cli
 
@@ -124,7 +124,7 @@ def test_a_swept_file_whose_contents_changed_is_refused(tmp_path):
         (tmp_path / name).mkdir()
         _measured_scene(tmp_path / name, R)
     files = [str(tmp_path / "a" / "surface.npy"), str(tmp_path / "b" / "surface.npy")]
-    scene = tmp_path / "a" / "scene.toml"
+    scene = load_scene(tmp_path / "a" / "scene.toml", allow_outside_files=True)  # b/ lies outside a/
     out = tmp_path / "sweep"
     first = run_sweep(scene, out, parameter="gap.file", values=files, workers=1)
     assert first["computed"] == [0, 1]

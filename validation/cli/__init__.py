@@ -45,6 +45,8 @@ examples:
   contactlab check my_scene.toml                     validate a scene, run nothing
   contactlab run hertz                               BEM + FEM + Hertz; writes results/hertz/
   contactlab run paper_root --out out/root           choose the result directory
+  contactlab run hertz --no-fem                      BEM + Hertz without the FEM reference (core install)
+  contactlab run my.toml --allow-code                a scene naming Python code you trust (layer.w, ...)
   contactlab run hertz --set bem.nodes_across=80 --set load.force=200
                                                      override scene keys (dotted, TOML values)
   contactlab run paper_elastic_rigid --set alpha_a=0.25
@@ -63,6 +65,9 @@ iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.
 effective scene, re-runnable), bem_field.vtu, fem_field.vtu and stress_field.vtu (open in ParaView).
 Written whole or not at all. Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
 scene is listed), or an unknown option.
+
+A scene file is data: the Python code it names is imported only with --allow-code, and the
+files it names are read only inside its folder unless --allow-outside-files (docs/scenes.md).
 """
 
 

@@ -2,24 +2,33 @@
 
 from __future__ import annotations
 
-from .common import add_set
+from .common import add_set, add_trust
 
 PARSER = {"help": "validate a scene without running it",
-          "description": "Validate a scene (and every point of its sweep); run nothing.",
+          "description": "Validate a scene (and every point of its sweep); run nothing. Every error is "
+                         "listed at once. Python code the scene names is checked for its form, never "
+                         "imported.",
           "epilog": "examples:\n  contactlab check my.toml\n  contactlab check hertz --set load.force=-1"}
 
 
 def add_args(p):
     p.add_argument("scene", metavar="SCENE")
     add_set(p)
+    add_trust(p, code=False)
 
 
 def run(args):
-    from ..scene import load_scene
+    from ..extras import require as require_extra
+    from ..scene import check_scene
 
-    scene = load_scene(args.scene, overrides=args.overrides)
+    scene = check_scene(args.scene, overrides=args.overrides, allow_outside_files=args.allow_outside_files)
+    if scene.fem is not None:
+        require_extra("fem", f"[fem] of scene {scene.name!r} (the FEM reference; contactlab run --no-fem skips it)")
     parts = ["bem"] + [k for k in ("fem", "analytic", "sweep", "stress", "report") if getattr(scene, k) is not None]
     b = scene.bem
     print(f"{scene.name}: OK ({', '.join(parts)}); lattice step {b['step']:.4g}, region "
           f"{b['extent'][0]:.4g} x {b['extent'][1]:.4g}, {b['n_nodes']} nodes   [units {scene.units.label}]")
+    for key, name in scene.unimported:
+        print(f"note: {key} = {name!r} names Python code, not imported here; run the scene with --allow-code "
+              "if you trust it.")
     return 0

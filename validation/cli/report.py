@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 
-from .common import add_set
+from .common import add_set, add_trust
 
 #: measured wall time of `contactlab report paper --quick` and of the full paper report on 2 cores shared
 #: with other jobs (load 2.3-5; CPU time 15-18 s and 36-42 s)
@@ -44,6 +44,7 @@ def add_args(p):
                    help=f"'paper' only: a coarse preview (a_H/c = 8, short sweeps): {QUICK_TIME} instead of "
                         f"{FULL_TIME} on 2 cores")
     add_set(p, "scene targets only: ")
+    add_trust(p, scope="scene targets only: ")
 
 
 class _ReportBar:

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
-from .common import add_set
+from .common import add_set, add_trust, trust
 
 PARSER = {"help": "run a scene and write its result directory",
           "description": "Run a scene: the BEM, and the FEM/closed form/comparison it names.",
@@ -15,37 +16,58 @@ PARSER = {"help": "run a scene and write its result directory",
 def add_args(p):
     p.add_argument("scene", metavar="SCENE", help="built-in scene name or path to a .toml file")
     p.add_argument("--out", metavar="DIR", help="result directory (default: results/<scene name>)")
+    p.add_argument("--no-fem", action="store_true",
+                   help="skip the scene's [fem]: no FEM reference, and no need of the fem extra (gmsh, scikit-fem)")
     add_set(p)
+    add_trust(p)
+
+
+def _g(value, spec=".6g"):
+    """``value`` formatted by ``spec``; ``-`` for a missing (``None``) or non-numeric value."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return "-"
+    return format(value, spec)
+
+
+def _relative(value, reference):
+    """``(value - reference) / reference`` in percent, or ``""`` when it is not a finite number."""
+    if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in (value, reference)) or reference == 0:
+        return ""
+    change = 100 * (value - reference) / reference
+    return f", {change:+.2f} %" if math.isfinite(change) else ""
 
 
 def _summary(result, out_dir):
-    """The lines ``contactlab run`` prints: the result's numbers with their units, and its files."""
+    """The lines ``contactlab run`` prints: the result's numbers with their units, and its files.
+
+    Any number may be ``None`` (a non-finite value in ``result.json``): it prints as ``-``.
+    """
     L, Pa, N = ((result.get("unit_symbols") or {}).get(k, "") for k in ("length", "pressure", "force"))
     lines = [f"scene      {result['scene']}: {result['title']}   [units {result['units']}]"]
-    p_line = f"p_max      {result['p_max']:.6g} {Pa}"
+    p_line = f"p_max      {_g(result['p_max'])} {Pa}"
     for ref in (result.get("fem"), result.get("analytic")):
         if ref is not None:  # the closed form names its kind, the FEM summary has none
             f = ref["p_max"]
-            p_line += f"   ({ref.get('kind', 'FEM')} {f:.6g}, {100 * (result['p_max'] - f) / f:+.2f} %)"
+            p_line += f"   ({ref.get('kind', 'FEM')} {_g(f)}{_relative(result['p_max'], f)})"
     lines.append(p_line)
     if "contact_radius" in result:
-        lines.append(f"contact    radius {result['contact_radius']:.6g} {L}, area {result['contact_area']:.6g} {L}^2")
+        lines.append(f"contact    radius {_g(result['contact_radius'])} {L}, area {_g(result['contact_area'])} {L}^2")
     else:
         ext = result["contact_extent"]
-        lines.append(f"contact    |x| <= {ext['x']:.6g} {L}, |y| <= {ext['y']:.6g} {L}, "
-                     f"area {result['contact_area']:.6g} {L}^2")
-    lines.append(f"load       force {result['force']:.6g} {N}, approach {result['approach']:.6g} {L}")
+        lines.append(f"contact    |x| <= {_g(ext['x'])} {L}, |y| <= {_g(ext['y'])} {L}, "
+                     f"area {_g(result['contact_area'])} {L}^2")
+    lines.append(f"load       force {_g(result['force'])} {N}, approach {_g(result['approach'])} {L}")
     if "alpha_b" in result:
-        lines.append(f"layer      alpha_b = p_max^root / p_max^lambda = {result['alpha_b']:.4f}")
+        lines.append(f"layer      alpha_b = p_max^root / p_max^lambda = {_g(result['alpha_b'], '.4f')}")
     conv = "yes" if result["converged"] else "NO"
     lines.append(f"converged  {conv} ({result['method']}, {result['iterations']} iterations, "
-                 f"KKT residual {result['kkt_residual']:.2e})")
-    times = ", ".join(f"{k} {v:.2f} s" for k, v in result["wall_time_s"].items() if v is not None)
+                 f"KKT residual {_g(result['kkt_residual'], '.2e')})")
+    times = ", ".join(f"{k} {_g(v, '.2f')} s" for k, v in result["wall_time_s"].items() if v is not None)
     lines.append(f"time       {times}")
     for name, body in (result.get("stress") or {}).get("bodies", {}).items():
         x, y, z = body["location_of_max"]
-        lines.append(f"stress     {name}: max von Mises {body['max_von_mises']:.6g} {Pa} at depth {z:.6g} {L} "
-                     f"(x {x:.3g}, y {y:.3g}), max shear {body['max_tresca']:.6g} {Pa}")
+        lines.append(f"stress     {name}: max von Mises {_g(body['max_von_mises'])} {Pa} at depth {_g(z)} {L} "
+                     f"(x {_g(x, '.3g')}, y {_g(y, '.3g')}), max shear {_g(body['max_tresca'])} {Pa}")
     lines += [f"note       {msg}" for msg in result["messages"]]
     if out_dir is not None:
         lines.append(f"files      {out_dir}/ ({', '.join(result['files'].values())})")
@@ -77,7 +99,7 @@ def run(args):
     from ..run import execute_scene, planned_stages, write_outputs
     from ..scene import load_scene
 
-    scene = load_scene(args.scene, overrides=args.overrides)
+    scene = load_scene(args.scene, overrides=args.overrides, no_fem=args.no_fem, **trust(args))
     out_dir = Path(args.out) if args.out else Path("results") / scene.name
     bar = _StageBar(planned_stages(scene, write=True), args.no_progress or None)
     try:

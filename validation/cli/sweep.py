@@ -8,7 +8,7 @@ from bem.checks import InputError
 
 from ..run.cluster import DEFAULT_TIMEOUT
 from ..scene.checks import MAX_SWEEP_POINTS
-from .common import add_set
+from .common import add_set, add_trust, trust
 
 PARSER = {"help": "sweep one scene parameter (resumable, parallel)",
           "description": "Run a scene for each value of one parameter. Finished points are saved "
@@ -35,7 +35,10 @@ def add_args(p):
                                                           "(needs dask.distributed)")
     p.add_argument("--scheduler-timeout", type=float, default=DEFAULT_TIMEOUT, metavar="S",
                    help=f"seconds allowed to reach the scheduler (default {DEFAULT_TIMEOUT:g})")
+    p.add_argument("--no-fem", action="store_true",
+                   help="skip the scene's [fem]: no FEM reference, and no need of the fem extra (gmsh, scikit-fem)")
     add_set(p)
+    add_trust(p)
 
 
 def run(args):
@@ -48,7 +51,7 @@ def run(args):
     if (args.param is None) != (values is None):
         raise InputError("--param and --values are not allowed alone: give both (or neither, to use the "
                          "scene's [sweep]).")
-    scene = load_scene(args.scene, overrides=args.overrides)
+    scene = load_scene(args.scene, overrides=args.overrides, no_fem=args.no_fem, **trust(args))
     param, _key, points = sweep_points(scene, args.param, values)
     out = Path(args.out) if args.out else Path("results") / f"{scene.name}-sweep-{param}"
     bar = tqdm(total=len(points), desc=f"sweep {param}", unit="point", disable=args.no_progress or None)

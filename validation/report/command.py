@@ -19,7 +19,9 @@ DEFAULT_PAPER_OUT = Path("reports") / "paper"
 #: which targets each option applies to (option -> (attribute, default, kinds))
 OPTIONS = {"--quick": ("quick", False, ("paper",)),
            "--units": ("units", None, ("scene", "results", "sweep")),
-           "--set": ("overrides", [], ("scene",))}
+           "--set": ("overrides", [], ("scene",)),
+           "--allow-code": ("allow_code", False, ("scene",)),
+           "--allow-outside-files": ("allow_outside_files", False, ("scene",))}
 
 
 def target_kind(target):
@@ -78,7 +80,8 @@ def build_from_args(args, progress=None):
         ``out`` (optional): the report directory (default ``reports/paper`` for ``paper``,
         ``TARGET/report`` for a directory); ``quick`` (bool, paper only): coarse preview;
         ``units`` (``"auto"``, ``"scene"``, ``"dimensionless"``; scenes, results and sweeps);
-        ``overrides`` (list of ``KEY=VALUE``; scenes only); ``format`` (``"png"``,
+        ``overrides`` (list of ``KEY=VALUE``; scenes only); ``allow_code`` and
+        ``allow_outside_files`` (scenes only, :mod:`validation.scene.trust`); ``format`` (``"png"``,
         ``"svg"``, ``"pdf"``): the figure files.
     progress : callable, optional
         ``progress(stage, done, total)`` at the start of each stage and at the end
@@ -123,11 +126,15 @@ def build_from_args(args, progress=None):
     if kind == "results":
         return report_results_dir(target, out, units=units, fmt=fmt, progress=progress)
     from validation.run import run_scene
+    from validation.scene import load_scene
 
     base = Path(out) if out is not None else Path("results") / Path(target).stem
     if progress is not None:
         progress("running the scene", 0, 1)
-    run_scene(target, base / "result", overrides=getattr(args, "overrides", None) or None)
+    scene = load_scene(target, overrides=getattr(args, "overrides", None) or None,
+                       allow_code=bool(getattr(args, "allow_code", False)),
+                       allow_outside_files=bool(getattr(args, "allow_outside_files", False)))
+    run_scene(scene, base / "result")
     return report_results_dir(base / "result", base / "report", units=units, fmt=fmt, progress=progress)
 
 

@@ -20,7 +20,9 @@ from bem.files import write_result_vtu, write_stress_vtu, write_text, write_vtu
 from ..compare import compare
 from ..io import atomic_directory, atomic_write_json
 from ..scene import paper
+from ..scene.checks import SceneError
 from ..scene.load import Scene, load_scene
+from ..scene.trust import refuse_code
 from ..scene.sizing import DOMAIN_MARGIN, SOLVER_KEYS, inner_domain
 from .result import build_result
 
@@ -143,7 +145,11 @@ def execute_scene(scene, *, progress=None, overrides=None):
     t0 = time.perf_counter()
     if not isinstance(scene, Scene) or overrides:
         scene = load_scene(scene, overrides=overrides)
+    if scene.unimported:
+        raise SceneError(refuse_code(*scene.unimported[0]))
     messages, times = [], {"bem": None, "fem": None, "layer_reference": None}
+    if "fem" in scene.skipped:
+        messages.append("FEM reference skipped: the scene's [fem] was not run (no_fem).")
     solve, calibrate = _BemRunner(scene, messages), _BemRunner(scene, messages, calibration=True)
     if "layer" in planned_stages(scene):
         _notify(progress, "layer", "start")

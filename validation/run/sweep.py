@@ -170,7 +170,7 @@ def sweep_points(scene, parameter=None, values=None, *, overrides=None):
     if isinstance(parameter, str) and isinstance(values, list | tuple):
         values = [_typed(raw, ALIASES.get(parameter, parameter), v) for v in values]
     raw["sweep"] = {"parameter": parameter, "values": list(values)}
-    checked = parse_scene(raw, source=base.source)  # checks the parameter and every value
+    checked = parse_scene(raw, source=base.source, **base.trust)  # checks the parameter and every value
     key = checked.sweep["key"]
     raw.pop("sweep")
     cache = {}
@@ -180,16 +180,17 @@ def sweep_points(scene, parameter=None, values=None, *, overrides=None):
     sweep["fingerprint"] = fingerprint(key, sweep["scene"], files)
     points = []
     for i, value in enumerate(checked.sweep["values"]):
-        point = parse_scene(apply_overrides(raw, {key: value}), source=base.source)
+        point = parse_scene(apply_overrides(raw, {key: value}), source=base.source, **base.trust)
         points.append(SweepPoint(i, value, point, files=file_digests(point.raw, cache), sweep=sweep))
     return parameter, key, points
 
 
-def _solve_point(raw, source):
-    """Worker: run one point's scene (BEM, and FEM/analytic when named) and return its result."""
+def _solve_point(raw, source, trust):
+    """Worker: run one point's scene (BEM, and FEM/analytic when named) and return its result;
+    ``trust`` is :attr:`Scene.trust` of the point."""
     from .runner import run_scene
 
-    return run_scene(parse_scene(raw, source=source))
+    return run_scene(parse_scene(raw, source=source, **trust))
 
 
 def _ordered(values):
@@ -221,12 +222,12 @@ def _local_map(jobs, workers):
     if workers == 1 or len(jobs) == 1:
         for point in jobs:
             try:
-                yield point, _solve_point(point.scene.raw, point.scene.source), None
+                yield point, _solve_point(point.scene.raw, point.scene.source, point.scene.trust), None
             except Exception:  # noqa: BLE001 - a failed point is reported, the sweep goes on
                 yield point, None, traceback.format_exc(limit=3)
         return
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = {pool.submit(_solve_point, p.scene.raw, p.scene.source): p for p in jobs}
+        futures = {pool.submit(_solve_point, p.scene.raw, p.scene.source, p.scene.trust): p for p in jobs}
         try:
             for fut in as_completed(futures):
                 exc = fut.exception()
@@ -242,7 +243,7 @@ def _dask_map(jobs, client):
     """Yield ``(point, result, error)`` as Dask futures finish on ``client``."""
     from dask.distributed import as_completed as dask_completed
 
-    futures = {client.submit(_solve_point, p.scene.raw, p.scene.source, pure=False): p for p in jobs}
+    futures = {client.submit(_solve_point, p.scene.raw, p.scene.source, p.scene.trust, pure=False): p for p in jobs}
     for fut in dask_completed(list(futures)):
         point = futures[fut]
         if fut.status == "error":

@@ -8,13 +8,14 @@ path into the scene file (``layer.lam``, ``bem.nodes_across``).
 from __future__ import annotations
 
 import contextlib
+import difflib
 import math
 from collections.abc import Mapping
 
 from bem import checks as v
 from bem.checks import InputError
 
-__all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one", "positive",
+__all__ = ["SceneError", "scene_errors", "unknown_keys", "closest", "require", "exactly_one", "positive",
            "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair", "options",
            "names", "MAX_SWEEP_POINTS", "sweep_size"]
 
@@ -74,14 +75,24 @@ def table(path, value):
     return value
 
 
+def closest(name, choices):
+    """`` Did you mean 'x'?`` for the choice closest to a misspelled ``name`` (difflib), or ``""``."""
+    match = difflib.get_close_matches(str(name), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f" Did you mean {match[0]!r}?" if match else ""
+
+
 def unknown_keys(path, d, allowed):
-    """Refuse keys of ``d`` not in ``allowed``; the message lists the known keys."""
+    """Refuse keys of ``d`` not in ``allowed``: one message per unknown key, each with the closest
+    known key and the list of known keys, all raised at once (:meth:`SceneError.of`)."""
+    messages = []
     for key, value in d.items():
         if key not in allowed:
             shown = value if not isinstance(value, Mapping) else "{...}"
-            raise SceneError(
-                f"{path}.{key} = {shown!r} is not allowed: [{path}] has no key {key!r} "
-                f"(known keys: {', '.join(allowed)}). Check the spelling.")
+            hint = closest(key, allowed) or " Check the spelling."
+            messages.append(f"{path}.{key} = {shown!r} is not allowed: [{path}] has no key {key!r} "
+                            f"(known keys: {', '.join(allowed)}).{hint}")
+    if messages:
+        raise SceneError.of(messages)
 
 
 def require(path, d, key, hint):

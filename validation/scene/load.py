@@ -27,23 +27,24 @@ from __future__ import annotations
 
 import copy
 import tomllib
-from dataclasses import dataclass, field
-from importlib import resources
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..extras import require as require_extra
-from ..provenance import display_path
 from ..units import Units
+from . import checks as ck
 from . import schema as sec
-from .checks import SceneError
+from .checks import SceneError, closest
 from .measured import measured_region
 from .paper import ALIASES
 from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
 from .sizing import EXCLUSIVE as BEM_EXCLUSIVE
 from .sizing import bem_options
+from .source import builtin_path, builtin_scenes, read_source, read_toml
+from .trust import check_code_name, code_names, refuse_code, scene_file
 
-__all__ = ["Scene", "SceneError", "load_scene", "parse_scene", "builtin_scenes", "builtin_path",
-           "apply_overrides", "parse_override", "SECTIONS"]
+__all__ = ["Scene", "SceneError", "load_scene", "check_scene", "parse_scene", "builtin_scenes", "builtin_path",
+           "read_toml", "apply_overrides", "parse_override", "SECTIONS"]
 
 SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report", "stress")
 _REQUIRED = ("scene", "bodies", "gap", "load")
@@ -60,6 +61,10 @@ class Scene:
     ``layer_spec`` the validated ``[layer]`` and ``layer`` the law built from it once (``None``
     without a layer, or for a law of the paper's parameters, which the runner resolves);
     ``bem`` the solver options with the resolved lattice (:func:`validation.scene.sizing.bem_options`).
+    ``base_dir``, ``allow_code`` and ``allow_outside_files``: the folder its file names start
+    from and what it may reach (:attr:`trust`); ``unimported``: ``(key, "module:function")``
+    of code named but not imported (:func:`check_scene`; such a scene does not run);
+    ``skipped``: sections dropped at load (``("fem",)`` with ``no_fem``).
     """
 
     name: str
@@ -82,35 +87,23 @@ class Scene:
     report: dict | None = None
     overrides: tuple = field(default=())
     stress: dict | None = None
+    base_dir: str | None = None
+    allow_code: bool = False
+    allow_outside_files: bool = False
+    unimported: tuple = field(default=())
+    skipped: tuple = field(default=())
+
+    @property
+    def trust(self):
+        """The keywords of :func:`parse_scene` that re-validate ``raw`` as this scene was: its
+        folder and what it was allowed (:mod:`validation.scene.trust`)."""
+        return {"base_dir": self.base_dir, "allow_code": self.allow_code,
+                "allow_outside_files": self.allow_outside_files}
 
     @property
     def axisymmetric(self):
         """Whether the gap is axisymmetric (contact radius and FEM reference apply)."""
         return bool(self.gap.is_axisymmetric)
-
-
-def builtin_dir():
-    """The folder of the built-in scene files."""
-    return Path(str(resources.files("validation") / "scenes"))
-
-
-def builtin_scenes():
-    """``{name: one-line description}`` of the built-in scenes, sorted by name."""
-    out = {}
-    for path in sorted(builtin_dir().glob("*.toml")):
-        with path.open("rb") as fh:
-            meta = tomllib.load(fh).get("scene", {})
-        out[path.stem] = meta.get("description") or meta.get("title", "")
-    return out
-
-
-def builtin_path(name):
-    """Path of the built-in scene ``name``; SceneError listing the names if there is none."""
-    path = builtin_dir() / f"{name}.toml"
-    if not path.is_file():
-        raise SceneError(f"scene = {name!r} is not allowed: it must be a built-in scene name ("
-                         + ", ".join(builtin_scenes()) + ") or a path to a .toml file.")
-    return path
 
 
 def parse_override(text):
@@ -195,23 +188,75 @@ class _Collect:
         self.errors.append(message)
 
 
-def _validate(raw, source, overrides):
+def _allowed_keys(section, d):
+    """The keys ``[section]`` may hold, or ``None`` when they depend on a value its validator checks."""
+    keys = sec.scene_keys()[section]
+    if section not in ("gap", "layer"):
+        return keys[""]
+    variant = d.get("type" if section == "gap" else "law")
+    if not isinstance(variant, str) or (variant not in keys and variant != "none"):
+        return None
+    return (*keys[""], *keys.get(variant, ()))
+
+
+def _known_keys_only(raw, check):
+    """``raw`` without the unknown keys of its sections, each recorded as an error of ``check``.
+
+    Every misspelled key is reported in the same pass as the other errors, also in a section whose
+    validator waits for another section; the validators then see only known keys.
+    """
+    out = {}
+    for section, d in raw.items():
+        allowed = _allowed_keys(section, d) if section in SECTIONS and isinstance(d, dict) else None
+        if allowed is None or all(k in allowed for k in d):
+            out[section] = d
+            continue
+        check(ck.unknown_keys, section, d, allowed)
+        out[section] = {k: v for k, v in d.items() if k in allowed}
+    return out
+
+
+def _code(raw, mode, check):
+    """Sections that name Python code (:mod:`validation.scene.trust`), and what to do with them.
+
+    ``mode``: ``"import"`` (allowed), ``"form"`` (checked, not imported: ``contactlab check``)
+    or ``"refuse"``. Returns ``(sections not to build, (key, name) pairs not imported)``.
+    """
+    names = code_names(raw)
+    if mode == "import":
+        return set(), ()
+    for key, value in names:
+        if check(check_code_name, key, value) is not check.FAILED and mode == "refuse":
+            check.fail(refuse_code(key, value))
+    return {key.split(".")[0] for key, _ in names}, tuple(names)
+
+
+def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_files=False):
     if not isinstance(raw, dict):
         raise SceneError(f"scene = {raw!r} is not allowed: it must be a table of sections.")
     check = _Collect()
     for key, value in raw.items():
         if key not in SECTIONS:
             check.fail(f"{key} = {'{...}' if isinstance(value, dict) else repr(value)} is not allowed: "
-                       f"there is no section [{key}] (sections: {', '.join(SECTIONS)}).")
+                       f"there is no section [{key}] (sections: {', '.join(SECTIONS)}).{closest(key, SECTIONS)}")
+    raw = _known_keys_only(raw, check)
     for key in _REQUIRED:
         if key not in raw:
             check.fail(f"[{key}] is missing: every scene needs the sections " + ", ".join(_REQUIRED) + ".")
+    coded, unimported = _code(raw, code, check)
     section = {k: (raw[k] if k in raw else check.FAILED) for k in _REQUIRED}
+    if check(_resolve_files, raw, base_dir, outside_files) is check.FAILED:
+        section["gap"] = check.FAILED
     meta = check(sec.scene_meta, section["scene"])
     body = check(sec.bodies, section["bodies"])
     load = check(sec.load, section["load"])
-    shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"]), section["gap"], body, meta)
-    layer = check(sec.layer, raw.get("layer"))
+    if code == "refuse":  # refused above: build nothing that imports
+        section["gap"] = check.FAILED if "gap" in coded else section["gap"]
+    layer_raw = check.FAILED if code == "refuse" and "layer" in coded else raw.get("layer")
+    build = {part: code == "import" or part not in coded for part in ("gap", "layer")}
+    shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"], build=build["gap"]),
+                  section["gap"], body, meta)
+    layer = check(lambda d: sec.layer(d, build=build["layer"]), layer_raw)
     bem = check(lambda g, la, b, ld: bem_options(raw.get("bem"), g[1], *la, b["E_star"], ld), shape, layer, body, load)
     shape = check(lambda g, b: (g[0], measured_region(g[1], b["extent"])), shape, bem)
     fem = check(lambda g, b: sec.fem_options(raw.get("fem"), g[1], b["materials"]), shape, body)
@@ -219,6 +264,7 @@ def _validate(raw, source, overrides):
     sweep = check(sec.sweep_spec, raw.get("sweep"), SECTIONS)
     report = check(sec.report, raw.get("report"))
     stress = check(lambda b: sec.stress_options(raw.get("stress"), b["materials"]), body)
+    stress = check(lambda st, b: sec.stress_depth_bound(st, b["extent"]), stress, bem)
     if check.errors:
         raise SceneError.of(check.errors)
     return Scene(
@@ -226,32 +272,53 @@ def _validate(raw, source, overrides):
         source=source, raw=raw, E_star=body["E_star"], materials=body["materials"], gap=shape[1],
         gap_spec=shape[0], layer_spec=layer[0], layer=layer[1], load=load, bem=bem, fem=fem, analytic=analytic,
         sweep=sweep, report=report, overrides=tuple(overrides), stress=stress,
+        base_dir=None if base_dir is None else str(base_dir), allow_code=code == "import",
+        allow_outside_files=outside_files, unimported=unimported,
     )
 
 
-def _check_sweep_points(scene):
+def _check_sweep_points(scene, **kw):
     """Every point of the scene's own sweep must be a valid scene too."""
     base = {k: v for k, v in scene.raw.items() if k != "sweep"}
     for i, value in enumerate(scene.sweep["values"]):
         try:
-            _validate(apply_overrides(base, {scene.sweep["key"]: value}), scene.source, ())
+            _validate(apply_overrides(base, {scene.sweep["key"]: value}), scene.source, (), **kw)
         except SceneError as exc:
             raise SceneError(f"sweep.values[{i}] = {value!r} gives an invalid scene: {exc}") from None
 
 
-def _resolve_files(raw, base_dir):
-    """Make the file a scene names (``gap.file`` of a measured gap) absolute, relative to ``base_dir``."""
+def _resolve_files(raw, base_dir, allow_outside):
+    """Make the file a scene names (``gap.file`` of a measured gap) absolute, relative to ``base_dir``
+    (:func:`validation.scene.trust.scene_file`)."""
     gap = raw.get("gap")
     if isinstance(gap, dict) and gap.get("type") == "measured" and isinstance(gap.get("file"), str):
-        gap["file"] = str((Path(base_dir) / Path(gap["file"]).expanduser()).absolute())
+        gap["file"] = scene_file("gap.file", gap["file"], base_dir, allow_outside=allow_outside)
 
 
-def parse_scene(raw, *, source="<dict>", overrides=None, base_dir=None):
+def _parse(raw, source, overrides, base_dir, code, allow_outside_files, no_fem=False):
+    overrides = list(overrides.items()) if isinstance(overrides, dict) else list(overrides or ())
+    raw = apply_overrides(raw, overrides)
+    skipped = ("fem",) if no_fem and "fem" in raw else ()
+    raw = {k: v for k, v in raw.items() if k not in skipped}
+    kw = {"base_dir": Path.cwd() if base_dir is None else Path(base_dir), "code": code,
+          "outside_files": allow_outside_files}
+    scene = _validate(raw, source, [o if isinstance(o, str) else f"{o[0]}={o[1]!r}" for o in overrides], **kw)
+    if scene.sweep is not None:
+        _check_sweep_points(scene, **kw)
+    return replace(scene, skipped=skipped) if skipped else scene
+
+
+def parse_scene(raw, *, source="<dict>", overrides=None, base_dir=None, allow_code=False,
+                allow_outside_files=False, no_fem=False):
     """Validate a scene given as a dict (the parsed TOML); returns a :class:`Scene`.
 
     ``base_dir`` is the folder that relative file names in the scene (``gap.file``) start
     from: the scene file's folder (:func:`load_scene`), the current directory by default.
-    ``Scene.raw`` holds them made absolute, so it re-loads from anywhere.
+    ``Scene.raw`` holds them made absolute. ``allow_code`` imports the Python code the scene
+    names (``gap.function``, ``layer.w``...) and ``allow_outside_files`` reads files outside
+    ``base_dir``; both are refused by default (:mod:`validation.scene.trust`). ``no_fem``
+    drops the scene's ``[fem]`` (no FEM reference, no need of the ``fem`` extra), noted in
+    :attr:`Scene.skipped`.
 
     Raises
     ------
@@ -261,26 +328,27 @@ def parse_scene(raw, *, source="<dict>", overrides=None, base_dir=None):
         The scene has ``[fem]`` but gmsh or scikit-fem cannot be imported ("install
         contactlab[fem]"); nothing has run.
     """
-    overrides = list(overrides.items()) if isinstance(overrides, dict) else list(overrides or ())
-    raw = apply_overrides(raw, overrides)
-    _resolve_files(raw, Path.cwd() if base_dir is None else base_dir)
-    scene = _validate(raw, source, [o if isinstance(o, str) else f"{o[0]}={o[1]!r}" for o in overrides])
-    if scene.sweep is not None:
-        _check_sweep_points(scene)
+    scene = _parse(raw, source, overrides, base_dir, "import" if allow_code else "refuse", allow_outside_files, no_fem)
     if scene.fem is not None:
         require_extra("fem", f"[fem] of scene {scene.name!r} (the FEM reference)")
     return scene
 
 
-def load_scene(source, *, overrides=None):
+def load_scene(source, *, overrides=None, allow_code=False, allow_outside_files=False, no_fem=False):
     """Load and validate a scene: a built-in name, a path to a TOML file, a dict or a Scene.
 
     Parameters
     ----------
     source : str, path-like, dict or Scene
-        Built-in name (``contactlab scenes`` lists them) or TOML file path.
+        Built-in name (``contactlab scenes`` lists them) or TOML file path. A Scene is
+        re-validated with its own folder and permissions (:attr:`Scene.trust`).
     overrides : dict or list of str, optional
         Dotted-key overrides (:func:`apply_overrides`), validated with the rest.
+    allow_code, allow_outside_files : bool
+        Import the Python code the scene names; read files outside the scene's folder
+        (:mod:`validation.scene.trust`). Refused by default.
+    no_fem : bool
+        Drop the scene's ``[fem]``: run it without the FEM reference (:attr:`Scene.skipped`).
 
     Raises
     ------
@@ -288,20 +356,22 @@ def load_scene(source, *, overrides=None):
         Anything wrong in the scene (the message names the key), or an unknown scene.
     """
     if isinstance(source, Scene):
-        return parse_scene(source.raw, source=source.source, overrides=overrides)
+        return parse_scene(source.raw, source=source.source, overrides=overrides, no_fem=no_fem, **source.trust)
+    kw = {"allow_code": allow_code, "allow_outside_files": allow_outside_files, "no_fem": no_fem}
     if isinstance(source, dict):
-        return parse_scene(source, overrides=overrides)
-    path = Path(source)
-    if path.suffix == ".toml" or path.exists():
-        if not path.is_file():
-            raise SceneError(f"scene = {str(source)!r} is not allowed: there is no such file.")
-        label = display_path(path)
+        return parse_scene(source, overrides=overrides, **kw)
+    raw, label, folder = read_source(source)
+    return parse_scene(raw, source=label, overrides=overrides, base_dir=folder, **kw)
+
+
+def check_scene(source, *, overrides=None, allow_outside_files=False):
+    """Validate a scene as :func:`load_scene` does, importing no code and needing no extra.
+
+    The Python code a scene names is checked for its form only; such a scene is returned with
+    the names in :attr:`Scene.unimported`, and does not run. Used by ``contactlab check``.
+    """
+    if isinstance(source, dict):
+        raw, label, folder = source, "<dict>", None
     else:
-        path = builtin_path(str(source))
-        label = f"builtin:{source}"
-    try:
-        with path.open("rb") as fh:
-            raw = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"scene file {str(path)!r} is not valid TOML: {exc}.") from None
-    return parse_scene(raw, source=label, overrides=overrides, base_dir=path.parent)
+        raw, label, folder = read_source(source)
+    return _parse(raw, label, overrides, folder, "form", allow_outside_files)

@@ -25,9 +25,9 @@ from .measured import measured_gap
 from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law, paper_keys
 from .sizing import KEYS as BEM_KEYS
 
-__all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic",
-           "report", "sweep_spec", "stress_options", "scene_keys", "KEYS", "report_sections", "ANALYTIC_KINDS",
-           "DEFAULT_UNITS", "BODY_KEYS"]
+__all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic", "report", "sweep_spec",
+           "stress_options", "stress_depth_bound", "scene_keys", "KEYS", "report_sections", "ANALYTIC_KINDS",
+           "DEFAULT_UNITS", "BODY_KEYS", "Unimported"]
 
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
@@ -118,8 +118,22 @@ def bodies(d):
     return {"E_star": E_star, "materials": {k: float(d[k]) for k in BODY_KEYS}}
 
 
-def gap(d, E_star, *, units=None):
+class Unimported(gaps.Gap):
+    """Stands for a gap whose Python code was not imported (``contactlab check``): no estimate of
+    the contact size, unbounded; it is never evaluated."""
+
+    def __init__(self, type_name):
+        self.type_name = type_name
+
+    def _evaluate(self, x, y):
+        raise ck.SceneError(f"gap.type = {self.type_name!r}: its code was not imported (contactlab check).")
+
+
+def gap(d, E_star, *, units=None, build=True):
     """``[gap]``: ``type`` and the parameters of the :mod:`bem.gaps` shape; returns (spec, Gap).
+
+    ``build = False`` checks the keys only and returns an :class:`Unimported` stand-in for a shape
+    that would import the Python code the scene names (:mod:`validation.scene.trust`).
 
     A log-crowned roller given by ``design_force`` takes ``E_star`` from ``[bodies]`` when the
     gap table leaves it out. ``type = "measured"`` reads a file (:mod:`validation.scene.measured`;
@@ -141,6 +155,8 @@ def gap(d, E_star, *, units=None):
     for name, p in params.items():
         if p.default is inspect.Parameter.empty and name not in spec:
             raise ck.SceneError(f"gap.{name} is missing: a {kind!r} gap needs " + ", ".join(params) + ".")
+    if not build:
+        return spec, Unimported(kind)
     with ck.scene_errors("gap."):
         shape = gap_from_dict(spec)
     return spec, shape
@@ -154,15 +170,16 @@ def load(d):
     return {"force": None, "approach": None, key: ck.positive(f"load.{key}", d[key])}
 
 
-def layer(d):
+def layer(d, *, build=True):
     """``[layer]``: ``(spec, law)``; see :func:`validation.scene.paper.check_layer`.
 
     ``law`` is the :mod:`bem.layers` object, built here once from direct parameters (which
-    checks their values); ``None`` without a layer (absent or ``law = "none"``) and for a law of
-    the paper's parameters, which the runner resolves by a solve.
+    checks their values); ``None`` without a layer (absent or ``law = "none"``), for a law of
+    the paper's parameters, which the runner resolves by a solve, and with ``build = False``
+    (a law whose Python code is not imported, :mod:`validation.scene.trust`).
     """
     spec = check_layer(d, "layer")
-    if spec is None or is_paper_law(spec):
+    if spec is None or is_paper_law(spec) or not build:
         return spec, None
     with ck.scene_errors("layer."):
         return spec, from_dict(spec)
@@ -291,3 +308,21 @@ def stress_options(d, materials):
         raise ck.SceneError(f"stress.bodies = {bodies!r} is not allowed: name each body once.")
     out["bodies"] = bodies
     return out
+
+
+#: deepest stress depth of a ``[stress] depths`` list, in half-widths of the candidate region
+MAX_DEPTH_REGIONS = 100.0
+
+
+def stress_depth_bound(stress, extent):
+    """``[stress] depths`` (a list) at most :data:`MAX_DEPTH_REGIONS` times the larger half-width of
+    the candidate region ``extent`` [m] (``bem.extent``): deeper, the stresses vanish and overflow."""
+    if stress is None or stress["depths"] == "auto":
+        return stress
+    bound = MAX_DEPTH_REGIONS * max(extent)
+    for i, depth in enumerate(stress["depths"]):
+        if depth > bound:
+            raise ck.SceneError(f"stress.depths[{i}] = {depth!r} is not allowed: a depth must be <= "
+                                f"{MAX_DEPTH_REGIONS:g} times the candidate region's half-width (bem.extent), "
+                                f"<= {bound:.6g} here.")
+    return stress

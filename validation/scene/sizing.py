@@ -104,7 +104,10 @@ def _extent(d, gap, axes):
                                    lambda p, v: ck.in_range(p, v, 1.0, 100.0))
         return (min(fx * axes[0], (1 - DOMAIN_MARGIN) * hx), min(fy * axes[1], (1 - DOMAIN_MARGIN) * hy)), True
     ex, ey = ck.number_or_pair("bem.extent", d["extent"], ck.positive)
-    if ex >= hx or ey >= hy:
+    if hasattr(gap, "check_region"):  # measured data: their own rule (bem.gaps.Measured.check_region)
+        with ck.scene_errors():
+            gap.check_region(d["extent"], name="bem.extent")
+    elif ex >= hx or ey >= hy:
         raise ck.SceneError(f"bem.extent = {d['extent']!r} is not allowed: the candidate region must lie "
                             f"inside the gap's domain, |x| < {hx:.6g}, |y| < {hy:.6g}.")
     if axes is not None and (ex < axes[0] or ey < axes[1]):
