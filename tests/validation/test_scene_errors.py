@@ -39,6 +39,7 @@ PAPER_ER = BASE + """
 [layer]
 law = "elastic_rigid"
 lam_over_cnn = 10.0
+cnn_step = 1e-5
 alpha_a = 0.5
 """
 ELLIPTIC = BASE.replace('type = "paraboloid"\nR = 0.01', 'type = "elliptic_paraboloid"\nRx = 0.02\nRy = 0.005')
@@ -84,7 +85,8 @@ CASES = {
     "missing_layer_compliance": (LAYER_BASE + 'law = "linear"\n', "layer.lam"),
     "lam_and_lam_over_cnn": (LAYER_BASE + 'law = "linear"\nlam = 1e-15\nlam_over_cnn = 10.0\n', "layer.lam"),
     "alpha_a_above_one": (PAPER_ER.replace("alpha_a = 0.5", "alpha_a = 1.5"), "layer.alpha_a"),
-    "alpha_c_right_angle": (LAYER_BASE + 'law = "bilinear"\nlam_over_cnn = 10.0\nalpha_a = 0.5\n'
+    "lam_over_cnn_without_its_step": (PAPER_ER.replace("cnn_step = 1e-5\n", ""), "layer.lam_over_cnn"),
+    "alpha_c_right_angle": (LAYER_BASE + 'law = "bilinear"\nlam_over_cnn = 10.0\ncnn_step = 1e-5\nalpha_a = 0.5\n'
                             "alpha_c = 1.6\n", "layer.alpha_c"),
     "unknown_layer_key": (LAYER_BASE + 'law = "power"\nlam = 1e-12\ns = 0.5\nt = 2.0\n', "layer.t"),
     "none_law_with_parameters": (LAYER_BASE + 'law = "none"\nlam = 1e-15\n', "layer.lam"),

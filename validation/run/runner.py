@@ -55,7 +55,7 @@ def _notify(progress, stage, status, **info):
 def planned_stages(scene, *, write=False):
     """Stage names :func:`run_scene` will report for ``scene`` (for progress bars)."""
     spec = scene.layer_spec
-    calibrated = spec is not None and ("alpha_a" in spec or (spec["law"] == "root" and "lam_over_cnn" in spec))
+    calibrated = paper.is_paper_law(spec) and ("alpha_a" in spec or spec["law"] == "root")
     wanted = {"layer": calibrated,
               "bem": True,
               "fem": scene.fem is not None,

@@ -5,10 +5,9 @@ expected contact: ``bem.nodes_across`` nodes across its smaller diameter and
 ``bem.extent_factor`` times its semi-axes. The expected semi-axes are the gap's own estimate,
 :meth:`bem.gaps.Gap.expected_semi_axes` (closed forms of :mod:`bem.reference`; tables,
 callables and measured surfaces have none, and such a scene gives ``bem.step`` and
-``bem.extent``). With a layer given by the paper's ``lam_over_cnn`` the layer depends on the
-step and the step on the expected contact: the two are iterated to a fixed point (the gap's
-radial profile is sampled once for all of them). An estimate only sizes the region: the runner
-enlarges an automatic region when the contact reaches its border.
+``bem.extent``). A layer given by the paper's parameters is sized by its linear reference
+layer. An estimate only sizes the region: the runner enlarges an automatic region when the
+contact reaches its border.
 
 The solver options are checked by the BEM itself (:func:`bem.options.check_options`: one rule,
 one message), and the option names come from :data:`bem.options.OPTIONS`.
@@ -66,21 +65,13 @@ def _axes(gap, layer, E_star, load):
                             "give bem.step and bem.extent.") from None
 
 
-def _expected(gap, layer_spec, layer, E_star, load, step, n_across):
-    """Expected semi-axes; with ``lam_over_cnn`` and an automatic step, iterate step <-> layer."""
-    axes = _axes(gap, None, E_star, load)
-    if axes is None or layer_spec is None:
-        return axes
-    if not is_paper_law(layer_spec):
-        return _axes(gap, layer, E_star, load)
-    s = step if step is not None else 2 * min(axes) / n_across
-    for _ in range(30):
-        axes = _axes(gap, Linear(reference_compliance(layer_spec, s, E_star)), E_star, load)
-        s_new = 2 * min(axes) / n_across
-        if step is not None or abs(s_new / s - 1.0) < 1e-9:
-            break
-        s = s_new
-    return axes
+def _expected(gap, layer_spec, layer, E_star, load):
+    """Expected semi-axes; a layer of the paper's parameters is represented by its linear reference."""
+    if layer_spec is None:
+        return _axes(gap, None, E_star, load)
+    if is_paper_law(layer_spec):
+        return _axes(gap, Linear(reference_compliance(layer_spec, E_star)), E_star, load)
+    return _axes(gap, layer, E_star, load)
 
 
 def _solver_options(d, method, layer_spec):
@@ -151,7 +142,7 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
     out.update(_solver_options(d, out["method"], layer_spec))
     step = ck.positive("bem.step", d["step"]) if "step" in d else None
     n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
-    axes = _expected(gap, layer_spec, layer, E_star, load, step, n_across)
+    axes = _expected(gap, layer_spec, layer, E_star, load)
     if axes is None and ("step" not in d or "extent" not in d):
         raise ck.SceneError(f"bem.step and bem.extent are missing: a {gap.type_name!r} gap has no estimate "
                             "of the contact size, so give the lattice step [m] and the region half-width [m].")
