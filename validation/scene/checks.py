@@ -15,7 +15,7 @@ from bem import checks as v
 from bem.checks import InputError
 
 __all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one", "positive",
-           "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair", "options",
+           "nonnegative", "scale", "rtol", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair", "options",
            "names"]
 
 
@@ -106,6 +106,16 @@ def positive(path, value):
 
 def nonnegative(path, value):
     return _wrap(v.check_nonnegative, path, value)
+
+
+def scale(path, value):
+    """A physical scale (modulus, load, length) in :data:`bem.checks.SCALE_RANGE`."""
+    return _wrap(v.check_scale, path, value)
+
+
+def rtol(path, value):
+    """A KKT tolerance of the BEM (:func:`bem.checks.check_rtol`)."""
+    return _wrap(v.check_rtol, path, value)
 
 
 def in_range(path, value, low, high, **kw):

@@ -110,7 +110,7 @@ def bodies(d):
             given = ", ".join(f"bodies.{k}" for k in BODY_KEYS if k in d)
             raise ck.SceneError(f"bodies.E_star = {d['E_star']!r} is not allowed together with {given}: "
                                 "give E_star alone or all of E1, nu1, E2, nu2.")
-        return {"E_star": ck.positive("bodies.E_star", d["E_star"]), "materials": None}
+        return {"E_star": ck.scale("bodies.E_star", d["E_star"]), "materials": None}
     for key in BODY_KEYS:
         ck.require("bodies", d, key, "give E1, nu1, E2, nu2 [Pa, -] (or E_star alone)")
     with ck.scene_errors("bodies."):
@@ -147,11 +147,11 @@ def gap(d, E_star, *, units=None):
 
 
 def load(d):
-    """``[load]``: exactly one of ``force`` [N] and ``approach`` [m], > 0."""
+    """``[load]``: exactly one of ``force`` [N] and ``approach`` [m], in :data:`bem.checks.SCALE_RANGE`."""
     _section("load", d)
     key = ck.exactly_one("load", d, KEYS["load"], "force control: force [N]; approach control: "
                          "approach [m]")
-    return {"force": None, "approach": None, key: ck.positive(f"load.{key}", d[key])}
+    return {"force": None, "approach": None, key: ck.scale(f"load.{key}", d[key])}
 
 
 def layer(d):

@@ -15,22 +15,19 @@ one message), and the option names come from :data:`bem.options.OPTIONS`.
 
 from __future__ import annotations
 
-import math
 from functools import partial
 
 from bem import METHODS, InputError
-from bem.lattice import SQRT3, Lattice
+from bem.checks import check_node_count
+from bem.lattice import Lattice, node_count
 from bem.layers import Linear
 from bem.options import OPTIONS, check_options, solver_for
 
 from . import checks as ck
 from .paper import is_paper_law, reference_compliance
 
-__all__ = ["bem_options", "inner_domain", "node_count", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "MAX_NODES",
-           "DOMAIN_MARGIN", "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
+__all__ = ["bem_options", "inner_domain", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "DOMAIN_MARGIN", "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
 
-#: Largest candidate region a scene may ask for (memory and time guard).
-MAX_NODES = 4_000_000
 #: An automatic extent stays this fraction inside a bounded gap domain.
 DOMAIN_MARGIN = 1e-3
 DEFAULT_NODES_ACROSS = 40
@@ -47,14 +44,6 @@ def inner_domain(gap):
     """Largest half-widths ``(hx, hy)`` of a centred rectangle inside ``gap.domain`` (may be inf)."""
     (x0, x1), (y0, y1) = gap.domain
     return min(-x0, x1), min(-y0, y1)
-
-
-def node_count(step, extent):
-    """Number of lattice nodes of the candidate region (as :meth:`bem.Lattice.from_extent`)."""
-    ex, ey = extent
-    cols = 2 * math.floor(ex / step + 1e-9) + 1
-    rows = 2 * math.floor(ey / (step * SQRT3 / 2) + 1e-9) + 1
-    return cols * rows
 
 
 def _axes(gap, layer, E_star, load):
@@ -137,7 +126,7 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
             raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
                                 "give one of them.")
     out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
-    out.update(ck.options("bem", d, {"rtol": ck.positive, "maxiter": partial(ck.integer, minimum=1),
+    out.update(ck.options("bem", d, {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1),
                                      "precondition": ck.boolean, "nested": ck.boolean}))
     out.update(_solver_options(d, out["method"], layer_spec))
     step = ck.positive("bem.step", d["step"]) if "step" in d else None
@@ -153,13 +142,11 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
                             f"{2 * min(axes):.4g} across ({2 * min(axes) / step:.1f} steps); make step smaller "
                             "(at least 4 nodes across the contact).")
     extent, auto = _extent(d, gap, axes)
-    with ck.scene_errors():
-        Lattice.from_extent(step, extent)
     n = node_count(step, extent)
-    if n > MAX_NODES:
-        raise ck.SceneError(f"bem.{'step' if 'step' in d else 'nodes_across'} = "
-                            f"{d.get('step', n_across)!r} is not allowed: the region would hold {n} nodes "
-                            f"(limit {MAX_NODES}); make the lattice coarser or the region smaller.")
+    key = "step" if "step" in d else "nodes_across"
+    with ck.scene_errors():
+        check_node_count(f"bem.{key}", d.get(key, n_across), n)  # bem's memory guard, before building
+        Lattice.from_extent(step, extent)
     out.update(step=step, extent=extent, extent_auto=auto, expected=axes,
                nodes_across=2 * min(axes) / step if axes else None, n_nodes=n)
     return out
