@@ -6,8 +6,9 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [bodies]   E1, nu1, E2, nu2 [Pa, -]  -- or E_star [Pa] alone
     [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...), or
                type = "measured" with a file (validation.scene.measured)
-    [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn, alpha_a,
-               alpha_b, alpha_c (validation.paper); absent or law = "none": no layer
+    [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn with cnn_step,
+               lam_ref, alpha_a, alpha_b, alpha_c (validation.scene.paper); absent or
+               law = "none": no layer
     [load]     force [N] or approach [m]
     [bem]      step [m] or nodes_across; extent [m] or extent_factor; method, rtol, maxiter,
                precondition, nested, relaxation
