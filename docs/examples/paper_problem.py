@@ -2,10 +2,11 @@
 
 Normalised units R = E* = P = 1. The layer laws are given as in the paper: the compliance
 ``lam = 10 C_nn`` (``C_nn`` the diagonal influence coefficient) taken at the reference step
-``a_H / 20``, a fixed compliance whatever lattice solves the problem, the elastic-rigid threshold ``p_cr = alpha_a p_max^lambda`` with
-``alpha_a = 0.5`` (``p_max^lambda``: the peak with the linear layer ``lam``), and the root law
-``w = lam sqrt(p_max^lambda) sqrt(p)``. Each law is solved by Newton's method on the generalised
-functional (the default) and, for the root law, also by the paper's variable compliance method.
+``a_H / 20``, a fixed compliance whatever lattice solves the problem, the elastic-rigid
+threshold ``p_cr = alpha_a p_max^lambda`` with ``alpha_a = 0.5`` (``p_max^lambda``: the peak
+with the linear layer ``lam``), and the root law ``w = lam sqrt(p_max^lambda) sqrt(p)``. Each
+law is solved by Newton's method on the generalised functional (the default) and, for the root
+law, also by the paper's variable compliance method.
 See docs/method.md, section 5. Run::
 
     python docs/examples/paper_problem.py

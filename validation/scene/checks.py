@@ -15,8 +15,8 @@ from bem import checks as v
 from bem.checks import InputError
 
 __all__ = ["SceneError", "scene_errors", "unknown_keys", "require", "exactly_one", "positive",
-           "nonnegative", "scale", "rtol", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair", "options",
-           "names"]
+           "nonnegative", "scale", "rtol", "in_range", "integer", "boolean", "string", "choice", "table",
+           "number_or_pair", "options", "names"]
 
 
 class SceneError(InputError):

@@ -26,7 +26,8 @@ from bem.options import OPTIONS, check_options, solver_for
 from . import checks as ck
 from .paper import is_paper_law, reference_compliance
 
-__all__ = ["bem_options", "inner_domain", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "DOMAIN_MARGIN", "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
+__all__ = ["bem_options", "inner_domain", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "DOMAIN_MARGIN", "DEFAULT_NODES_ACROSS",
+           "DEFAULT_EXTENT_FACTOR"]
 
 #: An automatic extent stays this fraction inside a bounded gap domain.
 DOMAIN_MARGIN = 1e-3
