@@ -105,6 +105,8 @@ CASES = {
     "radius_overflowing": (BASE.replace("R = 0.01", "R = 1e308"), "gap.R = 1e+308"),
     "force_overflowing": (BASE.replace("force = 100.0", "force = 1e308"), "load.force = 1e+308"),
     "modulus_overflowing": (BASE.replace("E1 = 210e9", "E1 = 1e308"), "bodies.E1 = 1e+308"),
+    "depth_overflowing": (BASE + "\n[stress]\ndepths = [0.0, 1e308]\n",
+                          "stress.depths[1] = 1e+308"),
     "extent_of_three": (BASE.replace("nodes_across = 16", "step = 1e-5\nextent = [5e-4, 5e-4, 5e-4]"),
                         "bem.extent"),
     "precondition_is_text": (BASE.replace("nodes_across = 16", 'nodes_across = 16\nprecondition = "yes"'),

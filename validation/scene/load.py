@@ -219,7 +219,7 @@ def _validate(raw, source, overrides):
     analytic = check(lambda g, la: sec.analytic(raw.get("analytic"), g[1], la[0]), shape, layer)
     sweep = check(sec.sweep_spec, raw.get("sweep"), SECTIONS)
     report = check(sec.report, raw.get("report"))
-    stress = check(lambda b: sec.stress_options(raw.get("stress"), b["materials"]), body)
+    stress = check(lambda b, bo: sec.stress_options(raw.get("stress"), b["materials"], bo["step"]), body, bem)
     if check.errors:
         raise SceneError.of(check.errors)
     return Scene(

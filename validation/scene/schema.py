@@ -16,6 +16,7 @@ from bem import gaps
 from bem.gaps import gap_from_dict
 from bem.layers import LAWS, from_dict
 from bem.materials import effective_modulus
+from bem.stress import Z_MAX_STEPS
 
 from ..units import DEFAULT_LABEL as DEFAULT_UNITS
 from ..units import parse_units
@@ -259,9 +260,10 @@ def sweep_spec(d, known_sections):
     return {"parameter": param, "key": key, "values": list(values)}
 
 
-def stress_options(d, materials):
-    """``[stress]``: ``depths`` (``"auto"`` or a list [m]), ``n_depths`` and ``max_depth`` (with
-    ``"auto"``: that many depths from 0 down to ``max_depth`` contact half-widths), ``bodies``."""
+def stress_options(d, materials, step=None):
+    """``[stress]``: ``depths`` (``"auto"`` or a list [m], at most :data:`bem.stress.Z_MAX_STEPS`
+    lattice steps ``step`` [m] deep), ``n_depths`` and ``max_depth`` (with ``"auto"``: that many
+    depths from 0 down to ``max_depth`` contact half-widths), ``bodies``."""
     if d is None:
         return None
     _section("stress", d)
@@ -282,6 +284,11 @@ def stress_options(d, materials):
             raise ck.SceneError(f"stress.depths = {depths!r} is not allowed: it must be \"auto\" or a list of 1 to "
                                 "1000 depths below the surface [m], e.g. [0.0, 1e-4, 2e-4].")
         out["depths"] = [ck.nonnegative(f"stress.depths[{i}]", v) for i, v in enumerate(depths)]
+        deepest = math.inf if step is None else Z_MAX_STEPS * step
+        for i, z in enumerate(out["depths"]):
+            if z > deepest:
+                raise ck.SceneError(f"stress.depths[{i}] = {z!r} is not allowed: it must be at most {Z_MAX_STEPS:g} "
+                                    f"lattice steps ({deepest:.6g} m) below the surface.")
         if len(set(out["depths"])) != len(depths):
             raise ck.SceneError(f"stress.depths = {depths!r} is not allowed: the depths must be distinct.")
     bodies = ck.names("stress.bodies", d.get("bodies", list(STRESS_BODIES)), STRESS_BODIES,
