@@ -39,6 +39,8 @@ def _how(r, res):
 
 
 def _problem(res, work):
+    from validation.scene.paper import c_nn
+
     from ..figures.profiles import plot_layer_laws
 
     smooth, info = res.outcomes["smooth"].scene, res.outcomes["elastic-rigid"].result["layer"]
@@ -58,8 +60,9 @@ def _problem(res, work):
         f"pressure p0 = {res.p0:.4g} {u['pressure']} and approach delta_H = {res.approach:.4g} {u['length']}; all "
         "pressures below are divided by p0 and all lengths by a_H.",
         f"The linear (Winkler) layer has the compliance lam = {info['lam_ref']:.4g} {u['length']}/{u['pressure']}, "
-        f"the paper's 10 C_nn at the reference step c = a_H/20 (C_nn = c/(pi E*) w_t(0,0), the diagonal influence "
-        f"coefficient, eq. 6), fixed in physical units so that every lattice solves the same problem; on this "
+        f"the paper's {info['lam_ref'] / c_nn(res.a / 20, smooth.E_star):.3g} C_nn at the reference step "
+        "c = a_H/20 (C_nn = c/(pi E*) w_t(0,0), the diagonal influence coefficient, eq. 6), fixed in physical "
+        f"units so that every lattice solves the same problem; on this "
         f"report's lattice c = a_H/{res.nodes_per_radius} it is {info['lam_over_cnn']:.3g} C_nn. Its peak pressure "
         f"p_max^lambda = {res.p_lin / res.p0:.4f} p0 scales the other laws: elastic-rigid w = lam min(p, p_cr) with "
         f"p_cr = alpha_a p_max^lambda, alpha_a = {info['alpha_a']:g}; root w = lam_b sqrt(p) with lam_b = lam "
