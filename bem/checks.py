@@ -27,7 +27,26 @@ __all__ = [
     "check_int",
     "check_bool",
     "check_load",
+    "check_scale",
+    "check_rtol",
+    "check_node_count",
+    "RTOL_MAX",
+    "SCALE_RANGE",
+    "MAX_NODES",
 ]
+
+#: Loosest tolerance on the KKT residual (:func:`bem.kkt.kkt_residual`) that :func:`bem.solve`
+#: accepts: the residual is relative (gap violations over the largest surface closure, force
+#: balance over ``P``), so 1e-2 already admits a 1 % error in the contact conditions.
+RTOL_MAX = 1e-2
+#: Range of the physical scales (moduli, loads, lengths of a gap shape) in any consistent units:
+#: the problem multiplies and divides them (``P R / E*``, ``C = c / (pi E*)``, ...), and beyond
+#: this range float64 overflows or underflows before an answer is reached.
+SCALE_RANGE = (1e-60, 1e60)
+#: Largest candidate region, in lattice nodes (a memory guard): a solve holds about 0.4 kB per
+#: node at its peak (``python benchmarks/bem_hertz.py`` reports the peak RSS), so the limit is
+#: about 6.5 GB.
+MAX_NODES = 16_000_000
 
 
 def fail(name, value, rule):
@@ -57,6 +76,36 @@ def check_nonnegative(name, value):
     if value < 0:
         fail(name, value, ">= 0")
     return value
+
+
+def check_scale(name, value):
+    """Return ``float(value)``; raise unless it is a physical scale in :data:`SCALE_RANGE`."""
+    value = check_positive(name, value)
+    low, high = SCALE_RANGE
+    if not low <= value <= high:
+        fail(name, value, f"in [{low:g}, {high:g}] (a physical scale in any consistent units; beyond "
+                          "that float64 overflows in the products of the problem)")
+    return value
+
+
+def check_rtol(name, value):
+    """Return ``float(value)``; raise unless ``0 < value <= RTOL_MAX`` (a relative KKT tolerance)."""
+    value = check_positive(name, value)
+    if value > RTOL_MAX:
+        fail(name, value, f"in (0, {RTOL_MAX:g}]: it bounds the relative KKT residual (gap violations over "
+                          "the largest surface closure, force balance over P), and a larger one accepts a "
+                          "wrong answer as converged")
+    return value
+
+
+def check_node_count(name, value, n_nodes):
+    """Raise unless a candidate region of ``n_nodes`` nodes is at most :data:`MAX_NODES`;
+    ``name = value`` is the argument blamed (the step, or what set it)."""
+    if n_nodes > MAX_NODES:
+        raise InputError(f"{name} = {value!r} is not allowed: the candidate region would hold {float(n_nodes):.3g} "
+                         f"nodes (limit {MAX_NODES:.3g}, about 0.4 kB each); make the lattice coarser or the region "
+                         "smaller.")
+    return n_nodes
 
 
 def check_range(name, value, low, high, *, low_open=False, high_open=False):
@@ -129,5 +178,5 @@ def check_load(force, approach):
     if (force is None) == (approach is None):
         fail("(force, approach)", (force, approach), "exactly one given (force control or approach control)")
     if force is not None:
-        return check_positive("force", force), None
-    return None, check_positive("approach", approach)
+        return check_scale("force", force), None
+    return None, check_scale("approach", approach)

@@ -20,11 +20,36 @@ from functools import cached_property
 
 import numpy as np
 
-from .checks import InputError, check_positive
+from .checks import InputError, check_node_count, check_positive
 
-__all__ = ["Lattice", "LatticeWindow", "SQRT3"]
+__all__ = ["Lattice", "LatticeWindow", "SQRT3", "node_count", "extent_pair"]
 
 SQRT3 = math.sqrt(3.0)
+
+
+def extent_pair(name, extent):
+    """``(ex, ey)`` [length] of a half-width given as one number or a pair; InputError naming ``name``."""
+    if np.ndim(extent) == 0:
+        ex = ey = extent
+    else:
+        try:
+            ex, ey = extent
+        except (TypeError, ValueError):
+            raise InputError(f"{name} = {extent!r} is not allowed: it must be a number or a pair (ex, ey).") from None
+    return check_positive(name, ex), check_positive(name, ey)
+
+
+def _half_counts(step, ex, ey):
+    """``(I, J)``: half the columns and rows of the region ``|x| <= ex``, ``|y| <= ey`` (floats, may be huge)."""
+    return (math.floor(min(ex / step, 1e300) + 1e-9), math.floor(min(ey / (step * SQRT3 / 2), 1e300) + 1e-9))
+
+
+def node_count(step, extent):
+    """Number of nodes of the brick array of ``step`` on the candidate region ``extent`` [length]
+    (:meth:`Lattice.from_extent`: the candidate nodes and the masked ends of odd rows), computed
+    without building it."""
+    half_cols, half_rows = _half_counts(step, *extent_pair("extent", extent))
+    return (2 * half_cols + 1) * (2 * half_rows + 1)
 
 
 @dataclass(frozen=True)
@@ -55,20 +80,19 @@ class Lattice:
             Lattice step ``c`` [length], > 0.
         extent : float or (float, float)
             Half-width of the candidate region [length]: one number for a square,
-            ``(ex, ey)`` for a rectangle. At least two steps.
+            ``(ex, ey)`` for a rectangle. At least two steps each way, and at most
+            :data:`bem.checks.MAX_NODES` nodes in all.
         """
         step = check_positive("step", step)
-        ex, ey = (extent, extent) if np.ndim(extent) == 0 else tuple(extent)
-        ex = check_positive("extent", ex)
-        ey = check_positive("extent", ey)
-        half_cols = int(math.floor(ex / step + 1e-9))
-        half_rows = int(math.floor(ey / (step * SQRT3 / 2) + 1e-9))
+        ex, ey = extent_pair("extent", extent)
+        half_cols, half_rows = _half_counts(step, ex, ey)
         if half_cols < 2 or half_rows < 2:
             raise InputError(
                 f"extent = {extent!r} is not allowed with step = {step!r}: "
                 "it must span at least 2 steps each way (make extent larger or step smaller)."
             )
-        return cls(step, half_cols, half_rows)
+        check_node_count("step", step, node_count(step, (ex, ey)))
+        return cls(step, int(half_cols), int(half_rows))
 
     @property
     def shape(self):

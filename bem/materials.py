@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from bem.checks import fail, check_positive, check_range
+from bem.checks import check_range, check_scale, fail
 
 __all__ = ["NU_MIN", "NU_MAX", "compliance", "effective_modulus"]
 
@@ -50,7 +50,7 @@ def compliance(E, nu, *, name="E", nu_name="nu"):
     nu = check_range(nu_name, nu, NU_MIN, NU_MAX, low_open=True)
     if isinstance(E, (int, float)) and not isinstance(E, bool) and E == math.inf:
         return 0.0
-    E = check_positive(name, E)
+    E = check_scale(name, E)
     return (1.0 - nu * nu) / E
 
 

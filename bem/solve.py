@@ -7,7 +7,8 @@ import time
 
 import numpy as np
 
-from .checks import check_bool, check_callable, check_choice, check_int, check_load, check_positive
+from .checks import (check_bool, check_callable, check_choice, check_finite_array, check_int, check_load,
+                     check_rtol, check_scale)
 from .errors import InputError, RegionTooSmallError
 from .kalker import QPSolution
 from .kkt import kkt_residual
@@ -29,7 +30,7 @@ def _modulus(E_star, E1, nu1, E2, nu2):
     if E_star is not None:
         if any(given):
             raise InputError("E_star is not allowed together with E1, nu1, E2, nu2: give one or the other.")
-        return check_positive("E_star", E_star)
+        return check_scale("E_star", E_star)
     if not all(given):
         raise InputError("E_star = None is not allowed without all of E1, nu1, E2, nu2: give E_star or all four.")
     return effective_modulus(E1, nu1, E2, nu2)
@@ -67,8 +68,9 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     step : float
         Lattice step ``c`` [length].
     extent : float or (float, float)
-        Half-width of the rectangular candidate region [length]. A gap with a
-        ``check_region(extent)`` method (a measured surface's table,
+        Half-width of the rectangular candidate region [length]; the region holds at most
+        :data:`bem.checks.MAX_NODES` nodes (a memory guard, checked before anything is built).
+        A gap with a ``check_region(extent)`` method (a measured surface's table,
         :meth:`bem.gaps.Measured.region`) refuses a region beyond its data.
     layer : bem.layers.Layer, optional
         Interface layer law ``w(p)``; ``None`` for smooth bodies.
@@ -80,10 +82,13 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         (:func:`bem.kalker.solve_qp`), smooth or linear layer only. Without a
         layer, and for ``"newton"`` with a linear layer, the functional is
         quadratic and the QP is solved directly (:func:`solver_for`);
-        ``result.method`` names the solver that ran.
+        ``result.method`` names the solver that ran, and an info message is logged when a
+        paper method is asked for such a problem.
     rtol : float
         Tolerance on the KKT residual ``r`` (:func:`bem.kkt.kkt_residual`) of the
         returned state, the same for every method: ``converged`` means ``r <= rtol``.
+        ``r`` is relative (gap violations over the largest surface closure, force balance
+        over ``P``), so ``rtol`` lies in ``(0, 1e-2]`` (:data:`bem.checks.RTOL_MAX`).
     maxiter : int, optional
         Iteration limit of the solver that runs (CG iterations of the QP, Newton steps,
         outer iterations of the paper's methods).
@@ -146,7 +151,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     E_star = _modulus(E_star, E1, nu1, E2, nu2)
     force, approach = check_load(force, approach)
     check_choice("method", method, METHODS)
-    rtol = check_positive("rtol", rtol)
+    rtol = check_rtol("rtol", rtol)
     if maxiter is not None:
         maxiter = check_int("maxiter", maxiter)
     precondition = check_bool("precondition", precondition)
@@ -163,8 +168,11 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     if nested is None:
         nested = solver in ("kalker", "newton")
     guess = None
+    if solver != method and method != "newton":  # a paper method asked for a quadratic problem
+        log.info("method = %r runs as Kalker's QP (result.method = %r): %s, so the functional is quadratic",
+                 method, solver, "there is no layer" if layer is None else "the layer is linear")
     if x0 is not None:
-        x0 = np.asarray(x0, dtype=float)
+        x0 = check_finite_array("x0", x0, ndim=1)
         if x0.shape != (lattice.n_nodes,):
             raise InputError(f"x0 has shape {x0.shape} which is not allowed: it must be ({lattice.n_nodes},).")
         guess = np.zeros(lattice.shape)

@@ -53,6 +53,9 @@ VOIGT = ("xx", "yy", "zz", "yz", "xz", "xy")
 _GROUPS = ((0, 1, 2), (3,), (4,), (5,))  # components of equal parity (bem.boussinesq.PARITY)
 _MARGIN = 4  # rows and columns the stencil reaches
 _PARALLEL_NODES = 50_000  # lattices from this size compute their depths in parallel threads
+#: Deepest depth [lattice steps]: the kernel agrees with the point force's 1/z^2 decay to 1e60 steps and
+#: under- or overflows in float64 beyond about 1e70 (1e308 gives NaN).
+Z_MAX_STEPS = 1e12
 
 
 def _deviator_angle(s):
@@ -289,7 +292,8 @@ def subsurface_stress(result, z, *, nu, x=None, y=None):
     result : bem.ContactResult
         A solution of :func:`bem.solve`; its nodal pressures (pyramid amplitudes) are the load.
     z : float or array_like, shape (n_z,)
-        Depths below the surface [length], ``>= 0``, any order.
+        Depths below the surface [length], ``>= 0`` and at most :data:`Z_MAX_STEPS` lattice
+        steps, any order.
     nu : float
         Poisson's ratio of the body, in ``(-1, 0.5]``. For dissimilar bodies call once per body:
         frictionless, each body carries the same pressure and its stresses depend only on its
@@ -307,7 +311,8 @@ def subsurface_stress(result, z, *, nu, x=None, y=None):
     Raises
     ------
     bem.InputError
-        ``result`` is not a ContactResult, ``nu`` out of range, a depth negative or not finite,
+        ``result`` is not a ContactResult, ``nu`` out of range, a depth negative, not finite or
+        deeper than :data:`Z_MAX_STEPS` lattice steps,
         ``x``/``y`` of unequal shapes or outside the candidate region.
 
     Notes
@@ -333,6 +338,12 @@ def subsurface_stress(result, z, *, nu, x=None, y=None):
         k = int(np.flatnonzero(z < 0)[0])
         raise InputError(f"{name.format(k)} = {float(z[k])!r} is not allowed: depths must be >= 0 (below the surface).")
     lattice = result.lattice
+    deep = z > Z_MAX_STEPS * lattice.step
+    if deep.any():
+        k = int(np.flatnonzero(deep)[0])
+        raise InputError(f"{name.format(k)} = {float(z[k])!r} is not allowed: depths must be at most {Z_MAX_STEPS:g} "
+                         f"lattice steps ({Z_MAX_STEPS * lattice.step:.6g}), where the stresses are those of a point "
+                         "force; far deeper the kernel's float64 arithmetic over- or underflows.")
     on_nodes = x is None and y is None
     if not on_nodes:
         x, y = _check_points(lattice, x, y)

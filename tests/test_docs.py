@@ -26,7 +26,7 @@ from validation.scene import schema as ss
 from validation.run import run_scene
 from validation.scene import SECTIONS
 from validation.scene import sizing
-from validation.scene.sizing import MAX_NODES
+from bem.checks import MAX_NODES
 from validation.run.sweep import SUMMARY_COLUMNS
 
 ROOT = Path(__file__).resolve().parents[1]

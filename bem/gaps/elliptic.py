@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ..checks import check_positive
+from ..checks import check_scale
 from .base import Gap
 
 __all__ = ["EllipticParaboloid"]
@@ -26,8 +26,8 @@ class EllipticParaboloid(Gap):
     units = {"Rx": "length", "Ry": "length"}
 
     def __init__(self, Rx, Ry):
-        self.Rx = check_positive("Rx", Rx)
-        self.Ry = check_positive("Ry", Ry)
+        self.Rx = check_scale("Rx", Rx)
+        self.Ry = check_scale("Ry", Ry)
 
     @property
     def is_axisymmetric(self):

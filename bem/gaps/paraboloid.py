@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..checks import check_positive
+from ..checks import check_scale
 from .base import AxisymmetricGap
 
 __all__ = ["Paraboloid"]
@@ -22,7 +22,7 @@ class Paraboloid(AxisymmetricGap):
     units = {"R": "length"}
 
     def __init__(self, R):
-        self.R = check_positive("R", R)
+        self.R = check_scale("R", R)
 
     def _profile(self, r):
         return r * r / (2.0 * self.R)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import check_positive
+from ..checks import check_scale
 from .base import AxisymmetricGap
 
 __all__ = ["FlatPunch"]
@@ -29,8 +29,8 @@ class FlatPunch(AxisymmetricGap):
     units = {"a": "length", "edge_radius": "length"}
 
     def __init__(self, a, edge_radius):
-        self.a = check_positive("a", a)
-        self.edge_radius = check_positive("edge_radius", edge_radius)
+        self.a = check_scale("a", a)
+        self.edge_radius = check_scale("edge_radius", edge_radius)
 
     def _profile(self, r):
         d = np.maximum(r - self.a, 0.0)

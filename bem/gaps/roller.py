@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ..checks import check_choice, check_positive, fail
+from ..checks import check_choice, check_positive, check_scale, fail
 from .base import Gap
 
 __all__ = ["CrownedRoller", "lundberg_coefficient"]
@@ -76,8 +76,8 @@ class CrownedRoller(Gap):
 
     def __init__(self, length, R, crown="log", *, A=None, crown_radius=None,
                  design_force=None, E_star=None):
-        self.length = check_positive("length", length)
-        self.R = check_positive("R", R)
+        self.length = check_scale("length", length)
+        self.R = check_scale("R", R)
         self.crown = check_choice("crown", crown, tuple(self.CROWN_KEYS))
         given = {"A": A, "crown_radius": crown_radius, "design_force": design_force, "E_star": E_star}
         for name, value in given.items():
@@ -96,7 +96,7 @@ class CrownedRoller(Gap):
             else:
                 self.A = lundberg_coefficient(design_force, self.length, E_star)
         elif self.crown == "circular":
-            self.crown_radius = check_positive("crown_radius", crown_radius)
+            self.crown_radius = check_scale("crown_radius", crown_radius)
         self.end_gap = 1e3 * self.length
         self.domain = ((-self.length / 2, self.length / 2), (-math.inf, math.inf))
 

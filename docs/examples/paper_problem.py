@@ -1,11 +1,12 @@
 """The paper's test problem: two paraboloids with a nonlinear interface layer (its section 6, Fig. 5).
 
-Normalised units R = E* = P = 1. The layer laws are given as in the paper, relative to the
-discrete problem: the compliance ``lam = 10 C_nn`` (``C_nn`` the diagonal influence coefficient
-of the lattice), the elastic-rigid threshold ``p_cr = alpha_a p_max^lambda`` with
-``alpha_a = 0.5`` (``p_max^lambda``: the peak with the linear layer ``lam``), and the root law
-``w = lam sqrt(p_max^lambda) sqrt(p)``. Each law is solved by Newton's method on the generalised
-functional (the default) and, for the root law, also by the paper's variable compliance method.
+Normalised units R = E* = P = 1. The layer laws are given as in the paper: the compliance
+``lam = 10 C_nn`` (``C_nn`` the diagonal influence coefficient) taken at the reference step
+``a_H / 20``, a fixed compliance whatever lattice solves the problem, the elastic-rigid
+threshold ``p_cr = alpha_a p_max^lambda`` with ``alpha_a = 0.5`` (``p_max^lambda``: the peak
+with the linear layer ``lam``), and the root law ``w = lam sqrt(p_max^lambda) sqrt(p)``. Each
+law is solved by Newton's method on the generalised functional (the default) and, for the root
+law, also by the paper's variable compliance method.
 See docs/method.md, section 5. Run::
 
     python docs/examples/paper_problem.py
@@ -24,7 +25,7 @@ def main(nodes_per_radius=12):
     R = E_star = P = 1.0
     hz = hertz_sphere(R, E_star, force=P)                    # p0, a of the smooth contact
     step = hz.contact_radius / nodes_per_radius                           # lattice step c
-    lam = 10 * c_nn(step, E_star)                            # the paper's lam = 10 C_nn
+    lam = 10 * c_nn(hz.contact_radius / 20, E_star)          # the paper's lam = 10 C_nn at c = a_H/20
 
     def solve(layer, method="newton"):
         return bem.solve(Paraboloid(R), E_star=E_star, force=P, step=step, extent=1.8 * hz.contact_radius, layer=layer,

@@ -24,6 +24,15 @@ GOOD = dict(E_star=1.0, force=0.01, step=0.05, extent=0.5)
     (dict(E_star=None, E1=2e11, nu1=0.3, E2=2e11), "E_star"),
     (dict(E_star=None, E1=2e11, nu1=0.7, E2=2e11, nu2=0.3), "nu1"),
     (dict(x0=np.zeros(3)), "x0"),
+    (dict(x0="abc"), "x0 = 'abc' is not allowed"),
+    (dict(rtol=10.0), r"rtol = 10\.0 is not allowed: it must be in \(0, 0\.01\]"),
+    (dict(rtol=0.05), "rtol = 0.05 is not allowed"),
+    (dict(extent=(0.5, 0.5, 0.5)), r"extent = \(0\.5, 0\.5, 0\.5\) is not allowed: it must be a number or a pair"),
+    (dict(E_star=1e308), r"E_star = 1e\+308 is not allowed"),
+    (dict(force=1e308), r"force = 1e\+308 is not allowed"),
+    (dict(force=None, approach=1e-308), r"approach = 1e-308 is not allowed"),
+    (dict(E_star=None, E1=1e308, nu1=0.3, E2=2.0, nu2=0.3), r"E1 = 1e\+308 is not allowed"),
+    (dict(step=1e-9), r"step = 1e-09 is not allowed: the candidate region would hold 1\.15e\+18 nodes"),
 ])
 def test_bad_input_is_refused_naming_the_argument(change, name):
     kw = {**GOOD, **change}
@@ -52,3 +61,14 @@ def test_non_convergence_is_reported_not_hidden():
     assert not res.converged
     assert "maxiter" in res.message
     assert np.all(np.isfinite(res.p))
+
+
+def test_an_overflowing_radius_is_refused_by_name():
+    with pytest.raises(InputError, match=r"R = 1e\+308 is not allowed"):
+        Paraboloid(1e308)
+
+
+def test_the_loosest_tolerance_is_accepted_and_met():
+    res = bem.solve(Paraboloid(1.0), rtol=bem.checks.RTOL_MAX, **GOOD)
+    assert res.converged and res.kkt_residual <= bem.checks.RTOL_MAX
+

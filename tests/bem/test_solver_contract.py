@@ -69,6 +69,21 @@ def test_result_method_is_the_solver_that_ran(method):
         assert layered.method == method
 
 
+@pytest.mark.parametrize("method", ["augmented_gap", "variable_compliance"])
+def test_a_paper_method_run_as_the_qp_says_so(caplog, method):
+    with caplog.at_level(logging.INFO, logger="bem"):
+        res = _hertz(method=method)
+    assert res.method == "kalker" and res.converged
+    said = [r.getMessage() for r in caplog.records if r.levelno == logging.INFO]
+    assert [m for m in said if f"method = {method!r} runs as Kalker's QP" in m and "there is no layer" in m]
+
+
+def test_the_default_method_on_a_quadratic_problem_logs_nothing_above_debug(caplog):
+    with caplog.at_level(logging.INFO, logger="bem"):
+        assert _hertz().method == "kalker"
+    assert not caplog.records
+
+
 def test_n_matvec_counts_the_products_with_c(monkeypatch):
     calls = []
     real = bem.InfluenceOperator.matvec

@@ -234,3 +234,19 @@ def test_bad_input_raises_input_error_naming_the_argument(hertz_ladder, kwargs, 
     args = {"result": hertz_ladder[8], "z": [0.0, A], "nu": NU, **kwargs}
     with pytest.raises(bem.InputError, match=match):
         bem.subsurface_stress(args.pop("result"), args.pop("z"), **args)
+
+
+@pytest.mark.parametrize("z, name", [(1e308, "z"), ([0.1, 1e308], r"z\[1\]"), (float("inf"), "z")])
+def test_a_depth_too_deep_for_float64_is_refused_by_name(hertz_ladder, z, name):
+    res = hertz_ladder[8]
+    with pytest.raises(bem.InputError, match=f"{name}.* is not allowed"):
+        bem.subsurface_stress(res, z, nu=0.3)
+
+
+def test_the_deepest_allowed_depth_gives_the_point_force_stress(hertz_ladder):
+    """At Z_MAX_STEPS lattice steps sigma_zz is the point force's -3 P / (2 pi z^2)."""
+    res = hertz_ladder[8]
+    z = bem.stress.Z_MAX_STEPS * res.lattice.step
+    st = bem.subsurface_stress(res, z, nu=0.3, x=[0.0], y=[0.0])
+    assert np.all(np.isfinite(st.von_mises))
+    assert st.sigma[0, 0, 2] == pytest.approx(-3 * res.force / (2 * math.pi * z**2), rel=1e-6)

@@ -39,6 +39,7 @@ PAPER_ER = BASE + """
 [layer]
 law = "elastic_rigid"
 lam_over_cnn = 10.0
+cnn_step = 1e-5
 alpha_a = 0.5
 """
 ELLIPTIC = BASE.replace('type = "paraboloid"\nR = 0.01', 'type = "elliptic_paraboloid"\nRx = 0.02\nRy = 0.005')
@@ -84,7 +85,8 @@ CASES = {
     "missing_layer_compliance": (LAYER_BASE + 'law = "linear"\n', "layer.lam"),
     "lam_and_lam_over_cnn": (LAYER_BASE + 'law = "linear"\nlam = 1e-15\nlam_over_cnn = 10.0\n', "layer.lam"),
     "alpha_a_above_one": (PAPER_ER.replace("alpha_a = 0.5", "alpha_a = 1.5"), "layer.alpha_a"),
-    "alpha_c_right_angle": (LAYER_BASE + 'law = "bilinear"\nlam_over_cnn = 10.0\nalpha_a = 0.5\n'
+    "lam_over_cnn_without_its_step": (PAPER_ER.replace("cnn_step = 1e-5\n", ""), "layer.lam_over_cnn"),
+    "alpha_c_right_angle": (LAYER_BASE + 'law = "bilinear"\nlam_over_cnn = 10.0\ncnn_step = 1e-5\nalpha_a = 0.5\n'
                             "alpha_c = 1.6\n", "layer.alpha_c"),
     "unknown_layer_key": (LAYER_BASE + 'law = "power"\nlam = 1e-12\ns = 0.5\nt = 2.0\n', "layer.t"),
     "none_law_with_parameters": (LAYER_BASE + 'law = "none"\nlam = 1e-15\n', "layer.lam"),
@@ -99,6 +101,14 @@ CASES = {
     "unknown_bem_key": (BASE.replace("nodes_across = 16", "nodes_across = 16\ntolerance = 1e-6"),
                         "bem.tolerance"),
     "negative_rtol": (BASE.replace("nodes_across = 16", "nodes_across = 16\nrtol = -1e-8"), "bem.rtol"),
+    "rtol_above_a_percent": (BASE.replace("nodes_across = 16", "nodes_across = 16\nrtol = 10.0"), "bem.rtol = 10.0"),
+    "radius_overflowing": (BASE.replace("R = 0.01", "R = 1e308"), "gap.R = 1e+308"),
+    "force_overflowing": (BASE.replace("force = 100.0", "force = 1e308"), "load.force = 1e+308"),
+    "modulus_overflowing": (BASE.replace("E1 = 210e9", "E1 = 1e308"), "bodies.E1 = 1e+308"),
+    "depth_overflowing": (BASE + "\n[stress]\ndepths = [0.0, 1e308]\n",
+                          "stress.depths[1] = 1e+308"),
+    "extent_of_three": (BASE.replace("nodes_across = 16", "step = 1e-5\nextent = [5e-4, 5e-4, 5e-4]"),
+                        "bem.extent"),
     "precondition_is_text": (BASE.replace("nodes_across = 16", 'nodes_across = 16\nprecondition = "yes"'),
                              "bem.precondition"),
     "kalker_with_nonlinear_layer": (BASE.replace("nodes_across = 16", 'nodes_across = 16\nmethod = "kalker"')

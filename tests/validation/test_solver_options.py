@@ -61,3 +61,27 @@ def test_a_calibration_that_fails_stops_the_run(monkeypatch):
     monkeypatch.setattr(runner.bem, "solve", failing)
     with pytest.raises(paper.CalibrationError, match="forced failure"):
         runner.execute_scene(load_scene(_scene("paper_root")))
+
+
+@pytest.mark.parametrize("method, note", [("augmented_gap", True), ("variable_compliance", True), ("newton", False)])
+def test_a_paper_method_on_a_smooth_scene_notes_the_solver_that_ran(method, note):
+    out = runner.execute_scene(load_scene("hertz", overrides=[f'bem.method="{method}"', "bem.nodes_across=16"]))
+    assert out.result["method"] == "kalker"
+    notes = [m for m in out.result["messages"] if "ran as Kalker's QP" in m]
+    assert notes == ([f"bem.method = {method!r} ran as Kalker's QP ('kalker'): the scene has no layer, so the "
+                      "problem is a QP and the QP solves it directly."] if note else [])
+
+
+def test_the_node_limit_is_one_rule_for_the_api_and_the_scenes():
+    """bem.solve and a scene refuse the same region, before building it, each naming its own key."""
+    step = 1.25e-4
+    assert bem.lattice.node_count(step, 0.5) > bem.checks.MAX_NODES >= bem.lattice.node_count(3 * step, 0.5)
+    rule = r"is not allowed: the candidate region would hold 7\.39e\+07 nodes \(limit 1\.6e\+07"
+    with pytest.raises(bem.InputError, match="^step = 0.000125 " + rule):
+        bem.solve(bem.gaps.Paraboloid(1.0), E_star=1.0, force=0.01, step=step, extent=0.5)
+    raw = {"scene": {"name": "t"}, "bodies": {"E_star": 1.0}, "gap": {"type": "paraboloid", "R": 1.0},
+           "load": {"force": 0.01}, "bem": {"step": step, "extent": 0.5}}
+    with pytest.raises(SceneError, match="^bem.step = 0.000125 " + rule):
+        load_scene(raw)
+    raw["bem"]["step"] = 3 * step
+    assert load_scene(raw).bem["n_nodes"] == bem.lattice.node_count(3 * step, 0.5)

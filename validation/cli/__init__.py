@@ -35,8 +35,9 @@ a closed-form comparison, a sweep, the subsurface stresses or a report only when
 Units: every number is in the scene's own consistent units, stated in its [scene] units
 label. The built-in scenes use SI: lengths in m, moduli and pressures in Pa, forces in N
 (e.g. E1 = 210e9 for steel, R = 0.01 for a 10 mm radius, force = 100.0 for 100 N).
-The paper's layer parameters are dimensionless: lam_over_cnn (compliance / C_nn),
-alpha_a = p_cr / p_max^lambda, alpha_b = p_max^root / p_max^lambda, alpha_c = arctan(lam2/lam1) [rad].
+The paper's layer parameters are dimensionless: lam_over_cnn (compliance / C_nn at the
+reference step cnn_step [m], which it needs), alpha_a = p_cr / p_max^lambda,
+alpha_b = p_max^root / p_max^lambda, alpha_c = arctan(lam2/lam1) [rad].
 """
 
 EPILOG = """\

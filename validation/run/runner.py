@@ -57,7 +57,7 @@ def _notify(progress, stage, status, **info):
 def planned_stages(scene, *, write=False):
     """Stage names :func:`run_scene` will report for ``scene`` (for progress bars)."""
     spec = scene.layer_spec
-    calibrated = spec is not None and ("alpha_a" in spec or (spec["law"] == "root" and "lam_over_cnn" in spec))
+    calibrated = paper.is_paper_law(spec) and ("alpha_a" in spec or spec["law"] == "root")
     wanted = {"layer": calibrated,
               "bem": True,
               "fem": scene.fem is not None,
@@ -169,6 +169,11 @@ def execute_scene(scene, *, progress=None, overrides=None):
     res = solve(layer, callback=callback if progress is not None else None)
     times["bem"] = time.perf_counter() - t
     _notify(progress, "bem", "done", converged=res.converged)
+    asked = scene.bem["method"]
+    if res.method != asked and asked != "newton":  # a paper method on a quadratic problem: the QP solved it
+        messages.append(f"bem.method = {asked!r} ran as Kalker's QP ({res.method!r}): "
+                        + ("the scene has no layer" if layer is None else "the layer is linear")
+                        + ", so the problem is a QP and the QP solves it directly.")
     if not res.converged:
         messages.append(f"BEM did not converge: {res.message}")
         log.info("BEM did not converge: %s", res.message)  # bem.solve has logged its warning

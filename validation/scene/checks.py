@@ -16,8 +16,8 @@ from bem import checks as v
 from bem.checks import InputError
 
 __all__ = ["SceneError", "scene_errors", "unknown_keys", "closest", "require", "exactly_one", "positive",
-           "nonnegative", "in_range", "integer", "boolean", "string", "choice", "table", "number_or_pair", "options",
-           "names", "MAX_SWEEP_POINTS", "sweep_size"]
+           "nonnegative", "scale", "rtol", "in_range", "integer", "boolean", "string", "choice", "table",
+           "number_or_pair", "options", "names", "MAX_SWEEP_POINTS", "sweep_size"]
 
 #: the most values one sweep may hold (each is a complete run; split a larger study into several sweeps)
 MAX_SWEEP_POINTS = 10_000
@@ -120,6 +120,16 @@ def positive(path, value):
 
 def nonnegative(path, value):
     return _wrap(v.check_nonnegative, path, value)
+
+
+def scale(path, value):
+    """A physical scale (modulus, load, length) in :data:`bem.checks.SCALE_RANGE`."""
+    return _wrap(v.check_scale, path, value)
+
+
+def rtol(path, value):
+    """A KKT tolerance of the BEM (:func:`bem.checks.check_rtol`)."""
+    return _wrap(v.check_rtol, path, value)
 
 
 def in_range(path, value, low, high, **kw):

@@ -6,8 +6,9 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [bodies]   E1, nu1, E2, nu2 [Pa, -]  -- or E_star [Pa] alone
     [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...), or
                type = "measured" with a file (validation.scene.measured)
-    [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn, alpha_a,
-               alpha_b, alpha_c (validation.paper); absent or law = "none": no layer
+    [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn with cnn_step,
+               lam_ref, alpha_a, alpha_b, alpha_c (validation.scene.paper); absent or
+               law = "none": no layer
     [load]     force [N] or approach [m]
     [bem]      step [m] or nodes_across; extent [m] or extent_factor; method, rtol, maxiter,
                precondition, nested, relaxation
@@ -263,8 +264,8 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     analytic = check(lambda g, la: sec.analytic(raw.get("analytic"), g[1], la[0]), shape, layer)
     sweep = check(sec.sweep_spec, raw.get("sweep"), SECTIONS)
     report = check(sec.report, raw.get("report"))
-    stress = check(lambda b: sec.stress_options(raw.get("stress"), b["materials"]), body)
-    stress = check(lambda st, b: sec.stress_depth_bound(st, b["extent"]), stress, bem)
+    stress = check(lambda b, bo: sec.stress_options(raw.get("stress"), b["materials"], bo["step"]), body, bem)
+    stress = check(lambda st, bo: sec.stress_depth_bound(st, bo["extent"]), stress, bem)
     if check.errors:
         raise SceneError.of(check.errors)
     return Scene(

@@ -3,12 +3,14 @@
 The test problem is the contact of two paraboloids with a layer between them (Fig. 4 a);
 the layer laws are those of Fig. 4 b-d, given relative to quantities of the discrete problem:
 
-- compliance relative to the diagonal influence coefficient (eq. 6):
-  ``lam = lam_over_cnn * C_nn``, ``C_nn = c / (pi E*) * w_t(0, 0)``, ``w_t(0, 0) =
-  (3 sqrt3 / 2) ln 3`` (:func:`bem.template`), ``c`` the scene's BEM step. Fig. 5 uses
-  ``lam = 10 C_nn``. As in the paper, the layer so defined depends on the mesh step: refining
-  the lattice makes the layer stiffer. Give ``lam`` directly to pin it.
-- ``p_max^lambda``: the peak pressure of the SAME problem (gap, bodies, load, lattice) with
+- compliance [length/pressure]: ``lam`` (``lam1``; ``lam_ref`` for the root law), a property
+  of the layer alone. Fig. 5 uses ``lam = 10 C_nn``, a multiple of the diagonal influence
+  coefficient (eq. 6) ``C_nn = c / (pi E*) * w_t(0, 0)``, ``w_t(0, 0) = (3 sqrt3 / 2) ln 3``
+  (:func:`bem.template`), which is proportional to the lattice step ``c``. The paper's value
+  may be given as ``lam_over_cnn`` together with ``cnn_step``, the reference step ``c`` at
+  which ``C_nn`` is taken: ``lam = lam_over_cnn * C_nn(cnn_step)``. Either way the layer is
+  the same on every lattice, so refining the lattice converges to one solution.
+- ``p_max^lambda``: the peak pressure of the same problem (gap, bodies, load, lattice) with
   the linear layer ``w = lam p``, solved first.
 - elastic-rigid (Fig. 4 b): ``w = lam min(p, p_cr)``, ``alpha_a = p_cr / p_max^lambda``
   in ``[0, 1]``; ``alpha_a = 0`` is the contact of smooth bodies (no layer), ``alpha_a = 1``
@@ -41,16 +43,16 @@ log = logging.getLogger(__name__)
 
 
 class CalibrationError(RuntimeError):
-    """A solve that calibrates a layer law (``alpha_a``, ``alpha_b``, ``lam_over_cnn``) failed."""
+    """A solve that calibrates a layer law (``alpha_a``, ``alpha_b``, the root law's reference) failed."""
 
 #: law -> {constructor parameter: (direct key, paper key)}
 PAPER_LAWS = {
     "linear": {"lam": ("lam", "lam_over_cnn")},
     "elastic_rigid": {"lam": ("lam", "lam_over_cnn"), "p_cr": ("p_cr", "alpha_a")},
     "bilinear": {"lam1": ("lam1", "lam_over_cnn"), "lam2": ("lam2", "alpha_c"), "p_star": ("p_star", "alpha_a")},
-    "root": {"lam": ("lam", "lam_over_cnn")},
+    "root": {"lam": ("lam_ref", "lam_over_cnn")},
 }
-PAPER_KEYS = ("lam_over_cnn", "alpha_a", "alpha_c", "alpha_b")
+PAPER_KEYS = ("lam_over_cnn", "lam_ref", "alpha_a", "alpha_c", "alpha_b")
 #: groups of layer keys that replace each other (a ``--set`` of one drops the others)
 EXCLUSIVE = (("lam", "lam_over_cnn"), ("lam1", "lam_over_cnn"), ("p_cr", "alpha_a"), ("p_star", "alpha_a"),
              ("lam2", "alpha_c"))
@@ -70,18 +72,20 @@ def is_paper_law(spec):
 
 def paper_keys(law):
     """The keys of a paper law's table besides ``law``: each parameter's direct and paper key."""
-    return [k for pair in PAPER_LAWS[law].values() for k in pair] + (["alpha_b"] if law == "root" else [])
+    return ([k for pair in PAPER_LAWS[law].values() for k in pair] + ["cnn_step"]
+            + (["alpha_b"] if law == "root" else []))
 
 
-def reference_compliance(spec, step, E_star):
-    """Compliance of the linear reference layer [length/pressure]: ``lam`` (``lam1``) or ``lam_over_cnn C_nn``."""
-    direct = PAPER_LAWS[spec["law"]][next(iter(PAPER_LAWS[spec["law"]]))][0]  # lam or lam1
-    return spec[direct] if direct in spec else spec["lam_over_cnn"] * c_nn(step, E_star)
+def reference_compliance(spec, E_star):
+    """Compliance of the linear reference layer [length/pressure]: ``lam`` (``lam1``, ``lam_ref``) or
+    ``lam_over_cnn C_nn(cnn_step)``, the same on every lattice."""
+    direct = PAPER_LAWS[spec["law"]][next(iter(PAPER_LAWS[spec["law"]]))][0]  # lam, lam1 or lam_ref
+    return spec[direct] if direct in spec else spec["lam_over_cnn"] * c_nn(spec["cnn_step"], E_star)
 
 
 def _check_paper_values(path, d):
     """Range checks of the direct and paper parameters of the four paper laws."""
-    for key in ("lam", "lam1", "p_cr", "p_star", "lam_over_cnn", "alpha_b"):
+    for key in ("lam", "lam1", "lam_ref", "p_cr", "p_star", "lam_over_cnn", "cnn_step", "alpha_b"):
         if key in d:
             positive(f"{path}.{key}", d[key])
     if "lam2" in d:
@@ -90,9 +94,14 @@ def _check_paper_values(path, d):
         in_range(f"{path}.alpha_a", d["alpha_a"], 0.0, 1.0)
     if "alpha_c" in d:
         in_range(f"{path}.alpha_c", d["alpha_c"], 0.0, math.pi / 2, high_open=True)
-    if "alpha_b" in d and "lam_over_cnn" not in d:
-        raise SceneError(f"{path}.alpha_b = {d['alpha_b']!r} is not allowed without {path}.lam_over_cnn: "
-                         "alpha_b is relative to the linear layer lam = lam_over_cnn * C_nn.")
+    if "lam_over_cnn" in d and "cnn_step" not in d:
+        raise SceneError(f"{path}.lam_over_cnn = {d['lam_over_cnn']!r} is not allowed without {path}.cnn_step: "
+                         "C_nn is proportional to the lattice step, so give the reference step [m] at which "
+                         "lam = lam_over_cnn * C_nn (the layer is then the same on every lattice), or give the "
+                         "compliance directly [m/Pa].")
+    if "cnn_step" in d and "lam_over_cnn" not in d:
+        raise SceneError(f"{path}.cnn_step = {d['cnn_step']!r} is not allowed without {path}.lam_over_cnn: "
+                         "it is the reference step of lam = lam_over_cnn * C_nn(cnn_step).")
 
 
 def _check_law_keys(path, d):
@@ -142,6 +151,10 @@ def check_layer(d, path="layer"):
     if law not in PAPER_LAWS or not any(k in d for k in PAPER_KEYS):
         _check_law_keys(path, d)
         return dict(d)
+    if "alpha_b" in d and "lam" in d:
+        raise SceneError(f"{path}.alpha_b = {d['alpha_b']!r} is not allowed together with {path}.lam: "
+                         "alpha_b sets the root coefficient; give the linear reference (lam_ref, or lam_over_cnn "
+                         "and cnn_step) and alpha_b, or lam alone.")
     unknown_keys(path, d, ["law", *paper_keys(law)])
     for param, (direct, paper) in PAPER_LAWS[law].items():
         present = [k for k in (direct, paper) if k in d]
@@ -150,9 +163,6 @@ def check_layer(d, path="layer"):
         if len(present) == 2:
             raise SceneError(f"{path}.{direct} = {d[direct]!r} and {path}.{paper} = {d[paper]!r} are not "
                              f"allowed together: give one of them ({param} directly or the paper's {paper}).")
-    if "alpha_b" in d and "lam" in d:
-        raise SceneError(f"{path}.alpha_b = {d['alpha_b']!r} is not allowed together with {path}.lam: "
-                         "alpha_b sets the root coefficient; give lam_over_cnn and alpha_b, or lam alone.")
     _check_paper_values(path, d)
     return dict(d)
 
@@ -220,7 +230,8 @@ def resolve_layer(spec, *, step, E_star, solve, layer=None):
     spec : dict or None
         Output of :func:`check_layer`.
     step : float
-        BEM step ``c`` [length] (for ``C_nn``).
+        BEM step ``c`` [length] of the lattice in use (for the reported ``c_nn``; the layer
+        does not depend on it).
     E_star : float
         Effective modulus [pressure].
     solve : callable
@@ -232,8 +243,9 @@ def resolve_layer(spec, *, step, E_star, solve, layer=None):
     -------
     layer : bem.layers.Layer or None
     info : dict
-        ``law`` and, when the paper's parameters are used, ``c_nn``, ``lam_over_cnn``,
-        ``lam_ref`` (the linear reference compliance), ``p_max_lambda``, ``alpha_a``,
+        ``law`` and, when the paper's parameters are used, ``c_nn`` (of the lattice in use),
+        ``lam_ref`` (the linear reference compliance), ``lam_over_cnn`` (``lam_ref / c_nn``: how
+        soft the layer is on the scale of one node of this lattice), ``p_max_lambda``, ``alpha_a``,
         ``alpha_c``, ``alpha_b_target``, ``reference_solves``; ``parameters`` (the resolved
         law's ``to_dict()``).
     """
@@ -245,8 +257,8 @@ def resolve_layer(spec, *, step, E_star, solve, layer=None):
         layer = from_dict(spec) if layer is None else layer
         return layer, dict(info, parameters=layer.to_dict())
     cnn = c_nn(step, E_star)
-    lam_ref = reference_compliance(spec, step, E_star)
-    info.update(c_nn=cnn, lam_over_cnn=spec.get("lam_over_cnn", lam_ref / cnn), lam_ref=lam_ref)
+    lam_ref = reference_compliance(spec, E_star)
+    info.update(c_nn=cnn, lam_over_cnn=lam_ref / cnn, lam_ref=lam_ref)
     p_lambda = None
     if "alpha_a" in spec or law == "root":
         p_lambda = solve(Linear(lam_ref)).p_max

@@ -16,6 +16,7 @@ from bem import gaps
 from bem.gaps import gap_from_dict
 from bem.layers import LAWS, from_dict
 from bem.materials import effective_modulus
+from bem.stress import Z_MAX_STEPS
 
 from ..units import DEFAULT_LABEL as DEFAULT_UNITS
 from ..units import parse_units
@@ -110,7 +111,7 @@ def bodies(d):
             given = ", ".join(f"bodies.{k}" for k in BODY_KEYS if k in d)
             raise ck.SceneError(f"bodies.E_star = {d['E_star']!r} is not allowed together with {given}: "
                                 "give E_star alone or all of E1, nu1, E2, nu2.")
-        return {"E_star": ck.positive("bodies.E_star", d["E_star"]), "materials": None}
+        return {"E_star": ck.scale("bodies.E_star", d["E_star"]), "materials": None}
     for key in BODY_KEYS:
         ck.require("bodies", d, key, "give E1, nu1, E2, nu2 [Pa, -] (or E_star alone)")
     with ck.scene_errors("bodies."):
@@ -163,11 +164,11 @@ def gap(d, E_star, *, units=None, build=True):
 
 
 def load(d):
-    """``[load]``: exactly one of ``force`` [N] and ``approach`` [m], > 0."""
+    """``[load]``: exactly one of ``force`` [N] and ``approach`` [m], in :data:`bem.checks.SCALE_RANGE`."""
     _section("load", d)
     key = ck.exactly_one("load", d, KEYS["load"], "force control: force [N]; approach control: "
                          "approach [m]")
-    return {"force": None, "approach": None, key: ck.positive(f"load.{key}", d[key])}
+    return {"force": None, "approach": None, key: ck.scale(f"load.{key}", d[key])}
 
 
 def layer(d, *, build=True):
@@ -277,9 +278,10 @@ def sweep_spec(d, known_sections):
     return {"parameter": param, "key": key, "values": list(values)}
 
 
-def stress_options(d, materials):
-    """``[stress]``: ``depths`` (``"auto"`` or a list [m]), ``n_depths`` and ``max_depth`` (with
-    ``"auto"``: that many depths from 0 down to ``max_depth`` contact half-widths), ``bodies``."""
+def stress_options(d, materials, step=None):
+    """``[stress]``: ``depths`` (``"auto"`` or a list [m], at most :data:`bem.stress.Z_MAX_STEPS`
+    lattice steps ``step`` [m] deep), ``n_depths`` and ``max_depth`` (with ``"auto"``: that many
+    depths from 0 down to ``max_depth`` contact half-widths), ``bodies``."""
     if d is None:
         return None
     _section("stress", d)
@@ -300,6 +302,11 @@ def stress_options(d, materials):
             raise ck.SceneError(f"stress.depths = {depths!r} is not allowed: it must be \"auto\" or a list of 1 to "
                                 "1000 depths below the surface [m], e.g. [0.0, 1e-4, 2e-4].")
         out["depths"] = [ck.nonnegative(f"stress.depths[{i}]", v) for i, v in enumerate(depths)]
+        deepest = math.inf if step is None else Z_MAX_STEPS * step
+        for i, z in enumerate(out["depths"]):
+            if z > deepest:
+                raise ck.SceneError(f"stress.depths[{i}] = {z!r} is not allowed: it must be at most {Z_MAX_STEPS:g} "
+                                    f"lattice steps ({deepest:.6g} m) below the surface.")
         if len(set(out["depths"])) != len(depths):
             raise ck.SceneError(f"stress.depths = {depths!r} is not allowed: the depths must be distinct.")
     bodies = ck.names("stress.bodies", d.get("bodies", list(STRESS_BODIES)), STRESS_BODIES,

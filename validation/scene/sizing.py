@@ -5,10 +5,9 @@ expected contact: ``bem.nodes_across`` nodes across its smaller diameter and
 ``bem.extent_factor`` times its semi-axes. The expected semi-axes are the gap's own estimate,
 :meth:`bem.gaps.Gap.expected_semi_axes` (closed forms of :mod:`bem.reference`; tables,
 callables and measured surfaces have none, and such a scene gives ``bem.step`` and
-``bem.extent``). With a layer given by the paper's ``lam_over_cnn`` the layer depends on the
-step and the step on the expected contact: the two are iterated to a fixed point (the gap's
-radial profile is sampled once for all of them). An estimate only sizes the region: the runner
-enlarges an automatic region when the contact reaches its border.
+``bem.extent``). A layer given by the paper's parameters is sized by its linear reference
+layer. An estimate only sizes the region: the runner enlarges an automatic region when the
+contact reaches its border.
 
 The solver options are checked by the BEM itself (:func:`bem.options.check_options`: one rule,
 one message), and the option names come from :data:`bem.options.OPTIONS`.
@@ -16,22 +15,20 @@ one message), and the option names come from :data:`bem.options.OPTIONS`.
 
 from __future__ import annotations
 
-import math
 from functools import partial
 
 from bem import METHODS, InputError
-from bem.lattice import SQRT3, Lattice
+from bem.checks import check_node_count
+from bem.lattice import Lattice, node_count
 from bem.layers import Linear
 from bem.options import OPTIONS, check_options, solver_for
 
 from . import checks as ck
 from .paper import is_paper_law, reference_compliance
 
-__all__ = ["bem_options", "inner_domain", "node_count", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "MAX_NODES",
-           "DOMAIN_MARGIN", "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
+__all__ = ["bem_options", "inner_domain", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "DOMAIN_MARGIN", "DEFAULT_NODES_ACROSS",
+           "DEFAULT_EXTENT_FACTOR"]
 
-#: Largest candidate region a scene may ask for (memory and time guard).
-MAX_NODES = 4_000_000
 #: An automatic extent stays this fraction inside a bounded gap domain.
 DOMAIN_MARGIN = 1e-3
 DEFAULT_NODES_ACROSS = 40
@@ -50,14 +47,6 @@ def inner_domain(gap):
     return min(-x0, x1), min(-y0, y1)
 
 
-def node_count(step, extent):
-    """Number of lattice nodes of the candidate region (as :meth:`bem.Lattice.from_extent`)."""
-    ex, ey = extent
-    cols = 2 * math.floor(ex / step + 1e-9) + 1
-    rows = 2 * math.floor(ey / (step * SQRT3 / 2) + 1e-9) + 1
-    return cols * rows
-
-
 def _axes(gap, layer, E_star, load):
     try:
         return gap.expected_semi_axes(E_star=E_star, force=load["force"], approach=load["approach"], layer=layer)
@@ -66,21 +55,13 @@ def _axes(gap, layer, E_star, load):
                             "give bem.step and bem.extent.") from None
 
 
-def _expected(gap, layer_spec, layer, E_star, load, step, n_across):
-    """Expected semi-axes; with ``lam_over_cnn`` and an automatic step, iterate step <-> layer."""
-    axes = _axes(gap, None, E_star, load)
-    if axes is None or layer_spec is None:
-        return axes
-    if not is_paper_law(layer_spec):
-        return _axes(gap, layer, E_star, load)
-    s = step if step is not None else 2 * min(axes) / n_across
-    for _ in range(30):
-        axes = _axes(gap, Linear(reference_compliance(layer_spec, s, E_star)), E_star, load)
-        s_new = 2 * min(axes) / n_across
-        if step is not None or abs(s_new / s - 1.0) < 1e-9:
-            break
-        s = s_new
-    return axes
+def _expected(gap, layer_spec, layer, E_star, load):
+    """Expected semi-axes; a layer of the paper's parameters is represented by its linear reference."""
+    if layer_spec is None:
+        return _axes(gap, None, E_star, load)
+    if is_paper_law(layer_spec):
+        return _axes(gap, Linear(reference_compliance(layer_spec, E_star)), E_star, load)
+    return _axes(gap, layer, E_star, load)
 
 
 def _solver_options(d, method, layer_spec):
@@ -149,12 +130,12 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
             raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
                                 "give one of them.")
     out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
-    out.update(ck.options("bem", d, {"rtol": ck.positive, "maxiter": partial(ck.integer, minimum=1),
+    out.update(ck.options("bem", d, {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1),
                                      "precondition": ck.boolean, "nested": ck.boolean}))
     out.update(_solver_options(d, out["method"], layer_spec))
     step = ck.positive("bem.step", d["step"]) if "step" in d else None
     n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
-    axes = _expected(gap, layer_spec, layer, E_star, load, step, n_across)
+    axes = _expected(gap, layer_spec, layer, E_star, load)
     if axes is None and ("step" not in d or "extent" not in d):
         raise ck.SceneError(f"bem.step and bem.extent are missing: a {gap.type_name!r} gap has no estimate "
                             "of the contact size, so give the lattice step [m] and the region half-width [m].")
@@ -165,13 +146,11 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
                             f"{2 * min(axes):.4g} across ({2 * min(axes) / step:.1f} steps); make step smaller "
                             "(at least 4 nodes across the contact).")
     extent, auto = _extent(d, gap, axes)
-    with ck.scene_errors():
-        Lattice.from_extent(step, extent)
     n = node_count(step, extent)
-    if n > MAX_NODES:
-        raise ck.SceneError(f"bem.{'step' if 'step' in d else 'nodes_across'} = "
-                            f"{d.get('step', n_across)!r} is not allowed: the region would hold {n} nodes "
-                            f"(limit {MAX_NODES}); make the lattice coarser or the region smaller.")
+    key = "step" if "step" in d else "nodes_across"
+    with ck.scene_errors():
+        check_node_count(f"bem.{key}", d.get(key, n_across), n)  # bem's memory guard, before building
+        Lattice.from_extent(step, extent)
     out.update(step=step, extent=extent, extent_auto=auto, expected=axes,
                nodes_across=2 * min(axes) / step if axes else None, n_nodes=n)
     return out

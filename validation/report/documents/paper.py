@@ -39,6 +39,8 @@ def _how(r, res):
 
 
 def _problem(res, work):
+    from validation.scene.paper import c_nn
+
     from ..figures.profiles import plot_layer_laws
 
     smooth, info = res.outcomes["smooth"].scene, res.outcomes["elastic-rigid"].result["layer"]
@@ -57,9 +59,11 @@ def _problem(res, work):
         f"section 6, Fig. 4). The smooth (Hertz) contact has radius a_H = {res.a:.4g} {u['length']}, peak "
         f"pressure p0 = {res.p0:.4g} {u['pressure']} and approach delta_H = {res.approach:.4g} {u['length']}; all "
         "pressures below are divided by p0 and all lengths by a_H.",
-        f"The linear (Winkler) layer has lam = {info['lam_over_cnn']:g} C_nn = {info['lam_ref']:.4g} "
-        f"{u['length']}/{u['pressure']}, where C_nn = c/(pi E*) w_t(0,0) = {info['c_nn']:.4g} is the diagonal "
-        f"influence coefficient (eq. 6) of the lattice step c = a_H/{res.nodes_per_radius}. Its peak pressure "
+        f"The linear (Winkler) layer has the compliance lam = {info['lam_ref']:.4g} {u['length']}/{u['pressure']}, "
+        f"the paper's {info['lam_ref'] / c_nn(res.a / 20, smooth.E_star):.3g} C_nn at the reference step "
+        "c = a_H/20 (C_nn = c/(pi E*) w_t(0,0), the diagonal influence coefficient, eq. 6), fixed in physical "
+        f"units so that every lattice solves the same problem; on this "
+        f"report's lattice c = a_H/{res.nodes_per_radius} it is {info['lam_over_cnn']:.3g} C_nn. Its peak pressure "
         f"p_max^lambda = {res.p_lin / res.p0:.4f} p0 scales the other laws: elastic-rigid w = lam min(p, p_cr) with "
         f"p_cr = alpha_a p_max^lambda, alpha_a = {info['alpha_a']:g}; root w = lam_b sqrt(p) with lam_b = lam "
         "sqrt(p_max^lambda) (root and linear laws close equally at p_max^lambda); bilinear with slope lam up to "
@@ -255,7 +259,7 @@ def _augmented_gap_summary(res):
     if not failed:
         return "The augmented gap method as printed in the paper (omega = 1) converges on every law tested."
     return (f"The augmented gap method as printed in the paper (omega = 1) does not converge for {len(failed)} of "
-            f"{len(rows)} laws ({', '.join(failed)}; see the stability table): with lam = {res.lam_over_cnn:g} C_nn "
+            f"{len(rows)} laws ({', '.join(failed)}; see the stability table): with lam = {res.lam_over_cnn:.3g} C_nn "
             "the layer is much softer than the bodies on the scale of one node, and the fixed-point map "
             "h_bar = h + w(p_k) is not a contraction.")
 
@@ -343,7 +347,7 @@ def report_paper_problem(out_dir, *, quick=False, fem=True, fmt="png", progress=
     """
     notify = Progress([s for s in STAGES if fem or s != SOLVE_STAGES[3]], progress)
     res = run_paper_problem(quick=quick, fem=fem, progress=notify)
-    subtitle = (f"Steel paraboloids (built-in scenes paper_*), lam = {res.lam_over_cnn:g} C_nn; BEM lattice "
+    subtitle = (f"Steel paraboloids (built-in scenes paper_*), lam = {res.lam:.4g} m/Pa; BEM lattice "
                 f"a_H/c = {res.nodes_per_radius}{' (quick preview)' if quick else ''}; "
                 f"computed in {res.wall_time_s:.0f} s.")
     return draw_and_build(lambda work: paper_sections(res, work), out_dir, title=TITLE, subtitle=subtitle, fmt=fmt,

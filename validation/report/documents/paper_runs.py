@@ -7,9 +7,9 @@ lattice for all, ``bem.step = a_H / n`` (Hertz's radius ``a_H`` of the smooth pr
 candidate region ``|x|, |y| <= 1.9 a_H``, the iteration histories with ``bem.record``, the
 methods with ``bem.method`` and their options, the sweeps with ``layer.alpha_a``,
 ``layer.alpha_c`` and the root coefficient ``layer.lam``, the subsurface stresses with
-``[stress] depths``, the FEM reference with ``[fem] n_contact``. The paper defines
-``lam = lam_over_cnn C_nn`` on the lattice in use, so the quick preview (``n = 8``) has a softer
-layer than the full report (``n = 20``).
+``[stress] depths``, the FEM reference with ``[fem] n_contact``. The scenes give the layer
+compliance in physical units (the paper's ``10 C_nn`` at the step ``a_H / 20``), so the quick
+preview (``n = 8``) and the full report (``n = 20``) solve the same problem on two lattices.
 """
 
 from __future__ import annotations
@@ -106,9 +106,17 @@ class PaperRuns:
         return self.outcomes["linear Winkler"].bem.p_max
 
     @property
+    def lam(self):
+        """Compliance of the linear layer [length/pressure]."""
+        return self.outcomes["linear Winkler"].layer.lam
+
+    @property
     def lam_over_cnn(self):
-        """``lam / C_nn`` of the linear layer (the scene's paper parameter)."""
-        return self.outcomes["linear Winkler"].result["layer"]["lam_over_cnn"]
+        """``lam / C_nn`` with ``C_nn`` of the lattice in use (how soft the layer is on the scale of one node)."""
+        from validation.scene.paper import c_nn
+
+        o = self.outcomes["linear Winkler"]
+        return self.lam / c_nn(o.result["bem"]["step"], o.scene.E_star)
 
     @property
     def stress(self):

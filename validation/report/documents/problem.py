@@ -28,9 +28,10 @@ _LAW_TEXT = {
     "custom": "user-defined layer law",
 }
 _MEASURED = "measured surface read from a file, interpolated onto the lattice"
-_PAPER_ROWS = (("c_nn", "C_nn = c w_t(0,0) / (pi E*), diagonal influence coefficient (eq. 6)", "compliance"),
-               ("lam_over_cnn", "lam / C_nn (paper parameter)", "-"),
-               ("lam_ref", "compliance of the linear reference layer lam_over_cnn C_nn", "compliance"),
+_PAPER_ROWS = (("c_nn", "C_nn = c w_t(0,0) / (pi E*), diagonal influence coefficient (eq. 6) of this lattice",
+                "compliance"),
+               ("lam_over_cnn", "lam / C_nn on this lattice", "-"),
+               ("lam_ref", "compliance of the linear reference layer", "compliance"),
                ("p_max_lambda", "p_max^lambda: peak with the linear layer lam (reference solve)", "pressure"),
                ("alpha_a", "alpha_a = p_cr / p_max^lambda (paper parameter)", "-"),
                ("alpha_c", "alpha_c = arctan(lam2 / lam1) (paper parameter)", "rad"),
