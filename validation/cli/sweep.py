@@ -10,7 +10,9 @@ from .common import add_set
 
 PARSER = {"help": "sweep one scene parameter (resumable, parallel)",
           "description": "Run a scene for each value of one parameter. Finished points are saved "
-                         "one file each; rerunning skips them (resume).",
+                         "one file each; rerunning skips them (resume). --out DIR is the sweep directory "
+                         "itself; it must be new, empty or a sweep directory contactlab wrote (marked by "
+                         "DIR/.contactlab).",
           "epilog": "examples:\n  contactlab sweep paper_elastic_rigid                 (its [sweep])\n"
                     "  contactlab sweep paper_bilinear --param alpha_c --values 0,0.4,0.8,1.2\n"
                     "  contactlab sweep hertz --param load.force --values 50:200:4 --workers 2\n"
@@ -21,7 +23,8 @@ def add_args(p):
     p.add_argument("scene", metavar="SCENE")
     p.add_argument("--param", metavar="P", help="alpha_a, alpha_b, alpha_c or a dotted key (layer.lam, load.force)")
     p.add_argument("--values", metavar="V", help="comma list 0,0.25,0.5 or start:stop:num")
-    p.add_argument("--out", metavar="DIR", help="sweep directory (default: results/<scene>-sweep-<param>)")
+    p.add_argument("--out", metavar="DIR", help="the sweep directory written (default: "
+                                                "results/<scene name>-sweep-<param>)")
     p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address (needs dask.distributed)")
     add_set(p)
@@ -30,7 +33,8 @@ def add_args(p):
 def run(args):
     from tqdm import tqdm
 
-    from ..run.sweep import parse_values, run_sweep, sweep_points
+    from ..io import check_output_dir, output_errors
+    from ..run.sweep import SWEEP_NAMES, parse_values, run_sweep, sweep_points
     from ..scene import load_scene
 
     values = parse_values(args.values) if args.values is not None else None
@@ -39,7 +43,11 @@ def run(args):
                          "scene's [sweep]).")
     scene = load_scene(args.scene, overrides=args.overrides)
     param, _key, points = sweep_points(scene, args.param, values)
-    out = Path(args.out) if args.out else Path("results") / f"{scene.name}-sweep-{param}"
+    if args.out:
+        out, what, value = Path(args.out), "--out", None
+    else:
+        out, what, value = Path("results") / f"{scene.name}-sweep-{param}", "scene.name", scene.name
+    check_output_dir(out, "sweep", SWEEP_NAMES, what=what, value=value)
     bar = tqdm(total=len(points), desc=f"sweep {param}", unit="point", disable=args.no_progress or None)
 
     def progress(done, total, row):
@@ -47,8 +55,9 @@ def run(args):
         bar.set_postfix_str(f"{param}={row['value']} {row['status']}")
 
     try:
-        summary = run_sweep(scene, out, parameter=args.param, values=values, workers=args.workers,
-                            scheduler=args.scheduler, progress=progress)
+        with output_errors(out, "--out" if args.out else "out_dir"):
+            summary = run_sweep(scene, out, parameter=args.param, values=values, workers=args.workers,
+                                scheduler=args.scheduler, progress=progress)
     finally:
         bar.close()
     print(f"sweep of {summary['key']} over {len(summary['points'])} values of scene {summary['scene']} "

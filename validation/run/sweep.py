@@ -1,9 +1,9 @@
 """Parameter sweeps of a scene: one scene parameter over a list of values, resumable.
 
 Every point is a complete scene (the base scene with ``parameter = value``) validated before
-any work. Points run in parallel on local cores (:class:`concurrent.futures.ProcessPoolExecutor`,
-``workers`` = cores by default) or on a Dask cluster when a scheduler address is given
-(``dask.distributed``, optional, imported only then). Each finished point is saved at once as
+any work. Points run in parallel on local cores (:func:`validation.run.pool.worker_pool`,
+``workers`` = cores by default; the workers end with the sweep) or on a Dask cluster when a
+scheduler address is given (``dask.distributed``, optional, imported only then). Each finished point is saved at once as
 its own JSON file (atomically), ``points/point-NNN.json``, holding the point's full result
 (``result.json`` content, the axial section profile included); a rerun skips the points
 already on disk for the same scene (``fingerprint``: SHA-256 of the point's scene), so an
@@ -23,23 +23,26 @@ import json
 import logging
 import os
 import traceback
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from pathlib import Path
 
 from bem.files import write_text
 
 from ..extras import require as require_extra
-from ..io import atomic_write_json
+from ..io import atomic_write_json, check_output_dir, write_marker
 from ..scene.checks import SceneError
 from ..scene.load import Scene, apply_overrides, load_scene, parse_scene
+from .pool import worker_pool
 
-__all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values"]
+__all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values", "SWEEP_NAMES"]
 
 log = logging.getLogger(__name__)
 
 SUMMARY_COLUMNS = ("index", "value", "status", "p_max", "force", "approach", "contact_radius", "contact_area",
                    "converged", "iterations", "kkt_residual", "alpha_b", "p_max_lambda", "wall_time_bem",
                    "wall_time_fem", "computed", "file")
+#: What a sweep directory holds besides its marker ``.contactlab`` (:func:`validation.io.check_output_dir`).
+SWEEP_NAMES = ("points", "summary.json", "summary.csv", "report")
 
 
 class SweepPoint:
@@ -154,7 +157,7 @@ def _local_map(jobs, workers):
             except Exception:  # noqa: BLE001 - a failed point is reported, the sweep goes on
                 yield point, None, traceback.format_exc(limit=3)
         return
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with worker_pool(workers) as pool:  # its workers end with this process
         futures = {pool.submit(_solve_point, p.scene.raw, p.scene.source): p for p in jobs}
         try:
             for fut in as_completed(futures):
@@ -212,7 +215,9 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
     scene : Scene, str, path-like or dict
         The base scene.
     out_dir : path-like
-        Sweep directory: ``points/point-NNN.json``, ``summary.json``, ``summary.csv``.
+        Sweep directory: ``points/point-NNN.json``, ``summary.json``, ``summary.csv`` and the
+        marker ``.contactlab``; it must be new, empty or a sweep directory (a directory holding
+        anything else is refused: :class:`validation.io.OutputError`).
     parameter, values : optional
         See :func:`sweep_points` (default: the scene's ``[sweep]``).
     workers : int, optional
@@ -236,7 +241,9 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
         raise SceneError(f"workers = {workers!r} is not allowed: it must be an integer >= 1.")
     client = _dask_client(scheduler) if scheduler is not None else None  # fails before any work
     out = Path(out_dir)
+    check_output_dir(out, "sweep", SWEEP_NAMES)  # new, empty or a sweep directory
     (out / "points").mkdir(parents=True, exist_ok=True)
+    write_marker(out, "sweep")
     rows, jobs = [], []
     for point in points:
         cached = _load_point(out / "points" / point.file, point.fingerprint)
