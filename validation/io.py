@@ -36,6 +36,7 @@ import os
 import shutil
 import signal
 import tempfile
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -325,16 +326,24 @@ def atomic_directory(target, kind="result", names=(), *, what="out_dir"):
 
 @contextlib.contextmanager
 def _signals_deferred():
-    """Hold ``SIGINT`` and ``SIGTERM`` back (POSIX) while the block runs; they arrive after it."""
-    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
+    """Hold ``SIGINT`` and ``SIGTERM`` back while the block runs (main thread); handle them after it."""
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    held = {signal.SIGINT, signal.SIGTERM}
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    received = []
+    saved = {signum: signal.signal(signum, lambda n, frame: received.append((n, frame)))
+             for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        for signum, handler in saved.items():
+            signal.signal(signum, handler)
+        for signum, frame in received:
+            handler = saved[signum]
+            if callable(handler):
+                handler(signum, frame)
+            elif handler == signal.SIG_DFL:
+                os.kill(os.getpid(), signum)
 
 
 def _swap(tmp, target):
