@@ -96,7 +96,6 @@ def atomic_write_json(path, obj):
     return write_text(path, text)
 
 
-
 def _contactlab_version():
     from importlib import metadata
 
@@ -123,7 +122,7 @@ def marker_kind(directory):
     return kind if kind in KINDS else None
 
 
-def _shown(what, value, target):
+def _shown(value, target):
     text = str(target) if value is None else str(value)
     return repr(text if len(text) <= 200 else text[:40] + "..." + text[-20:])
 
@@ -166,7 +165,7 @@ def check_output_dir(target, kind, names=(), *, what="out_dir", value=None):
         or is a folder holding anything contactlab did not write there.
     """
     target = Path(target).absolute()
-    shown = _shown(what, value, target)
+    shown = _shown(value, target)
     limit = _name_max(target)
     for part in target.parts:
         size = len(os.fsencode(part))

@@ -29,6 +29,13 @@ def test_every_subcommand_has_examples(cmd, capsys):
     assert "example" in text and f"contactlab {cmd}" in text
 
 
+@pytest.mark.parametrize("cmd, kind", [("run", "result"), ("sweep", "sweep"), ("report", "report")])
+def test_out_is_the_directory_written_in_every_help(cmd, kind, capsys):
+    assert main([cmd, "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"--out DIR the {kind} directory written" in text and "DIR/.contactlab" in text
+
+
 def test_scenes_lists_builtins():
     code, out, _ = cli("scenes")
     assert code == 0

@@ -11,7 +11,7 @@ import pytest
 
 import validation.io as vio
 import validation.run.runner as runner
-from validation.io import MARKER, OutputError, recover_output_dir
+from validation.io import MARKER, recover_output_dir
 
 from .conftest import cli
 

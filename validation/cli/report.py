@@ -22,8 +22,9 @@ PARSER = {"help": "figures and an HTML/Markdown report",
                          "every target; it must be new, empty or a report directory contactlab wrote\n"
                          "(marked by DIR/.contactlab), which is replaced.\n"
                          "Prints where it wrote report.html; a progress bar on stderr shows the stages.",
-          "epilog": "examples:\n  contactlab report hertz                     results/hertz/ and results/hertz/report/\n"
-                    "  contactlab report hertz --out rep/hertz      results/hertz/ and rep/hertz/report.html\n"
+          "epilog": "examples:\n"
+                    "  contactlab report hertz                     results/hertz/ and results/hertz/report/\n"
+                    "  contactlab report hertz --out rep/hertz     results/hertz/ and rep/hertz/report.html\n"
                     "  contactlab report results/hertz --out rep/   rep/report.html\n"
                     "  contactlab report results/paper_elastic_rigid-sweep-alpha_a      (a sweep)\n"
                     "  contactlab report reports/studies                (study files)\n"
