@@ -94,7 +94,6 @@ def _terminate_as_interrupt():
         signal.signal(signal.SIGTERM, previous)
 
 
-
 def build_parser():
     """The argparse parser of ``contactlab``: each subcommand module adds its own."""
     fmt = argparse.RawDescriptionHelpFormatter
