@@ -29,6 +29,13 @@ def test_every_subcommand_has_examples(cmd, capsys):
     assert "example" in text and f"contactlab {cmd}" in text
 
 
+@pytest.mark.parametrize("cmd, kind", [("run", "result"), ("sweep", "sweep"), ("report", "report")])
+def test_out_is_the_directory_written_in_every_help(cmd, kind, capsys):
+    assert main([cmd, "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"--out DIR the {kind} directory written" in text and "DIR/.contactlab" in text
+
+
 def test_scenes_lists_builtins():
     code, out, _ = cli("scenes")
     assert code == 0
@@ -70,7 +77,7 @@ def test_run_bad_input_exits_2_and_writes_nothing(tmp_path):
 def test_run_into_foreign_directory_exits_2(tmp_path):
     (tmp_path / "notes.txt").write_text("mine")
     code, _out, err = cli("run", "elliptic", "--out", tmp_path, "--set", "bem.nodes_across=16")
-    assert code == 2 and "not a contactlab result" in err
+    assert code == 2 and "did not write (notes.txt)" in err and str(tmp_path) in err
     assert (tmp_path / "notes.txt").read_text() == "mine"
 
 
@@ -159,14 +166,15 @@ def test_options_that_do_not_apply_to_the_target_are_refused(argv, word, tmp_pat
     assert list(tmp_path.iterdir()) == []  # nothing ran, nothing written
 
 
-def test_report_of_a_scene_applies_set(tmp_path):
+def test_report_of_a_scene_applies_set(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     code, out, err = cli("report", "elliptic", "--out", tmp_path / "e", "--set", "bem.nodes_across=12",
                          "--set", "load.force=50.0")
     assert code == 0, err
-    result = json.loads((tmp_path / "e" / "result" / "result.json").read_text())
+    result = json.loads((tmp_path / "results" / "elliptic" / "result.json").read_text())
     assert result["force"] == pytest.approx(50.0) and result["overrides"] == ["bem.nodes_across=12",
                                                                               "load.force=50.0"]
-    assert f"report written to {tmp_path / 'e' / 'report' / 'report.html'}" in out
+    assert f"report written to {tmp_path / 'e' / 'report.html'}" in out
 
 
 def test_quick_help_states_the_measured_time(capsys):

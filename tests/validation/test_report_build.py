@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from bem.checks import InputError
+from validation.io import OutputError
 from validation.report import build_report, main
 from validation.report.render import Figure, Section, Table, fmt, problem_section, status_class
 from validation.report.render import build as build_mod
@@ -81,7 +82,7 @@ def test_build_replaces_previous_report_whole(sections, tmp_path):
     out = tmp_path / "rep"
     build_report(sections, out, title="first")
     build_report(sections[:1], out, title="second")
-    assert sorted(os.listdir(out)) == ["figures", "report.html", "report.md"]
+    assert sorted(os.listdir(out)) == [".contactlab", "figures", "report.html", "report.md"]
     assert os.listdir(out / "figures") == ["one.png"]  # the old figure is gone
     assert "second" in (out / "report.html").read_text()
     assert sorted(os.listdir(tmp_path)) == ["one.png", "rep", "two.png"]  # no temporary directories
@@ -106,7 +107,7 @@ def test_build_refuses_directory_with_other_files(sections, tmp_path):
     out = tmp_path / "results"
     out.mkdir()
     (out / "result.json").write_text("{}")
-    with pytest.raises(InputError, match="not a report"):
+    with pytest.raises(OutputError, match="did not write .result.json"):
         build_report(sections, out, title="T")
     assert os.listdir(out) == ["result.json"]
     with pytest.raises(InputError, match="at least one section"):

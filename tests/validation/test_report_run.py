@@ -236,19 +236,20 @@ def test_comparison_metrics_when_recorded(reports, tmp_path):
         assert not [c for r in table.rows for c in r if "{" in c or "[" in c]
 
 
-def test_report_results_dir_and_command(reports, tmp_path):
+def test_report_results_dir_and_command(reports, tmp_path, monkeypatch):
     built = report_results_dir(reports["elliptic"]["dir"], tmp_path / "rep")
     html = built.html.read_text(encoding="utf-8")
     assert_valid_offline_html(html)
     assert "<h1>Elliptic Hertz contact</h1>" in html
-    # contactlab report SCENE.toml: run into OUT/result, report into OUT/report
+    # contactlab report SCENE.toml --out OUT: run into results/NAME, report into OUT
+    monkeypatch.chdir(tmp_path)
     raw = _scene_file("elliptic")
     raw["bem"]["nodes_across"] = 12
     scene = tmp_path / "small.toml"
     scene.write_text(dumps(raw))
     assert main(Namespace(target=str(scene), out=str(tmp_path / "out"))) == 0
-    assert (tmp_path / "out" / "result" / "result.json").is_file()
-    md = (tmp_path / "out" / "report" / "report.md").read_text(encoding="utf-8")
+    assert (tmp_path / "results" / raw["scene"]["name"] / "result.json").is_file()
+    md = (tmp_path / "out" / "report.md").read_text(encoding="utf-8")
     assert md.startswith("# Elliptic Hertz contact\n")
 
 
@@ -275,7 +276,7 @@ def test_report_does_not_modify_the_results(reports, tmp_path):
     assert res.data == before[0] and res.scene == before[1]
     assert all(np.array_equal(a, b) for a, b in zip(res.bem_field, before[2]))
     files = sorted(p.name for p in reports["paper_elastic_rigid"]["dir"].iterdir())
-    assert files == ["bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
+    assert files == [".contactlab", "bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
 
 
 def test_captions_say_how(reports, tmp_path):

@@ -66,7 +66,7 @@ def test_foreign_directory_is_not_replaced(tmp_path):
     out = tmp_path / "mine"
     out.mkdir()
     (out / "thesis.tex").write_text("precious")
-    with pytest.raises(OutputError, match="not a contactlab result"):
+    with pytest.raises(OutputError, match="did not write .thesis.tex"):
         run_scene("elliptic", out, overrides=FAST)
     assert (out / "thesis.tex").read_text() == "precious"
 
@@ -126,7 +126,7 @@ def test_scene_file_in_the_result_reruns_identically(tmp_path):
 
     first = run_scene("paper_bilinear", tmp_path / "a", overrides=["bem.nodes_across=16", "fem.n_contact=8"])
     files = sorted(p.name for p in (tmp_path / "a").iterdir())
-    assert files == ["bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
+    assert files == [".contactlab", "bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
     for name in files:  # every file has the permissions of a new file (fem_field.vtu was 0600)
         assert ((tmp_path / "a" / name).stat().st_mode & 0o777) == file_mode(), name
     second = run_scene(tmp_path / "a" / "scene.toml")

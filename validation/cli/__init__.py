@@ -1,7 +1,9 @@
 """The ``contactlab`` command line: one module per subcommand, each with ``add_args`` and ``run``.
 
 Exit codes: 0 success; 1 a solver did not converge (results are still written, flagged
-``converged = false``); 2 bad input (scene, option or output location); 130 interrupted.
+``converged = false``); 2 bad input (scene, option or output location); 130 interrupted
+(``SIGINT``, Ctrl-C); 143 terminated (``SIGTERM``). An interrupted or terminated command
+leaves the previous output or none, and stops its worker processes.
 """
 
 from __future__ import annotations
@@ -9,7 +11,9 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import signal
 import sys
+import threading
 
 from bem.checks import InputError
 
@@ -64,13 +68,36 @@ examples:
 result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
 iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.toml (the
 effective scene, re-runnable), bem_field.vtu, fem_field.vtu and stress_field.vtu (open in ParaView).
-Written whole or not at all. Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
-scene is listed), or an unknown option.
+Written whole or not at all. --out DIR is always the directory written (result, sweep or
+report directory); contactlab writes only into a new or empty directory or one it wrote itself
+(marked by DIR/.contactlab). Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
+scene is listed), an unknown option or an unusable output directory, 130 interrupted (Ctrl-C),
+143 terminated (SIGTERM).
 
 A scene file is data: the Python code it names is imported only with --allow-code, and the
 files it names are read only inside its folder unless --allow-outside-files (docs/scenes.md).
 """
 
+
+class Terminated(KeyboardInterrupt):
+    """Raised in the main thread when the process receives ``SIGTERM``: unwinds like Ctrl-C."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated()
+
+
+@contextlib.contextmanager
+def _terminate_as_interrupt():
+    """Handle ``SIGTERM`` like ``SIGINT`` while a command runs (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def build_parser():
@@ -113,7 +140,7 @@ def main(argv=None):
     except SystemExit as exc:
         return exc.code
     try:
-        with _log_to_stderr(args.verbose):
+        with _terminate_as_interrupt(), _log_to_stderr(args.verbose):
             return COMMANDS[args.command].run(args)
     except (InputError, OutputError) as exc:
         for message in getattr(exc, "errors", None) or (str(exc),):
@@ -122,6 +149,9 @@ def main(argv=None):
     except CalibrationError as exc:
         print(f"contactlab: error: {exc}", file=sys.stderr)
         return 1
+    except Terminated:
+        print("contactlab: terminated (no partial output was left)", file=sys.stderr)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
-        print("contactlab: interrupted (no partial result directory was left)", file=sys.stderr)
-        return 130
+        print("contactlab: interrupted (no partial output was left)", file=sys.stderr)
+        return 128 + signal.SIGINT

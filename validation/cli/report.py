@@ -16,11 +16,16 @@ FORMATS = ("png", "svg", "pdf")
 
 PARSER = {"help": "figures and an HTML/Markdown report",
           "description": "Build a report (report.html, report.md, figures/) from the paper's test\n"
-                         "problem, a scene (runs it first), a result directory of `contactlab run`, a\n"
-                         "sweep directory of `contactlab sweep` or a directory of study files.\n"
+                         "problem, a scene (runs it first, into results/NAME/ as `contactlab run` does),\n"
+                         "a result directory of `contactlab run`, a sweep directory of `contactlab sweep`\n"
+                         "or a directory of study files. --out DIR is the report directory itself, for\n"
+                         "every target; it must be new, empty or a report directory contactlab wrote\n"
+                         "(marked by DIR/.contactlab), which is replaced.\n"
                          "Prints where it wrote report.html; a progress bar on stderr shows the stages.",
-          "epilog": "examples:\n  contactlab report hertz                     runs it into results/hertz/\n"
-                    "  contactlab report results/hertz --out rep/\n"
+          "epilog": "examples:\n"
+                    "  contactlab report hertz                     results/hertz/ and results/hertz/report/\n"
+                    "  contactlab report hertz --out rep/hertz     results/hertz/ and rep/hertz/report.html\n"
+                    "  contactlab report results/hertz --out rep/   rep/report.html\n"
                     "  contactlab report results/paper_elastic_rigid-sweep-alpha_a      (a sweep)\n"
                     "  contactlab report reports/studies                (study files)\n"
                     "  contactlab report paper --quick --out /tmp/paper\n"
@@ -30,8 +35,9 @@ PARSER = {"help": "figures and an HTML/Markdown report",
 def add_args(p):
     p.add_argument("target", metavar="SCENE_OR_DIR",
                    help="'paper', a scene (built-in name or .toml), or a result, sweep or study directory")
-    p.add_argument("--out", metavar="DIR", help="report directory (default: reports/paper for 'paper', "
-                                                "DIR/report for a directory, results/NAME/report for a scene)")
+    p.add_argument("--out", metavar="DIR", help="the report directory written (default: reports/paper for "
+                                                "'paper', DIR/report for a directory, results/NAME/report for "
+                                                "a scene)")
     p.add_argument("--format", choices=FORMATS, default="png",
                    help="figure files: png (300 dpi, default), svg (vector, shown in the HTML), or pdf "
                         "(vector, beside a PNG for the HTML)")

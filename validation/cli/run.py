@@ -8,14 +8,18 @@ from pathlib import Path
 from .common import add_set, add_trust, trust
 
 PARSER = {"help": "run a scene and write its result directory",
-          "description": "Run a scene: the BEM, and the FEM/closed form/comparison it names.",
-          "epilog": "examples:\n  contactlab run hertz\n  contactlab run my.toml --out out/my "
-                    "--set bem.method=\"augmented_gap\"\n  contactlab run punch --set fem.n_contact=32"}
+          "description": "Run a scene: the BEM, and the FEM/closed form/comparison it names.\n"
+                         "--out DIR is the result directory itself; it must be new, empty or a result\n"
+                         "directory contactlab wrote (marked by DIR/.contactlab), which is replaced.",
+          "epilog": "examples:\n  contactlab run hertz                         writes results/hertz/\n"
+                    "  contactlab run my.toml --out out/my --set bem.method=\"augmented_gap\"\n"
+                    "                                               writes out/my/result.json, ...\n"
+                    "  contactlab run punch --set fem.n_contact=32"}
 
 
 def add_args(p):
     p.add_argument("scene", metavar="SCENE", help="built-in scene name or path to a .toml file")
-    p.add_argument("--out", metavar="DIR", help="result directory (default: results/<scene name>)")
+    p.add_argument("--out", metavar="DIR", help="the result directory written (default: results/<scene name>)")
     p.add_argument("--no-fem", action="store_true",
                    help="skip the scene's [fem]: no FEM reference, and no need of the fem extra (gmsh, scikit-fem)")
     add_set(p)
@@ -96,15 +100,19 @@ class _StageBar:
 
 
 def run(args):
-    from ..run import execute_scene, planned_stages, write_outputs
+    from ..run import check_result_dir, execute_scene, planned_stages, write_outputs
     from ..scene import load_scene
 
     scene = load_scene(args.scene, overrides=args.overrides, no_fem=args.no_fem, **trust(args))
-    out_dir = Path(args.out) if args.out else Path("results") / scene.name
+    if args.out:
+        out_dir, what, value = Path(args.out), "--out", None
+    else:
+        out_dir, what, value = Path("results") / scene.name, "scene.name", scene.name
+    check_result_dir(out_dir, what=what, value=value)  # before the solve
     bar = _StageBar(planned_stages(scene, write=True), args.no_progress or None)
     try:
         outcome = execute_scene(scene, progress=bar)
-        write_outputs(outcome, out_dir, progress=bar)
+        write_outputs(outcome, out_dir, progress=bar, what="--out" if args.out else "out_dir")
     finally:
         bar.close()
     print(_summary(outcome.result, out_dir))

@@ -16,7 +16,9 @@ PARSER = {"help": "sweep one scene parameter (resumable, parallel)",
                          "rerunning into the same --out skips them (resume), and other values extend "
                          "the folder (the summary lists every point). A folder of another sweep "
                          "(another parameter, scene or file contents) is refused: no point is "
-                         f"overwritten. At most {MAX_SWEEP_POINTS} values.",
+                         f"overwritten. At most {MAX_SWEEP_POINTS} values. --out DIR is the sweep "
+                         "directory itself; it must be new, empty or a sweep directory contactlab wrote "
+                         "(marked by DIR/.contactlab).",
           "epilog": "examples:\n  contactlab sweep paper_elastic_rigid                 (its [sweep])\n"
                     "  contactlab sweep paper_bilinear --param alpha_c --values 0,0.4,0.8,1.2\n"
                     "  contactlab sweep hertz --param load.force --values 50:200:4 --workers 2\n"
@@ -29,7 +31,8 @@ def add_args(p):
     p.add_argument("--param", metavar="P", help="alpha_a, alpha_b, alpha_c or a dotted key (layer.lam, load.force)")
     p.add_argument("--values", metavar="V", help="comma list of numbers or words (0,0.25,0.5 or none,tabulated) "
                                                  f"or start:stop:num; at most {MAX_SWEEP_POINTS} values")
-    p.add_argument("--out", metavar="DIR", help="sweep directory (default: results/<scene>-sweep-<param>)")
+    p.add_argument("--out", metavar="DIR", help="the sweep directory written (default: "
+                                                "results/<scene name>-sweep-<param>)")
     p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address host:port or tcp://host:port "
                                                           "(needs dask.distributed)")
@@ -44,7 +47,8 @@ def add_args(p):
 def run(args):
     from tqdm import tqdm
 
-    from ..run.sweep import parse_values, run_sweep, sweep_points
+    from ..io import check_output_dir, output_errors
+    from ..run.sweep import SWEEP_NAMES, parse_values, run_sweep, sweep_points
     from ..scene import load_scene
 
     values = parse_values(args.values) if args.values is not None else None
@@ -53,7 +57,11 @@ def run(args):
                          "scene's [sweep]).")
     scene = load_scene(args.scene, overrides=args.overrides, no_fem=args.no_fem, **trust(args))
     param, _key, points = sweep_points(scene, args.param, values)
-    out = Path(args.out) if args.out else Path("results") / f"{scene.name}-sweep-{param}"
+    if args.out:
+        out, what, value = Path(args.out), "--out", None
+    else:
+        out, what, value = Path("results") / f"{scene.name}-sweep-{param}", "scene.name", scene.name
+    check_output_dir(out, "sweep", SWEEP_NAMES, what=what, value=value)
     bar = tqdm(total=len(points), desc=f"sweep {param}", unit="point", disable=args.no_progress or None)
 
     def progress(done, total, row):
@@ -61,8 +69,10 @@ def run(args):
         bar.set_postfix_str(f"{param}={row['value']} {row['status']}")
 
     try:
-        summary = run_sweep(scene, out, parameter=args.param, values=values, workers=args.workers,
-                            scheduler=args.scheduler, scheduler_timeout=args.scheduler_timeout, progress=progress)
+        with output_errors(out, "--out" if args.out else "out_dir"):
+            summary = run_sweep(scene, out, parameter=args.param, values=values, workers=args.workers,
+                                scheduler=args.scheduler, scheduler_timeout=args.scheduler_timeout,
+                                progress=progress)
     finally:
         bar.close()
     print(f"sweep of {summary['key']} over {len(summary['points'])} values of scene {summary['scene']} "

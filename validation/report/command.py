@@ -72,13 +72,14 @@ def build_from_args(args, progress=None):
     ----------
     args : argparse.Namespace
         ``target``: ``"paper"`` (solve the paper's test problem and report it), a built-in
-        scene name or a scene TOML file (run it, with ``overrides``, into ``OUT/result``,
-        report into ``OUT/report``, ``OUT`` defaulting to ``results/NAME``), a results
-        directory holding ``result.json`` (:mod:`validation.report.documents.results`), a sweep
+        scene name or a scene TOML file (run it, with ``overrides``, into the result directory
+        ``results/NAME`` as ``contactlab run`` does, then report that), a results directory
+        holding ``result.json`` (:mod:`validation.report.documents.results`), a sweep
         directory (:mod:`validation.report.documents.sweep`) or a directory of study files
         (``error_time.json``, ``stability.json``: :mod:`validation.report.documents.studies`);
-        ``out`` (optional): the report directory (default ``reports/paper`` for ``paper``,
-        ``TARGET/report`` for a directory); ``quick`` (bool, paper only): coarse preview;
+        ``out`` (optional): the report directory written, for every target (default
+        ``reports/paper`` for ``paper``, ``TARGET/report`` for a directory,
+        ``results/NAME/report`` for a scene); ``quick`` (bool, paper only): coarse preview;
         ``units`` (``"auto"``, ``"scene"``, ``"dimensionless"``; scenes, results and sweeps);
         ``overrides`` (list of ``KEY=VALUE``; scenes only); ``allow_code`` and
         ``allow_outside_files`` (scenes only, :mod:`validation.scene.trust`); ``format`` (``"png"``,
@@ -94,8 +95,10 @@ def build_from_args(args, progress=None):
     Raises
     ------
     bem.InputError
-        Unknown target, an option that does not apply to it, or an output directory that
-        holds other files.
+        Unknown target or an option that does not apply to it.
+    validation.io.OutputError
+        The report directory (or a scene's result directory) holds files contactlab did not
+        write there, or cannot be written; checked before any work.
     validation.extras.MissingExtraError
         matplotlib or pillow (``contactlab[report]``), or for ``paper`` gmsh or scikit-fem
         (``contactlab[fem]``), cannot be imported; nothing has run.
@@ -107,35 +110,52 @@ def build_from_args(args, progress=None):
     kind = target_kind(target)
     _check_options(kind, target, args)
     require_extra("report", "contactlab report (figures)")
+    from .render.build import check_report_dir
+
+    what = "out_dir" if out is None else "--out"
     if kind == "paper":
         require_extra("fem", "contactlab report paper (the FEM validation)")
         from .documents.paper import report_paper_problem
 
-        return report_paper_problem(DEFAULT_PAPER_OUT if out is None else out,
-                                    quick=bool(getattr(args, "quick", False)), fmt=fmt, progress=progress)
+        out_dir = DEFAULT_PAPER_OUT if out is None else Path(out)
+        check_report_dir(out_dir, what=what)
+        return report_paper_problem(out_dir, quick=bool(getattr(args, "quick", False)), fmt=fmt, progress=progress)
+    if kind == "scene":
+        return _report_scene(target, out, args, units=units, fmt=fmt, progress=progress)
+    out_dir = Path(target) / "report" if out is None else Path(out)
+    check_report_dir(out_dir, what=what)
     if kind == "studies":
         from .documents.studies import report_studies_dir
 
-        return report_studies_dir(target, out, fmt=fmt, progress=progress)
+        return report_studies_dir(target, out_dir, fmt=fmt, progress=progress)
     if kind == "sweep":
         from .documents.sweep import report_sweep_dir
 
-        return report_sweep_dir(target, out, units=units, fmt=fmt, progress=progress)
+        return report_sweep_dir(target, out_dir, units=units, fmt=fmt, progress=progress)
     from .documents.sections import report_results_dir
 
-    if kind == "results":
-        return report_results_dir(target, out, units=units, fmt=fmt, progress=progress)
-    from validation.run import run_scene
+    return report_results_dir(target, out_dir, units=units, fmt=fmt, progress=progress)
+
+
+def _report_scene(target, out, args, *, units, fmt, progress):
+    """Run a scene into ``results/NAME`` and report it into ``out`` (default ``results/NAME/report``)."""
+    from validation.run import check_result_dir, run_scene
     from validation.scene import load_scene
 
-    base = Path(out) if out is not None else Path("results") / Path(target).stem
-    if progress is not None:
-        progress("running the scene", 0, 1)
+    from .documents.sections import report_results_dir
+    from .render.build import check_report_dir
+
     scene = load_scene(target, overrides=getattr(args, "overrides", None) or None,
                        allow_code=bool(getattr(args, "allow_code", False)),
                        allow_outside_files=bool(getattr(args, "allow_outside_files", False)))
-    run_scene(scene, base / "result")
-    return report_results_dir(base / "result", base / "report", units=units, fmt=fmt, progress=progress)
+    result_dir = Path("results") / scene.name
+    out_dir = result_dir / "report" if out is None else Path(out)
+    check_result_dir(result_dir, what="scene.name", value=scene.name)
+    check_report_dir(out_dir, what="scene.name" if out is None else "--out", value=scene.name if out is None else None)
+    if progress is not None:
+        progress("running the scene", 0, 1)
+    run_scene(scene, result_dir)
+    return report_results_dir(result_dir, out_dir, units=units, fmt=fmt, progress=progress)
 
 
 def main(args):

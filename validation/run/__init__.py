@@ -7,6 +7,7 @@
 - :mod:`validation.run.sweep`: one scene over a list of values of a parameter.
 """
 
-from .runner import FILES, RunOutcome, execute_scene, planned_stages, run_scene, write_outputs
+from .runner import FILES, RunOutcome, check_result_dir, execute_scene, planned_stages, run_scene, write_outputs
 
-__all__ = ["run_scene", "execute_scene", "write_outputs", "planned_stages", "RunOutcome", "FILES"]
+__all__ = ["run_scene", "execute_scene", "write_outputs", "check_result_dir", "planned_stages", "RunOutcome",
+           "FILES"]

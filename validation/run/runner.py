@@ -18,7 +18,7 @@ import bem
 from bem.files import write_result_vtu, write_stress_vtu, write_text, write_vtu
 
 from ..compare import compare
-from ..io import atomic_directory, atomic_write_json
+from ..io import atomic_directory, atomic_write_json, check_output_dir, output_errors, recover_output_dir
 from ..scene import paper
 from ..scene.checks import SceneError
 from ..scene.load import Scene, load_scene
@@ -26,13 +26,16 @@ from ..scene.trust import refuse_code
 from ..scene.sizing import DOMAIN_MARGIN, SOLVER_KEYS, inner_domain
 from .result import build_result
 
-__all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES"]
+__all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES", "RESULT_NAMES",
+           "check_result_dir"]
 
 log = logging.getLogger(__name__)
 
 #: Names of the files of a result directory.
 FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_field.vtu",
          "fem_field": "fem_field.vtu", "stress_field": "stress_field.vtu"}
+#: What a result directory may hold besides its marker: its files and its default report folder.
+RESULT_NAMES = (*FILES.values(), "report")
 _GROW, _MAX_GROW = 1.5, 3  # automatic region: enlarge x1.5, at most 3 times
 
 
@@ -214,14 +217,32 @@ def execute_scene(scene, *, progress=None, overrides=None):
     return RunOutcome(scene=scene, result=result, bem=res, fem=fem, analytic=ref, layer=layer, stress=stress)
 
 
-def write_outputs(outcome, out_dir, *, progress=None):
-    """Write the result directory of ``outcome`` atomically (whole or not at all); returns its path."""
+def check_result_dir(out_dir, *, what="out_dir", value=None):
+    """Clean up after a killed writer of ``out_dir`` and refuse it if it is not a result directory.
+
+    Raises
+    ------
+    validation.io.OutputError
+        :func:`validation.io.check_output_dir` (kind ``"result"``); ``what`` and ``value`` name
+        the argument in the message.
+    """
+    with output_errors(out_dir, what):
+        recover_output_dir(out_dir)
+        check_output_dir(out_dir, "result", RESULT_NAMES, what=what, value=value)
+
+
+def write_outputs(outcome, out_dir, *, progress=None, what="out_dir"):
+    """Write the result directory of ``outcome`` atomically (whole or not at all); returns its path.
+
+    ``out_dir`` must be new, empty or a result directory (:func:`check_result_dir`); errors name
+    it as ``what``.
+    """
     _notify(progress, "write", "start")
     res, scene = outcome.bem, outcome.scene
     absent = {"fem_field": outcome.fem is None, "stress_field": outcome.stress is None}
     files = {key: name for key, name in FILES.items() if not absent.get(key, False)}
     outcome.result["files"] = files
-    with atomic_directory(out_dir) as tmp:
+    with atomic_directory(out_dir, "result", RESULT_NAMES, what=what) as tmp:
         write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
         if outcome.fem is not None:
             write_vtu(tmp / files["fem_field"], **outcome.fem.field())
@@ -244,8 +265,9 @@ def run_scene(scene, out_dir=None, *, progress=None, overrides=None):
     out_dir : path-like, optional
         Result directory: ``result.json``, ``scene.toml`` (the effective scene, re-runnable),
         ``bem_field.vtu``, with an FEM reference ``fem_field.vtu``, with a ``[stress]`` section
-        ``stress_field.vtu`` (:mod:`validation.io`). Written atomically:
-        an existing result directory is replaced only when the run succeeded.
+        ``stress_field.vtu``, and the marker ``.contactlab`` (:mod:`validation.io`). Written
+        atomically: an existing result directory is replaced only when the run succeeded; a
+        directory holding anything else is refused before the run.
     progress : callable, optional
         See :func:`execute_scene`.
     overrides : dict or list of str, optional
@@ -262,7 +284,11 @@ def run_scene(scene, out_dir=None, *, progress=None, overrides=None):
         Bad scene (nothing run, nothing written).
     bem.RegionTooSmallError
         The contact reaches the border of an explicitly given region.
+    validation.io.OutputError
+        ``out_dir`` may not be written (nothing run) or writing it failed.
     """
+    if out_dir is not None:
+        check_result_dir(out_dir)
     outcome = execute_scene(scene, progress=progress, overrides=overrides)
     if out_dir is not None:
         write_outputs(outcome, out_dir, progress=progress)

@@ -2,8 +2,8 @@
 
 Every point is a complete scene (the base scene with ``parameter = value``) validated before
 any work; a sweep holds at most :data:`~validation.scene.checks.MAX_SWEEP_POINTS` values. Points
-run in parallel on local cores (:class:`concurrent.futures.ProcessPoolExecutor`, ``workers`` =
-cores by default) or on a Dask cluster when a scheduler address is given
+run in parallel on local cores (:func:`validation.run.pool.worker_pool`, ``workers`` = cores by
+default; the workers end with the sweep) or on a Dask cluster when a scheduler address is given
 (:mod:`validation.run.cluster`; ``dask.distributed``, optional, imported only then).
 
 A point is keyed by its scene and the contents of the files that scene names (every key
@@ -16,7 +16,8 @@ folder reuses the points already there and computes the others, so an interrupte
 resumes where it stopped and a rerun with other values extends the folder; the summary
 (``summary.json``, ``summary.csv``) lists every point of the folder, numbers in ascending order.
 A folder holding points of another sweep (another parameter, another base scene, a changed
-file) is refused before any work: no point is ever overwritten.
+file) is refused before any work: no point is ever overwritten. The folder itself must be new,
+empty or a sweep directory contactlab wrote (its marker ``.contactlab``).
 
 The paper's sweeps (section 6): ``alpha_a`` in ``[0, 1]`` (elastic-rigid, Fig. 5/9),
 ``alpha_c`` (bilinear), ``alpha_b`` (root law, Fig. 10-11).
@@ -31,19 +32,20 @@ import logging
 import os
 import re
 import traceback
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from pathlib import Path
 
 from bem.files import write_text
 
-from ..io import atomic_write_json
+from ..io import atomic_write_json, check_output_dir, write_marker
 from ..scene.checks import SceneError, sweep_size
 from ..scene.load import Scene, apply_overrides, load_scene, parse_scene
 from ..scene.paper import ALIASES
 from .cluster import DEFAULT_TIMEOUT, dask_client, scheduler_address
+from .pool import worker_pool
 from .sweep_folder import SWEPT, earlier_points, file_digests, fingerprint, keyed, other_point
 
-__all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values"]
+__all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values", "SWEEP_NAMES"]
 
 log = logging.getLogger(__name__)
 
@@ -51,6 +53,8 @@ SUMMARY_COLUMNS = ("index", "value", "status", "p_max", "force", "approach", "co
                    "converged", "iterations", "kkt_residual", "alpha_b", "p_max_lambda", "wall_time_bem",
                    "wall_time_fem", "computed", "file")
 _BARE_WORD = re.compile(r"^[^\s\"'\[\]{}=#,]+(\s+[^\s\"'\[\]{}=#,]+)*$")
+#: What a sweep directory holds besides its marker ``.contactlab`` (:func:`validation.io.check_output_dir`).
+SWEEP_NAMES = ("points", "summary.json", "summary.csv", "report")
 
 
 class SweepPoint:
@@ -226,7 +230,7 @@ def _local_map(jobs, workers):
             except Exception:  # noqa: BLE001 - a failed point is reported, the sweep goes on
                 yield point, None, traceback.format_exc(limit=3)
         return
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with worker_pool(workers) as pool:  # its workers end with this process
         futures = {pool.submit(_solve_point, p.scene.raw, p.scene.source, p.scene.trust): p for p in jobs}
         try:
             for fut in as_completed(futures):
@@ -273,8 +277,10 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
     scene : Scene, str, path-like or dict
         The base scene.
     out_dir : path-like
-        Sweep directory: ``points/point-<fingerprint>.json``, ``summary.json``, ``summary.csv``.
-        Points already there are reused; a folder holding points of another sweep is refused.
+        Sweep directory: ``points/point-<fingerprint>.json``, ``summary.json``, ``summary.csv``
+        and the marker ``.contactlab``; it must be new, empty or a sweep directory (a directory
+        holding anything else is refused: :class:`validation.io.OutputError`). Points already
+        there are reused; a folder holding points of another sweep is refused.
     parameter, values : optional
         See :func:`sweep_points` (default: the scene's ``[sweep]``).
     workers : int, optional
@@ -312,6 +318,7 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
     if isinstance(scheduler, str):
         scheduler_address(scheduler)
     out = Path(out_dir)
+    check_output_dir(out, "sweep", SWEEP_NAMES)  # new, empty or a sweep directory
     earlier = earlier_points(out, points[0].sweep)
     mine = {p.fingerprint for p in points}
     kept = [d for fp, d in earlier.items() if fp not in mine]
@@ -326,6 +333,7 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
     rows = [_row(position[len(points) + i], d["value"], d["file"], d["result"], computed=False)
             for i, d in enumerate(kept)]
     (out / "points").mkdir(parents=True, exist_ok=True)
+    write_marker(out, "sweep")
     jobs, done = [], 0
     for point in points:
         cached = earlier.get(point.fingerprint)

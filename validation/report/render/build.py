@@ -17,18 +17,19 @@ from pathlib import Path
 
 from bem.checks import InputError
 
-from ...io import atomic_directory
+from ...io import atomic_directory, check_output_dir, output_errors, recover_output_dir
 from ...provenance import report_footer
 from .content import Figure, Section
 from .html import render_html
 from .markdown import render_markdown
 from .style import figure_format, vector_copy
 
-__all__ = ["build_report", "BuiltReport", "REPORT_FILES", "Progress", "draw_and_build"]
+__all__ = ["build_report", "BuiltReport", "REPORT_FILES", "Progress", "draw_and_build", "check_report_dir"]
 
 log = logging.getLogger(__name__)
 
-#: what a report directory may hold (anything else makes :func:`build_report` refuse to replace it)
+#: what a report directory holds besides its marker ``.contactlab`` (anything else makes
+#: :func:`build_report` refuse to replace it)
 REPORT_FILES = ("report.html", "report.md", "figures")
 
 
@@ -92,17 +93,17 @@ def draw_and_build(make_sections, out_dir, *, title, subtitle="", fmt="png", not
     return built
 
 
-def _check_replaceable(out_dir):
-    if not out_dir.exists():
-        return
-    if not out_dir.is_dir():
-        raise InputError(f"out_dir = {str(out_dir)!r} is not allowed: it is a file; give a directory.")
-    foreign = sorted(p.name for p in out_dir.iterdir() if p.name not in REPORT_FILES and not p.name.startswith("."))
-    if foreign:
-        raise InputError(
-            f"out_dir = {str(out_dir)!r} is not allowed: it holds files that are not a report ({foreign[:5]}); "
-            "give an empty or new directory, or a previous report directory."
-        )
+def check_report_dir(out_dir, *, what="out_dir", value=None):
+    """Clean up after a killed writer of ``out_dir`` and refuse it if it is not a report directory.
+
+    Raises
+    ------
+    validation.io.OutputError
+        :func:`validation.io.check_output_dir` (kind ``"report"``).
+    """
+    with output_errors(out_dir, what):
+        recover_output_dir(out_dir)
+        check_output_dir(out_dir, "report", REPORT_FILES, what=what, value=value)
 
 
 def _figure_names(sections, root=None):
@@ -132,8 +133,9 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None, root=Non
     sections : sequence of Section
         The content (:mod:`validation.report.render.content`), in order.
     out_dir : path-like
-        Report directory; created, or replaced if it holds a previous report. A
-        directory with other files is refused (nothing is deleted).
+        Report directory; created, or replaced if it holds a previous report (marked by
+        ``.contactlab``, :mod:`validation.io`). A directory holding anything else is refused
+        (nothing is deleted).
     title : str
         Report title.
     subtitle : str
@@ -152,7 +154,10 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None, root=Non
     Raises
     ------
     bem.InputError
-        No sections, a non-Section item, or an ``out_dir`` that is not a report directory.
+        No sections or a non-Section item.
+    validation.io.OutputError
+        ``out_dir`` is not a new, empty or report directory (:func:`check_report_dir`), or
+        writing it failed.
     """
     sections = list(sections)
     if not sections:
@@ -167,7 +172,7 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None, root=Non
     images = {path: Path(path).read_bytes() for path in names}
     vectors = {names[path][:-4] + ".pdf": Path(pdf).read_bytes() for path in names
                if (pdf := vector_copy(path)) is not None}
-    with atomic_directory(out_dir, check=_check_replaceable) as tmp:
+    with atomic_directory(out_dir, "report", REPORT_FILES) as tmp:
         (tmp / "figures").mkdir()
         for path, name in names.items():
             (tmp / name).write_bytes(images[path])
