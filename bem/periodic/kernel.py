@@ -86,8 +86,9 @@ def _smooth_part(x, y, alpha):
     return out
 
 
-def _real_part(n_rows, n_cols, alpha):
-    """``W_R`` minus its mean at every node of the cell, brick array ``(n_rows, n_cols)``."""
+@lru_cache(maxsize=4)
+def _real_space_values(alpha):
+    """Lattice vectors ``(i, j)`` with ``|i e1 + j e2| <= 1 + 6.1 / alpha`` and ``R`` there (any cell)."""
     from ..template import template
 
     r_cut = 1.0 + _ERFC_ZERO / alpha
@@ -97,8 +98,13 @@ def _real_part(n_rows, n_cols, alpha):
     jj, ii = np.meshgrid(j, i, indexing="ij")
     vx, vy = ii + jj / 2.0, jj * (_SQRT3 / 2)
     near = vx * vx + vy * vy <= r_cut * r_cut
-    ii, jj, vx, vy = ii[near], jj[near], vx[near], vy[near]
-    values = template(vx, vy) - _smooth_part(vx, vy, alpha)
+    values = template(vx[near], vy[near]) - _smooth_part(vx[near], vy[near], alpha)
+    return ii[near], jj[near], values
+
+
+def _real_part(n_rows, n_cols, alpha):
+    """``W_R`` minus its mean at every node of the cell, brick array ``(n_rows, n_cols)``."""
+    ii, jj, values = _real_space_values(alpha)
     out = np.zeros((n_rows, n_cols))
     np.add.at(out, (np.mod(jj, n_rows), np.mod(ii + np.floor_divide(jj, 2), n_cols)), values)
     area = n_cols * n_rows * _SQRT3 / 2
@@ -111,30 +117,28 @@ def _fourier_part(n_rows, n_cols, alpha):
 
     half = n_rows // 2
     lx, ly = float(n_cols), n_rows * _SQRT3 / 2
-    area = lx * ly
     g_cut = 2 * alpha * _ERFC_ZERO
     m_max, n_max = int(g_cut * lx / (2 * math.pi)) + 1, int(g_cut * ly / (2 * math.pi)) + 1
-    m0 = np.arange(n_cols)[None, :]
-    n0 = np.arange(half)[:, None]
-    sums = np.zeros((2, half, n_cols), dtype=complex)
-    for big_m in range(-m_max // n_cols, m_max // n_cols + 1):
-        for big_n in range(-n_max // half, n_max // half + 1):
-            m = m0 + big_m * n_cols
-            n = n0 + big_n * half
-            gx, gy = 2 * math.pi * m / lx, 2 * math.pi * n / ly
-            gx, gy = np.broadcast_arrays(gx, gy)
-            k = np.hypot(gx, gy)
-            keep = (k <= g_cut) & (k > 0)
-            if not keep.any():
-                continue
-            kk = k[keep]
-            f = 2 * math.pi / kk * erfc(kk / (2 * alpha)) * pyramid_transform(gx[keep], gy[keep])
-            phase = np.exp(1j * math.pi * (np.broadcast_to(m, k.shape)[keep] / n_cols
-                                           + 2 * np.broadcast_to(n, k.shape)[keep] / n_rows))
-            sums[0][keep] += f
-            sums[1][keep] += f * phase
+    m = np.arange(-m_max, m_max + 1)
+    gx = 2 * math.pi * m / lx
+    sums = np.zeros((2, half * n_cols), dtype=complex)
+    for n0 in range(-n_max, n_max + 1, 256):  # blocks of rows keep the temporaries small
+        n = np.arange(n0, min(n0 + 256, n_max + 1))[:, None]
+        gy = 2 * math.pi * n / ly
+        k = np.sqrt(gx * gx + gy * gy)
+        keep = (k <= g_cut) & (k > 0)
+        rows, cols = np.nonzero(keep)
+        kk = k[keep]
+        f = 2 * math.pi / kk * erfc(kk / (2 * alpha)) * pyramid_transform(gx[cols], gy[rows, 0])
+        # node of parity s = 1: phase exp(i pi (m / n_cols + 2 n / n_rows)) relative to parity 0
+        phase = np.exp(1j * math.pi * (m[cols] / n_cols + 2 * n[rows, 0] / n_rows))
+        index = np.mod(n[rows, 0], half) * n_cols + np.mod(m[cols], n_cols)
+        for s, weight in ((0, f), (1, f * phase)):
+            sums[s] += np.bincount(index, weights=weight.real, minlength=sums.shape[1])
+            if s:
+                sums[s] += 1j * np.bincount(index, weights=weight.imag, minlength=sums.shape[1])
     # W_F(s)[k, q] = (1/A) sum A_s(n0, m0) exp(2 pi i (m0 q / n_cols + n0 k / half))
-    nodes = np.fft.ifft2(sums, axes=(-2, -1)).real * (half * n_cols / area)
+    nodes = np.fft.ifft2(sums.reshape(2, half, n_cols), axes=(-2, -1)).real * (half * n_cols / (lx * ly))
     out = np.empty((n_rows, n_cols))
     out[0::2], out[1::2] = nodes[0], nodes[1]
     return out
