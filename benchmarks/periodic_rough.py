@@ -170,7 +170,7 @@ def _full_contact_pressure(cell, h):
 def case_ladder(n):
     cell = PeriodicCell(1.0 / n, n, n)
     h = surface_on_cell(cell)
-    first, half = 1e-5, 0.08 * _full_contact_pressure(cell, h)
+    first, half = 1e-5, 0.13 * _full_contact_pressure(cell, h)  # 50 % contact at 512^2
     loads = np.geomspace(first, half, 20)
     t = time.perf_counter()
     p, iters, fractions = None, 0, []
