@@ -157,3 +157,38 @@ class PeriodicCell:
         first = at(a + (ei & ej), b)  # (a, b), or (a + 1, b) for the e2 - e1 edge
         second = at(a + (ei & (1 - ej)), b + ej)  # (a + 1, b) along e1, (a, b + 1) along e2 and e2 - e1
         return 0.5 * (first + second)
+
+    def interpolate(self, values, x, y):
+        """The piecewise-linear field ``sum values_n pyr_n`` at the points ``(x, y)`` [length], periodic.
+
+        Parameters
+        ----------
+        values : ndarray, shape :attr:`shape`
+            Nodal values.
+        x, y : array_like
+            Points, any broadcastable shapes; any point of the plane (the field repeats).
+
+        Returns
+        -------
+        ndarray
+            Linear interpolation on the triangle that holds each point.
+        """
+        values = np.asarray(values, dtype=float)
+        if values.shape != self.shape:
+            fail("values", f"<array of shape {values.shape}>", f"nodal values of the cell, shape {self.shape}")
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        t = y / (self.step * _SQRT3 / 2)  # lattice coordinates: point = c (s e1 + t e2)
+        s = x / self.step - t / 2
+        i0, j0 = np.floor(s), np.floor(t)
+        fs, ft = s - i0, t - j0
+        upper = fs + ft > 1.0
+        i0, j0 = i0.astype(np.int64), j0.astype(np.int64)
+
+        def at(i, j):
+            return values[np.mod(j, self.n_rows), np.mod(i + np.floor_divide(j, 2), self.n_cols)]
+
+        corner = np.where(upper, 1, 0)  # the third vertex: (i0, j0) below the diagonal, (i0 + 1, j0 + 1) above
+        w_a = np.where(upper, fs + ft - 1.0, 1.0 - fs - ft)
+        return (w_a * at(i0 + corner, j0 + corner) + np.where(upper, 1.0 - ft, fs) * at(i0 + 1, j0)
+                + np.where(upper, 1.0 - fs, ft) * at(i0, j0 + 1))
+

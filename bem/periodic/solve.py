@@ -139,7 +139,7 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
         without a layer it must be below ``mean(h)`` (a full contact leaves the mean pressure
         undetermined under approach control).
     layer, method, rtol, maxiter, x0, precondition, callback, **options
-        As for :func:`bem.solve` (``x0`` a brick array of the cell's shape).
+        As for :func:`bem.solve` (``x0`` a brick array of the cell's shape, or flattened).
     nested : bool, optional
         Start from the solution on cells of step ``2c``, ``4c``, ... (every other node,
         needs ``n_cols`` even and ``n_rows`` a multiple of 4 per level) interpolated onto the
@@ -181,8 +181,11 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
     guess = None
     if x0 is not None:
         guess = np.asarray(x0, dtype=float)
+        if guess.shape == (cell.n_nodes,):
+            guess = guess.reshape(cell.shape)
         if guess.shape != cell.shape:
-            raise InputError(f"x0 has shape {guess.shape} which is not allowed: it must be {cell.shape}.")
+            raise InputError(f"x0 has shape {guess.shape} which is not allowed: it must be {cell.shape} "
+                             f"or ({cell.n_nodes},).")
         nested = False
     levels = _levels(cell, h, gap, nested)
     n_matvec = 0

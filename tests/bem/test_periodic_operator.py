@@ -106,3 +106,17 @@ def test_periodic_cell_prolong_is_exact_for_linear_fields_and_restrict_takes_eve
 def test_periodic_cell_refuses_bad_shapes(kwargs, name):
     with pytest.raises(bem.InputError, match=f"^{name} = .* is not allowed"):
         PeriodicCell(**kwargs)
+
+
+def test_periodic_cell_interpolates_the_pyramid_field_periodically():
+    cell = PeriodicCell(0.1, 12, 8)
+    values = np.random.default_rng(4).random(cell.shape)
+    lx, ly = cell.size
+    assert np.allclose(cell.interpolate(values, cell.x, cell.y), values, rtol=0, atol=1e-14)
+    assert np.allclose(cell.interpolate(values, cell.x + 2 * lx, cell.y - ly), values, rtol=0, atol=1e-13)
+    # midpoint of the edge (along e2) from node (3, 1) to node (4, 2): the mean of its ends
+    mid = cell.interpolate(values, 0.5 * (cell.x[1, 3] + cell.x[2, 4]), 0.5 * (cell.y[1, 3] + cell.y[2, 4]))
+    assert mid == pytest.approx(0.5 * (values[1, 3] + values[2, 4]), abs=1e-14)
+    # and the pyramid field agrees with the prolongation, which takes the same edge midpoints
+    fine = PeriodicCell(0.05, 24, 16)
+    assert np.allclose(cell.interpolate(values, fine.x, fine.y), fine.prolong(values), rtol=0, atol=1e-14)
