@@ -57,30 +57,40 @@ class PeriodicOperator:
         w = periodic_template(lattice.n_rows, lattice.n_cols) * (lattice.step / (math.pi * self.E_star))
         self.kernel = w  # C between node (0, 0) and node (q, r), brick array
         even, odd = w[0::2], w[1::2]
-        self._half = even.shape
+        self._spectrum_shape = (even.shape[0], even.shape[1] // 2 + 1)
         spectra = sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
         # spectra of K_00 = K_11, K_10 and K_01 (real kernels: the 1/N of the inverse FFT is applied there)
         self._s00, self._s10, self._s01 = spectra
 
-    def _split(self, v):
-        return np.stack([v[0::2], v[1::2]])
+    def _forward(self, v):
+        """Spectra of the even and odd rows of a brick array: ``(2, n_rows/2, n_cols/2 + 1)``.
 
-    def _symbol_product(self, P, s00, s01, s10, s11):
-        u0 = s00 * P[0] + s01 * P[1]
-        u1 = s10 * P[0] + s11 * P[1]
-        return np.stack([u0, u1])
-
-    def _join(self, U):
-        parts = sfft.irfft2(U, s=self._half, workers=fft.threads())
-        out = np.empty(self.lattice.shape)
-        out[0::2], out[1::2] = parts[0], parts[1]
+        The real FFT along the rows runs on the whole array at once; the complex FFT along the
+        columns on each parity's strided rows, so the parities are never copied apart.
+        """
+        rows = sfft.rfft(v, axis=-1, workers=fft.threads())
+        out = np.empty((2,) + self._spectrum_shape, dtype=complex)
+        for a in (0, 1):
+            out[a] = sfft.fft(rows[a::2], axis=0, workers=fft.threads())
         return out
+
+    def _apply(self, v, s00, s01, s10, s11):
+        """``out_a = sum_b S_ab v_b`` by the spectra ``S`` of a 2 x 2 block symbol."""
+        P = self._forward(np.asarray(v, dtype=float))
+        u1 = s10 * P[0]
+        u1 += s11 * P[1]
+        P[0] *= s00
+        P[0] += s01 * P[1]
+        P[1] = u1
+        rows = np.empty((self.lattice.n_rows, self._spectrum_shape[1]), dtype=complex)
+        for a in (0, 1):
+            rows[a::2] = sfft.ifft(P[a], axis=0, overwrite_x=True, workers=fft.threads())
+        return sfft.irfft(rows, n=self.lattice.n_cols, axis=-1, overwrite_x=True, workers=fft.threads())
 
     def matvec(self, p):
         """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]; ``u`` has zero mean."""
         self.n_matvec += 1
-        P = sfft.rfft2(self._split(np.asarray(p, dtype=float)), workers=fft.threads())
-        return self._join(self._symbol_product(P, self._s00, self._s01, self._s10, self._s00))
+        return self._apply(p, self._s00, self._s01, self._s10, self._s00)
 
     __call__ = matvec
 
@@ -112,8 +122,7 @@ class PeriodicOperator:
         i00, i01, i10, i11 = d / det, -b / det, -c / det, a / det
 
         def apply(r):
-            R = sfft.rfft2(self._split(np.asarray(r, dtype=float)), workers=fft.threads())
-            return self._join(self._symbol_product(R, i00, i01, i10, i11))
+            return self._apply(r, i00, i01, i10, i11)
 
         return apply
 
