@@ -32,7 +32,6 @@ import argparse
 import json
 import math
 import os
-import resource
 import subprocess
 import sys
 import time
@@ -46,7 +45,7 @@ from bem.periodic import PeriodicCell, solve_periodic
 HURST, ROLLOFF, CUTOFF, RMS_SLOPE, SEED = 0.8, 4, 128, 0.1, 2026
 
 
-def _spectrum(lx, ly, m, n):
+def _spectrum(lx, ly):
     """Seeded complex amplitudes Z(m, n) of the surface, ``z(x) = Re sum Z exp(i G.x)``."""
     rng = np.random.default_rng(SEED)
     k = CUTOFF + 1
@@ -64,7 +63,7 @@ def _spectrum(lx, ly, m, n):
 def _on_grid(lx, ly, shape, shift=(0.0, 0.0)):
     """The surface on the grid ``x = shift_x + q lx / n1``, ``y = shift_y + k ly / n0`` by one inverse FFT."""
     n0, n1 = shape
-    mm, nn, z = _spectrum(lx, ly, None, None)
+    mm, nn, z = _spectrum(lx, ly)
     grid = np.zeros(shape, dtype=complex)
     phase = np.exp(1j * (2 * math.pi * mm / lx * shift[0] + 2 * math.pi * nn / ly * shift[1]))
     np.add.at(grid, (np.mod(nn, n0), np.mod(mm, n1)), z * phase)
@@ -72,7 +71,7 @@ def _on_grid(lx, ly, shape, shift=(0.0, 0.0)):
 
 
 def surface_on_cell(cell):
-    """Gap at the nodes of a :class:`PeriodicCell` (brick array): even rows, then odd rows shifted by (c/2, c sqrt3/2)."""
+    """Gap at the nodes of a :class:`PeriodicCell` (brick array); odd rows are shifted by (c/2, c sqrt3/2)."""
     lx, ly = cell.size
     half = (cell.n_rows // 2, cell.n_cols)
     z = np.empty(cell.shape)
@@ -213,11 +212,11 @@ def main():
     parser.add_argument("--ladder-size", type=int, default=512)
     parser.add_argument("--fraction-size", type=int, default=512)
     args = parser.parse_args()
-    print(f"# {os.cpu_count()} CPUs, bem.fft.threads() = {bem.fft.threads()}, load {open('/proc/loadavg').read().strip()}")
+    with open("/proc/loadavg") as f:
+        print(f"# {os.cpu_count()} CPUs, bem.fft.threads() = {bem.fft.threads()}, load {f.read().strip()}")
     for case in args.cases:
         {"main": lambda: case_main(args.size), "ladder": lambda: case_ladder(args.ladder_size),
          "fractions": lambda: case_fractions(args.fraction_size), "rss": lambda: case_rss(args.size)}[case]()
-    _ = resource  # the rss case measures in a child process
 
 
 if __name__ == "__main__":

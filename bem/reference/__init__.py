@@ -22,6 +22,7 @@ from .layer_limit import (
 )
 from .westergaard import Westergaard, westergaard
 
-__all__ = ["Westergaard", "westergaard", "HertzSphere", "HertzElliptic", "RigidLayerParaboloid", "hertz_sphere", "hertz_elliptic",
+__all__ = ["Westergaard", "westergaard", "HertzSphere", "HertzElliptic", "RigidLayerParaboloid", "hertz_sphere",
+           "hertz_elliptic",
            "rigid_layer_pressure", "rigid_layer_paraboloid", "rigid_layer_force", "estimate_contact_radius",
            "hertz_radius", "layer_radius"]

@@ -1,4 +1,5 @@
-"""Periodic contact (bem.solve_periodic): Westergaard, full contact of any surface, every method, an independent solver."""
+"""Periodic contact (bem.solve_periodic): Westergaard, full contact of any surface, every method, an
+independent solver."""
 
 import math
 
