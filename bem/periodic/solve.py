@@ -188,7 +188,6 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
                              f"or ({cell.n_nodes},).")
         nested = False
     levels = _levels(cell, h, gap, nested)
-    n_matvec = 0
     for level, (lat, h_lat) in enumerate(levels):
         finest = level == len(levels) - 1
         kw = dict(force=force, approach=approach, x0=guess, rtol=rtol if finest else max(rtol, 1e-6),
@@ -199,7 +198,6 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
         sol = _run(solver, op, h_lat, layer, precondition, kw, options)
         if not finest:
             guess = levels[level + 1][0].prolong(sol.p)
-            n_matvec += 0  # work on the finest cell only, as for bem.solve
     p = sol.p
     u = op.matvec(p)
     closure = np.zeros(cell.shape) if layer is None else layer.w(p)
