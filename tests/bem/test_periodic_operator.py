@@ -120,3 +120,10 @@ def test_periodic_cell_interpolates_the_pyramid_field_periodically():
     # and the pyramid field agrees with the prolongation, which takes the same edge midpoints
     fine = PeriodicCell(0.05, 24, 16)
     assert np.allclose(cell.interpolate(values, fine.x, fine.y), fine.prolong(values), rtol=0, atol=1e-14)
+
+
+def test_periodic_cell_from_size_takes_the_nearest_cell_with_an_even_number_of_rows():
+    cell = PeriodicCell.from_size(0.1, (1.0, 0.9))
+    assert (cell.n_cols, cell.n_rows) == (10, 10)  # 0.9 / (0.1 sqrt3/2) = 10.4 rows
+    assert cell.size == pytest.approx((1.0, 10 * 0.1 * SQRT3 / 2))
+    assert cell.area == pytest.approx(cell.n_nodes * cell.node_area)
