@@ -145,7 +145,8 @@ def _laws(lam):
             "power_2": layers.Power(lam / p0, 2.0), "elastic_rigid": layers.ElasticRigid(lam, 0.5 * p0),
             "bilinear": layers.Bilinear(lam, 0.3 * lam, 0.5 * p0),
             "tabulated": layers.Tabulated(np.linspace(0, 1, 11), lam * np.linspace(0, 1, 11) ** 1.5),
-            "series": layers.Series(layers.Linear(0.5 * lam), layers.Root(0.5 * lam * math.sqrt(p0)))}
+            "series": layers.Series(layers.Linear(0.5 * lam), layers.Root(0.5 * lam * math.sqrt(p0))),
+            "custom": layers.Custom(lambda p: lam * p * (1 + p / p0), p_scale=p0)}
 
 
 def _assert_kkt(res, layer, rtol=1e-10):
