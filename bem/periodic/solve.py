@@ -151,10 +151,12 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
 
     Notes
     -----
-    The stopping rules are those of :func:`bem.solve`: every method stops on the KKT
-    residual ``r <= rtol`` (:func:`bem.kkt.kkt_residual`, relative to the largest surface
-    closure ``max |C p + w(p)|``; force balance relative to the force on the cell), the
-    paper's methods on their increments as well. Timings: ``benchmarks/periodic_rough.py``.
+    Stopping rules, as for :func:`bem.solve`, with ``g = C p + w(p) + h - delta`` and the KKT
+    residual ``r = max(max_{p>0} |g|, max_{p=0} (-g)_+) / max |C p + w(p)|`` (and, under
+    ``mean_pressure``, ``|sqrt(3)/2 c^2 sum p - pbar Lx Ly| / (pbar Lx Ly)``): Kalker's QP and
+    Newton stop at ``r <= rtol`` on an exactly recomputed ``C p``; the paper's methods when
+    their increments (eq. 20, 23) are below ``eps_h``, ``eps_p`` AND ``r <= rtol``. Timings:
+    ``benchmarks/periodic_rough.py`` and docs/performance.md.
     """
     from ..solve import _check_layer, _inner_summary, _modulus, _run
 
