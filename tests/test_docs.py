@@ -220,7 +220,7 @@ def test_readme_links_resolve_inside_the_repository():
     for target in targets:
         assert not target.startswith(("/", "..")), target
         assert (ROOT / target).exists(), f"README links to {target}, which is not in the repository"
-    for page in ("method.md", "scenes.md", "results.md"):
+    for page in ("method.md", "scenes.md", "results.md", "rough.md"):
         for target in re.findall(r"\]\(([^)#\s]+)", (DOCS / page).read_text()):
             assert (DOCS / target).exists(), f"docs/{page} links to {target}"
 

@@ -22,12 +22,13 @@ ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
 PROJECT = PYPROJECT["project"]
 #: what a core install lacks (import names)
-NOT_CORE = ("matplotlib", "gmsh", "skfem", "vtk", "pyvista", "PIL", "dask", "distributed", "cupy")
+NOT_CORE = ("matplotlib", "gmsh", "skfem", "vtk", "pyvista", "PIL", "dask", "distributed", "cupy",
+            "SurfaceTopography")
 #: import name -> distribution name, for the packages the code may import
 DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "tqdm": "tqdm", "meshio": "meshio", "tomli_w": "tomli-w",
                  "gmsh": "gmsh", "skfem": "scikit-fem", "matplotlib": "matplotlib", "PIL": "pillow",
                  "dask": "dask", "distributed": "dask", "cupy": "cupy-cuda12x", "pytest": "pytest",
-                 "html5lib": "html5lib", "yaml": "pyyaml"}
+                 "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography"}
 OWN = ("bem", "fem_reference", "validation", "tests")
 #: pyvista/vtk are no dependency: only the 3-D figures still use them until they are redrawn
 #: with matplotlib (then this allowance goes)
@@ -76,7 +77,8 @@ def test_extras_layout():
     assert _extra("report") == {"matplotlib", "pillow"}
     assert _extra("dask") == {"dask"}
     assert _extra("gpu") == {"cupy-cuda12x"}
-    assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask")
+    assert _extra("rough") == {"surfacetopography"}
+    assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask") | _extra("rough")
     assert _extra("test") == _extra("all") | {"pytest", "html5lib", "pyyaml"}
     everything = {_name(r) for r in PROJECT["dependencies"]} | {d for e in PROJECT["optional-dependencies"]
                                                                 for d in _extra(e)}

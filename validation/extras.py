@@ -10,6 +10,7 @@ fem       gmsh, scikit-fem (skfem)    a scene with ``[fem]``, the studies, the p
 report    matplotlib, pillow (PIL)    ``contactlab report``, :mod:`validation.report`
 dask      dask[distributed]           ``contactlab sweep --scheduler ADDRESS``
                 (dask.distributed)
+rough     SurfaceTopography           :mod:`bem.rough`: instrument files, self-affine surfaces
 gpu       cupy-cuda12x (cupy)         declared for the GPU path (not used yet)
 ========  ==========================  ============================================
 
@@ -28,7 +29,7 @@ __all__ = ["EXTRAS", "MissingExtraError", "require", "missing"]
 
 #: extra -> import names of the packages it installs
 EXTRAS = {"fem": ("gmsh", "skfem"), "report": ("matplotlib", "PIL"), "dask": ("dask.distributed",),
-          "gpu": ("cupy",)}
+          "rough": ("SurfaceTopography",), "gpu": ("cupy",)}
 _DIST = {"skfem": "scikit-fem", "PIL": "pillow", "dask.distributed": "dask[distributed]", "cupy": "cupy-cuda12x"}
 _SYSTEM_LIBS = ("On Debian/Ubuntu: apt-get install libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 "
                 "libgomp1 (see the README's set-up).")
