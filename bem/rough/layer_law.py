@@ -178,7 +178,8 @@ def _check_monotone(p, ubar):
             "energy); solve with a smaller rtol or space the pressures further apart.")
 
 
-def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton", rtol=1e-8, progress=None):
+def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton", rtol=1e-8, maxiter=None,
+                          progress=None):
     """The layer law ``w(pbar)`` of a rough surface pressed against a flat (module docstring).
 
     Parameters
@@ -195,6 +196,8 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
         A method of :func:`bem.solve_periodic` (``bem.METHODS``).
     rtol : float
         The solver's KKT tolerance, ``> 0``.
+    maxiter : int, optional
+        The solver's iteration limit per step (its default if ``None``).
     progress : callable, optional
         Called after each step as ``progress(k, n, result)``, ``k = 1..n``, ``result`` the
         step's :class:`bem.PeriodicContactResult`.
@@ -227,7 +230,7 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
     guess = None
     for k, pbar in enumerate(p):
         res = solve_periodic(h, step=lattice.step, E_star=E_star, mean_pressure=float(pbar), method=method, rtol=rtol,
-                             x0=guess)
+                             x0=guess, **({} if maxiter is None else {"maxiter": maxiter}))
         if not res.converged:
             raise LadderNotConverged(f"step {k} of the ladder (mean pressure {pbar!r}) did not converge: "
                                      f"{res.message}; no layer law is made from it", k, float(pbar), res)
