@@ -220,3 +220,19 @@ def test_bad_arguments_are_refused_by_name(kwargs, match):
 def test_a_surface_must_be_a_rough_surface():
     with pytest.raises(bem.InputError, match="surface = 'ndarray' is not allowed"):
         rough.layer_from_topography(np.zeros((8, 8)), E_STAR, pressures=[0.1, 0.2], n_cols=8)
+
+
+def test_the_layer_law_example_of_docs_rough_runs(tmp_path, monkeypatch, capsys):
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "rough.md").read_text()
+    section = text[text.index("## A layer law from a topography"):]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    scope = {}
+    exec(compile(code, "docs/rough.md", "exec"), scope)
+    out = capsys.readouterr().out
+    assert "12/12" in out
+    assert isinstance(scope["layer"], layers.Tabulated)
+    assert np.array_equal(scope["layer"].w(scope["pressures"]), scope["law"].closure)
