@@ -21,8 +21,9 @@ with the real contact fraction ``A/A0`` (nodes with ``p > 0``) and the interfaci
 ``K = -d pbar / d ubar`` [pressure/length] beside it. Used as a layer between two smooth bodies
 (:class:`bem.layers.Tabulated`), the roughness closes as it does on the cell under the local
 pressure. The elastic energy of a law is convex when ``w`` is non-decreasing, which
-:class:`~bem.layers.Tabulated` requires: a ladder whose mean gap rises with the pressure is refused
-by name. Two rough surfaces in contact are their sum (:func:`bem.rough.combined`) with the
+:class:`~bem.layers.Tabulated` requires: a ladder whose mean gap rises with the pressure by more
+than the solver's tolerance ``rtol ubar(0+)`` is refused by name; smaller rises (the rounding of
+a mean gap of zero in full contact) are levelled, ``w_k = max_(j <= k) (ubar(0+) - ubar(p_j))``. Two rough surfaces in contact are their sum (:func:`bem.rough.combined`) with the
 effective modulus ``E*`` of the pair.
 
 The ladder of mean pressures is solved in order, each solve started from the previous
@@ -82,8 +83,8 @@ class TopographyLaw:
     contact_fraction : ndarray
         ``A/A0`` at each step [-].
     stiffness : ndarray
-        ``K = -d pbar/d ubar`` [pressure/length], second-order differences on the ladder
-        (``numpy.gradient``); ``inf`` where the mean gap no longer changes (full contact).
+        ``K = -d pbar/d ubar = d pbar/d w`` [pressure/length], second-order differences on the
+        ladder (``numpy.gradient``); ``inf`` where the closure changes on neither side (full contact).
     iterations : ndarray
         Solver iterations of each step.
     E_star : float
@@ -167,15 +168,16 @@ def _ladder(pressures):
     return p
 
 
-def _check_monotone(p, ubar):
-    """Refuse a ladder whose mean gap rises with the pressure (``w`` must not decrease)."""
-    rise = np.flatnonzero(np.diff(ubar) > 0)
+def _check_monotone(p, ubar, tol):
+    """Refuse a ladder whose mean gap rises with the pressure by more than ``tol`` (``w`` must not decrease)."""
+    rise = np.flatnonzero(np.diff(ubar) > tol)
     if rise.size:
         i = int(rise[0])
         raise InputError(
-            f"pressures[{i}..{i + 1}] = ({p[i]!r}, {p[i + 1]!r}) are not allowed: the mean gap rises from "
-            f"{ubar[i]!r} to {ubar[i + 1]!r} between them, and the closure w(p) must not decrease (a convex layer "
-            "energy); solve with a smaller rtol or space the pressures further apart.")
+            f"pressures[{i}..{i + 1}] = ({float(p[i])!r}, {float(p[i + 1])!r}) are not allowed: the mean gap rises "
+            f"from {float(ubar[i])!r} to {float(ubar[i + 1])!r} between them, more than the solver's tolerance "
+            f"{tol:.3g}, and the closure w(p) must not decrease (a convex layer energy); solve with a smaller rtol "
+            "or space the pressures further apart.")
 
 
 def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton", rtol=1e-8, maxiter=None,
@@ -238,11 +240,13 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
         guess = res.p.reshape(h.shape) * (p[k + 1] / pbar) if k + 1 < p.size else None
         if progress is not None:
             progress(k + 1, p.size, res)
-    _check_monotone(p, mean_gap)
-    closure = np.maximum(ubar0 - mean_gap, 0.0)
-    slope = np.gradient(mean_gap, p)
+    _check_monotone(p, mean_gap, rtol * ubar0)
+    closure = np.maximum.accumulate(ubar0 - mean_gap)  # levels rises within the tolerance (full contact)
+    steps = np.diff(closure)
+    flat = (np.r_[steps[0], steps] == 0) & (np.r_[steps, steps[-1]] == 0)  # no closure on either side
+    slope = np.gradient(closure, p)
     stiffness = np.full(p.size, np.inf)
-    np.divide(-1.0, slope, out=stiffness, where=slope < 0)
+    np.divide(1.0, slope, out=stiffness, where=(slope > 0) & ~flat)
     cell = dict(n_cols=lattice.n_cols, n_rows=lattice.n_rows, step=lattice.step, stretch_y=lattice.stretch_y,
                 method=method, rtol=rtol)
     return TopographyLaw(Tabulated(p, closure), p, closure, mean_gap, ubar0, fraction, stiffness, iterations, E_star,

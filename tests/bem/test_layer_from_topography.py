@@ -236,3 +236,16 @@ def test_the_layer_law_example_of_docs_rough_runs(tmp_path, monkeypatch, capsys)
     assert "12/12" in out
     assert isinstance(scope["layer"], layers.Tabulated)
     assert np.array_equal(scope["layer"].w(scope["pressures"]), scope["law"].closure)
+
+
+def test_full_contact_closes_the_whole_mean_gap_and_turns_the_interface_rigid(tmp_path):
+    """Beyond p_wfc the sinusoid is flat: w = Delta, K = inf, and the file keeps the inf."""
+    psi = np.array([0.5, 1.2, 1.5, 2.0])
+    law = rough.layer_from_topography(_sinusoid(64), E_STAR, pressures=psi * P_WFC, n_cols=64)
+    assert np.all(law.contact_fraction[1:] == 1.0)
+    assert np.allclose(law.closure[1:], DELTA, rtol=1e-12)
+    assert np.all(np.diff(law.closure) >= 0)
+    assert np.all(np.isinf(law.stiffness[2:])) and np.isfinite(law.stiffness[0])
+    assert np.isinf(law.law.inverse(1.01 * DELTA))  # rigid beyond the table
+    back = rough.read_layer_law(law.save(tmp_path / "flat.toml"))
+    assert np.array_equal(back.stiffness, law.stiffness)
