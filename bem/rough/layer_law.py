@@ -23,8 +23,9 @@ with the real contact fraction ``A/A0`` (nodes with ``p > 0``) and the interfaci
 pressure. The elastic energy of a law is convex when ``w`` is non-decreasing, which
 :class:`~bem.layers.Tabulated` requires: a ladder whose mean gap rises with the pressure by more
 than the solver's tolerance ``rtol ubar(0+)`` is refused by name; smaller rises (the rounding of
-a mean gap of zero in full contact) are levelled, ``w_k = max_(j <= k) (ubar(0+) - ubar(p_j))``. Two rough surfaces in contact are their sum (:func:`bem.rough.combined`) with the
-effective modulus ``E*`` of the pair.
+a mean gap of zero in full contact) are levelled, ``w_k = max_(j <= k) (ubar(0+) - ubar(p_j))``.
+Two rough surfaces in contact are their sum (:func:`bem.rough.combined`) with the effective
+modulus ``E*`` of the pair.
 
 The ladder of mean pressures is solved in order, each solve started from the previous
 pressure field scaled by the ratio of the mean pressures. A step that does not converge stops
@@ -39,13 +40,12 @@ Timings: ``benchmarks/layer_from_topography.py``.
 from __future__ import annotations
 
 import importlib.metadata
-import json
-import math
 import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
+import tomli_w
 
 from ..checks import InputError, check_choice, check_finite_array, check_positive, fail
 from ..files import write_text
@@ -120,34 +120,14 @@ class TopographyLaw:
         data = {k: self._plain(getattr(self, k)) for k in ("mean_pressure", "closure", "mean_gap", "contact_fraction",
                                                            "stiffness", "iterations")}
         data.update(first_touch_gap=self.first_touch_gap, E_star=self.E_star, version=self.version, **self.cell)
-        stats = {k: v for k, v in self.stats.as_dict().items() if v is not None}
-        text = ["# contactlab layer law of a rough surface: w(p) = ubar(0+) - ubar(p), ubar the mean gap of the",
-                "# periodic cell under the mean pressure p; [layer] is a scene's [layer] table (docs/rough.md).",
-                "", "[layer]", *_toml_items(self.layer_table()), "", "[topography]", *_toml_items(data), "",
-                "[topography.surface]", *_toml_items(stats), ""]
-        return write_text(path, "\n".join(text))
+        data["surface"] = {k: v for k, v in self.stats.as_dict().items() if v is not None}  # TOML has no null
+        head = ("# contactlab layer law of a rough surface: w(p) = ubar(0+) - ubar(p), ubar the mean gap of the\n"
+                "# periodic cell under the mean pressure p; [layer] is a scene's [layer] table (docs/rough.md).\n\n")
+        return write_text(path, head + tomli_w.dumps({"layer": self.layer_table(), "topography": data}))
 
     @staticmethod
     def _plain(a):
         return np.asarray(a).tolist()
-
-
-def _toml_value(v):
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else ("inf" if v > 0 else "-inf")
-    if isinstance(v, str):
-        return json.dumps(v)  # a TOML basic string
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    raise TypeError(f"no TOML form for {v!r}")
-
-
-def _toml_items(d):
-    return [f"{k} = {_toml_value(v)}" for k, v in d.items()]
 
 
 def _version():
