@@ -4,7 +4,7 @@ A seeded self-affine surface (Hurst 0.8, ``n x n`` points on a unit cell, roll-o
 cut-off at 1/32 of the cell, rms height 0.05) on the lattice of ``n`` nodes across, a ladder
 of ``--pressures`` mean pressures from ``3e-3`` to ``0.3 E* h'_rms`` (geometric), each solve
 warm-started from the previous one. Prints the ladder (contact fraction, mean gap, closure,
-stiffness, iterations), the wall time of the ladder (the synthesis apart), the fitted Persson
+stiffness, iterations), the wall and CPU time of the ladder (the synthesis apart), the fitted Persson
 rate ``gamma`` and the area factor ``kappa`` (docs/rough.md), and the load average of the
 machine: the timing is only comparable between runs at a similar load.
 
@@ -40,10 +40,10 @@ def main(argv=None):
     print(f"surface {args.n} x {args.n}, rms height {surface.stats.rms_height:.4g}, rms slope {slope:.4g} "
           f"(synthesis {t_surface:.2f} s); {args.pressures} mean pressures, {args.method}, rtol {args.rtol:g}")
     load_before = os.getloadavg()[0]
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     law = rough.layer_from_topography(surface, 1.0, pressures=pressures, n_cols=args.n, method=args.method,
                                       rtol=args.rtol)
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     load_after = os.getloadavg()[0]
     print("| p/(E* h'rms) | A/A0 | ubar/h_rms | w/h_rms | K h_rms/(E* h'rms) | iterations |")
     print("|---|---|---|---|---|---|")
@@ -58,7 +58,7 @@ def main(argv=None):
     kappa = float(np.dot(x, law.contact_fraction[small]) / np.dot(x, x)) if small.any() else np.nan
     print(f"gamma = {gamma:.3f} (fit over 1.5 % <= A/A0 <= 15 %), kappa = {kappa:.3f} (1 % <= A/A0 <= 5 %, "
           "h'rms from SurfaceStats)")
-    print(f"ladder: {wall:.2f} s wall, {int(law.iterations.sum())} iterations; 1-min load average "
+    print(f"ladder: {wall:.2f} s wall, {cpu:.2f} s CPU (all threads), {int(law.iterations.sum())} iterations; 1-min load average "
           f"{load_before:.2f} before, {load_after:.2f} after on {os.cpu_count()} cores (a shared machine: "
           "other processes slow the run)")
     if args.save:
