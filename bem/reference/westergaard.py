@@ -15,6 +15,14 @@ Below it (``pbar < p_wfc``) the contact is ``|x| < a`` (mod ``lambda``) with
 and above it the contact is full and ``p(x) = pbar + p_wfc cos(2 pi x / lambda)``: the
 pressure of a cosine displacement ``Delta cos(2 pi x / lambda)`` that closes the gap, whose
 transform ``2 / (E* |k|)`` gives ``p_wfc``. The two forms meet at ``pbar = p_wfc``.
+
+The displacement of zero mean over a period, ``u(x) = -(2/(pi E*)) integral p(s)
+ln|2 sin(pi (x - s)/lambda)| ds``, closes the gap where it touches, ``u(0) = delta``; with
+``psi = pbar/p_wfc`` that integral gives the approach and the mean gap (mean-plane separation)
+
+    delta = Delta psi (1 - ln psi),        ubar = Delta - delta        (psi < 1),
+
+and ``delta = Delta``, ``ubar = 0`` in full contact. At first touch ``ubar = Delta = mean(h)``.
 """
 
 from __future__ import annotations
@@ -57,6 +65,20 @@ class Westergaard:
     def contact_fraction(self):
         """``2 a / lambda``: the fraction of the period in contact."""
         return 2 * self.contact_half_width / self.wavelength
+
+    @property
+    def approach(self):
+        """``delta = Delta psi (1 - ln psi)`` [length], ``psi = pbar/p_wfc``; ``Delta`` in full contact.
+
+        The displacements have zero mean over a period (module docstring).
+        """
+        psi = self.mean_pressure / self.full_contact_pressure
+        return self.amplitude if psi >= 1 else self.amplitude * psi * (1.0 - math.log(psi))
+
+    @property
+    def mean_gap(self):
+        """Mean deformed gap ``ubar = Delta - delta`` [length] (the mean-plane separation)."""
+        return self.amplitude - self.approach
 
     @property
     def p_max(self):

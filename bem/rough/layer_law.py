@@ -1,0 +1,269 @@
+"""The layer law of a rough surface: its mean gap against the mean pressure, as a tabulated ``w(p)``.
+
+A rough surface pressed against a flat closes its mean gap as the load grows. On one periodic
+cell (:func:`bem.solve_periodic`) with the initial gap ``h = max z - z``
+(:meth:`bem.rough.LatticeHeights.gap`: the highest node touches first, ``h = 0`` there) and
+the mean pressure ``pbar``, the mean gap (mean-plane separation) is
+
+    ubar(pbar) = mean(h) - delta(pbar),
+
+``delta`` the approach (the displacements have zero mean over the cell). At first touch
+(``pbar -> 0+``: one node touches, nothing deforms) it is
+
+    ubar(0+) = mean(h) = max z - mean z,
+
+the height of the highest summit above the mean plane. The layer law is the closure of the
+mean gap,
+
+    w(pbar) = ubar(0+) - ubar(pbar) = delta(pbar),
+
+with the real contact fraction ``A/A0`` (nodes with ``p > 0``) and the interfacial stiffness
+``K = -d pbar / d ubar`` [pressure/length] beside it. Used as a layer between two smooth bodies
+(:class:`bem.layers.Tabulated`), the roughness closes as it does on the cell under the local
+pressure. The elastic energy of a law is convex when ``w`` is non-decreasing, which
+:class:`~bem.layers.Tabulated` requires: a ladder whose mean gap rises with the pressure by more
+than the solver's tolerance ``rtol ubar(0+)`` is refused by name; smaller rises (the rounding of
+a mean gap of zero in full contact) are levelled, ``w_k = max_(j <= k) (ubar(0+) - ubar(p_j))``.
+Two rough surfaces in contact are their sum (:func:`bem.rough.combined`) with the effective
+modulus ``E*`` of the pair.
+
+The ladder of mean pressures is solved in order, each solve started from the previous
+pressure field scaled by the ratio of the mean pressures. A step that does not converge stops
+the ladder with :class:`LadderNotConverged`: no table is made from it.
+
+The table file (TOML) holds a ``[layer]`` table a scene's ``[layer]`` takes as it is
+(``law = "tabulated"``, ``p``, ``w``) and a ``[topography]`` table with the ladder's data,
+the surface statistics and the contactlab version; :func:`read_layer_law` reads it back.
+Timings: ``benchmarks/layer_from_topography.py``.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import tomllib
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import numpy as np
+import tomli_w
+
+from ..checks import InputError, check_choice, check_finite_array, check_positive, fail
+from ..files import write_text
+from ..layers import Tabulated
+from ..options import METHODS
+from .surface import RoughSurface, SurfaceStats
+
+__all__ = ["TopographyLaw", "LadderNotConverged", "layer_from_topography", "read_layer_law"]
+
+
+class LadderNotConverged(RuntimeError):
+    """A step of the pressure ladder did not converge; ``result`` is its :class:`bem.PeriodicContactResult`."""
+
+    def __init__(self, message, index, mean_pressure, result):
+        super().__init__(message)
+        self.index, self.mean_pressure, self.result = index, mean_pressure, result
+
+
+@dataclass(frozen=True)
+class TopographyLaw:
+    """The layer law of a rough surface and the ladder it comes from (module docstring).
+
+    Attributes
+    ----------
+    law : bem.layers.Tabulated
+        ``w(pbar)`` through the ladder's points (and ``(0, 0)``).
+    mean_pressure : ndarray
+        The ladder ``pbar_k`` [pressure].
+    closure : ndarray
+        ``w_k = ubar(0+) - ubar(pbar_k)`` [length].
+    mean_gap : ndarray
+        ``ubar(pbar_k)`` [length].
+    first_touch_gap : float
+        ``ubar(0+) = mean(h)`` [length].
+    contact_fraction : ndarray
+        ``A/A0`` at each step [-].
+    stiffness : ndarray
+        ``K = -d pbar/d ubar = d pbar/d w`` [pressure/length], second-order differences on the
+        ladder (``numpy.gradient``); ``inf`` where the closure changes on neither side (full contact).
+    iterations : ndarray
+        Solver iterations of each step.
+    E_star : float
+        Effective modulus [pressure].
+    cell : dict
+        ``n_cols``, ``n_rows``, ``step`` [length], ``stretch_y`` of the lattice cell, ``method``
+        and ``rtol`` of the solves.
+    stats : SurfaceStats
+        Of the surface the law comes from.
+    version : str
+        The contactlab version that made it.
+    """
+
+    law: Tabulated
+    mean_pressure: np.ndarray
+    closure: np.ndarray
+    mean_gap: np.ndarray
+    first_touch_gap: float
+    contact_fraction: np.ndarray
+    stiffness: np.ndarray
+    iterations: np.ndarray
+    E_star: float
+    cell: dict
+    stats: SurfaceStats
+    version: str
+
+    def layer_table(self):
+        """The scene's ``[layer]`` table: ``{"law": "tabulated", "p": [...], "w": [...]}``."""
+        return self.law.to_dict()
+
+    def save(self, path):
+        """Write the table file (TOML, module docstring) whole or not at all; returns its path."""
+        data = {k: self._plain(getattr(self, k)) for k in ("mean_pressure", "closure", "mean_gap", "contact_fraction",
+                                                           "stiffness", "iterations")}
+        data.update(first_touch_gap=self.first_touch_gap, E_star=self.E_star, version=self.version, **self.cell)
+        data["surface"] = {k: v for k, v in self.stats.as_dict().items() if v is not None}  # TOML has no null
+        head = ("# contactlab layer law of a rough surface: w(p) = ubar(0+) - ubar(p), ubar the mean gap of the\n"
+                "# periodic cell under the mean pressure p; [layer] is a scene's [layer] table (docs/rough.md).\n\n")
+        return write_text(path, head + tomli_w.dumps({"layer": self.layer_table(), "topography": data}))
+
+    @staticmethod
+    def _plain(a):
+        return np.asarray(a).tolist()
+
+
+def _version():
+    try:
+        return importlib.metadata.version("contactlab")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown"
+
+
+def _ladder(pressures):
+    p = check_finite_array("pressures", pressures, ndim=1, min_size=2)
+    if p[0] <= 0:
+        fail("pressures[0]", float(p[0]), "> 0")
+    bad = np.flatnonzero(np.diff(p) <= 0)
+    if bad.size:
+        i = int(bad[0]) + 1
+        fail(f"pressures[{i}]", float(p[i]), f"> pressures[{i - 1}] = {float(p[i - 1])!r} (strictly increasing)")
+    return p
+
+
+def _check_monotone(p, ubar, tol):
+    """Refuse a ladder whose mean gap rises with the pressure by more than ``tol`` (``w`` must not decrease)."""
+    rise = np.flatnonzero(np.diff(ubar) > tol)
+    if rise.size:
+        i = int(rise[0])
+        raise InputError(
+            f"pressures[{i}..{i + 1}] = ({float(p[i])!r}, {float(p[i + 1])!r}) are not allowed: the mean gap rises "
+            f"from {float(ubar[i])!r} to {float(ubar[i + 1])!r} between them, more than the solver's tolerance "
+            f"{tol:.3g}, and the closure w(p) must not decrease (a convex layer energy); solve with a smaller rtol "
+            "or space the pressures further apart.")
+
+
+def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton", rtol=1e-8, maxiter=None,
+                          progress=None):
+    """The layer law ``w(pbar)`` of a rough surface pressed against a flat (module docstring).
+
+    Parameters
+    ----------
+    surface : RoughSurface
+        One periodic cell (two rough surfaces: :func:`bem.rough.combined`).
+    E_star : float
+        Effective modulus of the pair [pressure], ``> 0``.
+    pressures : array_like
+        The ladder of mean pressures [pressure], ``> 0``, strictly increasing, at least two.
+    n_cols : int
+        Lattice nodes across the cell (:meth:`RoughSurface.to_lattice`).
+    method : str
+        A method of :func:`bem.solve_periodic` (``bem.METHODS``).
+    rtol : float
+        The solver's KKT tolerance, ``> 0``.
+    maxiter : int, optional
+        The solver's iteration limit per step (its default if ``None``).
+    progress : callable, optional
+        Called after each step as ``progress(k, n, result)``, ``k = 1..n``, ``result`` the
+        step's :class:`bem.PeriodicContactResult`.
+
+    Returns
+    -------
+    TopographyLaw
+
+    Raises
+    ------
+    bem.InputError
+        A bad argument, or a ladder whose mean gap rises with the pressure.
+    LadderNotConverged
+        A step did not converge (its index, pressure and result are attached).
+    """
+    from ..periodic import solve_periodic
+
+    if not isinstance(surface, RoughSurface):
+        fail("surface", type(surface).__name__, "a bem.rough.RoughSurface")
+    E_star = check_positive("E_star", E_star)
+    p = _ladder(pressures)
+    check_choice("method", method, METHODS)
+    rtol = check_positive("rtol", rtol)
+    if progress is not None and not callable(progress):
+        fail("progress", progress, "callable or None")
+    lattice = surface.to_lattice(n_cols)
+    h = lattice.gap()
+    ubar0 = float(h.mean())
+    mean_gap, fraction, iterations = np.empty(p.size), np.empty(p.size), np.empty(p.size, dtype=int)
+    guess = None
+    for k, pbar in enumerate(p):
+        res = solve_periodic(h, step=lattice.step, E_star=E_star, mean_pressure=float(pbar), method=method, rtol=rtol,
+                             x0=guess, **({} if maxiter is None else {"maxiter": maxiter}))
+        if not res.converged:
+            raise LadderNotConverged(f"step {k} of the ladder (mean pressure {pbar!r}) did not converge: "
+                                     f"{res.message}; no layer law is made from it", k, float(pbar), res)
+        mean_gap[k], fraction[k], iterations[k] = res.mean_gap, res.contact_fraction, res.iterations
+        guess = res.p.reshape(h.shape) * (p[k + 1] / pbar) if k + 1 < p.size else None
+        if progress is not None:
+            progress(k + 1, p.size, res)
+    _check_monotone(p, mean_gap, rtol * ubar0)
+    closure = np.maximum.accumulate(ubar0 - mean_gap)  # levels rises within the tolerance (full contact)
+    steps = np.diff(closure)
+    flat = (np.r_[steps[0], steps] == 0) & (np.r_[steps, steps[-1]] == 0)  # no closure on either side
+    slope = np.gradient(closure, p)
+    stiffness = np.full(p.size, np.inf)
+    np.divide(1.0, slope, out=stiffness, where=(slope > 0) & ~flat)
+    cell = dict(n_cols=lattice.n_cols, n_rows=lattice.n_rows, step=lattice.step, stretch_y=lattice.stretch_y,
+                method=method, rtol=rtol)
+    return TopographyLaw(Tabulated(p, closure), p, closure, mean_gap, ubar0, fraction, stiffness, iterations, E_star,
+                         cell, surface.stats, _version())
+
+
+def read_layer_law(path):
+    """Read a table file written by :meth:`TopographyLaw.save`.
+
+    Returns
+    -------
+    TopographyLaw
+
+    Raises
+    ------
+    bem.InputError
+        The file cannot be read, is not TOML, or lacks the ``[layer]`` or ``[topography]`` table.
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise InputError(f"path = {str(path)!r} is not allowed: it must be a readable TOML table file "
+                         f"({type(exc).__name__}).") from None
+    layer, topo = data.get("layer"), data.get("topography")
+    if not isinstance(layer, dict) or layer.get("law") != "tabulated" or not isinstance(topo, dict):
+        fail("path", str(path), "a layer law file with [layer] law = 'tabulated' and a [topography] table")
+    try:
+        stats = dict(topo["surface"])
+        stats.update(size=tuple(stats["size"]), grid=tuple(stats["grid"]))
+        stats = SurfaceStats(**{f.name: stats[f.name] for f in fields(SurfaceStats) if f.name in stats})
+        arrays = {k: np.array(topo[k], dtype=float) for k in ("mean_pressure", "closure", "mean_gap",
+                                                               "contact_fraction", "stiffness")}
+        cell = {k: topo[k] for k in ("n_cols", "n_rows", "step", "stretch_y", "method", "rtol")}
+        return TopographyLaw(Tabulated(layer["p"], layer["w"]), arrays["mean_pressure"], arrays["closure"],
+                             arrays["mean_gap"], float(topo["first_touch_gap"]), arrays["contact_fraction"],
+                             arrays["stiffness"], np.array(topo["iterations"], dtype=int), float(topo["E_star"]),
+                             cell, stats, str(topo["version"]))
+    except (KeyError, TypeError) as exc:
+        raise InputError(f"path = {str(path)!r} is not allowed: its [topography] table lacks {exc}.") from None
