@@ -143,7 +143,7 @@ def test_core_install_runs_a_bem_scene_and_writes_its_files(tmp_path):
     code, out, err = _core_only(tmp_path, "run", "elliptic", "--out", "res", "--set", "bem.nodes_across=16")
     assert code == 0, err
     res = tmp_path / "res"
-    assert sorted(p.name for p in res.iterdir()) == ["bem_field.vtu", "result.json", "scene.toml"]
+    assert sorted(p.name for p in res.iterdir()) == [".contactlab", "bem_field.vtu", "result.json", "scene.toml"]
     result = json.loads((res / "result.json").read_text())
     assert result["converged"] and result["analytic"]["kind"] == "hertz_elliptic"
     assert set(result["provenance"]["packages"]) == {"numpy", "scipy", "meshio"}

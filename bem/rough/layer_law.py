@@ -84,7 +84,7 @@ class TopographyLaw:
         ``A/A0`` at each step [-].
     stiffness : ndarray
         ``K = -d pbar/d ubar = d pbar/d w`` [pressure/length], second-order differences on the
-        ladder (``numpy.gradient``); ``inf`` where the closure changes on neither side (full contact).
+        ladder (``numpy.gradient``); ``inf`` where the ladder is in full contact on both sides of a pressure.
     iterations : ndarray
         Solver iterations of each step.
     E_star : float
@@ -221,9 +221,9 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
         if progress is not None:
             progress(k + 1, p.size, res)
     _check_monotone(p, mean_gap, rtol * ubar0)
-    closure = np.maximum.accumulate(ubar0 - mean_gap)  # levels rises within the tolerance (full contact)
-    steps = np.diff(closure)
-    flat = (np.r_[steps[0], steps] == 0) & (np.r_[steps, steps[-1]] == 0)  # no closure on either side
+    full = fraction == 1.0  # every node touches: the mean gap is closed, whatever the rounding says
+    closure = np.where(full, ubar0, np.maximum.accumulate(ubar0 - mean_gap))  # levels rises within the tolerance
+    flat = full & np.r_[full[0], full[:-1]] & np.r_[full[1:], full[-1]]  # full contact on either side: rigid
     slope = np.gradient(closure, p)
     stiffness = np.full(p.size, np.inf)
     np.divide(1.0, slope, out=stiffness, where=(slope > 0) & ~flat)
