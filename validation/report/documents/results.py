@@ -33,7 +33,7 @@ from bem.checks import InputError, check_choice
 from ...units import Units, parse_units
 
 __all__ = ["RunResults", "load_results", "results_of", "units_of", "read_json", "is_number", "dimensionless_for",
-           "UNIT_CHOICES"]
+           "UNIT_CHOICES", "file_inside"]
 
 log = logging.getLogger(__name__)
 
@@ -160,6 +160,26 @@ def read_json(path):
         raise InputError(f"{path} is not allowed: it must be a readable JSON file ({exc}).") from None
 
 
+def file_inside(directory, name, entry):
+    """``directory / name`` when it resolves to a path inside ``directory``, else ``None``.
+
+    A report reads only files of the folder it reports: a name stored in a result or a sweep
+    summary (``entry``, e.g. ``files.scene``) that is absolute, climbs out with ``..`` or goes
+    through a link to elsewhere is skipped with a warning naming the entry.
+    """
+    root = Path(directory).resolve()
+    try:
+        path = (root / str(name)).resolve()
+    except (OSError, RuntimeError, ValueError) as exc:
+        log.warning("skipping %s = %r: it cannot be resolved (%s)", entry, name, exc)
+        return None
+    if not path.is_relative_to(root) or path == root:
+        log.warning("skipping %s = %r: it points outside %s, and a report reads only the files inside its folder",
+                    entry, str(name), root)
+        return None
+    return path
+
+
 def _read_scene(path):
     try:
         with path.open("rb") as fh:
@@ -170,8 +190,9 @@ def _read_scene(path):
 
 
 def _field(path, read):
-    """``read(path)``, or None when the file is missing or unreadable (a report without that figure)."""
-    if not path.is_file():
+    """``read(path)``, or None when the file is missing, outside the folder or unreadable (a report
+    without that figure)."""
+    if path is None or not path.is_file():
         return None
     try:
         return read(path)
@@ -221,13 +242,14 @@ def load_results(directory, *, units="auto"):
     if not str(data.get("schema", "")).startswith("contactlab.result/"):
         log.warning("%s has schema %r: it was not written by contactlab run; parts may be missing",
                     main, data.get("schema"))
-    files = {**_FILES, **{k: str(v) for k, v in (data.get("files") or {}).items()}}
-    scene = _read_scene(directory / files["scene"])
+    stored = data.get("files") if isinstance(data.get("files"), Mapping) else {}
+    files = {k: file_inside(directory, v, f"files.{k}" if k in stored else k)
+             for k, v in {**_FILES, **{k: str(v) for k, v in stored.items()}}.items()}
+    scene = _read_scene(files["scene"]) if files["scene"] is not None else {}
     parsed = units_of(data, (scene.get("scene") or {}).get("units"))
-    fem = _field(directory / files["fem_field"], section_field_from_vtu) if isinstance(data.get("fem"), Mapping) \
-        else None
+    fem = _field(files["fem_field"], section_field_from_vtu) if isinstance(data.get("fem"), Mapping) else None
     return RunResults(directory=directory, data=dict(data), scene=scene, units=parsed,
-                      bem_field=_field(directory / files["bem_field"], _bem_field), fem_field=fem,
+                      bem_field=_field(files["bem_field"], _bem_field), fem_field=fem,
                       dimensionless=dimensionless_for(units, parsed))
 
 
