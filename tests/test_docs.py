@@ -150,7 +150,7 @@ def test_results_doc_documents_every_field_of_real_results(real_results):
     assert not stale, f"docs/results.md documents fields no run writes: {sorted(stale)}"
 
 
-_FILE_TABLE = ("result.json", "scene.toml", "bem_field.vtu", "fem_field.vtu")
+_FILE_TABLE = ("result.json", "scene.toml", "bem_field.vtu", "fem_field.vtu", "stress_field.vtu")
 
 
 def test_results_doc_units_of_the_main_fields():
