@@ -48,6 +48,13 @@ def _image(path):
         return np.asarray(img.convert("RGB"), dtype=float)
 
 
+def section_field_size():
+    """Size of :func:`plot_section_field`'s figure [inch]: with pyvista its 3-D view is beside the section."""
+    from validation.report.figures.views3d import pyvista_or_none
+
+    return (5.8, 4.6) if pyvista_or_none() is None else (10.4, 4.6)
+
+
 def check_png(path, size_in=None, *, floor=8.0):
     """A real PNG, of ``size_in`` inches at DPI when given, with visible content."""
     assert os.path.isfile(path)
@@ -250,7 +257,7 @@ def test_von_mises_png(tmp_path):
     assert vm[k] / P0 == pytest.approx(0.62, abs=0.03)
     assert abs(z[k]) / A == pytest.approx(0.48, abs=0.12) and r[k] / A < 0.25
     check_png(plot_section_field(r, z, tri, vm, tmp_path / "vm.png", a=A, scale=P0, label="von Mises",
-                                 contact_radius=fem.contact_radius), (5.8, 4.6))
+                                 contact_radius=fem.contact_radius), section_field_size())
 
 
 # ---------------------------------------------------------------- inputs untouched, atomic writes

@@ -302,9 +302,14 @@ def fem_von_mises(res, work):
                               window=_round_up(window), contact_radius=rc or None, labels=labels,
                               length_unit=None if hertz else (f"${l_name}$" if normalised else l_name),
                               title="FEM reference: von Mises stress in the (r, z) section")
-    return Figure(path, "Von Mises stress of the FEM reference in the axial (r, z) section, mirrored about the "
-                        "axis, from the stresses recovered at the mesh nodes (fem_field.vtu); the thick line "
-                        "marks the contact. " + _fem_how(res))
+    from .views3d import pyvista_or_none
+
+    view = ("Left: the lower body (z <= 0) in 3-D, the section revolved about the axis with a quarter cut away, "
+            "the contact patch outlined in cyan (rendered with pyvista); right: the section. "
+            if pyvista_or_none() is not None else "")
+    return Figure(path, view + "Von Mises stress of the FEM reference in the axial (r, z) section, mirrored about the "
+                               "axis, from the stresses recovered at the mesh nodes (fem_field.vtu); the thick line "
+                               "marks the contact. " + _fem_how(res))
 
 
 def stress_view(res):

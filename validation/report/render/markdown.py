@@ -50,8 +50,8 @@ def _cell(text):
 def _table(tab, number):
     status = tab.status_column is not None
     head = list(tab.columns) + (["flag"] if status else [])
-    lines = [f"**Table {number}.** {md_escape(tab.caption)}".rstrip(), "", "| " + " | ".join(_cell(c) for c in head) + " |",
-             "|" + "|".join("---" for _ in head) + "|"]
+    lines = [f"**Table {number}.** {md_escape(tab.caption)}".rstrip(), "",
+             "| " + " | ".join(_cell(c) for c in head) + " |", "|" + "|".join("---" for _ in head) + "|"]
     for row in tab.rows:
         cells = [_cell(c) for c in row]
         if status:
