@@ -310,3 +310,31 @@ def test_bad_scales_raise(cases, tmp_path):
     with pytest.raises(InputError, match="curves"):
         fpr.plot_pressure_profiles([], tmp_path / "z.png", p0=P0, a=A)
     assert not (tmp_path / "z.png").exists()
+
+
+def _drawn_lines(monkeypatch, module):
+    """Every figure ``module.save_figure`` writes: its first axes' lines as (marker, x, y)."""
+    drawn, real = [], module.save_figure
+
+    def spy(fig, path, **kwargs):
+        drawn.append([(ln.get_marker(), np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float))
+                      for ln in fig.axes[0].lines])
+        return real(fig, path, **kwargs)
+
+    monkeypatch.setattr(module, "save_figure", spy)
+    return drawn
+
+
+def test_tabulated_layer_law_shows_its_points(tmp_path, monkeypatch):
+    from bem.layers import Linear, Tabulated
+    from validation.report.figures import profiles
+    from validation.report.figures.run import Scaled
+
+    p, w = np.array([0.0, 1e6, 2e6, 4e6, 8e6]), np.array([0.0, 0.5e-6, 0.8e-6, 1.0e-6, 1.1e-6])
+    drawn = _drawn_lines(monkeypatch, profiles)
+    check_png(profiles.plot_layer_laws([("table", Scaled(Tabulated(p, w), 1e6, 1e-6)), ("linear", Linear(1.0))],
+                                       tmp_path / "law.png", p_max=5.0, p_unit="MPa", w_unit="µm"))
+    points = [(x, y) for marker, x, y in drawn[0] if marker == "o"]
+    assert len(points) == 1, "the table's points, and no markers on the formula law"
+    np.testing.assert_allclose(points[0][0], [0.0, 1.0, 2.0, 4.0])  # in view: p <= p_max, in MPa
+    np.testing.assert_allclose(points[0][1], [0.0, 0.5, 0.8, 1.0])  # in µm

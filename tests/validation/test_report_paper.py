@@ -239,3 +239,18 @@ def test_paper_stresses_every_layer_lowers_the_subsurface_maximum(paper):
     # the linear and root layers flatten the pressure most: the maximum moves deeper
     assert st["linear Winkler"].depth_of_max > smooth.depth_of_max
     assert st["root"].depth_of_max > smooth.depth_of_max
+
+
+def test_quick_report_is_marked_a_coarse_preview(paper, monkeypatch, tmp_path):
+    from validation.report.documents import paper as paper_report
+    from validation.report.render import Section
+
+    monkeypatch.setattr(paper_report, "run_paper_problem", lambda *, quick, fem, progress: paper)
+    monkeypatch.setattr(paper_report, "paper_sections", lambda res, work: [Section("x", text="y")])
+    for quick in (True, False):
+        built = paper_report.report_paper_problem(tmp_path / f"q{quick}", quick=quick)
+        heading = re.search(r"<h1>(.*?)</h1>", built.html.read_text(encoding="utf-8")).group(1)
+        title = re.search(r"<title>(.*?)</title>", built.html.read_text(encoding="utf-8")).group(1)
+        md_heading = built.markdown.read_text(encoding="utf-8").splitlines()[0]
+        for text in (heading, title, md_heading):
+            assert ("COARSE PREVIEW" in text) == quick, text

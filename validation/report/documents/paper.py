@@ -23,6 +23,8 @@ from .results import results_of
 __all__ = ["report_paper_problem", "paper_sections", "expected_stalls", "STAGES", "TITLE"]
 
 TITLE = "contactlab: the paper's test problem - paraboloids with a nonlinear interface layer"
+#: what the title of a quick report adds: its numbers are those of a coarse lattice and short sweeps
+PREVIEW = "COARSE PREVIEW, --quick: not the numbers of record"
 #: the stages of :func:`report_paper_problem`, as reported to its ``progress``
 STAGES = (*SOLVE_STAGES, "figures", "writing")
 #: case -> its key in figure names and colours (``"linear Winkler"`` -> ``"linear"``)
@@ -367,8 +369,9 @@ def report_paper_problem(out_dir, *, quick=False, fem=True, fmt="png", progress=
     notify = Progress([s for s in STAGES if fem or s != SOLVE_STAGES[3]], progress)
     res = run_paper_problem(quick=quick, fem=fem, progress=notify)
     subtitle = (f"Steel paraboloids (built-in scenes paper_*), lam = {res.lam_over_cnn:g} C_nn; BEM lattice "
-                f"a_H/c = {res.nodes_per_radius}{' (quick preview)' if quick else ''}; "
+                f"a_H/c = {res.nodes_per_radius}{' (coarse preview)' if quick else ''}; "
                 f"computed in {res.wall_time_s:.0f} s.")
-    built = draw_and_build(lambda work: paper_sections(res, work), out_dir, title=TITLE, subtitle=subtitle, fmt=fmt,
+    title = f"{TITLE} ({PREVIEW})" if quick else TITLE
+    built = draw_and_build(lambda work: paper_sections(res, work), out_dir, title=title, subtitle=subtitle, fmt=fmt,
                            notify=notify)
     return dataclasses.replace(built, notes=expected_stalls(res))

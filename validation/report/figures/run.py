@@ -144,6 +144,13 @@ class Scaled:
     def w(self, p):
         return self.layer.w(p * self.pf) / self.wf
 
+    def measured(self):
+        """The tabulated law's points in display units, or ``None``."""
+        from .profiles import measured_points
+
+        points = measured_points(self.layer)
+        return None if points is None else (points[0] / self.pf, points[1] / self.wf)
+
 
 def layer_law(res, work):
     """The layer law w(p) the solver used over ``0 .. 1.25 max(p_max, p_cr, p_star)``, its kinks marked."""
@@ -165,7 +172,9 @@ def layer_law(res, work):
                            title="interface layer law: closure $w(p)$ under the pressure $p$")
     return Figure(path, f"The layer law w(p) used by the solver ({params['law']}), rebuilt from the run's result with "
                         "bem.layers.from_dict and evaluated at 200 pressures from 0 to 1.25 times the largest of the "
-                        "computed peak pressure and the law's kink pressures (marked).")
+                        "computed peak pressure and the law's kink pressures (marked)"
+                        + ("; the circles are the table's points, between which the law is interpolated."
+                           if params["law"] == "tabulated" else "."))
 
 
 def _reference(res, axis):
