@@ -254,3 +254,10 @@ def test_quick_report_is_marked_a_coarse_preview(paper, monkeypatch, tmp_path):
         md_heading = built.markdown.read_text(encoding="utf-8").splitlines()[0]
         for text in (heading, title, md_heading):
             assert ("COARSE PREVIEW" in text) == quick, text
+
+
+def test_one_name_for_the_hertz_peak(report):
+    """The paper calls Hertz's peak p0: the figures of its validation section too (no p_H)."""
+    for text in (report.markdown.read_text(encoding="utf-8"), report.html.read_text(encoding="utf-8")):
+        assert "p0" in text and "p_H" not in text
+    assert "Normalised by Hertz's peak p_0" in report.markdown.read_text(encoding="utf-8")

@@ -303,7 +303,7 @@ def _validation(res, work):
     for case, outcome in res.validation.items():
         folder = work / f"validation_{_KEYS[case]}"
         folder.mkdir(exist_ok=True)
-        items += run_figures.profiles(results_of(outcome, units="dimensionless"), folder)
+        items += run_figures.profiles(results_of(outcome, units="dimensionless", hertz_peak="p_0"), folder)
         b, f = outcome.bem, outcome.fem
         rows.append((case, b.p_max / res.p0, f.p_max / res.p0, f"{(b.p_max - f.p_max) / f.p_max:+.2%}",
                      b.contact_radius / res.a, f.contact_radius / res.a, b.approach / res.approach,
@@ -314,8 +314,8 @@ def _validation(res, work):
                         "status"), tuple(rows), status_column="status",
                        caption="BEM against FEM (Hertz: p_max / p0 = 1, r_c / a_H = 1, delta / delta_H = 1). BEM r_c "
                                "= sqrt(A/pi) from the loaded nodes; FEM r_c from the closure crossing zero."))
-    items.append(run_figures.fem_von_mises(results_of(res.validation["smooth"], units="dimensionless"),
-                                           work / "validation_smooth"))
+    smooth = results_of(res.validation["smooth"], units="dimensionless", hertz_peak="p_0")
+    items.append(run_figures.fem_von_mises(smooth, work / "validation_smooth"))
     wp = plot_work_precision(res.work_precision, work / "fig_work_precision.png",
                              error_label=r"peak-pressure error $|p_{max} - p_0|\,/\,p_0$",
                              title="Hertz problem: error against run time")

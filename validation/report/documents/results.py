@@ -75,6 +75,9 @@ class RunResults:
     dimensionless : bool
         Draw lengths and pressures divided by the contact's scales (:meth:`scales`) instead of
         in the scene's units (:func:`validation.report.render.style.report_unit`).
+    hertz_peak : str
+        The name of Hertz's peak pressure in a dimensionless report (``"p_H"``; the paper
+        report calls it ``"p_0"``, as the paper does): one name for it throughout a report.
     """
 
     directory: Path
@@ -84,6 +87,7 @@ class RunResults:
     bem_field: tuple | None = None
     fem_field: tuple | None = None
     dimensionless: bool = False
+    hertz_peak: str = "p_H"
 
     def section(self, name):
         """A table of ``scene.toml`` (empty dict when absent)."""
@@ -139,7 +143,7 @@ class RunResults:
     def scales(self):
         """``(p0, a, p_name, a_name)`` of a dimensionless report, or ``None`` (scene units).
 
-        Hertz's peak and radius (``p_H``, ``a_H``) when the run recorded them, else the BEM peak
+        Hertz's peak and radius (:attr:`hertz_peak`, ``a_H``) when the run recorded them, else the BEM peak
         pressure and the contact radius (or half-width along x): ``p_{max}``, ``a_c``.
         """
         if not self.dimensionless:
@@ -147,7 +151,7 @@ class RunResults:
         sc = self.get("scales") or {}
         p0, a = sc.get("p_hertz"), sc.get("a_hertz")
         if p0 and a and p0 > 0 and a > 0:
-            return float(p0), float(a), "p_H", "a_H"
+            return float(p0), float(a), self.hertz_peak, "a_H"
         p0, a = self.data.get("p_max"), self.contact_size
         return (float(p0), float(a), "p_{max}", "a_c") if p0 and a and p0 > 0 and a > 0 else None
 
@@ -253,13 +257,13 @@ def load_results(directory, *, units="auto"):
                       dimensionless=dimensionless_for(units, parsed))
 
 
-def results_of(outcome, *, units="auto", directory="."):
+def results_of(outcome, *, units="auto", directory=".", hertz_peak="p_H"):
     """The :class:`RunResults` of a run in memory (:class:`validation.run.RunOutcome`), as
-    :func:`load_results` would read them once written."""
+    :func:`load_results` would read them once written (``hertz_peak``: :attr:`RunResults.hertz_peak`)."""
     from ..figures.fields import von_mises_of
 
     res = outcome.bem
     return RunResults(directory=Path(directory), data=outcome.result, scene=outcome.scene.raw,
                       units=outcome.scene.units, bem_field=(res.x, res.y, res.p),
                       fem_field=None if outcome.fem is None else von_mises_of(outcome.fem),
-                      dimensionless=dimensionless_for(units, outcome.scene.units))
+                      dimensionless=dimensionless_for(units, outcome.scene.units), hertz_peak=hertz_peak)

@@ -229,7 +229,7 @@ def profiles(res, work):
 
 def _scale_text(view):
     """Caption sentence naming the scales of a dimensionless figure."""
-    if view.p_name.startswith("p_H"):
+    if view.x_name.startswith("a_H"):
         return f"Normalised by Hertz's peak {view.p_name} and radius {view.x_name} of the smooth problem."
     return f"Normalised by the BEM peak pressure {view.p_name} and the contact half-width along x {view.x_name}."
 
@@ -322,10 +322,9 @@ def fem_von_mises(res, work):
 
 
 def stress_view(res):
-    """``(a, scale, length name, stress name, normalised)`` of the ``stress`` block's figures and tables."""
-    bodies = res.get("stress")["bodies"]
-    a, l_name, normalised = scale(res, "length", max(float(np.max(b["axis"]["z"])) for b in bodies.values()))
-    s, s_name, _ = scale(res, "pressure", max(float(b["max_von_mises"]) for b in bodies.values()))
+    """``(a, scale, length name, stress name, normalised)`` of the ``stress`` block's figures and tables:
+    the units (or scales) of every other figure of the report, one unit per quantity."""
+    (a, l_name, normalised), (s, s_name, _) = scale(res, "length"), scale(res, "pressure")  # as every figure
     return a, s, l_name, s_name, normalised
 
 
@@ -377,7 +376,7 @@ def stress_figures(res, work):
                                     depth_label=z_label.replace("$z", "depth $z"), marks=marks,
                                     title="stresses on the axis x = y = 0")
     depths = np.asarray(block["depths"], dtype=float)
-    text = (f"{depths.size} depths from {fmt(depths.min())} to {fmt(depths.max())} {res.units.of('length')}"
+    text = (f"{depths.size} depths from {fmt(depths.min() / a)} to {fmt(depths.max() / a)} {l_name}"
             f" (down to {fmt(depths.max() / block['scale'])} contact half-widths), every candidate node; "
             "bem.subsurface_stress: the BEM pressure (pyramids on the lattice) convolved with the stresses "
             "under one pyramid, frictionless, each body with its own Poisson ratio.")
