@@ -126,7 +126,7 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
     height : float
         Drawn height of the highest peak relative to the width of the patch.
     columns : int, optional
-        Panels per row (default: all in one row up to 3, then rows of 3; 2 x 2 for 4).
+        Panels per row (default: 2, so that a panel fills half the width of a report page).
     panel_inches : (float, float)
         Size of one panel [inch].
     section : bool
@@ -142,7 +142,7 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
     data = [(label, _nodal(d)) for label, d in panels]
     vmax = max(float(p.max()) for _, (_, _, p) in data) / p0
     n = len(data)
-    ncol = columns or (2 if n == 4 else min(n, 3))
+    ncol = columns or min(n, 2)
     nrow = math.ceil(n / ncol)
     lab = axis_labels(labels)
     lab.setdefault("p_short", lab["p"].replace("contact pressure ", ""))

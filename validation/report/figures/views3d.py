@@ -52,7 +52,11 @@ def _screenshot(plotter):
         plotter.close()
     if img.ndim != 3 or float(img.std()) < 1.0:
         raise RuntimeError("the off-screen rendering is blank")
-    return img[:, :, :3]
+    img = img[:, :, :3]
+    drawn = np.nonzero((img < 250).any(axis=2))
+    pad = max(4, img.shape[0] // 40)  # cropped to what was drawn, with a margin
+    top, left = max(drawn[0].min() - pad, 0), max(drawn[1].min() - pad, 0)
+    return img[top: drawn[0].max() + pad + 1, left: drawn[1].max() + pad + 1]
 
 
 def _camera(plotter, elevation, azimuth, zoom=1.0):
@@ -102,13 +106,13 @@ def render_surface(pv, xs, ys, zs, triangles, *, clim, size, ztop, labels, secti
         xa, za = section
         pl.add_mesh(pv.lines_from_points(np.column_stack([xa, np.zeros_like(xa), za * k + 1e-3 * ztop])),
                     color="black", line_width=3)
-    font = max(10, int(size[1] / 24))
+    font = max(10, int(size[1] / 20))
     z0, z1 = z_range or clim
     pl.show_bounds(bounds=[xs.min(), xs.max(), ys.min(), ys.max(), 0.0, ztop],
                    axes_ranges=[xs.min(), xs.max(), ys.min(), ys.max(), z0, z1], xtitle=labels[0],
                    ytitle=labels[1], ztitle=labels[2], color="black", font_size=font, location="outer",
                    n_xlabels=3, n_ylabels=3, n_zlabels=2, fmt="%.2g", grid=False, ticks="outside")
-    _camera(pl, 30.0, -35.0, 1.0)
+    _camera(pl, 30.0, -35.0, 0.85)
     return _screenshot(pl)
 
 
