@@ -256,7 +256,8 @@ def write_stress_vtu(path, result, upper=None, lower=None):
     result : bem.ContactResult
         The BEM solution the stresses were computed from (its lattice and nodes).
     upper, lower : bem.SubsurfaceStress, optional
-        Stresses of the upper body (cell data ``body = 1``) and of the lower one (``body = 2``),
+        Stresses of the upper body (cell data ``body = 0``) and of the lower one (``body = 1``),
+        numbered as in the FEM reference's field file ``fem_field.vtu``,
         on the candidate nodes at increasing depths [length].
 
     Returns
@@ -271,7 +272,7 @@ def write_stress_vtu(path, result, upper=None, lower=None):
     """
     from .stress import principal_stresses
 
-    bodies = [(body, sign, st) for body, sign, st in ((1, 1.0, upper), (2, -1.0, lower)) if st is not None]
+    bodies = [(body, sign, st) for body, sign, st in ((0, 1.0, upper), (1, -1.0, lower)) if st is not None]
     rows, cols, nodes = volume_grid(result.lattice, max(st.z.size for *_, st in bodies), len(bodies))
     flat = nodes.ravel()
     points, data, cells, body_id = [], [], [], []

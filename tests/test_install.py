@@ -28,11 +28,9 @@ NOT_CORE = ("matplotlib", "gmsh", "skfem", "vtk", "pyvista", "PIL", "dask", "dis
 DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "tqdm": "tqdm", "meshio": "meshio", "tomli_w": "tomli-w",
                  "gmsh": "gmsh", "skfem": "scikit-fem", "matplotlib": "matplotlib", "PIL": "pillow",
                  "dask": "dask", "distributed": "dask", "cupy": "cupy-cuda12x", "pytest": "pytest",
-                 "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography"}
+                 "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography",
+                 "pyvista": "pyvista"}
 OWN = ("bem", "fem_reference", "validation", "tests")
-#: pyvista/vtk are no dependency: only the 3-D figures still use them until they are redrawn
-#: with matplotlib (then this allowance goes)
-UNDECLARED_3D = {"pyvista", "vtkmodules", "vtk"}
 
 
 def _name(requirement):
@@ -77,12 +75,10 @@ def test_extras_layout():
     assert _extra("report") == {"matplotlib", "pillow"}
     assert _extra("dask") == {"dask"}
     assert _extra("gpu") == {"cupy-cuda12x"}
+    assert _extra("3d") == {"pyvista"}
     assert _extra("rough") == {"surfacetopography"}
     assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask") | _extra("rough")
-    assert _extra("test") == _extra("all") | {"pytest", "html5lib", "pyyaml"}
-    everything = {_name(r) for r in PROJECT["dependencies"]} | {d for e in PROJECT["optional-dependencies"]
-                                                                for d in _extra(e)}
-    assert not everything & {"pyvista", "vtk"}, "pyvista/vtk are not dependencies any more"
+    assert _extra("test") == _extra("all") | _extra("3d") | {"pytest", "html5lib", "pyyaml"}
 
 
 def test_every_import_is_declared():
@@ -90,16 +86,11 @@ def test_every_import_is_declared():
     declared = {_name(r) for r in PROJECT["dependencies"]}
     extra = {d for e in PROJECT["optional-dependencies"] for d in _extra(e)}
     for package in ("bem", "fem_reference", "validation"):
-        for module in _imports(ROOT / package, skip=("figures_3d.py",)):
+        for module in _imports(ROOT / package):
             assert module in DISTRIBUTIONS, f"{package} imports {module!r}: declare it in pyproject.toml"
             assert DISTRIBUTIONS[module] in declared | extra, f"{package} imports undeclared {module!r}"
     test_needs = declared | _extra("test")
-    figures_3d = ROOT / "validation" / "report" / "figures_3d.py"
-    if figures_3d.exists():
-        assert {m for m in _imports(figures_3d) if DISTRIBUTIONS.get(m) not in declared | extra} <= UNDECLARED_3D
     for module in _imports(ROOT / "tests") | _imports(ROOT / "docs"):
-        if module in UNDECLARED_3D:  # optional: the tests that use them skip without them
-            continue
         assert DISTRIBUTIONS.get(module) in test_needs, f"tests or docs import {module!r}, not in [test]"
 
 

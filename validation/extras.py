@@ -8,6 +8,8 @@ extra     packages (import names)     needed by
 ========  ==========================  ============================================
 fem       gmsh, scikit-fem (skfem)    a scene with ``[fem]``, the studies, the paper report
 report    matplotlib, pillow (PIL)    ``contactlab report``, :mod:`validation.report`
+3d        pyvista                     the reports' 3-D views, rendered off-screen
+                                      (optional: matplotlib draws them without it)
 dask      dask[distributed]           ``contactlab sweep --scheduler ADDRESS``
                 (dask.distributed)
 rough     SurfaceTopography           :mod:`bem.rough`: instrument files, self-affine surfaces
@@ -28,8 +30,8 @@ from bem.errors import InputError
 __all__ = ["EXTRAS", "MissingExtraError", "require", "missing"]
 
 #: extra -> import names of the packages it installs
-EXTRAS = {"fem": ("gmsh", "skfem"), "report": ("matplotlib", "PIL"), "dask": ("dask.distributed",),
-          "rough": ("SurfaceTopography",), "gpu": ("cupy",)}
+EXTRAS = {"fem": ("gmsh", "skfem"), "report": ("matplotlib", "PIL"), "3d": ("pyvista",),
+          "dask": ("dask.distributed",), "rough": ("SurfaceTopography",), "gpu": ("cupy",)}
 _DIST = {"skfem": "scikit-fem", "PIL": "pillow", "dask.distributed": "dask[distributed]", "cupy": "cupy-cuda12x"}
 _SYSTEM_LIBS = ("On Debian/Ubuntu: apt-get install libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 "
                 "libgomp1 (see the README's set-up).")

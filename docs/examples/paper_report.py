@@ -28,15 +28,19 @@ def main(argv=None):
     parser.add_argument("--out", default="reports/paper", help="report directory (default: reports/paper)")
     parser.add_argument("--quick", action="store_true", help="coarse lattice and short sweeps (preview)")
     parser.add_argument("--no-fem", action="store_true", help="skip the FEM reference and the resolution study")
+    parser.add_argument("-v", "--verbose", action="store_true", help="log progress details (INFO), scikit-fem's too")
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
-    for name in ("bem", "fem_reference", "validation.run"):
-        logging.getLogger(name).setLevel(logging.ERROR)  # expected warnings of the diverging paper method
+    level = logging.INFO if args.verbose else logging.WARNING
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    for name in ("bem", "fem_reference", "validation", "skfem"):
+        logging.getLogger(name).setLevel(level)
 
     from validation.report import report_paper_problem
 
     built = report_paper_problem(args.out, quick=args.quick, fem=not args.no_fem)
     print(f"{built.html}\n{built.markdown}\n{len(built.figures)} figures in {built.out_dir / 'figures'}")
+    for note in getattr(built, "notes", ()):
+        print(f"note: {note}")
     return 0
 
 

@@ -48,6 +48,13 @@ def _image(path):
         return np.asarray(img.convert("RGB"), dtype=float)
 
 
+def section_field_size():
+    """Size of :func:`plot_section_field`'s figure [inch]: with pyvista its 3-D view is beside the section."""
+    from validation.report.figures.views3d import pyvista_or_none
+
+    return (5.8, 4.6) if pyvista_or_none() is None else (10.4, 4.6)
+
+
 def check_png(path, size_in=None, *, floor=8.0):
     """A real PNG, of ``size_in`` inches at DPI when given, with visible content."""
     assert os.path.isfile(path)
@@ -154,8 +161,9 @@ def test_convergence_png(cases, tmp_path):
 def test_pressure_surfaces_3d_png(cases, tmp_path):
     r = cases["er_vc"]
     panels = [("smooth", cases["smooth"]), ("k = 1", (r.x, r.y, r.history["p"][0])), ("final", r)]
-    img = check_png(f3d.plot_pressure_surfaces(panels, tmp_path / "s.png", p0=P0, a=A, title="t"))
-    assert img.shape[1] > 2 * img.shape[0]  # three panels side by side
+    # two panels per row (each half a report page wide): two rows of 3.3 x 2.8 in, the colour bar, the title
+    check_png(f3d.plot_pressure_surfaces(panels, tmp_path / "s.png", p0=P0, a=A, title="t"),
+              (3.3 * 2 + 0.9, 2.8 * 2 + 0.35))
 
 
 def test_pressure_surface_without_axis_nodes(tmp_path):
@@ -250,7 +258,7 @@ def test_von_mises_png(tmp_path):
     assert vm[k] / P0 == pytest.approx(0.62, abs=0.03)
     assert abs(z[k]) / A == pytest.approx(0.48, abs=0.12) and r[k] / A < 0.25
     check_png(plot_section_field(r, z, tri, vm, tmp_path / "vm.png", a=A, scale=P0, label="von Mises",
-                                 contact_radius=fem.contact_radius), (5.8, 4.6))
+                                 contact_radius=fem.contact_radius), section_field_size())
 
 
 # ---------------------------------------------------------------- inputs untouched, atomic writes
@@ -303,3 +311,31 @@ def test_bad_scales_raise(cases, tmp_path):
     with pytest.raises(InputError, match="curves"):
         fpr.plot_pressure_profiles([], tmp_path / "z.png", p0=P0, a=A)
     assert not (tmp_path / "z.png").exists()
+
+
+def _drawn_lines(monkeypatch, module):
+    """Every figure ``module.save_figure`` writes: its first axes' lines as (marker, x, y)."""
+    drawn, real = [], module.save_figure
+
+    def spy(fig, path, **kwargs):
+        drawn.append([(ln.get_marker(), np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float))
+                      for ln in fig.axes[0].lines])
+        return real(fig, path, **kwargs)
+
+    monkeypatch.setattr(module, "save_figure", spy)
+    return drawn
+
+
+def test_tabulated_layer_law_shows_its_points(tmp_path, monkeypatch):
+    from bem.layers import Linear, Tabulated
+    from validation.report.figures import profiles
+    from validation.report.figures.run import Scaled
+
+    p, w = np.array([0.0, 1e6, 2e6, 4e6, 8e6]), np.array([0.0, 0.5e-6, 0.8e-6, 1.0e-6, 1.1e-6])
+    drawn = _drawn_lines(monkeypatch, profiles)
+    check_png(profiles.plot_layer_laws([("table", Scaled(Tabulated(p, w), 1e6, 1e-6)), ("linear", Linear(1.0))],
+                                       tmp_path / "law.png", p_max=5.0, p_unit="MPa", w_unit="µm"))
+    points = [(x, y) for marker, x, y in drawn[0] if marker == "o"]
+    assert len(points) == 1, "the table's points, and no markers on the formula law"
+    np.testing.assert_allclose(points[0][0], [0.0, 1.0, 2.0, 4.0])  # in view: p <= p_max, in MPa
+    np.testing.assert_allclose(points[0][1], [0.0, 0.5, 0.8, 1.0])  # in µm

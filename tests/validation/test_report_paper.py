@@ -19,11 +19,23 @@ from .test_report_figures import check_png
 
 
 STAGES_SEEN = []
+#: the solver's warnings while the paper problem runs
+SOLVER_WARNINGS = []
+
+
+class _Collect(logging.Handler):
+    def emit(self, record):
+        SOLVER_WARNINGS.append(record.getMessage())
 
 
 @pytest.fixture(scope="module")
 def paper():
-    return run_paper_problem(quick=True, progress=STAGES_SEEN.append)
+    logger, handler = logging.getLogger("bem"), _Collect(logging.WARNING)
+    logger.addHandler(handler)
+    try:
+        return run_paper_problem(quick=True, progress=STAGES_SEEN.append)
+    finally:
+        logger.removeHandler(handler)
 
 
 @pytest.fixture(scope="module")
@@ -120,6 +132,47 @@ def test_paper_methods_and_validation(paper):
     assert bem_err[-1] < bem_err[0] and fem_err[-1] < fem_err[0]
 
 
+def test_expected_augmented_gap_stalls_are_one_note_not_bare_warnings(paper, report):
+    from validation.report.documents.paper import expected_stalls
+
+    stalled = [r for r in paper.stability if r["method"].startswith("augmented gap") and r["status"] != "converged"]
+    assert stalled, "the quick paper problem stalls the augmented gap method (its documented behaviour)"
+    assert not [m for m in SOLVER_WARNINGS if m.startswith("augmented_gap")]
+    (note,) = expected_stalls(paper)
+    assert "expected, documented behaviour of the augmented gap method" in note
+    assert f"in {len(stalled)} of its" in note and all(r["law"] in note for r in stalled)
+    anchor = re.search(r"report\.html#([a-z-]+)", note).group(1)
+    assert f'id="{anchor}"' in report.html.read_text(encoding="utf-8")
+
+
+def test_report_command_prints_the_notes(monkeypatch, tmp_path):
+    from validation.report.render import BuiltReport
+
+    from .conftest import cli
+
+    built = BuiltReport(tmp_path, tmp_path / "report.html", tmp_path / "report.md", (), notes=("stall expected",))
+    monkeypatch.setattr(command, "build_from_args", lambda args, progress=None: built)
+    code, out, err = cli("report", "paper", "--out", tmp_path)
+    assert code == 0 and "note: stall expected" in out.splitlines() and err == ""
+
+
+def test_scikit_fem_info_lines_only_when_verbose(monkeypatch, tmp_path):
+    from validation.report.render import BuiltReport
+
+    from .conftest import cli
+
+    def build(args, progress=None):
+        logging.getLogger("skfem.assembly").info("assembling a form")
+        logging.getLogger("skfem.assembly").warning("a real problem")
+        return BuiltReport(tmp_path, tmp_path / "report.html", tmp_path / "report.md", ())
+
+    monkeypatch.setattr(command, "build_from_args", build)
+    _code, _out, err = cli("report", "paper", "--out", tmp_path)
+    assert "a real problem" in err and "assembling" not in err
+    _code, _out, err = cli("-v", "report", "paper", "--out", tmp_path)
+    assert "a real problem" in err and "assembling" in err
+
+
 def test_main_dispatches_paper(monkeypatch, tmp_path):
     calls = []
 
@@ -156,13 +209,16 @@ def test_example_script_passes_its_options(monkeypatch, tmp_path):
     monkeypatch.setattr("validation.report.report_paper_problem", fake)
     script = Path(__file__).parents[2] / "docs" / "examples" / "paper_report.py"
     ns = runpy.run_path(str(script), run_name="example")
-    levels = {name: logging.getLogger(name).level for name in ("bem", "fem_reference", "validation.run")}
+    levels = {name: logging.getLogger(name).level for name in ("bem", "fem_reference", "validation", "skfem")}
     try:
         assert ns["main"](["--out", str(tmp_path), "--quick", "--no-fem"]) == 0
+        assert logging.getLogger("skfem").getEffectiveLevel() == logging.WARNING
+        assert ns["main"](["--out", str(tmp_path), "--verbose"]) == 0
+        assert logging.getLogger("skfem").getEffectiveLevel() == logging.INFO
     finally:
         for name, level in levels.items():
             logging.getLogger(name).setLevel(level)
-    assert calls == [(str(tmp_path), True, False)]
+    assert calls == [(str(tmp_path), True, False), (str(tmp_path), False, True)]
 
 
 def test_paper_report_tells_its_stages(paper, monkeypatch, tmp_path):
@@ -200,3 +256,25 @@ def test_paper_stresses_every_layer_lowers_the_subsurface_maximum(paper):
     # the linear and root layers flatten the pressure most: the maximum moves deeper
     assert st["linear Winkler"].depth_of_max > smooth.depth_of_max
     assert st["root"].depth_of_max > smooth.depth_of_max
+
+
+def test_quick_report_is_marked_a_coarse_preview(paper, monkeypatch, tmp_path):
+    from validation.report.documents import paper as paper_report
+    from validation.report.render import Section
+
+    monkeypatch.setattr(paper_report, "run_paper_problem", lambda *, quick, fem, progress: paper)
+    monkeypatch.setattr(paper_report, "paper_sections", lambda res, work: [Section("x", text="y")])
+    for quick in (True, False):
+        built = paper_report.report_paper_problem(tmp_path / f"q{quick}", quick=quick)
+        heading = re.search(r"<h1>(.*?)</h1>", built.html.read_text(encoding="utf-8")).group(1)
+        title = re.search(r"<title>(.*?)</title>", built.html.read_text(encoding="utf-8")).group(1)
+        md_heading = built.markdown.read_text(encoding="utf-8").splitlines()[0]
+        for text in (heading, title, md_heading):
+            assert ("COARSE PREVIEW" in text) == quick, text
+
+
+def test_one_name_for_the_hertz_peak(report):
+    """The paper calls Hertz's peak p0: the figures of its validation section too (no p_H)."""
+    for text in (report.markdown.read_text(encoding="utf-8"), report.html.read_text(encoding="utf-8")):
+        assert "p0" in text and "p_H" not in text
+    assert "Normalised by Hertz's peak p_0" in report.markdown.read_text(encoding="utf-8")

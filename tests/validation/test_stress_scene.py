@@ -2,6 +2,8 @@
 
 import math
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -112,6 +114,22 @@ def test_result_json_holds_the_maxima_per_body(stress_run):
     assert (out / "result.json").is_file() and outcome.result["files"]["stress_field"] == "stress_field.vtu"
 
 
+def test_stress_field_file_is_documented(stress_run):
+    """docs/results.md lists the file and describes each of its fields, and its body numbering."""
+    import re
+
+    import meshio
+
+    _outcome, out = stress_run
+    mesh = meshio.read(out / "stress_field.vtu")
+    text = (Path(__file__).parents[2] / "docs" / "results.md").read_text(encoding="utf-8")
+    assert re.search(r"^\| `stress_field.vtu` \|", text, re.M)
+    paragraph = text[text.index("`stress_field.vtu` holds"):].split("\n\n")[0]
+    for name in [*mesh.point_data, *mesh.cell_data]:
+        assert f"`{name}`" in paragraph, name
+    assert "`body` numbered as in `fem_field.vtu` (0 upper,\n1 lower)" in paragraph
+
+
 def test_stress_field_file_reads_back_with_meshio(stress_run):
     import meshio
 
@@ -124,8 +142,10 @@ def test_stress_field_file_reads_back_with_meshio(stress_run):
     per_body = run.depths.size * nodes.size
     assert mesh.points.shape == (2 * per_body, 3)
     hexa = mesh.cells_dict["hexahedron"]
-    assert set(np.unique(mesh.cell_data_dict["body"]["hexahedron"])) == {1, 2}
+    body = mesh.cell_data_dict["body"]["hexahedron"]
     p = mesh.points[hexa].astype(float)  # every cell has a positive volume (first face lowest)
+    centre = p[..., 2].mean(axis=1)  # numbered as in fem_field.vtu: 0 upper (z > 0), 1 lower (z < 0)
+    assert set(np.unique(body)) == {0, 1} and np.all(centre[body == 0] > 0) and np.all(centre[body == 1] < 0)
     volume = np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 3] - p[:, 0]), p[:, 4] - p[:, 0])
     assert np.all(volume > 0)
     flat = nodes.ravel()

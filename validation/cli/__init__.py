@@ -117,7 +117,8 @@ def _log_to_stderr(verbose):
     """Show the library's log records on the current stderr while a command runs."""
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("contactlab: %(levelname)s: %(message)s"))
-    loggers = [logging.getLogger(name) for name in ("bem", "fem_reference", "validation")]
+    # the packages' loggers, and scikit-fem's (its INFO lines only with --verbose)
+    loggers = [logging.getLogger(name) for name in ("bem", "fem_reference", "validation", "skfem")]
     saved = [(lg.level, lg.propagate) for lg in loggers]
     for lg in loggers:
         lg.addHandler(handler)

@@ -81,4 +81,6 @@ def run(args):
         bar.close()
     print(f"report written to {built.html}")
     print(f"  (also {built.markdown.name} and {len(built.figures)} figures in {built.out_dir / 'figures'}{os.sep})")
+    for note in built.notes:
+        print(f"note: {note}")
     return 0

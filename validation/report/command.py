@@ -162,4 +162,6 @@ def main(args):
     """Write the report of ``args.target`` (:func:`build_from_args`); returns the exit status 0."""
     built = build_from_args(args)
     log.info("report written: %s and %s (%d figures)", built.html, built.markdown, len(built.figures))
+    for note in getattr(built, "notes", ()):
+        log.info("note: %s", note)
     return 0

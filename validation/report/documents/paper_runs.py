@@ -14,6 +14,7 @@ preview (``n = 8``) and the full report (``n = 20``) solve the same problem on t
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import logging
 import math
@@ -186,6 +187,26 @@ def _sweeps(run, res, quick):
     res.sweep_c = [(float(t), run("bilinear", layer__alpha_c=float(t)).bem) for t in angles]
 
 
+class _AugmentedGapWarnings(logging.Filter):
+    """Holds back the solver's warning of an augmented gap run that does not converge: the
+    stability table records it, and :func:`validation.report.documents.paper.expected_stalls`
+    says once that it is the expected behaviour on this problem."""
+
+    def filter(self, record):
+        return not (record.levelno == logging.WARNING and record.getMessage().startswith("augmented_gap: "))
+
+
+@contextlib.contextmanager
+def _stability_runs():
+    """The stability runs: the augmented gap's non-convergence warnings of the solver held back."""
+    logger, quiet = logging.getLogger("bem.solve"), _AugmentedGapWarnings()
+    logger.addFilter(quiet)
+    try:
+        yield
+    finally:
+        logger.removeFilter(quiet)
+
+
 def _methods(run, res, quick):
     """Iteration histories (Fig. 6, 8, 10, 11) and the stability table."""
     er = {"layer__alpha_a": ALPHA_A_ITERATIONS}
@@ -206,7 +227,8 @@ def _methods(run, res, quick):
                (f"augmented gap, omega = {AG_RELAXATION}", relaxed)]
     for law, case, params in laws:
         for label, opts in methods:
-            r = run(case, **params, **opts).bem
+            with _stability_runs():
+                r = run(case, **params, **opts).bem
             res.stability.append({"law": law, "method": label, "status": _status(r), "iterations": r.iterations,
                                   "p_max/p0": r.p_max / res.p0, "kkt_residual": r.kkt_residual,
                                   "wall_time_s": r.wall_time_s, "message": r.message})

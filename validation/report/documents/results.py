@@ -33,7 +33,7 @@ from bem.checks import InputError, check_choice
 from ...units import Units, parse_units
 
 __all__ = ["RunResults", "load_results", "results_of", "units_of", "read_json", "is_number", "dimensionless_for",
-           "UNIT_CHOICES"]
+           "UNIT_CHOICES", "file_inside"]
 
 log = logging.getLogger(__name__)
 
@@ -75,6 +75,9 @@ class RunResults:
     dimensionless : bool
         Draw lengths and pressures divided by the contact's scales (:meth:`scales`) instead of
         in the scene's units (:func:`validation.report.render.style.report_unit`).
+    hertz_peak : str
+        The name of Hertz's peak pressure in a dimensionless report (``"p_H"``; the paper
+        report calls it ``"p_0"``, as the paper does): one name for it throughout a report.
     """
 
     directory: Path
@@ -84,6 +87,7 @@ class RunResults:
     bem_field: tuple | None = None
     fem_field: tuple | None = None
     dimensionless: bool = False
+    hertz_peak: str = "p_H"
 
     def section(self, name):
         """A table of ``scene.toml`` (empty dict when absent)."""
@@ -139,7 +143,7 @@ class RunResults:
     def scales(self):
         """``(p0, a, p_name, a_name)`` of a dimensionless report, or ``None`` (scene units).
 
-        Hertz's peak and radius (``p_H``, ``a_H``) when the run recorded them, else the BEM peak
+        Hertz's peak and radius (:attr:`hertz_peak`, ``a_H``) when the run recorded them, else the BEM peak
         pressure and the contact radius (or half-width along x): ``p_{max}``, ``a_c``.
         """
         if not self.dimensionless:
@@ -147,7 +151,7 @@ class RunResults:
         sc = self.get("scales") or {}
         p0, a = sc.get("p_hertz"), sc.get("a_hertz")
         if p0 and a and p0 > 0 and a > 0:
-            return float(p0), float(a), "p_H", "a_H"
+            return float(p0), float(a), self.hertz_peak, "a_H"
         p0, a = self.data.get("p_max"), self.contact_size
         return (float(p0), float(a), "p_{max}", "a_c") if p0 and a and p0 > 0 and a > 0 else None
 
@@ -160,6 +164,26 @@ def read_json(path):
         raise InputError(f"{path} is not allowed: it must be a readable JSON file ({exc}).") from None
 
 
+def file_inside(directory, name, entry):
+    """``directory / name`` when it resolves to a path inside ``directory``, else ``None``.
+
+    A report reads only files of the folder it reports: a name stored in a result or a sweep
+    summary (``entry``, e.g. ``files.scene``) that is absolute, climbs out with ``..`` or goes
+    through a link to elsewhere is skipped with a warning naming the entry.
+    """
+    root = Path(directory).resolve()
+    try:
+        path = (root / str(name)).resolve()
+    except (OSError, RuntimeError, ValueError) as exc:
+        log.warning("skipping %s = %r: it cannot be resolved (%s)", entry, name, exc)
+        return None
+    if not path.is_relative_to(root) or path == root:
+        log.warning("skipping %s = %r: it points outside %s, and a report reads only the files inside its folder",
+                    entry, str(name), root)
+        return None
+    return path
+
+
 def _read_scene(path):
     try:
         with path.open("rb") as fh:
@@ -170,8 +194,9 @@ def _read_scene(path):
 
 
 def _field(path, read):
-    """``read(path)``, or None when the file is missing or unreadable (a report without that figure)."""
-    if not path.is_file():
+    """``read(path)``, or None when the file is missing, outside the folder or unreadable (a report
+    without that figure)."""
+    if path is None or not path.is_file():
         return None
     try:
         return read(path)
@@ -221,23 +246,24 @@ def load_results(directory, *, units="auto"):
     if not str(data.get("schema", "")).startswith("contactlab.result/"):
         log.warning("%s has schema %r: it was not written by contactlab run; parts may be missing",
                     main, data.get("schema"))
-    files = {**_FILES, **{k: str(v) for k, v in (data.get("files") or {}).items()}}
-    scene = _read_scene(directory / files["scene"])
+    stored = data.get("files") if isinstance(data.get("files"), Mapping) else {}
+    files = {k: file_inside(directory, v, f"files.{k}" if k in stored else k)
+             for k, v in {**_FILES, **{k: str(v) for k, v in stored.items()}}.items()}
+    scene = _read_scene(files["scene"]) if files["scene"] is not None else {}
     parsed = units_of(data, (scene.get("scene") or {}).get("units"))
-    fem = _field(directory / files["fem_field"], section_field_from_vtu) if isinstance(data.get("fem"), Mapping) \
-        else None
+    fem = _field(files["fem_field"], section_field_from_vtu) if isinstance(data.get("fem"), Mapping) else None
     return RunResults(directory=directory, data=dict(data), scene=scene, units=parsed,
-                      bem_field=_field(directory / files["bem_field"], _bem_field), fem_field=fem,
+                      bem_field=_field(files["bem_field"], _bem_field), fem_field=fem,
                       dimensionless=dimensionless_for(units, parsed))
 
 
-def results_of(outcome, *, units="auto", directory="."):
+def results_of(outcome, *, units="auto", directory=".", hertz_peak="p_H"):
     """The :class:`RunResults` of a run in memory (:class:`validation.run.RunOutcome`), as
-    :func:`load_results` would read them once written."""
+    :func:`load_results` would read them once written (``hertz_peak``: :attr:`RunResults.hertz_peak`)."""
     from ..figures.fields import von_mises_of
 
     res = outcome.bem
     return RunResults(directory=Path(directory), data=outcome.result, scene=outcome.scene.raw,
                       units=outcome.scene.units, bem_field=(res.x, res.y, res.p),
                       fem_field=None if outcome.fem is None else von_mises_of(outcome.fem),
-                      dimensionless=dimensionless_for(units, outcome.scene.units))
+                      dimensionless=dimensionless_for(units, outcome.scene.units), hertz_peak=hertz_peak)

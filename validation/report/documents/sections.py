@@ -20,6 +20,7 @@ from ...provenance import display_path
 from ..figures import FIGURES
 from ..figures.run import stress_view
 from ..render import Progress, Section, Table, draw_and_build, fmt
+from ..render.content import fmt_distinct
 from ..render.style import method_text
 from .problem import scene_section
 from .results import is_number
@@ -62,7 +63,8 @@ def results_rows(res):
         [("closed form", res.get("analytic"))] if res.get("analytic") else [])
 
     def cells(key, scale=1.0):
-        return [fmt(p.get(key) / scale) if is_number(p.get(key)) else "-" for _, p in parts]
+        """The solvers' values of ``key``, with the digits that tell them apart (:func:`fmt_distinct`)."""
+        return fmt_distinct([float(p.get(key)) / scale if is_number(p.get(key)) else "-" for _, p in parts])
 
     rows = [(label, *cells(key), res.units.of(kind)) for key, label, kind in _QUANTITIES
             if any(is_number(p.get(key)) for _, p in parts)]

@@ -23,7 +23,7 @@ from ..figures.run import PAD, axis_label, contact_edge, scale
 from ..render import Figure, Progress, Section, Table, draw_and_build, fmt
 from ..render.style import report_unit
 from .problem import scene_section
-from .results import UNIT_CHOICES, RunResults, dimensionless_for, is_number, read_json, units_of
+from .results import UNIT_CHOICES, RunResults, dimensionless_for, file_inside, is_number, read_json, units_of
 
 __all__ = ["Sweep", "is_sweep_dir", "load_sweep", "sweep_section", "sweep_sections", "report_sweep_dir"]
 
@@ -63,10 +63,11 @@ def load_sweep(directory, *, units="auto"):
     if not isinstance(summary, dict) or not isinstance(summary.get("points"), list):
         raise InputError(f"{directory / 'summary.json'} is not allowed: it must hold the points of a sweep.")
     points = []
-    for row in summary["points"]:
+    for i, row in enumerate(summary["points"]):
         res = None
-        if row.get("file") and (directory / row["file"]).is_file():
-            point = read_json(directory / row["file"])
+        path = file_inside(directory, row["file"], f"points[{i}].file") if row.get("file") else None
+        if path is not None and path.is_file():
+            point = read_json(path)
             data = dict(point.get("result") or {})
             u = units_of(data, summary.get("units"))
             res = RunResults(directory=directory, data=data, scene=dict(point.get("scene") or {}), units=u,

@@ -9,14 +9,18 @@ and peak, or display units); other conventions: :mod:`validation.report.figures`
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from ..render.style import axis_labels, color_for, new_figure, save_figure
+from ..render.style import DPI, axis_labels, color_for, new_figure, save_figure
 
 __all__ = ["plot_section_field", "von_mises_of", "section_field_from_vtu", "plot_stress_section",
            "plot_depth_profiles"]
+
+log = logging.getLogger(__name__)
 
 
 def _mirrored(r, z, triangles, values, a, scale, keep):
@@ -29,9 +33,29 @@ def _mirrored(r, z, triangles, values, a, scale, keep):
     return triang, np.concatenate([values, values]) / scale
 
 
+def _volume_image(r, z, tri, values, *, window, vmax, contact_radius, size):
+    """pyvista's view of the field below the contact (:func:`.views3d.render_revolved_field`), or ``None``."""
+    from .views3d import pyvista_or_none, render_revolved_field
+
+    pv = pyvista_or_none()
+    if pv is None:
+        return None
+    try:
+        return render_revolved_field(pv, r, z, tri, values, window=window, clim=(0.0, vmax), size=size,
+                                     contact_radius=contact_radius)
+    except (RuntimeError, ValueError, OSError) as exc:
+        log.warning("pyvista cannot render the 3-D view of the stress field (%s): the section alone is drawn", exc)
+        return None
+
+
 def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window=3.0, contact_radius=None,
                        title=None, labels=None, length_unit=None):
     """A scalar field on an (r, z) triangulation, mirrored about the axis for readability.
+
+    With the ``[3d]`` extra (pyvista, :mod:`.views3d`) a left panel shows the lower body
+    (``z <= 0``) in 3-D: the section revolved about the axis, a quarter cut away to show the
+    field under the contact, the contact patch on top, in the same colours. Without it the
+    section alone is drawn.
 
     Parameters
     ----------
@@ -63,7 +87,18 @@ def plot_section_field(r, z, triangles, values, path, *, a, scale, label, window
         raise InputError("no triangle lies in the window: make window larger.")
     triang, vv = _mirrored(r, z, tri, values, a, scale, near)
     vmax = float(np.percentile(vv[np.unique(triang.triangles)], 99.8))
-    with new_figure((5.8, 4.6), title=title) as (fig, ax):
+    image = _volume_image(r / a, z / a, tri, values / scale, window=window, vmax=vmax, size=(4.4 * DPI, 4.0 * DPI),
+                          contact_radius=None if not contact_radius else contact_radius / a)
+    with new_figure((5.8, 4.6) if image is None else (10.4, 4.6), title=None if image is not None else title,
+                    **({} if image is None else {"ncols": 2, "width_ratios": (4.4, 5.8)})) as (fig, axes):
+        ax = axes if image is None else axes[1]
+        if image is not None:
+            axes[0].imshow(image, interpolation="lanczos")
+            axes[0].set_axis_off()
+            axes[0].set_title("below the contact, a quarter cut away", fontsize=9.5)
+            ax.set_title("(r, z) section", fontsize=9.5)
+            if title:
+                fig.suptitle(title)
         pc = ax.tripcolor(triang, vv, shading="gouraud", cmap="magma", vmin=0.0, vmax=vmax, rasterized=True)
         ax.tricontour(triang, vv, levels=np.linspace(0, vmax, 9)[1:-1], colors="white", linewidths=0.5, alpha=0.6)
         ax.axhline(0.0, color="#00d0ff", lw=1.0, ls="--")

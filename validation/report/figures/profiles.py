@@ -15,7 +15,7 @@ from bem.checks import InputError, check_positive
 from ..render.style import SOLVER_COLORS, axis_labels, color_for, new_figure, save_figure
 
 __all__ = ["axial_section", "section_of", "radial", "contact_edge", "auto_xlim", "curve_style",
-           "plot_pressure_profiles", "plot_profile_comparison", "plot_layer_laws"]
+           "plot_pressure_profiles", "plot_profile_comparison", "plot_layer_laws", "measured_points"]
 
 
 def axial_section(x, y, values, *, tol=None):
@@ -185,8 +185,21 @@ def plot_profile_comparison(curves, path, *, p0, a, reference=None, title=None, 
         return save_figure(fig, path)
 
 
+def measured_points(layer):
+    """``(p, w)``: the points a tabulated law interpolates (``layer.measured()`` when it has one,
+    e.g. a law drawn in display units), or ``None`` for a law given by a formula."""
+    if layer is None:
+        return None
+    if hasattr(layer, "measured"):
+        return layer.measured()
+    params = layer.to_dict() if hasattr(layer, "to_dict") else {}
+    if params.get("law") != "tabulated":
+        return None
+    return np.asarray(params["p"], dtype=float), np.asarray(params["w"], dtype=float)
+
+
 def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, marks=()):
-    """The layer laws ``w(p)`` on one plot (paper Fig. 4 b-d).
+    """The layer laws ``w(p)`` on one plot (paper Fig. 4 b-d); a tabulated law's points as markers.
 
     Parameters
     ----------
@@ -208,8 +221,16 @@ def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, mark
         for i, (label, layer) in enumerate(laws):
             w = np.zeros_like(p) if layer is None else np.asarray(layer.w(p), dtype=float)
             w_top = max(w_top, float(np.max(w, initial=0.0)))
-            ax.plot(p, w, color=color_for("smooth" if layer is None else getattr(layer, "law", None), i),
-                    label=label, lw=max(3.0 - 0.45 * i, 1.2), linestyle="--" if layer is None else "-")
+            color = color_for("smooth" if layer is None else getattr(layer, "law", None), i)
+            ax.plot(p, w, color=color, label=label, lw=max(3.0 - 0.45 * i, 1.2),
+                    linestyle="--" if layer is None else "-")
+            points = measured_points(layer)
+            if points is not None:
+                shown = points[0] <= p_max
+                ax.plot(points[0][shown], points[1][shown], "o", color=color, mfc="white", mew=1.4, ms=5.5,
+                        clip_on=False, label=f"{label}: the table's points ({int(shown.sum())} of {points[0].size} "
+                                             "in view)")
+                w_top = max(w_top, float(np.max(points[1][shown], initial=0.0)))
         for k, (label, value) in enumerate(marks):
             ax.axvline(value, color="#666666", lw=0.9, ls=":")
             right = value > 0.6 * p_max  # label on the left of a line near the right border

@@ -144,6 +144,13 @@ class Scaled:
     def w(self, p):
         return self.layer.w(p * self.pf) / self.wf
 
+    def measured(self):
+        """The tabulated law's points in display units, or ``None``."""
+        from .profiles import measured_points
+
+        points = measured_points(self.layer)
+        return None if points is None else (points[0] / self.pf, points[1] / self.wf)
+
 
 def layer_law(res, work):
     """The layer law w(p) the solver used over ``0 .. 1.25 max(p_max, p_cr, p_star)``, its kinks marked."""
@@ -165,7 +172,9 @@ def layer_law(res, work):
                            title="interface layer law: closure $w(p)$ under the pressure $p$")
     return Figure(path, f"The layer law w(p) used by the solver ({params['law']}), rebuilt from the run's result with "
                         "bem.layers.from_dict and evaluated at 200 pressures from 0 to 1.25 times the largest of the "
-                        "computed peak pressure and the law's kink pressures (marked).")
+                        "computed peak pressure and the law's kink pressures (marked)"
+                        + ("; the circles are the table's points, between which the law is interpolated."
+                           if params["law"] == "tabulated" else "."))
 
 
 def _reference(res, axis):
@@ -220,7 +229,7 @@ def profiles(res, work):
 
 def _scale_text(view):
     """Caption sentence naming the scales of a dimensionless figure."""
-    if view.p_name.startswith("p_H"):
+    if view.x_name.startswith("a_H"):
         return f"Normalised by Hertz's peak {view.p_name} and radius {view.x_name} of the smooth problem."
     return f"Normalised by the BEM peak pressure {view.p_name} and the contact half-width along x {view.x_name}."
 
@@ -302,16 +311,20 @@ def fem_von_mises(res, work):
                               window=_round_up(window), contact_radius=rc or None, labels=labels,
                               length_unit=None if hertz else (f"${l_name}$" if normalised else l_name),
                               title="FEM reference: von Mises stress in the (r, z) section")
-    return Figure(path, "Von Mises stress of the FEM reference in the axial (r, z) section, mirrored about the "
-                        "axis, from the stresses recovered at the mesh nodes (fem_field.vtu); the thick line "
-                        "marks the contact. " + _fem_how(res))
+    from .views3d import pyvista_or_none
+
+    view = ("Left: the lower body (z <= 0) in 3-D, the section revolved about the axis with a quarter cut away, "
+            "the contact patch outlined in cyan (rendered with pyvista); right: the section. "
+            if pyvista_or_none() is not None else "")
+    return Figure(path, view + "Von Mises stress of the FEM reference in the axial (r, z) section, mirrored about the "
+                               "axis, from the stresses recovered at the mesh nodes (fem_field.vtu); the thick line "
+                               "marks the contact. " + _fem_how(res))
 
 
 def stress_view(res):
-    """``(a, scale, length name, stress name, normalised)`` of the ``stress`` block's figures and tables."""
-    bodies = res.get("stress")["bodies"]
-    a, l_name, normalised = scale(res, "length", max(float(np.max(b["axis"]["z"])) for b in bodies.values()))
-    s, s_name, _ = scale(res, "pressure", max(float(b["max_von_mises"]) for b in bodies.values()))
+    """``(a, scale, length name, stress name, normalised)`` of the ``stress`` block's figures and tables:
+    the units (or scales) of every other figure of the report, one unit per quantity."""
+    (a, l_name, normalised), (s, s_name, _) = scale(res, "length"), scale(res, "pressure")  # as every figure
     return a, s, l_name, s_name, normalised
 
 
@@ -363,7 +376,7 @@ def stress_figures(res, work):
                                     depth_label=z_label.replace("$z", "depth $z"), marks=marks,
                                     title="stresses on the axis x = y = 0")
     depths = np.asarray(block["depths"], dtype=float)
-    text = (f"{depths.size} depths from {fmt(depths.min())} to {fmt(depths.max())} {res.units.of('length')}"
+    text = (f"{depths.size} depths from {fmt(depths.min() / a)} to {fmt(depths.max() / a)} {l_name}"
             f" (down to {fmt(depths.max() / block['scale'])} contact half-widths), every candidate node; "
             "bem.subsurface_stress: the BEM pressure (pyramids on the lattice) convolved with the stresses "
             "under one pyramid, frictionless, each body with its own Poisson ratio.")

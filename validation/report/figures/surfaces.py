@@ -2,22 +2,26 @@
 
 The surface is the piecewise-linear pressure on a Delaunay triangulation of the lattice
 nodes in and around the contact (the lattice is equilateral, so the triangulation is the
-lattice's own), lifted by ``p / p0`` and drawn with matplotlib's mplot3d. Conventions:
+lattice's own), lifted by ``p / p0``; pyvista renders it off-screen when the ``[3d]`` extra
+is installed (:mod:`.views3d`), matplotlib's mplot3d draws it otherwise. Conventions:
 :mod:`validation.report.figures`.
 """
 
 from __future__ import annotations
 
+import logging
 import math
 
 import numpy as np
 
 from bem.checks import InputError, check_positive
 
-from ..render.style import axis_labels, new_figure, save_figure
+from ..render.style import DPI, axis_labels, new_figure, save_figure
 from .profiles import axial_section
 
 __all__ = ["contact_patch", "covered_window", "plot_pressure_surfaces", "plot_contact_map"]
+
+log = logging.getLogger(__name__)
 
 
 def _nodal(data):
@@ -69,6 +73,24 @@ def _surface_panel(ax, xs, ys, ps, tri, *, p0, a, height, vmax, section, lab):
     ax.set_zlabel(lab["p_short"], labelpad=-3)
 
 
+def _rendered(patches, *, p0, a, height, vmax, lab, size):
+    """The pyvista image of every panel, or ``None`` (no pyvista, or it cannot render: mplot3d draws)."""
+    from .views3d import plain_label, pyvista_or_none, render_surface
+
+    pv = pyvista_or_none()
+    if pv is None:
+        return None
+    names = tuple(plain_label(lab[k]) for k in ("x", "y", "p_short"))
+    try:
+        return [render_surface(pv, xs / a, ys / a, ps / p0, tri, clim=(0.0, vmax), size=size, labels=names,
+                               ztop=1.25 * height * vmax,
+                               section=None if sec is None else (sec[0] / a, sec[1] / p0))
+                for _label, xs, ys, ps, tri, sec in patches]
+    except (RuntimeError, ValueError, OSError) as exc:
+        log.warning("pyvista cannot render the 3-D pressure surfaces (%s): drawn with matplotlib", exc)
+        return None
+
+
 def covered_window(x, y):
     """``(x0, x1), (y0, y1)``: the largest axis-parallel rectangle that the triangulation of the
     lattice nodes ``(x, y)`` covers [length].
@@ -90,11 +112,12 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
                            title=None, section=True, labels=None):
     """Isometric 3-D pressure surfaces, one panel per result, on a common colour scale.
 
-    Each panel is the piecewise-linear pressure on the lattice triangles, drawn with
-    matplotlib's mplot3d (orthographic view, axes with ticks and labels, the axial
-    section ``y = 0`` as a black line); one colour bar gives the scale of all panels.
-    The coloured surface is rasterised at the figure's DPI in SVG/PDF output (the axes,
-    ticks and text stay vector).
+    Each panel is the piecewise-linear pressure on the lattice triangles (orthographic view,
+    axes with ticks and labels, the axial section ``y = 0`` as a black line), rendered by
+    pyvista off-screen (lit, smooth-shaded) when the ``[3d]`` extra is installed and drawn
+    with matplotlib's mplot3d otherwise (or when pyvista cannot render); one colour bar gives
+    the scale of all panels. The coloured surface is rasterised at the figure's DPI in
+    SVG/PDF output (the titles, colour bar and text stay vector).
 
     Parameters
     ----------
@@ -103,7 +126,7 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
     height : float
         Drawn height of the highest peak relative to the width of the patch.
     columns : int, optional
-        Panels per row (default: all in one row up to 3, then rows of 3; 2 x 2 for 4).
+        Panels per row (default: 2, so that a panel fills half the width of a report page).
     panel_inches : (float, float)
         Size of one panel [inch].
     section : bool
@@ -119,21 +142,30 @@ def plot_pressure_surfaces(panels, path, *, p0, a, height=0.8, columns=None, pan
     data = [(label, _nodal(d)) for label, d in panels]
     vmax = max(float(p.max()) for _, (_, _, p) in data) / p0
     n = len(data)
-    ncol = columns or (2 if n == 4 else min(n, 3))
+    ncol = columns or min(n, 2)
     nrow = math.ceil(n / ncol)
     lab = axis_labels(labels)
     lab.setdefault("p_short", lab["p"].replace("contact pressure ", ""))
     w, h = panel_inches
+    patches = []
+    for label, (x, y, p) in data:
+        xs, ys, ps, tri = contact_patch(x, y, p)
+        on_axis = np.abs(ys) <= 1e-9 * float(np.abs(xs).max(initial=1.0))
+        patches.append((label, xs, ys, ps, tri, axial_section(xs, ys, ps) if section and on_axis.sum() > 1 else None))
+    images = _rendered(patches, p0=p0, a=a, height=height, vmax=vmax, lab=lab, size=(w * DPI, h * DPI))
     with new_figure((w * ncol + 0.9, h * nrow + (0.35 if title else 0.0))) as (fig, _):
         fig.delaxes(_)
         fig.set_layout_engine("none")
         grid = fig.add_gridspec(nrow, ncol + 1, width_ratios=[1.0] * ncol + [0.045], left=0.0, right=0.92,
                                 bottom=0.03, top=0.91 if title else 0.98, wspace=0.22, hspace=0.1)
-        for k, (label, (x, y, p)) in enumerate(data):
+        for k, (label, xs, ys, ps, tri, sec) in enumerate(patches):
+            if images is not None:
+                ax = fig.add_subplot(grid[k // ncol, k % ncol])
+                ax.imshow(images[k], interpolation="lanczos")
+                ax.set_axis_off()
+                ax.set_title(label, fontsize=9.5, pad=2)
+                continue
             ax = fig.add_subplot(grid[k // ncol, k % ncol], projection="3d")
-            xs, ys, ps, tri = contact_patch(x, y, p)
-            on_axis = np.abs(ys) <= 1e-9 * float(np.abs(xs).max(initial=1.0))
-            sec = axial_section(xs, ys, ps) if section and on_axis.sum() > 1 else None
             _surface_panel(ax, xs, ys, ps, tri, p0=p0, a=a, height=height, vmax=vmax, section=sec, lab=lab)
             ax.set_title(label, fontsize=9.5, pad=-6)
         cax = fig.add_subplot(grid[:, ncol])

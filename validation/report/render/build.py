@@ -35,12 +35,14 @@ REPORT_FILES = ("report.html", "report.md", "figures")
 
 @dataclass(frozen=True)
 class BuiltReport:
-    """Paths of a written report."""
+    """Paths of a written report, and the notes its run has for the reader (``notes``: one
+    sentence each, e.g. expected non-convergence the report discusses; the command prints them)."""
 
     out_dir: Path
     html: Path
     markdown: Path
     figures: tuple
+    notes: tuple = ()
 
 
 class Progress:

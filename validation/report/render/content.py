@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 
 from bem.checks import InputError
 
-__all__ = ["Figure", "Table", "Section", "KINDS", "status_class", "fmt", "problem_section", "table_from_rows"]
+__all__ = ["Figure", "Table", "Section", "KINDS", "status_class", "fmt", "fmt_distinct", "problem_section",
+           "table_from_rows"]
 
 #: kinds of section; ``"fem"`` marks anything that needs an FEM result
 KINDS = ("problem", "results", "iterations", "sweeps", "validation", "fem", "stability", "notes")
@@ -46,6 +47,19 @@ def fmt(value, digits=4):
     if isinstance(value, float) and math.isfinite(value):
         return f"{value:.{digits}g}"
     return str(value)
+
+
+def fmt_distinct(values, digits=4, most=9):
+    """Cells of values compared side by side (one row of solvers): :func:`fmt` with the fewest
+    significant digits, from ``digits`` up to ``most``, at which values that differ print
+    differently (``1.3713e+09`` and ``1.3708e+09``, not ``1.371e+09`` twice); not numbers
+    and ``None`` as :func:`fmt`."""
+    numbers = sorted({float(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool)
+                      and math.isfinite(v)})
+    for n in range(digits, most + 1):
+        if len({fmt(v, n) for v in numbers}) == len(numbers):
+            break
+    return [fmt(v, n) if isinstance(v, float) else fmt(v) for v in values]
 
 
 @dataclass(frozen=True)
