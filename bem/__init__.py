@@ -3,7 +3,8 @@
 Boundary elements on the elastic half-space with piecewise-linear (pyramid)
 pressure on a regular triangular lattice, closed-form influence coefficients,
 FFT-fast products, and Kalker's variational principle generalised to a
-nonlinear interface layer (paper sections 4-5, docs/method.md); the stresses below the
+nonlinear interface layer (paper sections 4-5, docs/method.md); periodic cells of
+rough surfaces (:func:`solve_periodic`); the stresses below the
 surface under the computed pressure (:func:`subsurface_stress`).
 """
 
@@ -14,10 +15,12 @@ from .materials import effective_modulus
 from .operator import InfluenceOperator, diagonal_coefficient
 from .result import ContactResult
 from .options import METHODS, OPTIONS
+from .periodic import PeriodicCell, PeriodicContactResult, PeriodicOperator, solve_periodic
 from .solve import solve
 from .stress import SubsurfaceStress, subsurface_stress
 from .template import template
 
-__all__ = ["solve", "subsurface_stress", "SubsurfaceStress", "template", "Lattice", "InfluenceOperator",
+__all__ = ["solve", "solve_periodic", "PeriodicCell", "PeriodicOperator", "PeriodicContactResult",
+           "subsurface_stress", "SubsurfaceStress", "template", "Lattice", "InfluenceOperator",
            "ContactResult", "METHODS", "OPTIONS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
            "effective_modulus", "gaps", "layers"]

@@ -345,7 +345,8 @@ def _check_border(lattice, p, extent):
         raise RegionTooSmallError(
             f"extent = {extent!r} is not allowed for this load: the contact reaches the border of the "
             f"candidate region at {n} node(s). Make extent larger (the contact must stay inside it) "
-            "or reduce the load."
+            "or reduce the load. For a rough surface patch whose contact spreads over the whole region, "
+            "the model is a periodic cell: bem.solve_periodic."
         )
 
 

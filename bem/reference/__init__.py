@@ -7,6 +7,7 @@ Every closed form is a result with the names every solver result uses
 
 - :mod:`bem.reference.hertz`: Hertz contact of a paraboloid and of an elliptic paraboloid;
 - :mod:`bem.reference.layer_limit`: the layer-dominated (rigid-body) limit;
+- :mod:`bem.reference.westergaard`: Westergaard's wavy (periodic) contact;
 - :mod:`bem.reference.estimate`: the expected contact radius of an axisymmetric gap, which
   sizes the BEM region and the FEM mesh before any solve.
 """
@@ -19,7 +20,8 @@ from .layer_limit import (
            rigid_layer_paraboloid,
            rigid_layer_pressure,
 )
+from .westergaard import Westergaard, westergaard
 
-__all__ = ["HertzSphere", "HertzElliptic", "RigidLayerParaboloid", "hertz_sphere", "hertz_elliptic",
+__all__ = ["Westergaard", "westergaard", "HertzSphere", "HertzElliptic", "RigidLayerParaboloid", "hertz_sphere", "hertz_elliptic",
            "rigid_layer_pressure", "rigid_layer_paraboloid", "rigid_layer_force", "estimate_contact_radius",
            "hertz_radius", "layer_radius"]

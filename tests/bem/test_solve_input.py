@@ -50,6 +50,11 @@ def test_contact_reaching_the_border_says_so():
         bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=0.5)
 
 
+def test_contact_reaching_the_border_names_the_periodic_cell_for_a_rough_patch():
+    with pytest.raises(bem.RegionTooSmallError, match="periodic cell: bem.solve_periodic"):
+        bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=0.5)
+
+
 def test_e1_nu1_e2_nu2_give_the_same_answer_as_e_star():
     a = bem.solve(Paraboloid(1.0), E_star=1.0 / (2 * (1 - 0.3**2) / 2.0), force=0.01, step=0.05, extent=0.5)
     b = bem.solve(Paraboloid(1.0), E1=2.0, nu1=0.3, E2=2.0, nu2=0.3, force=0.01, step=0.05, extent=0.5)

@@ -1,0 +1,194 @@
+"""The periodic cell of the triangular lattice.
+
+A cell of ``n_cols x n_rows`` nodes (``n_rows`` even) and step ``c`` repeats with the
+periods ``Lx = n_cols c`` and ``Ly = n_rows c sqrt3/2``. Node ``(q, r)``,
+``q = 0 .. n_cols - 1``, ``r = 0 .. n_rows - 1``, sits at
+
+    x = (q + (r mod 2)/2) c,   y = r c sqrt3/2,
+
+and nodal values are stored as brick arrays of shape ``(n_rows, n_cols)`` (row ``r``,
+column ``q``), the storage of :class:`bem.lattice.Lattice`. Every node is a candidate: a
+periodic cell has no border. Node ``(q, r)`` is the lattice node ``i e1 + j e2`` with
+``j = r``, ``i = q - floor(r/2)``; ``n_rows`` even makes the lattice periodic in ``y``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ..checks import check_int, check_positive, fail
+
+__all__ = ["PeriodicCell"]
+
+_SQRT3 = math.sqrt(3.0)
+
+
+@dataclass(frozen=True)
+class PeriodicCell:
+    """A periodic cell of the triangular lattice (module docstring).
+
+    Parameters
+    ----------
+    step : float
+        Lattice step ``c`` [length], > 0.
+    n_cols : int
+        Nodes per row, >= 4.
+    n_rows : int
+        Rows, even, >= 2.
+    """
+
+    step: float
+    n_cols: int
+    n_rows: int
+
+    def __post_init__(self):
+        object.__setattr__(self, "step", check_positive("step", self.step))
+        object.__setattr__(self, "n_cols", check_int("n_cols", self.n_cols, minimum=4))
+        n_rows = check_int("n_rows", self.n_rows, minimum=2)
+        if n_rows % 2:
+            fail("n_rows", n_rows, "even (the triangular lattice repeats every two rows)")
+        object.__setattr__(self, "n_rows", n_rows)
+
+    @classmethod
+    def from_size(cls, step, size):
+        """The cell of step ``step`` closest to the size ``(Lx, Ly)`` [length].
+
+        ``n_cols = round(Lx / c)`` and ``n_rows`` the even number nearest ``Ly / (c sqrt3/2)``;
+        :attr:`size` gives the cell's exact size.
+        """
+        step = check_positive("step", step)
+        lx, ly = (check_positive("size", v) for v in (size if np.ndim(size) else (size, size)))
+        return cls(step, max(4, int(round(lx / step))), max(2, 2 * int(round(ly / (step * _SQRT3)))))
+
+    @property
+    def shape(self):
+        """Shape ``(n_rows, n_cols)`` of a brick array."""
+        return (self.n_rows, self.n_cols)
+
+    @property
+    def size(self):
+        """Periods ``(Lx, Ly)`` [length]."""
+        return (self.n_cols * self.step, self.n_rows * self.step * _SQRT3 / 2)
+
+    @property
+    def area(self):
+        """Area of the cell ``Lx Ly`` [length^2]."""
+        lx, ly = self.size
+        return lx * ly
+
+    @property
+    def node_area(self):
+        """Quadrature weight of a node, the pyramid volume ``sqrt(3)/2 c^2`` [length^2]."""
+        return _SQRT3 / 2 * self.step**2
+
+    @property
+    def n_nodes(self):
+        """Number of nodes."""
+        return self.n_rows * self.n_cols
+
+    @cached_property
+    def parity(self):
+        """``r mod 2`` of each row, shape ``(n_rows,)``."""
+        return np.arange(self.n_rows) % 2
+
+    @cached_property
+    def x(self):
+        """Node abscissae [length], shape :attr:`shape`."""
+        return self.step * (np.arange(self.n_cols)[None, :] + 0.5 * self.parity[:, None])
+
+    @cached_property
+    def y(self):
+        """Node ordinates [length], shape :attr:`shape`."""
+        return np.broadcast_to(self.step * _SQRT3 / 2 * np.arange(self.n_rows)[:, None], self.shape).copy()
+
+    @cached_property
+    def mask(self):
+        """Every node is a candidate: all True, shape :attr:`shape`."""
+        return np.ones(self.shape, dtype=bool)
+
+    @cached_property
+    def border(self):
+        """A periodic cell has no border: all False, shape :attr:`shape`."""
+        return np.zeros(self.shape, dtype=bool)
+
+    def coarsen(self):
+        """The cell of step ``2c`` whose nodes are every other node of this one, or ``None``.
+
+        Needs ``n_cols`` even and ``n_rows`` a multiple of 4 (and at least 4 x 2 nodes left).
+        Coarse node ``(q, r)`` is fine node ``(2q + r mod 2, 2r)``.
+        """
+        if self.n_cols % 2 or self.n_rows % 4 or self.n_cols < 8:
+            return None
+        return PeriodicCell(2 * self.step, self.n_cols // 2, self.n_rows // 2)
+
+    def restrict(self, values):
+        """The values at the nodes of :meth:`coarsen` (every other node), shape of the coarse cell."""
+        values = np.asarray(values)
+        rows = values[0::2]
+        out = np.empty((self.n_rows // 2, self.n_cols // 2), dtype=values.dtype)
+        out[0::2] = rows[0::2, 0::2]
+        out[1::2] = rows[1::2, 1::2]
+        return out
+
+    def prolong(self, values):
+        """The piecewise-linear field of the coarse nodal ``values`` (cell :meth:`coarsen`) at this cell's nodes.
+
+        A fine node is a coarse node or the midpoint of a coarse edge (along ``e1``, ``e2`` or
+        ``e2 - e1``): it takes the coarse value or the mean of two. Periodic.
+        """
+        coarse = self.coarsen()
+        values = np.asarray(values, dtype=float)
+        if coarse is None or values.shape != coarse.shape:
+            fail("values", f"<array of shape {values.shape}>",
+                 f"nodal values of the coarse cell, shape {None if coarse is None else coarse.shape}")
+        r = np.arange(self.n_rows)[:, None]
+        q = np.arange(self.n_cols)[None, :]
+        i, j = q - r // 2, np.broadcast_to(r, self.shape)  # lattice coordinates of the fine nodes
+        a, b = i // 2, j // 2
+        ei, ej = i % 2, j % 2
+
+        def at(ic, jc):  # coarse value at coarse lattice node (ic, jc), periodic
+            return values[np.mod(jc, coarse.n_rows), np.mod(ic + np.floor_divide(jc, 2), coarse.n_cols)]
+
+        first = at(a + (ei & ej), b)  # (a, b), or (a + 1, b) for the e2 - e1 edge
+        second = at(a + (ei & (1 - ej)), b + ej)  # (a + 1, b) along e1, (a, b + 1) along e2 and e2 - e1
+        return 0.5 * (first + second)
+
+    def interpolate(self, values, x, y):
+        """The piecewise-linear field ``sum values_n pyr_n`` at the points ``(x, y)`` [length], periodic.
+
+        Parameters
+        ----------
+        values : ndarray, shape :attr:`shape`
+            Nodal values.
+        x, y : array_like
+            Points, any broadcastable shapes; any point of the plane (the field repeats).
+
+        Returns
+        -------
+        ndarray
+            Linear interpolation on the triangle that holds each point.
+        """
+        values = np.asarray(values, dtype=float)
+        if values.shape != self.shape:
+            fail("values", f"<array of shape {values.shape}>", f"nodal values of the cell, shape {self.shape}")
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        t = y / (self.step * _SQRT3 / 2)  # lattice coordinates: point = c (s e1 + t e2)
+        s = x / self.step - t / 2
+        i0, j0 = np.floor(s), np.floor(t)
+        fs, ft = s - i0, t - j0
+        upper = fs + ft > 1.0
+        i0, j0 = i0.astype(np.int64), j0.astype(np.int64)
+
+        def at(i, j):
+            return values[np.mod(j, self.n_rows), np.mod(i + np.floor_divide(j, 2), self.n_cols)]
+
+        corner = np.where(upper, 1, 0)  # the third vertex: (i0, j0) below the diagonal, (i0 + 1, j0 + 1) above
+        w_a = np.where(upper, fs + ft - 1.0, 1.0 - fs - ft)
+        return (w_a * at(i0 + corner, j0 + corner) + np.where(upper, 1.0 - ft, fs) * at(i0 + 1, j0)
+                + np.where(upper, 1.0 - fs, ft) * at(i0, j0 + 1))
+

@@ -1,0 +1,139 @@
+"""The periodic influence operator: ``u = C p`` on a periodic cell, by circular FFT convolution.
+
+``C[n, m] = c / (pi E*) W(x_n - x_m)``, ``W`` the periodic template of
+:func:`bem.periodic.kernel.periodic_template` (the pyramid and all its images, exact for the
+pyramid basis, with zero mean). The displacement of any pressure therefore has zero mean
+over the cell: a uniform pressure moves the periodic half-space rigidly by an undetermined
+amount, which is fixed to zero. The approach of a periodic contact is measured against
+this mean (:func:`bem.periodic.solve_periodic`).
+
+As in :mod:`bem.operator`, the rows split by parity into two rectangular lattices, and
+``u_a = sum_b K_ab * p_b`` is a 2 x 2 block convolution, here circular on arrays of
+``(n_rows/2, n_cols)`` with no padding: two real FFTs of the cell per product. The operator
+has the interface the solvers use (``lattice``, ``matvec``, ``preconditioner``,
+``diagonal``, ``n_matvec``), so :func:`bem.kalker.solve_qp`, :func:`bem.newton.solve_newton`
+and :mod:`bem.fixed_point` run on it unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.fft as sfft
+
+from .. import fft
+from ..checks import check_positive
+from ..operator import diagonal_coefficient
+from .kernel import periodic_template
+
+__all__ = ["PeriodicOperator"]
+
+
+class PeriodicOperator:
+    """Matrix-free ``u = C p`` on a :class:`bem.periodic.PeriodicCell`.
+
+    Parameters
+    ----------
+    lattice : bem.periodic.PeriodicCell
+        The cell.
+    E_star : float
+        Effective modulus ``E*`` [pressure].
+
+    Attributes
+    ----------
+    diagonal : float
+        The local self-compliance ``C_nn = c / (pi E*) w_t(0, 0)`` of the half-space (the
+        scale of layer compliances and of the solvers' Jacobi estimates), as for
+        :class:`bem.operator.InfluenceOperator`; the periodic coefficient ``C[n, n]`` differs
+        from it by the images and the zero mean.
+    """
+
+    def __init__(self, lattice, E_star):
+        self.lattice = lattice
+        self.E_star = check_positive("E_star", E_star)
+        self.n_matvec = 0
+        self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
+        w = periodic_template(lattice.n_rows, lattice.n_cols) * (lattice.step / (math.pi * self.E_star))
+        self.kernel = w  # C between node (0, 0) and node (q, r), brick array
+        even, odd = w[0::2], w[1::2]
+        self._spectrum_shape = (even.shape[0], even.shape[1] // 2 + 1)
+        spectra = sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
+        # spectra of K_00 = K_11, K_10 and K_01 (real kernels: the 1/N of the inverse FFT is applied there)
+        self._s00, self._s10, self._s01 = spectra
+
+    def _forward(self, v):
+        """Spectra of the even and odd rows of a brick array: ``(2, n_rows/2, n_cols/2 + 1)``.
+
+        The real FFT along the rows runs on the whole array at once; the complex FFT along the
+        columns on each parity's strided rows, so the parities are never copied apart.
+        """
+        rows = sfft.rfft(v, axis=-1, workers=fft.threads())
+        out = np.empty((2,) + self._spectrum_shape, dtype=complex)
+        for a in (0, 1):
+            out[a] = sfft.fft(rows[a::2], axis=0, workers=fft.threads())
+        return out
+
+    def _apply(self, v, s00, s01, s10, s11):
+        """``out_a = sum_b S_ab v_b`` by the spectra ``S`` of a 2 x 2 block symbol."""
+        P = self._forward(np.asarray(v, dtype=float))
+        u1 = s10 * P[0]
+        u1 += s11 * P[1]
+        P[0] *= s00
+        P[0] += s01 * P[1]
+        P[1] = u1
+        rows = np.empty((self.lattice.n_rows, self._spectrum_shape[1]), dtype=complex)
+        for a in (0, 1):
+            rows[a::2] = sfft.ifft(P[a], axis=0, overwrite_x=True, workers=fft.threads())
+        return sfft.irfft(rows, n=self.lattice.n_cols, axis=-1, overwrite_x=True, workers=fft.threads())
+
+    def matvec(self, p):
+        """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]; ``u`` has zero mean."""
+        self.n_matvec += 1
+        return self._apply(p, self._s00, self._s01, self._s10, self._s00)
+
+    __call__ = matvec
+
+    def preconditioner(self, lam=0.0):
+        """``z = (C + lam I)^-1 r`` on the whole cell, by the inverse 2 x 2 block symbol.
+
+        Exact for a contact over the whole cell. The constant mode, where ``C`` vanishes
+        (zero mean), gets the eigenvalue ``C_nn + lam`` instead, so that ``M`` is symmetric
+        positive definite for every ``lam >= 0``.
+
+        Parameters
+        ----------
+        lam : float
+            Uniform layer compliance [length/pressure] added on the diagonal.
+
+        Returns
+        -------
+        callable
+            ``M(r)`` on brick arrays.
+        """
+        a, d = self._s00 + lam, self._s00 + lam
+        b, c = self._s01.copy(), self._s10.copy()
+        shift = 0.5 * self.diagonal  # the constant mode (1, 1) / sqrt 2 of frequency 0 gets eigenvalue C_nn + lam
+        a[0, 0] += shift
+        d[0, 0] += shift
+        b[0, 0] += shift
+        c[0, 0] += shift
+        det = a * d - b * c
+        i00, i01, i10, i11 = d / det, -b / det, -c / det, a / det
+
+        def apply(r):
+            return self._apply(r, i00, i01, i10, i11)
+
+        return apply
+
+    def dense(self):
+        """The dense matrix ``C`` over the flattened nodes (small cells only), from :attr:`kernel` by offsets."""
+        lat = self.lattice
+        n_rows, n_cols = lat.shape
+        if lat.n_nodes > 20000:
+            raise MemoryError(f"dense C for {lat.n_nodes} nodes would need {8 * lat.n_nodes**2 / 1e9:.1f} GB")
+        r = np.repeat(np.arange(n_rows), n_cols)
+        q = np.tile(np.arange(n_cols), n_rows)
+        i, j = q - r // 2, r  # lattice coordinates
+        di, dj = i[:, None] - i[None, :], j[:, None] - j[None, :]
+        return self.kernel[np.mod(dj, n_rows), np.mod(di + np.floor_divide(dj, 2), n_cols)]

@@ -1,0 +1,221 @@
+"""The entry point :func:`solve_periodic`: contact of a periodic cell (a rough surface patch)."""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..checks import check_bool, check_choice, check_int, check_positive, fail
+from ..errors import InputError
+from ..kkt import kkt_residual
+from ..options import METHODS, check_options, solver_for
+from ..result import ContactResult
+from .cell import PeriodicCell
+from .influence import PeriodicOperator
+
+__all__ = ["solve_periodic", "PeriodicContactResult"]
+
+log = logging.getLogger(__name__)
+
+_COARSEST_NODES = 4096  # nested iteration stops coarsening below this many nodes
+_PERIODIC_RTOL = 1e-8  # gap(x + L) = gap(x) to this fraction of the gap's range
+
+
+@dataclass
+class PeriodicContactResult(ContactResult):
+    """:class:`bem.ContactResult` of a periodic cell (``lattice`` is the :class:`PeriodicCell`).
+
+    ``force`` is the force on one cell and ``displacement`` has zero mean over the cell;
+    ``gap`` is the deformed gap ``C p + w(p) + h - delta``.
+    """
+
+    @property
+    def mean_pressure(self):
+        """Mean pressure over the cell, ``force / (Lx Ly)`` [pressure]."""
+        return self.force / self.lattice.area
+
+    @property
+    def contact_fraction(self):
+        """Fraction of the nodes in contact (``p > 0``): the relative contact area."""
+        return float(np.count_nonzero(self.p > 0)) / self.p.size
+
+    @property
+    def mean_gap(self):
+        """Mean deformed gap over the cell, ``mean(h + w(p)) - delta`` [length] (the mean-plane separation)."""
+        return float(np.mean(self.gap))
+
+    def summary(self):
+        out = super().summary()
+        del out["contact_radius"]
+        out.update(mean_pressure=float(self.mean_pressure), contact_fraction=self.contact_fraction,
+                   mean_gap=self.mean_gap, cell=[int(self.lattice.n_cols), int(self.lattice.n_rows)])
+        return out
+
+
+def _cell_and_gap(gap, step, cell):
+    """The cell and the nodal gap (brick array) from an array or a periodic callable."""
+    if callable(gap):
+        if cell is None or not isinstance(cell, PeriodicCell):
+            fail("cell", cell, "a bem.periodic.PeriodicCell when gap is a callable")
+        if step is not None:
+            raise InputError(f"step = {step!r} is not allowed with a cell: the cell has its step.")
+        h = _evaluate(gap, cell, 0.0, 0.0)
+        lx, ly = cell.size
+        scale = float(np.ptp(h)) or max(float(np.abs(h).max()), 1.0)
+        for name, sx, sy in (("Lx", lx, 0.0), ("Ly", 0.0, ly)):
+            shifted = _evaluate(gap, cell, sx, sy)
+            worst = float(np.abs(shifted - h).max())
+            if worst > _PERIODIC_RTOL * scale:
+                raise InputError(f"gap = {gap!r} is not allowed: it must be periodic over the cell "
+                                 f"({cell.n_cols} x {cell.n_rows} nodes of step {cell.step:.6g}, Lx = {lx:.6g}, "
+                                 f"Ly = {ly:.6g}); gap(x + {name}) differs from gap(x) by {worst:.3g}.")
+        return cell, h
+    if cell is not None:
+        raise InputError("cell is not allowed with a gap array: the cell follows from the array's shape and step.")
+    h = np.asarray(gap, dtype=float) if not isinstance(gap, np.ndarray) else gap.astype(float, copy=False)
+    if h.ndim != 2:
+        fail("gap", f"<array of shape {h.shape}>", "a brick array of shape (n_rows, n_cols) or a callable")
+    if step is None:
+        fail("step", step, "given with a gap array (the lattice step c)")
+    cell = PeriodicCell(step, h.shape[1], h.shape[0])
+    if not np.all(np.isfinite(h)):
+        r, q = np.argwhere(~np.isfinite(h))[0]
+        fail("gap", f"<array with {h[r, q]!r} at row {r}, column {q}>", "finite")
+    return cell, h
+
+
+def _evaluate(gap, cell, sx, sy):
+    h = np.asarray(gap(cell.x + sx, cell.y + sy), dtype=float)
+    if h.shape != cell.shape:
+        raise InputError(f"gap returned shape {h.shape} which is not allowed: it must return the shape of x "
+                         f"({cell.shape}).")
+    if not np.all(np.isfinite(h)):
+        fail("gap(x, y)", "a non-finite value", "finite over the cell")
+    return h
+
+
+def _levels(cell, h, gap, nested):
+    """(cell, gap) pairs from the coarsest to the finest."""
+    levels = [(cell, h)]
+    while nested:
+        fine, hf = levels[-1]
+        coarse = fine.coarsen()
+        if coarse is None or coarse.n_nodes < _COARSEST_NODES:
+            break
+        levels.append((coarse, _evaluate(gap, coarse, 0.0, 0.0) if callable(gap) else fine.restrict(hf)))
+    return levels[::-1]
+
+
+def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None, E2=None, nu2=None,
+                   mean_pressure=None, approach=None, layer=None, method="newton", rtol=1e-10, maxiter=None,
+                   x0=None, nested=None, precondition=True, callback=None, **options):
+    """Frictionless normal contact of a periodic cell of two elastic half-spaces with an interface layer.
+
+    The gap repeats with the periods of the cell (:class:`PeriodicCell`): a rough surface
+    patch. Every node may touch. The same functional and solvers as :func:`bem.solve`, with
+    the periodic influence operator (:class:`bem.periodic.PeriodicOperator`), whose
+    displacements have zero mean over the cell.
+
+    Parameters
+    ----------
+    gap : ndarray or callable
+        Initial gap [length]: a brick array of shape ``(n_rows, n_cols)`` (node ``(q, r)`` at
+        ``x = (q + (r mod 2)/2) c``, ``y = r c sqrt3/2``; the cell follows from the shape and
+        ``step``), or a vectorised ``h(x, y)`` periodic over ``cell`` (checked at the nodes).
+    step : float
+        Lattice step ``c`` [length], with a gap array.
+    cell : PeriodicCell
+        The cell, with a callable gap.
+    E_star : float, optional
+        Effective modulus [pressure]; or give ``E1, nu1, E2, nu2`` instead.
+    mean_pressure, approach : float
+        Exactly one. ``mean_pressure`` ``pbar`` > 0 [pressure]: the force on a cell is
+        ``pbar Lx Ly = sqrt(3)/2 c^2 sum p``. ``approach`` ``delta`` [length]: the deformed gap is
+        ``C p + w(p) + h - delta`` with ``C p`` of zero mean, so that its mean (the mean-plane
+        separation, :attr:`PeriodicContactResult.mean_gap`) is ``mean(h + w(p)) - delta``;
+        without a layer it must be below ``mean(h)`` (a full contact leaves the mean pressure
+        undetermined under approach control).
+    layer, method, rtol, maxiter, x0, precondition, callback, **options
+        As for :func:`bem.solve` (``x0`` a brick array of the cell's shape, or flattened).
+    nested : bool, optional
+        Start from the solution on cells of step ``2c``, ``4c``, ... (every other node,
+        needs ``n_cols`` even and ``n_rows`` a multiple of 4 per level) interpolated onto the
+        finer one. Default: on for ``"newton"`` and the QP, off for the paper's methods.
+
+    Returns
+    -------
+    PeriodicContactResult
+
+    Notes
+    -----
+    The stopping rules are those of :func:`bem.solve`: every method stops on the KKT
+    residual ``r <= rtol`` (:func:`bem.kkt.kkt_residual`, relative to the largest surface
+    closure ``max |C p + w(p)|``; force balance relative to the force on the cell), the
+    paper's methods on their increments as well. Timings: ``benchmarks/periodic_rough.py``.
+    """
+    from ..solve import _check_layer, _inner_summary, _modulus, _run
+
+    t_start = time.perf_counter()
+    cell, h = _cell_and_gap(gap, step, cell)
+    E_star = _modulus(E_star, E1, nu1, E2, nu2)
+    if (mean_pressure is None) == (approach is None):
+        fail("(mean_pressure, approach)", (mean_pressure, approach), "exactly one given")
+    force = None if mean_pressure is None else check_positive("mean_pressure", mean_pressure) * cell.area
+    if approach is not None:
+        approach = float(approach) if np.isfinite(approach) else fail("approach", approach, "finite")
+        if layer is None and not approach < float(h.mean()):
+            fail("approach", approach, f"< the mean gap {float(h.mean()):.6g} without a layer (a full contact "
+                 "leaves the mean pressure undetermined: give mean_pressure)")
+    check_choice("method", method, METHODS)
+    rtol = check_positive("rtol", rtol)
+    if maxiter is not None:
+        maxiter = check_int("maxiter", maxiter)
+    precondition = check_bool("precondition", precondition)
+    _check_layer(layer, method)
+    solver = solver_for(method, layer)
+    options = check_options(method, solver, options)
+    nested = solver in ("kalker", "newton") if nested is None else check_bool("nested", nested)
+    guess = None
+    if x0 is not None:
+        guess = np.asarray(x0, dtype=float)
+        if guess.shape == (cell.n_nodes,):
+            guess = guess.reshape(cell.shape)
+        if guess.shape != cell.shape:
+            raise InputError(f"x0 has shape {guess.shape} which is not allowed: it must be {cell.shape} "
+                             f"or ({cell.n_nodes},).")
+        nested = False
+    levels = _levels(cell, h, gap, nested)
+    n_matvec = 0
+    for level, (lat, h_lat) in enumerate(levels):
+        finest = level == len(levels) - 1
+        kw = dict(force=force, approach=approach, x0=guess, rtol=rtol if finest else max(rtol, 1e-6),
+                  callback=callback if finest else None)
+        if maxiter is not None:
+            kw["maxiter"] = maxiter
+        op = PeriodicOperator(lat, E_star)
+        sol = _run(solver, op, h_lat, layer, precondition, kw, options)
+        if not finest:
+            guess = levels[level + 1][0].prolong(sol.p)
+            n_matvec += 0  # work on the finest cell only, as for bem.solve
+    p = sol.p
+    u = op.matvec(p)
+    closure = np.zeros(cell.shape) if layer is None else layer.w(p)
+    g = u + closure + h - sol.approach
+    a = cell.node_area
+    kkt = kkt_residual(p.ravel(), g.ravel(), displacement_scale=float(np.abs(u + closure).max()), force=force,
+                       node_area=a)
+    if not np.all(np.isfinite(p)):
+        raise FloatingPointError(f"{solver}: the solver produced non-finite pressures ({sol.message})")
+    result = PeriodicContactResult(
+        x=cell.x.ravel(), y=cell.y.ravel(), p=p.ravel(), displacement=u.ravel(), closure=closure.ravel(),
+        gap=g.ravel(), approach=float(sol.approach), force=float(a * p.sum()), p_max=float(p.max()),
+        contact_area=float(a * np.count_nonzero(p > 0)), converged=bool(sol.converged), message=sol.message,
+        iterations=int(sol.iterations), kkt_residual=float(kkt), method=solver,
+        wall_time_s=time.perf_counter() - t_start, lattice=cell, E_star=E_star, history=sol.history,
+        layer=layer, n_matvec=op.n_matvec)
+    if not result.converged:
+        log.warning("%s: %s%s", solver, result.message, _inner_summary(sol.history))
+    return result

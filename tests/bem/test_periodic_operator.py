@@ -1,0 +1,122 @@
+"""The periodic influence operator: exact image sum of the pyramid template, zero mean, FFT = dense."""
+
+import math
+
+import numpy as np
+import pytest
+
+import bem
+from bem.periodic import PeriodicCell, PeriodicOperator, periodic_template
+
+SQRT3 = math.sqrt(3.0)
+
+
+def _offsets(n_rows, n_cols):
+    r, q = np.meshgrid(np.arange(n_rows), np.arange(n_cols), indexing="ij")
+    return q + (r % 2) / 2, r * SQRT3 / 2
+
+
+def test_periodic_template_does_not_depend_on_the_ewald_split():
+    # the split parameter only moves work between the Fourier and the real-space sums
+    for shape in ((6, 5), (8, 12), (20, 7)):
+        ref = periodic_template(*shape, alpha=0.4)
+        for alpha in (0.25, 0.6):
+            other = periodic_template(*shape, alpha=alpha)
+            assert np.abs(other - ref).max() <= 1e-13 * np.abs(ref).max()  # measured <= 4e-16
+
+
+def test_periodic_template_is_the_limit_of_the_image_sum_of_the_template():
+    """Brute force: sum over the images L in a disc of radius R of w_t(x + L) - w_t(L).
+
+    The disc leaves out the quadrupole tail (sqrt3/2) pi |x|^2 / (2 A R) (the angular mean of
+    the second-order term of 1/|x + L|), which is added; the rest converges like R^-2.5.
+    """
+    n_rows, n_cols = 6, 5
+    w = periodic_template(n_rows, n_cols)
+    x, y = (v.ravel() for v in _offsets(n_rows, n_cols))
+    lx, ly = n_cols, n_rows * SQRT3 / 2
+    expected = w.ravel() - w[0, 0]
+    errors = []
+    for radius in (100.0, 200.0, 400.0):
+        m, n = int(radius / lx) + 1, int(radius / ly) + 1
+        a, b = np.meshgrid(np.arange(-m, m + 1) * lx, np.arange(-n, n + 1) * ly)
+        keep = np.hypot(a, b) <= radius
+        a, b = a[keep], b[keep]
+        base = bem.template(a, b).sum()
+        brute = np.array([bem.template(xi + a, yi + b).sum() - base for xi, yi in zip(x, y)])
+        brute += SQRT3 / 2 * math.pi * (x * x + y * y) / (2 * lx * ly * radius)
+        errors.append(np.abs(brute - expected).max() / np.abs(w).max())
+    orders = [math.log2(errors[k] / errors[k + 1]) for k in range(2)]
+    assert min(orders) > 2.2  # measured 2.58, 2.61
+    assert errors[-1] < 3e-6  # measured 1.1e-6
+
+
+@pytest.mark.parametrize("shape", [(6, 5), (8, 12)])
+def test_periodic_operator_is_the_dense_symmetric_matrix_with_zero_mean(shape):
+    cell = PeriodicCell(0.3, shape[1], shape[0])
+    op = PeriodicOperator(cell, 2.0)
+    dense = op.dense()
+    assert np.abs(dense - dense.T).max() <= 1e-13 * np.abs(dense).max()  # measured 7.5e-15, 8.2e-15
+    p = np.random.default_rng(1).random(cell.shape)
+    u = op.matvec(p)
+    assert np.abs(u.ravel() - dense @ p.ravel()).max() <= 1e-14 * np.abs(u).max()
+    assert abs(u.mean()) <= 1e-15 * np.abs(u).max()
+    eig = np.linalg.eigvalsh(dense)
+    assert abs(eig[0]) <= 1e-14 * eig[-1] and eig[1] > 0.01 * eig[-1]  # one zero mode: the constant
+
+
+def test_periodic_preconditioner_inverts_c_plus_lam_on_zero_mean_vectors():
+    cell = PeriodicCell(0.3, 5, 6)
+    op = PeriodicOperator(cell, 2.0)
+    dense = op.dense()
+    r = np.random.default_rng(2).random(cell.shape)
+    r -= r.mean()
+    for lam in (0.0, 0.1):
+        z = op.preconditioner(lam)(r)
+        assert np.abs((dense + lam * np.eye(cell.n_nodes)) @ z.ravel() - r.ravel()).max() <= 1e-13
+
+
+def test_periodic_template_matches_the_free_template_where_images_are_far():
+    # a large cell: near the source the images add a smooth, almost uniform field, so the
+    # second difference of W equals that of w_t to the curvature of the image field
+    n = 256
+    w = periodic_template(n, n)
+    free = bem.template(np.array([0.0, 1.0, 2.0]), np.zeros(3))
+    second = w[0, 0] - 2 * w[0, 1] + w[0, 2]
+    assert second == pytest.approx(free[0] - 2 * free[1] + free[2], rel=1e-5)
+
+
+def test_periodic_cell_prolong_is_exact_for_linear_fields_and_restrict_takes_every_other_node():
+    fine = PeriodicCell(0.1, 64, 32)
+    coarse = fine.coarsen()
+    assert (coarse.n_cols, coarse.n_rows, coarse.step) == (32, 16, 0.2)
+
+    def field(x, y):
+        return 1 + 0.3 * x - 0.7 * y
+
+    values = fine.prolong(field(coarse.x, coarse.y))
+    inner = (slice(0, 24), slice(16, 40))  # away from the periodic wrap of the linear field
+    assert np.abs(values - field(fine.x, fine.y))[inner].max() < 1e-14
+    assert np.array_equal(fine.restrict(field(fine.x, fine.y)), field(coarse.x, coarse.y))
+
+
+@pytest.mark.parametrize("kwargs, name", [(dict(step=0.1, n_cols=8, n_rows=5), "n_rows"),
+                                          (dict(step=0.1, n_cols=2, n_rows=4), "n_cols"),
+                                          (dict(step=-1.0, n_cols=8, n_rows=4), "step")])
+def test_periodic_cell_refuses_bad_shapes(kwargs, name):
+    with pytest.raises(bem.InputError, match=f"^{name} = .* is not allowed"):
+        PeriodicCell(**kwargs)
+
+
+def test_periodic_cell_interpolates_the_pyramid_field_periodically():
+    cell = PeriodicCell(0.1, 12, 8)
+    values = np.random.default_rng(4).random(cell.shape)
+    lx, ly = cell.size
+    assert np.allclose(cell.interpolate(values, cell.x, cell.y), values, rtol=0, atol=1e-14)
+    assert np.allclose(cell.interpolate(values, cell.x + 2 * lx, cell.y - ly), values, rtol=0, atol=1e-13)
+    # midpoint of the edge (along e2) from node (3, 1) to node (4, 2): the mean of its ends
+    mid = cell.interpolate(values, 0.5 * (cell.x[1, 3] + cell.x[2, 4]), 0.5 * (cell.y[1, 3] + cell.y[2, 4]))
+    assert mid == pytest.approx(0.5 * (values[1, 3] + values[2, 4]), abs=1e-14)
+    # and the pyramid field agrees with the prolongation, which takes the same edge midpoints
+    fine = PeriodicCell(0.05, 24, 16)
+    assert np.allclose(cell.interpolate(values, fine.x, fine.y), fine.prolong(values), rtol=0, atol=1e-14)
