@@ -7,8 +7,9 @@ operations the standard leaves out (gathers and scatters at a set of nodes, the
 
 Devices
     ``"cpu"`` (default): NumPy, FFTs by ``scipy.fft`` (pocketfft) on :func:`bem.fft.threads`
-    threads. ``"cuda"``: CuPy on the current CUDA device, FFTs by ``cupy.fft`` (cuFFT); needs
-    the ``gpu`` extra (``pip install contactlab[gpu]``) and a CUDA driver. Any other module
+    threads. ``"cuda"``: CuPy on the current CUDA device through ``array_api_compat.cupy``, FFTs
+    by ``cupy.fft`` (cuFFT); needs the ``gpu`` extra (``pip install contactlab[gpu]``) and a
+    CUDA driver. Any other module
     that implements the array API standard with its ``fft`` extension (e.g.
     ``array_api_strict``) may be passed as ``device``; its own ``xp.fft`` is used. Arrays
     stay in the device's namespace through the iterations; results come back to the host
@@ -183,6 +184,16 @@ class Backend:
 
 
 _CPU = Backend(np, "cpu")
+_CUDA = []
+
+
+def _cuda():
+    """The CuPy backend, through ``array_api_compat.cupy`` (the standard's names on CuPy's functions)."""
+    if not _CUDA:
+        import array_api_compat.cupy as xp
+
+        _CUDA.append(Backend(xp, "cuda"))
+    return _CUDA[0]
 
 
 def get_backend(device="cpu"):
@@ -218,7 +229,7 @@ def get_backend(device="cpu"):
             n = 0
         if n < 1:
             fail("device", device, "available only on a machine with a CUDA device")
-        return Backend(cupy, "cuda")
+        return _cuda()
     if not (hasattr(device, "asarray") and hasattr(device, "fft") and hasattr(device, "float64")):
         fail("device", device, "'cpu', 'cuda' or an array API namespace with the fft extension")
     return Backend(device, getattr(device, "__name__", "array_api"))
@@ -230,9 +241,9 @@ def backend_of(x):
         return _CPU
     mod = type(x).__module__.split(".")[0]
     if mod == "cupy":
-        import cupy
-
-        return Backend(cupy, "cuda")
+        return _cuda()
+    if hasattr(x, "__array_namespace__"):
+        return Backend(x.__array_namespace__(), mod)
     import array_api_compat
 
     return Backend(array_api_compat.array_namespace(x), mod)

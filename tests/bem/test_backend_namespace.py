@@ -116,3 +116,13 @@ def test_cuda_without_cupy_or_a_device_is_refused():
         pass
     with pytest.raises(bem.InputError, match="device = 'cuda' is not allowed"):
         bem.solve(Paraboloid(1.0), device="cuda", **KW)
+
+
+def test_strict_namespace_subsurface_stress_equals_the_numpy_stress(strict):
+    res = bem.solve(Paraboloid(1.0), **KW)
+    z = np.linspace(0.0, 0.3, 5)  # depths below one step (near-field correction) and beyond
+    ref = bem.subsurface_stress(res, z, nu=0.3)
+    out = bem.subsurface_stress(res, z, nu=0.3, device=strict)
+    assert isinstance(out.sigma, np.ndarray)
+    assert np.abs(out.sigma - ref.sigma).max() <= 1e-12 * np.abs(ref.sigma).max()
+    assert out.max_von_mises == pytest.approx(ref.max_von_mises, rel=1e-12)
