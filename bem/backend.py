@@ -236,8 +236,8 @@ def get_backend(device="cpu"):
 
 
 def backend_of(x):
-    """The :class:`Backend` of an array (the CPU one for NumPy arrays and Python scalars)."""
-    if isinstance(x, (np.ndarray, np.generic, float, int)):
+    """The :class:`Backend` of an array (the CPU one for NumPy arrays, Python scalars and sequences)."""
+    if isinstance(x, (np.ndarray, np.generic)) or not hasattr(x, "shape"):  # NumPy, scalars, lists
         return _CPU
     mod = type(x).__module__.split(".")[0]
     if mod == "cupy":
