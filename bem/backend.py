@@ -211,6 +211,7 @@ def get_backend(device="cpu"):
         Unknown device, CuPy not installed or no CUDA device.
     """
     from .checks import fail
+    from .errors import InputError
 
     if isinstance(device, Backend):
         return device
@@ -222,13 +223,14 @@ def get_backend(device="cpu"):
         try:
             import cupy
         except ImportError:
-            fail("device", device, "available only with CuPy installed (pip install contactlab[gpu])")
+            raise InputError("device = 'cuda' is not allowed: CuPy is not installed "
+                             "(pip install \"contactlab[gpu]\"); use device='cpu'.") from None
         try:
             n = cupy.cuda.runtime.getDeviceCount()
         except cupy.cuda.runtime.CUDARuntimeError:
             n = 0
         if n < 1:
-            fail("device", device, "available only on a machine with a CUDA device")
+            raise InputError("device = 'cuda' is not allowed: CuPy sees no CUDA device; use device='cpu'.")
         return _cuda()
     if not (hasattr(device, "asarray") and hasattr(device, "fft") and hasattr(device, "float64")):
         fail("device", device, "'cpu', 'cuda' or an array API namespace with the fft extension")
