@@ -2,7 +2,7 @@
 
 Cases (``--cases``), each with KKT residual 1e-10:
 
-- ``solve``: the issue's sphere (``benchmarks/side_by_side.py``: ``R = 1``, ``E* = 1``, square
+- ``solve``: the benchmark sphere (``benchmarks/side_by_side.py``: ``R = 1``, ``E* = 1``, square
   region of side 1, Hertz radius 0.1) at the node density of ``n x n`` grids, ``--sizes``
   (default 4096 and 8192: 16M and 64M nodes), ``hertz`` (no layer) and ``root``
   (``w = 0.04 sqrt(p)``, Newton);

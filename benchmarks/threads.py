@@ -1,6 +1,6 @@
 """Benchmark: the 1M-node solves on 1, 2, 4, 8, 16 FFT threads (a script, not a test).
 
-The issue's problem (as in ``benchmarks/side_by_side.py``): sphere ``R = 1`` on a flat,
+The benchmark sphere of ``benchmarks/side_by_side.py``: sphere ``R = 1`` on a flat,
 ``E* = 1``, square candidate region of side 1, Hertz radius 0.1, the node density of a
 1024 x 1024 grid (1,048,703 lattice nodes), KKT residual 1e-10; ``hertz`` (no layer) and
 ``root`` (``w = 0.04 sqrt(p)``, Newton). Each thread count runs in its own subprocess with
