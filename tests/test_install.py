@@ -28,7 +28,8 @@ NOT_CORE = ("matplotlib", "gmsh", "skfem", "vtk", "pyvista", "PIL", "dask", "dis
 DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "tqdm": "tqdm", "meshio": "meshio", "tomli_w": "tomli-w",
                  "gmsh": "gmsh", "skfem": "scikit-fem", "matplotlib": "matplotlib", "PIL": "pillow",
                  "dask": "dask", "distributed": "dask", "cupy": "cupy-cuda12x", "pytest": "pytest",
-                 "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography"}
+                 "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography",
+                 "array_api_compat": "array-api-compat", "array_api_strict": "array-api-strict"}
 OWN = ("bem", "fem_reference", "validation", "tests")
 #: pyvista/vtk are no dependency: only the 3-D figures still use them until they are redrawn
 #: with matplotlib (then this allowance goes)
@@ -76,10 +77,10 @@ def test_extras_layout():
     assert _extra("fem") == {"gmsh", "scikit-fem"}
     assert _extra("report") == {"matplotlib", "pillow"}
     assert _extra("dask") == {"dask"}
-    assert _extra("gpu") == {"cupy-cuda12x"}
+    assert _extra("gpu") == {"cupy-cuda12x", "array-api-compat"}
     assert _extra("rough") == {"surfacetopography"}
     assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask") | _extra("rough")
-    assert _extra("test") == _extra("all") | {"pytest", "html5lib", "pyyaml"}
+    assert _extra("test") == _extra("all") | {"pytest", "html5lib", "pyyaml", "array-api-strict", "array-api-compat"}
     everything = {_name(r) for r in PROJECT["dependencies"]} | {d for e in PROJECT["optional-dependencies"]
                                                                 for d in _extra(e)}
     assert not everything & {"pyvista", "vtk"}, "pyvista/vtk are not dependencies any more"
