@@ -43,13 +43,16 @@ class Backend:
         Array namespace (``numpy``, ``cupy`` or an array API standard namespace).
     name : str
         ``"cpu"``, ``"cuda"`` or the namespace's module name.
+    flat_indices : bool, optional
+        Node selections as flat integer indices (needs integer-array assignment and
+        ``reshape`` views, as NumPy and CuPy have); default: for NumPy and ``"cuda"``.
     """
 
-    def __init__(self, xp, name):
+    def __init__(self, xp, name, flat_indices=None):
         self.xp = xp
         self.name = name
         self.is_numpy = xp is np
-        self._flat = self.is_numpy or name == "cuda"  # integer-array assignment available
+        self._flat = (self.is_numpy or name == "cuda") if flat_indices is None else bool(flat_indices)
         self.float64 = xp.float64
 
     def __repr__(self):

@@ -124,3 +124,34 @@ def test_strict_namespace_subsurface_stress_equals_the_numpy_stress(strict):
     assert isinstance(out.sigma, np.ndarray)
     assert np.abs(out.sigma - ref.sigma).max() <= 1e-12 * np.abs(ref.sigma).max()
     assert out.max_von_mises == pytest.approx(ref.max_von_mises, rel=1e-12)
+
+
+def test_the_flat_index_path_of_cupy_emulated_on_numpy_equals_the_numpy_solve():
+    """CuPy's code path (flat-index selections, the namespace's own FFTs), run by array_api_compat.numpy."""
+    compat = pytest.importorskip("array_api_compat.numpy")
+    from bem.backend import Backend
+
+    device = Backend(compat, "compat-numpy", flat_indices=True)
+    for layer, method in ((None, "kalker"), (layers.Root(0.05), "newton"), (_laws()["tabulated"], "variable_compliance")):
+        ref = bem.solve(Paraboloid(1.0), layer=layer, method=method, **KW)
+        _same(ref, bem.solve(Paraboloid(1.0), layer=layer, method=method, device=device, **KW), tol=1e-10)
+    cell = PeriodicCell(1.0 / 32, 32, 32)
+    kw = dict(step=cell.step, E_star=1.0, mean_pressure=2.0, layer=layers.Root(0.2))
+    _same(solve_periodic(_rough(cell), **kw), solve_periodic(_rough(cell), device=device, **kw))
+
+
+@pytest.mark.parametrize("layer, method", [(None, "kalker"), (layers.Root(0.05), "newton")])
+def test_the_iterations_move_no_array_to_the_host(strict, monkeypatch, layer, method):
+    """Device arrays reach the host only through bem.backend.to_host (DLPack): the solution, its
+    displacement and the result's product, whatever the number of iterations."""
+    copies = []
+    from_dlpack = np.from_dlpack
+
+    def counted(x, *args, **kwargs):
+        copies.append(x.shape)
+        return from_dlpack(x, *args, **kwargs)
+
+    monkeypatch.setattr(np, "from_dlpack", counted)
+    res = bem.solve(Paraboloid(1.0), layer=layer, method=method, device=strict, nested=False, **KW)
+    assert res.converged and res.iterations > 3
+    assert len(copies) == 3
