@@ -32,11 +32,14 @@ in the layer-dominated limit ``C -> 0`` of a power law ``w = lam p^s``):
 from __future__ import annotations
 
 import logging
+import math
 
 import numpy as np
 
+from .backend import backend_of, operator_backend
 from .kalker import QPSolution, compliance_preconditioner, solve_qp
 from .kkt import layered_state
+from .layers.device import device_layer
 
 __all__ = ["solve_augmented_gap", "solve_variable_compliance"]
 
@@ -47,8 +50,9 @@ _STALL_STEPS = 15  # no new smallest increment for this many iterations = stalle
 
 
 def _increment(new, old):
-    norm = float(np.linalg.norm(new))
-    return float(np.linalg.norm(new - old)) / norm if norm > 0 else float(np.linalg.norm(new - old))
+    norm = backend_of(new).norm
+    size = norm(new)
+    return norm(new - old) / size if size > 0 else norm(new - old)
 
 
 class _Tracker:
@@ -56,6 +60,7 @@ class _Tracker:
 
     def __init__(self, op, h, layer, force, approach, record):
         self.op, self.h, self.layer, self.force, self.approach = op, h, layer, force, approach
+        self.backend, self.mask = operator_backend(op)
         self.hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "increment_p": [],
                      "increment_h": [], "inner_iterations": [], "inner_missed": 0, "inner_worst": 0.0}
         if record:
@@ -81,12 +86,13 @@ class _Tracker:
             self.best, self.since_best = inc_p, 0
         else:
             self.since_best += 1
-        for key, val in (("residual", kkt), ("p_max", float(p.max())), ("n_contact", int(contact.sum())),
-                         ("changes", int(np.count_nonzero(contact != prev_contact))), ("increment_p", inc_p),
+        xp = self.backend.xp
+        for key, val in (("residual", kkt), ("p_max", float(xp.max(p))), ("n_contact", int(xp.count_nonzero(contact))),
+                         ("changes", int(xp.count_nonzero(contact != prev_contact))), ("increment_p", inc_p),
                          ("increment_h", inc_h), ("inner_iterations", inner)):
             h[key].append(val)
         if "p" in h:
-            h["p"].append(p[self.op.lattice.mask].copy())
+            h["p"].append(self.backend.to_host(p[self.mask]).copy())
         return delta, kkt
 
     def failing(self):
@@ -145,22 +151,24 @@ def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rto
     """
     eps_h = rtol if eps_h is None else eps_h
     eps_p = rtol if eps_p is None else eps_p
-    mask = op.lattice.mask
-    h = np.where(mask, h, 0.0)
+    bk, mask = operator_backend(op)
+    xp = bk.xp
+    layer = device_layer(layer, bk)
+    h = xp.where(mask, bk.asarray(h), 0.0)
     track = _Tracker(op, h, layer, force, approach, record)
     precond = op.preconditioner() if precondition else None
-    p = np.zeros(op.lattice.shape) if x0 is None else np.where(mask, np.maximum(x0, 0.0), 0.0)
+    p = xp.zeros(op.lattice.shape, dtype=bk.float64) if x0 is None else xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
     u = op.matvec(p)
-    dh_old = np.where(mask, layer.w(p), 0.0)
+    dh_old = xp.where(mask, layer.w(p), 0.0)
     delta, kkt, rule_met, reason = approach, np.inf, False, f"no convergence in maxiter = {maxiter} iterations"
     for k in range(1, maxiter + 1):
-        dh = np.where(mask, layer.w(p), 0.0)
-        sub = solve_qp(op, h + dh, force=force, approach=approach, x0=p if p.any() else None,
+        dh = xp.where(mask, layer.w(p), 0.0)
+        sub = solve_qp(op, h + dh, force=force, approach=approach, x0=p if bool(xp.any(p != 0)) else None,
                        rtol=rtol / 10, preconditioner=precond)
         track.count_inner(sub)
         omega = relaxation if k > 1 else 1.0
         p_new = (1 - omega) * p + omega * sub.p
-        if not np.all(np.isfinite(p_new)):
+        if not bool(xp.all(xp.isfinite(p_new))):
             reason = f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
             break
         u = (1 - omega) * u + omega * sub.displacement
@@ -170,7 +178,7 @@ def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rto
         delta, kkt = track.record(p, u, prev_contact, inc_p, inc_h, sub.iterations)
         if callback is not None:
             callback(k, p)
-        if not np.isfinite(kkt):
+        if not math.isfinite(kkt):
             reason = "the iteration produced a non-finite value"
             break
         if k > 1 and inc_h <= eps_h and inc_p <= eps_p and kkt <= rtol:
@@ -222,37 +230,39 @@ def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=Non
     step); the next QP lets the contact grow again from there.
     """
     eps_p = rtol if eps_p is None else eps_p
-    mask = op.lattice.mask
-    h = np.where(mask, h, 0.0)
+    bk, mask = operator_backend(op)
+    xp = bk.xp
+    layer = device_layer(layer, bk)
+    h = xp.where(mask, bk.asarray(h), 0.0)
     track = _Tracker(op, h, layer, force, approach, record)
-    p = None if x0 is None else np.where(mask, np.maximum(x0, 0.0), 0.0)
-    u = np.zeros(op.lattice.shape) if p is None else op.matvec(p)
-    lam = np.zeros(op.lattice.shape)
+    p = None if x0 is None else xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
+    u = xp.zeros(op.lattice.shape, dtype=bk.float64) if p is None else op.matvec(p)
+    lam = xp.zeros(op.lattice.shape, dtype=bk.float64)
     delta, kkt, rule_met, reason = approach, np.inf, False, f"no convergence in maxiter = {maxiter} iterations"
     for k in range(1, maxiter + 1):
-        contact = np.zeros(op.lattice.shape, bool) if p is None else p > 0
+        contact = xp.zeros(op.lattice.shape, dtype=xp.bool) if p is None else p > 0
         if p is not None:
-            p_ref = float(np.mean(p[contact])) if contact.any() else 1.0
-            with np.errstate(divide="ignore", invalid="ignore"):
-                lam = np.where(contact, layer.secant(p), layer.secant(np.zeros_like(p)))
-            lam = np.where(np.isfinite(lam), lam, float(layer.secant(p_ref)))
-            lam = np.where(mask, lam, 0.0)
+            p_ref = float(xp.mean(p[contact])) if bool(xp.any(contact)) else 1.0
+            with bk.errstate(divide="ignore", invalid="ignore"):
+                lam = xp.where(contact, layer.secant(p), layer.secant(xp.zeros_like(p)))
+            lam = xp.where(xp.isfinite(lam), lam, float(layer.secant(p_ref)))
+            lam = xp.where(mask, lam, 0.0)
         precond = compliance_preconditioner(op, lam, contact) if precondition else None
         sub = solve_qp(op, h, force=force, approach=approach, lam=lam, x0=p, rtol=rtol / 10,
                        preconditioner=precond)
         track.count_inner(sub)
         p_new = sub.p
-        if not np.all(np.isfinite(p_new)):
+        if not bool(xp.all(xp.isfinite(p_new))):
             reason = f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
             break
         u = sub.displacement
         inc_p = 1.0 if p is None else _increment(p_new, p)
-        same_set = p is not None and np.array_equal(p_new > 0, contact)
+        same_set = p is not None and not bool(xp.any((p_new > 0) != contact))
         p = p_new
         delta, kkt = track.record(p, u, contact, inc_p, np.nan, sub.iterations)
         if callback is not None:
             callback(k, p)
-        if not np.isfinite(kkt):
+        if not math.isfinite(kkt):
             reason = "the iteration produced a non-finite value"
             break
         if same_set and inc_p <= eps_p and kkt <= rtol:

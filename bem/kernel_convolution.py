@@ -155,7 +155,7 @@ class SymmetricKernelConvolution:
             spectra.append(s)
         return spectra[0], spectra[1], self._phase * spectra[1], np.conj(self._phase) * spectra[0]
 
-    def apply(self, terms):
+    def apply(self, terms, backend=None):
         """``sum over (spectrum, input) of K * v`` on the nodes of the lattice.
 
         Parameters
@@ -163,12 +163,17 @@ class SymmetricKernelConvolution:
         terms : list of (spectrum, input)
             :meth:`spectrum` and :meth:`transform` results; the spectra share their batch
             shape and their parity.
+        backend : bem.backend.Backend, optional
+            Run the products and inverse FFTs on this device (the arrays of ``terms`` are
+            copied to it); the result is a NumPy array either way.
 
         Returns
         -------
         ndarray, shape (..., n_rows, n_cols)
             Brick arrays (batch axes of the spectra first).
         """
+        if backend is not None and not backend.is_numpy:
+            return self._apply_on(backend, terms)
         import scipy.fft as sfft
 
         workers = self.workers
@@ -201,3 +206,30 @@ class SymmetricKernelConvolution:
                 col *= factor
             out[..., self._out_rows[a], :] = sfft.irfft(col, n=2 * self.N_q, axis=-1, workers=workers)[..., :n_cols]
         return out
+
+    def _apply_on(self, bk, terms):
+        """:meth:`apply` in the namespace of ``bk``: the same sums, without ``out=`` arguments."""
+        xp = bk.xp
+        n, n_cols = self.N_k, self.lattice.shape[1]
+        first = terms[0][0]
+        odd_y, factor = first[2], first[3]
+        batch = first[0].shape[:-2]
+        out = xp.empty(batch + self.lattice.shape, dtype=bk.float64)
+        cplx = xp.complex128
+        for a in (0, 1):
+            acc = xp.zeros(batch + (2 * n, self.N_q + 1), dtype=cplx)
+            for (t00, t01, _, _), inp in terms:
+                t00, t01 = bk.asarray(t00), bk.asarray(t01)
+                direct, shifted = bk.asarray(inp[a], dtype=cplx), bk.asarray(inp[2 + a], dtype=cplx)
+                acc[..., : n + 1, :] += t00 * direct[: n + 1, :] + t01 * shifted[: n + 1, :]
+                acc[..., n + 1 :, :] += t00[..., n - 1 : 0 : -1, :] * direct[n + 1 :, :] \
+                    - t01[..., n - 1 : 0 : -1, :] * shifted[n + 1 :, :]
+            if odd_y:
+                acc[..., n + 1 :, :] = -acc[..., n + 1 :, :]
+            col = xp.fft.ifft(acc, axis=-2)[..., : len(self._out_rows[a]), :]
+            if factor != 1:
+                col = col * factor
+            rows = self._out_rows[a]
+            step_rows = slice(int(rows[0]), int(rows[-1]) + 1 if int(rows[-1]) + 1 < out.shape[-2] else None, 2)
+            out[..., step_rows, :] = xp.fft.irfft(col, n=2 * self.N_q, axis=-1)[..., :n_cols]
+        return bk.to_host(out)

@@ -14,7 +14,7 @@ returns the largest; every solver reports it for its final state.
 
 from __future__ import annotations
 
-import numpy as np
+from .backend import backend_of, operator_backend
 
 __all__ = ["kkt_residual", "layered_state"]
 
@@ -44,22 +44,24 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
         with ``s`` = ``displacement_scale`` (``max |g|`` when that is 0, e.g.
         for ``p = 0``); 0 for an exact solution. ``inf`` if anything is not finite.
     """
-    p = np.asarray(p, dtype=float)
-    gap = np.asarray(gap, dtype=float)
-    if not (np.all(np.isfinite(p)) and np.all(np.isfinite(gap))):
+    bk = backend_of(p)
+    xp = bk.xp
+    p = bk.asarray(p)
+    gap = bk.asarray(gap)
+    if not (bool(xp.all(xp.isfinite(p))) and bool(xp.all(xp.isfinite(gap)))):
         return float("inf")
     s = float(displacement_scale)
     if s <= 0:  # no deformation at all: measure the gap against itself
-        s = float(np.abs(gap).max(initial=0.0)) or 1.0
-    p_max = float(p.max(initial=0.0))
+        s = bk.max0(xp.abs(gap)) or 1.0
+    p_max = bk.max0(p)
     contact = p > 0
     parts = [
-        max(0.0, float(-p.min(initial=0.0))) / p_max if p_max > 0 else 0.0,
-        float(np.abs(gap[contact]).max(initial=0.0)) / s,
-        max(0.0, float(-gap[~contact].min(initial=0.0))) / s,
+        max(0.0, -bk.min0(p)) / p_max if p_max > 0 else 0.0,
+        bk.max0(xp.abs(gap[contact])) / s,
+        max(0.0, -bk.min0(gap[~contact])) / s,
     ]
     if force is not None:
-        parts.append(abs(node_area * float(p.sum()) - force) / force)
+        parts.append(abs(node_area * float(xp.sum(p)) - force) / force)
     return max(parts)
 
 
@@ -91,15 +93,17 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None):
         :func:`kkt_residual` of the state.
     """
     lat = op.lattice
-    mask = lat.mask if mask is None else mask
-    closure = np.zeros_like(p) if layer is None else np.where(mask, layer.w(p), 0.0)
+    bk, op_mask = operator_backend(op)
+    xp = bk.xp
+    mask = op_mask if mask is None else mask
+    closure = xp.zeros_like(p) if layer is None else xp.where(mask, layer.w(p), 0.0)
     total = u + closure
     contact = mask & (p > 0)
     if force is not None:
-        delta = float(np.mean(total[contact] + h[contact])) if contact.any() else 0.0
+        delta = float(xp.mean(total[contact] + h[contact])) if bool(xp.any(contact)) else 0.0
     else:
         delta = float(approach)
-    gap = np.where(mask, total + h - delta, 0.0)
-    kkt = kkt_residual(p[mask], gap[mask], displacement_scale=float(np.abs(total[mask]).max()),
+    gap = xp.where(mask, total + h - delta, 0.0)
+    kkt = kkt_residual(p[mask], gap[mask], displacement_scale=float(xp.max(xp.abs(total[mask]))),
                        force=force, node_area=lat.node_area)
     return gap, delta, kkt

@@ -352,6 +352,9 @@ class LatticeWindow:
 
     def embed(self, values):
         """A parent brick array holding ``values`` (shape :attr:`shape`) in the window, 0 elsewhere."""
-        out = np.zeros(self.parent.shape)
+        from .backend import backend_of
+
+        bk = backend_of(values)  # a device array stays on its device
+        out = bk.xp.zeros(self.parent.shape, dtype=bk.float64)
         out[self.index] = values
         return out

@@ -22,10 +22,13 @@ is used and the line search settles the kink.
 from __future__ import annotations
 
 import logging
+import math
 
 import numpy as np
 from scipy.optimize import brentq
 
+from .backend import backend_of, operator_backend
+from .layers.device import device_layer
 from .kalker import QPSolution, compliance_preconditioner, solve_qp
 from .kkt import layered_state
 
@@ -34,28 +37,25 @@ __all__ = ["solve_newton"]
 log = logging.getLogger(__name__)
 
 
-def _dot(a, b):
-    """``a.b`` of two 1-D arrays, without BLAS.
-
-    np.dot and np.vdot call the threaded OpenBLAS ddot, which waits for its second thread:
-    on 86,000 nodes 0.02 ms on an idle 2-core machine, 12 ms median (up to 130 ms) with the
-    other core busy; np.einsum stays at 0.05 ms either way.
-    """
-    return float(np.einsum("i,i->", a, b))
+# Dot products go through Backend.dot: on NumPy np.einsum, because np.dot and np.vdot call the
+# threaded OpenBLAS ddot, which waits for its second thread: on 86,000 nodes 0.02 ms on an idle
+# 2-core machine, 12 ms median (up to 130 ms) with the other core busy; np.einsum stays at
+# 0.05 ms either way.
 
 
-def _tangent(layer, p, gap, p_ref):
+def _tangent(bk, layer, p, gap, p_ref):
     """Per-node model compliance ``D``: ``w'(p)`` where finite, else a secant."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        d = np.asarray(layer.dw(p), dtype=float)
+    xp = bk.xp
+    with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        d = bk.asarray(layer.dw(p))
         # the pressure at which the layer alone closes the gap, w^-1(-g); p_ref where it has none
-        reach = np.asarray(layer.inverse(np.maximum(-gap, 0.0)), dtype=float)
-        reach = np.where((reach > 0) & np.isfinite(reach), np.minimum(reach, 1e6 * p_ref), p_ref)
-        secant = np.asarray(layer.w(reach), dtype=float) / reach
-    return np.where(np.isfinite(d) & (p > 0), d, secant)
+        reach = bk.asarray(layer.inverse(xp.maximum(-gap, 0.0)))
+        reach = xp.where((reach > 0) & xp.isfinite(reach), xp.minimum(reach, 1e6 * p_ref), p_ref)
+        secant = bk.asarray(layer.w(reach)) / reach
+    return xp.where(xp.isfinite(d) & (p > 0), d, secant)
 
 
-def _majorant(layer, p, q, D, mask):
+def _majorant(op, layer, p, q, D, mask):
     """``D`` raised where the quadratic model underestimates ``W`` on the move ``p -> q``.
 
     The curvature that makes the model exact at ``q``,
@@ -67,18 +67,19 @@ def _majorant(layer, p, q, D, mask):
     """
     # a move much smaller than the pressure itself loses the curvature to cancellation in
     # W(q) - W(p) - w(p)(q - p); the tangent is exact to O(step^3) there and is kept
-    moves = mask & (np.abs(q - p) > 1e-6 * np.maximum(np.abs(p), np.abs(q)))
-    qq, pp = np.maximum(q[moves], 0.0), p[moves]
+    bk, _ = operator_backend(op)
+    xp = bk.xp
+    moves = mask & (xp.abs(q - p) > 1e-6 * xp.maximum(xp.abs(p), xp.abs(q)))
+    qq, pp = xp.maximum(q[moves], 0.0), p[moves]
     step = qq - pp
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+    with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
         d_maj = 2.0 * (layer.energy(qq) - layer.energy(pp) - layer.w(pp) * step) / (step * step)
-    out = D.copy()
-    raise_ = np.isfinite(d_maj) & (d_maj > D[moves])
-    out.flat[np.flatnonzero(moves)[raise_]] = d_maj[raise_]
-    return out
+    out = bk.copy(D)
+    raise_ = xp.isfinite(d_maj) & (d_maj > D[moves])
+    return bk.put(out, bk.subset(bk.select(moves), raise_), d_maj[raise_])
 
 
-def _line_search(layer, p, d, u, cd, h, delta, mask):
+def _line_search(bk, layer, p, d, u, cd, h, delta, mask):
     """Exact minimiser of ``Phi(p + t d)`` on ``(0, 1]``: root of ``d.grad Phi(p + t d)``.
 
     Under force control ``sum d = 0``, so ``delta`` drops out of the derivative.
@@ -87,7 +88,7 @@ def _line_search(layer, p, d, u, cd, h, delta, mask):
     ps, ds, us, cds, hs = p[sel], d[sel], u[sel], cd[sel], h[sel]
 
     def slope(t):
-        return _dot(ds, us + t * cds + layer.w(np.maximum(ps + t * ds, 0.0)) + hs - delta)
+        return bk.dot(ds, us + t * cds + layer.w(bk.xp.maximum(ps + t * ds, 0.0)) + hs - delta)
 
     s0, s1 = slope(0.0), slope(1.0)
     if s0 >= 0:
@@ -97,20 +98,21 @@ def _line_search(layer, p, d, u, cd, h, delta, mask):
     return brentq(slope, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps)
 
 
-def _energy_change(layer, p, delta_p, u, c_dp, h, delta, mask):
+def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
     """``(Phi(p + dp) - Phi(p)) / a`` of eq. 15, free of cancellation.
 
     ``u = C p``, ``c_dp = C dp``. The layer term uses the Taylor expansion where the move
     is tiny against the pressure, so that changes far below the round-off of ``Phi``
     itself are still measured with their sign.
     """
+    xp = bk.xp
     dp, pp = delta_p[mask], p[mask]
-    lin = _dot(dp, u[mask] + h[mask] - delta) + 0.5 * _dot(dp, c_dp[mask])
-    small = np.abs(dp) < 1e-4 * pp
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        taylor = layer.w(pp) * dp + 0.5 * np.asarray(layer.dw(pp), dtype=float) * dp * dp
-        direct = layer.energy(np.maximum(pp + dp, 0.0)) - layer.energy(pp)
-    return lin + float(np.sum(np.where(small, taylor, direct)))
+    lin = bk.dot(dp, u[mask] + h[mask] - delta) + 0.5 * bk.dot(dp, c_dp[mask])
+    small = xp.abs(dp) < 1e-4 * pp
+    with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        taylor = layer.w(pp) * dp + 0.5 * bk.asarray(layer.dw(pp)) * dp * dp
+        direct = layer.energy(xp.maximum(pp + dp, 0.0)) - layer.energy(pp)
+    return lin + float(xp.sum(xp.where(small, taylor, direct)))
 
 
 def _count_inner(hist, sub):
@@ -122,7 +124,7 @@ def _count_inner(hist, sub):
 
 def _scaled(p, force, node_area):
     """``p`` rescaled to carry ``force`` (force control); ``p`` itself otherwise."""
-    return p if force is None else p * (force / node_area / p.sum())
+    return p if force is None else p * (force / node_area / float(backend_of(p).xp.sum(p)))
 
 
 def _release(op, layer, h, p, u, q, delta, *, force):
@@ -140,28 +142,28 @@ def _release(op, layer, h, p, u, q, delta, *, force):
     of 6; the others are released by the model of a later step).
     Returns ``(p, u)``.
     """
-    mask = op.lattice.mask
-    out = np.flatnonzero(mask & (q == 0) & (p > 0))
-    if not out.size:
+    bk, mask = operator_backend(op)
+    xp = bk.xp
+    out = bk.select(mask & (q == 0) & (p > 0))
+    if not bk.count(out):
         return p, u
-    pf, uf, hf = p.reshape(-1), u.reshape(-1), h.reshape(-1)
     if force is not None:
-        contact = np.flatnonzero(pf > 0)
-        delta = float(np.mean(uf[contact] + np.asarray(layer.w(pf[contact]), dtype=float) + hf[contact]))
-    pn = pf[out]
-    with np.errstate(over="ignore", invalid="ignore"):
-        gain = pn * (uf[out] + hf[out] - delta) + layer.energy(pn) - 0.5 * op.diagonal * pn * pn
-    out = out[gain > 0]
-    if not out.size:
+        contact = bk.select(p > 0)
+        pc = bk.take(p, contact)
+        delta = float(xp.mean(bk.take(u, contact) + bk.asarray(layer.w(pc)) + bk.take(h, contact)))
+    pn = bk.take(p, out)
+    with bk.errstate(over="ignore", invalid="ignore"):
+        gain = pn * (bk.take(u, out) + bk.take(h, out) - delta) + layer.energy(pn) - 0.5 * op.diagonal * pn * pn
+    out = bk.subset(out, gain > 0)
+    if not bk.count(out):
         return p, u
-    trial = p.copy()
-    trial.reshape(-1)[out] = 0.0
-    if force is not None and trial.sum() <= 0:
+    trial = bk.put(bk.copy(p), out, 0.0)
+    if force is not None and float(xp.sum(trial)) <= 0:
         return p, u
     trial = _scaled(trial, force, op.lattice.node_area)
     dp = trial - p
     c_dp = op.matvec(dp)
-    if _energy_change(layer, p, dp, u, c_dp, h, delta, mask) < 0:
+    if _energy_change(bk, layer, p, dp, u, c_dp, h, delta, mask) < 0:
         return trial, u + c_dp
     return p, u
 
@@ -212,23 +214,25 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     KKT residual, never below ``rtol / 3``): an inexact Newton method whose
     forcing term keeps the local convergence superlinear.
     """
-    mask = op.lattice.mask
-    h = np.where(mask, h, 0.0)
+    bk, mask = operator_backend(op)
+    xp = bk.xp
+    layer = device_layer(layer, bk)
+    h = xp.where(mask, bk.asarray(h), 0.0)
     if x0 is None:
         # smooth-body solution, then one secant (variable compliance) step: a start
         # that is fair for stiff and for layer-dominated problems alike
         start = solve_qp(op, h, force=force, approach=approach, rtol=1e-3,
                          preconditioner=op.preconditioner() if precondition else None)
         contact = start.p > 0
-        lam = float(layer.secant(np.mean(start.p[contact]))) if contact.any() else 0.0
-        if np.isfinite(lam) and lam > 0:
+        lam = float(layer.secant(float(xp.mean(start.p[contact])))) if bool(xp.any(contact)) else 0.0
+        if math.isfinite(lam) and lam > 0:
             start = solve_qp(op, h, force=force, approach=approach, lam=lam, rtol=1e-3,
                              preconditioner=op.preconditioner(lam=lam) if precondition else None)
         p = start.p
     else:
-        p = np.where(mask, np.maximum(x0, 0.0), 0.0)
+        p = xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
         if force is not None:
-            p *= force / op.lattice.node_area / p.sum()
+            p *= force / op.lattice.node_area / float(xp.sum(p))
     u = op.matvec(p)
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "step": [], "inner_iterations": [],
             "inner_missed": 0, "inner_worst": 0.0}
@@ -243,13 +247,13 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach)
         contact = p > 0
         hist["residual"].append(kkt)
-        hist["p_max"].append(float(p.max()))
-        hist["n_contact"].append(int(contact.sum()))
-        hist["changes"].append(int(np.count_nonzero(contact != prev)))
+        hist["p_max"].append(float(xp.max(p)))
+        hist["n_contact"].append(int(xp.count_nonzero(contact)))
+        hist["changes"].append(int(xp.count_nonzero(contact != prev)))
         if record:
-            hist["p"].append(p[mask].copy())
+            hist["p"].append(bk.to_host(p[mask]).copy())
         prev = contact
-        if not np.isfinite(kkt):
+        if not math.isfinite(kkt):
             message = "the iteration produced a non-finite value"
             break
         if kkt <= rtol:
@@ -258,9 +262,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         if k == maxiter:
             message = f"no convergence in maxiter = {maxiter} Newton steps (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
             break
-        p_ref = float(np.mean(p[contact])) if contact.any() else 1.0
-        D = np.where(mask, _tangent(layer, p, gap, p_ref), 0.0)
-        b = h + np.where(mask, layer.w(p), 0.0) - D * p
+        p_ref = float(xp.mean(p[contact])) if bool(xp.any(contact)) else 1.0
+        D = xp.where(mask, _tangent(bk, layer, p, gap, p_ref), 0.0)
+        b = h + xp.where(mask, layer.w(p), 0.0) - D * p
         inner = max(rtol / 3, min(1e-2, 0.1 * kkt**1.5))
         # the model starts at p with the product u Newton carries, and Newton checks every step on
         # its own residual: no product to start or to confirm the inner solve (root layer, 1M
@@ -271,11 +275,11 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         _count_inner(hist, sub)
         d = sub.p - p
         cd = sub.displacement - u
-        t = _line_search(layer, p, d, u, cd, h, delta, mask)
+        t = _line_search(bk, layer, p, d, u, cd, h, delta, mask)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
-            scale = float(np.abs(u + np.where(mask, layer.w(p), 0.0)).max())
-            D = _majorant(layer, p, sub.p, D, mask)
-            b = h + np.where(mask, layer.w(p), 0.0) - D * p
+            scale = float(xp.max(xp.abs(u + xp.where(mask, layer.w(p), 0.0))))
+            D = _majorant(op, layer, p, sub.p, D, mask)
+            b = h + xp.where(mask, layer.w(p), 0.0) - D * p
             sub = solve_qp(op, b, force=force, approach=approach, lam=D, x0=p, rtol=max(rtol / 3, 1e-3 * kkt),
                            maxiter=4 * inner_maxiter, scale=scale,
                            preconditioner=compliance_preconditioner(op, D, contact) if precondition else None,
@@ -283,7 +287,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             _count_inner(hist, sub)
             d = sub.p - p
             cd = sub.displacement - u
-            t = _line_search(layer, p, d, u, cd, h, delta, mask)
+            t = _line_search(bk, layer, p, d, u, cd, h, delta, mask)
         judged = None
         if t == 0.0:
             # No decrease of Phi measurable along d: the change of Phi falls below its round-off
@@ -291,7 +295,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             # still violate their gap. The step is then chosen by the KKT residual instead:
             # t = 1, 1/2, 1/4, 1/8, the first that lowers it.
             for t_try in (1.0, 0.5, 0.25, 0.125):
-                trial = _scaled(np.maximum(p + t_try * d, 0.0), force, op.lattice.node_area)
+                trial = _scaled(xp.maximum(p + t_try * d, 0.0), force, op.lattice.node_area)
                 u_trial = op.matvec(trial)
                 if layered_state(op, h, layer, trial, u_trial, force=force, approach=approach)[2] < kkt:
                     judged = t_try
@@ -304,7 +308,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             message = f"line search found no descent (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
             break
         else:
-            p = _scaled(np.maximum(p + t * d, 0.0), force, op.lattice.node_area)
+            p = _scaled(xp.maximum(p + t * d, 0.0), force, op.lattice.node_area)
             u, exact = u + t * cd, False
         p, u = _release(op, layer, h, p, u, sub.p, delta, force=force)
         if callback is not None:
@@ -313,7 +317,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         log.debug("Newton: %s", message)
     out = QPSolution(p=p, approach=delta, iterations=len(hist["step"]), converged=converged, message=message,
                      kkt_residual=float(kkt), displacement=u, history=hist)
-    if force is not None and not converged and np.isfinite(delta) and delta > 0:
+    if force is not None and not converged and math.isfinite(delta) and delta > 0:
         out = _force_by_approach(op, h, layer, force, out, rtol=rtol, maxiter=maxiter, precondition=precondition,
                                  inner_maxiter=inner_maxiter)
     return out
@@ -342,7 +346,7 @@ def _force_by_approach(op, h, layer, force, failed, *, rtol, **kw):
         if not sol.converged:
             raise _ApproachFailed(sol.message)
         solved[delta] = sol
-        return a * float(sol.p.sum()) / force - 1.0
+        return a * float(backend_of(sol.p).xp.sum(sol.p)) / force - 1.0
 
     delta = failed.approach
     try:

@@ -32,6 +32,7 @@ from collections import OrderedDict
 import numpy as np
 
 from . import fft
+from .backend import get_backend
 from .checks import check_positive
 from .template import template
 
@@ -63,13 +64,21 @@ def _contains(outer, inner):
     return all(within(o, i) for o, i in zip(outer[0], inner[0])) and within(outer[1], inner[1])
 
 
+def _rows(s, k0, n, n_rows):
+    """Slice of the brick rows ``s + 2 k``, ``k0 <= k < k0 + n``, of an array of ``n_rows`` rows."""
+    stop = s + 2 * (k0 + n) - 1
+    return slice(s + 2 * k0, stop if stop < n_rows else None, 2)
+
+
 def _block_product(S, V):
-    """``V_a <- sum_b S_ab V_b`` in place on a pair of spectra, two temporaries."""
-    t = S[0][1] * V[1]
-    V[1] *= S[1][1]
-    V[1] += S[1][0] * V[0]
-    V[0] *= S[0][0]
-    V[0] += t
+    """``V_a <- sum_b S_ab V_b`` in place on a pair of spectra (``V`` of shape ``(2, ...)``), two temporaries."""
+    if not isinstance(S, tuple):  # the kernel spectra of a window, one array S[a, b, ...]
+        S = ((S[0, 0, ...], S[0, 1, ...]), (S[1, 0, ...], S[1, 1, ...]))
+    t = S[0][1] * V[1, ...]
+    V[1, ...] *= S[1][1]
+    V[1, ...] += S[1][0] * V[0, ...]
+    V[0, ...] *= S[0][0]
+    V[0, ...] += t
     return V
 
 
@@ -82,17 +91,22 @@ class InfluenceOperator:
         The candidate region, or a window of it (the operator of the nodes in the window).
     E_star : float
         Effective modulus ``E*`` [pressure], ``1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2``.
+    device : {"cpu", "cuda"} or module, optional
+        Where the products run (:func:`bem.backend.get_backend`).
 
     Notes
     -----
-    Pressures are brick arrays of shape ``lattice.shape`` [pressure];
-    displacements come back in the same shape [length]. Masked nodes of the
-    input must be zero; they are zero on output too. The FFTs use
-    :func:`bem.fft.threads` threads.
+    Pressures are brick arrays of shape ``lattice.shape`` [pressure] in the device's
+    namespace; displacements come back in the same shape and namespace [length]. Masked
+    nodes of the input must be zero; they are zero on output too. On the CPU the FFTs use
+    :func:`bem.fft.threads` threads. The kernel spectra of a support window are built on
+    the host and copied to the device once per window (a few windows are cached).
     """
 
-    def __init__(self, lattice, E_star):
+    def __init__(self, lattice, E_star, device="cpu"):
         self.lattice = lattice
+        self.backend = get_backend(device)
+        self.mask = self.backend.asarray(lattice.mask, dtype=self.backend.xp.bool)  # candidate nodes, on the device
         self.n_matvec = 0  # products C p so far (the work measure of ContactResult.n_matvec)
         self.E_star = check_positive("E_star", E_star)
         n_rows, n_cols = lattice.shape
@@ -110,21 +124,25 @@ class InfluenceOperator:
 
     # -- geometry of the 2 x 2 block convolution -------------------------------------------------
 
-    def _parity_rows(self, v):
-        """Views of the even-class and odd-class rows of a brick array."""
-        return [v[s::2] for s in self._start]
-
     def _box(self, v):
         """Snapped bounding box of the support of ``v``: parity row ranges and a column range.
 
         Returns ``None`` for ``v = 0``.
         """
         n_rows, n_cols = v.shape
-        rows = np.flatnonzero(v.any(axis=1))  # NaN counts as support
-        if rows.size == 0:
-            return None
-        first, last = int(rows[0]), int(rows[-1])
-        cols = np.flatnonzero(v[first : last + 1].any(axis=0))
+        if self.backend.is_numpy:
+            rows = np.flatnonzero(v.any(axis=1))  # NaN counts as support
+            if rows.size == 0:
+                return None
+            first, last = int(rows[0]), int(rows[-1])
+            cols = np.flatnonzero(v[first : last + 1].any(axis=0))
+        else:  # the same on the device: two index vectors come back, not the array
+            xp = self.backend.xp
+            rows = xp.nonzero(xp.any(v != 0, axis=1))[0]
+            if rows.shape[0] == 0:
+                return None
+            first, last = int(rows[0]), int(rows[-1])
+            cols = xp.nonzero(xp.any(v[first : last + 1, :] != 0, axis=0))[0]
         gr, gc = -(-n_rows // _SNAP), -(-n_cols // _SNAP)
         r0, r1 = (first - 1) // gr * gr, min(n_rows, (last + 1 + gr) // gr * gr)
         c0, c1 = (int(cols[0]) - 1) // gc * gc, min(n_cols, (int(cols[-1]) + 1 + gc) // gc * gc)
@@ -164,7 +182,7 @@ class InfluenceOperator:
                     for cols, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq + 1, lq), slice(nq, None))):
                         kernels[a, b, rows, cols] = block[src_r, src_c]
         kernels /= lk * lq
-        return (lk, lq), fft.forward(kernels, (lk, lq))
+        return (lk, lq), self.backend.forward(self.backend.asarray(kernels), (lk, lq))
 
     def _cached(self, key, build):
         if key in self._spectra:
@@ -199,15 +217,16 @@ class InfluenceOperator:
     def _convolve(self, spectra, shape, v, in_box, out_box, out):
         """``out[out_box] = sum_b S_ab v_b[in_box]``; other entries of ``out`` are left alone."""
         (i_rows, (iq, bq)), (o_rows, (oq, nq)) = in_box, out_box
-        data = np.zeros((2, max(r[1] for r in i_rows), bq))
-        for b, vb in enumerate(self._parity_rows(v)):
+        bk = self.backend
+        data = bk.xp.zeros((2, max(r[1] for r in i_rows), bq), dtype=bk.float64)
+        for b, s in enumerate(self._start):  # the rows of parity b: brick rows s, s + 2, ...
             k0, nb = i_rows[b]
-            data[b, :nb] = vb[k0 : k0 + nb, iq : iq + bq]
-        V = _block_product(spectra, fft.forward(data, shape))
-        res = fft.inverse(V, shape, (max(r[1] for r in o_rows), nq))
-        for a, oa in enumerate(self._parity_rows(out)):
+            data[b, :nb, :] = v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq]
+        V = _block_product(spectra, bk.forward(data, shape))
+        res = bk.inverse(V, shape, (max(r[1] for r in o_rows), nq))
+        for a, s in enumerate(self._start):
             k0, na = o_rows[a]
-            oa[k0 : k0 + na, oq : oq + nq] = res[a, :na]
+            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = res[a, :na, :]
         if self._masked_last:
             out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 
@@ -216,11 +235,12 @@ class InfluenceOperator:
     def matvec(self, p):
         """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]."""
         self.n_matvec += 1
-        p = np.asarray(p, dtype=float)
+        bk = self.backend
+        p = bk.asarray(p)
         box = self._box(p)
         if box is None:
-            return np.zeros(self.lattice.shape)
-        out = np.empty(self.lattice.shape)  # every entry is written below
+            return bk.xp.zeros(self.lattice.shape, dtype=bk.float64)
+        out = bk.xp.empty(self.lattice.shape, dtype=bk.float64)  # every entry is written below
         box, (shape, spectra) = self._window(box)
         self._convolve(spectra, shape, p, box, self._full(), out)
         return out
@@ -262,9 +282,11 @@ class InfluenceOperator:
         full = check_choice("box", box, ("support", "full")) == "full"
         symbols = {}
 
+        bk = self.backend
+
         def apply(r):
-            r = np.asarray(r, dtype=float)
-            out = np.zeros(self.lattice.shape)
+            r = bk.asarray(r)
+            out = bk.xp.zeros(self.lattice.shape, dtype=bk.float64)
             box = self._box(r)
             if box is None:
                 return out
@@ -282,22 +304,23 @@ class InfluenceOperator:
 
     def _inverse_symbol(self, K, shape, lam, floor):
         """Spectra of ``(K + lam)^-1`` for a symmetric 2 x 2 block symbol (eigenvalues floored)."""
+        xp = self.backend.xp
         lam_hat = lam / (shape[0] * shape[1])  # spectra carry the 1/(Lk Lq) of the inverse FFT
-        A, D, B = K[0, 0].real + lam_hat, K[1, 1].real + lam_hat, K[0, 1]
+        A, D, B = xp.real(K[0, 0, ...]) + lam_hat, xp.real(K[1, 1, ...]) + lam_hat, K[0, 1, ...]
         m = (A + D) / 2
-        d = np.sqrt(((A - D) / 2) ** 2 + np.abs(B) ** 2)
+        d = xp.sqrt(((A - D) / 2) ** 2 + xp.abs(B) ** 2)
         low = (floor * self.diagonal + lam) / (shape[0] * shape[1])
-        inv_hi = 1.0 / np.maximum(m + d, low)
-        inv_lo = 1.0 / np.maximum(m - d, low)
+        inv_hi = 1.0 / xp.maximum(m + d, low)
+        inv_lo = 1.0 / xp.maximum(m - d, low)
         # H^-1 = P+/l+ + P-/l-,  P+ = (H - (m - d) I) / (2 d),  P- = I - P+
-        with np.errstate(divide="ignore", invalid="ignore"):
-            safe = d > 1e-14 * np.abs(m)
-            half = np.where(safe, 0.5 / np.where(safe, d, 1.0), 0.0)
+        with self.backend.errstate(divide="ignore", invalid="ignore"):
+            safe = d > 1e-14 * xp.abs(m)
+            half = xp.where(safe, 0.5 / xp.where(safe, d, 1.0), 0.0)
         diff = inv_hi - inv_lo
         pb = B * half * diff
         scale = 1.0 / (shape[0] * shape[1]) ** 2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
-        return ((inv_lo + np.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale), \
-            (np.conj(pb) * scale, (inv_lo + np.where(safe, (D - m + d) * half, 0.5) * diff) * scale)
+        return ((inv_lo + xp.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale), \
+            (xp.conj(pb) * scale, (inv_lo + xp.where(safe, (D - m + d) * half, 0.5) * diff) * scale)
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""

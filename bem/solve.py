@@ -7,6 +7,7 @@ import time
 
 import numpy as np
 
+from .backend import get_backend, to_host
 from .checks import (check_bool, check_callable, check_choice, check_finite_array, check_int, check_load,
                      check_rtol, check_scale)
 from .errors import InputError, RegionTooSmallError
@@ -49,7 +50,7 @@ def _levels(lattice, nested):
 
 def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None, approach=None,
           step, extent, layer=None, method="newton", rtol=1e-10, maxiter=None, x0=None,
-          nested=None, precondition=True, callback=None, **options):
+          nested=None, precondition=True, callback=None, device="cpu", **options):
     """Frictionless normal contact of two elastic half-spaces with an interface layer.
 
     Minimises the generalised Kalker functional (eq. 11, 15)
@@ -107,7 +108,15 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         Use the FFT (and, with a layer, block-Jacobi) preconditioner in the conjugate
         gradients.
     callback : callable, optional
-        ``callback(k, p_grid)`` after every iteration on the finest lattice.
+        ``callback(k, p_grid)`` after every iteration on the finest lattice; ``p_grid`` is a
+        brick array in the namespace of ``device``.
+    device : {"cpu", "cuda"} or module
+        Where the arrays live and the FFTs run (:mod:`bem.backend`): ``"cpu"`` (NumPy,
+        ``scipy.fft`` on :func:`bem.fft.threads` threads), ``"cuda"`` (CuPy and cuFFT, the
+        ``gpu`` extra), or an array API standard namespace. The iterations keep their arrays
+        on the device; the result's arrays are NumPy arrays on the host for every device.
+        Layer laws other than the closed forms of :mod:`bem.layers.analytic` are evaluated
+        on the host (:func:`bem.layers.device.device_layer`).
     **options
         Options of one solver, refused (:class:`bem.InputError`) where they do not apply
         to the solver that runs (:data:`OPTIONS`): ``record`` (keep every iterate in
@@ -159,6 +168,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         nested = check_bool("nested", nested)
     if callback is not None:
         check_callable("callback", callback)
+    backend = get_backend(device)
     lattice = Lattice.from_extent(step, extent)
     if hasattr(gap, "check_region"):  # a gap known on a bounded region only (bem.gaps.RegionTable)
         gap.check_region(extent)
@@ -188,12 +198,12 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         if maxiter is not None:
             kw["maxiter"] = maxiter
         window = _candidate_window(lat, h, delta) if nested else None
-        sol, ops = _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window)
+        sol, ops = _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window, backend)
         delta = sol.approach
         if not finest:
             guess = _prolong(lat, sol.p, levels[level + 1])
     _check_border(lattice, sol.p, extent)
-    op = ops[-1] if ops[-1].lattice is lattice else InfluenceOperator(lattice, E_star)
+    op = ops[-1] if ops[-1].lattice is lattice else InfluenceOperator(lattice, E_star, device=backend)
     closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
     result = _result(lattice, op, h, sol, closure, E_star, layer, solver, force, t_start,
                      n_matvec=sum(o.n_matvec for o in ops if o is not op))
@@ -211,7 +221,17 @@ def _inner_summary(history):
 
 
 def _run(solver, op, h, layer, precondition, kw, options):
-    """Dispatch one lattice level to the solver."""
+    """Dispatch one lattice level to the solver; the solution's arrays come back on the host."""
+    sol = _dispatch(solver, op, h, layer, precondition, kw, options)
+    if op.backend.is_numpy:
+        return sol
+    hist = dict(sol.history)
+    return QPSolution(p=to_host(sol.p), approach=float(sol.approach), iterations=sol.iterations,
+                      converged=sol.converged, message=sol.message, kkt_residual=sol.kkt_residual,
+                      displacement=to_host(sol.displacement), history=hist)
+
+
+def _dispatch(solver, op, h, layer, precondition, kw, options):
     from .fixed_point import solve_augmented_gap, solve_variable_compliance
     from .kalker import solve_qp
     from .newton import solve_newton
@@ -282,11 +302,11 @@ def _embedded(sol, window):
                       displacement=None, history=hist)
 
 
-def _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window):
+def _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window, backend):
     """Solve one lattice level, on ``window`` where given; returns the solution and the operators used."""
     ops = []
     if window is not None:
-        op = InfluenceOperator(window, E_star)
+        op = InfluenceOperator(window, E_star, device=backend)
         ops.append(op)
         kw_w = dict(kw, x0=None if kw["x0"] is None else kw["x0"][window.index])
         if kw["callback"] is not None:
@@ -300,7 +320,7 @@ def _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window)
         # solution; the result reports that solve's iterations.
         log.debug("candidate window too small (approach %.6g): solving on the full lattice", sol.approach)
         kw = dict(kw, x0=sol.p)
-    op = InfluenceOperator(lat, E_star)
+    op = InfluenceOperator(lat, E_star, device=backend)
     ops.append(op)
     return _run(solver, op, h, layer, precondition, kw, options), ops
 
@@ -353,7 +373,7 @@ def _check_border(lattice, p, extent):
 def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start, n_matvec=0):
     mask = lattice.mask
     p = sol.p
-    u = op.matvec(p)
+    u = to_host(op.matvec(p))
     g = u + closure + h - sol.approach
     a = lattice.node_area
     kkt = kkt_residual(p[mask], g[mask], displacement_scale=float(np.abs(u + closure).max()),

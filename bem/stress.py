@@ -241,18 +241,23 @@ def _check_points(lattice, x, y):
     return x, y
 
 
-def _convolve_depths(lattice, grid, loaded, depths, nu, x, y, on_nodes, store, vm):
+def _convolve_depths(lattice, grid, loaded, depths, nu, x, y, on_nodes, store, vm, backend):
     """Fill ``store[k]`` (6, M) and ``vm[k]`` for every depth (lattice units), depths in parallel threads."""
     (r0, q0), (r1, q1) = loaded.min(axis=0), loaded.max(axis=0)
     p_box = grid[r0: r1 + 1, q0: q1 + 1]
     m = _MARGIN
     cores = max(1, os.cpu_count() or 1)
-    threads = min(cores, len(depths)) if grid.size >= _PARALLEL_NODES else 1
+    threads = min(cores, len(depths)) if grid.size >= _PARALLEL_NODES and backend.is_numpy else 1
     conv = SymmetricKernelConvolution(lattice, (r0 - m, r1 + m), (q0 - m, q1 + m),
                                       workers=max(1, cores // threads))
     filtered = conv.transform(bq.filter_pressure(lattice, p_box, r0, m))
     direct = conv.transform(np.pad(p_box, m)) if (depths < bq.R_NEAR).any() else None
     offsets = conv.offsets()
+    if not backend.is_numpy:  # the pressure spectra go to the device once
+        def move(spectra):
+            return None if spectra is None else tuple(backend.asarray(v, dtype=backend.xp.complex128) for v in spectra)
+
+        filtered, direct = move(filtered), move(direct)
 
     def one(k):
         depth = float(depths[k])
@@ -268,7 +273,7 @@ def _convolve_depths(lattice, grid, loaded, depths, nu, x, y, on_nodes, store, v
             terms = [(conv.spectrum(g00[sl], g01[sl], odd_x=odd_x, odd_y=odd_y), filtered)]
             if near:
                 terms.append((conv.spectrum(c00[sl], c01[sl], odd_x=odd_x, odd_y=odd_y), direct))
-            fields[sl] = conv.apply(terms)
+            fields[sl] = conv.apply(terms, backend)
         if on_nodes:
             _gather(fields, lattice, store[k])
         else:
@@ -284,7 +289,7 @@ def _convolve_depths(lattice, grid, loaded, depths, nu, x, y, on_nodes, store, v
             list(pool.map(one, range(len(depths))))
 
 
-def subsurface_stress(result, z, *, nu, x=None, y=None):
+def subsurface_stress(result, z, *, nu, x=None, y=None, device="cpu"):
     """Stress tensor at depths ``z`` below the surface of a body under the computed contact pressure.
 
     Parameters
@@ -301,6 +306,12 @@ def subsurface_stress(result, z, *, nu, x=None, y=None):
     x, y : array_like, shape (M,), optional
         Horizontal points [length] inside the candidate region; default: every candidate node
         (``result.x``, ``result.y``). Values between nodes are interpolated linearly.
+    device : {"cpu", "cuda"} or module
+        Where the convolutions run (:mod:`bem.backend`). The kernel samples and their
+        cosine/sine transforms (not in the array API standard) are computed on the host and
+        copied to the device per depth; the products with the pressure spectra and the inverse
+        FFTs run on the device, and each depth's fields come back to the host. The result's
+        arrays are NumPy arrays for every device.
 
     Returns
     -------
@@ -324,7 +335,10 @@ def subsurface_stress(result, z, *, nu, x=None, y=None):
     points into the body; in a frame whose z axis points up into the upper body, the lower
     body's shear stresses ``xz`` and ``yz`` change sign.
     """
+    from .backend import get_backend
+
     t0 = time.perf_counter()
+    backend = get_backend(device)
     if not isinstance(result, ContactResult):
         raise InputError(f"result = {type(result).__name__} is not allowed: it must be a bem.ContactResult "
                          "(the return value of bem.solve).")
@@ -355,7 +369,7 @@ def subsurface_stress(result, z, *, nu, x=None, y=None):
     vm = np.zeros((z.size, x.size))
     loaded = np.argwhere(grid != 0)
     if loaded.size:
-        _convolve_depths(lattice, grid, loaded, z / c, nu, x, y, on_nodes, store, vm)
+        _convolve_depths(lattice, grid, loaded, z / c, nu, x, y, on_nodes, store, vm, backend)
     sigma = np.moveaxis(store, 1, 2)  # (n_z, M, 6), a view
     vmax, vdepth, vn = _peak(vm, z)
     # the largest maximum shear lies where von Mises >= (sqrt(3)/2) max von Mises (since

@@ -29,7 +29,8 @@ DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "tqdm": "tqdm", "meshio": "
                  "gmsh": "gmsh", "skfem": "scikit-fem", "matplotlib": "matplotlib", "PIL": "pillow",
                  "dask": "dask", "distributed": "dask", "cupy": "cupy-cuda12x", "pytest": "pytest",
                  "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography",
-                 "pyvista": "pyvista"}
+                 "pyvista": "pyvista", "array_api_compat": "array-api-compat",
+                 "array_api_strict": "array-api-strict"}
 OWN = ("bem", "fem_reference", "validation", "tests")
 
 
@@ -74,11 +75,12 @@ def test_extras_layout():
     assert _extra("fem") == {"gmsh", "scikit-fem"}
     assert _extra("report") == {"matplotlib", "pillow"}
     assert _extra("dask") == {"dask"}
-    assert _extra("gpu") == {"cupy-cuda12x"}
+    assert _extra("gpu") == {"cupy-cuda12x", "array-api-compat"}
     assert _extra("3d") == {"pyvista"}
     assert _extra("rough") == {"surfacetopography"}
     assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask") | _extra("rough")
-    assert _extra("test") == _extra("all") | _extra("3d") | {"pytest", "html5lib", "pyyaml"}
+    assert _extra("test") == _extra("all") | _extra("3d") | {"pytest", "html5lib", "pyyaml", "array-api-strict",
+                                                             "array-api-compat"}
 
 
 def test_every_import_is_declared():

@@ -13,7 +13,9 @@ report    matplotlib, pillow (PIL)    ``contactlab report``, :mod:`validation.re
 dask      dask[distributed]           ``contactlab sweep --scheduler ADDRESS``
                 (dask.distributed)
 rough     SurfaceTopography           :mod:`bem.rough`: instrument files, self-affine surfaces
-gpu       cupy-cuda12x (cupy)         declared for the GPU path (not used yet)
+gpu       cupy-cuda12x (cupy),        ``device="cuda"`` of :func:`bem.solve`, :func:`bem.solve_periodic`,
+                array-api-compat            :func:`bem.subsurface_stress` (:mod:`bem.backend`)
+                (array_api_compat)
 ========  ==========================  ============================================
 
 :func:`require` is called where a command or scene is checked, before any work: a missing
@@ -31,8 +33,9 @@ __all__ = ["EXTRAS", "MissingExtraError", "require", "missing"]
 
 #: extra -> import names of the packages it installs
 EXTRAS = {"fem": ("gmsh", "skfem"), "report": ("matplotlib", "PIL"), "3d": ("pyvista",),
-          "dask": ("dask.distributed",), "rough": ("SurfaceTopography",), "gpu": ("cupy",)}
-_DIST = {"skfem": "scikit-fem", "PIL": "pillow", "dask.distributed": "dask[distributed]", "cupy": "cupy-cuda12x"}
+          "dask": ("dask.distributed",), "rough": ("SurfaceTopography",), "gpu": ("cupy", "array_api_compat")}
+_DIST = {"skfem": "scikit-fem", "PIL": "pillow", "dask.distributed": "dask[distributed]", "cupy": "cupy-cuda12x",
+         "array_api_compat": "array-api-compat"}
 _SYSTEM_LIBS = ("On Debian/Ubuntu: apt-get install libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 "
                 "libgomp1 (see the README's set-up).")
 

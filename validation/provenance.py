@@ -35,7 +35,8 @@ log = logging.getLogger(__name__)
 
 #: module name -> distribution name of packages recorded when a run has loaded them
 OPTIONAL_PACKAGES = {"gmsh": "gmsh", "skfem": "scikit-fem", "matplotlib": "matplotlib",
-                     "PIL": "pillow", "dask": "dask", "distributed": "distributed", "cupy": "cupy-cuda12x"}
+                     "PIL": "pillow", "dask": "dask", "distributed": "distributed", "cupy": "cupy-cuda12x",
+                     "array_api_compat": "array-api-compat"}
 _ROOT = Path(__file__).resolve().parents[1]  # the directory holding the packages
 
 

@@ -14,25 +14,39 @@ import importlib
 
 import numpy as np
 
+from ..backend import backend_of
 from ..checks import InputError, check_callable
 from .base import Layer
 
 __all__ = ["LawBase", "as_pressure", "as_closure", "out", "callable_ref", "resolve_callable"]
 
 
+def _on_host(x):
+    return not hasattr(x, "shape") or isinstance(x, (np.ndarray, np.generic))
+
+
 def as_pressure(p):
-    """Return ``max(p, 0)`` as a new float array (``-0.0`` becomes ``+0.0``; NaN stays NaN)."""
-    return np.maximum(np.asarray(p, dtype=float), 0.0) + 0.0
+    """Return ``max(p, 0)`` as a new float array (``-0.0`` becomes ``+0.0``; NaN stays NaN).
+
+    A float64 array of another namespace (a device array) stays in its namespace.
+    """
+    if _on_host(p):
+        return np.maximum(np.asarray(p, dtype=float), 0.0) + 0.0
+    return backend_of(p).xp.maximum(p, 0.0) + 0.0
 
 
 def as_closure(closure):
-    """Return ``closure`` as a float array (a new one, never the caller's)."""
-    return np.array(closure, dtype=float)
+    """Return ``closure`` as a float array (a new one, never the caller's), in its namespace."""
+    if _on_host(closure):
+        return np.array(closure, dtype=float)
+    return backend_of(closure).copy(closure)
 
 
 def out(x):
-    """Return a NumPy scalar for 0-d results, the array otherwise."""
-    return np.asarray(x)[()]
+    """Return a NumPy scalar for 0-d results, the array otherwise (device arrays as they are)."""
+    if _on_host(x):
+        return np.asarray(x)[()]
+    return x
 
 
 class LawBase(Layer):

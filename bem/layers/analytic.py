@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..backend import anp
 from ..checks import check_nonnegative, check_positive, check_range
 from ._common import LawBase, as_closure, as_pressure, out
 
@@ -32,6 +33,7 @@ class Linear(LawBase):
     law = "linear"
     _required = ("lam",)
     is_linear = True
+    array_api = True
 
     def __init__(self, lam):
         self.lam = check_positive("lam", lam)
@@ -45,7 +47,7 @@ class Linear(LawBase):
 
     def dw(self, p):
         p = as_pressure(p)
-        return out(np.where(np.isnan(p), np.nan, self.lam))
+        return out(anp.where(anp.isnan(p), np.nan, self.lam))
 
     def energy(self, p):
         with np.errstate(over="ignore"):
@@ -53,7 +55,7 @@ class Linear(LawBase):
 
     def inverse(self, closure):
         c = as_closure(closure)
-        return out(np.where(c <= 0, 0.0, c) / self.lam)
+        return out(anp.where(c <= 0, 0.0, c) / self.lam)
 
     def secant(self, p):
         return self.dw(p)
@@ -78,6 +80,7 @@ class Power(LawBase):
 
     law = "power"
     _required = ("lam", "s")
+    array_api = True
     #: largest exponent ``s``: larger ones describe no interface layer, and ``p**s`` overflows
     #: for pressures in Pa once ``s`` exceeds about 34
     MAX_EXPONENT = 10.0
@@ -104,7 +107,7 @@ class Power(LawBase):
     def inverse(self, closure):
         c = as_closure(closure)
         with np.errstate(over="ignore"):
-            return out((np.where(c <= 0, 0.0, c) / self.lam) ** (1.0 / self.s))
+            return out((anp.where(c <= 0, 0.0, c) / self.lam) ** (1.0 / self.s))
 
     def secant(self, p):
         """``lam p**(s-1)``; at ``p = 0`` the limit (``inf``, ``lam`` or 0 as for ``dw``)."""
@@ -137,21 +140,21 @@ class Root(Power):
     # Square roots instead of the general power: np.power with exponent -0.5 or 1.5 costs
     # 10x np.sqrt (measured: 1,048,703 nodes, dw 29 ms against 3 ms).
     def w(self, p):
-        return out(self.lam * np.sqrt(as_pressure(p)))
+        return out(self.lam * anp.sqrt(as_pressure(p)))
 
     def dw(self, p):
         with np.errstate(divide="ignore", over="ignore"):
-            return out((0.5 * self.lam) / np.sqrt(as_pressure(p)))
+            return out((0.5 * self.lam) / anp.sqrt(as_pressure(p)))
 
     def energy(self, p):
         p = as_pressure(p)
         with np.errstate(over="ignore"):
-            return out((2.0 / 3.0 * self.lam) * (p * np.sqrt(p)))
+            return out((2.0 / 3.0 * self.lam) * (p * anp.sqrt(p)))
 
     def secant(self, p):
         """``lam / sqrt(p)``; ``inf`` at ``p = 0``."""
         with np.errstate(divide="ignore", over="ignore"):
-            return out(self.lam / np.sqrt(as_pressure(p)))
+            return out(self.lam / anp.sqrt(as_pressure(p)))
 
 
 class Bilinear(LawBase):
@@ -178,6 +181,7 @@ class Bilinear(LawBase):
 
     law = "bilinear"
     _required = ("lam1", "lam2", "p_star")
+    array_api = True
 
     def __init__(self, lam1, lam2, p_star):
         self.lam1 = check_positive("lam1", lam1)
@@ -193,21 +197,21 @@ class Bilinear(LawBase):
 
     def w(self, p):
         p = as_pressure(p)
-        w = self.lam1 * np.minimum(p, self.p_star)
+        w = self.lam1 * anp.minimum(p, self.p_star)
         if self.lam2 > 0:  # skip 0 * inf
             with np.errstate(over="ignore"):
-                w = w + self.lam2 * np.maximum(p - self.p_star, 0.0)
+                w = w + self.lam2 * anp.maximum(p - self.p_star, 0.0)
         return out(w)
 
     def dw(self, p):
         p = as_pressure(p)
-        return out(np.where(p < self.p_star, self.lam1, np.where(np.isnan(p), np.nan, self.lam2)))
+        return out(anp.where(p < self.p_star, self.lam1, anp.where(anp.isnan(p), np.nan, self.lam2)))
 
     def energy(self, p):
         p = as_pressure(p)
         ps, l1 = self.p_star, self.lam1
-        q = np.minimum(p, ps)
-        beyond = np.maximum(p - ps, 0.0)
+        q = anp.minimum(p, ps)
+        beyond = anp.maximum(p - ps, 0.0)
         with np.errstate(over="ignore"):
             energy = 0.5 * l1 * q**2 + l1 * ps * beyond
             if self.lam2 > 0:  # skip 0 * inf
@@ -217,13 +221,13 @@ class Bilinear(LawBase):
     def inverse(self, closure):
         c = as_closure(closure)
         w_star = self.lam1 * self.p_star
-        elastic = np.where(c <= 0, 0.0, np.minimum(c, w_star)) / self.lam1
-        elastic = np.where(c == w_star, self.p_star, elastic)
+        elastic = anp.where(c <= 0, 0.0, anp.minimum(c, w_star)) / self.lam1
+        elastic = anp.where(c == w_star, self.p_star, elastic)
         beyond = np.inf  # lam2 = 0: the rigid branch cannot close further
         if self.lam2 > 0:
             with np.errstate(over="ignore"):
-                beyond = self.p_star + np.maximum(c - w_star, 0.0) / self.lam2
-        return out(np.where(c > w_star, beyond, elastic))
+                beyond = self.p_star + anp.maximum(c - w_star, 0.0) / self.lam2
+        return out(anp.where(c > w_star, beyond, elastic))
 
 
 class ElasticRigid(Bilinear):

@@ -29,9 +29,14 @@ class Layer(abc.ABC):
     ----------
     is_linear : bool
         True when ``w(p) = lam * p`` (the Kalker QP then solves it exactly).
+    array_api : bool
+        True when the methods take and return arrays of any array API namespace (device
+        arrays stay on their device); other laws compute on NumPy arrays, and the solvers
+        copy their arguments to the host and back (:func:`bem.layers.device.device_layer`).
     """
 
     is_linear: bool = False
+    array_api: bool = False
 
     @abc.abstractmethod
     def w(self, p):
@@ -55,7 +60,10 @@ class Layer(abc.ABC):
 
     def secant(self, p):
         """Secant compliance ``w(p) / p`` [length/pressure], ``w'(0)`` at ``p = 0``."""
-        p = np.asarray(p, dtype=float)
+        from ..backend import anp
+
+        if not hasattr(p, "shape") or isinstance(p, (np.ndarray, np.generic)):
+            p = np.asarray(p, dtype=float)
         with np.errstate(divide="ignore", invalid="ignore"):
-            out = np.where(p > 0, self.w(p) / np.where(p > 0, p, 1.0), self.dw(np.zeros_like(p)))
+            out = anp.where(p > 0, self.w(p) / anp.where(p > 0, p, 1.0), self.dw(anp.zeros_like(p)))
         return out

@@ -23,6 +23,7 @@ import numpy as np
 import scipy.fft as sfft
 
 from .. import fft
+from ..backend import get_backend
 from ..checks import check_positive
 from ..operator import diagonal_coefficient
 from .kernel import periodic_template
@@ -39,6 +40,9 @@ class PeriodicOperator:
         The cell.
     E_star : float
         Effective modulus ``E*`` [pressure].
+    device : {"cpu", "cuda"} or module, optional
+        Where the products run (:func:`bem.backend.get_backend`); brick arrays in and out are
+        in its namespace. The kernel spectra are computed on the host once and copied over.
 
     Attributes
     ----------
@@ -49,8 +53,10 @@ class PeriodicOperator:
         from it by the images and the zero mean.
     """
 
-    def __init__(self, lattice, E_star):
+    def __init__(self, lattice, E_star, device="cpu"):
         self.lattice = lattice
+        self.backend = bk = get_backend(device)
+        self.mask = bk.asarray(lattice.mask, dtype=bk.xp.bool)
         self.E_star = check_positive("E_star", E_star)
         self.n_matvec = 0
         self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
@@ -60,7 +66,7 @@ class PeriodicOperator:
         self._spectrum_shape = (even.shape[0], even.shape[1] // 2 + 1)
         spectra = sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
         # spectra of K_00 = K_11, K_10 and K_01 (real kernels: the 1/N of the inverse FFT is applied there)
-        self._s00, self._s10, self._s01 = spectra
+        self._s00, self._s10, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra)
 
     def _forward(self, v):
         """Spectra of the even and odd rows of a brick array: ``(2, n_rows/2, n_cols/2 + 1)``.
@@ -68,24 +74,26 @@ class PeriodicOperator:
         The real FFT along the rows runs on the whole array at once; the complex FFT along the
         columns on each parity's strided rows, so the parities are never copied apart.
         """
-        rows = sfft.rfft(v, axis=-1, workers=fft.threads())
-        out = np.empty((2,) + self._spectrum_shape, dtype=complex)
+        bk = self.backend
+        rows = bk.rfft(v, axis=-1)
+        out = bk.xp.empty((2,) + self._spectrum_shape, dtype=bk.xp.complex128)
         for a in (0, 1):
-            out[a] = sfft.fft(rows[a::2], axis=0, workers=fft.threads())
+            out[a, ...] = bk.cfft(rows[a::2, :], axis=0)
         return out
 
     def _apply(self, v, s00, s01, s10, s11):
         """``out_a = sum_b S_ab v_b`` by the spectra ``S`` of a 2 x 2 block symbol."""
-        P = self._forward(np.asarray(v, dtype=float))
-        u1 = s10 * P[0]
-        u1 += s11 * P[1]
-        P[0] *= s00
-        P[0] += s01 * P[1]
-        P[1] = u1
-        rows = np.empty((self.lattice.n_rows, self._spectrum_shape[1]), dtype=complex)
+        bk = self.backend
+        P = self._forward(bk.asarray(v))
+        u1 = s10 * P[0, ...]
+        u1 += s11 * P[1, ...]
+        P[0, ...] *= s00
+        P[0, ...] += s01 * P[1, ...]
+        P[1, ...] = u1
+        rows = bk.xp.empty((self.lattice.n_rows, self._spectrum_shape[1]), dtype=bk.xp.complex128)
         for a in (0, 1):
-            rows[a::2] = sfft.ifft(P[a], axis=0, overwrite_x=True, workers=fft.threads())
-        return sfft.irfft(rows, n=self.lattice.n_cols, axis=-1, overwrite_x=True, workers=fft.threads())
+            rows[a::2, :] = bk.cfft(P[a, ...], axis=0, inverse=True)
+        return bk.irfft(rows, n=self.lattice.n_cols, axis=-1)
 
     def matvec(self, p):
         """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]; ``u`` has zero mean."""
@@ -112,7 +120,7 @@ class PeriodicOperator:
             ``M(r)`` on brick arrays.
         """
         a, d = self._s00 + lam, self._s00 + lam
-        b, c = self._s01.copy(), self._s10.copy()
+        b, c = self.backend.copy(self._s01), self.backend.copy(self._s10)
         shift = 0.5 * self.diagonal  # the constant mode (1, 1) / sqrt 2 of frequency 0 gets eigenvalue C_nn + lam
         a[0, 0] += shift
         d[0, 0] += shift

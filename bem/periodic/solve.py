@@ -111,7 +111,7 @@ def _levels(cell, h, gap, nested):
 
 def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None, E2=None, nu2=None,
                    mean_pressure=None, approach=None, layer=None, method="newton", rtol=1e-10, maxiter=None,
-                   x0=None, nested=None, precondition=True, callback=None, **options):
+                   x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
     """Frictionless normal contact of a periodic cell of two elastic half-spaces with an interface layer.
 
     The gap repeats with the periods of the cell (:class:`PeriodicCell`): a rough surface
@@ -138,8 +138,9 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
         separation, :attr:`PeriodicContactResult.mean_gap`) is ``mean(h + w(p)) - delta``;
         without a layer it must be below ``mean(h)`` (a full contact leaves the mean pressure
         undetermined under approach control).
-    layer, method, rtol, maxiter, x0, precondition, callback, **options
-        As for :func:`bem.solve` (``x0`` a brick array of the cell's shape, or flattened).
+    layer, method, rtol, maxiter, x0, precondition, callback, device, **options
+        As for :func:`bem.solve` (``x0`` a brick array of the cell's shape, or flattened; the
+        result's arrays are NumPy arrays on the host for every ``device``).
     nested : bool, optional
         Start from the solution on cells of step ``2c``, ``4c``, ... (every other node,
         needs ``n_cols`` even and ``n_rows`` a multiple of 4 per level) interpolated onto the
@@ -158,10 +159,12 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
     their increments (eq. 20, 23) are below ``eps_h``, ``eps_p`` AND ``r <= rtol``. Timings:
     ``benchmarks/periodic_rough.py`` and docs/performance.md.
     """
+    from ..backend import get_backend, to_host
     from ..solve import _check_layer, _inner_summary, _modulus, _run
 
     t_start = time.perf_counter()
     cell, h = _cell_and_gap(gap, step, cell)
+    backend = get_backend(device)
     E_star = _modulus(E_star, E1, nu1, E2, nu2)
     if (mean_pressure is None) == (approach is None):
         fail("(mean_pressure, approach)", (mean_pressure, approach), "exactly one given")
@@ -196,12 +199,12 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
                   callback=callback if finest else None)
         if maxiter is not None:
             kw["maxiter"] = maxiter
-        op = PeriodicOperator(lat, E_star)
+        op = PeriodicOperator(lat, E_star, device=backend)
         sol = _run(solver, op, h_lat, layer, precondition, kw, options)
         if not finest:
             guess = levels[level + 1][0].prolong(sol.p)
     p = sol.p
-    u = op.matvec(p)
+    u = to_host(op.matvec(p))
     closure = np.zeros(cell.shape) if layer is None else layer.w(p)
     g = u + closure + h - sol.approach
     a = cell.node_area

@@ -1,0 +1,157 @@
+"""The solvers run unchanged on a strict array API namespace and give the NumPy answer.
+
+``array_api_strict`` implements the standard and nothing else; its arrays are refused by NumPy
+here (``__array__`` raises), so a solve that converted an array to NumPy behind the back of the
+backend would fail instead of falling back silently. The callbacks see every iterate in the
+strict namespace.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import bem
+import bem.backend
+from bem import layers
+from bem.gaps import Paraboloid
+from bem.periodic import PeriodicCell, solve_periodic
+
+xs = pytest.importorskip("array_api_strict")
+
+KW = dict(E_star=1.0, force=1.0, step=0.05, extent=1.2)
+
+
+@pytest.fixture
+def strict(monkeypatch):
+    """``array_api_strict``, with any conversion of its arrays to NumPy arrays an error."""
+    from array_api_strict._array_object import Array
+
+    def refuse(self, *args, **kwargs):
+        raise AssertionError("an array_api_strict array was converted to NumPy")
+
+    monkeypatch.setattr(Array, "__array__", refuse)
+    return xs
+
+
+def _iterates(device):
+    seen = []
+    return seen, lambda k, p: seen.append(type(p).__module__.split(".")[0])
+
+
+def _same(a, b, tol=1e-12):
+    assert a.converged and b.converged
+    assert a.method == b.method
+    assert isinstance(b.p, np.ndarray) and isinstance(b.displacement, np.ndarray)
+    assert np.abs(b.p - a.p).max() <= tol * a.p.max()
+    assert abs(b.approach - a.approach) <= tol * abs(a.approach)
+    assert b.kkt_residual <= 1e-10
+
+
+@pytest.mark.parametrize("layer, method", [(None, "kalker"), (layers.Root(0.05), "newton")],
+                         ids=["hertz_kalker_qp", "root_layer_newton"])
+def test_strict_namespace_solve_equals_the_numpy_solve(strict, layer, method):
+    ref = bem.solve(Paraboloid(1.0), layer=layer, method=method, **KW)
+    seen, callback = _iterates(strict)
+    res = bem.solve(Paraboloid(1.0), layer=layer, method=method, device=strict, callback=callback, **KW)
+    _same(ref, res)
+    assert seen and set(seen) == {"array_api_strict"}
+
+
+def _laws():
+    return {"linear": layers.Linear(0.02), "power": layers.Power(0.1, 2.0), "bilinear": layers.Bilinear(0.02, 0.01, 0.3),
+            "tabulated": layers.Tabulated(np.linspace(0, 4, 41), 0.05 * np.sqrt(np.linspace(0, 4, 41)))}
+
+
+@pytest.mark.parametrize("method, law", [("newton", "tabulated"), ("newton", "bilinear"),
+                                         ("augmented_gap", "linear"), ("variable_compliance", "power"),
+                                         ("variable_compliance", "tabulated")])
+def test_every_solver_and_a_host_only_law_run_on_the_strict_namespace(strict, method, law):
+    layer = _laws()[law]
+    kw = dict(KW, step=0.1, nested=False)
+    ref = bem.solve(Paraboloid(1.0), layer=layer, method=method, **kw)
+    seen, callback = _iterates(strict)
+    res = bem.solve(Paraboloid(1.0), layer=layer, method=method, device=strict, callback=callback, **kw)
+    _same(ref, res, tol=1e-10)
+    assert set(seen) == {"array_api_strict"}
+
+
+def _rough(cell, seed=7):
+    rng = np.random.default_rng(seed)
+    h = np.zeros(cell.shape)
+    for _ in range(4):
+        kx, ky = rng.integers(1, 4, size=2)
+        h += rng.uniform(0.2, 1.0) * np.cos(2 * math.pi * (kx * cell.x / cell.size[0] + ky * cell.y / cell.size[1])
+                                            + rng.uniform(0, 2 * math.pi))
+    return h - h.min()
+
+
+@pytest.mark.parametrize("layer, method", [(None, "kalker"), (layers.Root(0.2), "newton")],
+                         ids=["periodic_kalker_qp", "periodic_root_newton"])
+def test_strict_namespace_periodic_solve_equals_the_numpy_solve(strict, layer, method):
+    cell = PeriodicCell(1.0 / 32, 32, 32)
+    h = _rough(cell)
+    kw = dict(step=cell.step, E_star=1.0, mean_pressure=2.0, layer=layer, method=method)
+    ref = solve_periodic(h, **kw)
+    seen, callback = _iterates(strict)
+    res = solve_periodic(h, device=strict, callback=callback, **kw)
+    assert 0.05 < ref.contact_fraction < 0.95
+    _same(ref, res)
+    assert set(seen) == {"array_api_strict"}
+
+
+def test_an_unknown_device_is_refused():
+    with pytest.raises(bem.InputError, match="device = 'tpu' is not allowed: .*'cpu', 'cuda' or an array API"):
+        bem.solve(Paraboloid(1.0), device="tpu", **KW)
+
+
+def test_cuda_without_cupy_or_a_device_is_refused():
+    try:
+        bem.backend.get_backend("cuda")
+    except bem.InputError:
+        pass
+    else:
+        pytest.skip("CuPy and a CUDA device are present")
+    with pytest.raises(bem.InputError, match="device = 'cuda' is not allowed: CuPy (is not installed|sees no CUDA device)"):
+        bem.solve(Paraboloid(1.0), device="cuda", **KW)
+
+
+def test_strict_namespace_subsurface_stress_equals_the_numpy_stress(strict):
+    res = bem.solve(Paraboloid(1.0), **KW)
+    z = np.linspace(0.0, 0.3, 5)  # depths below one step (near-field correction) and beyond
+    ref = bem.subsurface_stress(res, z, nu=0.3)
+    out = bem.subsurface_stress(res, z, nu=0.3, device=strict)
+    assert isinstance(out.sigma, np.ndarray)
+    assert np.abs(out.sigma - ref.sigma).max() <= 1e-12 * np.abs(ref.sigma).max()
+    assert out.max_von_mises == pytest.approx(ref.max_von_mises, rel=1e-12)
+
+
+def test_the_flat_index_path_of_cupy_emulated_on_numpy_equals_the_numpy_solve():
+    """CuPy's code path (flat-index selections, the namespace's own FFTs), run by array_api_compat.numpy."""
+    compat = pytest.importorskip("array_api_compat.numpy")
+    from bem.backend import Backend
+
+    device = Backend(compat, "compat-numpy", flat_indices=True)
+    for layer, method in ((None, "kalker"), (layers.Root(0.05), "newton"), (_laws()["tabulated"], "variable_compliance")):
+        ref = bem.solve(Paraboloid(1.0), layer=layer, method=method, **KW)
+        _same(ref, bem.solve(Paraboloid(1.0), layer=layer, method=method, device=device, **KW), tol=1e-10)
+    cell = PeriodicCell(1.0 / 32, 32, 32)
+    kw = dict(step=cell.step, E_star=1.0, mean_pressure=2.0, layer=layers.Root(0.2))
+    _same(solve_periodic(_rough(cell), **kw), solve_periodic(_rough(cell), device=device, **kw))
+
+
+@pytest.mark.parametrize("layer, method", [(None, "kalker"), (layers.Root(0.05), "newton")])
+def test_the_iterations_move_no_array_to_the_host(strict, monkeypatch, layer, method):
+    """Device arrays reach the host only through bem.backend.to_host (DLPack): the solution, its
+    displacement and the result's product, whatever the number of iterations."""
+    copies = []
+    from_dlpack = np.from_dlpack
+
+    def counted(x, *args, **kwargs):
+        copies.append(x.shape)
+        return from_dlpack(x, *args, **kwargs)
+
+    monkeypatch.setattr(np, "from_dlpack", counted)
+    res = bem.solve(Paraboloid(1.0), layer=layer, method=method, device=strict, nested=False, **KW)
+    assert res.converged and res.iterations > 3
+    assert len(copies) == 3
