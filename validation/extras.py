@@ -13,7 +13,7 @@ report    matplotlib, pillow (PIL)    ``contactlab report``, :mod:`validation.re
 dask      dask[distributed]           ``contactlab sweep --scheduler ADDRESS``
                 (dask.distributed)
 rough     SurfaceTopography           :mod:`bem.rough`: instrument files, self-affine surfaces
-gpu       cupy-cuda12x (cupy)         declared for the GPU path (not used yet)
+gpu       cupy-cuda12x (cupy)         installs CuPy; no module imports it
 ========  ==========================  ============================================
 
 :func:`require` is called where a command or scene is checked, before any work: a missing
