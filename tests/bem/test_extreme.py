@@ -96,7 +96,7 @@ def test_paper_method_is_right_or_says_it_failed(newton, name, method):
 def test_newton_converges_on_a_fine_lattice_with_infinite_layer_stiffness_gradient():
     """s = 0.2 at 100 nodes across: w' spans many decades near the contact edge.
 
-    Regression: the inner QP needs the oblique projection of its preconditioned residual,
+    The inner QP needs the oblique projection of its preconditioned residual,
     and the Newton step the majorising curvature where the model is too soft."""
     layer = _power(1.0, 0.2)
     a = _contact_radius("power s=0.2")

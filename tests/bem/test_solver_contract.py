@@ -30,7 +30,7 @@ def _dense_kkt(res, layer, gap=Paraboloid(1.0)):
                                 node_area=res.lattice.node_area)
 
 
-# --- item 2: options are checked, result.method names the solver that ran -----------------------
+# --- options are checked, result.method names the solver that ran ---------------------------------
 
 def test_an_unknown_option_is_refused_by_name():
     with pytest.raises(bem.InputError, match="frobnicate = 1 is not allowed"):
@@ -99,7 +99,7 @@ def test_n_matvec_counts_the_products_with_c(monkeypatch):
         assert res.n_matvec == len(calls) > res.iterations
 
 
-# --- item 3: one name, one meaning --------------------------------------------------------------
+# --- one name, one meaning ------------------------------------------------------------------------
 
 def test_rtol_is_the_kkt_tolerance_of_every_method():
     layer = layers.Root(0.02)
@@ -131,7 +131,7 @@ def test_qp_takes_a_preconditioner_callable_and_solve_a_precondition_flag():
     assert inspect.signature(bem.solve).parameters["precondition"].default is True
 
 
-# --- item 4: public errors ----------------------------------------------------------------------
+# --- public errors --------------------------------------------------------------------------------
 
 def test_errors_are_public_value_errors():
     assert issubclass(bem.InputError, ValueError)
@@ -154,7 +154,7 @@ def test_nothing_outside_bem_imports_its_private_modules():
     assert not offenders
 
 
-# --- items 1 and 7: Newton reaches rtol; near the rigid limit with a small exponent -------------
+# --- Newton reaches rtol; near the rigid limit with a small exponent ------------------------------
 
 @pytest.mark.parametrize("n_across", [20, 60, 100, 160, 200])
 def test_newton_near_the_rigid_limit_with_a_small_exponent(n_across):
@@ -185,7 +185,7 @@ def test_newton_force_control_with_an_extreme_concave_layer(k):
     assert res.force == pytest.approx(1.0, rel=1e-10)
 
 
-# --- item 6: variable compliance under force control where the layer dominates ------------------
+# --- variable compliance under force control where the layer dominates ----------------------------
 
 @pytest.mark.parametrize("layer, E_star", [(layers.Linear(1.0), 1e4), (layers.Root(1.0), 1e2),
                                            (layers.Root(1.0), 1e4)])
@@ -209,7 +209,7 @@ def test_variable_compliance_reports_failure_where_it_cannot_converge():
     assert "stalled" in res.message or "diverg" in res.message or "maxiter" in res.message
 
 
-# --- item 8: one warning, only when it failed ---------------------------------------------------
+# --- one warning, only when it failed -------------------------------------------------------------
 
 def test_a_converged_run_logs_no_warning(caplog):
     layer = layers.Power(1.0, 0.3)
@@ -229,7 +229,7 @@ def test_a_failed_run_logs_one_warning(caplog):
     assert math.isfinite(res.kkt_residual)
 
 
-# --- one meaning per name: a solver's displacement is C p, whatever the layer ------------------
+# --- one meaning per name: a solver's displacement is C p, whatever the layer ---------------------
 
 @pytest.mark.parametrize("lam", [0.0, 0.3, "per node"])
 def test_the_qp_displacement_is_the_elastic_closure(lam):

@@ -107,7 +107,7 @@ def test_bad_gap():
 
 def test_vtu_is_compressed_with_ordinary_permissions(result, tmp_path):
     """The one writer (bem.files.write_vtu): zlib-compressed VTK XML, read here by an independent
-    decoder of the format; the file gets the permissions of any new file (it was 0600)."""
+    decoder of the format; the file gets the permissions of any new file (umask), not 0600."""
     import os
     import stat
 
