@@ -113,23 +113,46 @@ def test_rtol_is_the_kkt_tolerance_of_every_method():
             assert res.kkt_residual > 1e-9, method
 
 
-def test_fem_reference_names_its_relative_extent_extent_factor():
-    import inspect
-
+def test_fem_reference_extent_factor_is_relative_to_the_contact_and_extent_is_refused():
+    """``extent`` is an absolute half-width in bem.solve; the FEM's domain size is relative to the
+    expected contact radius and has its own name."""
     import fem_reference
 
-    params = inspect.signature(fem_reference.solve).parameters
-    assert "extent_factor" in params and "extent" not in params
+    kw = dict(E1=2.0, nu1=0.3, E2=2.0, nu2=0.3, force=1.0, n_contact=3)
+    radius = {}
+    for factor in (10.0, 20.0):
+        res = fem_reference.solve(Paraboloid(1.0), extent_factor=factor, **kw)
+        radius[factor] = res.field()["points"][:, 0].max()
+    a_est = radius[10.0] / 10.0
+    assert radius[20.0] == pytest.approx(20.0 * a_est, rel=1e-9)
+    a_hertz = (3.0 * 0.91 / 4.0) ** (1 / 3)  # (3 P R / (4 E*))^(1/3), 1/E* = 2 (1 - 0.09) / 2
+    assert a_est == pytest.approx(a_hertz, rel=0.02)  # in units of the expected contact radius
+    with pytest.raises((TypeError, ValueError), match="extent"):
+        fem_reference.solve(Paraboloid(1.0), extent=20.0, **kw)
 
 
-def test_qp_takes_a_preconditioner_callable_and_solve_a_precondition_flag():
-    import inspect
-
+def test_qp_uses_the_preconditioner_callable_it_is_given_and_solve_preconditions_by_default():
     from bem.kalker import solve_qp
 
-    assert "preconditioner" in inspect.signature(solve_qp).parameters
-    assert "precondition" not in inspect.signature(solve_qp).parameters
-    assert inspect.signature(bem.solve).parameters["precondition"].default is True
+    res = _hertz(nested=False)
+    op = bem.InfluenceOperator(res.lattice, res.E_star)
+    h = Paraboloid(1.0)(res.lattice.x, res.lattice.y)
+    applied = []
+
+    def identity(r):
+        applied.append(1)
+        return r
+
+    sub = solve_qp(op, h, force=1.0, preconditioner=identity)
+    assert sub.converged and len(applied) >= sub.iterations - 1  # once per CG iteration
+    np.testing.assert_allclose(sub.p[res.lattice.mask], res.p, rtol=0, atol=1e-6 * res.p.max())
+    fft = solve_qp(op, h, force=1.0, preconditioner=op.preconditioner())
+    assert fft.converged and fft.iterations < sub.iterations  # the callable given is the one applied
+    with pytest.raises(TypeError, match="precondition"):
+        solve_qp(op, h, force=1.0, precondition=True)
+    default, on, off = (_hertz(nested=False, **kw) for kw in ({}, {"precondition": True}, {"precondition": False}))
+    assert default.iterations == on.iterations < off.iterations
+    assert default.n_matvec == on.n_matvec
 
 
 # --- public errors --------------------------------------------------------------------------------
