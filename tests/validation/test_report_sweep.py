@@ -56,6 +56,34 @@ def test_sweep_sections_hold_every_point_in_scene_units(sweep_dir, tmp_path):
     assert len(captions) == 2 and "coloured by load.force" in captions[0]
 
 
+def test_sweep_figures_show_every_point(sweep_dir, tmp_path, monkeypatch):
+    """The profiles figure has one curve per point, its colour bar the swept forces; the scalars
+    figure draws each point's p_max, in MPa (the report unit of the SI scene), against the force."""
+    from validation.report.figures import sweeps as fsw
+
+    figures = []
+
+    def spy(fig, path, *args, _save=fsw.save_figure, **kwargs):
+        figures.append(fig)
+        return _save(fig, path, *args, **kwargs)
+
+    monkeypatch.setattr(fsw, "save_figure", spy)
+    _summary, points = load_sweep(sweep_dir)
+    sweep_sections(_summary, points, tmp_path)
+    profiles, scalars = figures
+    ax, bar = profiles.axes
+    assert len(ax.get_lines()) == len(FORCES)
+    np.testing.assert_allclose(bar.get_yticks(), FORCES)
+    for ln, (_row, res) in zip(ax.get_lines(), points):
+        assert ln.get_ydata().max() * 1e6 == pytest.approx(res.data["p_max"], rel=0.02)  # MPa, as labelled
+    assert "MPa" in ax.get_ylabel()
+    p_panel = scalars.axes[0]
+    (line,) = p_panel.get_lines()
+    np.testing.assert_allclose(line.get_xdata(), FORCES)
+    np.testing.assert_allclose(line.get_ydata() * 1e6, [res.data["p_max"] for _, res in points])
+    assert "MPa" in p_panel.get_ylabel() and scalars.axes[-1].get_xlabel()
+
+
 def test_sweep_report_dimensionless_and_svg(sweep_dir, tmp_path):
     built = report_sweep_dir(sweep_dir, tmp_path / "rep", units="dimensionless", fmt="svg")
     assert sorted(p.suffix for p in built.figures) == [".svg", ".svg"]
