@@ -143,7 +143,7 @@ def test_report_dispatches_its_arguments_and_prints_where(monkeypatch, tmp_path)
 
 
 @pytest.mark.parametrize("argv, word", [
-    (["study", "error-time", "hertz", "--levels", "3"], "--levels"),  # was silently ignored
+    (["study", "error-time", "hertz", "--levels", "3"], "--levels"),  # refused, not ignored
     (["study", "stability", "--set", "bem.rtol=1e-6"], "--set"),  # studies have no scene keys
     (["report", "paper", "--bogus"], "--bogus"),
     (["check", "hertz", "--quick"], "--quick"),
