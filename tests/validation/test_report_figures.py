@@ -20,6 +20,8 @@ from validation.report.figures import sweeps as fsw
 from bem.files import atomic_path
 from validation.report.render.style import DPI, save_figure
 
+from .figure_spy import drawn, horizontal_at, lines_of, vertical_at  # noqa: F401 - drawn is a fixture
+
 HERTZ = hertz_sphere(R=1.0, E_star=1.0, force=1.0)
 A, P0 = HERTZ.contact_radius, HERTZ.p_max
 STEP = A / 6
@@ -66,35 +68,6 @@ def check_png(path, size_in=None, *, floor=8.0):
     # not only background: a sizeable share of pixels is not white
     assert np.mean(img.min(axis=2) < 200) > 0.01
     return img
-
-
-@pytest.fixture
-def drawn(monkeypatch):
-    """The matplotlib figures the plot functions save, in order (they are still written)."""
-    from validation.report.figures import fields
-
-    figures = []
-    for module in (fpr, fit, fva, f3d, fsw, fields):
-        def spy(fig, path, *args, _save=module.save_figure, **kwargs):
-            figures.append(fig)
-            return _save(fig, path, *args, **kwargs)
-
-        monkeypatch.setattr(module, "save_figure", spy)
-    return figures
-
-
-def _lines(ax):
-    """``{label: (x, y)}`` of the labelled lines of ``ax``, in drawing order."""
-    return {ln.get_label(): (np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float))
-            for ln in ax.get_lines() if not ln.get_label().startswith("_")}
-
-
-def _vertical_at(ax, value):
-    return any(np.allclose(ln.get_xdata(), value) for ln in ax.get_lines())
-
-
-def _horizontal_at(ax, value):
-    return any(np.allclose(ln.get_ydata(), value) for ln in ax.get_lines())
 
 
 # ---------------------------------------------------------------- helpers against hand values
@@ -161,7 +134,7 @@ def test_pressure_profiles_png(cases, tmp_path, drawn):
     path = fpr.plot_pressure_profiles(curves, tmp_path / "p.png", p0=P0, a=A, hertz=(s, HERTZ.pressure(s)))
     img = check_png(path, (8.2, 4.0))
     ax = drawn[-1].axes[0]
-    lines = _lines(ax)
+    lines = lines_of(ax)
     assert list(lines) == ["Hertz (closed form)", "smooth", "linear", "elastic-rigid"]
     np.testing.assert_allclose(lines["Hertz (closed form)"][1], HERTZ.pressure(s) / P0)
     edge = 0.0
@@ -172,7 +145,7 @@ def test_pressure_profiles_png(cases, tmp_path, drawn):
         np.testing.assert_allclose(lines[label][1], res.p[y0][order] / P0)
         edge = max(edge, np.abs(res.x[y0][res.p[y0] > 0]).max() / A)
     lo, hi = ax.get_xlim()
-    assert lo <= -edge and hi >= edge and hi <= 1.5 * edge + 0.5  # every loaded node, not the whole region
+    assert lo <= -edge and edge <= hi <= 1.5 * edge + 0.5  # every loaded node, not the whole region
     assert ax.get_ylim()[0] == 0.0 and ax.get_ylim()[1] >= max(r.p_max for _, r in curves) / P0
     assert "y = 0" in ax.get_xlabel() and "p_0" in ax.get_ylabel()
     # the data matter: a different set of curves gives a different picture
@@ -186,14 +159,14 @@ def test_layer_laws_png(cases, tmp_path, drawn):
     check_png(fpr.plot_layer_laws(laws, tmp_path / "w.png", p_max=P0, marks=[("p_cr", cases["er_law"].p_cr)]),
               (6.0, 3.8))
     ax = drawn[-1].axes[0]
-    lines = _lines(ax)
+    lines = lines_of(ax)
     assert list(lines) == [label for label, _ in laws]
     for label, layer in laws:  # w(p) of each law over 0..p_max; the smooth bodies on the axis
         p, w = lines[label]
         assert p[0] == 0.0 and p[-1] == P0
         np.testing.assert_allclose(w, 0.0 if layer is None else layer.w(p), rtol=1e-12, atol=0)
     assert ax.get_xlim() == (0.0, P0) and ax.get_ylim()[1] >= max(lines["root"][1].max(), lines["linear"][1].max())
-    assert _vertical_at(ax, cases["er_law"].p_cr)
+    assert vertical_at(ax, cases["er_law"].p_cr)
     assert "p" in ax.get_xlabel() and "w(p)" in ax.get_ylabel()
 
 
@@ -207,7 +180,7 @@ def test_iteration_profiles_png(cases, tmp_path, drawn):
     assert len(drawn_p) == ks.size + 1  # the iterates picked, then the final state
     for k, y in zip(ks, drawn_p):
         np.testing.assert_allclose(y, fpr.section_of(r, r.history["p"][k - 1])[1] / P0)
-    final = _lines(ax)
+    final = lines_of(ax)
     (label, (_x, y)), = final.items()
     assert label.startswith("final (converged") and f"k = {r.iterations}" in label
     np.testing.assert_allclose(y, fpr.section_of(r)[1] / P0)
@@ -222,14 +195,14 @@ def test_convergence_png(cases, tmp_path, drawn):
     runs = [("variable compliance", cases["er_vc"]), ("Newton", cases["er_newton"])]
     check_png(fit.plot_convergence(runs, tmp_path / "c.png", p0=P0, tol=1e-8), (6.6, 5.2))
     top, bot = drawn[-1].axes[:2]
-    lines = _lines(top)
+    lines = lines_of(top)
     assert list(lines) == ["variable compliance", "Newton"]
     for (label, r), (k, pm), res_line in zip(runs, lines.values(), bot.get_lines()):
         np.testing.assert_array_equal(k, np.arange(1, len(r.history["p_max"]) + 1))
         np.testing.assert_allclose(pm, np.asarray(r.history["p_max"]) / P0)
         np.testing.assert_allclose(res_line.get_ydata(), r.history["residual"])
         assert r.history["residual"][-1] <= 1e-8
-    assert _horizontal_at(bot, 1e-8) and bot.get_yscale() == "log" and bot.get_xscale() == "log"
+    assert horizontal_at(bot, 1e-8) and bot.get_yscale() == "log" and bot.get_xscale() == "log"
     assert bot.get_ylabel() == "KKT residual" and "p_0" in top.get_ylabel()
 
 
@@ -262,7 +235,7 @@ def test_contact_map_png(cases, tmp_path, drawn):
     xs, ys, ps, _tri = f3d.contact_patch(er.x, er.y, er.p, margin=0.3)
     np.testing.assert_allclose(field.get_array(), ps / P0)  # p / p0 over the patch around the contact
     assert field.get_clim() == pytest.approx((0.0, er.p_max / P0))
-    lines = _lines(ax)
+    lines = lines_of(ax)
     assert {"contact boundary", "p_cr"} < set(lines)
     circle = lines[r"equal-area circle $r = \sqrt{A/\pi}$"]
     np.testing.assert_allclose(np.hypot(*circle), er.contact_radius / A)
@@ -314,7 +287,7 @@ def test_sweep_and_transition_line_png(cases, tmp_path, drawn):
     check_png(fsw.plot_transition_line([0.5, 0.0, 1.0], [0.8, 1.0, 0.0], tmp_path / "tl.png", a=2.0,
                                        r_contact=[1.1, 1.0, 1.2]), (6.0, 4.0))
     ax = drawn[-1].axes[0]
-    lines = _lines(ax)
+    lines = lines_of(ax)
     np.testing.assert_allclose(lines["transition line $p = p_{cr}$"], [[0.0, 0.5, 1.0], [0.5, 0.4, 0.0]])
     np.testing.assert_allclose(lines["contact edge"], [[0.0, 0.5, 1.0], [0.5, 0.55, 0.6]])  # sorted, r / a
     assert ax.get_xlim() == (0.0, 1.0) and ax.get_ylim() == pytest.approx((0.0, 1.08 * 0.6))
@@ -327,16 +300,15 @@ def test_profile_comparison_png(cases, tmp_path, drawn):
     check_png(fpr.plot_profile_comparison(curves, tmp_path / "cmp.png", p0=P0, a=A,
                                           reference=("Hertz", HERTZ.pressure)), (6.6, 5.4))
     top, bot = drawn[-1].axes[:2]
-    lines = _lines(top)
+    lines = lines_of(top)
     assert list(lines) == ["Hertz", "BEM", "shifted"]
     r, pr = lines["BEM"][0] * A, lines["BEM"][1] * P0
     assert np.all(r >= 0) and np.isin(np.round(r / A, 9), np.round(np.abs(x) / A, 9)).all()
     errors = {ln.get_label().split(":")[0]: ln for ln in bot.get_lines() if not ln.get_label().startswith("_")}
     for label, factor in (("BEM", 1.0), ("shifted", 0.98)):  # the lower panel: (p - p_Hertz) / p0 at the nodes
-        ln = errors[label]
-        rr = ln.get_xdata() * A
-        np.testing.assert_allclose(ln.get_ydata(), (factor * np.interp(rr, r, pr) - HERTZ.pressure(rr)) / P0,
-                                   atol=1e-12)
+        rr = errors[label].get_xdata() * A
+        expected = (factor * np.interp(rr, r, pr) - HERTZ.pressure(rr)) / P0
+        np.testing.assert_allclose(errors[label].get_ydata(), expected, atol=1e-12)
     worst = max(np.abs(ln.get_ydata()).max() for ln in errors.values())
     assert bot.get_ylim() == pytest.approx((-1.15 * worst, 1.15 * worst))
     assert top.get_xlim()[0] == 0.0 and top.get_xlim()[1] >= np.abs(x[p > 0]).max() / A
@@ -350,12 +322,12 @@ def test_work_precision_png(tmp_path, drawn):
               "wall_time_s": 0.1 * n} for n in (4, 8)]
     check_png(fva.plot_work_precision(rows, tmp_path / "wp.png"), (7.0, 4.6))
     ax = drawn[-1].axes[0]
-    lines = _lines(ax)
+    lines = lines_of(ax)
     assert list(lines) == ["BEM (qp)", "FEM (P2)"]
     np.testing.assert_allclose(lines["BEM (qp)"], [[0.05, 0.1, 0.2], [0.3 / m**1.5 for m in (5, 10, 20)]])
     np.testing.assert_allclose(lines["FEM (P2)"], [[0.4, 0.8], [0.1 / 16, 0.1 / 64]])
     assert ax.get_xscale() == ax.get_yscale() == "log" and ax.get_ylabel() == "relative error"
-    assert _horizontal_at(ax, 0.01) and _horizontal_at(ax, 0.001)
+    assert horizontal_at(ax, 0.01) and horizontal_at(ax, 0.001)
     # repeats: the marker at the median, the bar from the fastest to the slowest
     spread = [dict(r, wall_times_s=[0.8 * r["wall_time_s"], r["wall_time_s"], 1.5 * r["wall_time_s"]])
               for r in fva.work_precision_rows(rows)]
@@ -386,10 +358,9 @@ def test_von_mises_png(tmp_path, drawn):
     shown = ax.collections[0].get_array()
     assert shown.max() == pytest.approx(vm.max() / P0, rel=1e-12)  # the FEM's von Mises stress / p0
     assert np.all(shown >= 0) and ax.get_xlim() == (-3.0, 3.0) and ax.get_ylim() == (-3.0, 3.0)
-    (label, (xc, zc)), = _lines(ax).items()
-    np.testing.assert_allclose(xc, [-fem.contact_radius / A, fem.contact_radius / A])
-    np.testing.assert_array_equal(zc, 0.0)
-    assert label.startswith("contact")
+    (label, (xc, zc)), = lines_of(ax).items()  # the contact, marked on the interface
+    assert label.startswith("contact") and np.all(zc == 0.0)
+    np.testing.assert_allclose(xc, np.array([-1.0, 1.0]) * fem.contact_radius / A)
 
 
 # ---------------------------------------------------------------- inputs untouched, atomic writes

@@ -14,6 +14,7 @@ from validation.run.sweep import run_sweep
 
 from .conftest import cli
 from .test_report_build import assert_valid_offline_html
+from .figure_spy import drawn  # noqa: F401 - a fixture
 from .test_report_figures import check_png
 
 FORCES = [50.0, 100.0, 200.0]
@@ -56,21 +57,12 @@ def test_sweep_sections_hold_every_point_in_scene_units(sweep_dir, tmp_path):
     assert len(captions) == 2 and "coloured by load.force" in captions[0]
 
 
-def test_sweep_figures_show_every_point(sweep_dir, tmp_path, monkeypatch):
+def test_sweep_figures_show_every_point(sweep_dir, tmp_path, drawn):
     """The profiles figure has one curve per point, its colour bar the swept forces; the scalars
     figure draws each point's p_max, in MPa (the report unit of the SI scene), against the force."""
-    from validation.report.figures import sweeps as fsw
-
-    figures = []
-
-    def spy(fig, path, *args, _save=fsw.save_figure, **kwargs):
-        figures.append(fig)
-        return _save(fig, path, *args, **kwargs)
-
-    monkeypatch.setattr(fsw, "save_figure", spy)
     _summary, points = load_sweep(sweep_dir)
     sweep_sections(_summary, points, tmp_path)
-    profiles, scalars = figures
+    profiles, scalars = drawn
     ax, bar = profiles.axes
     assert len(ax.get_lines()) == len(FORCES)
     np.testing.assert_allclose(bar.get_yticks(), FORCES)
