@@ -9,22 +9,11 @@ Thread count
     :func:`set_threads` (takes precedence; ``set_threads(None)`` undoes it).
 
 Back end
-    ``scipy.fft`` (pocketfft), chosen by measurement (``benchmarks/fft_floor.py`` and the
-    same pair at the operator's shapes; 2-core machine, load average 0.4-1.2, medians):
-
-    =========================  ==========  ===============  ==============================
-    transform                  pocketfft   FFTW_ESTIMATE    FFTW_MEASURE (planning)
-    =========================  ==========  ===============  ==============================
-    pair 2048^2 (floor, 1e6)   45 ms       --               25 ms (10 s)
-    pair 1024^2                14 ms       --               7.4 ms
-    operator 2 x 1080 x 1875   44 ms (*)   79 ms            89 ms (8-20 s)
-    operator 2 x 648 x 1125    16 ms (*)   45 ms            8 ms (0.5-5 s)
-    =========================  ==========  ===============  ==============================
-
-    (*) pruned as below. pyFFTW 0.15 wins only with ``FFTW_MEASURE`` plans, whose
-    planning takes longer than a whole solve, per shape (every support window has
-    its own); with ``FFTW_ESTIMATE`` it is 1.8-2.8x slower than pocketfft, which
-    plans in microseconds and caches its plans.
+    ``scipy.fft`` (pocketfft), chosen by measurement against pyFFTW
+    (``benchmarks/fft_floor.py``; the table is in ``docs/performance.md``). pyFFTW wins
+    only with ``FFTW_MEASURE`` plans, whose planning takes longer than a whole solve,
+    per shape (every support window has its own); with ``FFTW_ESTIMATE`` it is slower
+    than pocketfft, which plans in microseconds and caches its plans.
 
 Pruned transforms
     :func:`forward` and :func:`inverse` are the two halves of a zero-padded

@@ -38,9 +38,8 @@ log = logging.getLogger(__name__)
 
 
 # Dot products go through Backend.dot: on NumPy np.einsum, because np.dot and np.vdot call the
-# threaded OpenBLAS ddot, which waits for its second thread: on 86,000 nodes 0.02 ms on an idle
-# 2-core machine, 12 ms median (up to 130 ms) with the other core busy; np.einsum stays at
-# 0.05 ms either way.
+# threaded OpenBLAS ddot, which waits for its second thread and is slow by orders of magnitude
+# when the other cores are busy; np.einsum is not (docs/performance.md, "The FFT back end").
 
 
 def _tangent(bk, layer, p, gap, p_ref):

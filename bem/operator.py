@@ -20,8 +20,8 @@ Support windows
     support of ``p`` (snapped outwards to a grid of 1/16 of the region so
     that a slowly moving contact reuses the same window) and keeps the kernel
     spectrum of the last few windows. The product is exact for every window;
-    the window only changes the cost (issue problem, 1,048,703 nodes, contact
-    4 % of the region: 2.7x fewer FFT points per product).
+    the window only changes the cost (``benchmarks/side_by_side.py`` measures it;
+    ``docs/performance.md``).
 """
 
 from __future__ import annotations
@@ -268,9 +268,9 @@ class InfluenceOperator:
             ``"support"``: the embedding over the snapped bounding box of the
             support of each ``r``, 0 outside it; for all ``r`` with one box it
             is one symmetric positive definite operator. ``"full"``: over the
-            whole candidate region, one SPD operator for every ``r``. Measured on
-            the issue problem (1,048,703 nodes, contact 4 % of the region): same
-            15 iterations, Hertz solve 1.30 s against 2.06 s with ``"full"``.
+            whole candidate region, one SPD operator for every ``r``. Where the
+            contact is small ``"support"`` is cheaper for as many iterations
+            (``benchmarks/side_by_side.py``; ``docs/performance.md``).
 
         Returns
         -------

@@ -8,7 +8,7 @@ side by side, interleaved, median of ``--repeat``:
 * pyFFTW, if installed, with ``FFTW_ESTIMATE`` plans and with ``FFTW_MEASURE``
   plans (planning time reported separately; plans and aligned buffers cached).
 
-Then, on the issue problem (``benchmarks/side_by_side.py``, Hertz, KKT 1e-10), our
+Then, on the problem of ``benchmarks/side_by_side.py`` (Hertz, KKT 1e-10), our
 cost per conjugate-gradient iteration on the finest lattice (median interval
 between ``callback`` calls) and the cost of one ``C p`` and one preconditioner
 application on the converged contact, each divided by the floor. With

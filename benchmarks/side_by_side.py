@@ -1,6 +1,6 @@
 """Benchmark: contactlab against an independent Polonsky-Keer solver, same problem, same run.
 
-The issue's problem: sphere ``R = 1`` on a flat, ``E* = 1``, square candidate region
+The problem: sphere ``R = 1`` on a flat, ``E* = 1``, square candidate region
 of side 1, force such that the Hertz radius is 0.1, node density of an ``N x N``
 grid (contactlab: triangular lattice of step ``sqrt(2/sqrt3)/N``, the same nodes per
 area), KKT residual ``1e-10``. Cases: ``hertz`` (no layer; the yardstick is plain PK,

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerate every report the repository keeps (about 15 minutes on 2 cores):
+# Regenerate every report the repository keeps (its run time: docs/performance.md):
 #   reports/paper/        the paper's test problem (Fig. 4-11 analogues, validation)
 #   reports/hertz/        the built-in Hertz scene: BEM + FEM + closed form
 #   reports/studies/      raw study output (error_time.*, stability.*, robustness.*)

@@ -216,11 +216,13 @@ def test_nothing_points_outside_the_repository():
 def test_readme_links_resolve_inside_the_repository():
     text = (ROOT / "README.md").read_text()
     targets = re.findall(r"\]\(([^)#\s]+)", text)
-    assert {"docs/method.md", "docs/scenes.md", "docs/results.md", "LICENSE", "CITATION.cff"} <= set(targets)
+    assert {"docs/method.md", "docs/scenes.md", "docs/results.md", "docs/install.md", "docs/verification.md",
+            "docs/performance.md", "LICENSE", "CITATION.cff"} <= set(targets)
     for target in targets:
         assert not target.startswith(("/", "..")), target
         assert (ROOT / target).exists(), f"README links to {target}, which is not in the repository"
-    for page in ("method.md", "scenes.md", "results.md", "rough.md"):
+    for page in ("method.md", "scenes.md", "results.md", "rough.md", "install.md", "verification.md",
+                 "performance.md"):
         for target in re.findall(r"\]\(([^)#\s]+)", (DOCS / page).read_text()):
             assert (DOCS / target).exists(), f"docs/{page} links to {target}"
 

@@ -53,12 +53,10 @@ def _extra(name):
     return out
 
 
-def _imports(directory, skip=()):
+def _imports(directory):
     """Top-level third-party module names imported anywhere under ``directory`` (a folder or a file)."""
     found = set()
     for path in [directory] if directory.is_file() else directory.rglob("*.py"):
-        if path.name in skip:
-            continue
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.Import):
                 found |= {alias.name.split(".")[0] for alias in node.names}

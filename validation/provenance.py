@@ -194,7 +194,7 @@ def report_footer(prov=None, *, when=None):
     Parameters
     ----------
     prov : dict, optional
-        Default :func:`provenance` now.
+        Default: :func:`provenance` of the running process.
     when : str, optional
         Date text; default the local time ``YYYY-MM-DD HH:MM``.
     """

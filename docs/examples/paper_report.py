@@ -11,7 +11,7 @@ the FEM reference; then writes ``report.html`` (self-contained), ``report.md`` a
 Usage (from the repository root)::
 
     python docs/examples/paper_report.py --out reports/paper          # about a minute
-    python docs/examples/paper_report.py --out build/paper --quick    # coarse preview, ~30 s
+    python docs/examples/paper_report.py --out build/paper --quick    # coarse preview (times: docs/performance.md)
 
 The same report: ``contactlab report paper --out reports/paper``.
 """

@@ -1,4 +1,5 @@
-"""Stiff and extreme cases: Newton converges on all; a paper method either agrees or says it failed."""
+"""Stiff and extreme cases: Newton converges on all; a paper method converges where it must, and
+elsewhere either agrees or says it failed."""
 
 import functools
 import math
@@ -79,12 +80,22 @@ def test_newton_converges(newton, name):
         assert np.count_nonzero(res.p > 0) > 0.6 * res.p.size
 
 
+#: the cases each paper method must solve: the augmented gap method where the layer is much stiffer
+#: than the bodies (its fixed-point map -lam C^-1 contracts), variable compliance everywhere but the
+#: soft cubic layers
+MUST_CONVERGE = {
+    "augmented_gap": {"linear k=1e-3", "power s=3 k=1e-3", "elastic-rigid p_cr=1e-6 p0"},
+    "variable_compliance": set(CASES) - {"power s=3", "power s=3 k=1e3"},
+}
+
+
 @pytest.mark.parametrize("method", ["augmented_gap", "variable_compliance"])
 @pytest.mark.parametrize("name", list(CASES))
 def test_paper_method_is_right_or_says_it_failed(newton, name, method):
     res = _run(name, method)
     ref = newton[name]
     assert np.all(np.isfinite(res.p))
+    assert res.converged or name not in MUST_CONVERGE[method], res.message
     if res.converged:
         assert np.linalg.norm(res.p - ref.p) / np.linalg.norm(ref.p) <= 1e-6
         assert abs(res.p_max / ref.p_max - 1) <= 1e-6
@@ -96,7 +107,7 @@ def test_paper_method_is_right_or_says_it_failed(newton, name, method):
 def test_newton_converges_on_a_fine_lattice_with_infinite_layer_stiffness_gradient():
     """s = 0.2 at 100 nodes across: w' spans many decades near the contact edge.
 
-    Regression: the inner QP needs the oblique projection of its preconditioned residual,
+    The inner QP needs the oblique projection of its preconditioned residual,
     and the Newton step the majorising curvature where the model is too soft."""
     layer = _power(1.0, 0.2)
     a = _contact_radius("power s=0.2")

@@ -55,7 +55,7 @@ def test_kkt_of_eq14_holds_at_every_returned_solution(paper, method, law):
     C = bem.InfluenceOperator(res.lattice, E_STAR).dense()  # independent of the FFT path
     gap = C @ res.p + layer.w(res.p) + bem.gaps.Paraboloid(R)(res.x, res.y) - res.approach
     scale = np.abs(C @ res.p + layer.w(res.p)).max()
-    tol = 1e-10  # every method now meets rtol on the KKT residual
+    tol = 1e-10  # every method meets rtol on the KKT residual
     assert res.p.min() >= 0
     assert np.abs(gap[res.p > 0]).max() <= tol * scale
     assert gap[res.p == 0].min() >= -tol * scale

@@ -40,9 +40,24 @@ def test_vtu_readable_with_expected_fields(result, tmp_path):
     # the top moved down by the far-boundary approach
     top = m.points[:, 1] == m.points[:, 1].max()
     np.testing.assert_allclose(m.point_data["displacement"][top, 1], -result.truncation["approach_far"], rtol=1e-12)
-    # von Mises >= 0 and the bodies deform symmetrically (same materials): |u_z| mirrors
-    assert np.all(m.point_data["von_mises"] >= 0)
+    # same materials: the lower body mirrors the upper one about z = 0, with the top moved down by
+    # approach_far and the bottom held, so u_z(r, z) + u_z(r, -z) = -approach_far, u_r and the normal
+    # stresses are even in z, sigma_rz is odd; compared at the nodes whose mirror image is a node
+    _assert_mirror_symmetric(m, result.truncation["approach_far"], scale=result.p_max)
     assert [p.name for p in tmp_path.iterdir()] == ["field.vtu"]  # no temporary file left
+
+
+def _assert_mirror_symmetric(m, approach_far, *, scale):
+    key = {(round(r, 9), round(z, 9)): i for i, (r, z) in enumerate(m.points[:, :2] / m.points[:, 0].max())}
+    pairs = np.array([(i, key[(r, -z)]) for (r, z), i in key.items() if z > 0 and (r, -z) in key])
+    up, lo = pairs.T
+    assert np.count_nonzero(m.points[up, 0] > 0) >= 20 and np.count_nonzero(m.points[up, 0] == 0) >= 20
+    u, d = m.point_data["displacement"], m.point_data
+    np.testing.assert_allclose(u[up, 1] + u[lo, 1], -approach_far, rtol=0, atol=1e-3 * approach_far)
+    np.testing.assert_allclose(u[up, 0], u[lo, 0], rtol=0, atol=1e-3 * np.abs(u[:, 0]).max())
+    for name in ("sigma_rr", "sigma_zz", "sigma_tt", "von_mises"):
+        np.testing.assert_allclose(d[name][up], d[name][lo], rtol=0, atol=1e-2 * scale, err_msg=name)
+    np.testing.assert_allclose(d["sigma_rz"][up], -d["sigma_rz"][lo], rtol=0, atol=1e-2 * scale)
 
 
 def test_solve_writes_no_file_and_the_field_is_written_whole_or_not_at_all(gap, coarse_mesh, tmp_path,
@@ -107,7 +122,7 @@ def test_bad_gap():
 
 def test_vtu_is_compressed_with_ordinary_permissions(result, tmp_path):
     """The one writer (bem.files.write_vtu): zlib-compressed VTK XML, read here by an independent
-    decoder of the format; the file gets the permissions of any new file (it was 0600)."""
+    decoder of the format; the file gets the permissions of any new file (umask), not 0600."""
     import os
     import stat
 

@@ -1,6 +1,7 @@
-"""Every figure type of validation.report renders a real, non-blank PNG of the expected size;
-the helpers behind the figures are checked against hand-computed values; inputs stay untouched;
-files are written atomically."""
+"""Every figure type of validation.report renders a real, non-blank PNG of the expected size and
+draws what it is given: its curves are the data in the stated units, its limits hold them, its
+labels name them; the helpers behind the figures are checked against hand-computed values;
+inputs stay untouched; files are written atomically."""
 
 import math
 import os
@@ -18,6 +19,8 @@ from validation.report.figures import surfaces as f3d
 from validation.report.figures import sweeps as fsw
 from bem.files import atomic_path
 from validation.report.render.style import DPI, save_figure
+
+from .figure_spy import drawn, horizontal_at, lines_of, vertical_at  # noqa: F401 - drawn is a fixture
 
 HERTZ = hertz_sphere(R=1.0, E_star=1.0, force=1.0)
 A, P0 = HERTZ.contact_radius, HERTZ.p_max
@@ -125,27 +128,62 @@ def test_work_precision_rows_accepts_tuples_and_drops_unplottable():
 
 # ---------------------------------------------------------------- every figure type
 
-def test_pressure_profiles_png(cases, tmp_path):
+def test_pressure_profiles_png(cases, tmp_path, drawn):
     curves = [("smooth", cases["smooth"]), ("linear", cases["linear"]), ("elastic-rigid", cases["er"])]
     s = np.linspace(-1.5 * A, 1.5 * A, 301)
     path = fpr.plot_pressure_profiles(curves, tmp_path / "p.png", p0=P0, a=A, hertz=(s, HERTZ.pressure(s)))
     img = check_png(path, (8.2, 4.0))
+    ax = drawn[-1].axes[0]
+    lines = lines_of(ax)
+    assert list(lines) == ["Hertz (closed form)", "smooth", "linear", "elastic-rigid"]
+    np.testing.assert_allclose(lines["Hertz (closed form)"][1], HERTZ.pressure(s) / P0)
+    edge = 0.0
+    for label, res in curves:  # the axial section y = 0 of each result, in units of a and p0
+        y0 = np.abs(res.y) < 1e-12 * A
+        order = np.argsort(res.x[y0])
+        np.testing.assert_allclose(lines[label][0], res.x[y0][order] / A)
+        np.testing.assert_allclose(lines[label][1], res.p[y0][order] / P0)
+        edge = max(edge, np.abs(res.x[y0][res.p[y0] > 0]).max() / A)
+    lo, hi = ax.get_xlim()
+    assert lo <= -edge and edge <= hi <= 1.5 * edge + 0.5  # every loaded node, not the whole region
+    assert ax.get_ylim()[0] == 0.0 and ax.get_ylim()[1] >= max(r.p_max for _, r in curves) / P0
+    assert "y = 0" in ax.get_xlabel() and "p_0" in ax.get_ylabel()
     # the data matter: a different set of curves gives a different picture
     other = fpr.plot_pressure_profiles(curves[:1], tmp_path / "q.png", p0=P0, a=A)
     assert np.abs(_image(other) - img).mean() > 0.5
 
 
-def test_layer_laws_png(cases, tmp_path):
+def test_layer_laws_png(cases, tmp_path, drawn):
     laws = [("smooth", None), ("linear", cases["linear"].layer), ("elastic-rigid", cases["er_law"]),
             ("root", bem.layers.Root(LAM))]
     check_png(fpr.plot_layer_laws(laws, tmp_path / "w.png", p_max=P0, marks=[("p_cr", cases["er_law"].p_cr)]),
               (6.0, 3.8))
+    ax = drawn[-1].axes[0]
+    lines = lines_of(ax)
+    assert list(lines) == [label for label, _ in laws]
+    for label, layer in laws:  # w(p) of each law over 0..p_max; the smooth bodies on the axis
+        p, w = lines[label]
+        assert p[0] == 0.0 and p[-1] == P0
+        np.testing.assert_allclose(w, 0.0 if layer is None else layer.w(p), rtol=1e-12, atol=0)
+    assert ax.get_xlim() == (0.0, P0) and ax.get_ylim()[1] >= max(lines["root"][1].max(), lines["linear"][1].max())
+    assert vertical_at(ax, cases["er_law"].p_cr)
+    assert "p" in ax.get_xlabel() and "w(p)" in ax.get_ylabel()
 
 
-def test_iteration_profiles_png(cases, tmp_path):
+def test_iteration_profiles_png(cases, tmp_path, drawn):
     r = cases["er_vc"]
     assert len(r.history["p"]) == r.iterations
     check_png(fit.plot_iteration_profiles(r, tmp_path / "it.png", p0=P0, a=A), (6.8, 4.0))
+    ax = drawn[-1].axes[0]
+    ks = fit.pick_iterations(r.iterations)
+    drawn_p = [ln.get_ydata() for ln in ax.get_lines()]
+    assert len(drawn_p) == ks.size + 1  # the iterates picked, then the final state
+    for k, y in zip(ks, drawn_p):
+        np.testing.assert_allclose(y, fpr.section_of(r, r.history["p"][k - 1])[1] / P0)
+    final = lines_of(ax)
+    (label, (_x, y)), = final.items()
+    assert label.startswith("final (converged") and f"k = {r.iterations}" in label
+    np.testing.assert_allclose(y, fpr.section_of(r)[1] / P0)
     with pytest.raises(InputError, match="record=True"):
         fit.plot_iteration_profiles(cases["er"], tmp_path / "x.png", p0=P0, a=A)
     with pytest.raises(InputError, match="iterations"):
@@ -153,17 +191,32 @@ def test_iteration_profiles_png(cases, tmp_path):
     assert not (tmp_path / "x.png").exists()
 
 
-def test_convergence_png(cases, tmp_path):
+def test_convergence_png(cases, tmp_path, drawn):
     runs = [("variable compliance", cases["er_vc"]), ("Newton", cases["er_newton"])]
     check_png(fit.plot_convergence(runs, tmp_path / "c.png", p0=P0, tol=1e-8), (6.6, 5.2))
+    top, bot = drawn[-1].axes[:2]
+    lines = lines_of(top)
+    assert list(lines) == ["variable compliance", "Newton"]
+    for (label, r), (k, pm), res_line in zip(runs, lines.values(), bot.get_lines()):
+        np.testing.assert_array_equal(k, np.arange(1, len(r.history["p_max"]) + 1))
+        np.testing.assert_allclose(pm, np.asarray(r.history["p_max"]) / P0)
+        np.testing.assert_allclose(res_line.get_ydata(), r.history["residual"])
+        assert r.history["residual"][-1] <= 1e-8
+    assert horizontal_at(bot, 1e-8) and bot.get_yscale() == "log" and bot.get_xscale() == "log"
+    assert bot.get_ylabel() == "KKT residual" and "p_0" in top.get_ylabel()
 
 
-def test_pressure_surfaces_3d_png(cases, tmp_path):
+def test_pressure_surfaces_3d_png(cases, tmp_path, drawn):
     r = cases["er_vc"]
-    panels = [("smooth", cases["smooth"]), ("k = 1", (r.x, r.y, r.history["p"][0])), ("final", r)]
+    panels = [("final", r), ("k = 1", (r.x, r.y, r.history["p"][0])), ("smooth", cases["smooth"])]
     # two panels per row (each half a report page wide): two rows of 3.3 x 2.8 in, the colour bar, the title
     check_png(f3d.plot_pressure_surfaces(panels, tmp_path / "s.png", p0=P0, a=A, title="t"),
               (3.3 * 2 + 0.9, 2.8 * 2 + 0.35))
+    *surfaces, bar = drawn[-1].axes
+    assert [ax.get_title() for ax in surfaces] == ["final", "k = 1", "smooth"]
+    assert r.p_max < 0.97 * cases["smooth"].p_max  # the first panel is not the highest
+    vmax = max(cases["smooth"].p.max(), r.history["p"][0].max(), r.p.max()) / P0
+    assert bar.get_ylim() == pytest.approx((0.0, vmax))  # one colour scale: the highest peak of all panels
 
 
 def test_pressure_surface_without_axis_nodes(tmp_path):
@@ -173,10 +226,21 @@ def test_pressure_surface_without_axis_nodes(tmp_path):
                                          p0=1.0, a=1.0))
 
 
-def test_contact_map_png(cases, tmp_path):
+def test_contact_map_png(cases, tmp_path, drawn):
     er = cases["er"]
     check_png(f3d.plot_contact_map(er, tmp_path / "m.png", p0=P0, a=A, levels=[("p_cr", cases["er_law"].p_cr)]),
               (5.4, 4.4))
+    ax = drawn[-1].axes[0]
+    field = ax.collections[0]
+    xs, ys, ps, _tri = f3d.contact_patch(er.x, er.y, er.p, margin=0.3)
+    np.testing.assert_allclose(field.get_array(), ps / P0)  # p / p0 over the patch around the contact
+    assert field.get_clim() == pytest.approx((0.0, er.p_max / P0))
+    lines = lines_of(ax)
+    assert {"contact boundary", "p_cr"} < set(lines)
+    circle = lines[r"equal-area circle $r = \sqrt{A/\pi}$"]
+    np.testing.assert_allclose(np.hypot(*circle), er.contact_radius / A)
+    (x0, x1), (y0, y1) = f3d.covered_window(xs, ys)
+    assert ax.get_xlim() == pytest.approx((x0 / A, x1 / A)) and ax.get_ylim() == pytest.approx((y0 / A, y1 / A))
 
 
 def test_contact_map_window_is_covered_by_the_triangles(cases):
@@ -210,29 +274,60 @@ def test_contact_patch_covers_contact(cases):
     np.testing.assert_allclose(area, math.sqrt(3) / 4 * STEP**2, rtol=1e-9)
 
 
-def test_sweep_and_transition_line_png(cases, tmp_path):
+def test_sweep_and_transition_line_png(cases, tmp_path, drawn):
     curves = [(al, *fpr.section_of(r)) for al, r in ((0.0, cases["smooth"]), (0.5, cases["er"]),
                                                       (1.0, cases["linear"]))]
     check_png(fsw.plot_sweep(curves, tmp_path / "sw.png", p0=P0, a=A, name=r"$\alpha_a$"), (6.8, 4.0))
-    check_png(fsw.plot_transition_line([0.0, 0.5, 1.0], [1.0, 0.8, 0.0], tmp_path / "tl.png", a=1.0,
-                                       r_contact=[1.0, 1.1, 1.2]), (6.0, 4.0))
+    ax, bar = drawn[-1].axes
+    for (_alpha, x, p), ln in zip(curves, ax.get_lines(), strict=True):
+        np.testing.assert_allclose(ln.get_xdata(), x / A)
+        np.testing.assert_allclose(ln.get_ydata(), p / P0)
+    np.testing.assert_allclose(bar.get_yticks(), [0.0, 0.5, 1.0])  # the colour bar names the swept values
+    assert bar.get_ylabel() == r"$\alpha_a$"
+    check_png(fsw.plot_transition_line([0.5, 0.0, 1.0], [0.8, 1.0, 0.0], tmp_path / "tl.png", a=2.0,
+                                       r_contact=[1.1, 1.0, 1.2]), (6.0, 4.0))
+    ax = drawn[-1].axes[0]
+    lines = lines_of(ax)
+    np.testing.assert_allclose(lines["transition line $p = p_{cr}$"], [[0.0, 0.5, 1.0], [0.5, 0.4, 0.0]])
+    np.testing.assert_allclose(lines["contact edge"], [[0.0, 0.5, 1.0], [0.5, 0.55, 0.6]])  # sorted, r / a
+    assert ax.get_xlim() == (0.0, 1.0) and ax.get_ylim() == pytest.approx((0.0, 1.08 * 0.6))
 
 
-def test_profile_comparison_png(cases, tmp_path):
+def test_profile_comparison_png(cases, tmp_path, drawn):
     s = cases["smooth"]
     x, p = fpr.section_of(s)
     curves = [("BEM", x, p, "bem"), ("shifted", x, 0.98 * p, "fem")]
     check_png(fpr.plot_profile_comparison(curves, tmp_path / "cmp.png", p0=P0, a=A,
                                           reference=("Hertz", HERTZ.pressure)), (6.6, 5.4))
+    top, bot = drawn[-1].axes[:2]
+    lines = lines_of(top)
+    assert list(lines) == ["Hertz", "BEM", "shifted"]
+    r, pr = lines["BEM"][0] * A, lines["BEM"][1] * P0
+    assert np.all(r >= 0) and np.isin(np.round(r / A, 9), np.round(np.abs(x) / A, 9)).all()
+    errors = {ln.get_label().split(":")[0]: ln for ln in bot.get_lines() if not ln.get_label().startswith("_")}
+    for label, factor in (("BEM", 1.0), ("shifted", 0.98)):  # the lower panel: (p - p_Hertz) / p0 at the nodes
+        rr = errors[label].get_xdata() * A
+        expected = (factor * np.interp(rr, r, pr) - HERTZ.pressure(rr)) / P0
+        np.testing.assert_allclose(errors[label].get_ydata(), expected, atol=1e-12)
+    worst = max(np.abs(ln.get_ydata()).max() for ln in errors.values())
+    assert bot.get_ylim() == pytest.approx((-1.15 * worst, 1.15 * worst))
+    assert top.get_xlim()[0] == 0.0 and top.get_xlim()[1] >= np.abs(x[p > 0]).max() / A
     # reference given as samples (no callable)
     check_png(fpr.plot_profile_comparison(curves, tmp_path / "cmp2.png", p0=P0, a=A))
 
 
-def test_work_precision_png(tmp_path):
+def test_work_precision_png(tmp_path, drawn):
     rows = [("BEM", "qp", f"a/c={m}", 100 * m, 0.3 / m**1.5, 0.01 * m) for m in (5, 10, 20)]
     rows += [{"solver": "FEM", "method": "P2", "resolution": f"{n}/a", "N": 1000 * n, "error": 0.1 / n**2,
               "wall_time_s": 0.1 * n} for n in (4, 8)]
     check_png(fva.plot_work_precision(rows, tmp_path / "wp.png"), (7.0, 4.6))
+    ax = drawn[-1].axes[0]
+    lines = lines_of(ax)
+    assert list(lines) == ["BEM (qp)", "FEM (P2)"]
+    np.testing.assert_allclose(lines["BEM (qp)"], [[0.05, 0.1, 0.2], [0.3 / m**1.5 for m in (5, 10, 20)]])
+    np.testing.assert_allclose(lines["FEM (P2)"], [[0.4, 0.8], [0.1 / 16, 0.1 / 64]])
+    assert ax.get_xscale() == ax.get_yscale() == "log" and ax.get_ylabel() == "relative error"
+    assert horizontal_at(ax, 0.01) and horizontal_at(ax, 0.001)
     # repeats: the marker at the median, the bar from the fastest to the slowest
     spread = [dict(r, wall_times_s=[0.8 * r["wall_time_s"], r["wall_time_s"], 1.5 * r["wall_time_s"]])
               for r in fva.work_precision_rows(rows)]
@@ -244,7 +339,7 @@ def test_work_precision_png(tmp_path):
         fva.plot_work_precision([("BEM", "qp", "x", 1, 0.0, 1.0)], tmp_path / "none.png")
 
 
-def test_von_mises_png(tmp_path):
+def test_von_mises_png(tmp_path, drawn):
     from validation.report.figures.fields import plot_section_field, von_mises_of
 
     import fem_reference
@@ -259,6 +354,13 @@ def test_von_mises_png(tmp_path):
     assert abs(z[k]) / A == pytest.approx(0.48, abs=0.12) and r[k] / A < 0.25
     check_png(plot_section_field(r, z, tri, vm, tmp_path / "vm.png", a=A, scale=P0, label="von Mises",
                                  contact_radius=fem.contact_radius), section_field_size())
+    ax = next(ax for ax in drawn[-1].axes if ax.collections)  # the (r, z) map (beside a 3-D view with [3d])
+    shown = ax.collections[0].get_array()
+    assert shown.max() == pytest.approx(vm.max() / P0, rel=1e-12)  # the FEM's von Mises stress / p0
+    assert np.all(shown >= 0) and ax.get_xlim() == (-3.0, 3.0) and ax.get_ylim() == (-3.0, 3.0)
+    (label, (xc, zc)), = lines_of(ax).items()  # the contact, marked on the interface
+    assert label.startswith("contact") and np.all(zc == 0.0)
+    np.testing.assert_allclose(xc, np.array([-1.0, 1.0]) * fem.contact_radius / A)
 
 
 # ---------------------------------------------------------------- inputs untouched, atomic writes

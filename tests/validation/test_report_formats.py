@@ -92,7 +92,10 @@ def test_every_figure_in_every_format(cases, tmp_path, name, fmt):
         return
     img = check_png(out, size)  # 300 dpi: the pixel size of the stated inches, not blank
     assert img.shape[:2] == (round(size[1] * 300), round(size[0] * 300)) and DPI == 300
-    assert out.stat().st_size < 1.5e6, "PNG too large"
+    from PIL import Image
+
+    with Image.open(out) as png:
+        assert png.mode == "P"  # a palette image (save_figure's colors=256), not full RGB
     if fmt == "pdf":
         pdf = Path(vector_copy(out))
         data = pdf.read_bytes()
@@ -117,7 +120,6 @@ def test_colour_fields_are_rasterised_in_vector_files(cases, tmp_path, monkeypat
     images = [el for el in root.iter() if el.tag.endswith("image")]
     texts = [el for el in root.iter() if el.tag.endswith("path")]
     assert len(images) == 3 and len(texts) > (50 if view == "matplotlib" else 20)  # two surfaces, the colour bar
-    assert Path(out).stat().st_size < 2e6
 
 
 @pytest.mark.parametrize("fmt", FORMATS)

@@ -13,48 +13,70 @@ from validation.report import command
 from validation.report.documents.paper import TITLE, paper_sections
 from validation.report.documents.paper_runs import run_paper_problem
 from validation.report.render import build_report
+from validation.report.render.content import Figure
 
 from .test_report_build import PNG_MAGIC, assert_valid_offline_html
 from .test_report_figures import check_png
 
 
-STAGES_SEEN = []
-#: the solver's warnings while the paper problem runs
-SOLVER_WARNINGS = []
-
-
 class _Collect(logging.Handler):
+    """Keeps the messages of the records it is given."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages = []
+
     def emit(self, record):
-        SOLVER_WARNINGS.append(record.getMessage())
+        self.messages.append(record.getMessage())
 
 
 @pytest.fixture(scope="module")
-def paper():
-    logger, handler = logging.getLogger("bem"), _Collect(logging.WARNING)
+def paper_run():
+    """The quick paper problem, the stages it reported (in order) and the solver's warnings meanwhile."""
+    stages, handler, logger = [], _Collect(), logging.getLogger("bem")
     logger.addHandler(handler)
     try:
-        return run_paper_problem(quick=True, progress=STAGES_SEEN.append)
+        return run_paper_problem(quick=True, progress=stages.append), stages, handler.messages
     finally:
         logger.removeHandler(handler)
 
 
 @pytest.fixture(scope="module")
-def report(paper, tmp_path_factory):
-    work = tmp_path_factory.mktemp("work")
-    out = tmp_path_factory.mktemp("out") / "paper"
-    return build_report(paper_sections(paper, work), out, title=TITLE)
+def paper(paper_run):
+    return paper_run[0]
 
 
-def test_paper_report_files(report):
+@pytest.fixture(scope="module")
+def sections(paper, tmp_path_factory):
+    return paper_sections(paper, tmp_path_factory.mktemp("work"))
+
+
+@pytest.fixture(scope="module")
+def report(sections, tmp_path_factory):
+    return build_report(sections, tmp_path_factory.mktemp("out") / "paper", title=TITLE)
+
+
+def _figures(sections, *, fem=True):
+    return [item for s in sections if fem or s.kind != "fem" for item in s.items if isinstance(item, Figure)]
+
+
+def test_paper_report_files(report, sections):
+    from PIL import Image
+
     text = report.html.read_text(encoding="utf-8")
     assert_valid_offline_html(text)
-    assert len(report.figures) == 19
-    assert len(re.findall(r'src="data:image/png;base64,', text)) == 19
+    figures = _figures(sections)
+    analogues = {int(n) for f in figures for n in re.findall(r"analogue of (?:the paper's )?Fig\. (\d+)", f.caption)}
+    assert analogues == set(range(4, 12))  # every figure of the paper's section 6 has its analogue
+    assert any(s.kind == "fem" and _figures([s]) for s in sections)
+    # every figure drawn is in the report once: a file of its own, embedded in the HTML
+    assert len(set(report.figures)) == len(report.figures) == len(figures)
+    assert len(re.findall(r'src="data:image/png;base64,', text)) == len(figures)
     for path in report.figures:
         assert path.read_bytes().startswith(PNG_MAGIC)
         check_png(path)
-    total = sum(p.stat().st_size for p in report.out_dir.rglob("*") if p.is_file())
-    assert total < 6e6, f"report is {total / 1e6:.1f} MB"
+        with Image.open(path) as img:
+            assert img.mode == "P"  # saved as a palette image (save_figure's colors=256)
     for kind in ("problem", "results", "iterations", "sweeps", "stability", "fem"):
         assert f'class="kind-{kind}"' in text
     md = report.markdown.read_text(encoding="utf-8")
@@ -62,14 +84,17 @@ def test_paper_report_files(report):
         assert (report.out_dir / link).is_file()
 
 
-def test_paper_report_without_fem_has_no_fem_section(paper, tmp_path):
+def test_paper_report_without_fem_has_no_fem_section(paper, sections, tmp_path):
     import dataclasses
 
     bem_only = dataclasses.replace(paper, validation={}, work_precision=[])
-    built = build_report(paper_sections(bem_only, tmp_path / "w"), tmp_path / "out", title=TITLE)
+    without = paper_sections(bem_only, tmp_path / "w")
+    built = build_report(without, tmp_path / "out", title=TITLE)
     text = built.html.read_text(encoding="utf-8")
     assert "kind-fem" not in text and "FEM reference" not in text
-    assert len(built.figures) == 13
+    # the same figures as the full report, less those of its FEM section
+    assert [f.caption for f in _figures(without)] == [f.caption for f in _figures(sections, fem=False)]
+    assert len(built.figures) == len(_figures(without))
 
 
 def test_paper_trends(paper):
@@ -132,12 +157,14 @@ def test_paper_methods_and_validation(paper):
     assert bem_err[-1] < bem_err[0] and fem_err[-1] < fem_err[0]
 
 
-def test_expected_augmented_gap_stalls_are_one_note_not_bare_warnings(paper, report):
+def test_expected_augmented_gap_stalls_are_one_note_not_bare_warnings(paper_run, report):
     from validation.report.documents.paper import expected_stalls
+
+    paper, _stages, solver_warnings = paper_run
 
     stalled = [r for r in paper.stability if r["method"].startswith("augmented gap") and r["status"] != "converged"]
     assert stalled, "the quick paper problem stalls the augmented gap method (its documented behaviour)"
-    assert not [m for m in SOLVER_WARNINGS if m.startswith("augmented_gap")]
+    assert not [m for m in solver_warnings if m.startswith("augmented_gap")]
     (note,) = expected_stalls(paper)
     assert "expected, documented behaviour of the augmented gap method" in note
     assert f"in {len(stalled)} of its" in note and all(r["law"] in note for r in stalled)
@@ -221,12 +248,13 @@ def test_example_script_passes_its_options(monkeypatch, tmp_path):
     assert calls == [(str(tmp_path), True, False), (str(tmp_path), False, True)]
 
 
-def test_paper_report_tells_its_stages(paper, monkeypatch, tmp_path):
+def test_paper_report_tells_its_stages(paper_run, monkeypatch, tmp_path):
     from validation.report.documents import paper as paper_report
     from validation.report.documents.paper_runs import SOLVE_STAGES
     from validation.report.render import Section
 
-    assert STAGES_SEEN == list(SOLVE_STAGES)  # the real runs, in order
+    paper, stages, _warnings = paper_run
+    assert stages == list(SOLVE_STAGES)  # the real runs, in order
 
     def fake_solve(*, quick, fem, progress):
         for stage in SOLVE_STAGES[:3 + fem]:

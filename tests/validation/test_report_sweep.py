@@ -14,6 +14,7 @@ from validation.run.sweep import run_sweep
 
 from .conftest import cli
 from .test_report_build import assert_valid_offline_html
+from .figure_spy import drawn  # noqa: F401 - a fixture
 from .test_report_figures import check_png
 
 FORCES = [50.0, 100.0, 200.0]
@@ -54,6 +55,25 @@ def test_sweep_sections_hold_every_point_in_scene_units(sweep_dir, tmp_path):
     assert p_max[2] / p_max[0] == pytest.approx(4 ** (1 / 3), rel=0.03)  # Hertz: p_max ~ P^(1/3)
     captions = [item.caption for item in sections[1].items[1:]]
     assert len(captions) == 2 and "coloured by load.force" in captions[0]
+
+
+def test_sweep_figures_show_every_point(sweep_dir, tmp_path, drawn):
+    """The profiles figure has one curve per point, its colour bar the swept forces; the scalars
+    figure draws each point's p_max, in MPa (the report unit of the SI scene), against the force."""
+    _summary, points = load_sweep(sweep_dir)
+    sweep_sections(_summary, points, tmp_path)
+    profiles, scalars = drawn
+    ax, bar = profiles.axes
+    assert len(ax.get_lines()) == len(FORCES)
+    np.testing.assert_allclose(bar.get_yticks(), FORCES)
+    for ln, (_row, res) in zip(ax.get_lines(), points):
+        assert ln.get_ydata().max() * 1e6 == pytest.approx(res.data["p_max"], rel=0.02)  # MPa, as labelled
+    assert "MPa" in ax.get_ylabel()
+    p_panel = scalars.axes[0]
+    (line,) = p_panel.get_lines()
+    np.testing.assert_allclose(line.get_xdata(), FORCES)
+    np.testing.assert_allclose(line.get_ydata() * 1e6, [res.data["p_max"] for _, res in points])
+    assert "MPa" in p_panel.get_ylabel() and scalars.axes[-1].get_xlabel()
 
 
 def test_sweep_report_dimensionless_and_svg(sweep_dir, tmp_path):

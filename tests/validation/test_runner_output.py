@@ -127,7 +127,7 @@ def test_scene_file_in_the_result_reruns_identically(tmp_path):
     first = run_scene("paper_bilinear", tmp_path / "a", overrides=["bem.nodes_across=16", "fem.n_contact=8"])
     files = sorted(p.name for p in (tmp_path / "a").iterdir())
     assert files == [".contactlab", "bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
-    for name in files:  # every file has the permissions of a new file (fem_field.vtu was 0600)
+    for name in files:  # every file has the permissions of a new file (umask), fem_field.vtu too
         assert ((tmp_path / "a" / name).stat().st_mode & 0o777) == file_mode(), name
     second = run_scene(tmp_path / "a" / "scene.toml")
     assert second["p_max"] == first["p_max"] and second["approach"] == first["approach"]

@@ -6,9 +6,6 @@ import os
 
 from .common import add_set, add_trust
 
-#: measured wall time of `contactlab report paper --quick` and of the full paper report on 2 cores shared
-#: with other jobs (load 2.3-5; CPU time 15-18 s and 36-42 s)
-QUICK_TIME, FULL_TIME = "18-26 s", "50-80 s"
 #: figure formats of `contactlab report --format` (validation.report.style.FORMATS, kept here so the
 #: parser needs no import of the report package)
 FORMATS = ("png", "svg", "pdf")
@@ -47,8 +44,8 @@ def add_args(p):
                         "contact's scales (Hertz's p_H and a_H for a paraboloid, else p_max and the contact "
                         "half-width)")
     p.add_argument("--quick", action="store_true",
-                   help=f"'paper' only: a coarse preview (a_H/c = 8, short sweeps): {QUICK_TIME} instead of "
-                        f"{FULL_TIME} on 2 cores")
+                   help="'paper' only: a coarse preview (a_H/c = 8, short sweeps) in a fraction of the full "
+                        "report's time (measured times: docs/performance.md)")
     add_set(p, "scene targets only: ")
     add_trust(p, scope="scene targets only: ")
 
