@@ -42,6 +42,7 @@ from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
 from .sizing import EXCLUSIVE as BEM_EXCLUSIVE
 from .sizing import bem_options
 from .source import builtin_path, builtin_scenes, read_source, read_toml
+from .layer_file import resolve_layer_file
 from .trust import check_code_name, code_names, refuse_code, scene_file
 
 __all__ = ["Scene", "SceneError", "load_scene", "check_scene", "parse_scene", "builtin_scenes", "builtin_path",
@@ -248,16 +249,19 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     section = {k: (raw[k] if k in raw else check.FAILED) for k in _REQUIRED}
     if check(_resolve_files, raw, base_dir, outside_files) is check.FAILED:
         section["gap"] = check.FAILED
+    layer_file = check(resolve_layer_file, raw, base_dir, outside_files)
     meta = check(sec.scene_meta, section["scene"])
     body = check(sec.bodies, section["bodies"])
     load = check(sec.load, section["load"])
     if code == "refuse":  # refused above: build nothing that imports
         section["gap"] = check.FAILED if "gap" in coded else section["gap"]
     layer_raw = check.FAILED if code == "refuse" and "layer" in coded else raw.get("layer")
+    layer_raw = check.FAILED if layer_file is check.FAILED else layer_raw
     build = {part: code == "import" or part not in coded for part in ("gap", "layer")}
     shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"], build=build["gap"]),
                   section["gap"], body, meta)
-    layer = check(lambda d: sec.layer(d, build=build["layer"]), layer_raw)
+    layer = check(lambda d: sec.layer(d, build=build["layer"], E_star=None if body is check.FAILED else body["E_star"]),
+                  layer_raw)
     bem = check(lambda g, la, b, ld: bem_options(raw.get("bem"), g[1], *la, b["E_star"], ld), shape, layer, body, load)
     shape = check(lambda g, b: (g[0], measured_region(g[1], b["extent"])), shape, bem)
     fem = check(lambda g, b: sec.fem_options(raw.get("fem"), g[1], b["materials"]), shape, body)
