@@ -11,6 +11,7 @@ from .checks import (check_bool, check_callable, check_choice, check_finite_arra
                      check_rtol, check_scale)
 from .errors import InputError, RegionTooSmallError
 from .kalker import QPSolution
+from .layers import beyond_table
 from .kkt import kkt_residual
 from .lattice import Lattice
 from .materials import effective_modulus
@@ -144,7 +145,9 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     smaller increment in 15 iterations) or diverges (8 growing increments) stops and
     says so. A result that does not meet its rule has ``converged = False`` and the
     reason in ``message``, and one warning is logged (with a summary of inner solves
-    that missed their tolerance); a converged run logs no warning.
+    that missed their tolerance); a converged run logs no warning, except one whose peak
+    pressure exceeds the last pressure of a tabulated layer law
+    (:func:`bem.layers.beyond_table`: the law is continued beyond its data).
     """
     t_start = time.perf_counter()
     check_callable("gap", gap)
@@ -199,6 +202,8 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
                      n_matvec=sum(o.n_matvec for o in ops if o is not op))
     if not result.converged:
         log.warning("%s: %s%s", solver, result.message, _inner_summary(sol.history))
+    elif (note := beyond_table(layer, result.p_max)) is not None:
+        log.warning("%s", note)
     return result
 
 

@@ -85,3 +85,17 @@ def test_a_law_made_with_another_modulus_is_refused(topography_law, tmp_path):
     (tmp_path / "scene.toml").write_text(tomli_w.dumps(scene))
     with pytest.raises(SceneError, match=r"layer.file = .* made with E_star = .*the scene's E_star is"):
         load_scene(tmp_path / "scene.toml")
+
+
+def test_a_scene_loaded_beyond_its_law_file_notes_it_in_the_result_messages(topography_law, tmp_path):
+    """The law's ladder stops below the peak pressure: the result says so, the answer is kept."""
+    p, w = topography_law.mean_pressure[:3], topography_law.closure[:3]
+    (tmp_path / "short.toml").write_text(tomli_w.dumps({"layer": {"law": "tabulated", "p": p.tolist(),
+                                                                  "w": w.tolist()}}))
+    run = execute_scene(load_scene(_scene_file(tmp_path, {"law": "tabulated", "file": "short.toml"})))
+    assert run.bem.converged and run.bem.p_max > p[-1]
+    notes = [m for m in run.result["messages"] if "exceeds the tabulated layer law's range" in m]
+    assert len(notes) == 1 and notes[0].startswith("BEM: the peak pressure")
+    assert f"0 <= p <= {p[-1]:.6g}" in notes[0] and f"p_max = {run.bem.p_max:.6g}" in notes[0]
+    inline = execute_scene(load_scene(_scene_file(tmp_path, topography_law.layer_table(), "inline.toml")))
+    assert not any("exceeds" in m for m in inline.result["messages"])
