@@ -100,3 +100,13 @@ def test_a_scene_loaded_beyond_its_law_file_notes_it_in_the_result_messages(topo
     assert f"0 <= p <= {p[-1]:.6g}" in notes[0] and f"p_max = {run.bem.p_max:.6g}" in notes[0]
     inline = execute_scene(load_scene(_scene_file(tmp_path, topography_law.layer_table(), "inline.toml")))
     assert not any("exceeds" in m for m in inline.result["messages"])
+
+
+def test_set_layer_file_replaces_an_inline_table_and_back(topography_law, tmp_path):
+    topography_law.save(tmp_path / "law.toml")
+    inline = _scene_file(tmp_path, {"law": "tabulated", "p": [0.0, 1e9], "w": [0.0, 1e-6]})
+    scene = load_scene(inline, overrides=['layer.file="law.toml"'])
+    assert scene.layer.to_dict() == topography_law.layer_table()
+    by_file = _scene_file(tmp_path, {"law": "tabulated", "file": "law.toml"}, "by_file.toml")
+    scene = load_scene(by_file, overrides=["layer.p=[0.0, 1e9]", "layer.w=[0.0, 1e-6]"])
+    assert scene.layer.to_dict() == {"law": "tabulated", "p": [0.0, 1e9], "w": [0.0, 1e-6]}

@@ -24,7 +24,10 @@ from pathlib import Path
 
 from . import checks as ck
 
-__all__ = ["is_layer_file", "resolve_layer_file", "read_layer_file", "E_STAR_RTOL"]
+__all__ = ["is_layer_file", "resolve_layer_file", "read_layer_file", "E_STAR_RTOL", "EXCLUSIVE"]
+
+#: ``[layer]`` keys that replace each other (a ``--set layer.file=...`` drops ``p`` and ``w``)
+EXCLUSIVE = (("file", "p"), ("file", "w"))
 
 #: largest relative difference between the scene's ``E_star`` and the one the law file was made with
 E_STAR_RTOL = 0.01

@@ -42,6 +42,7 @@ from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
 from .sizing import EXCLUSIVE as BEM_EXCLUSIVE
 from .sizing import bem_options
 from .source import builtin_path, builtin_scenes, read_source, read_toml
+from .layer_file import EXCLUSIVE as FILE_EXCLUSIVE
 from .layer_file import resolve_layer_file
 from .trust import check_code_name, code_names, refuse_code, scene_file
 
@@ -51,7 +52,7 @@ __all__ = ["Scene", "SceneError", "load_scene", "check_scene", "parse_scene", "b
 SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report", "stress")
 _REQUIRED = ("scene", "bodies", "gap", "load")
 #: section -> groups of keys that replace each other (a ``--set`` of one drops the others)
-_EXCLUSIVE = {"bem": BEM_EXCLUSIVE, "load": (("force", "approach"),), "layer": LAYER_EXCLUSIVE,
+_EXCLUSIVE = {"bem": BEM_EXCLUSIVE, "load": (("force", "approach"),), "layer": LAYER_EXCLUSIVE + FILE_EXCLUSIVE,
               "bodies": tuple(("E_star", key) for key in sec.BODY_KEYS)}
 
 
