@@ -111,7 +111,7 @@ def synthetic_surface(*, hurst, size, grid, rms_height=None, rms_slope=None, lon
     size = check_positive("size", size)
     return rough.self_affine((grid, grid), (size, size), hurst=hurst, rms_height=rms_height, rms_slope=rms_slope,
                              long_cutoff=long_cutoff, short_cutoff=short_cutoff, rolloff=rolloff,
-                             seed=check_int("seed", seed))
+                             seed=check_int("seed", seed, minimum=0))
 
 
 def ladder(surface, E_star, *, pressures=None, relative=DEFAULT_RANGE, n=12):
