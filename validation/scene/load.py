@@ -7,8 +7,8 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...), or
                type = "measured" with a file (validation.scene.measured)
     [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn with cnn_step,
-               lam_ref, alpha_a, alpha_b, alpha_c (validation.scene.paper); absent or
-               law = "none": no layer
+               lam_ref, alpha_a, alpha_b, alpha_c (validation.scene.paper), or law = "tabulated"
+               with a law file (validation.scene.layer_file); absent or law = "none": no layer
     [load]     force [N] or approach [m]
     [bem]      step [m] or nodes_across; extent [m] or extent_factor; method, rtol, maxiter,
                precondition, nested, relaxation
