@@ -11,9 +11,9 @@ from .checks import (check_bool, check_callable, check_choice, check_finite_arra
                      check_rtol, check_scale)
 from .errors import InputError, RegionTooSmallError
 from .kalker import QPSolution
-from .layers import beyond_table
 from .kkt import kkt_residual
 from .lattice import Lattice
+from .layers import beyond_table
 from .materials import effective_modulus
 from .operator import InfluenceOperator
 from .options import METHODS, check_options, solver_for

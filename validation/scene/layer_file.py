@@ -84,7 +84,8 @@ def read_layer_file(d, E_star=None):
     if not isinstance(layer, dict) or layer.get("law") != "tabulated" or not {"p", "w"} <= layer.keys():
         _fail(file, "it must hold a [layer] table with law = 'tabulated', p and w (a layer law file: "
                     "contactlab layer-law, bem.rough.TopographyLaw.save)")
-    made_with = (data.get("topography") or {}).get("E_star") if isinstance(data.get("topography"), dict) else None
+    topography = data.get("topography")
+    made_with = topography.get("E_star") if isinstance(topography, dict) else None
     if E_star is not None and isinstance(made_with, (int, float)) and made_with > 0:
         if not math.isclose(E_star, made_with, rel_tol=E_STAR_RTOL):
             _fail(file, f"its law was made with E_star = {made_with!r}, the scene's E_star is {E_star!r}; they must "
