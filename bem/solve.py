@@ -14,6 +14,7 @@ from .errors import InputError, RegionTooSmallError
 from .kalker import QPSolution
 from .kkt import kkt_residual
 from .lattice import Lattice
+from .layers import beyond_table
 from .materials import effective_modulus
 from .operator import InfluenceOperator
 from .options import METHODS, check_options, solver_for
@@ -153,7 +154,9 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     smaller increment in 15 iterations) or diverges (8 growing increments) stops and
     says so. A result that does not meet its rule has ``converged = False`` and the
     reason in ``message``, and one warning is logged (with a summary of inner solves
-    that missed their tolerance); a converged run logs no warning.
+    that missed their tolerance); a converged run logs no warning, except one whose peak
+    pressure exceeds the last pressure of a tabulated layer law
+    (:func:`bem.layers.beyond_table`: the law is continued beyond its data).
     """
     t_start = time.perf_counter()
     check_callable("gap", gap)
@@ -209,6 +212,8 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
                      n_matvec=sum(o.n_matvec for o in ops if o is not op))
     if not result.converged:
         log.warning("%s: %s%s", solver, result.message, _inner_summary(sol.history))
+    elif (note := beyond_table(layer, result.p_max)) is not None:
+        log.warning("%s", note)
     return result
 
 

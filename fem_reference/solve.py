@@ -29,6 +29,7 @@ import time
 import numpy as np
 
 from bem.checks import InputError, check_callable, check_positive
+from bem.layers import beyond_table
 from bem.materials import effective_modulus
 from bem.reference import estimate_contact_radius
 
@@ -234,4 +235,6 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     )
     if not converged:
         log.warning("FEM reference did not converge: %s", message)
+    elif (note := beyond_table(layer, result.p_max)) is not None:
+        log.warning("FEM reference: %s", note)
     return result

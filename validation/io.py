@@ -10,7 +10,8 @@ untouched. Result folders and report folders both use it; sweep folders, written
 point, are checked the same way (:func:`check_output_dir`).
 
 Every folder contactlab writes holds a marker file, :data:`MARKER` (``.contactlab``: JSON with
-the folder's ``kind``, ``"result"``, ``"report"`` or ``"sweep"``, and the contactlab
+the folder's ``kind``, ``"result"``, ``"report"``, ``"sweep"`` or ``"layer-law"``
+(:mod:`validation.layer_law`), and the contactlab
 ``version``). contactlab writes only into a new or empty folder, or into a folder that holds
 the marker of the same kind and nothing but the files of that kind; any other folder is
 refused (:class:`OutputError`), so a user's files are never replaced.
@@ -51,7 +52,7 @@ log = logging.getLogger(__name__)
 #: The marker file of every folder contactlab writes: JSON ``{"kind": ..., "version": ...}``.
 MARKER = ".contactlab"
 #: The kinds of folder contactlab writes.
-KINDS = ("result", "report", "sweep")
+KINDS = ("result", "report", "sweep", "layer-law")
 #: Longest file or folder name in bytes when the file system does not say (POSIX ``NAME_MAX``).
 NAME_MAX = 255
 _TMP, _OLD = ".contactlab-tmp-", ".contactlab-old-"
@@ -149,8 +150,8 @@ def check_output_dir(target, kind, names=(), *, what="out_dir", value=None):
     ----------
     target : path-like
         The folder to write.
-    kind : {"result", "report", "sweep"}
-        What will be written there.
+    kind : str
+        What will be written there, one of :data:`KINDS`.
     names : iterable of str
         The names a ``kind`` folder holds.
     what : str
@@ -283,8 +284,8 @@ def atomic_directory(target, kind="result", names=(), *, what="out_dir"):
     ----------
     target : path-like
         The folder to create or replace.
-    kind : {"result", "report", "sweep"}
-        What the folder is; its marker (:data:`MARKER`) is written into it.
+    kind : str
+        What the folder is (one of :data:`KINDS`); its marker (:data:`MARKER`) is written into it.
     names : iterable of str
         The names such a folder holds (:func:`check_output_dir`).
     what : str

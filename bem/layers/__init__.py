@@ -11,7 +11,7 @@ from .base import Layer
 from .custom import Custom
 from .serial import LAWS, from_dict
 from .series import Series
-from .tabulated import Tabulated
+from .tabulated import Tabulated, beyond_table
 
 __all__ = [
     "Layer",
@@ -25,4 +25,5 @@ __all__ = [
     "Series",
     "LAWS",
     "from_dict",
+    "beyond_table",
 ]

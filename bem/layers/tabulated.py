@@ -8,7 +8,7 @@ from ..checks import InputError, check_finite_array, check_nonnegative
 from ._common import LawBase, as_closure, as_pressure, out
 from ._solve import newton_bisect
 
-__all__ = ["Tabulated"]
+__all__ = ["Tabulated", "beyond_table"]
 
 
 def _horner(coef, k, t):
@@ -37,7 +37,8 @@ class Tabulated(LawBase):
       and interpolated to it (the law always satisfies ``w(0) = 0``);
     - beyond the last point: continued linearly with the end slope ``d_n`` (C1); if the last
       segment is flat the law turns rigid there and ``inverse`` is ``+inf`` for closures
-      above ``w[-1]``.
+      above ``w[-1]``. The table's data end there: a solve whose peak pressure exceeds
+      ``p[-1]`` logs a warning (:func:`beyond_table`) and keeps its answer.
 
     Parameters
     ----------
@@ -168,3 +169,39 @@ class Tabulated(LawBase):
         pi[solve] = newton_bisect(self.w, self.dw, ci[solve], x[j[solve] - 1], x[j[solve]])
         res[inside] = pi
         return out(res)
+
+
+def beyond_table(layer, p_max):
+    """The note for a peak pressure beyond the last pressure of a tabulated law, or ``None``.
+
+    A :class:`Tabulated` law holds data up to its last pressure ``p[-1]`` and continues linearly
+    beyond it (class docstring); a solve that loads the layer beyond ``p[-1]`` uses that
+    continuation, not data. The laws of a :class:`bem.layers.Series` are looked at each.
+
+    Parameters
+    ----------
+    layer : bem.layers.Layer or None
+        The layer of the solve.
+    p_max : float
+        The peak pressure the solve reached [pressure].
+
+    Returns
+    -------
+    str or None
+        ``"the peak pressure p_max = ... exceeds the tabulated layer law's range 0 <= p <= ...: ..."``
+        when ``p_max > p[-1]`` of a tabulated law of ``layer``, else ``None``.
+    """
+    from .series import Series
+
+    laws = [layer]
+    while laws:
+        law = laws.pop(0)
+        if isinstance(law, Tabulated) and p_max > law._x[-1]:
+            last = float(law._x[-1])
+            return (f"the peak pressure p_max = {float(p_max):.6g} exceeds the tabulated layer law's range "
+                    f"0 <= p <= {last:.6g} ({float(p_max) / last:.3g} times its last pressure): beyond it the law "
+                    "is the linear continuation of its last interval, not data; extend the table (a layer law "
+                    "file: its pressure ladder) to cover the peak pressure.")
+        if isinstance(law, Series):
+            laws += [law.a, law.b]
+    return None

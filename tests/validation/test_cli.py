@@ -10,7 +10,7 @@ from validation.cli import build_parser, main
 
 from .conftest import cli
 
-SUBCOMMANDS = ("run", "scenes", "check", "sweep", "study", "report")
+SUBCOMMANDS = ("run", "scenes", "check", "sweep", "study", "report", "layer-law")
 
 
 def test_help_teaches(capsys):
@@ -29,7 +29,8 @@ def test_every_subcommand_has_examples(cmd, capsys):
     assert "example" in text and f"contactlab {cmd}" in text
 
 
-@pytest.mark.parametrize("cmd, kind", [("run", "result"), ("sweep", "sweep"), ("report", "report")])
+@pytest.mark.parametrize("cmd, kind", [("run", "result"), ("sweep", "sweep"), ("report", "report"),
+                                       ("layer-law", "layer-law")])
 def test_out_is_the_directory_written_in_every_help(cmd, kind, capsys):
     assert main([cmd, "--help"]) == 0
     text = " ".join(capsys.readouterr().out.split())

@@ -19,12 +19,13 @@ from bem.checks import InputError
 
 from ..io import OutputError
 from ..scene.paper import CalibrationError
-from . import check, report, run, scenes, study, sweep
+from . import check, layer_law, report, run, scenes, study, sweep
 
 __all__ = ["main", "build_parser"]
 
 #: the subcommands, in the order ``--help`` lists them
-COMMANDS = {"run": run, "scenes": scenes, "check": check, "sweep": sweep, "study": study, "report": report}
+COMMANDS = {"run": run, "scenes": scenes, "check": check, "sweep": sweep, "study": study, "report": report,
+            "layer-law": layer_law}
 
 DESCRIPTION = """\
 contactlab: frictionless normal contact of two elastic bodies with a nonlinear interface
@@ -64,6 +65,8 @@ examples:
   contactlab report results/hertz --out report/      figures + HTML/Markdown report
   contactlab report results/hertz-sweep-load.force   report of a sweep directory
   contactlab report paper --quick                    the paper's test problem, a quick preview
+  contactlab layer-law patch.x3p --E-star 115e9 --out laws/patch
+                                                     a rough surface's layer law file and figures
 
 result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
 iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.toml (the

@@ -16,6 +16,7 @@ import tomli_w
 
 import bem
 from bem.files import write_result_vtu, write_stress_vtu, write_text, write_vtu
+from bem.layers import beyond_table
 
 from ..compare import compare
 from ..io import atomic_directory, atomic_write_json, check_output_dir, output_errors, recover_output_dir
@@ -180,6 +181,8 @@ def execute_scene(scene, *, progress=None, overrides=None):
     if not res.converged:
         messages.append(f"BEM did not converge: {res.message}")
         log.info("BEM did not converge: %s", res.message)  # bem.solve has logged its warning
+    elif (note := beyond_table(layer, res.p_max)) is not None:
+        messages.append(f"BEM: {note}")  # bem.solve has logged it
     if "p_max_lambda" in layer_info and scene.layer_spec["law"] == "root":
         layer_info["alpha_b"] = res.p_max / layer_info["p_max_lambda"]
     fem = ref = metrics = None
@@ -192,6 +195,8 @@ def execute_scene(scene, *, progress=None, overrides=None):
         _notify(progress, "fem", "done", converged=fem.converged)
         if not fem.converged:
             messages.append(f"FEM did not converge: {fem.message}")
+        elif (note := beyond_table(layer, fem.p_max)) is not None:
+            messages.append(f"FEM: {note}")
     if scene.analytic is not None:
         ref = _analytic(scene, layer)
     if fem is not None or ref is not None:

@@ -7,8 +7,8 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...), or
                type = "measured" with a file (validation.scene.measured)
     [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn with cnn_step,
-               lam_ref, alpha_a, alpha_b, alpha_c (validation.scene.paper); absent or
-               law = "none": no layer
+               lam_ref, alpha_a, alpha_b, alpha_c (validation.scene.paper), or law = "tabulated"
+               with a law file (validation.scene.layer_file); absent or law = "none": no layer
     [load]     force [N] or approach [m]
     [bem]      step [m] or nodes_across; extent [m] or extent_factor; method, rtol, maxiter,
                precondition, nested, relaxation
@@ -42,6 +42,8 @@ from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
 from .sizing import EXCLUSIVE as BEM_EXCLUSIVE
 from .sizing import bem_options
 from .source import builtin_path, builtin_scenes, read_source, read_toml
+from .layer_file import EXCLUSIVE as FILE_EXCLUSIVE
+from .layer_file import resolve_layer_file
 from .trust import check_code_name, code_names, refuse_code, scene_file
 
 __all__ = ["Scene", "SceneError", "load_scene", "check_scene", "parse_scene", "builtin_scenes", "builtin_path",
@@ -50,7 +52,7 @@ __all__ = ["Scene", "SceneError", "load_scene", "check_scene", "parse_scene", "b
 SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report", "stress")
 _REQUIRED = ("scene", "bodies", "gap", "load")
 #: section -> groups of keys that replace each other (a ``--set`` of one drops the others)
-_EXCLUSIVE = {"bem": BEM_EXCLUSIVE, "load": (("force", "approach"),), "layer": LAYER_EXCLUSIVE,
+_EXCLUSIVE = {"bem": BEM_EXCLUSIVE, "load": (("force", "approach"),), "layer": LAYER_EXCLUSIVE + FILE_EXCLUSIVE,
               "bodies": tuple(("E_star", key) for key in sec.BODY_KEYS)}
 
 
@@ -248,16 +250,19 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     section = {k: (raw[k] if k in raw else check.FAILED) for k in _REQUIRED}
     if check(_resolve_files, raw, base_dir, outside_files) is check.FAILED:
         section["gap"] = check.FAILED
+    layer_file = check(resolve_layer_file, raw, base_dir, outside_files)
     meta = check(sec.scene_meta, section["scene"])
     body = check(sec.bodies, section["bodies"])
     load = check(sec.load, section["load"])
     if code == "refuse":  # refused above: build nothing that imports
         section["gap"] = check.FAILED if "gap" in coded else section["gap"]
     layer_raw = check.FAILED if code == "refuse" and "layer" in coded else raw.get("layer")
+    layer_raw = check.FAILED if layer_file is check.FAILED else layer_raw
     build = {part: code == "import" or part not in coded for part in ("gap", "layer")}
     shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"], build=build["gap"]),
                   section["gap"], body, meta)
-    layer = check(lambda d: sec.layer(d, build=build["layer"]), layer_raw)
+    layer = check(lambda d: sec.layer(d, build=build["layer"], E_star=None if body is check.FAILED else body["E_star"]),
+                  layer_raw)
     bem = check(lambda g, la, b, ld: bem_options(raw.get("bem"), g[1], *la, b["E_star"], ld), shape, layer, body, load)
     shape = check(lambda g, b: (g[0], measured_region(g[1], b["extent"])), shape, bem)
     fem = check(lambda g, b: sec.fem_options(raw.get("fem"), g[1], b["materials"]), shape, body)

@@ -21,6 +21,7 @@ from bem.stress import Z_MAX_STEPS
 from ..units import DEFAULT_LABEL as DEFAULT_UNITS
 from ..units import parse_units
 from . import checks as ck
+from .layer_file import is_layer_file, read_layer_file
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
 from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law, paper_keys
@@ -84,7 +85,7 @@ def scene_keys():
         keys = [*cls._required, *cls._optional]
         if law in PAPER_LAWS:
             keys += [k for k in paper_keys(law) if k not in keys]
-        out["layer"][law] = tuple(keys)
+        out["layer"][law] = tuple(keys) + (("file",) if law == "tabulated" else ())
     return out
 
 
@@ -171,14 +172,20 @@ def load(d):
     return {"force": None, "approach": None, key: ck.scale(f"load.{key}", d[key])}
 
 
-def layer(d, *, build=True):
-    """``[layer]``: ``(spec, law)``; see :func:`validation.scene.paper.check_layer`.
+def layer(d, *, build=True, E_star=None):
+    """``[layer]``: ``(spec, law)``; see :func:`validation.scene.paper.check_layer`, and
+    :mod:`validation.scene.layer_file` for a tabulated law read from a ``file`` (``E_star``: the
+    scene's modulus [pressure], compared with the file's).
 
     ``law`` is the :mod:`bem.layers` object, built here once from direct parameters (which
     checks their values); ``None`` without a layer (absent or ``law = "none"``), for a law of
     the paper's parameters, which the runner resolves by a solve, and with ``build = False``
     (a law whose Python code is not imported, :mod:`validation.scene.trust`).
     """
+    if is_layer_file(d):
+        spec = read_layer_file(d, E_star)
+        with ck.scene_errors("layer."):
+            return spec, from_dict({k: spec[k] for k in ("law", "p", "w")})
     spec = check_layer(d, "layer")
     if spec is None or is_paper_law(spec) or not build:
         return spec, None

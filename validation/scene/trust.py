@@ -8,7 +8,8 @@ are refused unless the user opts in:
   also nested in a series, ``layer.a.w``). Importing a module runs it. Only
   ``load_scene(..., allow_code=True)`` or ``contactlab run/sweep/report --allow-code`` import
   it; ``contactlab check`` checks the form of the name and never imports it.
-- **Files outside the scene's folder**: ``gap.file`` of a measured surface is a name relative
+- **Files outside the scene's folder**: ``gap.file`` of a measured surface (and ``layer.file`` of a
+  tabulated law, :mod:`validation.scene.layer_file`) is a name relative
   to the scene file's folder (to the current directory for a scene given as a dict). A name
   that leads out of that folder (an absolute name elsewhere, ``..``, a symbolic link pointing
   outside) is refused unless ``allow_outside_files=True`` (``--allow-outside-files``).

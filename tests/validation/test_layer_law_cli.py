@@ -1,0 +1,170 @@
+"""``contactlab layer-law``: a surface file becomes a layer-law folder (the law file a scene loads and
+three figures showing the ladder's data with units); bad input stops with exit code 2."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+import tomli_w
+
+from validation.io import MARKER
+from validation.layer_law import ladder, make_layer_law, synthetic_surface
+from validation.run import execute_scene
+from validation.scene import load_scene
+
+from .conftest import cli
+
+pytest.importorskip("SurfaceTopography")
+pytest.importorskip("matplotlib")
+
+E_STAR = 115e9  # Pa
+SIZE_UM = 100.0  # the file's cell size [um]
+SYNTHETIC = "hurst=0.8,rms_height=0.5e-6,size=1e-4,grid=64,long_cutoff=25e-6,short_cutoff=12.5e-6,seed=3"
+
+
+@pytest.fixture(scope="module")
+def surface_file(tmp_path_factory):
+    """A periodic self-affine cell saved as heights in um (a .npy states no unit)."""
+    surface = synthetic_surface(hurst=0.8, size=1e-4, grid=64, rms_height=0.5e-6, long_cutoff=25e-6,
+                                short_cutoff=12.5e-6, seed=3)
+    path = tmp_path_factory.mktemp("surface") / "heights.npy"
+    np.save(path, np.asarray(surface.heights) * 1e6)
+    return path
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    """The library call behind the command, on a small synthetic cell."""
+    surface = synthetic_surface(**{k: (int(v) if k in ("grid", "seed") else float(v))
+                                   for k, v in (item.split("=") for item in SYNTHETIC.split(","))})
+    pressures = ladder(surface, E_STAR, n=8)
+    calls = []
+    out = make_layer_law(surface, tmp_path_factory.mktemp("law") / "law", E_star=E_STAR, pressures=pressures,
+                         progress=lambda k, n, res: calls.append((k, n, res.converged)))
+    return out, calls
+
+
+def _run(tmp_path, *extra, out="law"):
+    return cli("layer-law", *extra, "--E-star", E_STAR, "--n-pressures", 8, "--out", tmp_path / out)
+
+
+def test_a_surface_file_becomes_a_law_folder_a_scene_loads(surface_file, tmp_path):
+    code, out, err = _run(tmp_path, surface_file, "--size", f"{SIZE_UM},{SIZE_UM}", "--scale", 1e-6)
+    assert code == 0, err
+    folder = tmp_path / "law"
+    assert json.loads((folder / MARKER).read_text())["kind"] == "layer-law"
+    assert sorted(p.name for p in folder.iterdir()) == sorted([MARKER, "layer_law.toml", "closure.png",
+                                                               "contact_fraction.png", "stiffness.png"])
+    assert "8 mean pressures" in out and "layer_law.toml" in out
+    scene = {"scene": {"name": "rough"}, "bodies": {"E_star": E_STAR}, "gap": {"type": "paraboloid", "R": 0.01},
+             "layer": {"law": "tabulated", "file": "layer_law.toml"}, "load": {"force": 50.0},
+             "bem": {"nodes_across": 16}}
+    (folder.parent / "law" / "scene.toml").write_text(tomli_w.dumps(scene))  # a scene beside the law file
+    run = execute_scene(load_scene(folder / "scene.toml"))
+    assert run.bem.converged and run.bem.closure.max() > 0
+    code, _, err = _run(tmp_path, surface_file, "--size", f"{SIZE_UM},{SIZE_UM}", "--scale", 1e-6)
+    assert code == 2 and "scene.toml" in err  # the folder holds a file contactlab did not write: refused
+
+
+def test_the_heights_in_um_are_converted_to_metres(surface_file, tmp_path, folder):
+    code, _, err = _run(tmp_path, surface_file, "--size", f"{SIZE_UM},{SIZE_UM}", "--scale", 1e-6, "--no-figures")
+    assert code == 0, err
+    import tomllib
+
+    data = tomllib.loads((tmp_path / "law" / "layer_law.toml").read_text())
+    assert data["topography"]["surface"]["rms_height"] == pytest.approx(0.5e-6, rel=0.05)
+    assert data["topography"]["step"] == pytest.approx(1e-4 / 64, rel=1e-12)
+    assert not (tmp_path / "law" / "closure.png").exists()
+
+
+def test_a_layer_law_folder_is_replaced_by_a_new_run(tmp_path):
+    for _ in range(2):
+        code, _, err = _run(tmp_path, "--synthetic", SYNTHETIC, "--no-figures")
+        assert code == 0, err
+
+
+@pytest.mark.parametrize("args, match", [
+    ((), "SURFACE is missing"),
+    (("x.npy", "--synthetic", SYNTHETIC), "not allowed together with --synthetic"),
+    (("--synthetic", "hurst=0.8,size=1e-4"), "--synthetic grid is missing"),
+    (("--synthetic", "hurst=0.8,size=1e-4,grid=64,colour=3"), "--synthetic 'colour=3' is not allowed"),
+    (("--synthetic", "hurst=0.8,size=1e-4,grid=6.5"), "--synthetic grid = '6.5' is not allowed"),
+    (("--synthetic", SYNTHETIC, "--p-range", "1e9:1e8"), "pressures[1] = 100000000.0 is not allowed: it must be >"),
+    (("--synthetic", SYNTHETIC, "--p-range", "1e9"), "--p-range = '1e9' is not allowed"),
+    (("--synthetic", SYNTHETIC, "--scale", "1e-6"), "--scale = 1e-06 is not allowed with --synthetic"),
+    (("--synthetic", SYNTHETIC, "--n-cols", "0"), "n_cols"),
+    (("--synthetic", SYNTHETIC, "--rtol", "-1"), "rtol = -1.0 is not allowed"),
+    (("no_such_file.x3p",), "no_such_file.x3p"),
+])
+def test_bad_input_exits_2_with_one_line(tmp_path, args, match):
+    code, _, err = _run(tmp_path, *args)
+    assert code == 2, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert match in err
+    assert not (tmp_path / "law").exists()
+
+
+def test_a_file_without_a_length_unit_needs_scale(surface_file, tmp_path):
+    code, _, err = _run(tmp_path, surface_file, "--size", f"{SIZE_UM},{SIZE_UM}")
+    assert code == 2 and "scale is missing" in err and "states no length unit" in err
+
+
+def test_n_pressures_and_the_output_folder_are_checked_before_solving(tmp_path):
+    code, _, err = cli("layer-law", "--synthetic", SYNTHETIC, "--E-star", E_STAR, "--n-pressures", 1, "--out",
+                       tmp_path / "law")
+    assert code == 2 and "n_pressures = 1 is not allowed" in err
+    (tmp_path / "file").write_text("")
+    code, _, err = _run(tmp_path, "--synthetic", SYNTHETIC, out="file")
+    assert code == 2 and "--out = " in err and "it is a file" in err
+
+
+def test_the_progress_hook_sees_every_step_of_the_ladder(folder):
+    _, calls = folder
+    assert calls == [(k, 8, True) for k in range(1, 9)]
+
+
+def _points(ax):
+    """The line of ``ax`` drawn with markers only (the ladder's points): its x and y data."""
+    (line,) = [ln for ln in ax.get_lines() if ln.get_marker() == "o" and ln.get_linestyle() == "None"]
+    return np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+
+
+def test_the_closure_figure_shows_the_ladder_in_labelled_units_on_linear_and_log_axes(folder):
+    out, _ = folder
+    law = out.law
+    lin, log = out.figures["closure.png"].axes
+    assert (lin.get_xscale(), log.get_xscale(), log.get_yscale()) == ("linear", "log", "log")
+    for ax in (lin, log):
+        assert ax.get_xlabel() == "mean pressure $p$ [GPa]" and ax.get_ylabel() == "closure $w$ [µm]"
+        x, y = _points(ax)
+        np.testing.assert_allclose(x * 1e9, law.mean_pressure, rtol=1e-12)
+        np.testing.assert_allclose(y * 1e-6, law.closure, rtol=1e-12)
+    assert lin.get_xlim()[0] == 0 and lin.get_xlim()[1] >= law.mean_pressure[-1] / 1e9
+    assert lin.get_ylim()[1] > law.first_touch_gap / 1e-6  # the full closure is in view
+    assert (out.path / "closure.png").stat().st_size > 10_000
+
+
+def test_the_contact_fraction_figure_is_against_the_pressure_over_e_star_times_rms_slope(folder):
+    out, _ = folder
+    law = out.law
+    (ax,) = out.figures["contact_fraction.png"].axes
+    assert ax.get_xscale() == ax.get_yscale() == "log"
+    assert "E^*" in ax.get_xlabel() and "h'_\\mathrm{rms}" in ax.get_xlabel() and "A/A_0" in ax.get_ylabel()
+    (data,) = [ln for ln in ax.get_lines() if ln.get_marker() == "o"]
+    x = np.asarray(data.get_xdata(), float)
+    np.testing.assert_allclose(x * E_STAR * law.stats.rms_slope, law.mean_pressure, rtol=1e-12)
+    np.testing.assert_allclose(data.get_ydata(), law.contact_fraction, rtol=1e-12)
+    assert x[0] == pytest.approx(3e-3, rel=1e-12) and x[-1] == pytest.approx(0.3, rel=1e-12)  # the default ladder
+
+
+def test_the_stiffness_figure_draws_the_finite_stiffness_in_pa_per_m(folder):
+    out, _ = folder
+    law = out.law
+    (ax,) = out.figures["stiffness.png"].axes
+    assert ax.get_xscale() == ax.get_yscale() == "log" and "[Pa/m]" in ax.get_ylabel()
+    (data,) = [ln for ln in ax.get_lines() if ln.get_marker() == "o"]
+    finite = np.isfinite(law.stiffness)
+    assert finite.all() and math.isfinite(float(np.max(data.get_ydata())))
+    np.testing.assert_allclose(data.get_ydata(), law.stiffness, rtol=1e-12)
+    np.testing.assert_allclose(np.asarray(data.get_xdata(), float) * 1e9, law.mean_pressure, rtol=1e-12)

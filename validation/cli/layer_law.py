@@ -1,0 +1,161 @@
+"""``contactlab layer-law SURFACE --out DIR``: a rough surface's layer law file and its figures
+(:mod:`validation.layer_law`)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from bem.checks import InputError
+
+PARSER = {
+    "help": "the layer law w(p) of a rough surface: law file and figures",
+    "description": (
+        "Solve the periodic contact of a rough surface against a flat on a ladder of mean pressures\n"
+        "(bem.rough.layer_from_topography) and write DIR: layer_law.toml, whose [layer] a scene names by\n"
+        "  [layer] law = \"tabulated\"\n  file = \"layer_law.toml\"\n"
+        "(the file beside the scene), and the figures closure.png (w(p), linear and log axes),\n"
+        "contact_fraction.png (A/A0 against p/(E* h'_rms)) and stiffness.png (K = dp/dw).\n"
+        "Units are SI: lengths in m, E* and pressures in Pa. A surface file's lengths are converted to m by\n"
+        "the unit it states, or by --scale. The ladder's last pressure must exceed the largest local\n"
+        "pressure of the problems the law is used in: beyond it the law holds no data (a solve there warns).\n"
+        "The law file needs the rough extra, the figures the report extra (or --no-figures).\n"
+        "--out DIR must be new, empty or a layer-law folder contactlab wrote (marked by DIR/.contactlab)."),
+    "epilog": (
+        "examples:\n"
+        "  contactlab layer-law patch.x3p --E-star 115e9 --out laws/patch\n"
+        "  contactlab layer-law heights.npy --size 100,100 --scale 1e-6 --E-star 115e9 --out laws/npy\n"
+        "                       (a file without units: size in its unit, --scale m per unit)\n"
+        "  contactlab layer-law --synthetic hurst=0.8,rms_height=0.5e-6,size=1e-4,grid=256,"
+        "long_cutoff=25e-6,short_cutoff=6.25e-6,seed=1 \\\n"
+        "                       --E-star 115e9 --p-range-rel 1e-3:0.5 --n-pressures 20 --out laws/synthetic\n"
+        "  contactlab layer-law patch.x3p --E-star 115e9 --p-range 1e6:3e9 --n-cols 512 --rtol 1e-10 --out laws/fine\n"
+        "Timings: benchmarks/layer_from_topography.py."),
+}
+
+#: keys of --synthetic and their types (bem.rough.self_affine; lengths in m)
+SYNTHETIC = {"hurst": float, "rms_height": float, "rms_slope": float, "size": float, "grid": int,
+             "long_cutoff": float, "short_cutoff": float, "rolloff": float, "seed": int}
+
+
+def add_args(p):
+    p.add_argument("surface", nargs="?", metavar="SURFACE",
+                   help="a surface file SurfaceTopography reads (x3p, sur, opd, datx, gwy, nc, npy, text, ...)")
+    p.add_argument("--synthetic", metavar="KEY=VALUE,...",
+                   help="instead of SURFACE, a seeded self-affine square cell: " + ", ".join(SYNTHETIC)
+                        + " (hurst, size [m], grid and rms_height or rms_slope required; lengths in m)")
+    p.add_argument("--out", metavar="DIR", required=True,
+                   help="the layer-law directory written: layer_law.toml and the figures")
+    p.add_argument("--E-star", dest="E_star", type=float, metavar="PA", required=True,
+                   help="effective modulus of the pair [Pa], e.g. 115e9 for steel on steel")
+    rng = p.add_mutually_exclusive_group()
+    rng.add_argument("--p-range", metavar="LOW:HIGH", help="first and last mean pressure of the ladder [Pa]")
+    rng.add_argument("--p-range-rel", metavar="LOW:HIGH", default="3e-3:0.3",
+                     help="the same in units of E* h'_rms, h'_rms the surface's rms slope (default 3e-3:0.3)")
+    p.add_argument("--n-pressures", type=int, default=12, metavar="N",
+                   help="mean pressures in the ladder, geometrically spaced (default 12)")
+    p.add_argument("--n-cols", type=int, metavar="N",
+                   help="lattice nodes across the cell (default: the surface's grid points along x)")
+    p.add_argument("--rtol", type=float, default=1e-8, help="the solver's KKT tolerance (default 1e-8)")
+    p.add_argument("--scale", type=float, metavar="M",
+                   help="metres per length unit of SURFACE (default: from the unit the file states)")
+    p.add_argument("--size", metavar="LX,LY", help="size of a SURFACE that does not state it, in its length unit")
+    p.add_argument("--no-figures", action="store_true", help="write the law file only (no report extra needed)")
+
+
+def _pair(option, text, sep):
+    parts = str(text).split(sep)
+    try:
+        values = tuple(float(v) for v in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 2:
+        raise InputError(f"{option} = {text!r} is not allowed: it must be two numbers separated by '{sep}'.")
+    return values
+
+
+def _synthetic(text):
+    out = {}
+    for item in str(text).split(","):
+        key, eq, value = (s.strip() for s in item.partition("="))
+        if not eq or key not in SYNTHETIC:
+            raise InputError(f"--synthetic {item!r} is not allowed: it must be key=value with key one of "
+                             + ", ".join(SYNTHETIC) + ".")
+        try:
+            out[key] = SYNTHETIC[key](value)
+        except ValueError:
+            raise InputError(f"--synthetic {key} = {value!r} is not allowed: it must be "
+                             f"{'an integer' if SYNTHETIC[key] is int else 'a number'}.") from None
+    for key in ("hurst", "size", "grid"):
+        if key not in out:
+            raise InputError(f"--synthetic {key} is missing: give at least hurst, size [m], grid and rms_height "
+                             "or rms_slope.")
+    return out
+
+
+class _LadderBar:
+    """tqdm bar over the ladder's steps: the contact fraction and iterations of the last step."""
+
+    def __init__(self, n, disable):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=n, desc="layer law", unit="pressure", disable=disable, leave=False)
+
+    def __call__(self, k, n, result):
+        self.bar.set_postfix({"A/A0": f"{result.contact_fraction:.3g}", "iterations": result.iterations},
+                             refresh=False)
+        self.bar.update(1)
+
+    def close(self):
+        self.bar.close()
+
+
+def _summary(folder):
+    law, stats = folder.law, folder.law.stats
+    p, w = law.mean_pressure, law.closure
+    lines = [f"surface    {stats.source}: rms height {stats.rms_height:.4g} m, rms slope {stats.rms_slope:.4g}, "
+             f"{law.cell['n_cols']} x {law.cell['n_rows']} lattice nodes",
+             f"ladder     {p.size} mean pressures {p[0]:.4g} .. {p[-1]:.4g} Pa (E* = {law.E_star:.4g} Pa), "
+             f"{int(law.iterations.sum())} iterations",
+             f"closure    w = {w[0]:.4g} .. {w[-1]:.4g} m of the first-touch mean gap {law.first_touch_gap:.4g} m",
+             f"contact    A/A0 = {law.contact_fraction[0]:.3g} .. {law.contact_fraction[-1]:.3g}",
+             f"range      the law holds data up to p = {p[-1]:.4g} Pa; a solve beyond it warns",
+             f"scene      [layer] law = \"tabulated\", file = \"{folder.law_file.name}\" (the file beside the scene)"]
+    names = [folder.law_file.name, *folder.figures]
+    lines.append(f"files      {folder.path}/ ({', '.join(names)})")
+    return "\n".join(lines)
+
+
+def run(args):
+    from bem.rough import LadderNotConverged
+
+    from ..layer_law import ladder, make_layer_law, surface_from_file, synthetic_surface
+
+    if (args.surface is None) == (args.synthetic is None):
+        raise InputError("SURFACE is missing: give a surface file or --synthetic (one of them)." if args.surface is None
+                         else f"SURFACE = {args.surface!r} is not allowed together with --synthetic: give one.")
+    if args.synthetic is not None:
+        for option, value in (("--scale", args.scale), ("--size", args.size)):
+            if value is not None:
+                raise InputError(f"{option} = {value!r} is not allowed with --synthetic: it is for a SURFACE file "
+                                 "(a synthetic surface is in m).")
+        surface = synthetic_surface(**_synthetic(args.synthetic))
+    else:
+        size = None if args.size is None else _pair("--size", args.size, ",")
+        surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size)
+    if args.p_range is not None:
+        pressures = ladder(surface, args.E_star, pressures=_pair("--p-range", args.p_range, ":"), n=args.n_pressures)
+    else:
+        pressures = ladder(surface, args.E_star, relative=_pair("--p-range-rel", args.p_range_rel, ":"),
+                           n=args.n_pressures)
+    bar = _LadderBar(len(pressures), args.no_progress or None)
+    try:
+        folder = make_layer_law(surface, args.out, E_star=args.E_star, pressures=pressures, n_cols=args.n_cols,
+                                rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out")
+    except LadderNotConverged as exc:
+        print(f"contactlab: error: {exc} (nothing was written)", file=sys.stderr)
+        return 1
+    finally:
+        bar.close()
+    print(_summary(folder))
+    return 0

@@ -1,0 +1,197 @@
+"""A rough surface's layer law written as a folder: the law file and its figures.
+
+The folder (a ``"layer-law"`` folder, :mod:`validation.io`) holds
+
+- ``layer_law.toml``: the table file of :meth:`bem.rough.TopographyLaw.save`, whose ``[layer]``
+  a scene names by ``[layer] law = "tabulated"``, ``file = "layer_law.toml"``;
+- ``closure.png``, ``contact_fraction.png``, ``stiffness.png``: the law ``w(p)`` on linear and
+  logarithmic axes, the contact fraction ``A/A0`` against ``p/(E* h'_rms)`` and the interfacial
+  stiffness ``K(p)`` (:mod:`validation.layer_law.figures`).
+
+Units are SI: a surface file's lengths are converted to metres by the unit the file states
+(or by ``scale``), ``E*`` and the pressures are in Pa. The ladder of mean pressures is
+geometric, by default from ``3e-3`` to ``0.3`` times ``E* h'_rms`` (``h'_rms`` the surface's
+rms slope, ``stats.rms_slope``): from a contact fraction of about 1 % to well into the
+exponential regime. Its last pressure must exceed the largest local pressure of the problems
+the law is used in: beyond it a tabulated law holds no data (:func:`bem.layers.beyond_table`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bem.checks import InputError, check_int, check_positive, fail
+
+from ..io import atomic_directory, check_output_dir, output_errors, recover_output_dir
+from ..units import METRES
+
+__all__ = ["make_layer_law", "surface_from_file", "synthetic_surface", "ladder", "LayerLawFolder", "KIND",
+           "LAW_FILE", "FIGURE_NAMES", "NAMES", "DEFAULT_RANGE"]
+
+KIND = "layer-law"
+LAW_FILE = "layer_law.toml"
+FIGURE_NAMES = ("closure.png", "contact_fraction.png", "stiffness.png")
+NAMES = (LAW_FILE, *FIGURE_NAMES)
+#: the default ladder's first and last mean pressure, in units of ``E* h'_rms``
+DEFAULT_RANGE = (3e-3, 0.3)
+
+
+@dataclass(frozen=True)
+class LayerLawFolder:
+    """What :func:`make_layer_law` wrote.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The folder.
+    law : bem.rough.TopographyLaw
+        The law and its ladder.
+    law_file : pathlib.Path
+        ``path / "layer_law.toml"``.
+    figures : dict
+        ``{file name: matplotlib Figure}`` of the figures written (empty without figures).
+    """
+
+    path: Path
+    law: object
+    law_file: Path
+    figures: dict = field(default_factory=dict)
+
+
+def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height"):
+    """A measured surface in metres (:func:`bem.rough.read_surface`).
+
+    Parameters
+    ----------
+    file : path-like
+        An instrument or data file SurfaceTopography reads (``bem.rough.formats()``).
+    scale : float, optional
+        Metres per length unit of the file. Default: from the unit the file states; a file
+        that states none (npy, plain text matrices) needs it.
+    physical_sizes : (float, float), optional
+        ``(Lx, Ly)`` in the file's length unit, for a file that does not state its size.
+    detrend : str or None
+        As :func:`bem.rough.read_surface`.
+
+    Raises
+    ------
+    bem.InputError
+        A file that cannot be read (:func:`bem.rough.read_surface`), or no ``scale`` for a file
+        that states no known length unit.
+    """
+    from bem import rough
+
+    given = scale
+    if scale is not None:
+        scale = check_positive("scale", scale)
+    surface = rough.read_surface(file, physical_sizes=physical_sizes, scale=1.0 if scale is None else scale,
+                                 detrend=detrend)
+    if given is not None:
+        return surface
+    unit = surface.stats.unit
+    if unit not in METRES:
+        raise InputError(f"scale is missing: {str(file)!r} states "
+                         + ("no length unit" if unit is None else f"the length unit {unit!r}, which is not known")
+                         + "; give the metres per length unit of the file (e.g. 1e-6 for a file in um).")
+    if METRES[unit] == 1.0:
+        return surface
+    return rough.read_surface(file, physical_sizes=physical_sizes, scale=METRES[unit], detrend=detrend)
+
+
+def synthetic_surface(*, hurst, size, grid, rms_height=None, rms_slope=None, long_cutoff=None, short_cutoff=None,
+                      rolloff=1.0, seed=0):
+    """A seeded self-affine square cell (:func:`bem.rough.self_affine`): ``size`` [m] across,
+    ``grid`` points across; the other arguments as there (lengths in m)."""
+    from bem import rough
+
+    grid = check_int("grid", grid)
+    size = check_positive("size", size)
+    return rough.self_affine((grid, grid), (size, size), hurst=hurst, rms_height=rms_height, rms_slope=rms_slope,
+                             long_cutoff=long_cutoff, short_cutoff=short_cutoff, rolloff=rolloff,
+                             seed=check_int("seed", seed, minimum=0))
+
+
+def ladder(surface, E_star, *, pressures=None, relative=DEFAULT_RANGE, n=12):
+    """The geometric ladder of ``n`` mean pressures [Pa].
+
+    ``pressures = (low, high)`` [Pa] gives its ends; otherwise ``relative = (low, high)`` does,
+    in units of ``E* h'_rms`` (``h'_rms = surface.stats.rms_slope``).
+    """
+    n = check_int("n_pressures", n, minimum=2)
+    E_star = check_positive("E_star", E_star)
+    if pressures is not None:
+        name, (low, high), unit = "pressures", pressures, 1.0
+    else:
+        name, (low, high), unit = "relative", relative, E_star * surface.stats.rms_slope
+    low, high = check_positive(f"{name}[0]", low), check_positive(f"{name}[1]", high)
+    if high <= low:
+        fail(f"{name}[1]", high, f"> {name}[0] = {low!r}")
+    return np.geomspace(low, high, n) * unit
+
+
+def _check_figures(figures):
+    if figures:
+        from ..extras import require
+
+        require("report", "the figures of a layer law (or no figures: contactlab layer-law --no-figures)")
+
+
+def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="newton", rtol=1e-8, figures=True,
+                   progress=None, what="out_dir"):
+    """Solve the layer law of ``surface`` and write its folder ``out_dir`` (module docstring).
+
+    Parameters
+    ----------
+    surface : bem.rough.RoughSurface
+        In metres.
+    out_dir : path-like
+        The folder written: new, empty, or a layer-law folder contactlab wrote (replaced whole).
+    E_star : float
+        Effective modulus of the pair [Pa].
+    pressures : array_like
+        The ladder of mean pressures [Pa] (:func:`ladder`).
+    n_cols : int, optional
+        Lattice nodes across the cell (default: the surface's grid points along x).
+    method, rtol, progress
+        As :func:`bem.rough.layer_from_topography` (``progress(k, n, result)`` after each step).
+    figures : bool
+        Draw the figures (needs the ``report`` extra).
+    what : str
+        The argument named in messages about ``out_dir`` (``"--out"``).
+
+    Returns
+    -------
+    LayerLawFolder
+
+    Raises
+    ------
+    bem.InputError
+        A bad argument, a missing extra, a ladder whose mean gap rises (checked before any solve
+        where possible).
+    validation.io.OutputError
+        ``out_dir`` may not be written (checked before the ladder is solved).
+    bem.rough.LadderNotConverged
+        A step of the ladder did not converge; nothing is written.
+    """
+    from bem import rough
+
+    _check_figures(figures)
+    out_dir = Path(out_dir)
+    with output_errors(out_dir.absolute(), what):
+        recover_output_dir(out_dir)
+        check_output_dir(out_dir, KIND, NAMES, what=what)
+    n_cols = surface.stats.grid[0] if n_cols is None else n_cols
+    law = rough.layer_from_topography(surface, E_star, pressures=pressures, n_cols=n_cols, method=method, rtol=rtol,
+                                      progress=progress)
+    drawn = {}
+    with atomic_directory(out_dir, KIND, NAMES, what=what) as tmp:
+        law.save(tmp / LAW_FILE)
+        if figures:
+            from .figures import draw_all
+
+            drawn = draw_all(law, tmp)
+    return LayerLawFolder(out_dir, law, out_dir / LAW_FILE, drawn)
+

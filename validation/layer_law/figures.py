@@ -1,0 +1,106 @@
+"""The figures of a rough surface's layer law (:class:`bem.rough.TopographyLaw`, SI units).
+
+- ``closure.png``: the closure ``w(p)`` on linear axes (with the first-touch mean gap
+  ``ubar(0+)``, the full closure) and on logarithmic axes: the ladder's points marked, the
+  tabulated law's interpolant (:class:`bem.layers.Tabulated`) between them;
+- ``contact_fraction.png``: ``A/A0`` against ``p/(E* h'_rms)`` (``h'_rms = stats.rms_slope``),
+  logarithmic axes, with the small-load line ``A/A0 = 2 p/(E* h'_rms)`` of Hyun et al.
+  (PRE 70, 026117, 2004) as a guide;
+- ``stiffness.png``: the interfacial stiffness ``K = dp/dw`` [Pa/m] against ``p``, logarithmic
+  axes; points in full contact (``K = inf``) are left out and named in the legend.
+
+Matplotlib is imported inside the functions (the ``report`` extra).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..report.render.style import display_unit, new_figure, save_figure
+
+__all__ = ["draw_all", "closure_figure", "contact_fraction_figure", "stiffness_figure", "HYUN_KAPPA"]
+
+#: the small-load slope of ``A/A0`` against ``p/(E* h'_rms)`` drawn as a guide (Hyun et al. 2004)
+HYUN_KAPPA = 2.0
+_POINTS = dict(marker="o", markersize=5, linestyle="none", color="#1f77b4")
+_CURVE = dict(color="#1f77b4", linewidth=1.2)
+
+
+def _source(law):
+    source = law.stats.source or "surface"
+    return source if len(source) <= 60 else "..." + source[-57:]
+
+
+def closure_figure(law, path):
+    """``w(p)`` on linear and logarithmic axes; returns the figure after writing ``path``."""
+    p, w = law.mean_pressure, law.closure
+    pu, pf = display_unit("Pa", float(p[-1]))
+    wu, wf = display_unit("m", float(max(w[-1], law.first_touch_gap)))
+    with new_figure((9.6, 4.0), ncols=2) as (fig, (lin, log)):
+        fine = np.linspace(0.0, p[-1], 400)
+        lin.plot(fine / pf, law.law.w(fine) / wf, label="tabulated law (monotone cubic)", **_CURVE)
+        lin.plot(p / pf, w / wf, label=f"ladder ({p.size} solves)", **_POINTS)
+        lin.axhline(law.first_touch_gap / wf, color="0.4", linestyle="--", linewidth=1,
+                    label=r"first-touch mean gap $\bar u(0^+)$ (full closure)")
+        lin.set_xlim(0.0, 1.02 * p[-1] / pf)
+        lin.set_ylim(0.0, 1.08 * law.first_touch_gap / wf)
+        lin.legend(loc="lower right", fontsize="small")
+        geo = np.geomspace(p[0], p[-1], 400)
+        log.loglog(geo / pf, law.law.w(geo) / wf, **_CURVE)
+        log.loglog(p / pf, w / wf, **_POINTS)
+        for ax in (lin, log):
+            ax.set_xlabel(f"mean pressure $p$ [{pu}]")
+            ax.set_ylabel(f"closure $w$ [{wu}]")
+            ax.grid(True, which="both", alpha=0.3)
+        lin.set_title("linear axes")
+        log.set_title("logarithmic axes")
+        fig.suptitle(r"Layer law $w(p) = \bar u(0^+) - \bar u(p)$ of " + _source(law)
+                     + f", $E^*$ = {law.E_star:.4g} Pa")
+        save_figure(fig, path)
+        return fig
+
+
+def contact_fraction_figure(law, path):
+    """``A/A0`` against ``p/(E* h'_rms)``, logarithmic axes; returns the figure after writing ``path``."""
+    slope = float(law.stats.rms_slope)
+    x = law.mean_pressure / (law.E_star * slope)
+    a = law.contact_fraction
+    with new_figure((6.4, 4.4)) as (fig, ax):
+        guide = np.geomspace(x[0], min(x[-1], 1.0 / HYUN_KAPPA), 50)
+        ax.loglog(guide, HYUN_KAPPA * guide, color="0.5", linestyle="--", linewidth=1,
+                  label=rf"$A/A_0 = {HYUN_KAPPA:g}\, p/(E^* h'_\mathrm{{rms}})$ (Hyun et al. 2004)")
+        ax.loglog(x, a, label=f"ladder ({x.size} solves)", **_CURVE, marker="o", markersize=5)
+        ax.set_xlabel(r"$p\,/\,(E^*\,h'_\mathrm{rms})$ [-]")
+        ax.set_ylabel(r"real contact fraction $A/A_0$ [-]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(loc="lower right", fontsize="small")
+        ax.set_title(rf"Contact fraction, $h'_\mathrm{{rms}}$ = {slope:.4g}, $E^*$ = {law.E_star:.4g} Pa",
+                     fontsize="medium")
+        save_figure(fig, path)
+        return fig
+
+
+def stiffness_figure(law, path):
+    """``K(p)`` [Pa/m], logarithmic axes, full-contact points left out; returns the figure after writing ``path``."""
+    p, k = law.mean_pressure, law.stiffness
+    finite = np.isfinite(k)
+    pu, pf = display_unit("Pa", float(p[-1]))
+    with new_figure((6.4, 4.4)) as (fig, ax):
+        ax.loglog(p[finite] / pf, k[finite], label=f"ladder ({int(finite.sum())} of {p.size} solves)", **_CURVE,
+                  marker="o", markersize=5)
+        if not finite.all():
+            ax.plot([], [], " ", label=f"full contact (K = inf) at p >= {p[~finite][0] / pf:.4g} {pu}: not drawn")
+        ax.set_xlabel(f"mean pressure $p$ [{pu}]")
+        ax.set_ylabel(r"interfacial stiffness $K = \mathrm{d}p/\mathrm{d}w$ [Pa/m]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(loc="lower right", fontsize="small")
+        ax.set_title(r"Interfacial stiffness $K = -\mathrm{d}p/\mathrm{d}\bar u$", fontsize="medium")
+        save_figure(fig, path)
+        return fig
+
+
+def draw_all(law, folder):
+    """Write the three figures into ``folder``; returns ``{file name: figure}``."""
+    return {name: draw(law, folder / name) for name, draw in (("closure.png", closure_figure),
+                                                             ("contact_fraction.png", contact_fraction_figure),
+                                                             ("stiffness.png", stiffness_figure))}
