@@ -54,7 +54,9 @@ def _summary(result, out_dir):
             f = ref["p_max"]
             p_line += f"   ({ref.get('kind', 'FEM')} {_g(f)}{_relative(result['p_max'], f)})"
     lines.append(p_line)
-    if "contact_radius" in result:
+    if result.get("periodic"):
+        lines += _periodic_lines(result, L, Pa)
+    elif "contact_radius" in result:
         lines.append(f"contact    radius {_g(result['contact_radius'])} {L}, area {_g(result['contact_area'])} {L}^2")
     else:
         ext = result["contact_extent"]
@@ -76,6 +78,18 @@ def _summary(result, out_dir):
     if out_dir is not None:
         lines.append(f"files      {out_dir}/ ({', '.join(result['files'].values())})")
     return "\n".join(lines)
+
+
+def _periodic_lines(result, L, Pa):
+    """The lines of a periodic cell: contact fraction, spots, mean gap and the surface's statistics."""
+    s, sp = result["surface"], result["spots"]
+    lines = [f"cell       mean pressure {_g(result['mean_pressure'])} {Pa}, contact fraction "
+             f"{_g(result['contact_fraction'], '.4f')}, {result['n_spots']} contact spots (largest "
+             f"{_g(sp['largest_area'], '.4g')} {L}^2), mean gap {_g(result['mean_gap'], '.4g')} {L}",
+             f"surface    rms height {_g(s['rms_height'], '.4g')} {L}, rms slope {_g(s['rms_slope'], '.4g')}, "
+             f"edge jump {_g(s['edge_jump'], '.4g')} {L}{' (LARGE)' if s['edge_jump_large'] else ''}, "
+             f"stretch_y {_g(s['stretch_y'], '.5f')}"]
+    return lines
 
 
 class _StageBar:

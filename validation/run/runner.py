@@ -51,6 +51,7 @@ class RunOutcome:
     analytic: object = None
     layer: object = None
     stress: object = None
+    spots: object = None  # periodic scenes: the contact-spot label of each node (validation.run.periodic)
 
 
 def _notify(progress, stage, status, **info):
@@ -151,6 +152,10 @@ def execute_scene(scene, *, progress=None, overrides=None):
         scene = load_scene(scene, overrides=overrides)
     if scene.unimported:
         raise SceneError(refuse_code(*scene.unimported[0]))
+    if scene.bem.get("periodic"):
+        from .periodic import execute_periodic
+
+        return execute_periodic(scene, progress=progress)
     messages, times = [], {"bem": None, "fem": None, "layer_reference": None}
     if "fem" in scene.skipped:
         messages.append("FEM reference skipped: the scene's [fem] was not run (no_fem).")
@@ -248,7 +253,11 @@ def write_outputs(outcome, out_dir, *, progress=None, what="out_dir"):
     files = {key: name for key, name in FILES.items() if not absent.get(key, False)}
     outcome.result["files"] = files
     with atomic_directory(out_dir, "result", RESULT_NAMES, what=what) as tmp:
-        write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
+        if outcome.spots is None:
+            write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
+        else:  # a periodic cell: its initial gap and contact spots (-1: no contact)
+            write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap.nodal_gap(),
+                             contact_spot=outcome.spots.ravel())
         if outcome.fem is not None:
             write_vtu(tmp / files["fem_field"], **outcome.fem.field())
         if outcome.stress is not None:

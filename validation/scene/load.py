@@ -9,9 +9,10 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn with cnn_step,
                lam_ref, alpha_a, alpha_b, alpha_c (validation.scene.paper), or law = "tabulated"
                with a law file (validation.scene.layer_file); absent or law = "none": no layer
-    [load]     force [N] or approach [m]
+    [load]     force [N] or approach [m] (a periodic cell: or mean_pressure [Pa])
     [bem]      step [m] or nodes_across; extent [m] or extent_factor; method, rtol, maxiter,
-               precondition, nested, relaxation
+               precondition, nested, relaxation; a rough gap (validation.scene.rough):
+               periodic = true, cell_nodes
     [fem]      only when an FEM reference is wanted (axisymmetric gaps): n_contact, extent, ...
     [analytic] only when wanted: kind = "hertz" | "hertz_elliptic" | "rigid_layer"
     [sweep]    only when wanted: parameter, values
@@ -39,8 +40,8 @@ from .checks import SceneError, closest
 from .measured import measured_region
 from .paper import ALIASES
 from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
+from .rough import bem_section
 from .sizing import EXCLUSIVE as BEM_EXCLUSIVE
-from .sizing import bem_options
 from .source import builtin_path, builtin_scenes, read_source, read_toml
 from .layer_file import EXCLUSIVE as FILE_EXCLUSIVE
 from .layer_file import resolve_layer_file
@@ -52,7 +53,8 @@ __all__ = ["Scene", "SceneError", "load_scene", "check_scene", "parse_scene", "b
 SECTIONS = ("scene", "bodies", "gap", "layer", "load", "bem", "fem", "analytic", "sweep", "report", "stress")
 _REQUIRED = ("scene", "bodies", "gap", "load")
 #: section -> groups of keys that replace each other (a ``--set`` of one drops the others)
-_EXCLUSIVE = {"bem": BEM_EXCLUSIVE, "load": (("force", "approach"),), "layer": LAYER_EXCLUSIVE + FILE_EXCLUSIVE,
+_EXCLUSIVE = {"bem": BEM_EXCLUSIVE, "load": (("force", "approach", "mean_pressure"),),
+              "layer": LAYER_EXCLUSIVE + FILE_EXCLUSIVE,
               "bodies": tuple(("E_star", key) for key in sec.BODY_KEYS)}
 
 
@@ -263,7 +265,8 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
                   section["gap"], body, meta)
     layer = check(lambda d: sec.layer(d, build=build["layer"], E_star=None if body is check.FAILED else body["E_star"]),
                   layer_raw)
-    bem = check(lambda g, la, b, ld: bem_options(raw.get("bem"), g[1], *la, b["E_star"], ld), shape, layer, body, load)
+    bem = check(lambda g, la, b, ld: bem_section(raw.get("bem"), g[1], *la, b["E_star"], ld, raw.get("stress")),
+                shape, layer, body, load)
     shape = check(lambda g, b: (g[0], measured_region(g[1], b["extent"])), shape, bem)
     fem = check(lambda g, b: sec.fem_options(raw.get("fem"), g[1], b["materials"]), shape, body)
     analytic = check(lambda g, la: sec.analytic(raw.get("analytic"), g[1], la[0]), shape, layer)
@@ -294,10 +297,10 @@ def _check_sweep_points(scene, **kw):
 
 
 def _resolve_files(raw, base_dir, allow_outside):
-    """Make the file a scene names (``gap.file`` of a measured gap) absolute, relative to ``base_dir``
+    """Make the file a scene names (``gap.file`` of a measured or surface gap) absolute, relative to ``base_dir``
     (:func:`validation.scene.trust.scene_file`)."""
     gap = raw.get("gap")
-    if isinstance(gap, dict) and gap.get("type") == "measured" and isinstance(gap.get("file"), str):
+    if isinstance(gap, dict) and gap.get("type") in ("measured", "surface") and isinstance(gap.get("file"), str):
         gap["file"] = scene_file("gap.file", gap["file"], base_dir, allow_outside=allow_outside)
 
 

@@ -25,6 +25,8 @@ from .layer_file import is_layer_file, read_layer_file
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
 from .paper import ALIASES, PAPER_LAWS, check_layer, is_paper_law, paper_keys
+from .rough import GAP_KEYS as ROUGH_GAP_KEYS
+from .rough import PERIODIC_KEYS, ROUGH_TYPES, rough_gap
 from .sizing import KEYS as BEM_KEYS
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic", "report", "sweep_spec",
@@ -40,7 +42,7 @@ _FEM_OPTIONS = {"n_contact": partial(ck.integer, minimum=4, maximum=400),
                 "maxiter": partial(ck.integer, minimum=1), "remesh": ck.boolean, "truncation_correction": ck.boolean}
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
 KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS),
-        "load": ("force", "approach"), "bem": BEM_KEYS, "fem": tuple(_FEM_OPTIONS), "analytic": ("kind",),
+        "load": ("force", "approach", "mean_pressure"), "bem": (*BEM_KEYS, *PERIODIC_KEYS), "fem": tuple(_FEM_OPTIONS), "analytic": ("kind",),
         "sweep": ("parameter", "values"), "report": ("sections", "format"),
         "stress": ("depths", "n_depths", "max_depth", "bodies")}
 GAP_TYPES = gaps.GAPS
@@ -79,7 +81,7 @@ def scene_keys():
     """
     out = {name: {"": keys} for name, keys in KEYS.items()}
     out["gap"] = {"": ("type",), **{kind: tuple(_gap_parameters(cls)) for kind, cls in GAP_TYPES.items()},
-                  "measured": tuple(k for k in MEASURED_KEYS if k != "type")}
+                  "measured": tuple(k for k in MEASURED_KEYS if k != "type"), **ROUGH_GAP_KEYS}
     out["layer"] = {"": ("law",)}
     for law, cls in LAWS.items():
         keys = [*cls._required, *cls._optional]
@@ -144,11 +146,13 @@ def gap(d, E_star, *, units=None, build=True):
     region.
     """
     ck.table("gap", d)
-    kinds = (*GAP_TYPES, "measured")
+    kinds = (*GAP_TYPES, "measured", *ROUGH_TYPES)
     kind = ck.require("gap", d, "type", "give one of " + ", ".join(map(repr, kinds)))
     ck.choice("gap.type", kind, kinds)
     if kind == "measured":
         return measured_gap(d, units=units)
+    if kind in ROUGH_TYPES:
+        return rough_gap(d, units=units)
     params = _gap_parameters(GAP_TYPES[kind])
     ck.unknown_keys("gap", d, ["type", *params])
     spec = dict(d)
@@ -165,10 +169,11 @@ def gap(d, E_star, *, units=None, build=True):
 
 
 def load(d):
-    """``[load]``: exactly one of ``force`` [N] and ``approach`` [m], in :data:`bem.checks.SCALE_RANGE`."""
+    """``[load]``: exactly one of ``force`` [N], ``approach`` [m] and (periodic scenes) ``mean_pressure``
+    [Pa], in :data:`bem.checks.SCALE_RANGE`; ``mean_pressure`` is in the dict only when given."""
     _section("load", d)
     key = ck.exactly_one("load", d, KEYS["load"], "force control: force [N]; approach control: "
-                         "approach [m]")
+                         "approach [m]; a periodic cell: mean_pressure [Pa]")
     return {"force": None, "approach": None, key: ck.scale(f"load.{key}", d[key])}
 
 

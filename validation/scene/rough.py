@@ -1,0 +1,205 @@
+"""Rough surfaces as the gap of a periodic scene: ``[gap] type = "self_affine"`` or ``"surface"``, ``[bem] periodic``.
+
+A rough scene solves the periodic cell of a rough surface pressed by a rigid flat
+(:func:`bem.solve_periodic`; docs/scenes.md, "Rough surfaces"). Keys of the ``[gap]`` table
+(lengths in the scene's length unit)::
+
+    type = "self_affine"     # a seeded synthetic surface (bem.rough.self_affine)
+    size = 1e-3              # cell (Lx, Ly): a number or a pair
+    grid = 256               # points (nx, ny): an integer or a pair
+    hurst = 0.8              # Hurst exponent, 0 < H <= 1
+    rms_height = 1e-6        # or rms_slope [-]; exactly one
+    long_cutoff = 2.5e-4     # roll-off wavelength (optional)
+    short_cutoff = 2e-5      # short cut-off wavelength (optional)
+    rolloff = 1.0            # PSD below the roll-off relative to C(q_L) (optional)
+    seed = 1                 # required: the same seed gives the same surface
+
+    type = "surface"         # a measured topography
+    file = "patch.x3p"       # relative to the scene file's folder (validation.scene.trust)
+    reader = "surfacetopography" | "core"   # bem.rough.read_surface (default) or bem.gaps.measured
+    format, channel, physical_sizes         # read_surface's (physical_sizes in the file's unit)
+    spacing, nodata                         # the core reader's (read_heights)
+    length_unit = "um"       # the file's length unit ("m", "mm", "um", "nm") or a factor
+    detrend = "height"       # bem.rough.DETRENDS or "none"
+
+Both need SurfaceTopography (the ``rough`` extra, statistics and synthesis): without it the
+scene stops before any work with :class:`validation.extras.MissingExtraError`. ``[bem]``
+takes ``periodic = true`` (required with a rough gap, refused without one) and
+``cell_nodes``, the lattice nodes along x (default: the surface's ``nx``); the cell is the
+surface's. ``[load]`` takes ``mean_pressure`` [pressure], ``force`` (the force on one cell,
+``mean_pressure Lx Ly``) or ``approach``.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+from bem import METHODS, InputError
+from bem.checks import check_node_count
+
+from ..extras import require as require_extra
+from . import checks as ck
+from .measured import _factor as length_factor
+from .paper import is_paper_law
+from .sizing import _solver_options
+
+__all__ = ["RoughGap", "ROUGH_TYPES", "GAP_KEYS", "PERIODIC_KEYS", "rough_gap", "bem_section"]
+
+#: gap type -> its keys besides ``type``
+GAP_KEYS = {"self_affine": ("size", "grid", "hurst", "rms_height", "rms_slope", "long_cutoff", "short_cutoff",
+                            "rolloff", "seed"),
+            "surface": ("file", "reader", "format", "channel", "physical_sizes", "spacing", "nodata", "length_unit",
+                        "detrend")}
+ROUGH_TYPES = tuple(GAP_KEYS)
+#: ``[bem]`` keys of a periodic scene besides the solver options
+PERIODIC_KEYS = ("periodic", "cell_nodes")
+_LATTICE_KEYS = ("step", "nodes_across", "extent", "extent_factor")
+_READERS = ("surfacetopography", "core")
+
+
+class RoughGap:
+    """The gap of a rough scene: a :class:`bem.rough.RoughSurface` against a rigid flat.
+
+    ``lattice`` (:class:`bem.rough.LatticeHeights`) is set by :func:`bem_section`, the initial
+    gap of the cell is ``lattice.gap()``.
+    """
+
+    is_axisymmetric = False
+
+    def __init__(self, type_name, surface):
+        self.type_name, self.surface, self.lattice = type_name, surface, None
+
+    def nodal_gap(self):
+        """The initial gap at the cell's nodes [length], flattened in the order of the result arrays."""
+        return self.lattice.gap().ravel()
+
+
+def _pair(path, value, check):
+    """A number (both axes) or a pair, each checked by ``check(path, v)``."""
+    items = value if isinstance(value, list) and len(value) == 2 else [value, value]
+    if isinstance(value, list) and len(value) != 2:
+        raise ck.SceneError(f"{path} = {value!r} is not allowed: it must be a number or a pair [x, y].")
+    return tuple(check(path, v) for v in items)
+
+
+def _self_affine(d):
+    from bem import rough
+
+    for key in ("size", "grid", "hurst", "seed"):
+        ck.require("gap", d, key, "a self_affine gap needs size, grid, hurst, seed and rms_height or rms_slope")
+    ck.exactly_one("gap", d, ("rms_height", "rms_slope"), "rms height [length] or rms slope [-]")
+    kw = {"size": _pair("gap.size", d["size"], ck.positive),
+          "grid": _pair("gap.grid", d["grid"], partial(ck.integer, minimum=rough.MIN_POINTS, maximum=8192)),
+          "seed": ck.integer("gap.seed", d["seed"], 0)}
+    kw.update({k: d[k] for k in ("hurst", "rms_height", "rms_slope", "long_cutoff", "short_cutoff", "rolloff")
+               if k in d})
+    with ck.scene_errors("gap."):
+        return rough.self_affine(**kw)
+
+
+def _surface(d, units):
+    from bem import rough
+    from bem.gaps.heights import read_heights
+
+    file = ck.string("gap.file", ck.require("gap", d, "file", 'give the topography file, e.g. file = "patch.x3p"'))
+    reader = ck.choice("gap.reader", d.get("reader", "surfacetopography"), _READERS)
+    own = {"surfacetopography": ("format", "channel", "physical_sizes"), "core": ("format", "spacing", "nodata")}
+    for key in GAP_KEYS["surface"][2:7]:
+        if key in d and key not in own[reader]:
+            raise ck.SceneError(f"gap.{key} = {d[key]!r} is not allowed with gap.reader = {reader!r}: that reader "
+                                f"takes {', '.join(own[reader])}.")
+    scale = length_factor(d, units)
+    detrend = d.get("detrend", "height")
+    detrend = None if detrend == "none" else ck.choice("gap.detrend", detrend, rough.DETRENDS)
+    with ck.scene_errors("gap."):
+        if reader == "surfacetopography":
+            kw = {k: d[k] for k in ("format", "channel", "physical_sizes") if k in d}
+            return rough.read_surface(file, scale=scale, detrend=detrend, **kw)
+        x, y, z = read_heights(file, **{k: d[k] for k in ("format", "spacing", "nodata") if k in d})
+        size = (x.size * (x[1] - x[0]) * scale, y.size * (y[1] - y[0]) * scale)
+        return rough.from_heights(z * scale, size, detrend=detrend, source=file)
+
+
+def rough_gap(d, *, units=None):
+    """``(spec, RoughGap)`` of a ``[gap]`` of a rough type (module docstring).
+
+    Raises
+    ------
+    validation.extras.MissingExtraError
+        SurfaceTopography cannot be imported ("install contactlab[rough]"); nothing has run.
+    validation.scene.SceneError
+        A bad key or value; the message names it (``gap.hurst = ...``).
+    """
+    kind = d["type"]
+    ck.unknown_keys("gap", d, ("type", *GAP_KEYS[kind]))
+    require_extra("rough", f"gap.type = {kind!r} (a rough surface)")
+    surface = _self_affine(d) if kind == "self_affine" else _surface(d, units)
+    return dict(d), RoughGap(kind, surface)
+
+
+def _periodic(d, gap, layer_spec, layer, load):
+    for key in _LATTICE_KEYS:
+        if key in d:
+            raise ck.SceneError(f"bem.{key} = {d[key]!r} is not allowed with bem.periodic = true: the cell is the "
+                                "surface's; give bem.cell_nodes (lattice nodes along x).")
+    if layer_spec is not None and is_paper_law(layer_spec):
+        raise ck.SceneError(f"layer.law = {layer_spec['law']!r} given by the paper's parameters is not allowed with "
+                            "bem.periodic = true: give the law's own parameters (e.g. lam).")
+    out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
+    out.update(ck.options("bem", d, {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1),
+                                     "precondition": ck.boolean, "nested": ck.boolean}))
+    out.update(_solver_options(d, out["method"], layer_spec))
+    n_cols = ck.integer("bem.cell_nodes", d.get("cell_nodes", gap.surface.heights.shape[0]), 8, 8192)
+    try:
+        lattice = gap.surface.to_lattice(n_cols)
+        check_node_count("bem.cell_nodes", n_cols, lattice.n_rows * lattice.n_cols)
+    except InputError as exc:
+        raise ck.SceneError(f"bem.cell_nodes = {n_cols!r} is not allowed: {exc}") from None
+    gap.lattice = lattice
+    h = lattice.gap()
+    if load.get("approach") is not None and layer is None and not load["approach"] < float(h.mean()):
+        raise ck.SceneError(f"load.approach = {load['approach']!r} is not allowed: without a layer it must be below "
+                            f"the cell's mean initial gap {float(h.mean()):.6g} (a full contact leaves the mean "
+                            "pressure undetermined: give load.mean_pressure).")
+    lx, ly = lattice.size
+    out.update(periodic=True, cell_nodes=n_cols, step=lattice.step, cell=[lattice.n_cols, lattice.n_rows],
+               size=[lx, ly], extent=(lx / 2, ly / 2), extent_auto=False, expected=None, nodes_across=None,
+               n_nodes=lattice.n_rows * lattice.n_cols)
+    return out
+
+
+def bem_section(d, gap, layer_spec, layer, E_star, load, stress=None):
+    """``[bem]`` of any scene: the periodic cell of a rough gap, else :func:`validation.scene.sizing.bem_options`.
+
+    ``stress`` is the raw ``[stress]`` table (refused with a periodic cell).
+    """
+    from .sizing import bem_options
+
+    d = {} if d is None else ck.table("bem", d)
+    periodic = ck.boolean("bem.periodic", d.get("periodic", False))
+    rough = isinstance(gap, RoughGap)
+    if rough and not periodic:
+        raise ck.SceneError(f"gap.type = {gap.type_name!r} needs bem.periodic = true: a rough surface is solved on "
+                            "its periodic cell.")
+    if periodic and not rough:
+        raise ck.SceneError(f"bem.periodic = true is not allowed with gap.type = {gap.type_name!r}: the periodic "
+                            f"cell needs a rough surface (gap.type = {' or '.join(map(repr, ROUGH_TYPES))}).")
+    if not periodic:
+        if "cell_nodes" in d:
+            raise ck.SceneError(f"bem.cell_nodes = {d['cell_nodes']!r} is not allowed without bem.periodic = true: "
+                                "give bem.step or bem.nodes_across.")
+        if load.get("mean_pressure") is not None:
+            raise ck.SceneError(f"load.mean_pressure = {load['mean_pressure']!r} is not allowed without "
+                                "bem.periodic = true: give load.force or load.approach.")
+        return bem_options({k: v for k, v in d.items() if k != "periodic"}, gap, layer_spec, layer, E_star, load)
+    if stress is not None:
+        raise ck.SceneError("stress = {...} is not allowed with bem.periodic = true: the subsurface stresses are "
+                            "computed for a bounded contact.")
+    ck.unknown_keys("bem", d, (*_LATTICE_KEYS, *PERIODIC_KEYS, *_solver_keys()))
+    return _periodic(d, gap, layer_spec, layer, load)
+
+
+def _solver_keys():
+    from .sizing import SOLVER_KEYS
+
+    return SOLVER_KEYS
