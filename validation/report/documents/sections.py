@@ -22,6 +22,7 @@ from ..figures.run import stress_view
 from ..render import Progress, Section, Table, draw_and_build, fmt
 from ..render.content import fmt_distinct
 from ..render.style import method_text
+from .periodic import rough_section
 from .problem import scene_section
 from .results import is_number
 from .sweep import sweep_section
@@ -231,6 +232,7 @@ SECTIONS = {
     "stress": stress,
     "comparison": comparison,
     "sweep": sweep_section,
+    "rough": rough_section,
 }
 
 

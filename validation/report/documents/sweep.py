@@ -101,8 +101,11 @@ def _key_label(key, units):
 
 
 def _figures(summary, points, work):
+    from ..figures.periodic import sweep_curves
     from ..figures.sweeps import plot_sweep, plot_sweep_scalars
 
+    if any(res is not None and res.data.get("periodic") for _, res in points):  # a rough surface's cell
+        return sweep_curves(points, work, str(summary.get("key", "value")))
     done = [(row, res) for row, res in points if res is not None and (res.get("profile") or {}).get("x")]
     if not done:
         return []

@@ -20,7 +20,7 @@ section ``section`` of :data:`validation.report.documents.sections.SECTIONS`, af
 section's tables. A new figure is one function and one line here.
 """
 
-from . import run
+from . import periodic, run
 
 __all__ = ["FIGURES"]
 
@@ -31,4 +31,5 @@ FIGURES = {
     "convergence": ("convergence", run.convergence),
     "fem_von_mises": ("fem_field", run.fem_von_mises),
     "stress": ("stress", run.stress_figures),
+    "cell_maps": ("rough", periodic.cell_maps),
 }
