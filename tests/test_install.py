@@ -150,6 +150,8 @@ def test_core_install_runs_a_bem_scene_and_writes_its_files(tmp_path):
     (["study", "stability", "--quick", "--out", "res"], "fem"),
     (["layer-law", "--synthetic", "hurst=0.8,size=1e-4,grid=16,rms_height=1e-6", "--E-star", "1e11", "--out", "res"],
      "rough"),
+    (["run", "rough_flat", "--out", "res"], "rough"),
+    (["sweep", "rough_flat", "--param", "load.mean_pressure", "--values", "1e8,2e8", "--out", "res"], "rough"),
 ])
 def test_missing_extra_stops_before_any_work(tmp_path, argv, extra):
     code, out, err = _core_only(tmp_path, *argv)

@@ -26,6 +26,7 @@ with status 2) whose message says ``install contactlab[fem]``.
 from __future__ import annotations
 
 import importlib
+import warnings
 
 from bem.errors import InputError
 
@@ -61,8 +62,10 @@ def missing(extra):
         parts = module.split(".")
         chain = [".".join(parts[:i]) for i in range(1, len(parts) + 1)]  # "dask", "dask.distributed"
         try:
-            for name in chain:  # the parents too: a cached submodule would hide a missing parent
-                importlib.import_module(name)
+            with warnings.catch_warnings():  # SurfaceTopography warns that it runs without MPI, as wanted
+                warnings.simplefilter("ignore", ImportWarning)
+                for name in chain:  # the parents too: a cached submodule would hide a missing parent
+                    importlib.import_module(name)
         except ImportError as exc:
             out.append((module, "not installed" if getattr(exc, "name", None) in chain else str(exc)))
         except OSError as exc:  # the package is there, a shared library it loads is not

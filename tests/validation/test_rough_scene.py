@@ -1,0 +1,183 @@
+"""Periodic scenes of rough surfaces: the keys and their errors, contact spots, a run of rough_flat, its report.
+
+The run's numbers are checked against independent computations from its .vtu field: the
+contact fraction and mean pressure from the nodal pressures, the spots by a flood fill over
+neighbours found from the node coordinates (distance one step, minimum image across the cell).
+"""
+
+import json
+import math
+from collections import deque
+
+import numpy as np
+import pytest
+
+from validation.run.periodic import contact_spots
+from validation.scene import SceneError, load_scene
+from validation.scene.load import read_toml
+from validation.scene.source import builtin_path
+
+from ..vtu_reader import read_vtu
+from .conftest import cli
+
+SQRT3 = math.sqrt(3.0)
+
+
+def _base(**changes):
+    raw = read_toml(builtin_path("rough_flat"))
+    raw["gap"].update(grid=32, size=1e-3, long_cutoff=2.5e-4, short_cutoff=1e-4)
+    raw["bem"]["cell_nodes"] = 32
+    raw.pop("report")
+    for key, value in changes.items():
+        section, name = key.split("__")
+        if value is None:
+            raw[section].pop(name, None)
+        else:
+            raw.setdefault(section, {})[name] = value
+    return raw
+
+
+def _flood_fill(x, y, contact, size, step):
+    """Spots by breadth-first search; neighbours: nodes one step apart, minimum image in the cell."""
+    lx, ly = size
+    nodes = np.flatnonzero(contact)
+    label = {}
+    count = 0
+    for start in nodes:
+        if start in label:
+            continue
+        label[start] = count
+        queue = deque([start])
+        while queue:
+            i = queue.popleft()
+            dx = (x[nodes] - x[i] + lx / 2) % lx - lx / 2
+            dy = (y[nodes] - y[i] + ly / 2) % ly - ly / 2
+            for j in nodes[np.abs(np.hypot(dx, dy) - step) < 1e-6 * step]:
+                if j not in label:
+                    label[j] = count
+                    queue.append(j)
+        count += 1
+    return label, count
+
+
+def _same_partition(labels, reference):
+    pairs = {(int(labels[i]), reference[i]) for i in reference}
+    return len(pairs) == len({a for a, _ in pairs}) == len({b for _, b in pairs})
+
+
+def test_contact_spots_of_a_hand_made_pattern():
+    c = np.zeros((6, 8), dtype=bool)
+    c[2, 0] = c[2, 7] = True  # neighbours across the x edge: one spot
+    c[0, 4] = c[5, 4] = True  # row 5 (odd) node 4 sits at x = 4.5: (4, 0) is its neighbour across y
+    c[2, 3] = c[3, 2] = True  # even row 2: (q - 1, r + 1) is a neighbour
+    c[4, 1] = c[5, 7] = True  # x = 1 and x = 7.5: not neighbours, nor of the others
+    labels, n = contact_spots(c)
+    assert n == 5
+    assert labels[2, 0] == labels[2, 7] and labels[0, 4] == labels[5, 4] and labels[2, 3] == labels[3, 2]
+    assert labels[4, 1] != labels[5, 7]
+    assert np.all(labels[~c] == -1) and sorted(set(labels[c].tolist())) == list(range(n))
+    c2 = np.zeros((6, 8), dtype=bool)
+    c2[2, 4] = c2[3, 5] = True  # even row 2: (q + 1, r + 1) is NOT a neighbour (x = 4 and x = 5.5)
+    assert contact_spots(c2)[1] == 2
+    assert contact_spots(np.zeros((4, 4), dtype=bool))[1] == 0
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_contact_spots_match_a_flood_fill_over_the_coordinates(seed):
+    n_rows, n_cols = 12, 10
+    c = np.random.default_rng(seed).random((n_rows, n_cols)) < 0.45
+    r, q = np.mgrid[0:n_rows, 0:n_cols]
+    x, y = (q + 0.5 * (r % 2)).ravel(), (r * SQRT3 / 2).ravel()
+    reference, count = _flood_fill(x, y, c.ravel(), (n_cols, n_rows * SQRT3 / 2), 1.0)
+    labels, n = contact_spots(c)
+    assert n == count
+    assert _same_partition(labels.ravel(), reference)
+
+
+@pytest.mark.parametrize("changes, key", [
+    ({"bem__periodic": None}, "bem.periodic"),
+    ({"load__force": 10.0}, "load.mean_pressure"),
+    ({"gap__hurst": 1.5}, "gap.hurst"),
+    ({"gap__seed": None}, "gap.seed"),
+    ({"gap__rms_height": 1e-6}, "gap.rms_height"),
+    ({"gap__grid": 4}, "gap.grid"),
+    ({"gap__spacing": 1e-6}, "gap.spacing"),
+    ({"bem__step": 1e-5}, "bem.step"),
+    ({"bem__cell_nodes": 4}, "bem.cell_nodes"),
+    ({"bem__cell_nodes": "many"}, "bem.cell_nodes"),
+    ({"bem__periodic": "yes"}, "bem.periodic"),
+    ({"load__mean_pressure": None, "load__approach": 1.0}, "load.approach"),
+    ({"stress__depths": "auto"}, "stress"),
+    ({"layer__law": "root", "layer__lam_ref": 1e-12}, "layer.law"),
+])
+def test_bad_periodic_keys_name_the_key(changes, key):
+    with pytest.raises(SceneError) as err:
+        load_scene(_base(**changes))
+    assert key in str(err.value)
+
+
+def test_periodic_keys_are_refused_outside_a_rough_scene():
+    smooth = read_toml(builtin_path("elliptic"))
+    for section, key, value in (("bem", "periodic", True), ("bem", "cell_nodes", 64), ("load", "mean_pressure", 1e6)):
+        raw = json.loads(json.dumps(smooth))
+        raw[section][key] = value
+        if key == "mean_pressure":
+            raw["load"] = {"mean_pressure": value}
+        with pytest.raises(SceneError, match=f"{section}.{key}"):
+            load_scene(raw)
+
+
+def test_surface_file_outside_the_scene_folder_is_refused(tmp_path):
+    (tmp_path / "scene").mkdir()
+    np.save(tmp_path / "z.npy", np.random.default_rng(0).random((16, 16)) * 1e-6)
+    raw = _base()
+    raw["gap"] = {"type": "surface", "file": "../z.npy", "reader": "core", "spacing": 1e-5}
+    (tmp_path / "scene" / "s.toml").write_text(
+        "\n".join(f"[{s}]\n" + "\n".join(f"{k} = {json.dumps(v)}" for k, v in t.items()) for s, t in raw.items()))
+    with pytest.raises(SceneError, match="gap.file"):
+        load_scene(tmp_path / "scene" / "s.toml")
+    scene = load_scene(tmp_path / "scene" / "s.toml", allow_outside_files=True)
+    assert scene.bem["cell"][0] == 32 and scene.gap.surface.stats.grid == (16, 16)
+    assert scene.gap.surface.size == pytest.approx((16e-5, 16e-5))
+
+
+def test_run_rough_flat_records_what_its_field_shows(tmp_path):
+    out = tmp_path / "res"
+    code, stdout, stderr = cli("run", "rough_flat", "--out", out)
+    assert code == 0, stderr
+    r = json.loads((out / "result.json").read_text())
+    points, _, data, _, _ = read_vtu(out / "bem_field.vtu")
+    p, gap = data["p"], data["gap"]
+    n_cols, n_rows = r["bem"]["cell"]
+    step = r["bem"]["step"]
+    assert p.size == n_cols * n_rows == r["bem"]["n_nodes"]
+    lx, ly = n_cols * step, n_rows * step * SQRT3 / 2
+    assert r["converged"] and r["periodic"]
+    assert r["contact_fraction"] == np.count_nonzero(p > 0) / p.size
+    assert 0.01 < r["contact_fraction"] < 0.2
+    assert r["mean_pressure"] == pytest.approx(SQRT3 / 2 * step**2 * p.sum() / (lx * ly), rel=1e-12)
+    assert r["mean_pressure"] == pytest.approx(read_toml(builtin_path("rough_flat"))["load"]["mean_pressure"],
+                                               rel=1e-8)
+    assert r["mean_gap"] == pytest.approx(gap.mean(), rel=1e-12)
+    reference, count = _flood_fill(points[:, 0], points[:, 1], p > 0, (lx, ly), step)
+    assert r["n_spots"] == r["spots"]["count"] == count > 10
+    assert _same_partition(data["contact_spot"], reference)
+    assert np.all(data["contact_spot"][p <= 0] == -1)
+    s = r["surface"]
+    assert s["rms_slope"] == pytest.approx(0.1, rel=1e-12)  # the scene's rms_slope
+    assert s["stretch_y"] == pytest.approx(ly / s["size"][1], rel=1e-12)
+    h = data["initial_gap"]
+    assert h.min() == 0.0
+    assert h.std() == pytest.approx(s["rms_height"], rel=0.02)  # the band-limited surface on the lattice
+    assert s["edge_jump_large"] is False and s["edge_jump"] > 0
+    for text in ("contact fraction", f"{count} contact spots", "rms height", "stretch_y"):
+        assert text in stdout
+
+
+def test_core_install_refusal_message_names_the_extra(monkeypatch):
+    from validation import extras
+
+    monkeypatch.setattr(extras, "missing", lambda extra: [("SurfaceTopography", "not installed")]
+                        if extra == "rough" else [])
+    with pytest.raises(extras.MissingExtraError, match=r"gap.type = 'self_affine'.*install contactlab\[rough\]"):
+        load_scene(_base())
