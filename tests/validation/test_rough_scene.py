@@ -141,10 +141,27 @@ def test_surface_file_outside_the_scene_folder_is_refused(tmp_path):
     assert scene.gap.surface.size == pytest.approx((16e-5, 16e-5))
 
 
-def test_run_rough_flat_records_what_its_field_shows(tmp_path):
-    out = tmp_path / "res"
+@pytest.fixture(scope="module")
+def rough_run(tmp_path_factory):
+    """``contactlab run rough_flat``, once: (result folder, stdout)."""
+    out = tmp_path_factory.mktemp("rough") / "res"
     code, stdout, stderr = cli("run", "rough_flat", "--out", out)
     assert code == 0, stderr
+    return out, stdout
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The matplotlib figures the periodic figures save, in order."""
+    from validation.report.figures import periodic
+
+    figures, save = [], periodic.save_figure
+    monkeypatch.setattr(periodic, "save_figure", lambda fig, path, **kw: (figures.append(fig), save(fig, path, **kw))[1])
+    return figures
+
+
+def test_run_rough_flat_records_what_its_field_shows(rough_run):
+    out, stdout = rough_run
     r = json.loads((out / "result.json").read_text())
     points, _, data, _, _ = read_vtu(out / "bem_field.vtu")
     p, gap = data["p"], data["gap"]
@@ -181,3 +198,51 @@ def test_core_install_refusal_message_names_the_extra(monkeypatch):
                         if extra == "rough" else [])
     with pytest.raises(extras.MissingExtraError, match=r"gap.type = 'self_affine'.*install contactlab\[rough\]"):
         load_scene(_base())
+
+
+def test_report_maps_show_the_pressure_and_the_spots(rough_run, drawn):
+    out, _ = rough_run
+    code, _, stderr = cli("report", out)
+    assert code == 0, stderr
+    r = json.loads((out / "result.json").read_text())
+    md = (out / "report" / "report.md").read_text()
+    assert "Rough surface on a flat: the periodic cell" in md and "| contact spots | " + str(r["n_spots"]) in md
+    (fig,) = drawn
+    ax_p, ax_s, bar = fig.axes
+    image = ax_p.images[0].get_array()
+    assert image.max() == pytest.approx(r["p_max"] / 1e9)  # GPa
+    assert np.count_nonzero(~np.ma.getmaskarray(image)) == r["bem"]["n_contact"]
+    assert "GPa" in bar.get_ylabel()
+    lx, ly = r["bem"]["size"]
+    for ax in (ax_p, ax_s):
+        assert ax.get_xlabel() == "$x$ [mm]" and ax.get_ylabel() == "$y$ [mm]"
+        assert ax.get_xlim() == pytest.approx((0.0, lx * 1e3)) and ax.get_ylim() == pytest.approx((0.0, ly * 1e3))
+        assert ax.get_aspect() == 1.0
+    assert ax_s.get_title().startswith(f"{r['n_spots']} contact spots")
+    rgb = ax_s.images[0].get_array()
+    white = np.all(rgb == 1.0, axis=-1)
+    assert np.count_nonzero(~white) == r["bem"]["n_contact"]
+    n_colours = len({tuple(c) for c in rgb[~white]})
+    assert min(r["n_spots"], 10) <= n_colours <= r["n_spots"]
+
+
+def test_sweep_of_the_mean_pressure_draws_the_load_curves(tmp_path, drawn):
+    values = [5e7, 2e8, 8e8]
+    code, _, stderr = cli("sweep", "rough_flat", "--param", "load.mean_pressure", "--values", ",".join(map(str, values)),
+                          "--set", "gap.grid=64", "--set", "bem.cell_nodes=64", "--workers", "1", "--out", tmp_path / "sw")
+    assert code == 0, stderr
+    code, _, stderr = cli("report", tmp_path / "sw")
+    assert code == 0, stderr
+    points = [json.loads(f.read_text())["result"] for f in sorted((tmp_path / "sw" / "points").glob("point-*.json"))]
+    points.sort(key=lambda p: p["mean_pressure"])
+    (fig,) = drawn
+    ax_a, ax_g = fig.axes
+    (area,), (gap,) = ax_a.get_lines(), ax_g.get_lines()
+    assert area.get_xdata() == pytest.approx([v / 1e6 for v in values])  # MPa
+    assert area.get_ydata() == pytest.approx([p["contact_fraction"] for p in points])
+    assert np.all(np.diff(area.get_ydata()) > 0)
+    assert gap.get_xdata() == pytest.approx([p["mean_gap"] / 1e-6 for p in points])  # um
+    assert np.all(np.diff(gap.get_xdata()) < 0)
+    assert "MPa" in ax_a.get_xlabel() and "A/A_0" in ax_a.get_ylabel()
+    assert "µm" in ax_g.get_xlabel() and "MPa" in ax_g.get_ylabel()
+    assert ax_a.get_xscale() == ax_a.get_yscale() == ax_g.get_yscale() == "log"
