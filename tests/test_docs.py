@@ -129,7 +129,8 @@ def real_results(tmp_path_factory):
     runs = [("hertz", ["bem.nodes_across=16", "fem.n_contact=8"]),           # FEM, Hertz, report, files
             ("paper_bilinear", ["bem.nodes_across=16", "fem.n_contact=8"]),  # paper layer: alpha_a, alpha_c
             ("paper_root", ["bem.nodes_across=16", "layer.alpha_b=0.9"]),    # alpha_b target and result
-            ("elliptic", ["bem.nodes_across=16"])]                          # hertz_elliptic, not axisymmetric
+            ("elliptic", ["bem.nodes_across=16"]),                          # hertz_elliptic, not axisymmetric
+            ("rough_flat", ["gap.grid=32", "bem.cell_nodes=32"])]           # a periodic cell
     out = []
     for name, overrides in runs:
         run_scene(name, tmp / name, overrides=overrides)
