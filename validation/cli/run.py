@@ -62,7 +62,8 @@ def _summary(result, out_dir):
         ext = result["contact_extent"]
         lines.append(f"contact    |x| <= {_g(ext['x'])} {L}, |y| <= {_g(ext['y'])} {L}, "
                      f"area {_g(result['contact_area'])} {L}^2")
-    lines.append(f"load       force {_g(result['force'])} {N}, approach {_g(result['approach'])} {L}")
+    on = " on one cell" if result.get("periodic") else ""
+    lines.append(f"load       force {_g(result['force'])} {N}{on}, approach {_g(result['approach'])} {L}")
     if "alpha_b" in result:
         lines.append(f"layer      alpha_b = p_max^root / p_max^lambda = {_g(result['alpha_b'], '.4f')}")
     conv = "yes" if result["converged"] else "NO"
