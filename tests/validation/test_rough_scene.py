@@ -207,6 +207,7 @@ def test_report_maps_show_the_pressure_and_the_spots(rough_run, drawn):
     r = json.loads((out / "result.json").read_text())
     md = (out / "report" / "report.md").read_text()
     assert "Rough surface on a flat: the periodic cell" in md and "| contact spots | " + str(r["n_spots"]) in md
+    assert "| load: mean pressure over the cell | 2e+08 | Pa |" in md and "| gap long_cutoff | 0.00025 | m |" in md
     (fig,) = drawn
     ax_p, ax_s, bar = fig.axes
     image = ax_p.images[0].get_array()

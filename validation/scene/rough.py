@@ -43,7 +43,7 @@ from .measured import _factor as length_factor
 from .paper import is_paper_law
 from .sizing import _solver_options
 
-__all__ = ["RoughGap", "ROUGH_TYPES", "GAP_KEYS", "PERIODIC_KEYS", "rough_gap", "bem_section"]
+__all__ = ["RoughGap", "ROUGH_TYPES", "GAP_KEYS", "GAP_UNITS", "PERIODIC_KEYS", "rough_gap", "bem_section"]
 
 #: gap type -> its keys besides ``type``
 GAP_KEYS = {"self_affine": ("size", "grid", "hurst", "rms_height", "rms_slope", "long_cutoff", "short_cutoff",
@@ -51,6 +51,8 @@ GAP_KEYS = {"self_affine": ("size", "grid", "hurst", "rms_height", "rms_slope", 
             "surface": ("file", "reader", "format", "channel", "physical_sizes", "spacing", "nodata", "length_unit",
                         "detrend")}
 ROUGH_TYPES = tuple(GAP_KEYS)
+#: unit kind of the ``[gap]`` keys of a rough type that carry one (the others are dimensionless or in the file's unit)
+GAP_UNITS = dict.fromkeys(("size", "rms_height", "long_cutoff", "short_cutoff"), "length")
 #: ``[bem]`` keys of a periodic scene besides the solver options
 PERIODIC_KEYS = ("periodic", "cell_nodes")
 _LATTICE_KEYS = ("step", "nodes_across", "extent", "extent_factor")

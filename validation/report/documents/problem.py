@@ -11,6 +11,7 @@ from collections.abc import Mapping
 
 from bem.gaps import GAPS
 
+from ...scene.rough import GAP_UNITS as ROUGH_GAP_UNITS
 from ..render.content import Section, Table, fmt
 from ..render.style import method_text
 from .results import is_number
@@ -91,7 +92,7 @@ def _gap_rows(res):
         if kind == "measured" and key in ("spacing", "nodata"):  # in the file's length unit
             file_unit = gap.get("length_unit")
             return file_unit if isinstance(file_unit, str) else res.units.of("length")
-        return res.units.of(shape.units.get(key, "-") if shape else "-")
+        return res.units.of(shape.units.get(key, "-") if shape else ROUGH_GAP_UNITS.get(key, "-"))
 
     for key, value in gap.items():
         if key == "type":
@@ -124,6 +125,8 @@ def _load_rows(res):
         return [("load: total force P (force control)", fmt(float(load["force"])), res.units.of("force"))]
     if "approach" in load:
         return [("load: approach delta (approach control)", fmt(float(load["approach"])), res.units.of("length"))]
+    if "mean_pressure" in load:  # a periodic cell
+        return [("load: mean pressure over the cell", fmt(float(load["mean_pressure"])), res.units.of("pressure"))]
     return []
 
 
