@@ -12,8 +12,9 @@ from collections import deque
 import numpy as np
 import pytest
 
+from validation.run import run_scene
 from validation.run.periodic import contact_spots
-from validation.scene import SceneError, load_scene
+from validation.scene import SceneError, load_scene, parse_scene
 from validation.scene.load import read_toml
 from validation.scene.source import builtin_path
 
@@ -139,6 +140,21 @@ def test_surface_file_outside_the_scene_folder_is_refused(tmp_path):
     scene = load_scene(tmp_path / "scene" / "s.toml", allow_outside_files=True)
     assert scene.bem["cell"][0] == 32 and scene.gap.surface.stats.grid == (16, 16)
     assert scene.gap.surface.size == pytest.approx((16e-5, 16e-5))
+    z = np.random.default_rng(0).random((16, 16))
+    z[3, 4] = np.nan
+    np.save(tmp_path / "scene" / "holes.npy", z)
+    raw["gap"]["file"] = str(tmp_path / "scene" / "holes.npy")
+    with pytest.raises(SceneError, match=r"gap.file = .*holes.npy.* 1 points without data"):
+        parse_scene(raw, base_dir=tmp_path / "scene")
+
+
+def test_force_on_one_cell_is_the_mean_pressure_times_the_cell():
+    by_pressure = run_scene(_base())
+    lx, ly = by_pressure["bem"]["size"]
+    by_force = run_scene(_base(load__mean_pressure=None, load__force=by_pressure["mean_pressure"] * lx * ly))
+    assert by_force["mean_pressure"] == pytest.approx(by_pressure["mean_pressure"], rel=1e-12)
+    assert by_force["contact_fraction"] == by_pressure["contact_fraction"]
+    assert by_force["approach"] == pytest.approx(by_pressure["approach"], rel=1e-8)
 
 
 @pytest.fixture(scope="module")

@@ -34,6 +34,8 @@ from __future__ import annotations
 
 from functools import partial
 
+import numpy as np
+
 from bem import METHODS, InputError
 from bem.checks import check_node_count
 
@@ -118,6 +120,11 @@ def _surface(d, units):
             kw = {k: d[k] for k in ("format", "channel", "physical_sizes") if k in d}
             return rough.read_surface(file, scale=scale, detrend=detrend, **kw)
         x, y, z = read_heights(file, **{k: d[k] for k in ("format", "spacing", "nodata") if k in d})
+    holes = int(np.count_nonzero(~np.isfinite(z)))
+    if holes:
+        raise ck.SceneError(f"gap.file = {file!r} is not allowed: it has {holes} points without data (NaN holes or "
+                            "nodata); the periodic cell needs every point: fill or crop them first.")
+    with ck.scene_errors("gap."):
         size = (x.size * (x[1] - x[0]) * scale, y.size * (y[1] - y[0]) * scale)
         return rough.from_heights(z * scale, size, detrend=detrend, source=file)
 
