@@ -263,3 +263,11 @@ def test_sweep_of_the_mean_pressure_draws_the_load_curves(tmp_path, drawn):
     assert "MPa" in ax_a.get_xlabel() and "A/A_0" in ax_a.get_ylabel()
     assert "µm" in ax_g.get_xlabel() and "MPa" in ax_g.get_ylabel()
     assert ax_a.get_xscale() == ax_a.get_yscale() == ax_g.get_yscale() == "log"
+
+
+def test_check_describes_the_periodic_cell():
+    code, stdout, stderr = cli("check", "rough_flat")
+    assert code == 0, stderr
+    step = 1e-3 / 256
+    n_rows = 2 * round(1e-3 / (step * SQRT3))  # the even number of rows nearest Ly / (c sqrt(3)/2)
+    assert f"periodic cell 0.001 x 0.001001 of 256 x {n_rows}, {256 * n_rows} nodes" in stdout
