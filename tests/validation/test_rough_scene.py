@@ -172,7 +172,11 @@ def drawn(monkeypatch):
     from validation.report.figures import periodic
 
     figures, save = [], periodic.save_figure
-    monkeypatch.setattr(periodic, "save_figure", lambda fig, path, **kw: (figures.append(fig), save(fig, path, **kw))[1])
+    def keep(fig, path, **kw):
+        figures.append(fig)
+        return save(fig, path, **kw)
+
+    monkeypatch.setattr(periodic, "save_figure", keep)
     return figures
 
 
@@ -245,8 +249,9 @@ def test_report_maps_show_the_pressure_and_the_spots(rough_run, drawn):
 
 def test_sweep_of_the_mean_pressure_draws_the_load_curves(tmp_path, drawn):
     values = [5e7, 2e8, 8e8]
-    code, _, stderr = cli("sweep", "rough_flat", "--param", "load.mean_pressure", "--values", ",".join(map(str, values)),
-                          "--set", "gap.grid=64", "--set", "bem.cell_nodes=64", "--workers", "1", "--out", tmp_path / "sw")
+    code, _, stderr = cli("sweep", "rough_flat", "--param", "load.mean_pressure", "--values",
+                          ",".join(map(str, values)), "--set", "gap.grid=64", "--set", "bem.cell_nodes=64",
+                          "--workers", "1", "--out", tmp_path / "sw")
     assert code == 0, stderr
     code, _, stderr = cli("report", tmp_path / "sw")
     assert code == 0, stderr

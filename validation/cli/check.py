@@ -26,8 +26,10 @@ def run(args):
         require_extra("fem", f"[fem] of scene {scene.name!r} (the FEM reference; contactlab run --no-fem skips it)")
     parts = ["bem"] + [k for k in ("fem", "analytic", "sweep", "stress", "report") if getattr(scene, k) is not None]
     b = scene.bem
-    where = (f"periodic cell {b['size'][0]:.4g} x {b['size'][1]:.4g} of {b['cell'][0]} x {b['cell'][1]}" if b.get("periodic")
-             else f"region {b['extent'][0]:.4g} x {b['extent'][1]:.4g}")
+    if b.get("periodic"):
+        where = f"periodic cell {b['size'][0]:.4g} x {b['size'][1]:.4g} of {b['cell'][0]} x {b['cell'][1]}"
+    else:
+        where = f"region {b['extent'][0]:.4g} x {b['extent'][1]:.4g}"
     print(f"{scene.name}: OK ({', '.join(parts)}); lattice step {b['step']:.4g}, {where}, {b['n_nodes']} nodes   "
           f"[units {scene.units.label}]")
     for key, name in scene.unimported:

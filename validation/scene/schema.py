@@ -42,7 +42,8 @@ _FEM_OPTIONS = {"n_contact": partial(ck.integer, minimum=4, maximum=400),
                 "maxiter": partial(ck.integer, minimum=1), "remesh": ck.boolean, "truncation_correction": ck.boolean}
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
 KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS),
-        "load": ("force", "approach", "mean_pressure"), "bem": (*BEM_KEYS, *PERIODIC_KEYS), "fem": tuple(_FEM_OPTIONS), "analytic": ("kind",),
+        "load": ("force", "approach", "mean_pressure"), "bem": (*BEM_KEYS, *PERIODIC_KEYS),
+        "fem": tuple(_FEM_OPTIONS), "analytic": ("kind",),
         "sweep": ("parameter", "values"), "report": ("sections", "format"),
         "stress": ("depths", "n_depths", "max_depth", "bodies")}
 GAP_TYPES = gaps.GAPS

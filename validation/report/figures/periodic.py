@@ -130,11 +130,12 @@ def cell_maps(res, work):
 
 def sweep_curves(points, work, key):
     """The load-area and load-gap curves of a sweep of periodic runs (``[]`` with fewer than two points)."""
+    keys = ("mean_pressure", "contact_fraction", "mean_gap")
     done = [res for _, res in points if res is not None and res.data.get("periodic")
-            and all(isinstance(res.data.get(k), (int, float)) for k in ("mean_pressure", "contact_fraction", "mean_gap"))]
+            and all(isinstance(res.data.get(k), (int, float)) for k in keys)]
     if len(done) < 2:
         return []
-    p, a, g = (np.array([r.data[k] for r in done], float) for k in ("mean_pressure", "contact_fraction", "mean_gap"))
+    p, a, g = (np.array([r.data[k] for r in done], float) for k in keys)
     kw = _units(done[0], float(np.median(p)), float(np.abs(g).max()))
     path = plot_load_curves(p, a, g, work / "load_curves.png", **kw)
     u = done[0].units
