@@ -151,7 +151,7 @@ def test_surface_file_outside_the_scene_folder_is_refused(tmp_path):
 def test_force_on_one_cell_is_the_mean_pressure_times_the_cell():
     by_pressure = run_scene(_base())
     lx, ly = by_pressure["bem"]["size"]
-    by_force = run_scene(_base(load__mean_pressure=None, load__force=by_pressure["mean_pressure"] * lx * ly))
+    by_force = run_scene(_base(), overrides={"load.force": by_pressure["mean_pressure"] * lx * ly})  # replaces it
     assert by_force["mean_pressure"] == pytest.approx(by_pressure["mean_pressure"], rel=1e-12)
     assert by_force["contact_fraction"] == by_pressure["contact_fraction"]
     assert by_force["approach"] == pytest.approx(by_pressure["approach"], rel=1e-8)
