@@ -259,10 +259,12 @@ def test_sweep_of_the_mean_pressure_draws_the_load_curves(tmp_path, drawn):
     points.sort(key=lambda p: p["mean_pressure"])
     (fig,) = drawn
     ax_a, ax_g = fig.axes
-    (area,), (gap,) = ax_a.get_lines(), ax_g.get_lines()
+    (area, hyun), (gap,) = ax_a.get_lines(), ax_g.get_lines()
     assert area.get_xdata() == pytest.approx([v / 1e6 for v in values])  # MPa
     assert area.get_ydata() == pytest.approx([p["contact_fraction"] for p in points])
     assert np.all(np.diff(area.get_ydata()) > 0)
+    slope_modulus = points[0]["bem"]["E_star"] * points[0]["surface"]["rms_slope"]
+    assert hyun.get_ydata() == pytest.approx([2 * v / slope_modulus for v in values])
     assert gap.get_xdata() == pytest.approx([p["mean_gap"] / 1e-6 for p in points])  # um
     assert np.all(np.diff(gap.get_xdata()) < 0)
     assert "MPa" in ax_a.get_xlabel() and "A/A_0" in ax_a.get_ylabel()
