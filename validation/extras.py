@@ -12,7 +12,8 @@ report    matplotlib, pillow (PIL)    ``contactlab report``, :mod:`validation.re
                                       (optional: matplotlib draws them without it)
 dask      dask[distributed]           ``contactlab sweep --scheduler ADDRESS``
                 (dask.distributed)
-rough     SurfaceTopography           :mod:`bem.rough`: instrument files, self-affine surfaces
+rough     SurfaceTopography           :mod:`bem.rough`: instrument files, self-affine surfaces,
+                                      scenes with a rough gap (:mod:`validation.scene.rough`)
 gpu       cupy-cuda12x (cupy),        ``device="cuda"`` of :func:`bem.solve`, :func:`bem.solve_periodic`,
                 array-api-compat            :func:`bem.subsurface_stress` (:mod:`bem.backend`)
                 (array_api_compat)
