@@ -37,7 +37,10 @@ def _imports(name, path, modules, *, top_level_only):
                 module = ".".join(base + ([node.module] if node.module else []))
             else:
                 module = node.module
-            targets = [module] + [f"{module}.{a.name}" for a in node.names]
+            submodules = [f"{module}.{a.name}" for a in node.names]
+            # ``from package import submodule`` needs the submodule; the package itself is
+            # initialised before any of its submodules runs, so it is no dependency of its own
+            targets = submodules if all(t in modules for t in submodules) else [module] + submodules
         else:
             continue
         for target in targets:
