@@ -9,11 +9,12 @@ PARSER = {"help": "error-time and stability studies",
                          "(no scene keys to override).",
           "epilog": "examples:\n  contactlab study error-time hertz --out reports/studies\n"
                     "  contactlab study stability --quick\n"
+                    "  contactlab study two-scale --quick    (rough_sphere_two_scale, the small two-scale check)\n"
                     "  contactlab report reports/studies      (work-precision plot and tables)"}
 
 #: study name -> module with ``main(args)``
 STUDIES = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
-           "robustness": "validation.studies.robustness"}
+           "robustness": "validation.studies.robustness", "two-scale": "validation.studies.two_scale"}
 
 
 def add_args(p):

@@ -15,10 +15,11 @@ from bem.checks import InputError
 from ...provenance import display_path
 from ..render import Figure, Progress, Section, Table, draw_and_build, table_from_rows
 from .results import read_json
+from .two_scale import two_scale_sections
 
 __all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "study_markdown", "report_studies_dir"]
 
-STUDY_FILES = ("error_time.json", "stability.json", "robustness.json")
+STUDY_FILES = ("error_time.json", "stability.json", "robustness.json", "two_scale.json")
 
 
 def is_study_dir(directory):
@@ -115,7 +116,8 @@ def _robustness_sections(data, work=None):
 
 
 #: study file -> function(data, work) -> sections (``work``: the figures' folder, None for none)
-_SECTIONS = dict(zip(STUDY_FILES, (_error_time_sections, _stability_sections, _robustness_sections)))
+_SECTIONS = dict(zip(STUDY_FILES, (_error_time_sections, _stability_sections, _robustness_sections,
+                                   two_scale_sections)))
 
 
 def study_sections(directory, work):
@@ -136,7 +138,8 @@ def study_markdown(name, data):
     from ..render.markdown import render_markdown
 
     title = {"error_time.json": "Error against run time", "stability.json": "Stability on stiff and extreme cases",
-             "robustness.json": "Robustness of the layer methods"}[name]
+             "robustness.json": "Robustness of the layer methods",
+             "two_scale.json": "Two-scale check"}[name]
     return render_markdown(_SECTIONS[name](data, None), title=title, names={})
 
 
