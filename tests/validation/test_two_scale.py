@@ -116,3 +116,20 @@ def test_gw_integral_and_greenwood_tripp_law():
     law = greenwood_tripp_law(moments, 1.0, h0, p_max=p[-1])
     d = np.linspace(h0, -h0, 7)[1:]
     np.testing.assert_allclose(law.w(gw_pressure(d, moments, 1.0)), h0 - d, rtol=1e-3)
+
+
+def test_cli_runs_the_two_scale_study_and_refuses_a_scene(monkeypatch):
+    import sys
+    import types
+
+    from .conftest import cli
+
+    seen = {}
+    fake = types.ModuleType("validation.studies.two_scale")
+    fake.main = lambda args: seen.setdefault("args", args) and 7
+    monkeypatch.setitem(sys.modules, "validation.studies.two_scale", fake)
+    code, _, _ = cli("study", "two-scale", "--quick")
+    assert code == 7 and seen["args"].quick
+    monkeypatch.undo()
+    code, out, err = cli("study", "two-scale", "hertz")
+    assert code == 2 and "scene = 'hertz' is not allowed" in err and "Traceback" not in err

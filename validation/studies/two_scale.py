@@ -211,6 +211,11 @@ def main(args):
     and, when matplotlib is installed, the two figures of the first case; prints the Markdown."""
     from pathlib import Path
 
+    from bem.checks import InputError
+
+    if getattr(args, "scene", None):
+        raise InputError(f"scene = {args.scene!r} is not allowed: the two-scale study takes no scene "
+                         "(--quick chooses the small run).")
     quick = bool(getattr(args, "quick", False))
     data = run_two_scale(quick=quick, keep=True)
     fields = data.pop("fields")
