@@ -30,7 +30,7 @@ def test_tiny_study_gives_every_error_finite_for_both_loads(tiny):
     for r in rows:
         assert r["resolved_converged"] and r["layer_converged"] and r["gt_converged"]
         for model in ("layer", "gt"):
-            for what in ("approach", "radius", "l2", "peak"):
+            for what in ("approach", "radius", "l2", "peak", "l2_wide"):
                 assert math.isfinite(r[f"{model}_{what}_err"])
         assert 0 <= r["first_touch_offset"] < tiny["first_touch_gap"]
     assert rows[1]["approach"] > rows[0]["approach"] > 0  # the heavier load presses further
