@@ -6,9 +6,11 @@
 - :mod:`~validation.studies.stability`: every method on stiff and extreme cases; a wrong answer
   or a NaN raises ``StabilityFailure``;
 - :mod:`~validation.studies.robustness`: the layer methods over 12 decades of layer compliance,
-  every converged answer checked against the KKT conditions with the dense influence matrix.
+  every converged answer checked against the KKT conditions with the dense influence matrix;
+- :mod:`~validation.studies.two_scale`: a fully resolved rough sphere against the smooth sphere
+  with the layer law of its roughness and Greenwood-Tripp.
 
-Each has ``main(args)`` for ``contactlab study error-time | stability | robustness``. This module
+Each has ``main(args)`` for ``contactlab study error-time | stability | robustness | two-scale``. This module
 holds what they share: running a scene (:func:`attempt`, :func:`timed`), the status of an outcome
 (:func:`classify`) and the files (:func:`save`).
 """

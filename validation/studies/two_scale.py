@@ -146,7 +146,8 @@ def run_case(s, surface, laws, ratio, load_factor):
         models[name] = _summary(out, width, extent)
         row[f"{name}_converged"] = models[name]["converged"]
         row.update({f"{name}_{k}_err": v for k, v in _errors(models[name], resolved).items()})
-    return row, dict(resolved=res, layer=results["layer"], gt=results["gt"], width=width, extent=extent,
+    return row, dict(resolved=res, layer=results["layer"], gt=results["gt"], width=width, wide=WIDE * width,
+                     extent=extent,
                      ratio=ratio, load_factor=load_factor)
 
 

@@ -66,14 +66,21 @@ def plot_pressure_map(x, y, p, *, extent, radius, layer_radius, path, title=None
         return save_figure(fig, path)
 
 
-def plot_windowed_profile(resolved, layer, gt, *, width, path, title=None):
-    """Windowed pressure along ``y = 0`` [GPa] against x [um]; each argument an ``(x, y, p)`` of nodal values."""
+def plot_windowed_profile(resolved, layer, gt, *, width, path, title=None, wide=None):
+    """Windowed pressure along ``y = 0`` [GPa] against x [um]; each argument an ``(x, y, p)`` of nodal values.
+
+    ``wide`` (optional): a second window width [length], the resolved pressure's means over it drawn too.
+    """
     from .profiles import axial_section
 
     with new_figure((6.4, 4.0), title=title) as (fig, ax):
         xr, pr = window_row(*resolved, width)
         ax.step(xr * 1e6, pr / 1e9, where="mid", color=color_for("", 0), lw=1.6,
                 label=f"resolved, mean over {width * 1e6:g} um windows")
+        if wide:
+            xw, pw = window_row(*resolved, wide)
+            ax.step(xw * 1e6, pw / 1e9, where="mid", color=color_for("", 3), lw=1.2,
+                    label=f"resolved, mean over {wide * 1e6:g} um windows")
         xs, ps = axial_section(*layer)
         ax.plot(xs * 1e6, ps / 1e9, color=color_for("", 1), lw=1.2, label="layer model, nodal")
         xl, pl = window_row(*layer, width)
@@ -82,8 +89,8 @@ def plot_windowed_profile(resolved, layer, gt, *, width, path, title=None):
         ax.plot(xg * 1e6, pg / 1e9, color=color_for("", 2), lw=1.0, ls="--", label="Greenwood-Tripp, nodal")
         ax.set_xlabel("x [um]")
         ax.set_ylabel("pressure [GPa]")
-        ax.set_ylim(bottom=0)
-        ax.legend(fontsize="small")
+        ax.set_ylim(0, 1.5 * ax.get_ylim()[1])  # room for the legend above the curves
+        ax.legend(fontsize="x-small", loc="upper left", ncols=2)
         return save_figure(fig, path)
 
 
@@ -106,4 +113,4 @@ def plot_two_scale(data, fields, out):
                               layer_radius=nominal_radius(*lay), path=out / "two_scale_map.png",
                               title=f"Resolved rough sphere, {case}"),
             plot_windowed_profile(res, lay, gt, width=fields["width"], path=out / "two_scale_profile.png",
-                                  title=f"Pressure along y = 0, {case}")]
+                                  title=f"Pressure along y = 0, {case}", wide=fields.get("wide"))]
