@@ -133,3 +133,18 @@ def test_cli_runs_the_two_scale_study_and_refuses_a_scene(monkeypatch):
     monkeypatch.undo()
     code, out, err = cli("study", "two-scale", "hertz")
     assert code == 2 and "scene = 'hertz' is not allowed" in err and "Traceback" not in err
+
+
+def test_map_pixels_and_profile_windows_hold_the_field_drawn():
+    from validation.report.figures.two_scale import binned_map, window_row
+
+    lat = Lattice.from_extent(0.01, 1.0)
+    x, y = lat.x[lat.mask], lat.y[lat.mask]
+    p = np.where(x >= 0.0, 2.0, 0.0) + y  # a step in x (at a pixel edge) and a ramp in y
+    edges, image = binned_map(x, y, p, 0.8, pixels=16)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    expected = np.where(centres[None, :] > 0, 2.0, 0.0) + centres[:, None]
+    np.testing.assert_allclose(image, expected, atol=0.01)  # a pixel mean: the ramp's mean over its nodes
+    xs, means = window_row(x, y, p, 0.25)
+    assert np.all(np.diff(xs) > 0) and xs[0] <= -0.75 and xs[-1] >= 0.75
+    np.testing.assert_allclose(means[np.abs(xs) > 0.2], np.where(xs[np.abs(xs) > 0.2] > 0, 2.0, 0.0), atol=0.01)
