@@ -224,14 +224,18 @@ def table(data):
 
 def main(args):
     """``contactlab study two-scale [--quick] [--out DIR]``: writes ``two_scale.json``, ``two_scale.md``
-    and, when matplotlib is installed, the two figures of the first case; prints the Markdown."""
+    and the two figures of the first case (needs the ``rough`` and ``report`` extras); prints the Markdown."""
     from pathlib import Path
 
     from bem.checks import InputError
 
+    from ..extras import require
+
     if getattr(args, "scene", None):
         raise InputError(f"scene = {args.scene!r} is not allowed: the two-scale study takes no scene "
                          "(--quick chooses the small run).")
+    require("rough", "contactlab study two-scale (the self-affine surface)")
+    require("report", "contactlab study two-scale (its figures)")
     quick = bool(getattr(args, "quick", False))
     data = run_two_scale(quick=quick, keep=True)
     fields = data.pop("fields")
