@@ -50,6 +50,10 @@ def test_study_writes_json_and_table_and_figures(tiny, tmp_path):
     assert json.loads((tmp_path / "two_scale.json").read_text())["rows"][0]["ratio"] == 2
     for _, heading, _ in COLUMNS:
         assert heading.replace("[", "\\[").replace("]", "\\]") in text
+    from validation.report.documents.studies import report_studies_dir
+
+    report_studies_dir(tmp_path, tmp_path / "report")
+    assert "Two-scale check" in (tmp_path / "report" / "report.md").read_text()
     from PIL import Image
 
     for path in plot_two_scale(data, tiny["fields"], tmp_path):
