@@ -36,8 +36,8 @@ from ...units import Units, parse_units
 from ..render.content import fmt
 from ..render.style import report_unit
 
-__all__ = ["RunResults", "Shown", "load_results", "results_of", "units_of", "read_json", "is_number", "dimensionless_for",
-           "UNIT_CHOICES", "file_inside"]
+__all__ = ["RunResults", "Shown", "load_results", "results_of", "units_of", "read_json", "is_number",
+           "dimensionless_for", "UNIT_CHOICES", "file_inside"]
 
 log = logging.getLogger(__name__)
 
