@@ -217,8 +217,9 @@ class RunResults:
         return value / self.display(kind, power).factor if is_number(value) else value
 
     def engineering(self, kind):
-        """``(factor, name)`` of ``kind`` in readable units, whatever the report's: how a dimensionless
-        report states its scales (``a_H = 0.1866 mm``)."""
+        """``(factor, name)`` of ``kind`` (``"length"``, ``"pressure"``, ``"force"``) in units, never
+        scales: those of :meth:`display` when it does not normalise; how a dimensionless report states
+        its scales (``a_H = 0.1866 mm``). ``name`` is ``""`` when the scene names no such unit."""
         unit = getattr(self.units, kind)
         name, factor = (unit or "", 1.0) if self.scene_units else report_unit(unit)
         return factor, name
@@ -227,19 +228,22 @@ class RunResults:
         """The sentence stating the report's units once (in the problem statement)."""
         u = self.units
         scene = f"scene units: {u.label}" if u.label else "the scene names no units"
-        (lf, ln, normalised), (pf, pn, _), force = self.display("length"), self.display("pressure"), \
-            self.display("force").name
+        (lf, ln, normalised), (pf, pn, _) = self.display("length"), self.display("pressure")
+        force = self.display("force").name
+        forces = f"forces in {force}" if force != "-" else "forces in the scene's units"
         if normalised:
-            (lfe, lu), (pfe, pu) = self.engineering("length"), self.engineering("pressure")
+            def value(factor, kind):
+                f, unit = self.engineering(kind)
+                return " ".join((fmt(factor / f), unit)).strip()
+
             of_l = "Hertz's contact radius" if ln == "a_H" else "the contact half-width along x"
             of_p = "Hertz's peak pressure" if pn == self.hertz_peak else "the BEM peak pressure"
-            return (f"Units ({scene}): every length is shown divided by {of_l} {ln} = {fmt(lf / lfe)} {lu}, every "
-                    f"pressure, modulus and stress divided by {of_p} {pn} = {fmt(pf / pfe)} {pu}; forces in "
-                    f"{force}.").replace(" -;", ";").replace(" - ", " ").replace("in -.", "as given.")
+            return (f"Units ({scene}): every length is shown divided by {of_l} {ln} = {value(lf, 'length')}, every "
+                    f"pressure, modulus and stress divided by {of_p} {pn} = {value(pf, 'pressure')}; {forces}.")
         if not u.known:
             return f"Units: {u.label or 'not named'}."
         return (f"Units ({scene}): throughout this report lengths are in {ln}, pressures, moduli and stresses in "
-                f"{pn}, forces in {force}, areas in {self.display('area').name}.")
+                f"{pn}, {forces}, areas in {self.display('area').name}.")
 
 def read_json(path):
     """The JSON content of ``path``; InputError when it cannot be read."""
