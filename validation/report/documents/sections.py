@@ -79,9 +79,10 @@ def results_rows(res):
         rows.append(("contact half-widths along x, y", pair(ext.get("x"), ext.get("y")),
                      *(closed.get(name, "-") for name, _ in parts[1:]), res.display("length").name))
     scales = res.get("scales") or {}
-    shown = {"p_hertz": res.display("pressure").name == res.hertz_peak, "a_hertz": res.display("length").name == "a_H"}
+    drawn_over = {"p_hertz": res.display("pressure").name == res.hertz_peak,  # a ratio the table shows already
+                  "a_hertz": res.display("length").name == "a_H"}
     rows += [(label, *cells(key, scales[skey]), "-") for key, label, skey in _RATIOS
-             if is_number(scales.get(skey)) and scales[skey] > 0 and not shown.get(skey)]  # not twice
+             if is_number(scales.get(skey)) and scales[skey] > 0 and not drawn_over.get(skey)]
     if is_number(res.data.get("alpha_b")):
         rows.append(("alpha_b = p_max / p_max^lambda", fmt(res.data["alpha_b"]), *("-" for _ in parts[1:]), "-"))
     return ("quantity", *(name for name, _ in parts), "unit"), tuple(rows)
@@ -196,8 +197,7 @@ def _scales_text(res, a, s, l_name, s_name):
     if not res.display("length").normalised:
         return ""
     (lf, lu), (pf, pu) = res.engineering("length"), res.engineering("pressure")
-    return f" Scales: {s_name} = {fmt(s / pf)} {pu}, {l_name} = {fmt(a / lf)} {lu}.".replace(" -,", ",").replace(
-        " -.", ".")
+    return f" Scales: {s_name} = {fmt(s / pf)} {pu}".rstrip() + f", {l_name} = {fmt(a / lf)} {lu}".rstrip() + "."
 
 
 def _metric_cell(key, value):

@@ -158,16 +158,16 @@ def layer_law(res, work):
     p_top = 1.25 * max(float(res.data.get("p_max") or 0.0), *(float(params.get(k) or 0.0) for k in ("p_cr", "p_star")))
     if p_top <= 0:
         return None
-    (pf, p_name, normalised), (wf, w_name, _) = res.display("pressure"), res.display("length")
-    p_unit, w_unit = ("", "") if normalised else (p_name.replace("-", ""), w_name.replace("-", ""))
-    unit = rf" ${p_name}$" if normalised else f" {p_unit}".rstrip()  # "= 0.74 $p_H$" or "= 1370 MPa"
+    pressure, length = res.display("pressure"), res.display("length")  # the closure w is a length
+    pf, wf = pressure.factor, length.factor
+    # "= 0.74 p_H" or "= 1370 MPa"
+    unit = rf" ${pressure.name}$" if pressure.normalised else f" {pressure.name}".replace(" -", "")
     marks = [(rf"$p_{{max}}$ (BEM) = {fmt(res.data['p_max'] / pf, 3)}{unit}", res.data["p_max"] / pf)]
     marks += [(f"{name} = {fmt(params[key] / pf, 3)}{unit}", params[key] / pf)
               for key, name in (("p_cr", r"$p_{cr}$"), ("p_star", r"$p^*$")) if params.get(key)]
     path = plot_layer_laws([(params["law"].replace("_", "-"), Scaled(res.layer, pf, wf))], work / "layer_law.png",
-                           p_max=p_top / pf, p_unit=p_unit, w_unit=w_unit, marks=marks,
-                           p_label=axis_label("p", (pf, p_name, normalised), "pressure "),
-                           w_label=axis_label("w(p)", (wf, w_name, normalised), "layer closure "),
+                           p_max=p_top / pf, marks=marks, p_label=axis_label("p", pressure, "pressure "),
+                           w_label=axis_label("w(p)", length, "layer closure "),
                            title="interface layer law: closure $w(p)$ under the pressure $p$")
     return Figure(path, f"The layer law w(p) used by the solver ({params['law']}), rebuilt from the run's result with "
                         "bem.layers.from_dict and evaluated at 200 pressures from 0 to 1.25 times the largest of the "
