@@ -85,9 +85,12 @@ def _layer_rows(res):
 
 
 def _file_length(res, value, file_unit):
-    """``(value, unit)`` of a measured file's length (in its ``length_unit``) in the report's length
-    unit; as the file gives it when either unit is unknown."""
-    to_scene = METRES.get(file_unit) and res.units.metres and METRES[file_unit] / res.units.metres
+    """``(value, unit)`` of a measured file's length (in its ``length_unit``: a unit symbol or the factor
+    to the scene's length unit) in the report's length unit; as the file gives it when either unit is unknown."""
+    if is_number(file_unit):
+        to_scene = float(file_unit)
+    else:
+        to_scene = METRES.get(file_unit) and res.units.metres and METRES[file_unit] / res.units.metres
     if not to_scene:
         return fmt(value), file_unit if isinstance(file_unit, str) else res.units.of("length")
     return fmt(res.shown(value * to_scene, "length")), res.display("length").name

@@ -288,8 +288,9 @@ def report_results_dir(directory, out_dir=None, *, title=None, units="auto", fmt
     title : str, optional
         Default: the scene's title.
     units : {"auto", "scene", "dimensionless"}
-        Axes in the scene's units (lengths in mm, pressures in MPa for SI scenes) or divided
-        by the contact's scales (:func:`validation.report.documents.results.load_results`).
+        One unit per quantity in every table, caption and figure: readable units (mm, MPa, N for
+        SI scenes), the scene's own, or lengths and pressures divided by the contact's scales
+        (:meth:`validation.report.documents.results.RunResults.display`).
     fmt : {"png", "svg", "pdf"}
         Figure files (:func:`validation.report.render.style.figure_format`).
     progress : callable, optional
