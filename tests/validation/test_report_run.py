@@ -83,15 +83,19 @@ def test_tables_hold_no_raw_containers(reports, name):
 
 
 @pytest.mark.parametrize("name", list(SMALL))
-def test_title_and_units_are_the_scenes(reports, name):
+def test_title_is_the_scenes_and_units_are_the_reports(reports, name):
+    """An SI scene's report shows lengths in mm and pressures in MPa in its tables, as in its figures
+    (test_report_units.py), and its problem statement names them and the scene's units label."""
     meta = reports[name]["scene"]["scene"]
     html = reports[name]["built"].html.read_text(encoding="utf-8")
     assert f"<h1>{meta['title']}</h1>" in html.replace("&#x27;", "'") and "contactlab report: result" not in html
     assert meta["units"] == "SI (m, Pa, N)"
     units = {row[-1] for row in _results_table(reports[name]["sections"]).rows}
-    assert {"Pa", "N", "m", "m^2"} <= units and not units & {"pressure", "length", "force", "length^2"}
+    assert {"MPa", "N", "mm", "mm^2"} <= units <= {"MPa", "N", "mm", "mm^2", "-"}
     problem = reports[name]["sections"][0]
-    assert problem.kind == "problem" and any(meta["units"] in t for t in problem.text)
+    stated = [t for t in problem.text if t.startswith("Units")]
+    assert problem.kind == "problem" and len(stated) == 1 and meta["units"] in stated[0]
+    assert "lengths are in mm" in stated[0] and "stresses in MPa" in stated[0]
 
 
 def test_problem_statement_of_the_layer_scene(reports):
@@ -101,12 +105,16 @@ def test_problem_statement_of_the_layer_scene(reports):
     bodies = rep["scene"]["bodies"]
     es = e_star(bodies["E1"], bodies["nu1"], bodies["E2"], bodies["nu2"])
     label = next(k for k in rows if k.startswith("effective modulus"))
-    assert float(rows[label][0]) == pytest.approx(es, rel=1e-3) and rows[label][1] == "Pa"
-    assert rows["gap R"] == ("0.01", "m") and rows["load: total force P (force control)"] == ("100", "N")
+    assert float(rows[label][0]) * 1e6 == pytest.approx(es, rel=1e-3) and rows[label][1] == "MPa"
+    assert rows["gap R"] == ("10", "mm") and rows["load: total force P (force control)"] == ("100", "N")
     assert rows["interface layer"][0].startswith("elastic-rigid")
-    p_cr = rep["res"].data["layer"]["parameters"]["p_cr"]
-    assert float(rows["layer p_cr"][0]) == pytest.approx(p_cr, rel=1e-3) and rows["layer p_cr"][1] == "Pa"
-    assert rows["layer lam"][1] == "m/Pa"
+    params = rep["res"].data["layer"]["parameters"]
+    assert float(rows["layer p_cr"][0]) * 1e6 == pytest.approx(params["p_cr"], rel=1e-3)
+    assert rows["layer p_cr"][1] == "MPa" and rows["layer lam"][1] == "mm/MPa"
+    assert float(rows["layer lam"][0]) * 1e-3 / 1e6 == pytest.approx(params["lam"], rel=1e-3)  # mm/MPa -> m/Pa
+    in_scene_units = run_sections(load_results(rep["dir"], units="scene"), rep["dir"].parent / "scene", ["scene"])
+    scene = {r[0]: r[1:] for r in in_scene_units[0].items[0].rows}
+    assert scene["gap R"] == ("0.01", "m") and scene["layer lam"][1] == "m/Pa"  # --units scene
     assert not [i for i in problem.items if isinstance(i, Figure)]
     figures = [i for s in rep["sections"] if s.title == "Interface layer law" for i in s.items]
     assert len(figures) == 1 and isinstance(figures[0], Figure) and "w(p)" in figures[0].caption
@@ -212,7 +220,7 @@ def test_fem_section_and_columns(reports):
     assert float(_row(table, "delta / delta_H (Hertz approach)")[3]) == pytest.approx(1.0, rel=1e-3)
     run_rows = {r[0]: r[1] for r in next(s for s in rep["sections"] if s.title == "Solver and timings").items[0].rows}
     assert run_rows["iterations (finest lattice)"] == str(data["iterations"])
-    assert float(run_rows["lattice step c"]) == pytest.approx(data["bem"]["step"], rel=1e-3)
+    assert float(run_rows["lattice step c"]) * 1e-3 == pytest.approx(data["bem"]["step"], rel=1e-3)  # mm
 
 
 def test_comparison_metrics_when_recorded(reports, tmp_path):

@@ -44,13 +44,13 @@ def test_report_of_a_sweep_directory_from_the_cli(sweep_dir, tmp_path):
         check_png(png)
 
 
-def test_sweep_sections_hold_every_point_in_scene_units(sweep_dir, tmp_path):
+def test_sweep_sections_hold_every_point_in_the_reports_units(sweep_dir, tmp_path):
     summary, points = load_sweep(sweep_dir)
     assert [row["value"] for row, _ in points] == FORCES and all(res is not None for _, res in points)
     sections = sweep_sections(summary, points, tmp_path)
     assert [s.kind for s in sections] == ["problem", "sweeps"]
     table = sections[1].items[0]
-    assert table.columns[:3] == ("load.force", "status", "p_max [Pa]")
+    assert table.columns[:3] == ("load.force [N]", "status", "p_max [MPa]")  # an SI scene: MPa, as its figures
     p_max = [float(r[2]) for r in table.rows]
     assert p_max[2] / p_max[0] == pytest.approx(4 ** (1 / 3), rel=0.03)  # Hertz: p_max ~ P^(1/3)
     captions = [item.caption for item in sections[1].items[1:]]

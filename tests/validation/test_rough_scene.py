@@ -227,13 +227,13 @@ def test_report_maps_show_the_pressure_and_the_spots(rough_run, drawn):
     r = json.loads((out / "result.json").read_text())
     md = (out / "report" / "report.md").read_text()
     assert "Rough surface on a flat: the periodic cell" in md and "| contact spots | " + str(r["n_spots"]) in md
-    assert "| load: mean pressure over the cell | 2e+08 | Pa |" in md and "| gap long_cutoff | 0.00025 | m |" in md
+    assert "| load: mean pressure over the cell | 200 | MPa |" in md and "| gap long_cutoff | 0.25 | mm |" in md
     (fig,) = drawn
     ax_p, ax_s, bar = fig.axes
     image = ax_p.images[0].get_array()
-    assert image.max() == pytest.approx(r["p_max"] / 1e9)  # GPa
+    assert image.max() == pytest.approx(r["p_max"] / 1e6)  # MPa, as every pressure of the report
     assert np.count_nonzero(~np.ma.getmaskarray(image)) == r["bem"]["n_contact"]
-    assert "GPa" in bar.get_ylabel()
+    assert "MPa" in bar.get_ylabel()
     lx, ly = r["bem"]["size"]
     for ax in (ax_p, ax_s):
         assert ax.get_xlabel() == "$x$ [mm]" and ax.get_ylabel() == "$y$ [mm]"
@@ -265,10 +265,10 @@ def test_sweep_of_the_mean_pressure_draws_the_load_curves(tmp_path, drawn):
     assert np.all(np.diff(area.get_ydata()) > 0)
     slope_modulus = points[0]["bem"]["E_star"] * points[0]["surface"]["rms_slope"]
     assert hyun.get_ydata() == pytest.approx([2 * v / slope_modulus for v in values])
-    assert gap.get_xdata() == pytest.approx([p["mean_gap"] / 1e-6 for p in points])  # um
+    assert gap.get_xdata() == pytest.approx([p["mean_gap"] / 1e-3 for p in points])  # mm, as every length
     assert np.all(np.diff(gap.get_xdata()) < 0)
     assert "MPa" in ax_a.get_xlabel() and "A/A_0" in ax_a.get_ylabel()
-    assert "µm" in ax_g.get_xlabel() and "MPa" in ax_g.get_ylabel()
+    assert "mm" in ax_g.get_xlabel() and "MPa" in ax_g.get_ylabel()
     assert ax_a.get_xscale() == ax_a.get_yscale() == ax_g.get_yscale() == "log"
 
 

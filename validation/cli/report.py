@@ -38,11 +38,12 @@ def add_args(p):
     p.add_argument("--format", choices=FORMATS, default="png",
                    help="figure files: png (300 dpi, default), svg (vector, shown in the HTML), or pdf "
                         "(vector, beside a PNG for the HTML)")
-    p.add_argument("--units", choices=("scene", "dimensionless"),
-                   help="axes of a scene, result or sweep report: in the scene's units (mm and MPa for SI "
-                        "scenes; the default when the scene's units label names them) or divided by the "
-                        "contact's scales (Hertz's p_H and a_H for a paraboloid, else p_max and the contact "
-                        "half-width)")
+    p.add_argument("--units", choices=("auto", "scene", "dimensionless"),
+                   help="units of a scene, result or sweep report, one per quantity in every table and figure: "
+                        "auto (default): readable ones (mm, MPa, N for an SI scene; dimensionless when the "
+                        "scene's units label names none); scene: the scene's own units; dimensionless: lengths "
+                        "and pressures divided by the contact's scales (Hertz's a_H and p_H for a paraboloid, "
+                        "else the contact half-width and p_max)")
     p.add_argument("--quick", action="store_true",
                    help="'paper' only: a coarse preview (a_H/c = 8, short sweeps) in a fraction of the full "
                         "report's time (measured times: docs/performance.md)")

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..figures import run as run_figures
 from ..render import Figure, Progress, Section, Table, draw_and_build, problem_section
-from ..render.style import display_unit, method_text, report_unit
+from ..render.style import method_text
 from .paper_runs import AG_RELAXATION, ALPHA_A_ITERATIONS, RTOL, SCENES, SOLVE_STAGES, run_paper_problem
 from .results import results_of
 
@@ -48,9 +48,10 @@ def _problem(res, work):
 
     smooth, info = res.outcomes["smooth"].scene, res.outcomes["elastic-rigid"].result["layer"]
     u, laws = smooth.units.as_dict(), res.laws
-    (pu, pf), (wu, wf) = report_unit(u["pressure"]), display_unit(u["length"], float(laws["root"].w(res.p0)))
+    pf, wf = res.p0, res.a  # as every pressure and length of the report: over p_0 and a_H
     path = plot_layer_laws([(k, v and run_figures.Scaled(v, pf, wf)) for k, v in laws.items()],
-                           work / "fig04_layer_laws.png", p_max=1.1 * res.p0 / pf, p_unit=pu, w_unit=wu,
+                           work / "fig04_layer_laws.png", p_max=1.1, p_label=r"pressure $p\,/\,p_0$",
+                           w_label=r"layer closure $w(p)\,/\,a_H$",
                            marks=[(r"$p_{cr} = \alpha_a p_{max}^{\lambda}$", laws["elastic-rigid"].p_cr / pf)],
                            title="interface layer laws $w(p)$ (paper Fig. 4 b-d)")
     m = smooth.materials
@@ -60,14 +61,14 @@ def _problem(res, work):
         f"nu2 = {m['nu2']:g}) pressed together by the force P = {smooth.load['force']:g} {u['force']}, with a thin "
         "interface layer between them whose closure w(p) depends nonlinearly on the contact pressure p (paper "
         f"section 6, Fig. 4). The smooth (Hertz) contact has radius a_H = {res.a:.4g} {u['length']}, peak "
-        f"pressure p0 = {res.p0:.4g} {u['pressure']} and approach delta_H = {res.approach:.4g} {u['length']}; all "
-        "pressures below are divided by p0 and all lengths by a_H.",
+        f"pressure p_0 = {res.p0:.4g} {u['pressure']} and approach delta_H = {res.approach:.4g} {u['length']}; all "
+        "pressures below are divided by p_0 and all lengths by a_H.",
         f"The linear (Winkler) layer has the compliance lam = {info['lam_ref']:.4g} {u['length']}/{u['pressure']}, "
         f"the paper's {info['lam_ref'] / c_nn(res.a / 20, smooth.E_star):.3g} C_nn at the reference step "
         "c = a_H/20 (C_nn = c/(pi E*) w_t(0,0), the diagonal influence coefficient, eq. 6), fixed in physical "
         f"units so that every lattice solves the same problem; on this "
         f"report's lattice c = a_H/{res.nodes_per_radius} it is {info['lam_over_cnn']:.3g} C_nn. Its peak pressure "
-        f"p_max^lambda = {res.p_lin / res.p0:.4f} p0 scales the other laws: elastic-rigid w = lam min(p, p_cr) with "
+        f"p_max^lambda = {res.p_lin / res.p0:.4f} p_0 scales the other laws: elastic-rigid w = lam min(p, p_cr) with "
         f"p_cr = alpha_a p_max^lambda, alpha_a = {info['alpha_a']:g}; root w = lam_b sqrt(p) with lam_b = lam "
         "sqrt(p_max^lambda) (root and linear laws close equally at p_max^lambda); bilinear with slope lam up to "
         "p* = alpha_a p_max^lambda and lam tan(alpha_c) beyond, alpha_c = "
@@ -93,7 +94,7 @@ def _distributions(res, work):
     rows = tuple((k, _method(r), r.p_max / res.p0, r.contact_radius / res.a, r.approach / res.approach,
                   r.iterations, r.kkt_residual, r.wall_time_s, "converged" if r.converged else "not converged")
                  for k, r in b.items())
-    table = Table(("case", "method", "p_max / p0", "r_c / a_H", "approach / delta_H", "iterations", "KKT residual",
+    table = Table(("case", "method", "p_max / p_0", "r_c / a_H", "approach / delta_H", "iterations", "KKT residual",
                    "time [s]", "status"), rows, status_column="status",
                   caption="Key numbers of the Fig. 5 cases (r_c = sqrt(A/pi) from the loaded node area; approach "
                           "relative to the Hertz approach delta_H).")
@@ -137,12 +138,12 @@ def _stresses(res, work):
     shallower = [k for k, s in st.items() if s.depth_of_max < smooth.depth_of_max]
     moves = [f"{way} with {', '.join(laws)}" for way, laws in (("deeper", deeper), ("towards the surface", shallower))
              if laws]
-    summary = (f"Smooth bodies: the largest von Mises stress is {smooth.max_von_mises / res.p0:.3f} p0 at depth "
-               f"{smooth.depth_of_max / res.a:.3f} a_H below the centre (Hertz: 0.620 p0 at 0.481 a_H for nu = 0.3). "
+    summary = (f"Smooth bodies: the largest von Mises stress is {smooth.max_von_mises / res.p0:.3f} p_0 at depth "
+               f"{smooth.depth_of_max / res.a:.3f} a_H below the centre (Hertz: 0.620 p_0 at 0.481 a_H for nu = 0.3). "
                "With the same force it is, for the laws of Fig. 5: " + "; ".join(parts) + ". "
                + ("It moves " + " and ".join(moves) + "." if moves else ""))
-    table = Table(("case", "max von Mises / p0", "vs smooth", "its depth / a_H", "depth shift / a_H",
-                   "its distance from the axis / a_H", "max shear / p0", "vs smooth", "p_max / p0"), tuple(rows),
+    table = Table(("case", "max von Mises / p_0", "vs smooth", "its depth / a_H", "depth shift / a_H",
+                   "its distance from the axis / a_H", "max shear / p_0", "vs smooth", "p_max / p_0"), tuple(rows),
                   caption="Largest von Mises stress and largest maximum shear (s1 - s3)/2 over the body (every "
                           f"candidate node, {smooth.z.size} depths from 0 to {smooth.z.max() / res.a:g} a_H, refined "
                           f"in depth by a parabola), nu = {nu:g}; changes against the smooth contact. The peak "
@@ -226,15 +227,15 @@ def _sweeps(res, work):
                     name=r"$\alpha_c = \arctan(\lambda_2/\lambda_1)$ [rad]", cmap="cividis",
                     title=r"bilinear law: angle $\alpha_c$ of the second branch")
     how = f"Newton (eq. 15), a_H/c = {res.nodes_per_radius}, KKT tolerance {RTOL:.0e}"
-    t_a = Table(("alpha_a", "p_max / p0", "r_transition / a_H", "r_c / a_H"),
+    t_a = Table(("alpha_a", "p_max / p_0", "r_transition / a_H", "r_c / a_H"),
                 tuple((al, r.p_max / p0, rt / a, rc / a) for (al, r), rt, rc in zip(res.sweep_a, r_tr, r_c)),
                 caption="Elastic-rigid sweep: transition radius (p crosses p_cr on the axial section, linear "
                         "interpolation between nodes; at alpha_a = 0 the whole contact is rigid) and contact radius "
                         "r_c = sqrt(A/pi).")
-    t_b = Table(("lam_b / (lam sqrt(p_max^lambda))", "alpha_b", "p_max / p0", "r_c / a_H"),
+    t_b = Table(("lam_b / (lam sqrt(p_max^lambda))", "alpha_b", "p_max / p_0", "r_c / a_H"),
                 tuple((f, ab, r.p_max / p0, r.contact_radius / a) for f, ab, r in res.sweep_b),
                 caption="Root-law sweep.")
-    t_c = Table(("alpha_c [rad]", "lam2 / lam1", "p_max / p0", "r_c / a_H"),
+    t_c = Table(("alpha_c [rad]", "lam2 / lam1", "p_max / p_0", "r_c / a_H"),
                 tuple((t, math.tan(t), r.p_max / p0, r.contact_radius / a) for t, r in res.sweep_c),
                 caption="Bilinear sweep (alpha_c = 0 is the elastic-rigid law, pi/4 the linear layer).")
     return Section("Parameter sweeps alpha_a, alpha_b, alpha_c (Fig. 5, 7, 9)", kind="sweeps", text=(
@@ -246,7 +247,7 @@ def _sweeps(res, work):
         Figure(f7, "Radius of the transition p = p_cr between region I (rigid branch) and region II (elastic branch), "
                    "and the contact edge, against alpha_a (analogue of Fig. 7); from the sweep above."),
         Figure(f9, "Isometric pressure surfaces for several alpha_a (analogue of Fig. 9); one colour scale, height "
-                   f"proportional to p / p0; black line: the axial section. {how}."),
+                   f"proportional to p / p_0; black line: the axial section. {how}."),
         Figure(fb, "Root law for several coefficients lam_b; the colour gives alpha_b = p_max^root / p_max^lambda; "
                    f"dashed: the linear layer. {how}."), t_b,
         Figure(fc, f"Bilinear law (p* = alpha_a p_max^lambda, alpha_a = {alpha_a:g}) for several alpha_c. {how}."),
@@ -291,7 +292,7 @@ def _stability(res):
     rows = tuple((r["law"], r["method"], r["status"], r["iterations"], r["p_max/p0"], r["kkt_residual"],
                   r["wall_time_s"], r["message"] if len(r["message"]) <= 90
                   else r["message"][: r["message"].rfind(" ", 0, 90)] + " ...") for r in res.stability)
-    table = Table(("law", "method", "status", "iterations", "p_max / p0", "KKT residual", "time [s]", "message"),
+    table = Table(("law", "method", "status", "iterations", "p_max / p_0", "KKT residual", "time [s]", "message"),
                   rows, status_column="status",
                   caption=f"Every method on the same problems (a_H/c = {res.nodes_per_radius}, tolerance {RTOL:.0e}); "
                           "green: converged, amber: stalled, red: diverged or failed.")
@@ -313,10 +314,10 @@ def _validation(res, work):
                      b.contact_radius / res.a, f.contact_radius / res.a, b.approach / res.approach,
                      f.approach / res.approach, b.wall_time_s, f.wall_time_s,
                      "converged" if (b.converged and f.converged) else "failed"))
-    items.append(Table(("case", "BEM p_max / p0", "FEM p_max / p0", "rel. difference", "BEM r_c / a_H",
+    items.append(Table(("case", "BEM p_max / p_0", "FEM p_max / p_0", "rel. difference", "BEM r_c / a_H",
                         "FEM r_c / a_H", "BEM delta / delta_H", "FEM delta / delta_H", "BEM time [s]", "FEM time [s]",
                         "status"), tuple(rows), status_column="status",
-                       caption="BEM against FEM (Hertz: p_max / p0 = 1, r_c / a_H = 1, delta / delta_H = 1). BEM r_c "
+                       caption="BEM against FEM (Hertz: p_max / p_0 = 1, r_c / a_H = 1, delta / delta_H = 1). BEM r_c "
                                "= sqrt(A/pi) from the loaded nodes; FEM r_c from the closure crossing zero."))
     smooth = results_of(res.validation["smooth"], units="dimensionless", hertz_peak="p_0")
     items.append(run_figures.fem_von_mises(smooth, work / "validation_smooth"))
@@ -336,7 +337,7 @@ def _validation(res, work):
         "solution and with the toolkit's own axisymmetric FEM reference (scikit-fem), which carries the same layer "
         "law through the interface. The profiles are those of a run's report of each case run with [fem] and, for "
         "the smooth case, [analytic] kind = \"hertz\"; the von Mises stress of the FEM reference (nu = 0.3) peaks "
-        "at about 0.62 p0 at depth 0.48 a_H below the centre of the smooth contact.",))
+        "at about 0.62 p_0 at depth 0.48 a_H below the centre of the smooth contact.",))
 
 
 def paper_sections(res, work):

@@ -18,29 +18,35 @@ def rough_section(res, work):
     d = res.data
     if not d.get("periodic"):
         return None
-    L, P = res.units.of("length"), res.units.of("pressure")
+    (lf, L), (pf, P) = res.engineering("length"), res.engineering("pressure")  # the report's units, never scales
+    L, P, F = L or "-", P or "-", res.display("force").name
+    area = f"{L}^2" if L != "-" else "-"
+
+    def num(value, factor=1.0):
+        return fmt(value / factor if is_number(value) else value)
+
     s, sp, b = res.get("surface", {}), res.get("spots", {}), res.bem
-    rows = [("mean pressure", fmt(d.get("mean_pressure")), P),
-            ("force on one cell", fmt(d.get("force")), res.units.of("force")),
+    rows = [("mean pressure", num(d.get("mean_pressure"), pf), P),
+            ("force on one cell", num(d.get("force"), res.display("force").factor), F),
             ("real contact fraction A/A0", fmt(d.get("contact_fraction")), "-"),
-            ("mean gap (mean-plane separation)", fmt(d.get("mean_gap")), L),
-            ("approach", fmt(d.get("approach")), L),
-            ("peak pressure", fmt(d.get("p_max")), P),
+            ("mean gap (mean-plane separation)", num(d.get("mean_gap"), lf), L),
+            ("approach", num(d.get("approach"), lf), L),
+            ("peak pressure", num(d.get("p_max"), pf), P),
             ("contact spots", fmt(sp.get("count")), "-"),
-            ("largest spot area", fmt(sp.get("largest_area")), f"{L}^2"),
-            ("mean spot area", fmt(sp.get("mean_area")), f"{L}^2"),
+            ("largest spot area", num(sp.get("largest_area"), lf * lf), area),
+            ("mean spot area", num(sp.get("mean_area"), lf * lf), area),
             ("spots of a single node", fmt(sp.get("single_node")), "-")]
     cell = b.get("cell") or ["-", "-"]
     surface = [("source", str(s.get("source", "-")), "-"),
-               ("cell Lx, Ly", ", ".join(map(fmt, s.get("size") or [])), L),
+               ("cell Lx, Ly", ", ".join(num(v, lf) for v in s.get("size") or []), L),
                ("data grid nx, ny", ", ".join(map(str, s.get("grid") or [])), "-"),
                ("lattice nodes n_cols x n_rows", f"{cell[0]} x {cell[1]}", "-"),
-               ("lattice step c", fmt(b.get("step")), L),
-               ("rms height Sq", fmt(s.get("rms_height")), L),
+               ("lattice step c", num(b.get("step"), lf), L),
+               ("rms height Sq", num(s.get("rms_height"), lf), L),
                ("rms slope", fmt(s.get("rms_slope")), "-"),
-               ("rms curvature", fmt(s.get("rms_curvature")), f"1/{L}"),
-               ("edge jump (rms, opposite edges)", fmt(s.get("edge_jump")), L),
-               ("grid step (rms, neighbours)", fmt(s.get("grid_step")), L),
+               ("rms curvature", num(s.get("rms_curvature"), 1.0 / lf), f"1/{L}"),
+               ("edge jump (rms, opposite edges)", num(s.get("edge_jump"), lf), L),
+               ("grid step (rms, neighbours)", num(s.get("grid_step"), lf), L),
                ("edge jump flagged large", "yes" if s.get("edge_jump_large") else "no", "-"),
                ("stretch along y, Ly / Ly of the data", fmt(s.get("stretch_y")), "-")]
     text = ["The rough surface is pressed by a rigid flat; the cell repeats in the plane (bem.solve_periodic). "

@@ -2,7 +2,9 @@
 
 Everything is read from the effective scene (``scene.toml``) and the run's ``result.json``: the
 layer is the one the solver used (``result["layer"]["parameters"]``), with the paper's relative
-parameters (``lam_over_cnn``, ``alpha_a``, ...) shown next to the values they resolved to.
+parameters (``lam_over_cnn``, ``alpha_a``, ...) shown next to the values they resolved to. Values
+are shown in the report's units (:meth:`validation.report.documents.results.RunResults.display`),
+which the section's text states once.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from collections.abc import Mapping
 from bem.gaps import GAPS
 
 from ...scene.rough import GAP_UNITS as ROUGH_GAP_UNITS
+from ...units import METRES
 from ..render.content import Section, Table, fmt
 from ..render.style import method_text
 from .results import is_number
@@ -41,15 +44,13 @@ _MATERIALS = (("E1", "Young's modulus E1 (body 1)"), ("nu1", "Poisson's ratio nu
               ("E2", "Young's modulus E2 (body 2)"), ("nu2", "Poisson's ratio nu2 (body 2)"))
 
 
-def _param_unit(law, key, params, units):
+def _param_kind(law, key, params):
+    """``(kind, power)`` of a layer parameter for :meth:`RunResults.display`."""
     if key in ("p_cr", "p_star"):
-        return units.of("pressure")
+        return "pressure", 1.0
     if key in ("lam", "lam1", "lam2"):
-        if not (units.length and units.pressure):
-            return "-"
-        power = {"root": "0.5", "power": fmt(params.get("s", 1.0))}.get(law)
-        return f"{units.length}/{units.pressure}" + (f"^{power}" if power else "")
-    return "-"
+        return "compliance", {"root": 0.5, "power": float(params.get("s", 1.0))}.get(law, 1.0)
+    return "-", 1.0
 
 
 def _layer_rows(res):
@@ -59,16 +60,18 @@ def _layer_rows(res):
     law = params.get("law") or info.get("law") or res.section("layer").get("law")
     if law in (None, "none"):
         return [("interface layer", "none (smooth bodies, w = 0)", "-")]
-    u = res.units
     rows = [("interface layer", _LAW_TEXT.get(law, law), "-")]
     for key, value in params.items():
         if key == "law":
             continue
         if isinstance(value, list) and law == "tabulated":
-            unit = u.of("pressure" if key == "p" else "length")
-            rows.append((f"layer {key} (table)", f"{len(value)} points, {fmt(min(value))} to {fmt(max(value))}", unit))
+            kind = "pressure" if key == "p" else "length"
+            shown = [res.shown(v, kind) for v in value]
+            rows.append((f"layer {key} (table)", f"{len(value)} points, {fmt(min(shown))} to {fmt(max(shown))}",
+                         res.display(kind).name))
         elif is_number(value):
-            rows.append((f"layer {key}", fmt(value), _param_unit(law, key, params, u)))
+            kind, power = _param_kind(law, key, params)
+            rows.append((f"layer {key}", fmt(res.shown(value, kind, power)), res.display(kind, power).name))
         elif isinstance(value, Mapping):
             rows.append((f"layer {key}", _LAW_TEXT.get(value.get("law"), str(value.get("law", "?"))), "-"))
     for key, text, kind in _PAPER_ROWS:
@@ -78,8 +81,20 @@ def _layer_rows(res):
         if key == "lam_ref" and value == params.get("lam"):
             continue
         if is_number(value):
-            rows.append((text, fmt(value), u.of(kind) if kind not in ("-", "rad") else kind))
+            rows.append((text, fmt(res.shown(value, kind)), res.display(kind).name))
     return rows
+
+
+def _file_length(res, value, file_unit):
+    """``(value, unit)`` of a measured file's length (in its ``length_unit``: a unit symbol or the factor
+    to the scene's length unit) in the report's length unit; as the file gives it when either unit is unknown."""
+    if is_number(file_unit):
+        to_scene = float(file_unit)
+    else:
+        to_scene = METRES.get(file_unit) and res.units.metres and METRES[file_unit] / res.units.metres
+    if not to_scene:
+        return fmt(value), file_unit if isinstance(file_unit, str) else res.units.of("length")
+    return fmt(res.shown(value * to_scene, "length")), res.display("length").name
 
 
 def _gap_rows(res):
@@ -88,51 +103,55 @@ def _gap_rows(res):
     shape = GAPS.get(kind)  # the shape says what it is and the kind of each parameter
     rows = [("gap h(x, y)", _MEASURED if kind == "measured" else shape.describe() if shape else kind, "-")]
 
-    def unit(key):
-        if kind == "measured" and key in ("spacing", "nodata"):  # in the file's length unit
-            file_unit = gap.get("length_unit")
-            return file_unit if isinstance(file_unit, str) else res.units.of("length")
-        return res.units.of(shape.units.get(key, "-") if shape else ROUGH_GAP_UNITS.get(key, "-"))
+    def kind_of(key):
+        return shape.units.get(key, "-") if shape else ROUGH_GAP_UNITS.get(key, "-")
 
     for key, value in gap.items():
         if key == "type":
             continue
-        if is_number(value):
-            rows.append((f"gap {key}", fmt(value), unit(key)))
+        if kind == "measured" and key in ("spacing", "nodata") and is_number(value):
+            rows.append((f"gap {key}", *_file_length(res, value, gap.get("length_unit"))))
+        elif is_number(value):
+            rows.append((f"gap {key}", fmt(res.shown(value, kind_of(key))), res.display(kind_of(key)).name))
         elif isinstance(value, str):
             rows.append((f"gap {key}", value, "-"))
         elif isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value):
-            rows.append((f"gap {key}", ", ".join(fmt(v) for v in value), unit(key)))
+            rows.append((f"gap {key}", ", ".join(fmt(res.shown(v, kind_of(key))) for v in value),
+                         res.display(kind_of(key)).name))
         elif isinstance(value, list):
             rows.append((f"gap {key}", f"table of {len(value)} values", "-"))
     return rows
 
 
 def _material_rows(res):
-    bodies, u = res.section("bodies"), res.units
-    rows = [(label, fmt(float(bodies[key])), "-" if key.startswith("nu") else u.of("pressure"))
+    bodies, pressure = res.section("bodies"), res.display("pressure")
+    rows = [(label, fmt(float(bodies[key])), "-") if key.startswith("nu") else
+            (label, fmt(res.shown(float(bodies[key]), "pressure")), pressure.name)
             for key, label in _MATERIALS if key in bodies]
     e_star = res.bem.get("E_star", bodies.get("E_star"))
     if e_star is not None:
-        rows.append(("effective modulus E* = 1 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)", fmt(float(e_star)),
-                     u.of("pressure")))
+        rows.append(("effective modulus E* = 1 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)",
+                     fmt(res.shown(float(e_star), "pressure")), pressure.name))
     return rows
 
 
 def _load_rows(res):
     load = res.section("load")
     if "force" in load:
-        return [("load: total force P (force control)", fmt(float(load["force"])), res.units.of("force"))]
+        return [("load: total force P (force control)", fmt(res.shown(float(load["force"]), "force")),
+                 res.display("force").name)]
     if "approach" in load:
-        return [("load: approach delta (approach control)", fmt(float(load["approach"])), res.units.of("length"))]
+        return [("load: approach delta (approach control)", fmt(res.shown(float(load["approach"]), "length")),
+                 res.display("length").name)]
     if "mean_pressure" in load:  # a periodic cell
-        return [("load: mean pressure over the cell", fmt(float(load["mean_pressure"])), res.units.of("pressure"))]
+        return [("load: mean pressure over the cell", fmt(res.shown(float(load["mean_pressure"]), "pressure")),
+                 res.display("pressure").name)]
     return []
 
 
 def scene_section(res, work):
     """The problem statement: the effective scene's inputs (``work``: unused, no figure)."""
-    meta, law, u = res.section("scene"), getattr(res.layer, "law", None), res.units
+    meta, law = res.section("scene"), getattr(res.layer, "law", None)
     text = [str(meta["description"])] if meta.get("description") else []
     text.append("Frictionless normal contact of two elastic half-spaces whose surfaces are separated by the "
                 "initial gap h(x, y)" + (", with an interface layer between them whose closure w(p) depends "
@@ -140,8 +159,7 @@ def scene_section(res, work):
                 + f" Solved by the BEM: {method_text(res.data.get('method'), law)}.")
     if res.data.get("overrides"):
         text.append("Scene overrides of this run: " + ", ".join(map(str, res.data["overrides"])) + ".")
-    text.append(f"Units: {u.label}" + (f" - lengths in {u.length}, pressures and moduli in {u.pressure}, forces in "
-                                       f"{u.force}, areas in {u.of('area')}." if u.known else "."))
+    text.append(res.units_text())
     rows = _gap_rows(res) + _material_rows(res) + _layer_rows(res) + _load_rows(res)
     return Section("Problem statement", kind="problem", text=tuple(text), items=(
         Table(("quantity", "value", "unit"), tuple(rows),

@@ -13,7 +13,9 @@ What is read (names from ``result.json["files"]``, :data:`validation.run.runner.
     The BEM nodal pressure ``p`` and the FEM's (r, z) von Mises field.
 
 Units are the symbols the run recorded (``unit_symbols``); a result written before they were
-recorded has its units label read by :func:`validation.units.parse_units`.
+recorded has its units label read by :func:`validation.units.parse_units`. A report shows each
+quantity in one unit, in every table, caption and figure (:meth:`RunResults.display`): the
+report's ``units`` (:data:`UNIT_CHOICES`) choose them.
 """
 
 from __future__ import annotations
@@ -31,16 +33,39 @@ import numpy as np
 from bem.checks import InputError, check_choice
 
 from ...units import Units, parse_units
+from ..render.content import fmt
+from ..render.style import report_unit
 
-__all__ = ["RunResults", "load_results", "results_of", "units_of", "read_json", "is_number", "dimensionless_for",
-           "UNIT_CHOICES", "file_inside"]
+__all__ = ["RunResults", "Shown", "load_results", "results_of", "units_of", "read_json", "is_number",
+           "dimensionless_for", "UNIT_CHOICES", "file_inside"]
 
 log = logging.getLogger(__name__)
 
 _FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_field.vtu", "fem_field": "fem_field.vtu"}
-#: ``units`` choices of a report: the scene's units (``"auto"``: when they are known), or
-#: lengths and pressures divided by the contact's scales
+#: ``units`` choices of a report: ``"auto"``: readable units (an SI scene's m and Pa shown as mm and
+#: MPa, :func:`validation.report.render.style.report_unit`; dimensionless when the scene's units are
+#: unknown); ``"scene"``: the scene's own units; ``"dimensionless"``: lengths and pressures divided
+#: by the contact's scales (:meth:`RunResults.scales`)
 UNIT_CHOICES = ("auto", "scene", "dimensionless")
+#: unit kinds :meth:`RunResults.display` converts; any other kind (``"-"``, ``"s"``, ``"rad"``) is shown as it is
+_KINDS = ("length", "pressure", "force", "area", "compliance")
+
+
+class Shown(tuple):
+    """``(factor, name, normalised)``: a quantity is shown as ``value / factor`` [``name``].
+
+    ``name`` is the unit symbol (``"mm"``, ``"mm^2"``, ``"mm/MPa"``) or, when ``normalised``,
+    the symbol of the scale (``"a_H"``, ``"p_H"``, ``"a_H^2"``).
+    """
+
+    __slots__ = ()
+
+    def __new__(cls, factor, name, normalised):
+        return super().__new__(cls, (float(factor), str(name), bool(normalised)))
+
+    factor = property(lambda self: self[0])
+    name = property(lambda self: self[1])
+    normalised = property(lambda self: self[2])
 
 
 def is_number(value):
@@ -73,8 +98,11 @@ class RunResults:
     fem_field : tuple of ndarray or None
         ``(r, z, triangles, von_mises)`` of the FEM reference [length], [pressure], when it ran.
     dimensionless : bool
-        Draw lengths and pressures divided by the contact's scales (:meth:`scales`) instead of
-        in the scene's units (:func:`validation.report.render.style.report_unit`).
+        Show lengths and pressures divided by the contact's scales (:meth:`scales`) instead of
+        in units (:meth:`display`).
+    scene_units : bool
+        Show every quantity in the scene's own units (``units = "scene"``); otherwise an SI
+        scene's m and Pa are shown as mm and MPa (:func:`validation.report.render.style.report_unit`).
     hertz_peak : str
         The name of Hertz's peak pressure in a dimensionless report (``"p_H"``; the paper
         report calls it ``"p_0"``, as the paper does): one name for it throughout a report.
@@ -87,6 +115,7 @@ class RunResults:
     bem_field: tuple | None = None
     fem_field: tuple | None = None
     dimensionless: bool = False
+    scene_units: bool = False
     hertz_peak: str = "p_H"
 
     def section(self, name):
@@ -156,6 +185,66 @@ class RunResults:
         return (float(p0), float(a), "p_{max}", "a_c") if p0 and a and p0 > 0 and a > 0 else None
 
 
+    def display(self, kind, power=1.0):
+        """How a quantity of ``kind`` is shown in every table, caption and figure of the report: a
+        :class:`Shown` ``(factor, name, normalised)``, the value shown being ``value / factor``.
+
+        ``kind``: ``"length"``, ``"pressure"`` (moduli and stresses too), ``"force"``, ``"area"``
+        or ``"compliance"`` (length per pressure to the ``power``, a layer's ``lam``); any other
+        kind is returned as the name with factor 1. Lengths and pressures are divided by the
+        contact's scales in a dimensionless report (forces stay in units), else shown in the
+        scene's units (:attr:`scene_units`) or in readable ones (mm, MPa for an SI scene).
+        """
+        if kind == "area":
+            f, name, norm = self.display("length")
+            return Shown(f * f, f"{name}^2" if name != "-" else "-", norm)
+        if kind == "compliance":
+            (lf, ln, norm), (pf, pn, _) = self.display("length"), self.display("pressure")
+            power = float(power)
+            exponent = "" if power == 1.0 else f"^{power:g}"
+            return Shown(lf / pf**power, f"{ln}/{pn}{exponent}" if "-" not in (ln, pn) else "-", norm)
+        if kind not in _KINDS:
+            return Shown(1.0, kind, False)
+        scales = self.scales() if kind in ("length", "pressure") else None
+        if scales is not None:
+            return Shown(scales[1], scales[3], True) if kind == "length" else Shown(scales[0], scales[2], True)
+        unit = getattr(self.units, kind)
+        name, factor = (unit or "", 1.0) if self.scene_units else report_unit(unit)
+        return Shown(factor, name or "-", False)
+
+    def shown(self, value, kind, power=1.0):
+        """``value`` [scene unit of ``kind``] as :meth:`display` shows it (non-numbers unchanged)."""
+        return value / self.display(kind, power).factor if is_number(value) else value
+
+    def engineering(self, kind):
+        """``(factor, name)`` of ``kind`` (``"length"``, ``"pressure"``, ``"force"``) in units, never
+        scales: those of :meth:`display` when it does not normalise; how a dimensionless report states
+        its scales (``a_H = 0.1866 mm``). ``name`` is ``""`` when the scene names no such unit."""
+        unit = getattr(self.units, kind)
+        name, factor = (unit or "", 1.0) if self.scene_units else report_unit(unit)
+        return factor, name
+
+    def units_text(self):
+        """The sentence stating the report's units once (in the problem statement)."""
+        u = self.units
+        scene = f"scene units: {u.label}" if u.label else "the scene names no units"
+        (lf, ln, normalised), (pf, pn, _) = self.display("length"), self.display("pressure")
+        force = self.display("force").name
+        forces = f"forces in {force}" if force != "-" else "forces in the scene's units"
+        if normalised:
+            def value(factor, kind):
+                f, unit = self.engineering(kind)
+                return " ".join((fmt(factor / f), unit)).strip()
+
+            of_l = "Hertz's contact radius" if ln == "a_H" else "the contact half-width along x"
+            of_p = "Hertz's peak pressure" if pn == self.hertz_peak else "the BEM peak pressure"
+            return (f"Units ({scene}): every length is shown divided by {of_l} {ln} = {value(lf, 'length')}, every "
+                    f"pressure, modulus and stress divided by {of_p} {pn} = {value(pf, 'pressure')}; {forces}.")
+        if not u.known:
+            return f"Units: {u.label or 'not named'}."
+        return (f"Units ({scene}): throughout this report lengths are in {ln}, pressures, moduli and stresses in "
+                f"{pn}, {forces}, areas in {self.display('area').name}.")
+
 def read_json(path):
     """The JSON content of ``path``; InputError when it cannot be read."""
     try:
@@ -223,8 +312,9 @@ def dimensionless_for(units, parsed):
 def load_results(directory, *, units="auto"):
     """Read a result directory of ``contactlab run`` (see the module docstring).
 
-    ``units`` (:data:`UNIT_CHOICES`) sets :attr:`RunResults.dimensionless`: ``"auto"`` draws
-    in the scene's units when they are known, dimensionless otherwise.
+    ``units`` (:data:`UNIT_CHOICES`) sets :attr:`RunResults.dimensionless` and
+    :attr:`RunResults.scene_units`: ``"auto"`` shows readable units (mm, MPa for an SI scene) when the
+    scene's units are known, dimensionless otherwise.
 
     Raises
     ------
@@ -254,7 +344,7 @@ def load_results(directory, *, units="auto"):
     fem = _field(files["fem_field"], section_field_from_vtu) if isinstance(data.get("fem"), Mapping) else None
     return RunResults(directory=directory, data=dict(data), scene=scene, units=parsed,
                       bem_field=_field(files["bem_field"], _bem_field), fem_field=fem,
-                      dimensionless=dimensionless_for(units, parsed))
+                      dimensionless=dimensionless_for(units, parsed), scene_units=units == "scene")
 
 
 def results_of(outcome, *, units="auto", directory=".", hertz_peak="p_H"):
@@ -266,4 +356,5 @@ def results_of(outcome, *, units="auto", directory=".", hertz_peak="p_H"):
     return RunResults(directory=Path(directory), data=outcome.result, scene=outcome.scene.raw,
                       units=outcome.scene.units, bem_field=(res.x, res.y, res.p),
                       fem_field=None if outcome.fem is None else von_mises_of(outcome.fem),
-                      dimensionless=dimensionless_for(units, outcome.scene.units), hertz_peak=hertz_peak)
+                      dimensionless=dimensionless_for(units, outcome.scene.units), scene_units=units == "scene",
+                      hertz_peak=hertz_peak)

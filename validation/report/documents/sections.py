@@ -67,17 +67,23 @@ def results_rows(res):
         """The solvers' values of ``key``, with the digits that tell them apart (:func:`fmt_distinct`)."""
         return fmt_distinct([float(p.get(key)) / scale if is_number(p.get(key)) else "-" for _, p in parts])
 
-    rows = [(label, *cells(key), res.units.of(kind)) for key, label, kind in _QUANTITIES
+    rows = [(label, *cells(key, res.display(kind).factor), res.display(kind).name) for key, label, kind in _QUANTITIES
             if any(is_number(p.get(key)) for _, p in parts)]
     ext = res.get("contact_extent")
     if ext and not res.axisymmetric:
         ref = res.get("analytic") or {}
-        closed = {"closed form": f"{fmt(ref.get('a'))}, {fmt(ref.get('b'))}"} if is_number(ref.get("a")) else {}
-        rows.append(("contact half-widths along x, y", f"{fmt(ext.get('x'))}, {fmt(ext.get('y'))}",
-                     *(closed.get(name, "-") for name, _ in parts[1:]), res.units.of("length")))
+
+        def pair(a, b):
+            return f"{fmt(res.shown(a, 'length'))}, {fmt(res.shown(b, 'length'))}"
+
+        closed = {"closed form": pair(ref.get("a"), ref.get("b"))} if is_number(ref.get("a")) else {}
+        rows.append(("contact half-widths along x, y", pair(ext.get("x"), ext.get("y")),
+                     *(closed.get(name, "-") for name, _ in parts[1:]), res.display("length").name))
     scales = res.get("scales") or {}
+    drawn_over = {"p_hertz": res.display("pressure").name == res.hertz_peak,  # a ratio the table shows already
+                  "a_hertz": res.display("length").name == "a_H"}
     rows += [(label, *cells(key, scales[skey]), "-") for key, label, skey in _RATIOS
-             if is_number(scales.get(skey)) and scales[skey] > 0]
+             if is_number(scales.get(skey)) and scales[skey] > 0 and not drawn_over.get(skey)]
     if is_number(res.data.get("alpha_b")):
         rows.append(("alpha_b = p_max / p_max^lambda", fmt(res.data["alpha_b"]), *("-" for _ in parts[1:]), "-"))
     return ("quantity", *(name for name, _ in parts), "unit"), tuple(rows)
@@ -90,7 +96,7 @@ def summary(res, work):
             + ("The run converged." if res.data.get("converged") else "The run did NOT converge.")]
     if res.data.get("messages"):
         text.append("Run messages: " + "; ".join(map(str, res.data["messages"])) + ".")
-    caption = "Key results in the scene's units."
+    caption = "Key results, in the report's units (problem statement)."
     if res.axisymmetric:
         caption += " BEM: r_c = sqrt(A / pi), A = loaded node count times the node area" + (
             "; FEM: edge of the loaded zone, interpolated between the interface nodes." if res.fem is not None else ".")
@@ -104,16 +110,17 @@ def summary(res, work):
 
 def timings(res, work):
     """How the BEM ran: method, lattice, iterations, residual, wall times."""
-    d, b, u = res.data, res.bem, res.units
+    d, b, length = res.data, res.bem, res.display("length")
     rows = [("method", method_text(d.get("method"), getattr(res.layer, "law", None)), "-"),
             ("status", "converged" if d.get("converged") else "not converged", "-"),
             ("solver message", str(d.get("message", "-")), "-"),
             ("iterations (finest lattice)", fmt(d.get("iterations")), "-"),
             ("KKT residual", fmt(d.get("kkt_residual")), "-")]
     if is_number(b.get("step")):
-        rows.append(("lattice step c", fmt(b["step"]), u.of("length")))
+        rows.append(("lattice step c", fmt(b["step"] / length.factor), length.name))
     if isinstance(b.get("extent"), list) and len(b["extent"]) == 2:
-        rows.append(("candidate region |x| <= X, |y| <= Y (X, Y)", ", ".join(map(fmt, b["extent"])), u.of("length")))
+        rows.append(("candidate region |x| <= X, |y| <= Y (X, Y)",
+                     ", ".join(fmt(v / length.factor) for v in b["extent"]), length.name))
     rows += [(label, fmt(b[key], 3), "-") for key, label in _BEM_COUNTS if is_number(b.get(key))]
     rows += _timed(res.get("wall_time_s"), _TIMES)
     return Section("Solver and timings", kind="results", items=(
@@ -122,7 +129,7 @@ def timings(res, work):
 
 def fem_field(res, work):
     """The FEM reference: mesh, solver and time split (its von Mises field is a figure)."""
-    fem, u = res.fem, res.units
+    fem, length = res.fem, res.display("length")
     if fem is None:
         return None
     mesh, penalty, trunc = ((fem.get(k) if isinstance(fem.get(k), Mapping) else {})
@@ -133,10 +140,11 @@ def fem_field(res, work):
             ("degrees of freedom", fmt(fem.get("n_dofs")), "-"),
             ("elements", fmt(fem.get("n_elements")), "-"),
             ("elements across the contact radius", fmt(fem.get("n_elements_across_contact"), 3), "-")]
-    optional = ((mesh, "h_fine", "element size at the contact", u.of("length")),
-                (mesh, "extent_factor", "mesh half-size / estimated contact radius", "-"),
-                (penalty, "relative_penetration", "penalty: largest penetration / approach", "-"))
-    rows += [(label, fmt(part[key]), unit) for part, key, label, unit in optional if is_number(part.get(key))]
+    optional = ((mesh, "h_fine", "element size at the contact", length),
+                (mesh, "extent_factor", "mesh half-size / estimated contact radius", res.display("-")),
+                (penalty, "relative_penetration", "penalty: largest penetration / approach", res.display("-")))
+    rows += [(label, fmt(part[key] / unit.factor), unit.name) for part, key, label, unit in optional
+             if is_number(part.get(key))]
     if "applied" in trunc:
         rows.append(("far-field (truncation) correction applied", fmt(bool(trunc["applied"])), "-"))
     rows += _timed(fem.get("timings"), _FEM_TIMES)
@@ -159,8 +167,7 @@ def stress(res, work):
                     f"max shear / {s_name}", f"its depth / {l_name}"), tuple(rows),
                    caption="Largest von Mises stress and largest maximum shear (s1 - s3)/2 of each body over all "
                            "candidate nodes and depths, refined in depth by a parabola through the largest sample and "
-                           f"its neighbours. Units: {s_name} = {fmt(s)} {res.units.of('pressure')}, {l_name} = "
-                           f"{fmt(a)} {res.units.of('length')}.")]
+                           f"its neighbours.{_scales_text(res, a, s, l_name, s_name)}")]
     fem_rows = [(name, fmt(f["max_von_mises"] / s), f"{100 * f['max_von_mises_rel']:+.2f} %", fmt(f["max_tresca"] / s),
                  f"{100 * f['max_tresca_rel']:+.2f} %", fmt(f["axis_depth_of_max"] / a),
                  fmt(f["bem_axis_depth_of_max"] / a), f"{100 * f['axis_depth_of_max_rel']:+.2f} %",
@@ -185,6 +192,15 @@ def stress(res, work):
     return Section("Subsurface stresses", kind="results", text=(text,), items=tuple(items))
 
 
+def _scales_text(res, a, s, l_name, s_name):
+    """Caption sentence of the stress table: the scales of a dimensionless report, else nothing (the
+    headers name the units)."""
+    if not res.display("length").normalised:
+        return ""
+    (lf, lu), (pf, pu) = res.engineering("length"), res.engineering("pressure")
+    return f" Scales: {s_name} = {fmt(s / pf)} {pu}".rstrip() + f", {l_name} = {fmt(a / lf)} {lu}".rstrip() + "."
+
+
 def _metric_cell(key, value):
     if not is_number(value):
         return "-" if value is None else str(value)
@@ -205,7 +221,7 @@ def comparison(res, work):
             caption="Comparison metrics of the run (candidate vs reference at the candidate's nodes; signed "
                     "differences are (candidate - reference) / reference)."))
     balance = metrics.get("force_balance") if isinstance(metrics.get("force_balance"), Mapping) else {}
-    rows = [("target force P", fmt(v), res.units.of("force")) if k == "target" else
+    rows = [("target force P", fmt(res.shown(v, "force")), res.display("force").name) if k == "target" else
             (f"force balance |F - P| / P ({k.upper()})", _metric_cell(k, v), "-")
             for k, v in balance.items() if is_number(v)]
     rows += [(k, _metric_cell(k, v), "-") for k, v in metrics.items() if is_number(v)]
@@ -274,8 +290,9 @@ def report_results_dir(directory, out_dir=None, *, title=None, units="auto", fmt
     title : str, optional
         Default: the scene's title.
     units : {"auto", "scene", "dimensionless"}
-        Axes in the scene's units (lengths in mm, pressures in MPa for SI scenes) or divided
-        by the contact's scales (:func:`validation.report.documents.results.load_results`).
+        One unit per quantity in every table, caption and figure: readable units (mm, MPa, N for
+        SI scenes), the scene's own, or lengths and pressures divided by the contact's scales
+        (:meth:`validation.report.documents.results.RunResults.display`).
     fmt : {"png", "svg", "pdf"}
         Figure files (:func:`validation.report.render.style.figure_format`).
     progress : callable, optional

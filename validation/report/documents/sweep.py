@@ -4,8 +4,10 @@ Reads ``summary.json`` (the table of points) and ``points/point-*.json`` (each p
 and full result, the axial section included) and builds: the problem statement of the first
 point, a table of every point, the axial-section pressure of every point coloured by the swept
 value, and the peak pressure, contact size and approach against that value. Units as in a run's
-report (:mod:`validation.report.figures.run`): the scene's (mm and MPa for SI scenes) or
-dimensionless (each point divided by its own scales).
+report (:meth:`validation.report.documents.results.RunResults.display`): readable ones (mm and
+MPa for SI scenes) or the scene's, one per quantity in every table and figure; a dimensionless
+report divides each point's profile by its own scales and shows the table, the swept values and
+the scalar figure in readable units (the scales differ from point to point).
 """
 
 from __future__ import annotations
@@ -21,7 +23,6 @@ from bem.checks import InputError, check_choice
 from ...provenance import display_path
 from ..figures.run import PAD, axis_label, contact_edge, scale
 from ..render import Figure, Progress, Section, Table, draw_and_build, fmt
-from ..render.style import report_unit
 from .problem import scene_section
 from .results import UNIT_CHOICES, RunResults, dimensionless_for, file_inside, is_number, read_json, units_of
 
@@ -71,33 +72,52 @@ def load_sweep(directory, *, units="auto"):
             data = dict(point.get("result") or {})
             u = units_of(data, summary.get("units"))
             res = RunResults(directory=directory, data=data, scene=dict(point.get("scene") or {}), units=u,
-                             dimensionless=dimensionless_for(units, u))
+                             dimensionless=dimensionless_for(units, u), scene_units=units == "scene")
         points.append((row, res))
     return Sweep(summary, points)
 
 
+def _units(summary, points):
+    """The first computed point's results (their units), or results holding only the summary's units."""
+    return next((res for _, res in points if res is not None),
+                RunResults(directory=Path("."), data={}, units=units_of(summary)))
+
+
 def _table(summary, points):
-    u = next((res.units for _, res in points if res is not None), units_of(summary))
-    columns = (str(summary.get("key", "value")), "status", f"p_max [{u.of('pressure')}]",
-               f"contact radius or half-width x [{u.of('length')}]", f"approach [{u.of('length')}]",
-               "iterations", "KKT residual", "BEM time [s]")
+    first = _units(summary, points)
+    (lf, lu), (pf, pu) = first.engineering("length"), first.engineering("pressure")
+    vf, key = _key_unit(str(summary.get("key", "value")), first)
+    columns = (key, "status", f"p_max [{pu or '-'}]", f"contact radius or half-width x [{lu or '-'}]",
+               f"approach [{lu or '-'}]", "iterations", "KKT residual", "BEM time [s]")
+
+    def shown(value, factor):
+        return value / factor if is_number(value) else value
+
     rows = []
     for row, res in points:
         radius = row.get("contact_radius")
         if radius is None and res is not None:
             radius = res.contact_size
-        rows.append((fmt(row.get("value")), row.get("status", "?"), row.get("p_max"), radius, row.get("approach"),
-                     row.get("iterations"), row.get("kkt_residual"), row.get("wall_time_bem")))
+        rows.append((fmt(shown(row.get("value"), vf)), row.get("status", "?"), shown(row.get("p_max"), pf),
+                     shown(radius, lf), shown(row.get("approach"), lf), row.get("iterations"),
+                     row.get("kkt_residual"), row.get("wall_time_bem")))
     return Table(columns, tuple(rows), status_column="status",
                  caption=f"Every point of the sweep of {summary.get('key')} (summary.json); contact radius "
                          "sqrt(A / pi) for axisymmetric scenes, else the farthest loaded node along x.")
 
 
-def _key_label(key, units):
-    """Axis label of a swept key with its unit in the scene's units (``load.force [N]``)."""
+def _key_unit(key, res):
+    """``(factor, label)``: the swept values of ``key`` are shown as ``value / factor`` in the readable
+    units of ``res`` (:meth:`RunResults.engineering`), labelled ``load.force [N]``."""
     kind = _KEY_KINDS.get(key.rsplit(".", 1)[-1])
-    unit = units.of(kind) if kind else "-"
-    return key if unit == "-" else f"{key} [{unit}]"
+    if kind == "compliance":
+        power = {"root": 0.5, "power": float((res.section("layer") or {}).get("s", 1.0))}.get(
+            getattr(res.layer, "law", None), 1.0)
+        (lf, lu), (pf, pu) = res.engineering("length"), res.engineering("pressure")
+        factor, unit = lf / pf**power, f"{lu}/{pu}" + ("" if power == 1.0 else f"^{power:g}") if lu and pu else ""
+    else:
+        factor, unit = res.engineering(kind) if kind else (1.0, "")
+    return factor, (f"{key} [{unit}]" if unit else key)
 
 
 def _figures(summary, points, work):
@@ -111,7 +131,8 @@ def _figures(summary, points, work):
         return []
     values = [row["value"] for row, _ in done]
     numeric = all(is_number(v) for v in values)
-    alpha = [float(v) for v in values] if numeric else list(range(len(values)))
+    vf, name = _key_unit(str(summary.get("key", "value")), done[0][1])
+    alpha = [float(v) / vf for v in values] if numeric else list(range(len(values)))
     ticks = None if numeric else [str(v) for v in values]
     key, first = str(summary.get("key", "value")), done[0][1]
     x_scale, p_scale = scale(first, "length"), scale(first, "pressure")
@@ -120,14 +141,12 @@ def _figures(summary, points, work):
     curves = [(a_i, np.asarray(res.get("profile")["x"], float) * xf / scale(res, "length")[0],
                np.asarray(res.get("profile")["p"], float) * pf / scale(res, "pressure")[0])
               for a_i, (_, res) in zip(alpha, done)]
-    u = first.units
-    name = _key_label(key, u)
     edge = contact_edge([(x / xf, p) for _, x, p in curves])
     path = plot_sweep(curves, work / "sweep_profiles.png", p0=pf, a=xf, name=name, ticklabels=ticks,
                       labels={"x": axis_label("x", x_scale), "p": axis_label("p", p_scale, "contact pressure ")},
                       cmap="viridis", xlim=(-PAD * edge, PAD * edge),
                       title=f"contact pressure on the axial section as {key} varies")
-    (lu, lf), (pu, pfac) = report_unit(u.length), report_unit(u.pressure)
+    (lf, lu), (pfac, pu) = first.engineering("length"), first.engineering("pressure")
 
     def series(get, factor):
         return np.array([get(res) / factor if get(res) is not None else math.nan for _, res in done])
@@ -142,7 +161,8 @@ def _figures(summary, points, work):
     return [Figure(path, "Contact pressure on the axial section y = 0 of every computed point, coloured by "
                          f"{key}. " + ("Each point divided by its own scales. " if first.scales() else "") + how),
             Figure(path2, f"Peak pressure, contact size (radius sqrt(A / pi) of an axisymmetric contact, else the "
-                          f"half-width along x) and approach against {key}, in the scene's units. " + how)]
+                          f"half-width along x) and approach against {key}"
+                          + (f", in {lu} and {pu}. " if lu and pu else ". ") + how)]
 
 
 def sweep_section(sweep, work):

@@ -13,7 +13,7 @@ import numpy as np
 from bem.checks import InputError
 
 from ..render.content import Figure, Table, fmt
-from ..render.style import display_unit, new_figure, save_figure
+from ..render.style import new_figure, save_figure
 
 __all__ = ["plot_cell_maps", "plot_load_curves", "cell_maps", "sweep_curves", "brick"]
 
@@ -107,10 +107,11 @@ def plot_load_curves(p_mean, fraction, gap, path, *, p_unit, l_unit, p_factor, l
         return save_figure(fig, path)
 
 
-def _units(res, p_mag, l_mag):
-    (p_unit, pf), (l_unit, lf) = display_unit(res.units.pressure, p_mag), display_unit(res.units.length, l_mag)
-    return {"p_unit": p_unit or res.units.of("pressure"), "p_factor": pf, "l_unit": l_unit or res.units.of("length"),
-            "l_factor": lf}
+def _units(res):
+    """The report's pressure and length units (:meth:`RunResults.engineering`: mm and MPa for an SI scene,
+    the scene's own with ``--units scene``), as every other table and figure of the report."""
+    (pf, p_unit), (lf, l_unit) = res.engineering("pressure"), res.engineering("length")
+    return {"p_unit": p_unit or "-", "p_factor": pf, "l_unit": l_unit or "-", "l_factor": lf}
 
 
 def cell_maps(res, work):
@@ -124,15 +125,16 @@ def cell_maps(res, work):
         return None
     labels, n = contact_spots(p > 0)
     size = res.bem.get("size")
-    kw = _units(res, float(p.max()), float(max(size)))
+    kw = _units(res)
+    (lf, lu), (pf, pu) = res.engineering("length"), res.engineering("pressure")
     path = plot_cell_maps(p, labels, size, work / "cell_maps.png", **kw)
     return Figure(path, f"Contact pressure (left) and the {n} contact spots (right) over the periodic cell "
-                        f"({res.bem['cell'][0]} x {res.bem['cell'][1]} nodes of step {fmt(res.bem.get('step'))} "
-                        f"{res.units.of('length')}; bem_field.vtu), each node drawn as one cell of its row, odd rows "
+                        f"({res.bem['cell'][0]} x {res.bem['cell'][1]} nodes of step {fmt(res.bem.get('step') / lf)} "
+                        f"{lu}; bem_field.vtu), each node drawn as one cell of its row, odd rows "
                         "shifted by half a step in the lattice. A spot is a set of nodes in contact connected "
                         "through the lattice's six nearest neighbours, across the cell's edges too (the cell "
                         "repeats): a spot cut by an edge has one colour on both sides. "
-                        f"Mean pressure {fmt(res.data.get('mean_pressure'))} {res.units.of('pressure')}, contact "
+                        f"Mean pressure {fmt(res.data.get('mean_pressure') / pf)} {pu}, contact "
                         f"fraction {fmt(res.data.get('contact_fraction'))}.")
 
 
@@ -144,15 +146,15 @@ def sweep_curves(points, work, key):
     if len(done) < 2:
         return []
     p, a, g = (np.array([r.data[k] for r in done], float) for k in keys)
-    kw = _units(done[0], float(np.median(p)), float(np.abs(g).max()))
+    kw = _units(done[0])
     e_star, slope = done[0].bem.get("E_star"), (done[0].get("surface") or {}).get("rms_slope")
     if isinstance(e_star, (int, float)) and isinstance(slope, (int, float)) and e_star * slope > 0:
         kw["slope_modulus"] = e_star * slope
     path = plot_load_curves(p, a, g, work / "load_curves.png", **kw)
-    u = done[0].units
-    table = Table((f"mean pressure [{u.of('pressure')}]", "contact fraction A/A0", f"mean gap [{u.of('length')}]",
-                   "contact spots"), tuple((fmt(r.data["mean_pressure"]), fmt(r.data["contact_fraction"]),
-                                            fmt(r.data["mean_gap"]), fmt(r.data.get("n_spots"))) for r in done),
+    pf, lf = kw["p_factor"], kw["l_factor"]
+    table = Table((f"mean pressure [{kw['p_unit']}]", "contact fraction A/A0", f"mean gap [{kw['l_unit']}]",
+                   "contact spots"), tuple((fmt(r.data["mean_pressure"] / pf), fmt(r.data["contact_fraction"]),
+                                            fmt(r.data["mean_gap"] / lf), fmt(r.data.get("n_spots"))) for r in done),
                   caption="The periodic cell at each computed point (result.json of each point).")
     return [table, Figure(path, f"Real contact fraction A/A0 against the mean pressure (left) and the mean pressure "
                          f"against the mean gap, the mean-plane separation (right), over the {len(done)} computed "

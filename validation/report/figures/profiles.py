@@ -198,7 +198,7 @@ def measured_points(layer):
     return np.asarray(params["p"], dtype=float), np.asarray(params["w"], dtype=float)
 
 
-def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, marks=()):
+def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, marks=(), p_label=None, w_label=None):
     """The layer laws ``w(p)`` on one plot (paper Fig. 4 b-d); a tabulated law's points as markers.
 
     Parameters
@@ -208,7 +208,9 @@ def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, mark
     p_max : float
         Largest pressure drawn [pressure].
     p_unit, w_unit : str
-        Unit labels of pressure and closure (e.g. ``"MPa"``, ``"µm"``); blank when normalised.
+        Unit labels of pressure and closure (e.g. ``"MPa"``, ``"mm"``); blank when normalised.
+    p_label, w_label : str, optional
+        Axis labels (mathtext) replacing ``pressure $p$ [p_unit]`` and ``layer closure $w(p)$ [w_unit]``.
     marks : sequence of (str, float)
         Labelled vertical lines at special pressures (e.g. ``("p_cr", 0.24)``) [pressure].
     """
@@ -239,7 +241,7 @@ def plot_layer_laws(laws, path, *, p_max, p_unit="", w_unit="", title=None, mark
                         color="#444444", ha="right" if right else "left")
         ax.set_xlim(0.0, p_max)
         ax.set_ylim(0.0, 1.15 * w_top if w_top > 0 else None)  # headroom for the labels of the marks
-        ax.set_xlabel("pressure $p$" + (f" [{p_unit}]" if p_unit else ""))
-        ax.set_ylabel("layer closure $w(p)$" + (f" [{w_unit}]" if w_unit else ""))
+        ax.set_xlabel(p_label or "pressure $p$" + (f" [{p_unit}]" if p_unit else ""))
+        ax.set_ylabel(w_label or "layer closure $w(p)$" + (f" [{w_unit}]" if w_unit else ""))
         ax.legend(loc="upper left", frameon=False)
         return save_figure(fig, path)

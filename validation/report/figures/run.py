@@ -4,11 +4,12 @@ Each figure function takes ``(res, work)`` (the results and the folder its files
 returns a :class:`validation.report.render.Figure`, a list of them, or ``None`` when the results
 cannot support it; :data:`validation.report.figures.FIGURES` registers them.
 
-Units: the scene's, lengths in mm and pressures in MPa for an SI scene
-(:func:`validation.report.render.style.report_unit`), in a window around the contact
-(:func:`profile_view`); a dimensionless report (``contactlab report --units dimensionless``)
-divides by the contact's scales (:meth:`RunResults.scales`: Hertz's ``p_H``, ``a_H`` of a
-paraboloid, else the BEM peak ``p_max`` and the contact half-width ``a_c``).
+Units: those of the whole report (:meth:`RunResults.display`, one per quantity, as in its
+tables): readable ones by default (lengths, layer closures included, in mm and pressures in MPa
+for an SI scene), the scene's own (``contactlab report --units scene``), or lengths and pressures
+divided by the contact's scales (``--units dimensionless``, :meth:`RunResults.scales`: Hertz's
+``p_H``, ``a_H`` of a paraboloid, else the BEM peak ``p_max`` and the contact half-width ``a_c``);
+profiles are drawn in a window around the contact (:func:`profile_view`).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..render.content import Figure, fmt
-from ..render.style import display_unit, method_text, report_unit
+from ..render.style import method_text
 from .profiles import contact_edge
 
 __all__ = ["scale", "axis_label", "Scaled", "ProfileView", "profile_view", "contact_edge", "how", "layer_law",
@@ -34,17 +35,12 @@ _REFERENCE = {"hertz": "Hertz (closed form)", "hertz_elliptic": "Hertz ellipse (
               "rigid_layer": "rigid bodies on the layer (closed form)"}
 
 
-def scale(res, kind, magnitude=None):
+def scale(res, kind):
     """``(factor, name, normalised)``: a ``kind`` (``"length"`` or ``"pressure"``) quantity is drawn
     as ``value / factor``; ``name`` is the symbol of the scale (dimensionless: ``"a_H"``,
-    ``"p_H"``, ...) or the unit drawn in (``"mm"``; with ``magnitude``, the SI prefix that puts
-    it in [1, 1000), :func:`display_unit`)."""
-    scales = res.scales()
-    if scales is not None:
-        return (scales[1], scales[3], True) if kind == "length" else (scales[0], scales[2], True)
-    unit = getattr(res.units, kind)
-    name, factor = report_unit(unit) if magnitude is None else display_unit(unit, magnitude)
-    return factor, name, False
+    ``"p_H"``, ...) or the unit drawn in (``"mm"``): the report's unit of that quantity
+    (:meth:`RunResults.display`), the same in every table and figure."""
+    return res.display(kind)
 
 
 def axis_label(symbol, sc, what=""):
@@ -53,7 +49,7 @@ def axis_label(symbol, sc, what=""):
     _, name, normalised = sc
     if normalised:
         return rf"{what}${symbol}\,/\,{name}$"
-    return f"{what}${symbol}$" + (f" [{name}]" if name else "")
+    return f"{what}${symbol}$" + (f" [{name}]" if name and name != "-" else "")
 
 
 @dataclass(frozen=True)
@@ -98,8 +94,8 @@ def profile_view(res, curves, *, axis="x"):
     (xf, xn, normalised), (pf, pn, _) = length, pressure
     if normalised:
         half = min(PAD * max(edge / xf, 1.0), max(reach, 1.02 * edge) / xf)
-        xn, pn = (f"{n} = {fmt(f)} {res.units.of(k)}".replace(" -", "") for n, f, k in
-                  ((xn, xf, "length"), (pn, pf, "pressure")))
+        xn, pn = (f"{n} = {fmt(f / e)} {u}".rstrip() for n, f, (e, u) in
+                  ((xn, xf, res.engineering("length")), (pn, pf, res.engineering("pressure"))))
     else:
         edge = edge or float(max((np.abs(np.asarray(x, float)).max(initial=0.0) for x, _ in curves), default=1.0)) \
             or 1.0
@@ -119,9 +115,9 @@ def _tolerance(res):
 
 def how(res):
     """One sentence: how the BEM solution was computed."""
-    b, tol = res.bem, _tolerance(res)
+    b, tol, length = res.bem, _tolerance(res), res.display("length")
     text = (f"BEM: {method_text(res.data.get('method'), getattr(res.layer, 'law', None), short=True)}; lattice step "
-            f"c = {fmt(b.get('step'))} {res.units.of('length')}, {b.get('n_nodes', '?')} candidate nodes, "
+            f"c = {fmt(res.shown(b.get('step'), 'length'))} {length.name}, {b.get('n_nodes', '?')} candidate nodes, "
             f"{b.get('n_contact', '?')} in contact")
     if b.get("nodes_across_contact"):
         text += f" ({b['nodes_across_contact']:.0f} across the contact)"
@@ -129,9 +125,9 @@ def how(res):
 
 
 def _fem_how(res):
-    fem = res.fem
+    fem, h = res.fem, res.shown((res.fem.get("mesh") or {}).get("h_fine"), "length")
     return (f"FEM: axisymmetric quadratic triangles, {fmt(fem.get('n_elements_across_contact'), 3)} elements "
-            f"across the contact radius (h = {fmt((fem.get('mesh') or {}).get('h_fine'))} {res.units.of('length')} "
+            f"across the contact radius (h = {fmt(h)} {res.display('length').name} "
             f"there), {fem.get('n_dofs', '?')} DOFs, interface nodal pressures.")
 
 
@@ -162,13 +158,16 @@ def layer_law(res, work):
     p_top = 1.25 * max(float(res.data.get("p_max") or 0.0), *(float(params.get(k) or 0.0) for k in ("p_cr", "p_star")))
     if p_top <= 0:
         return None
-    p_unit, pf = report_unit(res.units.pressure)
-    w_unit, wf = display_unit(res.units.length, float(np.max(res.layer.w(np.linspace(0.0, p_top, 200)))))
-    marks = [(rf"$p_{{max}}$ (BEM) = {fmt(res.data['p_max'] / pf, 3)} {p_unit}".rstrip(), res.data["p_max"] / pf)]
-    marks += [(f"{name} = {fmt(params[key] / pf, 3)} {p_unit}".rstrip(), params[key] / pf)
+    pressure, length = res.display("pressure"), res.display("length")  # the closure w is a length
+    pf, wf = pressure.factor, length.factor
+    # "= 0.74 p_H" or "= 1370 MPa"
+    unit = rf" ${pressure.name}$" if pressure.normalised else f" {pressure.name}".replace(" -", "")
+    marks = [(rf"$p_{{max}}$ (BEM) = {fmt(res.data['p_max'] / pf, 3)}{unit}", res.data["p_max"] / pf)]
+    marks += [(f"{name} = {fmt(params[key] / pf, 3)}{unit}", params[key] / pf)
               for key, name in (("p_cr", r"$p_{cr}$"), ("p_star", r"$p^*$")) if params.get(key)]
     path = plot_layer_laws([(params["law"].replace("_", "-"), Scaled(res.layer, pf, wf))], work / "layer_law.png",
-                           p_max=p_top / pf, p_unit=p_unit, w_unit=w_unit, marks=marks,
+                           p_max=p_top / pf, marks=marks, p_label=axis_label("p", pressure, "pressure "),
+                           w_label=axis_label("w(p)", length, "layer closure "),
                            title="interface layer law: closure $w(p)$ under the pressure $p$")
     return Figure(path, f"The layer law w(p) used by the solver ({params['law']}), rebuilt from the run's result with "
                         "bem.layers.from_dict and evaluated at 200 pressures from 0 to 1.25 times the largest of the "
@@ -260,7 +259,8 @@ def pressure_map(res, work):
                             title="BEM contact pressure over the plane", **kw)
     extra = " The dotted contour is p = p_cr (rigid branch of the layer inside)." if levels else ""
     if elongated:
-        extra += (f" The contact is elongated (half-widths {fmt(ex)} and {fmt(ey)} {res.units.of('length')}): "
+        extra += (f" The contact is elongated (half-widths {fmt(res.shown(ex, 'length'))} and "
+                  f"{fmt(res.shown(ey, 'length'))} {res.display('length').name}): "
                   "x and y are drawn to different scales, the y axis stretched.")
     return Figure(path, "BEM contact pressure over the contact plane, interpolated linearly on the lattice "
                         "triangles (bem_field.vtu); white: the contact boundary, midway between loaded and "
