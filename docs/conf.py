@@ -1,0 +1,47 @@
+"""Sphinx configuration of the contactlab API reference and documentation.
+
+Build (needs the ``docs`` extra): ``python -m sphinx -b html docs docs/_build/html``. The build is
+offline (no intersphinx) and its warnings are errors in ``tests/test_sphinx.py``.
+"""
+
+import re
+import warnings
+
+project = "contactlab"
+author = "the contactlab developers"
+copyright = "the contactlab developers, BSD-3-Clause"
+
+extensions = ["sphinx.ext.autodoc", "sphinx.ext.mathjax", "numpydoc", "myst_parser"]
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+root_doc = "index"
+exclude_patterns = ["_build", "examples", "**/__pycache__"]
+
+# autodoc: members in each module's ``__all__``, in source order; signatures without type hints
+autodoc_default_options = {"members": True, "member-order": "bysource"}
+autodoc_typehints = "none"
+autodoc_mock_imports = []
+# numpydoc: the members are listed by autodoc, not again in a numpydoc table
+numpydoc_show_class_members = False
+numpydoc_attributes_as_param_list = False
+numpydoc_xref_param_type = False
+# numpydoc reports a malformed docstring (an unknown section, a wrong underline) as a Python
+# warning, which ``-W`` does not see: make it an error that stops the build
+warnings.filterwarnings("error", category=UserWarning, module="numpydoc")
+# Markdown pages: GitHub's heading anchors (``scenes.md#sweep-folders``), $...$ maths
+myst_heading_anchors = 4
+myst_enable_extensions = ["dollarmath"]
+
+html_theme = "alabaster"
+html_title = "contactlab"
+
+
+def _report_links(app, docname, source):
+    """Markdown links to files outside ``docs/`` (the generated reports) become file links.
+
+    myst's ``path:`` scheme copies the file into the site, as GitHub shows it beside the page.
+    """
+    source[0] = re.sub(r"\]\((\.\./[^)#\s]+\.md)\)", r"](path:\1)", source[0])
+
+
+def setup(app):
+    app.connect("source-read", _report_links)
