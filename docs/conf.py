@@ -5,13 +5,18 @@ offline (no intersphinx) and its warnings are errors in ``tests/test_sphinx.py``
 """
 
 import re
+import sys
 import warnings
+from pathlib import Path
+
+# the packages of this checkout, whatever is installed
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 project = "contactlab"
 author = "the contactlab developers"
 copyright = "the contactlab developers, BSD-3-Clause"
 
-extensions = ["sphinx.ext.autodoc", "sphinx.ext.mathjax", "numpydoc", "myst_parser"]
+extensions = ["sphinx.ext.autodoc", "numpydoc", "myst_parser"]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "examples", "**/__pycache__"]
@@ -19,17 +24,15 @@ exclude_patterns = ["_build", "examples", "**/__pycache__"]
 # autodoc: members in each module's ``__all__``, in source order; signatures without type hints
 autodoc_default_options = {"members": True, "member-order": "bysource"}
 autodoc_typehints = "none"
-autodoc_mock_imports = []
 # numpydoc: the members are listed by autodoc, not again in a numpydoc table
 numpydoc_show_class_members = False
 numpydoc_attributes_as_param_list = False
 numpydoc_xref_param_type = False
 # numpydoc reports a malformed docstring (an unknown section, a wrong underline) as a Python
-# warning, which ``-W`` does not see: make it an error that stops the build
+# warning, which ``-W`` does not see: as an error, autodoc reports it as a warning of the build
 warnings.filterwarnings("error", category=UserWarning, module="numpydoc")
-# Markdown pages: GitHub's heading anchors (``scenes.md#sweep-folders``), $...$ maths
+# Markdown pages: GitHub's heading anchors (``scenes.md#sweep-folders``)
 myst_heading_anchors = 4
-myst_enable_extensions = ["dollarmath"]
 
 html_theme = "alabaster"
 html_title = "contactlab"
