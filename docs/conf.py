@@ -4,6 +4,7 @@ Build (needs the ``docs`` extra): ``python -m sphinx -b html docs docs/_build/ht
 offline (no intersphinx) and its warnings are errors in ``tests/test_sphinx.py``.
 """
 
+import inspect
 import re
 import sys
 import warnings
@@ -46,5 +47,32 @@ def _report_links(app, docname, source):
     source[0] = re.sub(r"\]\((\.\./[^)#\s]+\.md)\)", r"](path:\1)", source[0])
 
 
+def _defining_comment(package, name, obj):
+    """The ``#:`` comment of ``package.name`` in the submodule that defines it, or ``None``."""
+    from sphinx.errors import PycodeError
+    from sphinx.pycode import ModuleAnalyzer
+
+    for modname, module in sorted(sys.modules.items()):
+        if modname.startswith(package + ".") and getattr(module, name, None) is obj:
+            try:
+                comment = ModuleAnalyzer.for_module(modname).find_attr_docs().get(("", name))
+            except PycodeError:  # a compiled module, no source to read
+                continue
+            if comment:
+                return list(comment)
+    return None
+
+
+def _data_doc(app, what, name, obj, options, lines):
+    """The description of a constant: its ``#:`` comment, in the submodule that defines it for a
+    package's re-export, and never the docstring of its type (``tuple``, ``str``)."""
+    if what == "data":
+        package, _, attr = name.rpartition(".")
+        comment = _defining_comment(package, attr, obj)
+        if comment is not None or " ".join(lines).split() == (inspect.getdoc(type(obj)) or "").split():
+            lines[:] = comment or []
+
+
 def setup(app):
     app.connect("source-read", _report_links)
+    app.connect("autodoc-process-docstring", _data_doc, priority=100)

@@ -30,7 +30,7 @@ DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "tqdm": "tqdm", "meshio": "
                  "dask": "dask", "distributed": "dask", "cupy": "cupy-cuda12x", "pytest": "pytest",
                  "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography",
                  "pyvista": "pyvista", "array_api_compat": "array-api-compat",
-                 "array_api_strict": "array-api-strict"}
+                 "array_api_strict": "array-api-strict", "sphinx": "sphinx"}
 OWN = ("bem", "fem_reference", "validation", "tests")
 
 
