@@ -50,6 +50,7 @@ MAX_NODES = 16_000_000
 
 
 def fail(name, value, rule):
+    """Raise :class:`InputError` with the message ``"{name} = {value!r} is not allowed: it must be {rule}."``."""
     raise InputError(f"{name} = {value!r} is not allowed: it must be {rule}.")
 
 

@@ -30,7 +30,7 @@ DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "tqdm": "tqdm", "meshio": "
                  "dask": "dask", "distributed": "dask", "cupy": "cupy-cuda12x", "pytest": "pytest",
                  "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography",
                  "pyvista": "pyvista", "array_api_compat": "array-api-compat",
-                 "array_api_strict": "array-api-strict"}
+                 "array_api_strict": "array-api-strict", "sphinx": "sphinx"}
 OWN = ("bem", "fem_reference", "validation", "tests")
 
 
@@ -76,9 +76,10 @@ def test_extras_layout():
     assert _extra("gpu") == {"cupy-cuda12x", "array-api-compat"}
     assert _extra("3d") == {"pyvista"}
     assert _extra("rough") == {"surfacetopography"}
+    assert _extra("docs") == {"sphinx", "numpydoc", "myst-parser"}
     assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask") | _extra("rough")
-    assert _extra("test") == _extra("all") | _extra("3d") | {"pytest", "html5lib", "pyyaml", "array-api-strict",
-                                                             "array-api-compat"}
+    assert _extra("test") == _extra("all") | _extra("3d") | _extra("docs") | {
+        "pytest", "html5lib", "pyyaml", "array-api-strict", "array-api-compat"}
 
 
 def test_every_import_is_declared():
