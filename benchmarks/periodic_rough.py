@@ -157,8 +157,9 @@ def case_main(n, pk=True):
         print(json.dumps(rows[-1]), flush=True)
     if pk:
         out, wall, cpu = _pk(n, cell, 0.01)
-        rows.append(dict(solver="plain PK", n=n, wall_s=round(wall, 2), cpu_s=round(cpu, 2), iterations=out["iterations"],
-                         kkt=out["kkt"], fraction=round(out["fraction"], 4), load=_load()))
+        rows.append(dict(solver="plain PK", n=n, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
+                         iterations=out["iterations"], kkt=out["kkt"], fraction=round(out["fraction"], 4),
+                         load=_load()))
         print(json.dumps(rows[-1]), flush=True)
     return rows
 
