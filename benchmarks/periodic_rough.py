@@ -19,9 +19,13 @@ Cases (``--cases``):
 - ``fractions``: iterations and time from 0.1 % to 100 % contact, ours and PK, at
   ``--fraction-size`` (default 512).
 - ``rss``: the peak resident set (``ru_maxrss``) of a fresh process that solves ``main``.
+- ``products``: the cost of one product ``C p``, one preconditioner application ``M r`` and a
+  bare ``rfft2``/``irfft2`` pair of the same number of points, at ``N x N`` (medians of 30).
 
-Every timed solve includes the build of the periodic kernel unless the row says "warm". The
-1-minute load average is printed: the machine may be shared, compare ratios, not absolute times.
+Every timed solve includes the build of the periodic kernel unless the row says "warm". Each row
+gives the wall time and the CPU time of the process (``time.process_time``, all its threads),
+and the 1-minute load average: on a shared machine the wall time grows with the load, the CPU
+time much less; compare ratios within a run, not absolute times across runs.
 
 Run: ``python benchmarks/periodic_rough.py [--cases main ladder fractions rss] [--size 1024]``
 """
@@ -123,18 +127,18 @@ def _load():
 
 
 def _ours(h, cell, pbar, **kw):
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     res = solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=pbar, rtol=1e-10, **kw)
-    return res, time.perf_counter() - t
+    return res, time.perf_counter() - t, time.process_time() - c
 
 
 def _pk(n, cell, pbar, **kw):
     lx, ly = cell.size
     h = _on_grid(lx, ly, (n, n))
     h = h.max() - h
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     out = plain_pk(h, cell.size, pbar, **kw)
-    return out, time.perf_counter() - t
+    return out, time.perf_counter() - t, time.process_time() - c
 
 
 def _root(cell):
@@ -146,15 +150,16 @@ def case_main(n, pk=True):
     h = surface_on_cell(cell)
     rows = []
     for name, kw in (("ours", {}), ("ours warm", {}), ("ours root layer", {"layer": _root(cell)})):
-        res, wall = _ours(h, cell, 0.01, **kw)
-        rows.append(dict(solver=name, n=n, wall_s=round(wall, 2), iterations=res.iterations,
+        res, wall, cpu = _ours(h, cell, 0.01, **kw)
+        rows.append(dict(solver=name, n=n, wall_s=round(wall, 2), cpu_s=round(cpu, 2), iterations=res.iterations,
                          n_matvec=res.n_matvec, kkt=res.kkt_residual, fraction=round(res.contact_fraction, 4),
                          converged=res.converged, load=_load()))
         print(json.dumps(rows[-1]), flush=True)
     if pk:
-        out, wall = _pk(n, cell, 0.01)
-        rows.append(dict(solver="plain PK", n=n, wall_s=round(wall, 2), iterations=out["iterations"],
-                         kkt=out["kkt"], fraction=round(out["fraction"], 4), load=_load()))
+        out, wall, cpu = _pk(n, cell, 0.01)
+        rows.append(dict(solver="plain PK", n=n, wall_s=round(wall, 2), cpu_s=round(cpu, 2),
+                         iterations=out["iterations"], kkt=out["kkt"], fraction=round(out["fraction"], 4),
+                         load=_load()))
         print(json.dumps(rows[-1]), flush=True)
     return rows
 
@@ -171,7 +176,7 @@ def case_ladder(n):
     h = surface_on_cell(cell)
     first, half = 1e-5, 0.13 * _full_contact_pressure(cell, h)  # 50 % contact at 512^2
     loads = np.geomspace(first, half, 20)
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     p, iters, fractions = None, 0, []
     for pbar in loads:
         res = solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=pbar, rtol=1e-10, x0=p)
@@ -179,7 +184,8 @@ def case_ladder(n):
         iters += res.iterations
         fractions.append(round(res.contact_fraction, 4))
         assert res.converged, res.message
-    row = dict(case="ladder", n=n, loads=len(loads), wall_s=round(time.perf_counter() - t, 2), iterations=iters,
+    row = dict(case="ladder", n=n, loads=len(loads), wall_s=round(time.perf_counter() - t, 2),
+               cpu_s=round(time.process_time() - c, 2), iterations=iters,
                first=first, last=float(half), fractions=fractions, load=_load())
     print(json.dumps(row), flush=True)
 
@@ -189,8 +195,8 @@ def case_fractions(n):
     h = surface_on_cell(cell)
     full = _full_contact_pressure(cell, h)
     for ratio in (1e-4, 1e-3, 0.01, 0.1, 0.3, 0.6, 0.9, 1.1):
-        res, wall = _ours(h, cell, ratio * full)
-        out, wall_pk = _pk(n, cell, ratio * full)
+        res, wall, _ = _ours(h, cell, ratio * full)
+        out, wall_pk, _ = _pk(n, cell, ratio * full)
         print(json.dumps(dict(case="fractions", n=n, pbar_over_full=ratio, fraction=round(res.contact_fraction, 5),
                               iterations=res.iterations, wall_s=round(wall, 2), pk_iterations=out["iterations"],
                               pk_fraction=round(out["fraction"], 5), pk_wall_s=round(wall_pk, 2),
@@ -205,9 +211,27 @@ def case_rss(n):
     print(out.stdout.strip().splitlines()[-1], flush=True)
 
 
+def case_products(n, repeat=30):
+    cell = PeriodicCell(1.0 / n, n, n)
+    op = bem.PeriodicOperator(cell, 1.0)
+    precondition = op.preconditioner()
+    v = np.random.default_rng(SEED).standard_normal(cell.shape)
+    workers = bem.fft.threads()
+    pair = lambda: sfft.irfft2(sfft.rfft2(v, workers=workers), s=v.shape, workers=workers)  # noqa: E731
+    for name, f in (("C p", lambda: op.matvec(v)), ("M r", lambda: precondition(v)), ("rfft2 + irfft2", pair)):
+        times = []
+        for _ in range(repeat):
+            t, c = time.perf_counter(), time.process_time()
+            f()
+            times.append((time.perf_counter() - t, time.process_time() - c))
+        wall, cpu = np.median(times, axis=0) * 1e3
+        print(json.dumps(dict(case="products", n=n, what=name, wall_ms=round(wall, 2), cpu_ms=round(cpu, 2),
+                              load=_load())), flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", nargs="+", default=["main", "ladder", "fractions", "rss"])
+    parser.add_argument("--cases", nargs="+", default=["main", "ladder", "fractions", "rss", "products"])
     parser.add_argument("--size", type=int, default=1024)
     parser.add_argument("--ladder-size", type=int, default=512)
     parser.add_argument("--fraction-size", type=int, default=512)
@@ -216,7 +240,8 @@ def main():
         print(f"# {os.cpu_count()} CPUs, bem.fft.threads() = {bem.fft.threads()}, load {f.read().strip()}")
     for case in args.cases:
         {"main": lambda: case_main(args.size), "ladder": lambda: case_ladder(args.ladder_size),
-         "fractions": lambda: case_fractions(args.fraction_size), "rss": lambda: case_rss(args.size)}[case]()
+         "fractions": lambda: case_fractions(args.fraction_size), "rss": lambda: case_rss(args.size),
+         "products": lambda: case_products(args.size)}[case]()
 
 
 if __name__ == "__main__":
