@@ -36,14 +36,14 @@ from functools import partial
 
 import numpy as np
 
-from bem import METHODS, InputError
+from bem import InputError
 from bem.checks import check_node_count
 
 from ..extras import require as require_extra
 from . import checks as ck
 from .measured import _factor as length_factor
 from .paper import is_paper_law
-from .sizing import _solver_options
+from .sizing import solver_options
 
 __all__ = ["RoughGap", "ROUGH_TYPES", "GAP_KEYS", "GAP_UNITS", "PERIODIC_KEYS", "rough_gap", "bem_section"]
 
@@ -154,10 +154,7 @@ def _periodic(d, gap, layer_spec, layer, load):
     if layer_spec is not None and is_paper_law(layer_spec):
         raise ck.SceneError(f"layer.law = {layer_spec['law']!r} given by the paper's parameters is not allowed with "
                             "bem.periodic = true: give the law's own parameters (e.g. lam).")
-    out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
-    out.update(ck.options("bem", d, {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1),
-                                     "precondition": ck.boolean, "nested": ck.boolean}))
-    out.update(_solver_options(d, out["method"], layer_spec))
+    out = solver_options(d, layer_spec)
     n_cols = ck.integer("bem.cell_nodes", d.get("cell_nodes", gap.surface.heights.shape[0]), 8, 8192)
     try:
         lattice = gap.surface.to_lattice(n_cols)

@@ -64,7 +64,17 @@ def _expected(gap, layer_spec, layer, E_star, load):
     return _axes(gap, layer, E_star, load)
 
 
-def _solver_options(d, method, layer_spec):
+def solver_options(d, layer_spec):
+    """``[bem]``'s method and the options of every solver, those of the one that will run checked
+    by the BEM itself (shared by lattice and periodic scenes)."""
+    out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
+    out.update(ck.options("bem", d, {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1),
+                                     "precondition": ck.boolean, "nested": ck.boolean}))
+    out.update(_own_options(d, out["method"], layer_spec))
+    return out
+
+
+def _own_options(d, method, layer_spec):
     """The options of the solver that will run, checked by the BEM itself."""
     kind = None if layer_spec is None else ("linear" if layer_spec["law"] == "linear" else "nonlinear")
     if method == "kalker" and kind == "nonlinear":
@@ -129,10 +139,7 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
         if a in d and b in d:
             raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
                                 "give one of them.")
-    out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
-    out.update(ck.options("bem", d, {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1),
-                                     "precondition": ck.boolean, "nested": ck.boolean}))
-    out.update(_solver_options(d, out["method"], layer_spec))
+    out = solver_options(d, layer_spec)
     step = ck.positive("bem.step", d["step"]) if "step" in d else None
     n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
     axes = _expected(gap, layer_spec, layer, E_star, load)
