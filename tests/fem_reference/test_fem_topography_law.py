@@ -5,7 +5,7 @@ import logging
 
 import numpy as np
 import pytest
-from .fem_cases import E, E_SOFT, NU, NU_SOFT, P, R, e_star
+from .fem_cases import E, E_SOFT, NU, NU_SOFT, P, e_star
 
 import bem
 import fem_reference as fr
