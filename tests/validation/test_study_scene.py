@@ -113,3 +113,21 @@ def test_bad_study_section_is_refused_naming_the_key(tmp_path, body, key, hint):
 def test_study_scene_refuses_an_override_of_an_unknown_option(tmp_path):
     code, _, err = cli("check", "rough_sphere_two_scale", "--set", "study.quikc=false")
     assert code == 2 and "study.quikc" in err and "Did you mean 'quick'?" in err
+
+
+@pytest.mark.parametrize("argv, what", [
+    (("report", "rough_sphere_two_scale"), "a report of a scene"),
+    (("sweep", "rough_sphere_two_scale", "--param", "study.quick", "--values", "false"), "a sweep"),
+])
+def test_commands_of_one_contact_problem_refuse_a_study_scene(tmp_path, argv, what):
+    code, _, err = cli(*argv, "--out", tmp_path / "out")
+    assert code == 2 and what in err and "contactlab run rough_sphere_two_scale" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_runner_refuses_a_study_scene():
+    from validation.run import execute_scene
+    from validation.scene import SceneError
+
+    with pytest.raises(SceneError, match="runs the built-in study 'two-scale'"):
+        execute_scene("rough_sphere_two_scale")

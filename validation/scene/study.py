@@ -15,7 +15,7 @@ from . import checks as ck
 from . import schema as sec
 from .checks import SceneError, closest
 
-__all__ = ["StudyScene", "STUDY_OPTIONS", "is_study_scene", "parse_study_scene"]
+__all__ = ["StudyScene", "STUDY_OPTIONS", "is_study_scene", "parse_study_scene", "refuse_study"]
 
 #: study name -> {option: check(dotted key, value)}
 STUDY_OPTIONS = {"two-scale": {"quick": ck.boolean}}
@@ -67,3 +67,12 @@ def parse_study_scene(raw, source="<dict>", overrides=()):
     ck.unknown_keys("study", study, ["name", *rules])
     return StudyScene(name=meta["name"], title=meta["title"], description=meta["description"], source=source,
                       raw=raw, study=name, options=ck.options("study", study, rules), overrides=tuple(overrides))
+
+
+def refuse_study(scene, what):
+    """Raise :class:`SceneError` when ``scene`` is a :class:`StudyScene`: ``what`` (``"a sweep"``)
+    needs one contact problem, and the scene runs a study (``contactlab run`` does)."""
+    if isinstance(scene, StudyScene):
+        raise SceneError(f"scene = {scene.name!r} is not allowed: {what} needs a contact problem, and this scene "
+                         f"runs the built-in study {scene.study!r} ([study]); run it with `contactlab run "
+                         f"{scene.name}` and report its result folder.")
