@@ -19,6 +19,9 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [report]   only when wanted: sections, format
     [stress]   only when wanted: depths ("auto" or a list [m]), n_depths, max_depth, bodies
 
+A scene with ``[study]`` (name, options) and ``[scene]`` alone runs a built-in study instead
+(:mod:`validation.scene.study`); it loads as a :class:`~validation.scene.study.StudyScene`.
+
 :func:`load_scene` validates the WHOLE scene (every point of its sweep included) before any
 work: unknown keys, wrong types, out-of-range values, missing keys and impossible combinations
 raise :class:`SceneError` whose message names the dotted key (``layer.lam``), the value and
