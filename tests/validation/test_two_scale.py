@@ -53,7 +53,10 @@ def test_study_writes_json_and_table_and_figures(tiny, tmp_path):
     from validation.report.documents.studies import report_studies_dir
 
     report_studies_dir(tmp_path, tmp_path / "report")
-    assert "Two-scale check" in (tmp_path / "report" / "report.md").read_text()
+    md = (tmp_path / "report" / "report.md").read_text()
+    assert "Two-scale check" in md
+    for name in ("two_scale_map.png", "two_scale_profile.png"):  # drawn from the JSON alone
+        assert f"figures/{name}" in md and (tmp_path / "report" / "figures" / name).is_file()
     from PIL import Image
 
     for path in plot_two_scale(data, tiny["fields"], tmp_path):

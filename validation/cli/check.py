@@ -19,9 +19,13 @@ def add_args(p):
 
 def run(args):
     from ..extras import require as require_extra
-    from ..scene import check_scene
+    from ..scene import StudyScene, check_scene
 
     scene = check_scene(args.scene, overrides=args.overrides, allow_outside_files=args.allow_outside_files)
+    if isinstance(scene, StudyScene):
+        options = ", ".join(f"{k} = {'true' if v is True else 'false' if v is False else repr(v)}" for k, v in scene.options.items())
+        print(f"{scene.name}: OK (study {scene.study}{', ' + options if options else ''})")
+        return 0
     if scene.fem is not None:
         require_extra("fem", f"[fem] of scene {scene.name!r} (the FEM reference; contactlab run --no-fem skips it)")
     parts = ["bem"] + [k for k in ("fem", "analytic", "sweep", "stress", "report") if getattr(scene, k) is not None]

@@ -8,13 +8,15 @@ from pathlib import Path
 from .common import add_set, add_trust, trust
 
 PARSER = {"help": "run a scene and write its result directory",
-          "description": "Run a scene: the BEM, and the FEM/closed form/comparison it names.\n"
+          "description": "Run a scene: the BEM, and the FEM/closed form/comparison it names; a scene with\n"
+                         "[study] runs that built-in study and writes its files (docs/scenes.md).\n"
                          "--out DIR is the result directory itself; it must be new, empty or a result\n"
                          "directory contactlab wrote (marked by DIR/.contactlab), which is replaced.",
           "epilog": "examples:\n  contactlab run hertz                         writes results/hertz/\n"
                     "  contactlab run my.toml --out out/my --set bem.method=\"augmented_gap\"\n"
                     "                                               writes out/my/result.json, ...\n"
-                    "  contactlab run punch --set fem.n_contact=32"}
+                    "  contactlab run punch --set fem.n_contact=32\n"
+                    "  contactlab run rough_sphere_two_scale       the small two-scale check (a [study] scene)"}
 
 
 def add_args(p):
@@ -114,15 +116,42 @@ class _StageBar:
         self.bar.close()
 
 
+def _run_study(scene, out_dir, what, value):
+    """Run the built-in study of a ``[study]`` scene; write its files, the scene and the marker into ``out_dir``."""
+    import importlib
+
+    import tomli_w
+    from bem.files import write_text
+
+    from ..io import atomic_directory, check_output_dir, output_errors, recover_output_dir
+    from .study import STUDIES
+
+    study = importlib.import_module(STUDIES[scene.study])
+    names = (*study.OUTPUT_NAMES, "scene.toml", "report")
+    with output_errors(out_dir, what):
+        recover_output_dir(out_dir)
+        check_output_dir(out_dir, "result", names, what=what, value=value)  # before the study runs
+    with atomic_directory(out_dir, "result", names, what=what) as tmp:
+        data, _, _ = study.write_study(tmp, **scene.options)
+        write_text(tmp / "scene.toml", tomli_w.dumps(scene.raw))
+    lines = [f"scene      {scene.name}: {scene.title}   [study {scene.study}]"]
+    lines += [f"error      {line}" for line in study.summary_lines(data)]
+    lines.append(f"files      {out_dir}/ ({', '.join(names[:-1])})")
+    print("\n".join(lines))
+    return 0
+
+
 def run(args):
     from ..run import check_result_dir, execute_scene, planned_stages, write_outputs
-    from ..scene import load_scene
+    from ..scene import StudyScene, load_scene
 
     scene = load_scene(args.scene, overrides=args.overrides, no_fem=args.no_fem, **trust(args))
     if args.out:
         out_dir, what, value = Path(args.out), "--out", None
     else:
         out_dir, what, value = Path("results") / scene.name, "scene.name", scene.name
+    if isinstance(scene, StudyScene):
+        return _run_study(scene, out_dir, what, value)
     check_result_dir(out_dir, what=what, value=value)  # before the solve
     bar = _StageBar(planned_stages(scene, write=True), args.no_progress or None)
     try:

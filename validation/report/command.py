@@ -141,6 +141,7 @@ def _report_scene(target, out, args, *, units, fmt, progress):
     """Run a scene into ``results/NAME`` and report it into ``out`` (default ``results/NAME/report``)."""
     from validation.run import check_result_dir, run_scene
     from validation.scene import load_scene
+    from validation.scene.study import refuse_study
 
     from .documents.sections import report_results_dir
     from .render.build import check_report_dir
@@ -148,6 +149,7 @@ def _report_scene(target, out, args, *, units, fmt, progress):
     scene = load_scene(target, overrides=getattr(args, "overrides", None) or None,
                        allow_code=bool(getattr(args, "allow_code", False)),
                        allow_outside_files=bool(getattr(args, "allow_outside_files", False)))
+    refuse_study(scene, "a report of a scene")
     result_dir = Path("results") / scene.name
     out_dir = result_dir / "report" if out is None else Path(out)
     check_result_dir(result_dir, what="scene.name", value=scene.name)

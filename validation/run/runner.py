@@ -23,6 +23,7 @@ from ..io import atomic_directory, atomic_write_json, check_output_dir, output_e
 from ..scene import paper
 from ..scene.checks import SceneError
 from ..scene.load import Scene, load_scene
+from ..scene.study import refuse_study
 from ..scene.trust import refuse_code
 from ..scene.sizing import DOMAIN_MARGIN, SOLVER_KEYS, inner_domain
 from .result import build_result
@@ -150,6 +151,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
     t0 = time.perf_counter()
     if not isinstance(scene, Scene) or overrides:
         scene = load_scene(scene, overrides=overrides)
+    refuse_study(scene, "a run of the solvers")
     if scene.unimported:
         raise SceneError(refuse_code(*scene.unimported[0]))
     if scene.bem.get("periodic"):

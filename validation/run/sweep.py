@@ -41,6 +41,7 @@ from ..io import atomic_write_json, check_output_dir, write_marker
 from ..scene.checks import SceneError, sweep_size
 from ..scene.load import Scene, apply_overrides, load_scene, parse_scene
 from ..scene.paper import ALIASES
+from ..scene.study import refuse_study
 from .cluster import DEFAULT_TIMEOUT, dask_client, scheduler_address
 from .pool import worker_pool
 from .sweep_folder import SWEPT, earlier_points, file_digests, fingerprint, keyed, other_point
@@ -165,6 +166,7 @@ def sweep_points(scene, parameter=None, values=None, *, overrides=None):
         Applied to the base scene first.
     """
     base = scene if isinstance(scene, Scene) and not overrides else load_scene(scene, overrides=overrides)
+    refuse_study(base, "a sweep")
     if parameter is None and values is None and base.sweep is not None:
         parameter, values = base.sweep["parameter"], base.sweep["values"]
     if parameter is None or values is None:

@@ -19,6 +19,9 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [report]   only when wanted: sections, format
     [stress]   only when wanted: depths ("auto" or a list [m]), n_depths, max_depth, bodies
 
+A scene with ``[study]`` (name, options) and ``[scene]`` alone runs a built-in study instead
+(:mod:`validation.scene.study`); it loads as a :class:`~validation.scene.study.StudyScene`.
+
 :func:`load_scene` validates the WHOLE scene (every point of its sweep included) before any
 work: unknown keys, wrong types, out-of-range values, missing keys and impossible combinations
 raise :class:`SceneError` whose message names the dotted key (``layer.lam``), the value and
@@ -43,6 +46,7 @@ from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
 from .rough import bem_section
 from .sizing import EXCLUSIVE as BEM_EXCLUSIVE
 from .source import builtin_path, builtin_scenes, read_source, read_toml
+from .study import StudyScene, is_study_scene, parse_study_scene
 from .layer_file import EXCLUSIVE as FILE_EXCLUSIVE
 from .layer_file import resolve_layer_file
 from .trust import check_code_name, code_names, refuse_code, scene_file
@@ -307,6 +311,8 @@ def _resolve_files(raw, base_dir, allow_outside):
 def _parse(raw, source, overrides, base_dir, code, allow_outside_files, no_fem=False):
     overrides = list(overrides.items()) if isinstance(overrides, dict) else list(overrides or ())
     raw = apply_overrides(raw, overrides)
+    if is_study_scene(raw):
+        return parse_study_scene(raw, source, [o if isinstance(o, str) else f"{o[0]}={o[1]!r}" for o in overrides])
     skipped = ("fem",) if no_fem and "fem" in raw else ()
     raw = {k: v for k, v in raw.items() if k not in skipped}
     kw = {"base_dir": Path.cwd() if base_dir is None else Path(base_dir), "code": code,
@@ -319,7 +325,8 @@ def _parse(raw, source, overrides, base_dir, code, allow_outside_files, no_fem=F
 
 def parse_scene(raw, *, source="<dict>", overrides=None, base_dir=None, allow_code=False,
                 allow_outside_files=False, no_fem=False):
-    """Validate a scene given as a dict (the parsed TOML); returns a :class:`Scene`.
+    """Validate a scene given as a dict (the parsed TOML); returns a :class:`Scene`, or a
+    :class:`~validation.scene.study.StudyScene` for a scene with ``[study]``.
 
     ``base_dir`` is the folder that relative file names in the scene (``gap.file``) start
     from: the scene file's folder (:func:`load_scene`), the current directory by default.
@@ -338,7 +345,7 @@ def parse_scene(raw, *, source="<dict>", overrides=None, base_dir=None, allow_co
         contactlab[fem]"); nothing has run.
     """
     scene = _parse(raw, source, overrides, base_dir, "import" if allow_code else "refuse", allow_outside_files, no_fem)
-    if scene.fem is not None:
+    if not isinstance(scene, StudyScene) and scene.fem is not None:
         require_extra("fem", f"[fem] of scene {scene.name!r} (the FEM reference)")
     return scene
 
@@ -364,8 +371,9 @@ def load_scene(source, *, overrides=None, allow_code=False, allow_outside_files=
     SceneError
         Anything wrong in the scene (the message names the key), or an unknown scene.
     """
-    if isinstance(source, Scene):
-        return parse_scene(source.raw, source=source.source, overrides=overrides, no_fem=no_fem, **source.trust)
+    if isinstance(source, (Scene, StudyScene)):
+        trust = source.trust if isinstance(source, Scene) else {}
+        return parse_scene(source.raw, source=source.source, overrides=overrides, no_fem=no_fem, **trust)
     kw = {"allow_code": allow_code, "allow_outside_files": allow_outside_files, "no_fem": no_fem}
     if isinstance(source, dict):
         return parse_scene(source, overrides=overrides, **kw)

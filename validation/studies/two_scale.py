@@ -38,7 +38,11 @@ from . import fmt, save
 from .two_scale_models import (TiledRoughness, greenwood_tripp_law, nominal_radius, spectral_moments,
                                windowed)
 
-__all__ = ["SETTINGS", "QUICK", "make_surface", "run_case", "run_two_scale", "refinement", "main"]
+__all__ = ["SETTINGS", "QUICK", "make_surface", "run_case", "run_two_scale", "refinement", "write_study",
+           "summary_lines", "OUTPUT_NAMES", "main"]
+
+#: the files :func:`write_study` writes
+OUTPUT_NAMES = ("two_scale.json", "two_scale.md", "two_scale_map.png", "two_scale_profile.png")
 
 #: the full study (SI units)
 SETTINGS = dict(E_star=115e9, hurst=0.8, roll_off=20e-6, cutoff_ratio=4, cell_roll_offs=4, rms_height=0.1e-6,
@@ -152,10 +156,14 @@ def run_case(s, surface, laws, ratio, load_factor):
 
 
 def run_two_scale(settings=None, *, quick=False, keep=False, progress=None):
-    """Run the two-scale check; returns a JSON-ready dict (``rows``, ``refinement``, ``settings``).
+    """Run the two-scale check; returns a JSON-ready dict (``rows``, ``refinement``, ``settings``,
+    ``figure``: what the figures of the first case draw,
+    :func:`validation.report.figures.two_scale.figure_data`).
 
     ``keep``: also return the fields of the first case (for the figures) under ``"fields"``.
     """
+    from ..report.figures.two_scale import figure_data
+
     s = dict(QUICK if quick else SETTINGS, **(settings or {}))
     surface = make_surface(s)
     R, P1 = _sphere(s, min(s["ratios"]))  # the highest pressure: smallest sphere, heaviest load
@@ -173,7 +181,7 @@ def run_two_scale(settings=None, *, quick=False, keep=False, progress=None):
     out = {"study": "two_scale", "mode": "quick" if quick else "full",
            "settings": {k: list(v) if isinstance(v, tuple) else v for k, v in s.items()},
            "surface": surface.stats.as_dict(), "first_touch_gap": float(laws[0].first_touch_gap),
-           "rows": rows, "refinement": refinement(s, surface)}
+           "rows": rows, "refinement": refinement(s, surface), "figure": figure_data(fields)}
     if keep:
         out["fields"] = fields
     return out
@@ -222,6 +230,37 @@ def table(data):
     return heads, rows
 
 
+def write_study(out, *, quick=False):
+    """Run the check and write :data:`OUTPUT_NAMES` into the folder ``out``: the JSON, its tables as
+    Markdown and the two figures of the first case (needs the ``rough`` and ``report`` extras).
+
+    Returns ``(data, markdown, figure files)``.
+    """
+    from types import SimpleNamespace
+
+    from ..extras import require
+    from ..report.figures.two_scale import plot_two_scale
+
+    require("rough", "the two-scale check (the self-affine surface)")
+    require("report", "the two-scale check (its figures)")
+    data = run_two_scale(quick=quick, keep=True)
+    fields = data.pop("fields")
+    text = save(SimpleNamespace(out=str(out)), "two_scale", data)
+    return data, text, plot_two_scale(data, fields, out)
+
+
+def summary_lines(data):
+    """The key errors of the layer model and of Greenwood-Tripp per case: lines for a terminal."""
+    lines = []
+    for r in data["rows"]:
+        case = f"a_H/lambda_L = {r['ratio']:g}, P = {r['load_factor']:g} P1"
+        for model, name in (("layer", "layer model"), ("gt", "Greenwood-Tripp")):
+            lines.append(f"{case}, {name}: approach {r[f'{model}_approach_err']:+.2%}, radius "
+                         f"{r[f'{model}_radius_err']:+.2%}, windowed pressure L2 {r[f'{model}_l2_err']:.2%} "
+                         f"(over {WIDE} lambda_L {r[f'{model}_l2_wide_err']:.2%})")
+    return lines
+
+
 def main(args):
     """``contactlab study two-scale [--quick] [--out DIR]``: writes ``two_scale.json``, ``two_scale.md``
     and the two figures of the first case (needs the ``rough`` and ``report`` extras); prints the Markdown."""
@@ -229,20 +268,11 @@ def main(args):
 
     from bem.checks import InputError
 
-    from ..extras import require
-
     if getattr(args, "scene", None):
         raise InputError(f"scene = {args.scene!r} is not allowed: the two-scale study takes no scene "
                          "(--quick chooses the small run).")
-    require("rough", "contactlab study two-scale (the self-affine surface)")
-    require("report", "contactlab study two-scale (its figures)")
-    quick = bool(getattr(args, "quick", False))
-    data = run_two_scale(quick=quick, keep=True)
-    fields = data.pop("fields")
-    print(save(args, "two_scale", data))
-    from ..report.figures.two_scale import plot_two_scale
-
-    out = Path(getattr(args, "out", None) or ".")
-    for path in plot_two_scale(data, fields, out):
+    _, text, files = write_study(Path(getattr(args, "out", None) or "."), quick=bool(getattr(args, "quick", False)))
+    print(text)
+    for path in files:
         print(f"figure: {path}")
     return 0

@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
-from ..render import Section, Table
+from ..render import Figure, Section, Table
 
 __all__ = ["two_scale_sections"]
 
 
 def two_scale_sections(data, work=None):
-    """The errors table and the refinement table of a ``two_scale.json``; no figures (``contactlab
-    study two-scale`` draws them beside the file)."""
-    from validation.studies.two_scale import table
+    """The errors table, the refinement table and, with a figures folder ``work``, the pressure map
+    and the windowed profile of the first case, drawn from the file's ``figure``."""
+    from validation.studies.two_scale import WIDE, table
 
     heads, rows = table(data)
     s = data.get("settings", {})
@@ -22,6 +22,16 @@ def two_scale_sections(data, work=None):
             "solution: approach (both from the flat touching the highest summit's plane at the apex), nominal "
             "radius (99 % of the force), pressure averaged over windows of lambda_L (L2 over the windows, peak)."]
     items = [Table(heads, tuple(rows), caption="Two-scale errors of the layer model and of Greenwood-Tripp.")]
+    if work is not None and data.get("figure"):
+        from ..figures.two_scale import plot_two_scale_data
+
+        map_png, profile_png = plot_two_scale_data(data["figure"], work)
+        items += [Figure(map_png, "The resolved rough sphere's pressure (mean over square pixels) with the nominal "
+                                  "contact circles (99 % of the force) of the resolved solution and of the layer "
+                                  "model."),
+                  Figure(profile_png, "Along y = 0: the resolved pressure averaged over windows of lambda_L (and "
+                                      f"of {WIDE} lambda_L), the layer model's nodal pressure and its window "
+                                      "means, and Greenwood-Tripp's nodal pressure.")]
     ref = data.get("refinement")
     if ref:
         items.append(Table(

@@ -6,6 +6,9 @@
 - :func:`plot_windowed_profile`: along ``y = 0``, the resolved pressure averaged over windows of
   one roll-off wavelength, the layer model's nodal pressure and its window averages, and
   Greenwood and Tripp's.
+
+:func:`figure_data` keeps what the two figures draw, small enough for ``two_scale.json``
+(a binned map and the profiles); :func:`plot_two_scale_data` draws them from it (the studies report).
 """
 
 from __future__ import annotations
@@ -16,7 +19,11 @@ import numpy as np
 
 from ..render.style import color_for, new_figure, save_figure
 
-__all__ = ["binned_map", "window_row", "plot_pressure_map", "plot_windowed_profile", "plot_two_scale"]
+__all__ = ["binned_map", "window_row", "plot_pressure_map", "plot_pressure_image", "plot_windowed_profile",
+           "plot_profile_curves", "plot_two_scale", "figure_data", "plot_two_scale_data"]
+
+#: pixels across the pressure map kept in ``two_scale.json``
+JSON_PIXELS = 96
 
 
 def binned_map(x, y, p, extent, pixels=400):
@@ -44,11 +51,21 @@ def window_row(x, y, p, width):
 def plot_pressure_map(x, y, p, *, extent, radius, layer_radius, path, title=None):
     """The pressure map [GPa] over ``[-extent, extent]^2`` [um] with the nominal contact circles; returns the file.
 
-    Pixels of about two lattice steps (at most 400 across) hold several nodes each; the colour
-    scale ends at the 99.5th percentile of the pixels, brighter ones are drawn at its end.
+    Pixels of about two lattice steps (at most 400 across) hold several nodes each
+    (:func:`plot_pressure_image`).
     """
     step = np.sqrt(4 * extent**2 / max(np.asarray(x).size, 1))  # about the node spacing
     edges, image = binned_map(x, y, p, extent, pixels=int(min(400, max(8, extent / step))))
+    return plot_pressure_image(edges, image, radius=radius, layer_radius=layer_radius, path=path, title=title)
+
+
+def plot_pressure_image(edges, image, *, radius, layer_radius, path, title=None):
+    """A binned pressure map ``image`` [Pa] on square pixels with ``edges`` [m] and the circles of
+    ``radius`` (resolved) and ``layer_radius`` [m]; returns the file.
+
+    The colour scale ends at the 99.5th percentile of the pixels, brighter ones are drawn at its end.
+    """
+    edges, image = np.asarray(edges, dtype=float), np.asarray(image, dtype=float)
     t = np.linspace(0, 2 * np.pi, 361)
     with new_figure((5.6, 4.8), title=title) as (fig, ax):
         im = ax.pcolormesh(edges * 1e6, edges * 1e6, image / 1e9, cmap="viridis", shading="flat",
@@ -66,26 +83,46 @@ def plot_pressure_map(x, y, p, *, extent, radius, layer_radius, path, title=None
         return save_figure(fig, path)
 
 
+def profile_curves(resolved, layer, gt, *, width, wide=None):
+    """The curves of the windowed profile along ``y = 0``: ``{name: (x [m], p [Pa])}``.
+
+    ``resolved`` (window means of ``width``, and of ``wide`` when given), ``layer`` (nodal),
+    ``layer_windows`` (its window means), ``gt`` (nodal); each argument an ``(x, y, p)`` of nodal values.
+    """
+    from .profiles import axial_section
+
+    out = {"resolved": window_row(*resolved, width)}
+    if wide:
+        out["resolved_wide"] = window_row(*resolved, wide)
+    out.update(layer=axial_section(*layer), layer_windows=window_row(*layer, width), gt=axial_section(*gt))
+    return out
+
+
 def plot_windowed_profile(resolved, layer, gt, *, width, path, title=None, wide=None):
     """Windowed pressure along ``y = 0`` [GPa] against x [um]; each argument an ``(x, y, p)`` of nodal values.
 
     ``wide`` (optional): a second window width [length], the resolved pressure's means over it drawn too.
     """
-    from .profiles import axial_section
+    return plot_profile_curves(profile_curves(resolved, layer, gt, width=width, wide=wide), width=width, wide=wide,
+                               path=path, title=title)
 
+
+def plot_profile_curves(curves, *, width, path, title=None, wide=None):
+    """The windowed profile from :func:`profile_curves` (``curves``: name -> ``(x [m], p [Pa])``); returns the file."""
+    c = {k: (np.asarray(x, dtype=float), np.asarray(p, dtype=float)) for k, (x, p) in curves.items()}
     with new_figure((6.4, 4.0), title=title) as (fig, ax):
-        xr, pr = window_row(*resolved, width)
+        xr, pr = c["resolved"]
         ax.step(xr * 1e6, pr / 1e9, where="mid", color=color_for("", 0), lw=1.6,
                 label=f"resolved, mean over {width * 1e6:g} um windows")
-        if wide:
-            xw, pw = window_row(*resolved, wide)
+        if wide and "resolved_wide" in c:
+            xw, pw = c["resolved_wide"]
             ax.step(xw * 1e6, pw / 1e9, where="mid", color=color_for("", 3), lw=1.2,
                     label=f"resolved, mean over {wide * 1e6:g} um windows")
-        xs, ps = axial_section(*layer)
+        xs, ps = c["layer"]
         ax.plot(xs * 1e6, ps / 1e9, color=color_for("", 1), lw=1.2, label="layer model, nodal")
-        xl, pl = window_row(*layer, width)
+        xl, pl = c["layer_windows"]
         ax.plot(xl * 1e6, pl / 1e9, "o", color=color_for("", 1), ms=4, label="layer model, window means")
-        xg, pg = axial_section(*gt)
+        xg, pg = c["gt"]
         ax.plot(xg * 1e6, pg / 1e9, color=color_for("", 2), lw=1.0, ls="--", label="Greenwood-Tripp, nodal")
         ax.set_xlabel("x [um]")
         ax.set_ylabel("pressure [GPa]")
@@ -100,17 +137,65 @@ def plot_two_scale(data, fields, out):
     ``fields`` holds ``resolved``, ``layer``, ``gt`` (results or dicts with ``x, y, p``), ``width``,
     ``extent``, ``ratio`` and ``load_factor``; ``data`` the study's dict. Returns the files.
     """
-    def nodal(r):
-        return tuple(np.asarray(r[k] if isinstance(r, dict) else getattr(r, k)) for k in ("x", "y", "p"))
-
     from validation.studies.two_scale_models import nominal_radius
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    res, lay, gt = nodal(fields["resolved"]), nodal(fields["layer"]), nodal(fields["gt"])
-    case = f"a_H/lambda_L = {fields['ratio']:g}, P = {fields['load_factor']:g} P1"
+    res, lay, gt = _nodal(fields["resolved"]), _nodal(fields["layer"]), _nodal(fields["gt"])
+    case = _case(fields)
     return [plot_pressure_map(*res, extent=fields["extent"], radius=nominal_radius(*res),
                               layer_radius=nominal_radius(*lay), path=out / "two_scale_map.png",
                               title=f"Resolved rough sphere, {case}"),
             plot_windowed_profile(res, lay, gt, width=fields["width"], path=out / "two_scale_profile.png",
                                   title=f"Pressure along y = 0, {case}", wide=fields.get("wide"))]
+
+
+def _nodal(r):
+    return tuple(np.asarray(r[k] if isinstance(r, dict) else getattr(r, k)) for k in ("x", "y", "p"))
+
+
+def _case(f):
+    return f"a_H/lambda_L = {f['ratio']:g}, P = {f['load_factor']:g} P1"
+
+
+def _short(values):
+    """Floats rounded to 4 significant digits, NaN as None (JSON)."""
+    a = np.asarray(values, dtype=float)
+    return [None if not np.isfinite(v) else float(f"{v:.4g}") for v in a.ravel()] if a.ndim == 1 else \
+        [_short(row) for row in a]
+
+
+def figure_data(fields, pixels=JSON_PIXELS):
+    """What the two figures of the case in ``fields`` draw, JSON-ready and modest in size.
+
+    ``map``: the resolved pressure [Pa] binned on ``pixels x pixels`` squares over
+    ``[-extent, extent]^2``, at most ``pixels`` and about two lattice steps across (``image[i][j]``: row ``i`` along y; ``None`` where no node falls);
+    ``radius``, ``layer_radius``: the nominal radii [m]; ``profile``: the curves of
+    :func:`profile_curves`, each ``[x [m], p [Pa]]``; ``width``, ``wide`` [m]; 4 significant digits.
+    """
+    from validation.studies.two_scale_models import nominal_radius
+
+    res, lay, gt = _nodal(fields["resolved"]), _nodal(fields["layer"]), _nodal(fields["gt"])
+    extent = float(fields["extent"])
+    step = np.sqrt(4 * extent**2 / max(res[0].size, 1))  # about the node spacing: pixels of two steps or more
+    _, image = binned_map(*res, extent, pixels=int(min(pixels, max(8, extent / step))))
+    curves = profile_curves(res, lay, gt, width=fields["width"], wide=fields.get("wide"))
+    return dict(ratio=fields["ratio"], load_factor=fields["load_factor"], extent=extent,
+                width=float(fields["width"]), wide=fields.get("wide"), radius=nominal_radius(*res),
+                layer_radius=nominal_radius(*lay), map=_short(image),
+                profile={k: [_short(x), _short(p)] for k, (x, p) in curves.items()})
+
+
+def plot_two_scale_data(figure, out):
+    """The two figures from :func:`figure_data` (``figure``, as read from ``two_scale.json``) in ``out``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    image = np.array([[np.nan if v is None else v for v in row] for row in figure["map"]], dtype=float)
+    edges = np.linspace(-figure["extent"], figure["extent"], image.shape[1] + 1)
+    case = _case(figure)
+    curves = {k: tuple(np.array([np.nan if v is None else v for v in a], dtype=float) for a in xy)
+              for k, xy in figure["profile"].items()}
+    return [plot_pressure_image(edges, image, radius=figure["radius"], layer_radius=figure["layer_radius"],
+                                path=out / "two_scale_map.png", title=f"Resolved rough sphere, {case}"),
+            plot_profile_curves(curves, width=figure["width"], wide=figure.get("wide"),
+                                path=out / "two_scale_profile.png", title=f"Pressure along y = 0, {case}")]
