@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import importlib
 
-PARSER = {"help": "error-time and stability studies",
+PARSER = {"help": "studies: error-time, stability, robustness, two-scale",
           "description": "Studies of the methods (validation.studies) on their built-in problems "
                          "(no scene keys to override).",
           "epilog": "examples:\n  contactlab study error-time hertz --out reports/studies\n"
