@@ -232,7 +232,7 @@ def _run(solver, op, h, layer, precondition, kw, options):
         return sol
     hist = dict(sol.history)
     return QPSolution(p=to_host(sol.p), approach=float(sol.approach), iterations=sol.iterations,
-                      converged=sol.converged, message=sol.message, kkt_residual=sol.kkt_residual,
+                      converged=sol.converged, message=sol.message, status=sol.status, kkt_residual=sol.kkt_residual,
                       displacement=to_host(sol.displacement), history=hist)
 
 
@@ -303,7 +303,7 @@ def _embedded(sol, window):
 
         hist["p"] = [lift(v) for v in hist["p"]]
     return QPSolution(p=window.embed(sol.p), approach=sol.approach, iterations=sol.iterations,
-                      converged=sol.converged, message=sol.message, kkt_residual=sol.kkt_residual,
+                      converged=sol.converged, message=sol.message, status=sol.status, kkt_residual=sol.kkt_residual,
                       displacement=None, history=hist)
 
 
@@ -390,7 +390,7 @@ def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start,
         closure=closure[mask], gap=g[mask],
         approach=float(sol.approach), force=float(a * p.sum()), p_max=float(p.max()),
         contact_area=float(a * np.count_nonzero(p[mask] > 0)), converged=bool(sol.converged),
-        message=sol.message, iterations=int(sol.iterations), kkt_residual=float(kkt), method=method,
+        message=sol.message, status=sol.status, iterations=int(sol.iterations), kkt_residual=float(kkt), method=method,
         wall_time_s=time.perf_counter() - t_start, lattice=lattice, E_star=E_star,
         history=sol.history, layer=layer, n_matvec=n_matvec + op.n_matvec,
     )
