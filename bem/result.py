@@ -47,6 +47,8 @@ class ContactResult:
         Why the method stopped, for people to read.
     status : str
         The outcome, one of :data:`bem.result.STATUSES`, for programs to read.
+    rtol : float
+        The KKT tolerance the solve was asked for (``converged`` means ``kkt_residual <= rtol``).
     iterations : int
         Iterations of the method on the finest lattice: conjugate-gradient
         iterations of the QP (no layer, linear layer with ``"newton"`` or
@@ -91,6 +93,7 @@ class ContactResult:
     layer: object = None
     n_matvec: int = 0
     status: str = ""
+    rtol: float = math.nan
 
     def __post_init__(self):
         if self.status not in STATUSES or self.converged != (self.status == "converged"):
@@ -132,6 +135,7 @@ class ContactResult:
             "iterations": int(self.iterations),
             "n_matvec": int(self.n_matvec),
             "kkt_residual": float(self.kkt_residual),
+            "rtol": float(self.rtol),
             "wall_time_s": float(self.wall_time_s),
             "n_nodes": int(self.p.size),
             "n_contact": int(np.count_nonzero(self.p > 0)),
