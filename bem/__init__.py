@@ -13,7 +13,7 @@ from .errors import InputError, RegionTooSmallError
 from .lattice import Lattice
 from .materials import effective_modulus
 from .operator import InfluenceOperator, diagonal_coefficient
-from .result import ContactResult
+from .result import STATUSES, ContactResult
 from .options import METHODS, OPTIONS
 from .periodic import PeriodicCell, PeriodicContactResult, PeriodicOperator, solve_periodic
 from .solve import solve
@@ -22,5 +22,5 @@ from .template import template
 
 __all__ = ["solve", "solve_periodic", "PeriodicCell", "PeriodicOperator", "PeriodicContactResult",
            "subsurface_stress", "SubsurfaceStress", "template", "Lattice", "InfluenceOperator",
-           "ContactResult", "METHODS", "OPTIONS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
+           "ContactResult", "STATUSES", "METHODS", "OPTIONS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
            "effective_modulus", "gaps", "layers"]

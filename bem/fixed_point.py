@@ -96,21 +96,22 @@ class _Tracker:
         return delta, kkt
 
     def failing(self):
-        """Why the iteration is hopeless, or ``""``."""
+        """``(status, reason)`` when the iteration is hopeless, else ``None``."""
         if self.growing >= _DIVERGING_STEPS:
-            return f"diverging: the pressure increment grew {_DIVERGING_STEPS} times in a row"
+            return "diverged", f"diverging: the pressure increment grew {_DIVERGING_STEPS} times in a row"
         if self.since_best >= _STALL_STEPS:
-            return (f"stalled: the pressure increment did not fall below 0.9 x its best value "
+            return "stalled", (f"stalled: the pressure increment did not fall below 0.9 x its best value "
                     f"{self.best:.2e} in {_STALL_STEPS} iterations")
-        return ""
+        return None
 
-    def finish(self, name, p, u, delta, kkt, rule_met, reason, rtol):
+    def finish(self, name, p, u, delta, kkt, rule_met, reason, rtol, status):
         converged = bool(rule_met and kkt <= rtol)
+        status = "converged" if converged else status
         message = f"{reason}; KKT residual {kkt:.2e}" if converged else f"{reason} (KKT residual {kkt:.2e})"
         if not converged:
             log.debug("%s: %s", name, message)
         return QPSolution(p=p, approach=delta, iterations=len(self.hist["residual"]), converged=converged,
-                          message=message, kkt_residual=float(kkt), displacement=u, history=self.hist)
+                          message=message, status=status, kkt_residual=float(kkt), displacement=u, history=self.hist)
 
 
 def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, eps_h=None,
@@ -160,7 +161,8 @@ def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rto
     p = xp.zeros(op.lattice.shape, dtype=bk.float64) if x0 is None else xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
     u = op.matvec(p)
     dh_old = xp.where(mask, layer.w(p), 0.0)
-    delta, kkt, rule_met, reason = approach, np.inf, False, f"no convergence in maxiter = {maxiter} iterations"
+    delta, kkt, rule_met, status = approach, np.inf, False, "maxiter"
+    reason = f"no convergence in maxiter = {maxiter} iterations"
     for k in range(1, maxiter + 1):
         dh = xp.where(mask, layer.w(p), 0.0)
         sub = solve_qp(op, h + dh, force=force, approach=approach, x0=p if bool(xp.any(p != 0)) else None,
@@ -169,7 +171,7 @@ def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rto
         omega = relaxation if k > 1 else 1.0
         p_new = (1 - omega) * p + omega * sub.p
         if not bool(xp.all(xp.isfinite(p_new))):
-            reason = f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
+            status, reason = "diverged", f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
             break
         u = (1 - omega) * u + omega * sub.displacement
         inc_p, inc_h = _increment(p_new, p), _increment(dh, dh_old) if k > 1 else 1.0
@@ -179,15 +181,16 @@ def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rto
         if callback is not None:
             callback(k, p)
         if not math.isfinite(kkt):
-            reason = "the iteration produced a non-finite value"
+            status, reason = "nonfinite", "the iteration produced a non-finite value"
             break
         if k > 1 and inc_h <= eps_h and inc_p <= eps_p and kkt <= rtol:
             rule_met, reason = True, f"increments of eq. 20 below eps after {k} iterations"
             break
         if track.failing():
-            reason = track.failing() + " (try relaxation < 1)"
+            status, reason = track.failing()
+            reason += " (try relaxation < 1)"
             break
-    return track.finish("augmented gap", p, u, delta, kkt, rule_met, reason, rtol)
+    return track.finish("augmented gap", p, u, delta, kkt, rule_met, reason, rtol, status)
 
 
 def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10,
@@ -238,7 +241,8 @@ def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=Non
     p = None if x0 is None else xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
     u = xp.zeros(op.lattice.shape, dtype=bk.float64) if p is None else op.matvec(p)
     lam = xp.zeros(op.lattice.shape, dtype=bk.float64)
-    delta, kkt, rule_met, reason = approach, np.inf, False, f"no convergence in maxiter = {maxiter} iterations"
+    delta, kkt, rule_met, status = approach, np.inf, False, "maxiter"
+    reason = f"no convergence in maxiter = {maxiter} iterations"
     for k in range(1, maxiter + 1):
         contact = xp.zeros(op.lattice.shape, dtype=xp.bool) if p is None else p > 0
         if p is not None:
@@ -253,7 +257,7 @@ def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=Non
         track.count_inner(sub)
         p_new = sub.p
         if not bool(xp.all(xp.isfinite(p_new))):
-            reason = f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
+            status, reason = "diverged", f"diverged: non-finite pressure at iteration {k}; the last finite iterate is returned"
             break
         u = sub.displacement
         inc_p = 1.0 if p is None else _increment(p_new, p)
@@ -263,12 +267,12 @@ def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=Non
         if callback is not None:
             callback(k, p)
         if not math.isfinite(kkt):
-            reason = "the iteration produced a non-finite value"
+            status, reason = "nonfinite", "the iteration produced a non-finite value"
             break
         if same_set and inc_p <= eps_p and kkt <= rtol:
             rule_met, reason = True, f"contact set and pressure stable after {k} iterations"
             break
         if track.failing():
-            reason = track.failing()
+            status, reason = track.failing()
             break
-    return track.finish("variable compliance", p, u, delta, kkt, rule_met, reason, rtol)
+    return track.finish("variable compliance", p, u, delta, kkt, rule_met, reason, rtol, status)

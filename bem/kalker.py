@@ -42,6 +42,7 @@ class QPSolution:
     message: str
     kkt_residual: float
     displacement: np.ndarray
+    status: str  # one of bem.result.STATUSES
     history: dict = field(default_factory=dict)
 
 
@@ -186,7 +187,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     t = xp.zeros(lat.shape, dtype=bk.float64)
     gz_old, restart = 1.0, True
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
-    converged, message, kkt, delta = False, "", np.inf, approach
+    converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
     prev_contact = p > 0
     m_one = None
     fixed_scale = scale
@@ -233,14 +234,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         hist["n_contact"].append(n_idx)
         hist["changes"].append(changes)
         if not math.isfinite(kkt):
-            message = "the iteration produced a non-finite value"
+            message, status = "the iteration produced a non-finite value", "nonfinite"
             break
         if kkt <= rtol:
-            converged, message = True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}"
+            converged, message, status = True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}", "converged"
             break
         if n_idx == 0:
             if float(xp.min(g)) >= 0:  # no contact at this approach: p = 0 is the solution
-                converged, message, kkt = True, "no contact at this approach", 0.0
+                converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
                 break
         if preconditioner is None:
             z = bk.copy(g_c)
@@ -272,7 +273,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             # force: only nodes entering the contact (below) can move the iterate
             tau = 0.0
         elif tt <= 0 or not math.isfinite(tt):
-            message = f"search direction lost positive curvature (t.Ct = {tt:.3e})"
+            message, status = f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
             break
         else:
             tau = gz / tt
@@ -316,7 +317,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         log.debug("Kalker QP: %s", message)
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
-                      message=message, kkt_residual=float(kkt), displacement=elastic, history=hist)
+                      message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)
 
 
 def compliance_preconditioner(op, D, contact, threshold=4.0):

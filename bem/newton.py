@@ -237,7 +237,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             "inner_missed": 0, "inner_worst": 0.0}
     if record:
         hist["p"] = []
-    converged, message, exact = False, "", True
+    converged, message, status, exact = False, "", "maxiter", True
     prev = p > 0
     for k in range(maxiter + 1):
         gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach)
@@ -253,10 +253,10 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             hist["p"].append(bk.to_host(p[mask]).copy())
         prev = contact
         if not math.isfinite(kkt):
-            message = "the iteration produced a non-finite value"
+            message, status = "the iteration produced a non-finite value", "nonfinite"
             break
         if kkt <= rtol:
-            converged, message = True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e} after {k} Newton steps"
+            converged, status, message = True, "converged", f"KKT residual {kkt:.2e} <= rtol {rtol:.1e} after {k} Newton steps"
             break
         if k == maxiter:
             message = f"no convergence in maxiter = {maxiter} Newton steps (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
@@ -305,6 +305,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             p, u, exact = trial, u_trial, True
         elif t == 0.0:
             message = f"line search found no descent (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
+            status = "stalled"
             break
         else:
             p = _scaled(xp.maximum(p + t * d, 0.0), force, op.lattice.node_area)
@@ -315,7 +316,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     if not converged:
         log.debug("Newton: %s", message)
     out = QPSolution(p=p, approach=delta, iterations=len(hist["step"]), converged=converged, message=message,
-                     kkt_residual=float(kkt), displacement=u, history=hist)
+                     status=status, kkt_residual=float(kkt), displacement=u, history=hist)
     if force is not None and not converged and math.isfinite(delta) and delta > 0:
         out = _force_by_approach(op, h, layer, force, out, rtol=rtol, maxiter=maxiter, precondition=precondition,
                                  inner_maxiter=inner_maxiter)
@@ -373,4 +374,5 @@ def _force_by_approach(op, h, layer, force, failed, *, rtol, **kw):
     message = (f"KKT residual {kkt:.2e} {'<=' if converged else '>'} rtol {rtol:.1e}: force control by "
                f"{len(solved)} approach-controlled solves ({steps} Newton steps) after '{failed.message}'")
     return QPSolution(p=sol.p, approach=delta_f, iterations=failed.iterations + steps, converged=converged,
-                      message=message, kkt_residual=float(kkt), displacement=u, history=hist)
+                      message=message, status="converged" if converged else failed.status, kkt_residual=float(kkt),
+                      displacement=u, history=hist)

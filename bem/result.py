@@ -7,7 +7,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["ContactResult"]
+__all__ = ["ContactResult", "STATUSES"]
+
+#: The outcomes a solver reports in ``status``: the stopping rule was met (``"converged"``),
+#: the iteration budget ran out (``"maxiter"``), the iteration stopped making progress
+#: (``"stalled"``: no smaller increment for many iterations, no descent along the search
+#: direction, or a search direction without positive curvature), the increments grew
+#: (``"diverged"``), or a residual was not finite (``"nonfinite"``).
+STATUSES = ("converged", "maxiter", "stalled", "diverged", "nonfinite")
 
 
 @dataclass
@@ -35,9 +42,13 @@ class ContactResult:
     contact_area : float
         Number of nodes with ``p > 0`` times the node area ``sqrt(3)/2 c^2`` [length^2].
     converged : bool
-        Whether the method met its stopping rule; see ``message``.
+        Whether the method met its stopping rule (``status == "converged"``).
     message : str
-        Why the method stopped.
+        Why the method stopped, for people to read.
+    status : str
+        The outcome, one of :data:`bem.result.STATUSES`, for programs to read.
+    rtol : float
+        The KKT tolerance the solve was asked for (``converged`` means ``kkt_residual <= rtol``).
     iterations : int
         Iterations of the method on the finest lattice: conjugate-gradient
         iterations of the QP (no layer, linear layer with ``"newton"`` or
@@ -81,6 +92,13 @@ class ContactResult:
     history: dict = field(default_factory=dict)
     layer: object = None
     n_matvec: int = 0
+    status: str = ""
+    rtol: float = math.nan
+
+    def __post_init__(self):
+        if self.status not in STATUSES or self.converged != (self.status == "converged"):
+            raise ValueError(f"status = {self.status!r} is not allowed with converged = {self.converged}: "
+                             f"one of {STATUSES}, 'converged' exactly when converged")
 
     @property
     def contact_radius(self):
@@ -107,6 +125,7 @@ class ContactResult:
         return {
             "method": self.method,
             "converged": bool(self.converged),
+            "status": self.status,
             "message": self.message,
             "p_max": float(self.p_max),
             "force": float(self.force),
@@ -116,6 +135,7 @@ class ContactResult:
             "iterations": int(self.iterations),
             "n_matvec": int(self.n_matvec),
             "kkt_residual": float(self.kkt_residual),
+            "rtol": float(self.rtol),
             "wall_time_s": float(self.wall_time_s),
             "n_nodes": int(self.p.size),
             "n_contact": int(np.count_nonzero(self.p > 0)),

@@ -208,7 +208,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     _check_border(lattice, sol.p, extent)
     op = ops[-1] if ops[-1].lattice is lattice else InfluenceOperator(lattice, E_star, device=backend)
     closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
-    result = _result(lattice, op, h, sol, closure, E_star, layer, solver, force, t_start,
+    result = _result(lattice, op, h, sol, closure, E_star, layer, solver, force, t_start, rtol,
                      n_matvec=sum(o.n_matvec for o in ops if o is not op))
     if not result.converged:
         log.warning("%s: %s%s", solver, result.message, _inner_summary(sol.history))
@@ -232,7 +232,7 @@ def _run(solver, op, h, layer, precondition, kw, options):
         return sol
     hist = dict(sol.history)
     return QPSolution(p=to_host(sol.p), approach=float(sol.approach), iterations=sol.iterations,
-                      converged=sol.converged, message=sol.message, kkt_residual=sol.kkt_residual,
+                      converged=sol.converged, message=sol.message, status=sol.status, kkt_residual=sol.kkt_residual,
                       displacement=to_host(sol.displacement), history=hist)
 
 
@@ -303,7 +303,7 @@ def _embedded(sol, window):
 
         hist["p"] = [lift(v) for v in hist["p"]]
     return QPSolution(p=window.embed(sol.p), approach=sol.approach, iterations=sol.iterations,
-                      converged=sol.converged, message=sol.message, kkt_residual=sol.kkt_residual,
+                      converged=sol.converged, message=sol.message, status=sol.status, kkt_residual=sol.kkt_residual,
                       displacement=None, history=hist)
 
 
@@ -375,7 +375,7 @@ def _check_border(lattice, p, extent):
         )
 
 
-def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start, n_matvec=0):
+def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start, rtol, n_matvec=0):
     mask = lattice.mask
     p = sol.p
     u = to_host(op.matvec(p))
@@ -390,7 +390,7 @@ def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start,
         closure=closure[mask], gap=g[mask],
         approach=float(sol.approach), force=float(a * p.sum()), p_max=float(p.max()),
         contact_area=float(a * np.count_nonzero(p[mask] > 0)), converged=bool(sol.converged),
-        message=sol.message, iterations=int(sol.iterations), kkt_residual=float(kkt), method=method,
+        message=sol.message, status=sol.status, rtol=float(rtol), iterations=int(sol.iterations), kkt_residual=float(kkt), method=method,
         wall_time_s=time.perf_counter() - t_start, lattice=lattice, E_star=E_star,
         history=sol.history, layer=layer, n_matvec=n_matvec + op.n_matvec,
     )

@@ -11,7 +11,7 @@ packages are imported inside the functions.
 """
 
 from .mesh import AxiMesh, build_mesh
-from .result import FemResult
+from .result import STATUSES, FemResult
 from .solve import solve
 
-__all__ = ["solve", "FemResult", "build_mesh", "AxiMesh"]
+__all__ = ["solve", "FemResult", "STATUSES", "build_mesh", "AxiMesh"]

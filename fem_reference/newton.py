@@ -56,6 +56,8 @@ class InterfaceSolution:
         Whether the stopping rule was met.
     message : str
         Why the iteration stopped.
+    status : str
+        The outcome, one of :data:`fem_reference.result.STATUSES`.
     iterations : int
         Newton steps taken.
     history : dict
@@ -69,6 +71,7 @@ class InterfaceSolution:
     converged: bool
     message: str
     iterations: int
+    status: str
     history: dict = field(default_factory=dict)
 
 
@@ -109,7 +112,7 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
     try:
         cho = cho_factor(C)
     except LinAlgError:
-        return InterfaceSolution(g=g, p=law.pressure(g), delta=delta, converged=False, iterations=0,
+        return InterfaceSolution(g=g, p=law.pressure(g), delta=delta, converged=False, iterations=0, status="singular",
                                  message="interface compliance is not positive definite (mesh too coarse "
                                         "for the truncation correction?)", history=history)
 
@@ -124,7 +127,7 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
         value = 0.5 * d @ cho_solve(cho, d) + float(np.sum(A * law.potential(g)))
         return value - force * delta if force_control else value
 
-    converged, message, k = False, f"maxiter = {maxiter} Newton steps reached", 0
+    converged, message, status, k = False, f"maxiter = {maxiter} Newton steps reached", "maxiter", 0
     p, F1, F2 = residuals(g, delta)
     for k in range(maxiter + 1):
         scale = max(abs(delta), float(np.abs(delta - h - g).max()), np.finfo(float).tiny)
@@ -134,10 +137,10 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
         history["force_residual"].append(res_f)
         history["n_contact"].append(int(np.count_nonzero(g > 0)))
         if not (np.isfinite(res) and np.isfinite(res_f)):
-            message = "non-finite residual"
+            message, status = "non-finite residual", "nonfinite"
             break
         if res <= rtol and res_f <= rtol:
-            converged, message = True, "stopping rule met"
+            converged, message, status = True, "stopping rule met", "converged"
             break
         if k == maxiter:
             break
@@ -150,7 +153,7 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
         try:
             dx = solve(J, rhs, check_finite=True)
         except (LinAlgError, ValueError) as exc:
-            message = f"singular Newton matrix ({exc}); no node in contact?"
+            message, status = f"singular Newton matrix ({exc}); no node in contact?", "singular"
             break
         dg, dd = (dx[:n], float(dx[n])) if force_control else (dx, 0.0)
         grad_g = cho_solve(cho, F1)
@@ -165,11 +168,11 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
             if t < _MIN_STEP:
                 break
         if t < _MIN_STEP:
-            message = "line search failed (no descent along the Newton direction)"
+            message, status = "line search failed (no descent along the Newton direction)", "stalled"
             break
         g, delta = g + t * dg, delta + t * dd
         history["step"].append(t)
         p, F1, F2 = residuals(g, delta)
     log.debug("interface Newton: %s after %d steps, residual %.3g", message, k, history["residual"][-1])
     return InterfaceSolution(g=g, p=law.pressure(g), delta=float(delta), converged=converged, message=message,
-                             iterations=k, history=history)
+                             iterations=k, status=status, history=history)

@@ -6,7 +6,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["FemResult", "axis_pressure", "contact_radius"]
+__all__ = ["FemResult", "STATUSES", "axis_pressure", "contact_radius"]
+
+#: The outcomes the FEM reference reports in ``status``: the stopping rule was met
+#: (``"converged"``), the Newton budget ran out (``"maxiter"``), the line search found no
+#: descent (``"stalled"``), a residual was not finite (``"nonfinite"``), the interface
+#: compliance or the Newton matrix was singular (``"singular"``), or the contact reaches the
+#: outer boundary of the domain (``"boundary"``).
+STATUSES = ("converged", "maxiter", "stalled", "nonfinite", "singular", "boundary")
 
 
 def axis_pressure(r, p):
@@ -78,9 +85,12 @@ class FemResult:
     contact_radius : float
         Edge of the loaded zone [length], see :func:`contact_radius`.
     converged : bool
-        Whether Newton's stopping rule was met (and the contact stays inside the domain).
+        Whether Newton's stopping rule was met (and the contact stays inside the domain):
+        ``status == "converged"``.
     message : str
-        Why the solve stopped.
+        Why the solve stopped, for people to read.
+    status : str
+        The outcome, one of :data:`fem_reference.result.STATUSES`, for programs to read.
     iterations : int
         Newton steps (last mesh).
     timings : dict
@@ -137,6 +147,12 @@ class FemResult:
     history: dict = field(default_factory=dict)
     model: object = field(default=None, repr=False)
     displacement: np.ndarray = field(default=None, repr=False)
+    status: str = ""
+
+    def __post_init__(self):
+        if self.status not in STATUSES or self.converged != (self.status == "converged"):
+            raise ValueError(f"status = {self.status!r} is not allowed with converged = {self.converged}: "
+                             f"one of {STATUSES}, 'converged' exactly when converged")
 
     @property
     def wall_time_s(self):
@@ -166,7 +182,7 @@ class FemResult:
         return {
             "p_max": float(self.p_max), "force": float(self.force), "approach": float(self.approach),
             "contact_radius": float(self.contact_radius), "converged": bool(self.converged),
-            "message": self.message, "iterations": int(self.iterations), "n_dofs": int(self.n_dofs),
+            "status": self.status, "message": self.message, "iterations": int(self.iterations), "n_dofs": int(self.n_dofs),
             "n_elements": int(self.n_elements),
             "n_elements_across_contact": float(self.n_elements_across_contact),
             "timings": {k: float(v) for k, v in self.timings.items()},

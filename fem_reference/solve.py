@@ -204,9 +204,10 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     u = model.displacement(A * sol.p, delta_far)
     reaction = model.reaction_force(u)
     timings = dict(timings, mesh=mesh_time, recover=time.perf_counter() - t0)
-    converged, message = sol.converged, sol.message
+    converged, message, status = sol.converged, sol.message, sol.status
     if p[-1] > 0:
-        converged, message = False, "the contact reaches the outer boundary r = R: increase extent_factor"
+        converged, status = False, "boundary"
+        message = "the contact reaches the outer boundary r = R: increase extent_factor"
     g = sol.g[A > 0]  # the axis node (ring area 0) carries no force: its closure is free
     if layer is None:
         penetration = float(max(g.max(), 0.0))
@@ -222,7 +223,7 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     result = FemResult(
         r=model.r.copy(), p=p, closure=sol.g.copy(), gap=h, approach=float(sol.delta), force=force,
         force_reaction=reaction, p_max=float(p.max()), contact_radius=a_c, converged=converged,
-        message=message, iterations=sol.iterations, timings=timings, n_dofs=model.n_dofs,
+        message=message, status=status, iterations=sol.iterations, timings=timings, n_dofs=model.n_dofs,
         n_elements=amesh.n_elements, n_interface_nodes=int(model.r.size),
         n_elements_across_contact=float(np.interp(a_c, corner_r, np.arange(corner_r.size))),
         penalty={"factor": penalty, "stiffness": law.k_pen, "max_penetration": penetration,

@@ -224,6 +224,7 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
         x=cell.x.ravel(), y=cell.y.ravel(), p=p.ravel(), displacement=u.ravel(), closure=closure.ravel(),
         gap=g.ravel(), approach=float(sol.approach), force=float(a * p.sum()), p_max=float(p.max()),
         contact_area=float(a * np.count_nonzero(p > 0)), converged=bool(sol.converged), message=sol.message,
+        status=sol.status, rtol=float(rtol),
         iterations=int(sol.iterations), kkt_residual=float(kkt), method=solver,
         wall_time_s=time.perf_counter() - t_start, lattice=cell, E_star=E_star, history=sol.history,
         layer=layer, n_matvec=op.n_matvec)

@@ -42,7 +42,7 @@ def test_augmented_gap_reports_failure_for_a_soft_layer(paper, law):
     """lam = 10 C_nn: the fixed point map has spectral radius ~ lam / C_nn > 1."""
     res = paper(paper_laws(10.0)[law], "augmented_gap", maxiter=100)
     assert not res.converged
-    assert "diverg" in res.message or "stalled" in res.message
+    assert res.status in ("diverged", "stalled")
     assert np.all(np.isfinite(res.p))
 
 

@@ -183,7 +183,7 @@ def test_augmented_gap_reports_its_stall_for_an_infinite_slope_at_zero(law, capl
     layer = _laws(0.3 * C_NN)[law]
     res = solve_periodic(GAP, cell=CELL, E_star=E_STAR, mean_pressure=PBAR, layer=layer, method="augmented_gap",
                          relaxation=0.5)
-    assert not res.converged and ("stalled" in res.message or "diverg" in res.message)
+    assert not res.converged and res.status in ("stalled", "diverged")
     assert np.all(np.isfinite(res.p)) and res.kkt_residual > 1e-10
 
 

@@ -38,6 +38,7 @@ def _fem(r, p, **kw):
     """A FemResult holding the profile ``p(r)``."""
     fields = dict(r=r, p=p, closure=np.zeros_like(r), gap=r**2 / 2, approach=H.approach, force=H.force,
                   force_reaction=H.force, p_max=float(p.max()), contact_radius=H_A, converged=True, message="",
+                  status="converged",
                   iterations=1, timings={"total": 0.0}, n_dofs=0, n_elements=0, n_interface_nodes=r.size,
                   n_elements_across_contact=0.0, penalty={}, truncation={}, mesh={}, E_star=1.0)
     fields.update(kw)

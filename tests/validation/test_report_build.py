@@ -124,6 +124,16 @@ def test_section_validation(tmp_path):
     assert Figure(_png(tmp_path / "f.png"), "See Fig. 5 of the paper. Then more.").alt_text == "See Fig. 5 of the paper"
 
 
+def test_every_solver_status_colours_its_cell():
+    import bem
+    import fem_reference
+
+    expected = {"converged": "ok", "maxiter": "warn", "stalled": "warn", "diverged": "bad", "nonfinite": "bad",
+                "singular": "bad", "boundary": "bad"}
+    statuses = set(bem.STATUSES) | set(fem_reference.STATUSES)
+    assert {s: status_class(s) for s in statuses} == {s: expected[s] for s in statuses}
+
+
 def test_status_and_format():
     assert [status_class(s) for s in ("converged", "Converged (KKT 1e-9)", "stalled", "diverged: x",
                                       "not converged", "pending")] == ["ok", "ok", "warn", "bad", "bad", "other"]

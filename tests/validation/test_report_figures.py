@@ -441,3 +441,13 @@ def test_tabulated_layer_law_shows_its_points(tmp_path, monkeypatch):
     assert len(points) == 1, "the table's points, and no markers on the formula law"
     np.testing.assert_allclose(points[0][0], [0.0, 1.0, 2.0, 4.0])  # in view: p <= p_max, in MPa
     np.testing.assert_allclose(points[0][1], [0.0, 0.5, 0.8, 1.0])  # in µm
+
+
+def test_the_tolerance_in_a_caption_is_the_recorded_bem_rtol_never_read_from_the_message():
+    from types import SimpleNamespace
+
+    from validation.report.figures.run import _tolerance
+
+    quoted = {"message": "KKT residual 1e-12 <= rtol 1.0e-03"}
+    assert _tolerance(SimpleNamespace(bem={"rtol": 1e-8}, data=quoted)) == 1e-8
+    assert _tolerance(SimpleNamespace(bem={}, data=quoted)) is None

@@ -24,7 +24,7 @@ def test_no_outcome_is_wrong(rows):
 
 
 def test_newton_converges_on_every_corner(rows):
-    bad = [r for r in rows if r.method == "newton" and r.status != "converged"]
+    bad = [r for r in rows if r.method == "newton" and (r.status, r.solver_status) != ("converged", "converged")]
     assert not bad, bad
 
 
@@ -41,6 +41,7 @@ def test_augmented_gap_fails_loudly_where_the_layer_dominates(rows):
     for r in rows:
         if r.method == "augmented_gap" and r.k > 1:
             assert r.status == "reported failure" and r.message, r
+            assert r.solver_status in (None, "maxiter", "stalled", "diverged", "nonfinite"), r
         if r.method == "augmented_gap" and r.k < 1:
             assert r.status == "converged", r
 

@@ -53,7 +53,8 @@ class ErrorTimeRow:
     ``n``: unknowns (BEM candidate nodes, FEM displacement DOFs); ``error_l2``, ``error_peak``:
     against the reference (module docstring); ``wall_time_s``: median of the ``runs`` timed runs
     [s], ``wall_times_s`` every one of them [s]; ``iterations``, ``converged``, ``message``: the
-    solver's.
+    solver's; ``solver_status``: the solver's ``status`` (:data:`bem.STATUSES`,
+    :data:`fem_reference.STATUSES`).
     """
 
     problem: str
@@ -70,6 +71,7 @@ class ErrorTimeRow:
     runs: int = 1
     message: str = ""
     wall_times_s: list = field(default_factory=list)
+    solver_status: str | None = None
 
     @property
     def label(self):
@@ -201,7 +203,7 @@ def _climb(study, problem, method, ladder, reference, opts):
             study.rows.append(ErrorTimeRow(
                 name, part, method, n, int(res.p.size if part == "bem" else res.n_dofs), m["l2_rel"],
                 None if m["peak_rel"] is None else abs(m["peak_rel"]), t, int(res.iterations), bool(res.converged),
-                omega, len(times), res.message, times))
+                omega, len(times), res.message, times, res.status))
             if res.converged:
                 break
         else:

@@ -45,7 +45,8 @@ SETTING = (f"Paraboloid R = 1, P = 1, power layer `w = lam p^s`; {NODES_ACROSS} 
 
 @dataclass
 class RobustnessRow:
-    """One method on one grid point; ``kkt_dense`` is the independent check (``None`` if it raised)."""
+    """One method on one grid point; ``kkt_dense`` is the independent check (``None`` if it raised);
+    ``solver_status`` the solver's ``status`` (:data:`bem.STATUSES`; ``None`` if it raised)."""
 
     s: float
     k: float
@@ -58,6 +59,7 @@ class RobustnessRow:
     iterations: int
     wall_time_s: float
     message: str
+    solver_status: str | None = None
 
 
 def _dense_kkt(outcome):
@@ -79,7 +81,7 @@ def _row(point, control, method, run):
     kkt = _dense_kkt(outcome) if finite(res) else math.inf
     status, _ = classify(res, converged=res.converged, error=kkt if res.converged else None, tolerance=2 * RTOL)
     return RobustnessRow(*point, control, method, status, bool(res.converged), kkt, int(res.iterations),
-                         outcome.result["wall_time_s"]["bem"], res.message)
+                         outcome.result["wall_time_s"]["bem"], res.message, res.status)
 
 
 def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODULI, methods=LAYER_METHODS,

@@ -60,7 +60,8 @@ class StabilityRow:
     ``kkt_residual``: BEM KKT residual, FEM final relative Newton residual (``None`` when the run
     raised); ``error_vs_reference`` against ``reference`` (``"-"``: none) with ``tolerance``;
     ``wall_time_s`` [s]: the solver's (the whole run's when it raised); ``message``: why the
-    status, and the solver's message.
+    status, and the solver's message; ``solver_status``: the solver's ``status``
+    (:data:`bem.STATUSES`, :data:`fem_reference.STATUSES`; ``None`` when the run raised).
     """
 
     case: str
@@ -74,6 +75,7 @@ class StabilityRow:
     iterations: int
     wall_time_s: float
     message: str
+    solver_status: str | None = None
 
 
 @dataclass
@@ -145,7 +147,7 @@ def _row(case, solver, method, part, reference):
     kkt = float(result.residual if solver == "fem" else result.kkt_residual)
     return StabilityRow(**row, status=status, kkt_residual=kkt if math.isfinite(kkt) else None,
                         error_vs_reference=error, iterations=int(result.iterations), wall_time_s=seconds,
-                        message=f"{why}; {result.message}")
+                        message=f"{why}; {result.message}", solver_status=result.status)
 
 
 def _run_case(case, limit):

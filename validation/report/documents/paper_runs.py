@@ -157,13 +157,6 @@ class _Runner:
         return execute_scene(raw, overrides={k.replace("__", "."): v for k, v in changes.items() if "__" in k})
 
 
-def _status(result):
-    if result.converged:
-        return "converged"
-    msg = result.message.lower()
-    return "diverged" if "diverg" in msg else "stalled" if "stall" in msg else "not converged"
-
-
 def _cases(run, res, quick):
     depths = {"stress": {"depths": list(STRESS_DEPTHS * run.a), "bodies": ["body1"]}}
     for case in SCENES:
@@ -229,7 +222,7 @@ def _methods(run, res, quick):
         for label, opts in methods:
             with _stability_runs():
                 r = run(case, **params, **opts).bem
-            res.stability.append({"law": law, "method": label, "status": _status(r), "iterations": r.iterations,
+            res.stability.append({"law": law, "method": label, "status": r.status, "iterations": r.iterations,
                                   "p_max/p0": r.p_max / res.p0, "kkt_residual": r.kkt_residual,
                                   "wall_time_s": r.wall_time_s, "message": r.message})
 

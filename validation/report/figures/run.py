@@ -15,7 +15,6 @@ profiles are drawn in a window around the contact (:func:`profile_view`).
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -105,12 +104,9 @@ def profile_view(res, curves, *, axis="x"):
 
 
 def _tolerance(res):
-    """The KKT tolerance of the run: ``bem.rtol``, or the one quoted in its message (``... rtol 1.0e-10``)."""
-    m = re.search(r"rtol\s+([0-9.eE+-]+)", str(res.data.get("message") or ""))
-    try:
-        return res.bem.get("rtol") or (float(m.group(1)) if m else None)
-    except ValueError:
-        return None
+    """The KKT tolerance of the run, ``bem.rtol`` (None where the result does not record it)."""
+    tol = res.bem.get("rtol")
+    return float(tol) if isinstance(tol, (int, float)) and math.isfinite(tol) else None
 
 
 def how(res):

@@ -24,7 +24,8 @@ KINDS = ("problem", "results", "iterations", "sweeps", "validation", "fem", "sta
 _STATUS = {
     "ok": ("ok", "converged", "pass", "passed", "success", "yes", "true"),
     "warn": ("warning", "warn", "stalled", "slow", "partial", "maxiter"),
-    "bad": ("failed", "fail", "diverged", "diverging", "error", "not converged", "no", "false", "nan"),
+    "bad": ("failed", "fail", "diverged", "diverging", "error", "not converged", "no", "false", "nan", "nonfinite",
+            "singular", "boundary"),
 }
 
 
