@@ -27,6 +27,12 @@ __all__ = ["PeriodicCell"]
 _SQRT3 = math.sqrt(3.0)
 
 
+def rows_for(step, ly):
+    """Rows of the cell of step ``step`` closest to the period ``ly`` [length]: the even number
+    nearest ``ly / (step sqrt3/2)``, at least 2 (the rule of :meth:`PeriodicCell.from_size`)."""
+    return max(2, 2 * int(round(ly / (step * _SQRT3))))
+
+
 @dataclass(frozen=True)
 class PeriodicCell:
     """A periodic cell of the triangular lattice (module docstring).
@@ -62,7 +68,7 @@ class PeriodicCell:
         """
         step = check_positive("step", step)
         lx, ly = (check_positive("size", v) for v in (size if np.ndim(size) else (size, size)))
-        return cls(step, max(4, int(round(lx / step))), max(2, 2 * int(round(ly / (step * _SQRT3)))))
+        return cls(step, max(4, int(round(lx / step))), rows_for(step, ly))
 
     @property
     def shape(self):

@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_finite_array, check_int, check_positive, fail
+from ..periodic.cell import rows_for
 
 __all__ = ["LatticeHeights", "to_lattice", "MAX_STRETCH"]
 
@@ -153,7 +154,7 @@ def to_lattice(heights, size, n_cols):
     lx, ly = _size(size)
     n_cols = check_int("n_cols", n_cols, minimum=2)
     step = lx / n_cols
-    n_rows = max(2, 2 * int(round(ly / (step * _SQRT3))))
+    n_rows = rows_for(step, ly)
     cell = (n_cols * step, n_rows * step * _SQRT3 / 2)
     stretch = cell[1] / ly
     large = abs(stretch - 1.0) > MAX_STRETCH
