@@ -134,9 +134,18 @@ def test_every_solver_status_colours_its_cell():
     assert {s: status_class(s) for s in statuses} == {s: expected[s] for s in statuses}
 
 
+def test_every_study_outcome_colours_its_cell():
+    from validation.studies import STATUSES
+
+    assert [status_class(s) for s in STATUSES] == ["ok", "bad", "bad"]
+
+
 def test_status_and_format():
-    assert [status_class(s) for s in ("converged", "Converged (KKT 1e-9)", "stalled", "diverged: x",
-                                      "not converged", "pending")] == ["ok", "ok", "warn", "bad", "bad", "other"]
+    assert [status_class(s) for s in ("converged", "stalled", "not converged", "reported failure", "pending")] \
+        == ["ok", "warn", "bad", "bad", "other"]
+    # a cell is a status word or nothing: a message that merely contains one colours nothing
+    assert [status_class(s) for s in ("Converged (KKT 1e-9)", "diverged: x", "no", "maxiter reached")] \
+        == ["other"] * 4
     assert fmt(0.000123456) == "0.0001235" and fmt(2.5e-9) == "2.5e-09" and fmt(12.34567) == "12.35"
     assert fmt(3) == "3" and fmt(True) == "yes" and fmt(None) == "-"
 

@@ -21,19 +21,24 @@ __all__ = ["Figure", "Table", "Section", "KINDS", "status_class", "fmt", "fmt_di
 #: kinds of section; ``"fem"`` marks anything that needs an FEM result
 KINDS = ("problem", "results", "iterations", "sweeps", "validation", "fem", "stability", "notes")
 
+#: the CSS class of every status word a table shows: the solvers' ``status``
+#: (:data:`bem.STATUSES`, :data:`fem_reference.STATUSES`), the studies' outcomes
+#: (:data:`validation.studies.STATUSES`), a sweep point's status and the reports' own
+#: "converged" / "not converged" / "failed"; compared whole, never searched in a message
 _STATUS = {
-    "ok": ("ok", "converged", "pass", "passed", "success", "yes", "true"),
-    "warn": ("warning", "warn", "stalled", "slow", "partial", "maxiter"),
-    "bad": ("failed", "fail", "diverged", "diverging", "error", "not converged", "no", "false", "nan", "nonfinite",
-            "singular", "boundary"),
+    "ok": ("ok", "converged"),
+    "warn": ("maxiter", "stalled"),
+    "bad": ("diverged", "nonfinite", "singular", "boundary", "not converged", "not_converged", "failed", "error",
+            "reported failure", "wrong"),
 }
 
 
 def status_class(status):
-    """CSS class of a status word: ``"ok"``, ``"warn"``, ``"bad"`` or ``"other"``."""
-    text = str(status).strip().lower()
+    """CSS class of a status word (the whole cell, see ``_STATUS``): ``"ok"``, ``"warn"``,
+    ``"bad"``, or ``"other"`` for anything else, messages included."""
+    text = str(status).strip()
     for cls, words in _STATUS.items():
-        if text in words or any(text.startswith(w + " ") or text.startswith(w + ":") for w in words if len(w) > 3):
+        if text in words:
             return cls
     return "other"
 
