@@ -1,6 +1,7 @@
 """The results a report is drawn from: a result directory of ``contactlab run``, or a run in memory.
 
-What is read (names from ``result.json["files"]``, :data:`validation.run.runner.FILES`):
+What is read (names from ``result.json["files"]``, else :data:`validation.run.runner.FILES`, the one
+list of the files a run writes):
 
 ``result.json`` (required)
     The run's result (:func:`validation.run.result.build_result`, docs/results.md): the BEM
@@ -32,6 +33,7 @@ import numpy as np
 
 from bem.checks import InputError, check_choice
 
+from ...run.runner import FILES
 from ...units import Units, parse_units
 from ..render.content import fmt
 from ..render.style import report_unit
@@ -41,7 +43,6 @@ __all__ = ["RunResults", "Shown", "load_results", "results_of", "units_of", "rea
 
 log = logging.getLogger(__name__)
 
-_FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_field.vtu", "fem_field": "fem_field.vtu"}
 #: ``units`` choices of a report: ``"auto"``: readable units (an SI scene's m and Pa shown as mm and
 #: MPa, :func:`validation.report.render.style.report_unit`; dimensionless when the scene's units are
 #: unknown); ``"scene"``: the scene's own units; ``"dimensionless"``: lengths and pressures divided
@@ -106,6 +107,9 @@ class RunResults:
     hertz_peak : str
         The name of Hertz's peak pressure in a dimensionless report (``"p_H"``; the paper
         report calls it ``"p_0"``, as the paper does): one name for it throughout a report.
+    files : dict
+        ``{key: Path}`` of the run's files found in ``directory`` (keys of
+        :data:`validation.run.runner.FILES`); empty for a run in memory.
     """
 
     directory: Path
@@ -117,6 +121,7 @@ class RunResults:
     dimensionless: bool = False
     scene_units: bool = False
     hertz_peak: str = "p_H"
+    files: dict = field(default_factory=dict)
 
     def section(self, name):
         """A table of ``scene.toml`` (empty dict when absent)."""
@@ -326,7 +331,7 @@ def load_results(directory, *, units="auto"):
     directory = Path(directory)
     if not directory.is_dir():
         raise InputError(f"directory = {str(directory)!r} is not allowed: it must be a result directory.")
-    main = directory / _FILES["result"]
+    main = directory / FILES["result"]
     if not main.is_file():
         raise InputError(f"directory = {str(directory)!r} is not allowed: it has no result.json "
                          "(run the scene first: contactlab run SCENE --out DIR).")
@@ -338,12 +343,13 @@ def load_results(directory, *, units="auto"):
                     main, data.get("schema"))
     stored = data.get("files") if isinstance(data.get("files"), Mapping) else {}
     files = {k: file_inside(directory, v, f"files.{k}" if k in stored else k)
-             for k, v in {**_FILES, **{k: str(v) for k, v in stored.items()}}.items()}
+             for k, v in {**FILES, **{k: str(v) for k, v in stored.items()}}.items()}
     scene = _read_scene(files["scene"]) if files["scene"] is not None else {}
     parsed = units_of(data, (scene.get("scene") or {}).get("units"))
     fem = _field(files["fem_field"], section_field_from_vtu) if isinstance(data.get("fem"), Mapping) else None
     return RunResults(directory=directory, data=dict(data), scene=scene, units=parsed,
                       bem_field=_field(files["bem_field"], _bem_field), fem_field=fem,
+                      files={k: p for k, p in files.items() if p is not None and p.is_file()},
                       dimensionless=dimensionless_for(units, parsed), scene_units=units == "scene")
 
 
