@@ -143,38 +143,18 @@ def test_vtu_is_compressed_with_ordinary_permissions(result, tmp_path):
     np.testing.assert_allclose(point_data["contact_pressure"][centre], result.p[0])
 
 
-def _vtk_array(text, name):
-    """A ``format="binary"`` DataArray of a zlib-compressed VTK XML file, decoded by the VTK file
-    format's rules (UInt32 block header, each block zlib-compressed): independent of meshio."""
-    import base64
-    import re
-    import zlib
-
-    m = re.search(rf'<DataArray type="(\w+)" Name="{name}"[^>]*format="binary">\s*([^<\s]+)\s*<', text)
-    dtype, data = {"Int64": "<i8", "Int32": "<i4", "UInt8": "u1", "Float64": "<f8"}[m.group(1)], m.group(2)
-    n_blocks = int(np.frombuffer(base64.b64decode(data[:8])[:4], "<u4")[0])
-    head = 4 * -(-(3 + n_blocks) * 4 // 3)  # base64 characters of the header
-    sizes = np.frombuffer(base64.b64decode(data[:head]), "<u4")[3:]
-    raw, out, start = base64.b64decode(data[head:]), b"", 0
-    for size in sizes:
-        out += zlib.decompress(raw[start:start + size])
-        start += size
-    return np.frombuffer(out, dtype)
-
-
 def test_vtk_reader_opens_the_file(result, tmp_path):
-    """What ParaView's reader sees, decoded by the VTK XML format's rules: quadratic triangles
-    (VTK cell type 22) and the fields, one value per point."""
-    import re
+    """What ParaView's reader sees, decoded by the VTK XML format's rules (tests/vtu_reader.py):
+    quadratic triangles (VTK cell type 22) and the fields, one value per point."""
+    from ..vtu_reader import read_vtu
 
     path = write_vtu(tmp_path / "paraview.vtu", **result.field())
-    text = Path(path).read_text()
-    assert 'type="UnstructuredGrid"' in text and 'compressor="vtkZLibDataCompressor"' in text
-    n_points, n_cells = map(int, re.search(r'NumberOfPoints="(\d+)" NumberOfCells="(\d+)"', text).groups())
+    points, (_, offsets, types), point_data, _, attrs = read_vtu(path)
+    assert attrs["type"] == "UnstructuredGrid" and attrs["compressor"] == "vtkZLibDataCompressor"
+    n_points, n_cells = points.shape[0], types.size
     assert n_cells == result.n_elements
-    types = _vtk_array(text, "types")
-    assert types.size == n_cells and set(np.unique(types)) == {22}  # VTK_QUADRATIC_TRIANGLE
-    assert np.array_equal(_vtk_array(text, "offsets"), 6 * np.arange(1, n_cells + 1))
+    assert set(np.unique(types)) == {22}  # VTK_QUADRATIC_TRIANGLE
+    assert np.array_equal(offsets, 6 * np.arange(1, n_cells + 1))
     for name in ("von_mises", "sigma_tt"):
-        assert _vtk_array(text, name).size == n_points
-    assert _vtk_array(text, "displacement").size == 3 * n_points
+        assert point_data[name].size == n_points
+    assert point_data["displacement"].shape == (n_points, 3)
