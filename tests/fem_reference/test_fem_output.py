@@ -1,7 +1,5 @@
 """Result file, failure reporting, input validation, inputs left untouched."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from .fem_cases import E, NU, P
