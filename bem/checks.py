@@ -30,6 +30,8 @@ __all__ = [
     "check_scale",
     "check_rtol",
     "check_node_count",
+    "check_layer",
+    "check_gap_values",
     "RTOL_MAX",
     "SCALE_RANGE",
     "MAX_NODES",
@@ -181,3 +183,46 @@ def check_load(force, approach):
     if force is not None:
         return check_scale("force", force), None
     return None, check_scale("approach", approach)
+
+
+def check_layer(name, value):
+    """Return ``value``; raise unless it is ``None`` or a law of :mod:`bem.layers` (a ``Layer``)."""
+    if value is None:
+        return None
+    from .layers.base import Layer
+
+    if not isinstance(value, Layer):
+        fail(name, value, "a bem.layers law or None")
+    return value
+
+
+def check_gap_values(h, points, *, region, mask=None):
+    """Return the values ``h`` of a gap function as a float array; raise unless they have the
+    shape of the points it was evaluated at and are finite (where ``mask`` is true).
+
+    Parameters
+    ----------
+    h : array_like
+        What the gap function returned [length].
+    points : dict
+        ``{argument name: coordinates}`` of the call, in order (``{"x": x, "y": y}``) [length];
+        the message names the call ``gap(x, y)`` and the first point where ``h`` is not finite.
+    region : str
+        Where the gap must be finite, completing "the gap must be finite ..." (``"over the
+        candidate region"``).
+    mask : ndarray of bool, optional
+        The points that count (default: all).
+    """
+    coords = [np.asarray(c) for c in points.values()]
+    h = np.asarray(h, dtype=float)
+    if h.shape != coords[0].shape:
+        raise InputError(f"gap returned shape {h.shape} which is not allowed: it must return the shape of "
+                         f"{next(iter(points))} ({coords[0].shape}).")
+    bad = ~np.isfinite(h) if mask is None else mask & ~np.isfinite(h)
+    if bad.any():
+        i = tuple(int(k) for k in np.argwhere(bad)[0])
+        names = ", ".join(points)
+        at = ", ".join(f"{float(c[i]):.6g}" for c in coords)
+        raise InputError(f"gap({names}) = {float(h[i])!r} at ({names}) = ({at}) is not allowed: the gap must be finite "
+                         f"{region}.")
+    return h

@@ -8,8 +8,8 @@ import time
 import numpy as np
 
 from .backend import get_backend, to_host
-from .checks import (check_bool, check_callable, check_choice, check_finite_array, check_int, check_load,
-                     check_rtol, check_scale)
+from .checks import (check_bool, check_callable, check_choice, check_finite_array, check_gap_values, check_int,
+                     check_layer, check_load, check_rtol, check_scale)
 from .errors import InputError, RegionTooSmallError
 from .kalker import QPSolution
 from .kkt import kkt_residual
@@ -335,12 +335,8 @@ def _prolong(coarse, p, fine):
 
 
 def _check_layer(layer, method):
-    if layer is None:
+    if check_layer("layer", layer) is None:
         return
-    from .layers.base import Layer
-
-    if not isinstance(layer, Layer):
-        raise InputError(f"layer = {layer!r} is not allowed: it must be a bem.layers law or None.")
     if method == "kalker" and not layer.is_linear:
         raise InputError(
             f"method = 'kalker' is not allowed with layer = {layer!r}: Kalker's QP solves smooth bodies "
@@ -349,17 +345,9 @@ def _check_layer(layer, method):
 
 
 def _gap_values(gap, lattice):
-    h = np.asarray(gap(lattice.x, lattice.y), dtype=float)
-    if h.shape != lattice.shape:
-        raise InputError(f"gap returned shape {h.shape} which is not allowed: it must return the shape of x "
-                         f"({lattice.shape}).")
-    bad = lattice.mask & ~np.isfinite(h)
-    if bad.any():
-        r, q = np.argwhere(bad)[0]
-        raise InputError(
-            f"gap(x, y) = {h[r, q]!r} at (x, y) = ({lattice.x[r, q]:.6g}, {lattice.y[r, q]:.6g}) is not allowed: "
-            "the gap must be finite over the candidate region (make extent smaller or fix the gap)."
-        )
+    x, y = lattice.x, lattice.y
+    h = check_gap_values(gap(x, y), {"x": x, "y": y}, mask=lattice.mask,
+                         region="over the candidate region (make extent smaller or fix the gap)")
     return np.where(lattice.mask, h, 0.0)
 
 

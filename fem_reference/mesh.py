@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bem.checks import InputError, check_positive
+from bem.checks import InputError, check_int, check_positive
 
 __all__ = ["AxiMesh", "build_mesh", "BOUNDARIES"]
 
@@ -266,8 +266,7 @@ def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, grow
     """
     t0 = time.perf_counter()
     a_est = check_positive("a_est", a_est)
-    if isinstance(n_contact, bool) or not isinstance(n_contact, (int, np.integer)) or n_contact < 2:
-        raise InputError(f"n_contact = {n_contact!r} is not allowed: it must be an integer >= 2.")
+    n_contact = check_int("n_contact", n_contact, minimum=2)
     extent_factor = check_positive("extent_factor", extent_factor)
     fine_radius = check_positive("fine_radius", fine_radius)
     growth = check_positive("growth", growth)

@@ -28,13 +28,14 @@ import time
 
 import numpy as np
 
-from bem.checks import InputError, check_callable, check_positive
+from bem.checks import (check_bool, check_callable, check_gap_values, check_int, check_layer, check_load,
+                        check_positive, fail)
 from bem.layers import beyond_table
 from bem.materials import effective_modulus
 from bem.reference import estimate_contact_radius
 
 from .interface import InterfaceLaw
-from .mesh import build_mesh
+from .mesh import AxiMesh, build_mesh
 from .model import AxiModel, check_materials
 from .newton import solve_interface
 from .result import FemResult, axis_pressure, contact_radius
@@ -47,33 +48,10 @@ log = logging.getLogger(__name__)
 _LOW, _HIGH = 0.6, 1.25
 
 
-def _check_int(name, value, minimum):
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise InputError(f"{name} = {value!r} is not allowed: it must be an integer >= {minimum}.")
-    return int(value)
-
-
-def _check_layer(layer):
-    if layer is None:
-        return None
-    from bem.layers import Layer
-
-    if not isinstance(layer, Layer):
-        raise InputError(f"layer = {layer!r} is not allowed: it must be a bem.layers law or None.")
-    return layer
-
-
 def _gap_at(gap, r):
-    h = np.asarray(gap(r, np.zeros_like(r)), dtype=float)
-    if h.shape != r.shape:
-        raise InputError(f"gap returned shape {h.shape} which is not allowed: "
-                         f"it must return the shape of x ({r.shape}).")
-    bad = ~np.isfinite(h)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise InputError(f"gap(r, 0) = {h[i]!r} at r = {r[i]:.6g} is not allowed: "
-                         "the gap must be finite on the interface.")
-    return h
+    """``h(r, 0)`` at the interface nodes [length], checked by :func:`bem.checks.check_gap_values`."""
+    y = np.zeros_like(r)
+    return check_gap_values(gap(r, y), {"x": r, "y": y}, region="on the interface")
 
 
 def _start(layer, h_edge, force, a_est):
@@ -157,14 +135,15 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     t_start = time.perf_counter()
     check_callable("gap", gap)
     check_materials(E1, nu1, E2, nu2)
-    if (force is None) == (approach is None):
-        raise InputError(f"force = {force!r}, approach = {approach!r} is not allowed: give exactly one of them.")
-    force = None if force is None else check_positive("force", force)
-    approach = None if approach is None else check_positive("approach", approach)
-    layer = _check_layer(layer)
+    force, approach = check_load(force, approach)
+    layer = check_layer("layer", layer)
     penalty = check_positive("penalty", penalty)
     rtol = check_positive("rtol", rtol)
-    maxiter = _check_int("maxiter", maxiter, 1)
+    maxiter = check_int("maxiter", maxiter)
+    truncation_correction = check_bool("truncation_correction", truncation_correction)
+    remesh = check_bool("remesh", remesh)
+    if mesh is not None and not isinstance(mesh, AxiMesh):
+        fail("mesh", mesh, "a fem_reference.mesh.AxiMesh (from fem_reference.build_mesh) or None")
     E_star = effective_modulus(E1, nu1, E2, nu2)
     if mesh is None and a_est is None:
         a_est = estimate_contact_radius(gap, E_star=E_star, force=force, approach=approach, layer=layer)

@@ -1,5 +1,7 @@
 """bem.solve refuses bad input early and reports an undersized candidate region."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -41,8 +43,19 @@ def test_bad_input_is_refused_naming_the_argument(change, name):
 
 
 def test_gap_with_nan_is_refused():
-    with pytest.raises(InputError, match="gap"):
+    """The message shows the value and a point of the candidate region where the gap is NaN."""
+    rule = (r"^gap\(x, y\) = nan at \(x, y\) = \((\S+), (\S+)\) is not allowed: the gap must be finite over "
+            r"the candidate region")
+    with pytest.raises(InputError, match=rule) as err:
         bem.solve(lambda x, y: np.where(x > 0.2, np.nan, x * x + y * y), **GOOD)
+    x, y = map(float, re.match(rule, str(err.value)).groups())
+    assert 0.2 < x <= 0.5 and abs(y) <= 0.5
+
+
+def test_gap_of_the_wrong_shape_is_refused():
+    with pytest.raises(InputError, match=r"^gap returned shape \(3,\) which is not allowed: it must return the "
+                                         r"shape of x \(\(\d+, \d+\)\)\.$"):
+        bem.solve(lambda x, y: np.zeros(3), **GOOD)
 
 
 def test_contact_reaching_the_border_says_so():
