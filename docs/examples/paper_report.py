@@ -5,7 +5,7 @@ the paper: linear Winkler (lam = 10 C_nn), elastic-rigid (alpha_a = 0.5), root, 
 as the built-in scenes ``paper_*``, run by the runner (``validation.run.execute_scene``); the
 paper's iterative methods with their histories, the alpha_a / alpha_b / alpha_c sweeps, the
 stability table of every method, the subsurface stresses and the validation against Hertz and
-the FEM reference; then writes ``report.html`` (self-contained), ``report.md`` and
+the FEM reference; then writes ``report.html`` and ``report.md``, which both show the figures of
 ``figures/*.png``.
 
 Usage (from the repository root)::

@@ -1,5 +1,5 @@
-"""Report documents: strict-HTML5 validity, no network references, embedded figures, Markdown
-with relative figure files, written whole or not at all. (Reports of result directories:
+"""Report documents: strict-HTML5 validity, no network references, HTML and Markdown linking
+the same relative figure files (each figure stored once), written whole or not at all. (Reports of result directories:
 test_report_run.py.)"""
 
 import base64
@@ -52,19 +52,37 @@ def sections(tmp_path):
             Section("Results", items=(table, f2))]
 
 
-def test_html_is_valid_self_contained_and_embeds_every_figure(sections, tmp_path):
+def figure_sources(html):
+    """The ``src`` of every ``<img>`` of an HTML report, in order."""
+    return re.findall(r'<img src="([^"]+)"', html)
+
+
+def test_html_is_valid_offline_and_links_every_figure(sections, tmp_path):
     built = build_report(sections, tmp_path / "rep", title="T & <t>")
     text = built.html.read_text(encoding="utf-8")
     assert_valid_offline_html(text)
-    uris = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
-    assert len(uris) == 2
-    embedded = sorted(base64.b64decode(u) for u in uris)
-    on_disk = sorted(p.read_bytes() for p in built.figures)
-    assert embedded == on_disk and all(b.startswith(PNG_MAGIC) for b in embedded)
+    sources = figure_sources(text)
+    assert [built.out_dir / s for s in sources] == list(built.figures)
+    assert all(not os.path.isabs(s) and (built.out_dir / s).read_bytes().startswith(PNG_MAGIC) for s in sources)
     # escaping and status colours
     assert "Problem &lt;statement&gt;" in text and "<statement>" not in text
     assert re.search(r'<tr class="ok">.*converged', text) and re.search(r'<tr class="bad">.*diverged', text)
     assert re.search(r'<tr class="warn">.*stalled', text)
+
+
+def test_each_figure_is_stored_once(sections, tmp_path):
+    """The HTML and the Markdown show the same files of figures/; no figure's bytes are also in a document."""
+    built = build_report(sections, tmp_path / "rep", title="T")
+    html, md = built.html.read_text(encoding="utf-8"), built.markdown.read_text(encoding="utf-8")
+    assert figure_sources(html) == re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md) == ["figures/one.png", "figures/two.png"]
+    assert "data:" not in html
+    for path in built.figures:
+        data = path.read_bytes()
+        for text in (html, md):
+            assert base64.b64encode(data)[:40].decode() not in text
+            assert base64.b64encode(data[1:])[:40].decode() not in text  # at another alignment too
+    stored = sorted(p.relative_to(built.out_dir).as_posix() for p in built.out_dir.rglob("*") if p.is_file())
+    assert stored == [".contactlab", "figures/one.png", "figures/two.png", "report.html", "report.md"]
 
 
 def test_markdown_links_relative_figures_that_exist(sections, tmp_path):

@@ -19,6 +19,7 @@ from validation.report.figures.fields import plot_section_field
 from validation.report.render import Figure, Section, build_report
 from validation.report.render.style import DPI, FORMATS, figure_format, vector_copy
 
+from .test_report_build import figure_sources
 from .test_report_figures import A, HERTZ, P0, cases, check_png, section_field_size  # noqa: F401 - cases: fixture
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -133,13 +134,14 @@ def test_report_carries_the_format(cases, tmp_path, fmt):
     files = sorted(p.name for p in (built.out_dir / "figures").iterdir())
     if fmt == "svg":
         assert files == ["contact_map.svg", "profiles.svg"]
-        assert len(re.findall(r'src="data:image/svg\+xml;base64,', html)) == 2
+        assert figure_sources(html) == ["figures/profiles.svg", "figures/contact_map.svg"]
         assert "](figures/profiles.svg)" in md
     else:
-        assert len(re.findall(r'src="data:image/png;base64,', html)) == 2
+        assert figure_sources(html) == ["figures/profiles.png", "figures/contact_map.png"]
         pngs = ["contact_map.png", "profiles.png"]
         assert files == (sorted(pngs + ["contact_map.pdf", "profiles.pdf"]) if fmt == "pdf" else pngs)
         assert ("(vector: [figures/profiles.pdf](figures/profiles.pdf))" in md) == (fmt == "pdf")
+        assert ('(vector: <a href="figures/profiles.pdf">figures/profiles.pdf</a>)' in html) == (fmt == "pdf")
     from .test_report_build import assert_valid_offline_html
 
     assert_valid_offline_html(html)
@@ -155,9 +157,21 @@ def test_figure_format_is_checked_and_scoped(tmp_path):
         pass
     out = fsw.plot_transition_line([0.0, 1.0], [1.0, 0.0], tmp_path / "t.png", a=1.0)
     assert out.endswith(".png")  # back to the default after the block
-    from validation.cli import report as cli
 
-    assert cli.FORMATS == FORMATS  # the parser's copy (it imports no report code)
+
+def test_the_command_line_offers_the_figure_formats(capsys):
+    """``contactlab report --format`` takes exactly :data:`FORMATS` and its help states :data:`DPI`."""
+    from validation.cli import build_parser
+
+    parser = build_parser()
+    for fmt in FORMATS:
+        assert parser.parse_args(["report", "hertz", "--format", fmt]).format == fmt
+    with pytest.raises(SystemExit):
+        parser.parse_args(["report", "hertz", "--format", "jpg"])
+    assert "{" + ",".join(FORMATS) + "}" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        parser.parse_args(["report", "--help"])
+    assert f"png ({DPI} dpi, default)" in " ".join(capsys.readouterr().out.split())
 
 
 def test_only_the_3d_views_import_pyvista_inside_functions():

@@ -1,8 +1,6 @@
 """`contactlab report SWEEP_DIR`: the report of a sweep directory, as `report --help` promises; and
 the stages every report build tells its progress callback."""
 
-import re
-
 import numpy as np
 import pytest
 
@@ -13,7 +11,7 @@ from validation.run import run_scene
 from validation.run.sweep import run_sweep
 
 from .conftest import cli
-from .test_report_build import assert_valid_offline_html
+from .test_report_build import assert_valid_offline_html, figure_sources
 from .figure_spy import drawn  # noqa: F401 - a fixture
 from .test_report_figures import check_png
 
@@ -34,7 +32,7 @@ def test_report_of_a_sweep_directory_from_the_cli(sweep_dir, tmp_path):
     assert f"report written to {tmp_path / 'rep' / 'report.html'}" in out
     html = (tmp_path / "rep" / "report.html").read_text(encoding="utf-8")
     assert_valid_offline_html(html)
-    assert len(re.findall(r'src="data:image/png;base64,', html)) == 2
+    assert len(figure_sources(html)) == 2 and all((tmp_path / "rep" / s).is_file() for s in figure_sources(html))
     md = (tmp_path / "rep" / "report.md").read_text(encoding="utf-8")
     assert md.startswith("# Elliptic Hertz contact: sweep of load.force")
     rows = [line for line in md.splitlines() if line.startswith("| 50 |") or line.startswith("| 100 |")

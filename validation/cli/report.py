@@ -4,12 +4,8 @@ from __future__ import annotations
 
 import os
 
+from ..report.render.style import DPI, FORMATS
 from .common import add_set, add_trust
-
-#: figure formats of `contactlab report --format` (validation.report.style.FORMATS, kept here so the
-#: parser needs no import of the report package)
-FORMATS = ("png", "svg", "pdf")
-
 
 PARSER = {"help": "figures and an HTML/Markdown report",
           "description": "Build a report (report.html, report.md, figures/) from the paper's test\n"
@@ -36,7 +32,7 @@ def add_args(p):
                                                 "'paper', DIR/report for a directory, results/NAME/report for "
                                                 "a scene)")
     p.add_argument("--format", choices=FORMATS, default="png",
-                   help="figure files: png (300 dpi, default), svg (vector, shown in the HTML), or pdf "
+                   help=f"figure files: png ({DPI} dpi, default), svg (vector, shown in the HTML), or pdf "
                         "(vector, beside a PNG for the HTML)")
     p.add_argument("--units", choices=("auto", "scene", "dimensionless"),
                    help="units of a scene, result or sweep report, one per quantity in every table and figure: "

@@ -1,4 +1,4 @@
-"""Reports: self-contained HTML and Markdown documents of runs, sweeps, studies and the paper's problem.
+"""Reports: HTML and Markdown documents of runs, sweeps, studies and the paper's problem.
 
 - :mod:`.render`: the content (:class:`Section`, :class:`Figure`, :class:`Table`), HTML,
   Markdown, the atomic build of a report directory (:func:`build_report`), the figure style;

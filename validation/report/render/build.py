@@ -1,7 +1,8 @@
 """Write a report directory whole or not at all.
 
-``out_dir/report.html`` (self-contained), ``out_dir/report.md`` and ``out_dir/figures/`` (the
-PNG or SVG of every figure, and the PDF beside a PNG drawn in ``"pdf"`` format) are first
+``out_dir/report.html``, ``out_dir/report.md`` and ``out_dir/figures/`` (the PNG or SVG of
+every figure, which both documents link, and the PDF beside a PNG drawn in ``"pdf"`` format:
+each figure stored once) are first
 written into a fresh temporary directory beside ``out_dir``; only when all of them are
 complete is that directory renamed onto ``out_dir`` (a previous report there is
 moved aside first and deleted afterwards: :func:`validation.io.atomic_directory`). An
@@ -22,7 +23,7 @@ from ...provenance import report_footer
 from .content import Figure, Section
 from .html import render_html
 from .markdown import render_markdown
-from .style import figure_format, vector_copy
+from .style import figure_format, vector_copy, vector_name
 
 __all__ = ["build_report", "BuiltReport", "REPORT_FILES", "Progress", "draw_and_build", "check_report_dir"]
 
@@ -172,7 +173,7 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None, root=Non
         footer = report_footer()
     names = _figure_names(sections, root)
     images = {path: Path(path).read_bytes() for path in names}
-    vectors = {names[path][:-4] + ".pdf": Path(pdf).read_bytes() for path in names
+    vectors = {vector_name(names[path]): Path(pdf).read_bytes() for path in names
                if (pdf := vector_copy(path)) is not None}
     with atomic_directory(out_dir, "report", REPORT_FILES) as tmp:
         (tmp / "figures").mkdir()
@@ -181,7 +182,8 @@ def build_report(sections, out_dir, *, title, subtitle="", footer=None, root=Non
         for name, data in vectors.items():
             (tmp / name).write_bytes(data)
         (tmp / "report.html").write_text(
-            render_html(sections, title=title, subtitle=subtitle, images=images, footer=footer), encoding="utf-8")
+            render_html(sections, title=title, subtitle=subtitle, names=names, footer=footer, vectors=vectors),
+            encoding="utf-8")
         (tmp / "report.md").write_text(
             render_markdown(sections, title=title, subtitle=subtitle, names=names, footer=footer,
                             vectors=vectors), encoding="utf-8")

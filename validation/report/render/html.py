@@ -1,16 +1,17 @@
-"""Self-contained HTML5 rendering of a report.
+"""HTML5 rendering of a report.
 
-Figures are embedded as ``data:image/png;base64`` (or ``image/svg+xml``) URIs and the style sheet is inline, so
-the file opens offline and can be mailed as one file: no external link, script or font.
+Figures are relative links to the files of ``figures/`` that the Markdown shows too, so a report
+stores each figure once; the style sheet is inline and nothing refers outside the report's
+folder (no external link, script or font), so the folder opens offline.
 """
 
 from __future__ import annotations
 
-import base64
 import html
-import os
+from urllib.parse import quote
 
 from .content import Figure, Table
+from .style import vector_name
 
 __all__ = ["render_html", "CSS"]
 
@@ -52,14 +53,14 @@ def _is_number(text):
     return True
 
 
-_MIME = {".png": "image/png", ".svg": "image/svg+xml"}
+def _href(name):
+    return html.escape(quote(name))
 
 
-def _figure(fig, number, data):
-    mime = _MIME.get(os.path.splitext(fig.path)[1].lower(), "image/png")
-    uri = f"data:{mime};base64," + base64.b64encode(data).decode("ascii")
-    return (f'<figure>\n<img src="{uri}" alt="{html.escape(fig.alt_text)}">\n'
-            f"<figcaption><b>Figure {number}.</b> {html.escape(fig.caption)}</figcaption>\n</figure>")
+def _figure(fig, number, name, vector):
+    link = f' (vector: <a href="{_href(vector)}">{html.escape(vector)}</a>)' if vector else ""
+    return (f'<figure>\n<img src="{_href(name)}" alt="{html.escape(fig.alt_text)}">\n'
+            f"<figcaption><b>Figure {number}.</b> {html.escape(fig.caption)}{link}</figcaption>\n</figure>")
 
 
 def _table(tab, number):
@@ -76,7 +77,7 @@ def _table(tab, number):
     return "\n".join(out)
 
 
-def render_html(sections, *, title, subtitle="", images, footer=""):
+def render_html(sections, *, title, subtitle="", names, footer="", vectors=()):
     """The whole report as one HTML5 string.
 
     Parameters
@@ -87,10 +88,13 @@ def render_html(sections, *, title, subtitle="", images, footer=""):
         Document title and heading.
     subtitle : str
         Line under the heading.
-    images : mapping of str to bytes
-        PNG or SVG bytes of every figure, keyed by ``Figure.path``.
+    names : mapping of str to str
+        Relative file name (``figures/x.png``) of every figure, keyed by ``Figure.path``.
     footer : str
         Text of the footer (e.g. how the report was generated).
+    vectors : collection of str
+        Relative names of the PDF copies written beside the PNGs (``figures/x.pdf``,
+        :func:`validation.report.render.style.vector_name`); the caption links them.
     """
     body = [f"<h1>{html.escape(title)}</h1>"]
     if subtitle:
@@ -106,7 +110,8 @@ def render_html(sections, *, title, subtitle="", images, footer=""):
         for item in sec.items:
             if isinstance(item, Figure):
                 n_fig += 1
-                body.append(_figure(item, n_fig, images[item.path]))
+                pdf = vector_name(names[item.path])
+                body.append(_figure(item, n_fig, names[item.path], pdf if pdf in vectors else None))
             elif isinstance(item, Table):
                 n_tab += 1
                 body.append(_table(item, n_tab))

@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 
 from .content import Figure, Table
+from .style import vector_name
 
 __all__ = ["render_markdown", "md_escape"]
 
@@ -88,7 +89,7 @@ def render_markdown(sections, *, title, subtitle="", names, footer="", vectors=(
         for item in sec.items:
             if isinstance(item, Figure):
                 n_fig += 1
-                pdf = names[item.path][:-4] + ".pdf"
+                pdf = vector_name(names[item.path])
                 link = f" (vector: [{pdf}]({pdf}))" if pdf in vectors else ""
                 out += [f"![{_cell(item.alt_text)}]({names[item.path]})", "",
                         f"*Figure {n_fig}.* {md_escape(item.caption)}{link}", ""]

@@ -20,7 +20,7 @@ from bem.checks import check_choice
 from bem.files import atomic_path
 
 __all__ = ["NORMALISED_LABELS", "axis_labels", "DPI", "FORMATS", "LAW_COLORS", "METHOD_COLORS", "SOLVER_COLORS",
-           "color_for", "new_figure", "figure_format", "save_figure", "vector_copy", "METHOD_LABELS",
+           "color_for", "new_figure", "figure_format", "save_figure", "vector_copy", "vector_name", "METHOD_LABELS",
            "method_label", "method_text", "display_unit", "report_unit", "REPORT_UNITS"]
 
 DPI = 300  #: resolution of every PNG (and of the rasterised colour fields of SVG/PDF) [dots per inch]
@@ -189,11 +189,15 @@ def figure_format(fmt):
         _FORMAT.reset(token)
 
 
+def vector_name(name):
+    """The name of the PDF that ``"pdf"`` format writes beside the PNG ``name`` (``x.png``: ``x.pdf``)."""
+    return os.path.splitext(os.fspath(name))[0] + ".pdf"
+
+
 def vector_copy(path):
     """The PDF written beside the PNG ``path`` in ``"pdf"`` format, or ``None``."""
-    root, ext = os.path.splitext(os.fspath(path))
-    pdf = root + ".pdf"
-    return pdf if ext.lower() == ".png" and os.path.isfile(pdf) else None
+    pdf = vector_name(path)
+    return pdf if os.path.splitext(os.fspath(path))[1].lower() == ".png" and os.path.isfile(pdf) else None
 
 
 def _save_vector(fig, path, fmt):
@@ -231,5 +235,5 @@ def save_figure(fig, path, *, colors=256):
     with atomic_path(path) as tmp:
         out.save(tmp, format="PNG", optimize=True, dpi=(DPI, DPI))
     if fmt == "pdf":
-        _save_vector(fig, root + ".pdf", "pdf")
+        _save_vector(fig, vector_name(path), "pdf")
     return path
