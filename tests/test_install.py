@@ -101,6 +101,13 @@ def test_extras_module_matches_pyproject():
         assert dists == _extra(extra), extra
 
 
+def test_every_extra_has_code_behind_it():
+    """Each package an extra installs is imported by the product's code (gpu: bem.backend's CuPy)."""
+    imported = set().union(*(_imports(ROOT / package) for package in ("bem", "fem_reference", "validation")))
+    for extra, modules in extras.EXTRAS.items():
+        assert {m.split(".")[0] for m in modules} <= imported, extra
+
+
 BLOCKER = textwrap.dedent("""
     import sys
 
