@@ -6,6 +6,7 @@ import base64
 import os
 import re
 from argparse import Namespace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -57,6 +58,11 @@ def figure_sources(html):
     return re.findall(r'<img src="([^"]+)"', html)
 
 
+def markdown_figures(md):
+    """The file of every image of a Markdown report, in order (alt texts may hold escaped brackets)."""
+    return re.findall(r"!\[(?:\\.|[^\]\\])*\]\(([^)]+)\)", md)
+
+
 def test_html_is_valid_offline_and_links_every_figure(sections, tmp_path):
     built = build_report(sections, tmp_path / "rep", title="T & <t>")
     text = built.html.read_text(encoding="utf-8")
@@ -74,7 +80,7 @@ def test_each_figure_is_stored_once(sections, tmp_path):
     """The HTML and the Markdown show the same files of figures/; no figure's bytes are also in a document."""
     built = build_report(sections, tmp_path / "rep", title="T")
     html, md = built.html.read_text(encoding="utf-8"), built.markdown.read_text(encoding="utf-8")
-    assert figure_sources(html) == re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md) == ["figures/one.png", "figures/two.png"]
+    assert figure_sources(html) == markdown_figures(md) == ["figures/one.png", "figures/two.png"]
     assert "data:" not in html
     for path in built.figures:
         data = path.read_bytes()
@@ -85,10 +91,21 @@ def test_each_figure_is_stored_once(sections, tmp_path):
     assert stored == [".contactlab", "figures/one.png", "figures/two.png", "report.html", "report.md"]
 
 
+@pytest.mark.parametrize("name", ["paper", "hertz", "validation"])
+def test_kept_reports_store_each_figure_once(name):
+    """The repository's reports (docs/regenerate_reports.sh): each file of figures/ is shown by both
+    documents, and neither embeds a figure."""
+    folder = Path(__file__).resolve().parents[2] / "reports" / name
+    html, md = (folder / "report.html").read_text(encoding="utf-8"), (folder / "report.md").read_text(encoding="utf-8")
+    files = sorted(f"figures/{p.name}" for p in (folder / "figures").iterdir())
+    assert files and "data:" not in html and "data:" not in md
+    assert sorted(set(figure_sources(html))) == sorted(set(markdown_figures(md))) == files
+
+
 def test_markdown_links_relative_figures_that_exist(sections, tmp_path):
     built = build_report(sections, tmp_path / "rep", title="T")
     md = built.markdown.read_text(encoding="utf-8")
-    links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md)
+    links = markdown_figures(md)
     assert links == ["figures/one.png", "figures/two.png"]
     for link in links:
         assert not os.path.isabs(link) and (built.out_dir / link).read_bytes().startswith(PNG_MAGIC)
