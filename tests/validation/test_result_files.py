@@ -66,3 +66,12 @@ def test_the_docs_table_lists_every_file():
     table = text[:text.index("\n## ")]
     listed = set(re.findall(r"^\| `([^`]+)` \|", table, re.M))
     assert listed == set(FILES.values()) | {".contactlab"}
+
+
+def test_the_command_line_help_names_every_file(capsys):
+    from validation.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["--help"])
+    text = capsys.readouterr().out
+    assert all(name in text for name in FILES.values())
