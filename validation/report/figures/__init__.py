@@ -6,12 +6,13 @@ reference, layer laws), :mod:`.iterations` (iterates and convergence), :mod:`.sw
 (families of curves, the transition line), :mod:`.surfaces` (3-D surfaces and contact maps),
 :mod:`.fields` (stress fields and depth profiles), :mod:`.precision` (work-precision);
 :mod:`.run` draws them from a run's results. Their conventions: ``path`` names the file to
-write, in the format of :func:`validation.report.render.style.figure_format` (a 300 dpi PNG,
-an SVG, or a PDF beside the PNG), written atomically and returned; ``p0`` [pressure] and ``a``
-[length] are the scales pressures and lengths are divided by (Hertz's peak and radius, or
-``1`` and ``1`` with ``labels`` naming the units); ``labels`` overrides the axis labels
-(mathtext); ``title`` is the axes title; bad input raises :class:`bem.InputError` before
-anything is written. Matplotlib is imported inside the functions.
+write, in the format of :func:`validation.report.render.style.figure_format` (a PNG at
+:data:`~validation.report.render.style.DPI`, an SVG, or a PDF beside the PNG: the one rule of
+the figure formats, :data:`~validation.report.render.style.FORMATS`), written atomically and
+returned; ``p0`` [pressure] and ``a`` [length] are the scales pressures and lengths are divided
+by (Hertz's peak and radius, or ``1`` and ``1`` with ``labels`` naming the units); ``labels``
+overrides the axis labels (mathtext); ``title`` is the axes title; bad input raises
+:class:`bem.InputError` before anything is written. Matplotlib is imported inside the functions.
 
 :data:`FIGURES` maps a figure's name to ``(section, function)``: ``function(results, work)``
 returns a :class:`validation.report.render.Figure` (or a list of them, or ``None`` when the
