@@ -131,6 +131,12 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     FemResult
         ``converged = False`` with a ``message`` when the stopping rule was not met or the
         contact reaches the outer boundary; the fields are then the last finite iterate.
+
+    Raises
+    ------
+    bem.InputError
+        A bad argument, before any work (the checks of :mod:`bem.checks`: "name = value is
+        not allowed: rule"), or a gap that is not finite on the interface.
     """
     t_start = time.perf_counter()
     check_callable("gap", gap)
