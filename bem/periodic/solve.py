@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_bool, check_choice, check_int, check_positive, fail
+from ..checks import check_bool, check_choice, check_gap_values, check_int, check_positive, fail
 from ..errors import InputError
 from ..kkt import kkt_residual
 from ..options import METHODS, check_options, solver_for
@@ -95,13 +95,8 @@ def _cell_and_gap(gap, step, cell):
 
 
 def _evaluate(gap, cell, sx, sy):
-    h = np.asarray(gap(cell.x + sx, cell.y + sy), dtype=float)
-    if h.shape != cell.shape:
-        raise InputError(f"gap returned shape {h.shape} which is not allowed: it must return the shape of x "
-                         f"({cell.shape}).")
-    if not np.all(np.isfinite(h)):
-        fail("gap(x, y)", "a non-finite value", "finite over the cell")
-    return h
+    x, y = cell.x + sx, cell.y + sy
+    return check_gap_values(gap(x, y), {"x": x, "y": y}, region="over the cell")
 
 
 def _levels(cell, h, gap, nested):

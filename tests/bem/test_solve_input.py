@@ -52,6 +52,18 @@ def test_gap_with_nan_is_refused():
     assert 0.2 < x <= 0.5 and abs(y) <= 0.5
 
 
+def test_periodic_gap_with_nan_is_refused_in_the_same_form():
+    from bem.periodic import PeriodicCell
+
+    cell = PeriodicCell.from_size(0.05, (1.0, 1.0))
+    rule = r"^gap\(x, y\) = nan at \(x, y\) = \((\S+), (\S+)\) is not allowed: the gap must be finite over the cell\.$"
+    with pytest.raises(InputError, match=rule) as err:
+        bem.solve_periodic(lambda x, y: np.where(x > 0.6, np.nan, 0.01 * np.cos(2 * np.pi * x)), cell=cell,
+                           E_star=1.0, mean_pressure=1e-3)
+    x, _ = map(float, re.match(rule, str(err.value)).groups())
+    assert x >= 0.6  # shown to 6 significant digits
+
+
 def test_gap_of_the_wrong_shape_is_refused():
     with pytest.raises(InputError, match=r"^gap returned shape \(3,\) which is not allowed: it must return the "
                                          r"shape of x \(\(\d+, \d+\)\)\.$"):
