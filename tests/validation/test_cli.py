@@ -104,17 +104,24 @@ def test_default_output_directory(tmp_path, monkeypatch):
     (["study", "error-time", "hertz", "--out", "x", "--quick"], "validation.studies.error_time"),
     (["study", "stability"], "validation.studies.stability"),
 ])
-def test_study_dispatches_its_arguments(argv, module, monkeypatch):
+def test_study_dispatches_its_arguments(argv, module, monkeypatch, tmp_path):
+    from validation.studies import save
+
     seen = {}
     fake = types.ModuleType(module)
-    fake.main = lambda args: seen.setdefault("args", args) and 7
+
+    def main(**kw):
+        seen.update(kw)
+        return save(tmp_path, "stability", {"rows": []}, status=7)
+
+    fake.main = main
     monkeypatch.setitem(sys.modules, module, fake)
-    code, _out, _err = cli(*argv)
-    assert code == 7
-    args = seen["args"]
-    assert args.study == argv[1]
-    assert getattr(args, "scene", None) == (argv[2] if len(argv) > 2 else None)
-    assert args.quick == ("--quick" in argv)
+    monkeypatch.setattr("validation.report.documents.studies.study_markdown", lambda name, data: "# tables\n")
+    code, out, _err = cli(*argv)
+    assert code == 7 and out == "# tables\n" and (tmp_path / "stability.md").read_text() == "# tables\n"
+    assert seen["out"] == ("x" if "--out" in argv else None)
+    assert seen["scene"] == (argv[2] if len(argv) > 2 and not argv[2].startswith("-") else None)
+    assert seen["quick"] == ("--quick" in argv)
 
 
 def test_report_dispatches_its_arguments_and_prints_where(monkeypatch, tmp_path):

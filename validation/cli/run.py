@@ -124,7 +124,7 @@ def _run_study(scene, out_dir, what, value):
     from bem.files import write_text
 
     from ..io import atomic_directory, check_output_dir, output_errors, recover_output_dir
-    from .study import STUDIES
+    from .study import STUDIES, write_study
 
     study = importlib.import_module(STUDIES[scene.study])
     names = (*study.OUTPUT_NAMES, "scene.toml", "report")
@@ -132,7 +132,7 @@ def _run_study(scene, out_dir, what, value):
         recover_output_dir(out_dir)
         check_output_dir(out_dir, "result", names, what=what, value=value)  # before the study runs
     with atomic_directory(out_dir, "result", names, what=what) as tmp:
-        data, _, _ = study.write_study(tmp, **scene.options)
+        data = write_study(scene.study, tmp, **scene.options)[0].data
         write_text(tmp / "scene.toml", tomli_w.dumps(scene.raw))
     lines = [f"scene      {scene.name}: {scene.title}   [study {scene.study}]"]
     lines += [f"error      {line}" for line in study.summary_lines(data)]

@@ -29,7 +29,10 @@ from ..run import execute_scene
 from . import fmt, save, timed, write_json
 from .problems import ERROR_TIME_PROBLEMS, get_problem, methods
 
-__all__ = ["method_label", "ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "LADDERS", "TARGETS"]
+__all__ = ["method_label", "ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "STEM", "LADDERS", "TARGETS"]
+
+#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
+STEM = "error_time"
 
 #: resolution ladders: BEM steps across the contact diameter, FEM elements across the radius
 LADDERS = {"full": {"bem": (10, 20, 40, 80, 160), "fem": (4, 8, 16, 32)},
@@ -267,15 +270,13 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
     return study
 
 
-def main(args):
-    """``contactlab study error-time [SCENE] [--out DIR] [--quick]``: the problem ``args.scene`` (a name of
-    :data:`~validation.studies.problems.ERROR_TIME_PROBLEMS`; ``None``: all); writes ``error_time.json``
-    and ``error_time.md`` to ``args.out`` (default: the current directory) and prints the markdown. Returns 0."""
+def main(*, out=None, scene=None, quick=False, progress=False):
+    """``contactlab study error-time``: the problem ``scene`` (a name of
+    :data:`~validation.studies.problems.ERROR_TIME_PROBLEMS`; ``None``: all), a short ladder when
+    ``quick``; writes ``error_time.json`` into the folder ``out`` (``None``: the current directory)
+    (:class:`~validation.studies.StudyRun`, status 0). ``progress``: a tqdm bar on stderr."""
     from ..extras import require
 
     require("fem", "contactlab study error-time (the FEM reference)")
-    scene = getattr(args, "scene", None)
-    study = run_error_time(None if scene is None else [scene], quick=bool(getattr(args, "quick", False)),
-                           progress=not getattr(args, "no_progress", False))
-    print(save(args, "error_time", study.to_dict()))
-    return 0
+    study = run_error_time(None if scene is None else [scene], quick=bool(quick), progress=progress)
+    return save(out, STEM, study.to_dict())

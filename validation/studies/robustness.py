@@ -26,11 +26,14 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..scene import load_scene
-from . import attempt, classify, finite, fmt, save
+from . import attempt, classify, finite, fmt, no_scene, save
 from .problems import robustness_scene
 
 __all__ = ["RobustnessRow", "run_robustness", "summary_table", "matrix_table", "failure_table",
-           "rows_from_json", "main", "EXPONENTS", "COMPLIANCES", "MODULI", "LAYER_METHODS", "SETTING"]
+           "rows_from_json", "main", "STEM", "EXPONENTS", "COMPLIANCES", "MODULI", "LAYER_METHODS", "SETTING"]
+
+#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
+STEM = "robustness"
 
 EXPONENTS = (0.05, 0.2, 0.5, 1.0, 2.0, 3.0, 10.0)
 COMPLIANCES = (1e-6, 1e-3, 1.0, 1e3, 1e6)
@@ -164,12 +167,12 @@ def _json_row(row):
     return out
 
 
-def main(args):
-    """``contactlab study robustness [--out DIR] [--quick]``: writes ``robustness.json`` and ``robustness.md``
-    to ``args.out`` (default: the current directory) and prints the markdown. Returns 1 if any outcome is
-    wrong, else 0."""
-    quick = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
-    rows = run_robustness(progress=not getattr(args, "no_progress", False),
-                          **(quick if getattr(args, "quick", False) else {}))
-    print(save(args, "robustness", [_json_row(r) for r in rows]), end="")
-    return 1 if any(r.status == "wrong" for r in rows) else 0
+def main(*, out=None, scene=None, quick=False, progress=False):
+    """``contactlab study robustness``: the whole grid, or a small one when ``quick``; writes
+    ``robustness.json`` into the folder ``out`` (``None``: the current directory). Returns the
+    :class:`~validation.studies.StudyRun`, status 1 if any outcome is wrong, else 0. The study takes no ``scene``; ``progress``: a tqdm bar
+    on stderr."""
+    no_scene("robustness", scene)
+    quick_grid = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
+    rows = run_robustness(progress=progress, **(quick_grid if quick else {}))
+    return save(out, STEM, [_json_row(r) for r in rows], status=int(any(r.status == "wrong" for r in rows)))

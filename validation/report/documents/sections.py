@@ -235,7 +235,8 @@ def _figures_only(title, kind):
     return lambda res, work: Section(title, kind=kind)
 
 
-#: section name -> function(results, work) -> Section or None, in the default order of a report
+#: section name -> function(results, work) -> Section or None, in the default order of a report; the
+#: names are those a scene may list (:data:`validation.scene.schema.REPORT_SECTIONS`)
 SECTIONS = {
     "scene": scene_section,
     "layer_law": _figures_only("Interface layer law", "problem"),
