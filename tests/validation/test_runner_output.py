@@ -158,6 +158,36 @@ def test_automatic_region_grows_when_the_estimate_is_short():
     assert any("enlarged" in m for m in r["messages"])
 
 
+@pytest.mark.parametrize("scene_name, overrides", [
+    ("paper_root", ["bem.extent_factor=1.0"]),  # enlarged while calibrating the root law
+    ("paper_elastic_rigid", ["bem.extent_factor=1.0", "layer.alpha_a=1.0"]),
+])
+def test_an_enlarged_region_is_the_estimate_times_1_5_and_solves_as_if_given(scene_name, overrides):
+    """The region grows by 1.5 (up to the gap's domain) and the run is that of a scene giving the grown
+    region itself: the calibration and the solve both use it."""
+    from validation.scene.sizing import region_limit
+
+    scene = load_scene(scene_name, overrides=["bem.nodes_across=16", "fem.n_contact=8", *overrides])
+    grown = execute_scene(scene).result
+    limit = region_limit(scene.gap)
+    ex, ey = grown["bem"]["extent"]
+    assert any("enlarged" in m for m in grown["messages"])
+    assert (ex, ey) == tuple(min(1.5 * e, lim) for e, lim in zip(scene.bem["extent"], limit))
+    given = execute_scene(scene, overrides=[f"bem.extent=[{ex!r}, {ey!r}]"]).result
+    assert not any("enlarged" in m for m in given["messages"])
+    for key in ("p_max", "approach", "contact_area", "iterations"):
+        assert given[key] == grown[key], key
+    assert given["layer"]["parameters"] == grown["layer"]["parameters"]
+
+
+def test_planned_stages_hold_the_calibration_exactly_when_it_solves():
+    """The "layer" stage is planned for the scenes whose layer needs calibration solves, and only those."""
+    for name in ("paper_linear", "paper_root", "paper_elastic_rigid", "paper_bilinear", "hertz"):
+        scene = load_scene(name, overrides=["bem.nodes_across=12"], no_fem=True)
+        solves = execute_scene(scene).result["layer"].get("reference_solves", 0)
+        assert ("layer" in runner.planned_stages(scene)) == (solves > 0), name
+
+
 def test_run_does_not_modify_the_scene():
     scene = load_scene("paper_root", overrides=["bem.nodes_across=16"])
     raw = json.dumps(scene.raw, sort_keys=True)

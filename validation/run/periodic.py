@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from ..provenance import provenance
-from ..scene import paper
+from .calibrate import resolve_layer
 from .result import SCHEMA, _history
 
 __all__ = ["execute_periodic", "contact_spots", "periodic_result"]
@@ -140,8 +140,8 @@ def execute_periodic(scene, *, progress=None):
     if lattice.stretch_large:
         messages.append(f"the lattice stretches the surface along y by {lattice.stretch_y:.4f}: choose bem.cell_nodes "
                         "for which the cell's rows fit (docs/rough.md)")
-    layer, layer_info = paper.resolve_layer(scene.layer_spec, step=lattice.step, E_star=scene.E_star, solve=None,
-                                            layer=scene.layer)
+    layer, layer_info = resolve_layer(scene.layer_spec, step=lattice.step, E_star=scene.E_star, solve=None,
+                                      layer=scene.layer)
     area = lattice.size[0] * lattice.size[1]
     mean_pressure = load.get("mean_pressure") or (None if load["force"] is None else load["force"] / area)
     kw = {k: v for k, v in opts.items() if k not in _CELL_KEYS}  # the solver options

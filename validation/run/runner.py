@@ -20,12 +20,13 @@ from bem.layers import beyond_table
 
 from ..compare import compare
 from ..io import atomic_directory, atomic_write_json, check_output_dir, output_errors, recover_output_dir
-from ..scene import paper
+from ..scene.paper import needs_calibration
 from ..scene.checks import SceneError
 from ..scene.load import Scene, load_scene
 from ..scene.study import refuse_study
 from ..scene.trust import refuse_code
-from ..scene.sizing import DOMAIN_MARGIN, SOLVER_KEYS, inner_domain
+from ..scene.sizing import SOLVER_KEYS, inner_domain, region_limit
+from .calibrate import CalibrationError, resolve_layer
 from .result import build_result
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES", "RESULT_NAMES",
@@ -62,9 +63,7 @@ def _notify(progress, stage, status, **info):
 
 def planned_stages(scene, *, write=False):
     """Stage names :func:`run_scene` will report for ``scene`` (for progress bars)."""
-    spec = scene.layer_spec
-    calibrated = paper.is_paper_law(spec) and ("alpha_a" in spec or spec["law"] == "root")
-    wanted = {"layer": calibrated,
+    wanted = {"layer": needs_calibration(scene.layer_spec),
               "bem": True,
               "fem": scene.fem is not None,
               "compare": scene.fem is not None or scene.analytic is not None,
@@ -91,7 +90,7 @@ class _BemRunner:
     def __call__(self, layer, callback=None):
         res = self._solve(layer, callback)
         if self.calibration and not res.converged:
-            raise paper.CalibrationError(
+            raise CalibrationError(
                 f"the calibration of the layer law ({layer!r}) did not converge with method 'newton': "
                 f"{res.message}. The run stops: the layer parameters would be wrong.")
         return res
@@ -105,7 +104,7 @@ class _BemRunner:
                 if not self.scene.bem["extent_auto"]:
                     raise
                 hx, hy = inner_domain(self.scene.gap)
-                limit = ((1 - DOMAIN_MARGIN) * hx, (1 - DOMAIN_MARGIN) * hy)
+                limit = region_limit(self.scene.gap)
                 grown = tuple(min(_GROW * e, lim) for e, lim in zip(self.extent, limit))
                 if attempt == _MAX_GROW or grown == self.extent:
                     if any(e >= lim for e, lim in zip(self.extent, limit)):
@@ -165,8 +164,8 @@ def execute_scene(scene, *, progress=None, overrides=None):
     if "layer" in planned_stages(scene):
         _notify(progress, "layer", "start")
     t = time.perf_counter()
-    layer, layer_info = paper.resolve_layer(scene.layer_spec, step=scene.bem["step"], E_star=scene.E_star,
-                                            solve=calibrate, layer=scene.layer)
+    layer, layer_info = resolve_layer(scene.layer_spec, step=scene.bem["step"], E_star=scene.E_star,
+                                      solve=calibrate, layer=scene.layer)
     if calibrate.solves:
         times["layer_reference"] = time.perf_counter() - t
         solve.extent = calibrate.extent

@@ -66,7 +66,8 @@ def figure_data(fields, pixels=JSON_PIXELS):
     """What the two figures of the case in ``fields`` draw, JSON-ready and modest in size.
 
     ``map``: the resolved pressure [Pa] binned on ``pixels x pixels`` squares over
-    ``[-extent, extent]^2``, at most ``pixels`` and about two lattice steps across (``image[i][j]``: row ``i`` along y; ``None`` where no node falls);
+    ``[-extent, extent]^2``, at most ``pixels`` and about two lattice steps across (``image[i][j]``:
+    row ``i`` along y; ``None`` where no node falls);
     ``radius``, ``layer_radius``: the nominal radii [m]; ``profile``: the curves of
     :func:`profile_curves`, each ``[x [m], p [Pa]]``; ``width``, ``wide`` [m]; 4 significant digits.
     """
