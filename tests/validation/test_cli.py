@@ -132,20 +132,22 @@ def test_report_dispatches_its_arguments_and_prints_where(monkeypatch, tmp_path)
 
     seen = {}
 
-    def fake(args, progress=None):
-        seen["args"] = args
+    def fake(target, progress=None, **kw):
+        seen["args"] = dict(kw, target=target)
         for k in range(3):
             progress(f"stage {k}", k, 3)
-        out = Path(args.out)
+        out = Path(kw["out"])
         return BuiltReport(out, out / "report.html", out / "report.md", (out / "figures" / "a.svg",))
 
-    monkeypatch.setattr(command, "build_from_args", fake)
-    code, out, err = cli("report", "results/hertz", "--out", tmp_path / "rep", "--format", "svg", "--units",
+    monkeypatch.setattr(command, "build", fake)
+    (tmp_path / "hertz").mkdir()
+    (tmp_path / "hertz" / "result.json").write_text("{}")
+    code, out, err = cli("report", tmp_path / "hertz", "--out", tmp_path / "rep", "--format", "svg", "--units",
                          "dimensionless")
     assert code == 0, err
     args = seen["args"]
-    assert (args.target, args.out, args.format, args.units) == ("results/hertz", str(tmp_path / "rep"), "svg",
-                                                                "dimensionless")
+    assert (args["target"], args["out"], args["fmt"], args["units"]) == (str(tmp_path / "hertz"), str(tmp_path / "rep"),
+                                                                         "svg", "dimensionless")
     assert f"report written to {tmp_path / 'rep' / 'report.html'}" in out
     assert "1 figures" in out
 

@@ -4,7 +4,6 @@ describes (section 6) checked on the cases, run as scenes by the runner."""
 import logging
 import math
 import re
-from argparse import Namespace
 
 import numpy as np
 import pytest
@@ -178,7 +177,7 @@ def test_report_command_prints_the_notes(monkeypatch, tmp_path):
     from .conftest import cli
 
     built = BuiltReport(tmp_path, tmp_path / "report.html", tmp_path / "report.md", (), notes=("stall expected",))
-    monkeypatch.setattr(command, "build_from_args", lambda args, progress=None: built)
+    monkeypatch.setattr(command, "build", lambda target, **kw: built)
     code, out, err = cli("report", "paper", "--out", tmp_path)
     assert code == 0 and "note: stall expected" in out.splitlines() and err == ""
 
@@ -188,12 +187,12 @@ def test_scikit_fem_info_lines_only_when_verbose(monkeypatch, tmp_path):
 
     from .conftest import cli
 
-    def build(args, progress=None):
+    def build(target, **kw):
         logging.getLogger("skfem.assembly").info("assembling a form")
         logging.getLogger("skfem.assembly").warning("a real problem")
         return BuiltReport(tmp_path, tmp_path / "report.html", tmp_path / "report.md", ())
 
-    monkeypatch.setattr(command, "build_from_args", build)
+    monkeypatch.setattr(command, "build", build)
     _code, _out, err = cli("report", "paper", "--out", tmp_path)
     assert "a real problem" in err and "assembling" not in err
     _code, _out, err = cli("-v", "report", "paper", "--out", tmp_path)
@@ -213,8 +212,8 @@ def test_main_dispatches_paper(monkeypatch, tmp_path):
         return Built()
 
     monkeypatch.setattr("validation.report.documents.paper.report_paper_problem", fake)
-    assert command.main(Namespace(target="paper", out=str(tmp_path), quick=True)) == 0
-    assert command.main(Namespace(target="paper", out=None, format="pdf")) == 0
+    command.main("paper", out=str(tmp_path), quick=True)
+    command.main("paper", fmt="pdf")
     assert calls == [(str(tmp_path), True, "png"), (str(command.DEFAULT_PAPER_OUT), False, "pdf")]
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 
-from .common import add_set, add_trust
+from .common import add_set, add_trust, trust
 
 #: figure formats of `contactlab report --format` (validation.report.style.FORMATS, kept here so the
 #: parser needs no import of the report package)
@@ -69,12 +69,24 @@ class _ReportBar:
         self.bar.close()
 
 
+#: the option of each keyword of validation.report.command.build
+_FLAGS = {"quick": "--quick", "units": "--units", "overrides": "--set", "allow_code": "--allow-code",
+          "allow_outside_files": "--allow-outside-files"}
+
+
 def run(args):
+    from bem.checks import InputError
+
     from ..report import command
 
+    options = dict(quick=args.quick, units=args.units, overrides=args.overrides, **trust(args))
+    kind = command.target_kind(args.target)
+    for key in command.refused_options(kind, options):
+        raise InputError(f"{_FLAGS[key]} is not allowed with target {args.target!r} (a {kind} target): it applies "
+                         f"to {command.applies_to(key)}.")
     bar = _ReportBar(args.no_progress or None)
     try:
-        built = command.build_from_args(args, progress=bar)
+        built = command.build(args.target, out=args.out, fmt=args.format, progress=bar, what="--out", **options)
     finally:
         bar.close()
     print(f"report written to {built.html}")
