@@ -10,7 +10,7 @@ import pytest
 
 from validation.report import command
 from validation.report.documents.paper import TITLE, paper_sections
-from validation.report.documents.paper_runs import run_paper_problem
+from validation.studies.paper_problem import run_paper_problem
 from validation.report.render import build_report
 from validation.report.render.content import Figure
 
@@ -249,7 +249,7 @@ def test_example_script_passes_its_options(monkeypatch, tmp_path):
 
 def test_paper_report_tells_its_stages(paper_run, monkeypatch, tmp_path):
     from validation.report.documents import paper as paper_report
-    from validation.report.documents.paper_runs import SOLVE_STAGES
+    from validation.studies.paper_problem import SOLVE_STAGES
     from validation.report.render import Section
 
     paper, stages, _warnings = paper_run
@@ -306,3 +306,17 @@ def test_one_name_for_the_hertz_peak(report):
         text = re.sub(r"data:image/[a-z+]+;base64,[^\"')]*", "", text)  # the words, not the images
         assert "p_0" in text and "p_H" not in text and not re.search(r"(?<![\w.])p0\b", text)
     assert "Normalised by Hertz's peak p_0" in report.markdown.read_text(encoding="utf-8")
+
+
+def test_the_paper_study_takes_the_scenes_override_syntax():
+    """Its cases take dotted keys and the short names of ``--set``; a wrong key is named as a scene names it."""
+    from validation.scene import SceneError
+    from validation.studies.paper_problem import CaseRunner
+
+    run = CaseRunner(6)
+    short = run("elastic-rigid", {"alpha_a": 0.3}).result
+    dotted = run("elastic-rigid", {"layer.alpha_a": 0.3}).result
+    assert short["layer"]["alpha_a"] == dotted["layer"]["alpha_a"] == 0.3
+    assert short["p_max"] == dotted["p_max"] and short["layer"]["parameters"] == dotted["layer"]["parameters"]
+    with pytest.raises(SceneError, match="bem.methd"):
+        run("smooth", {"bem.methd": "newton"})

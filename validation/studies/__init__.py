@@ -8,13 +8,15 @@
 - :mod:`~validation.studies.robustness`: the layer methods over 12 decades of layer compliance,
   every converged answer checked against the KKT conditions with the dense influence matrix;
 - :mod:`~validation.studies.two_scale`: a fully resolved rough sphere against the smooth sphere
-  with the layer law of its roughness and Greenwood-Tripp.
+  with the layer law of its roughness and Greenwood-Tripp;
+- :mod:`~validation.studies.paper_problem`: the paper's test problem (section 6) on one lattice,
+  its cases, sweeps and methods, which the paper report draws (``contactlab report paper``).
 
-Each has ``main(out=..., scene=..., quick=..., progress=...)`` for ``contactlab study error-time |
-stability | robustness | two-scale``: it writes its JSON file (``STEM + ".json"``) and returns a
-:class:`StudyRun`, which the report renders (:mod:`validation.report.documents.studies`). This module holds what they share: running a
-scene (:func:`attempt`, :func:`timed`), the status of an outcome (:func:`classify`) and the files
-(:func:`save`).
+The first four have ``main(out=..., scene=..., quick=..., progress=...)`` for ``contactlab study
+error-time | stability | robustness | two-scale``: it writes the study's JSON file (``STEM + ".json"``)
+and returns a :class:`StudyRun`, which the report renders (:mod:`validation.report.documents.studies`).
+This module holds what they share: running a scene (:func:`attempt`, :func:`timed`), the status of an
+outcome (:func:`classify`) and the files (:func:`save`).
 """
 
 from __future__ import annotations
