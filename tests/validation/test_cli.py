@@ -204,11 +204,11 @@ def test_parser_is_buildable_without_heavy_imports():
 def test_report_progress_bar_shows_the_stages_on_stderr(monkeypatch):
     import io
 
-    from validation.cli import report as cli_mod
+    from validation.cli.common import ProgressBar
 
     err = io.StringIO()
     monkeypatch.setattr(sys, "stderr", err)
-    bar = cli_mod._ReportBar(False)
+    bar = ProgressBar("report", "stage", False)
     for k, stage in enumerate(("layer laws", "parameter sweeps", "figures")):
         bar(stage, k, 3)
     bar("done", 3, 3)

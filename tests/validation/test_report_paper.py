@@ -35,7 +35,7 @@ def paper_run():
     stages, handler, logger = [], _Collect(), logging.getLogger("bem")
     logger.addHandler(handler)
     try:
-        return run_paper_problem(quick=True, progress=stages.append), stages, handler.messages
+        return run_paper_problem(quick=True, progress=lambda *a: stages.append(a)), stages, handler.messages
     finally:
         logger.removeHandler(handler)
 
@@ -253,7 +253,8 @@ def test_paper_report_tells_its_stages(paper_run, monkeypatch, tmp_path):
     from validation.report.render import Section
 
     paper, stages, _warnings = paper_run
-    assert stages == list(SOLVE_STAGES)  # the real runs, in order
+    n = len(SOLVE_STAGES)  # the real runs, in order, told as every job of the library tells its progress
+    assert stages == [(s, k, n) for k, s in enumerate(SOLVE_STAGES)] + [("done", n, n)]
 
     def fake_solve(*, quick, fem, progress):
         for stage in SOLVE_STAGES[:3 + fem]:

@@ -134,13 +134,21 @@ def test_scene_file_in_the_result_reruns_identically(tmp_path):
     assert second["fem"]["p_max"] == first["fem"]["p_max"]
 
 
-def test_progress_reports_every_planned_stage():
+def test_progress_reports_every_planned_stage(tmp_path):
+    """The run tells progress(label, done, total) (validation.progress): each stage at its start, the
+    BEM iterations within their stage, then the end; with a result directory, its writing too."""
     events = []
     scene = load_scene("paper_elastic_rigid", overrides=["bem.nodes_across=16", "fem.n_contact=8"])
-    execute_scene(scene, progress=lambda stage, status, info: events.append((stage, status)))
-    done = [s for s, st in events if st == "done"]
-    assert done == runner.planned_stages(scene) == ["layer", "bem", "fem", "compare"]
-    assert ("bem", "iteration") in events
+    execute_scene(scene, progress=lambda *a: events.append(a))
+    stages = runner.planned_stages(scene)
+    assert stages == ["layer", "bem", "fem", "compare"]
+    assert [e for e in events if ":" not in e[0]] == [(s, k, 4) for k, s in enumerate(stages)] + [("done", 4, 4)]
+    iterations = [e for e in events if e[0].startswith("bem: iteration")]
+    assert iterations and all(e[1:] == (1, 4) for e in iterations)
+    events.clear()
+    run_scene(scene, tmp_path / "r", progress=lambda *a: events.append(a))
+    assert [e for e in events if ":" not in e[0]] == [(s, k, 5) for k, s in enumerate(stages + ["write"])] + [
+        ("done", 5, 5)]
 
 
 def test_not_converged_is_flagged_and_written(tmp_path):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 
-from .common import add_set, add_trust, trust
+from .common import ProgressBar, add_set, add_trust, trust
 
 #: figure formats of `contactlab report --format` (validation.report.style.FORMATS, kept here so the
 #: parser needs no import of the report package)
@@ -51,24 +51,6 @@ def add_args(p):
     add_trust(p, scope="scene targets only: ")
 
 
-class _ReportBar:
-    """tqdm bar (stderr) over the stages of a report build."""
-
-    def __init__(self, disable):
-        from tqdm import tqdm
-
-        self.bar = tqdm(total=1, desc="report", unit="stage", disable=disable, leave=False)
-
-    def __call__(self, stage, done, total):
-        self.bar.total = total
-        self.bar.n = done
-        self.bar.set_description(stage)
-        self.bar.refresh()
-
-    def close(self):
-        self.bar.close()
-
-
 #: the option of each keyword of validation.report.command.build
 _FLAGS = {"quick": "--quick", "units": "--units", "overrides": "--set", "allow_code": "--allow-code",
           "allow_outside_files": "--allow-outside-files"}
@@ -84,7 +66,7 @@ def run(args):
     for key in command.refused_options(kind, options):
         raise InputError(f"{_FLAGS[key]} is not allowed with target {args.target!r} (a {kind} target): it applies "
                          f"to {command.applies_to(key)}.")
-    bar = _ReportBar(args.no_progress or None)
+    bar = ProgressBar("report", "stage", args.no_progress or None)
     try:
         built = command.build(args.target, out=args.out, fmt=args.format, progress=bar, what="--out", **options)
     finally:

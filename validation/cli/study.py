@@ -35,8 +35,13 @@ def write_study(name, out=None, **options):
 
 
 def run(args):
-    study, text, figures = write_study(args.study, args.out, scene=args.scene, quick=args.quick,
-                                       progress=not args.no_progress)
+    from .common import ProgressBar
+
+    bar = ProgressBar(args.study, "step", args.no_progress or None)
+    try:
+        study, text, figures = write_study(args.study, args.out, scene=args.scene, quick=args.quick, progress=bar)
+    finally:
+        bar.close()
     print(text, end="" if text.endswith("\n") else "\n")
     for path in figures:
         print(f"figure: {path}")

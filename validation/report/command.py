@@ -98,7 +98,7 @@ def build(target, *, out=None, fmt="png", units=None, quick=False, overrides=(),
         Scenes only (:mod:`validation.scene.trust`).
     progress : callable, optional
         ``progress(stage, done, total)`` at the start of each stage and at the end
-        (:class:`validation.report.render.Progress`).
+        (:class:`validation.progress.Progress`).
     what : str
         How errors name ``out`` (the command line's ``--out``).
 

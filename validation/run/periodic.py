@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from ..provenance import provenance
+from ..progress import stages_of
 from .calibrate import resolve_layer
 from .result import SCHEMA, _history
 
@@ -123,11 +124,14 @@ def execute_periodic(scene, *, progress=None):
     """Solve a periodic scene (:func:`bem.solve_periodic`); returns a :class:`validation.run.RunOutcome`.
 
     ``load.force`` is the force on one cell, solved as the mean pressure ``force / (Lx Ly)``.
-    ``progress`` as for :func:`validation.run.execute_scene` (stages ``"bem"``).
+    ``progress``: a :class:`validation.progress.Progress` holding the stage ``"bem"``, or a callback
+    (:mod:`validation.progress`).
     """
     import bem
 
-    from .runner import RunOutcome, _notify
+    from .runner import RunOutcome
+
+    stages = stages_of(progress, ["bem"])
 
     t0 = time.perf_counter()
     messages = []
@@ -147,15 +151,14 @@ def execute_periodic(scene, *, progress=None):
     kw = {k: v for k, v in opts.items() if k not in _CELL_KEYS}  # the solver options
 
     def callback(k, _p):
-        _notify(progress, "bem", "iteration", iteration=k)
+        stages.note(f"iteration {k}")
 
-    _notify(progress, "bem", "start")
+    stages("bem")
     t = time.perf_counter()
     res = bem.solve_periodic(lattice.gap(), step=lattice.step, E_star=scene.E_star, mean_pressure=mean_pressure,
                              approach=load["approach"], layer=layer,
-                             callback=callback if progress is not None else None, **kw)
+                             callback=callback if stages.callback is not None else None, **kw)
     times = {"bem": time.perf_counter() - t}
-    _notify(progress, "bem", "done", converged=res.converged)
     if not res.converged:
         messages.append(f"BEM did not converge: {res.message}")
     spots = contact_spots(res.p.reshape(res.lattice.shape) > 0)

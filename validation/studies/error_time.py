@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass, field
 from bem.checks import InputError, check_choice, check_positive
 
 from ..compare import pair_metrics, relative_l2
+from ..progress import each
 from ..run import execute_scene
 from . import fmt, save, timed, write_json
 from .problems import ERROR_TIME_PROBLEMS, get_problem, methods
@@ -218,7 +219,7 @@ def _climb(study, problem, method, ladder, reference, opts):
 
 
 def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=None, repeats=3, slow_s=2.0,
-                   time_budget_s=60.0, relaxations=None, fem=True, progress=False):
+                   time_budget_s=60.0, relaxations=None, fem=True, progress=None):
     """Run the error-time study.
 
     Parameters
@@ -238,15 +239,13 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
         Relaxations of the augmented gap method, tried in turn (default ``(1, 0.5, 0.2)``, quick ``(1, 0.3)``).
     fem : bool
         Run the FEM ladder.
-    progress : bool
-        Show a tqdm progress bar (stderr), one step per ladder.
+    progress : callable, optional
+        ``progress(label, done, total)`` (:mod:`validation.progress`), one step per ladder.
 
     Returns
     -------
     ErrorTimeStudy
     """
-    from tqdm import tqdm
-
     mode = "quick" if quick else "full"
     bem_ladder = tuple(LADDERS[mode]["bem"] if bem_ladder is None else bem_ladder)
     fem_ladder = tuple(LADDERS[mode]["fem"] if fem_ladder is None else fem_ladder) if fem else ()
@@ -259,7 +258,7 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
                                      **opts, "relaxations": list(relaxations)})
     ladders = [(p, m, fem_ladder if m == "fem" else bem_ladder) for p in problems
                for m in (methods(p) if "layer" in p else ("kalker",)) + (("fem",) if fem_ladder else ())]
-    for problem, method, ladder in tqdm(ladders, desc="error-time", unit="ladder", disable=not progress):
+    for problem, method, ladder in each(ladders, progress, lambda t: f"{t[0]['scene']['title']} {t[1]}"):
         name = problem["scene"]["title"]
         if name not in study.references:
             reference, study.references[name] = _reference(problem, max(bem_ladder))
@@ -270,11 +269,11 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
     return study
 
 
-def main(*, out=None, scene=None, quick=False, progress=False):
+def main(*, out=None, scene=None, quick=False, progress=None):
     """``contactlab study error-time``: the problem ``scene`` (a name of
     :data:`~validation.studies.problems.ERROR_TIME_PROBLEMS`; ``None``: all), a short ladder when
     ``quick``; writes ``error_time.json`` into the folder ``out`` (``None``: the current directory)
-    (:class:`~validation.studies.StudyRun`, status 0). ``progress``: a tqdm bar on stderr."""
+    (:class:`~validation.studies.StudyRun`, status 0). ``progress(label, done, total)``: :mod:`validation.progress`."""
     from ..extras import require
 
     require("fem", "contactlab study error-time (the FEM reference)")

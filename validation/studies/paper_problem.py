@@ -26,7 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["PaperRuns", "CaseRunner", "run_paper_problem", "SCENES", "SOLVE_STAGES", "AG_RELAXATION", "ALPHA_A_ITERATIONS"]
+__all__ = ["PaperRuns", "CaseRunner", "run_paper_problem", "SCENES", "SOLVE_STAGES", "AG_RELAXATION",
+           "ALPHA_A_ITERATIONS"]
 
 log = logging.getLogger(__name__)
 
@@ -262,15 +263,19 @@ def run_paper_problem(*, quick=False, fem=True, progress=None):
         sweep values (seconds instead of minutes).
     fem : bool
         Also run the FEM reference and the resolution study.
-    progress : callable, optional
-        ``progress(stage)`` at the start of each stage of :data:`SOLVE_STAGES` (the FEM stage
-        only with ``fem``).
+    progress : callable or validation.progress.Progress, optional
+        ``progress(label, done, total)`` (:mod:`validation.progress`) at the start of each stage of
+        :data:`SOLVE_STAGES` (the FEM stage only with ``fem``) and at the end (``"done"``); a
+        :class:`~validation.progress.Progress` of a caller's job that holds these stages is told them
+        and not the end.
 
     Returns
     -------
     PaperRuns
     """
-    notify = progress or (lambda stage: None)
+    from ..progress import stages_of
+
+    notify = stages_of(progress, [s for s in SOLVE_STAGES if fem or s != SOLVE_STAGES[3]])
     t0 = time.perf_counter()
     n = 8 if quick else 20
     run, res = CaseRunner(n), PaperRuns(quick=quick, nodes_per_radius=n)
@@ -278,6 +283,8 @@ def run_paper_problem(*, quick=False, fem=True, progress=None):
         if stage != SOLVE_STAGES[3] or fem:
             notify(stage)
             step(run, res, quick)
+    if notify is not progress:
+        notify.done()
     res.wall_time_s = time.perf_counter() - t0
     log.info("paper problem run in %.1f s", res.wall_time_s)
     return res

@@ -32,6 +32,7 @@ from dataclasses import asdict, dataclass, field
 from bem.reference import hertz_sphere
 
 from ..compare import pair_metrics
+from ..progress import each
 from . import STATUSES, attempt, classify, finite, fmt, no_scene, save
 from .problems import LIMIT_TOL, methods, stability_cases
 
@@ -183,7 +184,7 @@ def _run_case(case, limit):
     return rows
 
 
-def run_stability(cases=None, *, quick=False, check=True, progress=False):
+def run_stability(cases=None, *, quick=False, check=True, progress=None):
     """Run the stability study.
 
     Parameters
@@ -195,28 +196,27 @@ def run_stability(cases=None, *, quick=False, check=True, progress=False):
     check : bool
         Raise :class:`StabilityFailure` when any outcome is wrong (a NaN anywhere, or a wrong answer
         called converged).
-    progress : bool
-        Show a tqdm progress bar (stderr).
+    progress : callable, optional
+        ``progress(label, done, total)`` (:mod:`validation.progress`), one step per case.
 
     Returns
     -------
     StabilityStudy
     """
-    from tqdm import tqdm
-
     cases = stability_cases(quick) if cases is None else list(cases)
     study = StabilityStudy(settings={"mode": "quick" if quick else "full", "method_tol": METHOD_TOL,
                                      "fem_tol": FEM_TOL, "cases": [c["scene"]["title"] for c, _ in cases]})
-    for case, limit in tqdm(cases, desc="stability", unit="case", disable=not progress):
+    for case, limit in each(cases, progress, lambda c: c[0]["scene"]["title"]):
         study.rows += _run_case(case, limit)
     return study.check() if check else study
 
 
-def main(*, out=None, scene=None, quick=False, progress=False):
+def main(*, out=None, scene=None, quick=False, progress=None):
     """``contactlab study stability``: every case, or a short list when ``quick``; writes
     ``stability.json`` into the folder ``out`` (``None``: the current directory). Returns the
     :class:`~validation.studies.StudyRun`, status 1 if any outcome is wrong (logged as an error with
-    the :class:`StabilityFailure` message), else 0. The study takes no ``scene``; ``progress``: a tqdm bar on stderr."""
+    the :class:`StabilityFailure` message), else 0. The study takes no ``scene``;
+    ``progress(label, done, total)``: :mod:`validation.progress`."""
     from ..extras import require
 
     no_scene("stability", scene)

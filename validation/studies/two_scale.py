@@ -34,6 +34,7 @@ import time
 
 import numpy as np
 
+from ..progress import each
 from . import fmt, no_scene, save
 from .two_scale_models import (TiledRoughness, greenwood_tripp_law, nominal_radius, spectral_moments,
                                windowed)
@@ -163,7 +164,8 @@ def run_two_scale(settings=None, *, quick=False, keep=False, progress=None):
     ``figure``: what the figures of the first case draw,
     :func:`validation.studies.two_scale_figure.figure_data`).
 
-    ``keep``: also return the fields of the first case (for the figures) under ``"fields"``.
+    ``keep``: also return the fields of the first case (for the figures) under ``"fields"``;
+    ``progress(label, done, total)`` (:mod:`validation.progress`): one step per case.
     """
     from .two_scale_figure import figure_data
 
@@ -174,13 +176,11 @@ def run_two_scale(settings=None, *, quick=False, keep=False, progress=None):
     p_max = 1.5 * 3 * s["load_ratio"] * P1 / (2 * math.pi * a**2)
     laws = layer_laws(s, surface, 4 * p_max)
     rows, fields = [], None
-    for ratio in s["ratios"]:
-        for factor in (1.0, s["load_ratio"]):
-            row, f = run_case(s, surface, (laws[0].law, laws[1]), ratio, factor)
-            rows.append(row)
-            fields = fields or f
-            if progress:
-                progress(row)
+    cases = [(ratio, factor) for ratio in s["ratios"] for factor in (1.0, s["load_ratio"])]
+    for ratio, factor in each(cases, progress, lambda c: "a_H/lambda_L = {:g}, P = {:g} P1".format(*c)):
+        row, f = run_case(s, surface, (laws[0].law, laws[1]), ratio, factor)
+        rows.append(row)
+        fields = fields or f
     out = {"study": "two_scale", "mode": "quick" if quick else "full",
            "settings": {k: list(v) if isinstance(v, tuple) else v for k, v in s.items()},
            "surface": surface.stats.as_dict(), "first_touch_gap": float(laws[0].first_touch_gap),
@@ -245,7 +245,7 @@ def summary_lines(data):
     return lines
 
 
-def main(*, out=None, scene=None, quick=False, progress=False):
+def main(*, out=None, scene=None, quick=False, progress=None):
     """``contactlab study two-scale``: the full check, or the small run ``rough_sphere_two_scale`` when
     ``quick``; writes ``two_scale.json`` into the folder ``out`` (``None``: the current directory) and
     returns the :class:`~validation.studies.StudyRun` with the fields of the first case (for its
@@ -255,6 +255,6 @@ def main(*, out=None, scene=None, quick=False, progress=False):
 
     no_scene("two-scale", scene)
     require("rough", "the two-scale check (the self-affine surface)")
-    data = run_two_scale(quick=bool(quick), keep=True)
+    data = run_two_scale(quick=bool(quick), keep=True, progress=progress)
     fields = data.pop("fields")
     return save(out, STEM, data, fields=fields)

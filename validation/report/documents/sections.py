@@ -297,7 +297,7 @@ def report_results_dir(directory, out_dir=None, *, title=None, units="auto", fmt
     fmt : {"png", "svg", "pdf"}
         Figure files (:func:`validation.report.render.style.figure_format`).
     progress : callable, optional
-        ``progress(stage, done, total)`` (:class:`validation.report.render.Progress`).
+        ``progress(stage, done, total)`` (:class:`validation.progress.Progress`).
 
     Returns
     -------

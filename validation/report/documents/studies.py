@@ -170,7 +170,7 @@ def report_studies_dir(directory, out_dir=None, *, title="contactlab validation 
 
     ``fmt`` (``"png"``, ``"svg"``, ``"pdf"``) chooses the figure files
     (:func:`validation.report.render.style.figure_format`); ``progress(stage, done, total)``
-    hears the stages (:class:`validation.report.render.Progress`).
+    hears the stages (:class:`validation.progress.Progress`).
     """
     from .sections import STAGES
 
