@@ -9,6 +9,10 @@ PACKAGES = ("bem", "fem_reference", "validation")
 ALLOWED = {"bem": {"bem"}, "fem_reference": {"bem", "fem_reference"},
            "validation": {"bem", "fem_reference", "validation"}}
 MAX_LINES = 400
+#: the layers of ``validation``, lowest first: each imports only the layers below it and the shared
+#: modules (``validation.io``, ``units``, ``provenance``, ``compare``, ``extras``: any module of
+#: ``validation`` outside these sub-packages), which import no layer
+LAYERS = ("scene", "run", "studies", "report", "layer_law", "cli")
 
 
 def _modules():
@@ -57,6 +61,32 @@ def test_dependencies_flow_one_way():
                    for target in _imports(name, path, modules, top_level_only=False)
                    if target.split(".")[0] not in ALLOWED[name.split(".")[0]])
     assert not wrong, wrong
+
+
+def _layer(name):
+    """Rank of a module of ``validation`` in :data:`LAYERS` (-1: a shared module)."""
+    parts = name.split(".")
+    return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else -1
+
+
+def upward_imports(modules):
+    """``(module, imported module)`` of every import, function-level included, from a layer of
+    ``validation`` to a layer above it (or from a shared module to any layer)."""
+    return sorted((name, target) for name, path in modules.items() if name.startswith("validation")
+                  for target in _imports(name, path, modules, top_level_only=False)
+                  if target.startswith("validation.") and _layer(target) > _layer(name))
+
+
+def test_validation_layers_import_downwards():
+    assert not upward_imports(_modules()), upward_imports(_modules())
+
+
+def test_layer_check_sees_function_level_imports(tmp_path):
+    """A scene module importing the report inside a function is an upward import."""
+    source = "def sections():\n    from ..report.documents.sections import SECTIONS\n    return SECTIONS\n"
+    (tmp_path / "planted.py").write_text(source, encoding="utf-8")
+    modules = {**_modules(), "validation.scene.planted": tmp_path / "planted.py"}
+    assert ("validation.scene.planted", "validation.report.documents.sections") in upward_imports(modules)
 
 
 def test_no_import_cycles():

@@ -34,11 +34,26 @@ from bem.checks import InputError, check_finite_array, check_positive
 from bem.result import ContactResult
 from fem_reference.result import FemResult
 
-__all__ = ["ring_weights", "relative_l2", "pair_metrics", "compare",
+__all__ = ["axial_section", "ring_weights", "relative_l2", "pair_metrics", "compare",
            "PAIR_KEYS"]
 
 #: keys of one pair of :func:`pair_metrics` / :func:`compare`
 PAIR_KEYS = ("l2_rel", "max_rel", "peak_rel", "contact_radius_rel", "approach_rel", "force_rel", "n_points")
+
+
+def axial_section(x, y, values, *, tol=None):
+    """``(xs, vs)``: the nodes ``(x, y)`` [length] on the line ``y = 0`` (``|y| <= tol``, default
+    ``1e-9 max|x|``), sorted by ``x``, and their ``values`` (any unit)."""
+    x, y, values = (np.asarray(v, dtype=float) for v in (x, y, values))
+    if not (x.shape == y.shape == values.shape):
+        raise InputError(f"x, y, values have shapes {x.shape}, {y.shape}, {values.shape} which is not allowed: "
+                         "they must be equal.")
+    tol = 1e-9 * float(np.abs(x).max(initial=1.0)) if tol is None else tol
+    on = np.abs(y) <= tol
+    if not on.any():
+        raise InputError("x, y have no node on the axial section y = 0: the section needs nodes with |y| <= tol.")
+    order = np.argsort(x[on], kind="stable")
+    return x[on][order], values[on][order]
 
 
 def ring_weights(r):

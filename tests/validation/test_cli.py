@@ -104,17 +104,24 @@ def test_default_output_directory(tmp_path, monkeypatch):
     (["study", "error-time", "hertz", "--out", "x", "--quick"], "validation.studies.error_time"),
     (["study", "stability"], "validation.studies.stability"),
 ])
-def test_study_dispatches_its_arguments(argv, module, monkeypatch):
+def test_study_dispatches_its_arguments(argv, module, monkeypatch, tmp_path):
+    from validation.studies import save
+
     seen = {}
     fake = types.ModuleType(module)
-    fake.main = lambda args: seen.setdefault("args", args) and 7
+
+    def main(**kw):
+        seen.update(kw)
+        return save(tmp_path, "stability", {"rows": []}, status=7)
+
+    fake.main = main
     monkeypatch.setitem(sys.modules, module, fake)
-    code, _out, _err = cli(*argv)
-    assert code == 7
-    args = seen["args"]
-    assert args.study == argv[1]
-    assert getattr(args, "scene", None) == (argv[2] if len(argv) > 2 else None)
-    assert args.quick == ("--quick" in argv)
+    monkeypatch.setattr("validation.report.documents.studies.study_markdown", lambda name, data: "# tables\n")
+    code, out, _err = cli(*argv)
+    assert code == 7 and out == "# tables\n" and (tmp_path / "stability.md").read_text() == "# tables\n"
+    assert seen["out"] == ("x" if "--out" in argv else None)
+    assert seen["scene"] == (argv[2] if len(argv) > 2 and not argv[2].startswith("-") else None)
+    assert seen["quick"] == ("--quick" in argv)
 
 
 def test_report_dispatches_its_arguments_and_prints_where(monkeypatch, tmp_path):
@@ -125,20 +132,22 @@ def test_report_dispatches_its_arguments_and_prints_where(monkeypatch, tmp_path)
 
     seen = {}
 
-    def fake(args, progress=None):
-        seen["args"] = args
+    def fake(target, progress=None, **kw):
+        seen["args"] = dict(kw, target=target)
         for k in range(3):
             progress(f"stage {k}", k, 3)
-        out = Path(args.out)
+        out = Path(kw["out"])
         return BuiltReport(out, out / "report.html", out / "report.md", (out / "figures" / "a.svg",))
 
-    monkeypatch.setattr(command, "build_from_args", fake)
-    code, out, err = cli("report", "results/hertz", "--out", tmp_path / "rep", "--format", "svg", "--units",
+    monkeypatch.setattr(command, "build", fake)
+    (tmp_path / "hertz").mkdir()
+    (tmp_path / "hertz" / "result.json").write_text("{}")
+    code, out, err = cli("report", tmp_path / "hertz", "--out", tmp_path / "rep", "--format", "svg", "--units",
                          "dimensionless")
     assert code == 0, err
     args = seen["args"]
-    assert (args.target, args.out, args.format, args.units) == ("results/hertz", str(tmp_path / "rep"), "svg",
-                                                                "dimensionless")
+    assert (args["target"], args["out"], args["fmt"], args["units"]) == (str(tmp_path / "hertz"), str(tmp_path / "rep"),
+                                                                         "svg", "dimensionless")
     assert f"report written to {tmp_path / 'rep' / 'report.html'}" in out
     assert "1 figures" in out
 
@@ -195,11 +204,11 @@ def test_parser_is_buildable_without_heavy_imports():
 def test_report_progress_bar_shows_the_stages_on_stderr(monkeypatch):
     import io
 
-    from validation.cli import report as cli_mod
+    from validation.cli.common import ProgressBar
 
     err = io.StringIO()
     monkeypatch.setattr(sys, "stderr", err)
-    bar = cli_mod._ReportBar(False)
+    bar = ProgressBar("report", "stage", False)
     for k, stage in enumerate(("layer laws", "parameter sweeps", "figures")):
         bar(stage, k, 3)
     bar("done", 3, 3)

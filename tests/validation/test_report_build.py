@@ -5,7 +5,6 @@ test_report_run.py.)"""
 import base64
 import os
 import re
-from argparse import Namespace
 from pathlib import Path
 
 import numpy as np
@@ -208,6 +207,20 @@ def test_problem_section_lists_inputs(tmp_path):
 
 # ---------------------------------------------------------------- command
 
+@pytest.mark.parametrize("target, options, word", [
+    ("hertz", {"quick": True}, "quick = True"),  # paper only
+    ("paper", {"units": "scene"}, "units = 'scene'"),
+    ("paper", {"overrides": ["load.force=2"]}, "overrides = ['load.force=2']"),  # scenes only
+])
+def test_build_refuses_a_keyword_that_does_not_apply_to_the_target(target, options, word, tmp_path, monkeypatch):
+    from validation.report.command import build
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match=re.escape(word) + ".* is not allowed with target"):
+        build(target, out=tmp_path / "rep", **options)
+    assert list(tmp_path.iterdir()) == []  # nothing ran, nothing written
+
+
 def test_main_rejects_unknown_target(tmp_path):
     with pytest.raises(InputError, match="built-in scene name, a scene TOML file, a results directory"):
-        main(Namespace(target=str(tmp_path / "no-such-scene.toml"), out=None))
+        main(str(tmp_path / "no-such-scene.toml"))

@@ -4,14 +4,13 @@ describes (section 6) checked on the cases, run as scenes by the runner."""
 import logging
 import math
 import re
-from argparse import Namespace
 
 import numpy as np
 import pytest
 
 from validation.report import command
 from validation.report.documents.paper import TITLE, paper_sections
-from validation.report.documents.paper_runs import run_paper_problem
+from validation.studies.paper_problem import run_paper_problem
 from validation.report.render import build_report
 from validation.report.render.content import Figure
 
@@ -36,7 +35,7 @@ def paper_run():
     stages, handler, logger = [], _Collect(), logging.getLogger("bem")
     logger.addHandler(handler)
     try:
-        return run_paper_problem(quick=True, progress=stages.append), stages, handler.messages
+        return run_paper_problem(quick=True, progress=lambda *a: stages.append(a)), stages, handler.messages
     finally:
         logger.removeHandler(handler)
 
@@ -178,7 +177,7 @@ def test_report_command_prints_the_notes(monkeypatch, tmp_path):
     from .conftest import cli
 
     built = BuiltReport(tmp_path, tmp_path / "report.html", tmp_path / "report.md", (), notes=("stall expected",))
-    monkeypatch.setattr(command, "build_from_args", lambda args, progress=None: built)
+    monkeypatch.setattr(command, "build", lambda target, **kw: built)
     code, out, err = cli("report", "paper", "--out", tmp_path)
     assert code == 0 and "note: stall expected" in out.splitlines() and err == ""
 
@@ -188,12 +187,12 @@ def test_scikit_fem_info_lines_only_when_verbose(monkeypatch, tmp_path):
 
     from .conftest import cli
 
-    def build(args, progress=None):
+    def build(target, **kw):
         logging.getLogger("skfem.assembly").info("assembling a form")
         logging.getLogger("skfem.assembly").warning("a real problem")
         return BuiltReport(tmp_path, tmp_path / "report.html", tmp_path / "report.md", ())
 
-    monkeypatch.setattr(command, "build_from_args", build)
+    monkeypatch.setattr(command, "build", build)
     _code, _out, err = cli("report", "paper", "--out", tmp_path)
     assert "a real problem" in err and "assembling" not in err
     _code, _out, err = cli("-v", "report", "paper", "--out", tmp_path)
@@ -213,8 +212,8 @@ def test_main_dispatches_paper(monkeypatch, tmp_path):
         return Built()
 
     monkeypatch.setattr("validation.report.documents.paper.report_paper_problem", fake)
-    assert command.main(Namespace(target="paper", out=str(tmp_path), quick=True)) == 0
-    assert command.main(Namespace(target="paper", out=None, format="pdf")) == 0
+    command.main("paper", out=str(tmp_path), quick=True)
+    command.main("paper", fmt="pdf")
     assert calls == [(str(tmp_path), True, "png"), (str(command.DEFAULT_PAPER_OUT), False, "pdf")]
 
 
@@ -250,11 +249,12 @@ def test_example_script_passes_its_options(monkeypatch, tmp_path):
 
 def test_paper_report_tells_its_stages(paper_run, monkeypatch, tmp_path):
     from validation.report.documents import paper as paper_report
-    from validation.report.documents.paper_runs import SOLVE_STAGES
+    from validation.studies.paper_problem import SOLVE_STAGES
     from validation.report.render import Section
 
     paper, stages, _warnings = paper_run
-    assert stages == list(SOLVE_STAGES)  # the real runs, in order
+    n = len(SOLVE_STAGES)  # the real runs, in order, told as every job of the library tells its progress
+    assert stages == [(s, k, n) for k, s in enumerate(SOLVE_STAGES)] + [("done", n, n)]
 
     def fake_solve(*, quick, fem, progress):
         for stage in SOLVE_STAGES[:3 + fem]:
@@ -306,3 +306,17 @@ def test_one_name_for_the_hertz_peak(report):
     for text in (report.markdown.read_text(encoding="utf-8"), report.html.read_text(encoding="utf-8")):
         assert "p_0" in text and "p_H" not in text and not re.search(r"(?<![\w.])p0\b", text)
     assert "Normalised by Hertz's peak p_0" in report.markdown.read_text(encoding="utf-8")
+
+
+def test_the_paper_study_takes_the_scenes_override_syntax():
+    """Its cases take dotted keys and the short names of ``--set``; a wrong key is named as a scene names it."""
+    from validation.scene import SceneError
+    from validation.studies.paper_problem import CaseRunner
+
+    run = CaseRunner(6)
+    short = run("elastic-rigid", {"alpha_a": 0.3}).result
+    dotted = run("elastic-rigid", {"layer.alpha_a": 0.3}).result
+    assert short["layer"]["alpha_a"] == dotted["layer"]["alpha_a"] == 0.3
+    assert short["p_max"] == dotted["p_max"] and short["layer"]["parameters"] == dotted["layer"]["parameters"]
+    with pytest.raises(SceneError, match="bem.methd"):
+        run("smooth", {"bem.methd": "newton"})

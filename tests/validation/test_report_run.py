@@ -9,7 +9,6 @@ import json
 import re
 import shutil
 import tomllib
-from argparse import Namespace
 
 import numpy as np
 import pytest
@@ -254,7 +253,7 @@ def test_report_results_dir_and_command(reports, tmp_path, monkeypatch):
     raw["bem"]["nodes_across"] = 12
     scene = tmp_path / "small.toml"
     scene.write_text(dumps(raw))
-    assert main(Namespace(target=str(scene), out=str(tmp_path / "out"))) == 0
+    main(str(scene), out=str(tmp_path / "out"))
     assert (tmp_path / "results" / raw["scene"]["name"] / "result.json").is_file()
     md = (tmp_path / "out" / "report.md").read_text(encoding="utf-8")
     assert md.startswith("# Elliptic Hertz contact\n")

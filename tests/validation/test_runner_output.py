@@ -134,13 +134,21 @@ def test_scene_file_in_the_result_reruns_identically(tmp_path):
     assert second["fem"]["p_max"] == first["fem"]["p_max"]
 
 
-def test_progress_reports_every_planned_stage():
+def test_progress_reports_every_planned_stage(tmp_path):
+    """The run tells progress(label, done, total) (validation.progress): each stage at its start, the
+    BEM iterations within their stage, then the end; with a result directory, its writing too."""
     events = []
     scene = load_scene("paper_elastic_rigid", overrides=["bem.nodes_across=16", "fem.n_contact=8"])
-    execute_scene(scene, progress=lambda stage, status, info: events.append((stage, status)))
-    done = [s for s, st in events if st == "done"]
-    assert done == runner.planned_stages(scene) == ["layer", "bem", "fem", "compare"]
-    assert ("bem", "iteration") in events
+    execute_scene(scene, progress=lambda *a: events.append(a))
+    stages = runner.planned_stages(scene)
+    assert stages == ["layer", "bem", "fem", "compare"]
+    assert [e for e in events if ":" not in e[0]] == [(s, k, 4) for k, s in enumerate(stages)] + [("done", 4, 4)]
+    iterations = [e for e in events if e[0].startswith("bem: iteration")]
+    assert iterations and all(e[1:] == (1, 4) for e in iterations)
+    events.clear()
+    run_scene(scene, tmp_path / "r", progress=lambda *a: events.append(a))
+    assert [e for e in events if ":" not in e[0]] == [(s, k, 5) for k, s in enumerate(stages + ["write"])] + [
+        ("done", 5, 5)]
 
 
 def test_not_converged_is_flagged_and_written(tmp_path):
@@ -156,6 +164,36 @@ def test_automatic_region_grows_when_the_estimate_is_short():
     r = run_scene("paper_root", overrides=["bem.nodes_across=16", "bem.extent_factor=1.0"])
     assert r["converged"]
     assert any("enlarged" in m for m in r["messages"])
+
+
+@pytest.mark.parametrize("scene_name, overrides", [
+    ("paper_root", ["bem.extent_factor=1.0"]),  # enlarged while calibrating the root law
+    ("paper_elastic_rigid", ["bem.extent_factor=1.0", "layer.alpha_a=1.0"]),
+])
+def test_an_enlarged_region_is_the_estimate_times_1_5_and_solves_as_if_given(scene_name, overrides):
+    """The region grows by 1.5 (up to the gap's domain) and the run is that of a scene giving the grown
+    region itself: the calibration and the solve both use it."""
+    from validation.scene.sizing import region_limit
+
+    scene = load_scene(scene_name, overrides=["bem.nodes_across=16", "fem.n_contact=8", *overrides])
+    grown = execute_scene(scene).result
+    limit = region_limit(scene.gap)
+    ex, ey = grown["bem"]["extent"]
+    assert any("enlarged" in m for m in grown["messages"])
+    assert (ex, ey) == tuple(min(1.5 * e, lim) for e, lim in zip(scene.bem["extent"], limit))
+    given = execute_scene(scene, overrides=[f"bem.extent=[{ex!r}, {ey!r}]"]).result
+    assert not any("enlarged" in m for m in given["messages"])
+    for key in ("p_max", "approach", "contact_area", "iterations"):
+        assert given[key] == grown[key], key
+    assert given["layer"]["parameters"] == grown["layer"]["parameters"]
+
+
+def test_planned_stages_hold_the_calibration_exactly_when_it_solves():
+    """The "layer" stage is planned for the scenes whose layer needs calibration solves, and only those."""
+    for name in ("paper_linear", "paper_root", "paper_elastic_rigid", "paper_bilinear", "hertz"):
+        scene = load_scene(name, overrides=["bem.nodes_across=12"], no_fem=True)
+        solves = execute_scene(scene).result["layer"].get("reference_solves", 0)
+        assert ("layer" in runner.planned_stages(scene)) == (solves > 0), name
 
 
 def test_run_does_not_modify_the_scene():

@@ -12,7 +12,8 @@ from bem.layers import Bilinear, ElasticRigid, Linear, Root
 from bem.reference import hertz_sphere
 from validation.run import execute_scene, run_scene
 from validation.scene import builtin_path, load_scene
-from validation.scene.paper import c_nn, check_layer, resolve_layer
+from validation.run.calibrate import CalibrationError, resolve_layer
+from validation.scene.paper import c_nn, check_layer
 
 from .conftest import STEEL_E, STEEL_NU, e_star
 
@@ -171,7 +172,5 @@ def test_alpha_b_target_is_reached():
 
 
 def test_alpha_b_out_of_reach_is_refused():
-    from validation.scene import SceneError
-
-    with pytest.raises(SceneError, match="layer.alpha_b"):
+    with pytest.raises(CalibrationError, match="layer.alpha_b"):
         run_scene("paper_root", overrides=SMALL + ["alpha_b=5.0"])

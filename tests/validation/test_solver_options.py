@@ -7,7 +7,7 @@ import pytest
 
 import bem
 from validation.run import runner
-from validation.scene import paper
+from validation.run.calibrate import CalibrationError
 from validation.scene import SceneError, load_scene
 
 from .conftest import cli
@@ -59,7 +59,7 @@ def test_a_calibration_that_fails_stops_the_run(monkeypatch):
         return res
 
     monkeypatch.setattr(runner.bem, "solve", failing)
-    with pytest.raises(paper.CalibrationError, match="forced failure"):
+    with pytest.raises(CalibrationError, match="forced failure"):
         runner.execute_scene(load_scene(_scene("paper_root")))
 
 

@@ -1,6 +1,5 @@
 """The error-time and stability studies in quick mode, and their classification rules."""
 
-import argparse
 import dataclasses
 import json
 import math
@@ -17,6 +16,8 @@ from validation.studies.error_time import ErrorTimeRow, ErrorTimeStudy, run_erro
 from validation.run import execute_scene
 from validation.studies.problems import get_problem, methods, stability_cases
 from validation.studies.stability import STATUSES, StabilityFailure, classify, run_stability
+
+from .conftest import cli
 
 LADDER = error_time.LADDERS["quick"]
 
@@ -123,19 +124,22 @@ def test_first_to_reach_on_the_study(et):
     assert text.count("| bem | newton |") == len(LADDER["bem"])
 
 
-def test_error_time_json_and_main(et, tmp_path, capsys):
+def test_error_time_json_and_main(et, tmp_path, capsys, monkeypatch):
     path = et.to_json(tmp_path / "sub" / "et.json")
     data = json.loads(path.read_text())
     assert len(data["rows"]) == len(et.rows) and set(data["first_to_reach"]) == {"hertz", "paper-root"}
     assert [p.name for p in path.parent.iterdir()] == ["et.json"]  # no temporary file left
-    args = argparse.Namespace(scene="hertz", out=str(tmp_path / "cli"), quick=True)
-    assert error_time.main(args) == 0
-    assert "| bem | kalker |" in capsys.readouterr().out
+    run = error_time.main(scene="hertz", out=tmp_path / "cli", quick=True)
+    assert run.status == 0 and capsys.readouterr().out == ""  # the library prints nothing
     written = json.loads((tmp_path / "cli" / "error_time.json").read_text())
-    assert {r["problem"] for r in written["rows"]} == {"hertz"}
-    assert (tmp_path / "cli" / "error_time.md").read_text().startswith("# Error against run time")
+    assert written == run.data and {r["problem"] for r in written["rows"]} == {"hertz"}
+    monkeypatch.setattr(error_time, "run_error_time", lambda *a, **kw: et)
+    code, out, err = cli("study", "error-time", "hertz", "--quick", "--out", tmp_path / "cmd")
+    assert code == 0 and "| bem | kalker |" in out, err
+    monkeypatch.undo()
+    assert (tmp_path / "cmd" / "error_time.md").read_text().startswith("# Error against run time")
     with pytest.raises(InputError, match="scene"):
-        error_time.main(argparse.Namespace(scene="nope", out=str(tmp_path), quick=True))
+        error_time.main(scene="nope", out=tmp_path, quick=True)
 
 
 def test_stability_quick_has_no_nan_and_no_wrong_answer(st):
@@ -218,13 +222,13 @@ def test_a_nan_result_makes_the_study_raise_even_when_not_converged(monkeypatch)
         run_stability([_case()])
 
 
-def test_stability_main_writes_then_raises(monkeypatch, tmp_path, capsys, st):
+def test_stability_main_writes_then_fails(monkeypatch, tmp_path, st):
     bad = dataclasses.replace(st.rows[0], status="wrong", error_vs_reference=0.5, tolerance=1e-6)
     study = stability.StabilityStudy(rows=[bad] + st.rows[1:], settings=st.settings)
     monkeypatch.setattr(stability, "run_stability", lambda **kw: study)
-    with pytest.raises(StabilityFailure):
-        stability.main(argparse.Namespace(out=str(tmp_path), quick=True))
+    code, out, err = cli("study", "stability", "--quick", "--out", tmp_path)
+    assert code == 1 and "wrong outcome(s) in the stability study" in err and "Traceback" not in err
     assert json.loads((tmp_path / "stability.json").read_text())["counts"]
-    assert "## Stability" in capsys.readouterr().out
+    assert "## Stability" in out and "## Stability" in (tmp_path / "stability.md").read_text()
     monkeypatch.setattr(stability, "run_stability", lambda **kw: st)
-    assert stability.main(argparse.Namespace(out=str(tmp_path), quick=True)) == 0
+    assert stability.main(out=tmp_path, quick=True).status == 0

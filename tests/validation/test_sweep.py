@@ -52,6 +52,14 @@ def test_points_are_saved_with_profile_and_summary(tmp_path):
     assert json.loads((tmp_path / "summary.json").read_text())["points"][1]["value"] == 100.0
 
 
+def test_sweep_tells_its_progress_as_label_done_total(tmp_path):
+    """One progress protocol (validation.progress): the point and its status, then how many of all are done."""
+    calls = []
+    _sweep(tmp_path, progress=lambda *a: calls.append(a))
+    assert sorted(c[1] for c in calls) == [1, 2, 3] and {c[2] for c in calls} == {3}
+    assert {c[0] for c in calls} == {f"load.force = {f}: ok" for f in FORCES}
+
+
 def test_sweep_resumes_recomputing_only_missing_points(tmp_path):
     first = _sweep(tmp_path)
     kept = {i: _point(tmp_path, first, i).stat().st_mtime_ns for i in (0, 2)}

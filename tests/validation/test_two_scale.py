@@ -2,7 +2,7 @@
 
 import json
 import math
-from argparse import Namespace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -41,12 +41,13 @@ def test_tiny_study_gives_every_error_finite_for_both_loads(tiny):
 
 
 def test_study_writes_json_and_table_and_figures(tiny, tmp_path):
-    from validation.report.figures.two_scale import plot_two_scale
+    from validation.report.documents.studies import write_study_outputs
     from validation.studies import save
     from validation.studies.two_scale import COLUMNS
 
     data = {k: v for k, v in tiny.items() if k != "fields"}
-    text = save(Namespace(out=tmp_path), "two_scale", data)
+    text, figures = write_study_outputs(save(tmp_path, "two_scale", data, fields=tiny["fields"]))
+    assert (tmp_path / "two_scale.md").read_text() == text
     assert json.loads((tmp_path / "two_scale.json").read_text())["rows"][0]["ratio"] == 2
     for _, heading, _ in COLUMNS:
         assert heading.replace("[", "\\[").replace("]", "\\]") in text
@@ -59,7 +60,8 @@ def test_study_writes_json_and_table_and_figures(tiny, tmp_path):
         assert f"figures/{name}" in md and (tmp_path / "report" / "figures" / name).is_file()
     from PIL import Image
 
-    for path in plot_two_scale(data, tiny["fields"], tmp_path):
+    assert [Path(f).name for f in figures] == ["two_scale_map.png", "two_scale_profile.png"]
+    for path in figures:
         with Image.open(path) as img:
             arr = np.asarray(img.convert("L"), dtype=float)
         assert arr.shape[0] > 200 and arr.std() > 5  # drawn, not blank
@@ -125,25 +127,27 @@ def test_gw_integral_and_greenwood_tripp_law():
     np.testing.assert_allclose(law.w(gw_pressure(d, moments, 1.0)), h0 - d, rtol=1e-3)
 
 
-def test_cli_runs_the_two_scale_study_and_refuses_a_scene(monkeypatch):
+def test_cli_runs_the_two_scale_study_and_refuses_a_scene(monkeypatch, tmp_path):
     import sys
     import types
+
+    from validation.studies import save
 
     from .conftest import cli
 
     seen = {}
     fake = types.ModuleType("validation.studies.two_scale")
-    fake.main = lambda args: seen.setdefault("args", args) and 7
+    fake.main = lambda **kw: seen.update(kw) or save(tmp_path, "robustness", [], status=7)
     monkeypatch.setitem(sys.modules, "validation.studies.two_scale", fake)
     code, _, _ = cli("study", "two-scale", "--quick")
-    assert code == 7 and seen["args"].quick
+    assert code == 7 and seen["quick"]
     monkeypatch.undo()
     code, out, err = cli("study", "two-scale", "hertz")
     assert code == 2 and "scene = 'hertz' is not allowed" in err and "Traceback" not in err
 
 
 def test_map_pixels_and_profile_windows_hold_the_field_drawn():
-    from validation.report.figures.two_scale import binned_map, window_row
+    from validation.studies.two_scale_figure import binned_map, window_row
 
     lat = Lattice.from_extent(0.01, 1.0)
     x, y = lat.x[lat.mask], lat.y[lat.mask]

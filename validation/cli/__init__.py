@@ -18,7 +18,7 @@ import threading
 from bem.checks import InputError
 
 from ..io import OutputError
-from ..scene.paper import CalibrationError
+from ..run.calibrate import CalibrationError
 from . import check, layer_law, report, run, scenes, study, sweep
 
 __all__ = ["main", "build_parser"]

@@ -28,3 +28,24 @@ def trust(args):
     """The keywords of :func:`validation.scene.load_scene` that ``args`` give (:func:`add_trust`)."""
     return {"allow_code": bool(getattr(args, "allow_code", False)),
             "allow_outside_files": bool(getattr(args, "allow_outside_files", False))}
+
+
+class ProgressBar:
+    """A tqdm bar on stderr drawing the library's ``progress(label, done, total)`` (:mod:`validation.progress`).
+
+    ``disable``: ``True`` draws nothing, ``None`` draws only on a terminal (tqdm's rule).
+    """
+
+    def __init__(self, desc, unit, disable):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=1, desc=desc, unit=unit, disable=disable, leave=False)
+
+    def __call__(self, label, done, total):
+        self.bar.total = total
+        self.bar.n = done
+        self.bar.set_description(label)
+        self.bar.refresh()
+
+    def close(self):
+        self.bar.close()

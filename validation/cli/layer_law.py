@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from bem.checks import InputError
+from .common import ProgressBar
 
 PARSER = {
     "help": "the layer law w(p) of a rough surface: law file and figures",
@@ -93,23 +94,6 @@ def _synthetic(text):
     return out
 
 
-class _LadderBar:
-    """tqdm bar over the ladder's steps: the contact fraction and iterations of the last step."""
-
-    def __init__(self, n, disable):
-        from tqdm import tqdm
-
-        self.bar = tqdm(total=n, desc="layer law", unit="pressure", disable=disable, leave=False)
-
-    def __call__(self, k, n, result):
-        self.bar.set_postfix({"A/A0": f"{result.contact_fraction:.3g}", "iterations": result.iterations},
-                             refresh=False)
-        self.bar.update(1)
-
-    def close(self):
-        self.bar.close()
-
-
 def _summary(folder):
     law, stats = folder.law, folder.law.stats
     p, w = law.mean_pressure, law.closure
@@ -148,7 +132,7 @@ def run(args):
     else:
         pressures = ladder(surface, args.E_star, relative=_pair("--p-range-rel", args.p_range_rel, ":"),
                            n=args.n_pressures)
-    bar = _LadderBar(len(pressures), args.no_progress or None)
+    bar = ProgressBar("layer law", "pressure", args.no_progress or None)
     try:
         folder = make_layer_law(surface, args.out, E_star=args.E_star, pressures=pressures, n_cols=args.n_cols,
                                 rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out")

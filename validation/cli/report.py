@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 
 from ..report.render.style import DPI, FORMATS
-from .common import add_set, add_trust
+from .common import ProgressBar, add_set, add_trust, trust
 
 PARSER = {"help": "figures and an HTML/Markdown report",
           "description": "Build a report (report.html, report.md, figures/) from the paper's test\n"
@@ -47,30 +47,24 @@ def add_args(p):
     add_trust(p, scope="scene targets only: ")
 
 
-class _ReportBar:
-    """tqdm bar (stderr) over the stages of a report build."""
-
-    def __init__(self, disable):
-        from tqdm import tqdm
-
-        self.bar = tqdm(total=1, desc="report", unit="stage", disable=disable, leave=False)
-
-    def __call__(self, stage, done, total):
-        self.bar.total = total
-        self.bar.n = done
-        self.bar.set_description(stage)
-        self.bar.refresh()
-
-    def close(self):
-        self.bar.close()
+#: the option of each keyword of validation.report.command.build
+_FLAGS = {"quick": "--quick", "units": "--units", "overrides": "--set", "allow_code": "--allow-code",
+          "allow_outside_files": "--allow-outside-files"}
 
 
 def run(args):
+    from bem.checks import InputError
+
     from ..report import command
 
-    bar = _ReportBar(args.no_progress or None)
+    options = dict(quick=args.quick, units=args.units, overrides=args.overrides, **trust(args))
+    kind = command.target_kind(args.target)
+    for key in command.refused_options(kind, options):
+        raise InputError(f"{_FLAGS[key]} is not allowed with target {args.target!r} (a {kind} target): it applies "
+                         f"to {command.applies_to(key)}.")
+    bar = ProgressBar("report", "stage", args.no_progress or None)
     try:
-        built = command.build_from_args(args, progress=bar)
+        built = command.build(args.target, out=args.out, fmt=args.format, progress=bar, what="--out", **options)
     finally:
         bar.close()
     print(f"report written to {built.html}")

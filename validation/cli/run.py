@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .common import add_set, add_trust, trust
+from .common import ProgressBar, add_set, add_trust, trust
 
 PARSER = {"help": "run a scene and write its result directory",
           "description": "Run a scene: the BEM, and the FEM/closed form/comparison it names; a scene with\n"
@@ -95,27 +95,6 @@ def _periodic_lines(result, L, Pa):
     return lines
 
 
-class _StageBar:
-    """tqdm bar over the run stages; BEM iterations shown as a postfix."""
-
-    def __init__(self, stages, disable):
-        from tqdm import tqdm
-
-        self.bar = tqdm(total=len(stages), desc="run", unit="stage", disable=disable, leave=False)
-
-    def __call__(self, stage, status, info):
-        if status == "start":
-            self.bar.set_description(stage)
-        elif status == "iteration":
-            self.bar.set_postfix(iteration=info["iteration"], refresh=False)
-            self.bar.refresh()
-        elif status == "done":
-            self.bar.update(1)
-
-    def close(self):
-        self.bar.close()
-
-
 def _run_study(scene, out_dir, what, value):
     """Run the built-in study of a ``[study]`` scene; write its files, the scene and the marker into ``out_dir``."""
     import importlib
@@ -124,7 +103,7 @@ def _run_study(scene, out_dir, what, value):
     from bem.files import write_text
 
     from ..io import atomic_directory, check_output_dir, output_errors, recover_output_dir
-    from .study import STUDIES
+    from .study import STUDIES, write_study
 
     study = importlib.import_module(STUDIES[scene.study])
     names = (*study.OUTPUT_NAMES, "scene.toml", "report")
@@ -132,7 +111,7 @@ def _run_study(scene, out_dir, what, value):
         recover_output_dir(out_dir)
         check_output_dir(out_dir, "result", names, what=what, value=value)  # before the study runs
     with atomic_directory(out_dir, "result", names, what=what) as tmp:
-        data, _, _ = study.write_study(tmp, **scene.options)
+        data = write_study(scene.study, tmp, **scene.options)[0].data
         write_text(tmp / "scene.toml", tomli_w.dumps(scene.raw))
     lines = [f"scene      {scene.name}: {scene.title}   [study {scene.study}]"]
     lines += [f"error      {line}" for line in study.summary_lines(data)]
@@ -142,6 +121,7 @@ def _run_study(scene, out_dir, what, value):
 
 
 def run(args):
+    from ..progress import Progress
     from ..run import check_result_dir, execute_scene, planned_stages, write_outputs
     from ..scene import StudyScene, load_scene
 
@@ -153,10 +133,11 @@ def run(args):
     if isinstance(scene, StudyScene):
         return _run_study(scene, out_dir, what, value)
     check_result_dir(out_dir, what=what, value=value)  # before the solve
-    bar = _StageBar(planned_stages(scene, write=True), args.no_progress or None)
+    bar = ProgressBar("run", "stage", args.no_progress or None)
+    stages = Progress(planned_stages(scene, write=True), bar)
     try:
-        outcome = execute_scene(scene, progress=bar)
-        write_outputs(outcome, out_dir, progress=bar, what="--out" if args.out else "out_dir")
+        outcome = execute_scene(scene, progress=stages)
+        write_outputs(outcome, out_dir, progress=stages, what="--out" if args.out else "out_dir")
     finally:
         bar.close()
     print(_summary(outcome.result, out_dir))

@@ -12,7 +12,7 @@ PARSER = {"help": "studies: error-time, stability, robustness, two-scale",
                     "  contactlab study two-scale --quick    (rough_sphere_two_scale, the small two-scale check)\n"
                     "  contactlab report reports/studies      (work-precision plot and tables)"}
 
-#: study name -> module with ``main(args)``
+#: study name -> module with ``main(out=, scene=, quick=, progress=)``
 STUDIES = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
            "robustness": "validation.studies.robustness", "two-scale": "validation.studies.two_scale"}
 
@@ -25,5 +25,24 @@ def add_args(p):
     p.add_argument("--out", metavar="DIR")
 
 
+def write_study(name, out=None, **options):
+    """Run the study ``name`` (a key of :data:`STUDIES`) with ``options`` into the folder ``out``: its
+    JSON (the study), then its Markdown and figures (the report). Returns ``(StudyRun, markdown, figures)``."""
+    from ..report.documents.studies import write_study_outputs
+
+    study = importlib.import_module(STUDIES[name]).main(out=out, **options)
+    return (study, *write_study_outputs(study))
+
+
 def run(args):
-    return importlib.import_module(STUDIES[args.study]).main(args)
+    from .common import ProgressBar
+
+    bar = ProgressBar(args.study, "step", args.no_progress or None)
+    try:
+        study, text, figures = write_study(args.study, args.out, scene=args.scene, quick=args.quick, progress=bar)
+    finally:
+        bar.close()
+    print(text, end="" if text.endswith("\n") else "\n")
+    for path in figures:
+        print(f"figure: {path}")
+    return study.status

@@ -8,7 +8,7 @@ from bem.checks import InputError
 
 from ..run.cluster import DEFAULT_TIMEOUT
 from ..scene.checks import MAX_SWEEP_POINTS
-from .common import add_set, add_trust, trust
+from .common import ProgressBar, add_set, add_trust, trust
 
 PARSER = {"help": "sweep one scene parameter (resumable, parallel)",
           "description": "Run a scene for each value of one parameter. Finished points are saved "
@@ -45,8 +45,6 @@ def add_args(p):
 
 
 def run(args):
-    from tqdm import tqdm
-
     from ..io import check_output_dir, output_errors
     from ..run.sweep import SWEEP_NAMES, parse_values, run_sweep, sweep_points
     from ..scene import load_scene
@@ -62,17 +60,12 @@ def run(args):
     else:
         out, what, value = Path("results") / f"{scene.name}-sweep-{param}", "scene.name", scene.name
     check_output_dir(out, "sweep", SWEEP_NAMES, what=what, value=value)
-    bar = tqdm(total=len(points), desc=f"sweep {param}", unit="point", disable=args.no_progress or None)
-
-    def progress(done, total, row):
-        bar.update(1)
-        bar.set_postfix_str(f"{param}={row['value']} {row['status']}")
-
+    bar = ProgressBar(f"sweep {param}", "point", args.no_progress or None)
     try:
         with output_errors(out, "--out" if args.out else "out_dir"):
             summary = run_sweep(scene, out, parameter=args.param, values=values, workers=args.workers,
                                 scheduler=args.scheduler, scheduler_timeout=args.scheduler_timeout,
-                                progress=progress)
+                                progress=bar)
     finally:
         bar.close()
     print(f"sweep of {summary['key']} over {len(summary['points'])} values of scene {summary['scene']} "

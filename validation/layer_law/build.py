@@ -155,8 +155,11 @@ def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="
         The ladder of mean pressures [Pa] (:func:`ladder`).
     n_cols : int, optional
         Lattice nodes across the cell (default: the surface's grid points along x).
-    method, rtol, progress
-        As :func:`bem.rough.layer_from_topography` (``progress(k, n, result)`` after each step).
+    method, rtol
+        As :func:`bem.rough.layer_from_topography`.
+    progress : callable, optional
+        ``progress(label, done, total)`` (:mod:`validation.progress`) after each step of the ladder,
+        the label giving the step's contact fraction and iterations.
     figures : bool
         Draw the figures (needs the ``report`` extra).
     what : str
@@ -184,8 +187,10 @@ def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="
         recover_output_dir(out_dir)
         check_output_dir(out_dir, KIND, NAMES, what=what)
     n_cols = surface.stats.grid[0] if n_cols is None else n_cols
+    step = None if progress is None else (
+        lambda k, n, res: progress(f"A/A0 {res.contact_fraction:.3g}, {res.iterations} iterations", k, n))
     law = rough.layer_from_topography(surface, E_star, pressures=pressures, n_cols=n_cols, method=method, rtol=rtol,
-                                      progress=progress)
+                                      progress=step)
     drawn = {}
     with atomic_directory(out_dir, KIND, NAMES, what=what) as tmp:
         law.save(tmp / LAW_FILE)

@@ -1,4 +1,4 @@
-"""``contactlab report TARGET [--out DIR] [options]``: the entry point the command line calls."""
+"""The report of a target (``contactlab report TARGET``): :func:`build` takes the target and plain keywords."""
 
 from __future__ import annotations
 
@@ -9,19 +9,19 @@ from bem.checks import InputError
 
 from ..extras import require as require_extra
 
-__all__ = ["main", "build_from_args", "target_kind", "DEFAULT_PAPER_OUT", "OPTIONS"]
+__all__ = ["main", "build", "refused_options", "applies_to", "target_kind", "DEFAULT_PAPER_OUT", "OPTIONS"]
 
 log = logging.getLogger(__name__)
 
 #: where ``contactlab report paper`` writes without ``--out`` (relative to the working directory)
 DEFAULT_PAPER_OUT = Path("reports") / "paper"
 
-#: which targets each option applies to (option -> (attribute, default, kinds))
-OPTIONS = {"--quick": ("quick", False, ("paper",)),
-           "--units": ("units", None, ("scene", "results", "sweep")),
-           "--set": ("overrides", [], ("scene",)),
-           "--allow-code": ("allow_code", False, ("scene",)),
-           "--allow-outside-files": ("allow_outside_files", False, ("scene",))}
+#: which targets each keyword of :func:`build` applies to: keyword -> (default, kinds)
+OPTIONS = {"quick": (False, ("paper",)),
+           "units": (None, ("scene", "results", "sweep")),
+           "overrides": ((), ("scene",)),
+           "allow_code": (False, ("scene",)),
+           "allow_outside_files": (False, ("scene",))}
 
 
 def target_kind(target):
@@ -57,36 +57,50 @@ def target_kind(target):
     )
 
 
-def _check_options(kind, target, args):
-    for option, (attr, default, kinds) in OPTIONS.items():
-        value = getattr(args, attr, default)
-        if value not in (default, None) and kind not in kinds:
-            raise InputError(f"{option} is not allowed with target {target!r} (a {kind} target): it applies to "
-                             + " and ".join(f"{k} targets" if k != "paper" else "'paper'" for k in kinds) + ".")
+def refused_options(kind, given):
+    """The keywords of :func:`build` in ``given`` (keyword -> value) that are set but do not apply to a
+    ``kind`` target (:func:`target_kind`), in the order of :data:`OPTIONS`."""
+    return [key for key, (default, kinds) in OPTIONS.items()
+            if given.get(key, default) not in (default, None, [], ()) and kind not in kinds]
 
 
-def build_from_args(args, progress=None):
-    """Write the report ``args`` ask for and return it.
+def applies_to(key):
+    """The targets the keyword ``key`` of :func:`build` applies to, in words."""
+    kinds = OPTIONS[key][1]
+    return " and ".join(f"{k} targets" if k != "paper" else "'paper'" for k in kinds)
+
+
+def build(target, *, out=None, fmt="png", units=None, quick=False, overrides=(), allow_code=False,
+          allow_outside_files=False, progress=None, what="out"):
+    """Write the report of ``target`` and return it.
 
     Parameters
     ----------
-    args : argparse.Namespace
-        ``target``: ``"paper"`` (solve the paper's test problem and report it), a built-in
-        scene name or a scene TOML file (run it, with ``overrides``, into the result directory
-        ``results/NAME`` as ``contactlab run`` does, then report that), a results directory
-        holding ``result.json`` (:mod:`validation.report.documents.results`), a sweep
-        directory (:mod:`validation.report.documents.sweep`) or a directory of study files
-        (``error_time.json``, ``stability.json``: :mod:`validation.report.documents.studies`);
-        ``out`` (optional): the report directory written, for every target (default
-        ``reports/paper`` for ``paper``, ``TARGET/report`` for a directory,
-        ``results/NAME/report`` for a scene); ``quick`` (bool, paper only): coarse preview;
-        ``units`` (``"auto"``, ``"scene"``, ``"dimensionless"``; scenes, results and sweeps);
-        ``overrides`` (list of ``KEY=VALUE``; scenes only); ``allow_code`` and
-        ``allow_outside_files`` (scenes only, :mod:`validation.scene.trust`); ``format`` (``"png"``,
-        ``"svg"``, ``"pdf"``): the figure files.
+    target : str
+        ``"paper"`` (solve the paper's test problem and report it), a built-in scene name or a
+        scene TOML file (run it, with ``overrides``, into the result directory ``results/NAME`` as
+        ``contactlab run`` does, then report that), a results directory holding ``result.json``
+        (:mod:`validation.report.documents.results`), a sweep directory
+        (:mod:`validation.report.documents.sweep`) or a directory of study files
+        (``error_time.json``, ``stability.json``: :mod:`validation.report.documents.studies`).
+    out : path-like, optional
+        The report directory written, for every target (default ``reports/paper`` for ``paper``,
+        ``TARGET/report`` for a directory, ``results/NAME/report`` for a scene).
+    fmt : {"png", "svg", "pdf"}
+        The figure files.
+    units : {"auto", "scene", "dimensionless"}, optional
+        Scenes, results and sweeps only (default ``"auto"``).
+    quick : bool
+        ``paper`` only: a coarse preview.
+    overrides : list of str
+        ``KEY=VALUE`` scene overrides; scenes only.
+    allow_code, allow_outside_files : bool
+        Scenes only (:mod:`validation.scene.trust`).
     progress : callable, optional
         ``progress(stage, done, total)`` at the start of each stage and at the end
-        (:class:`validation.report.render.Progress`).
+        (:class:`validation.progress.Progress`).
+    what : str
+        How errors name ``out`` (the command line's ``--out``).
 
     Returns
     -------
@@ -103,25 +117,30 @@ def build_from_args(args, progress=None):
         matplotlib or pillow (``contactlab[report]``), or for ``paper`` gmsh or scikit-fem
         (``contactlab[fem]``), cannot be imported; nothing has run.
     """
-    target = str(getattr(args, "target", "") or "")
-    out = getattr(args, "out", None)
-    fmt = getattr(args, "format", None) or "png"
-    units = getattr(args, "units", None) or "auto"
+    target = str(target or "")
+    fmt = fmt or "png"
+    units = units or "auto"
     kind = target_kind(target)
-    _check_options(kind, target, args)
+    given = dict(quick=quick, units=units if units != "auto" else None, overrides=overrides, allow_code=allow_code,
+                 allow_outside_files=allow_outside_files)
+    for key in refused_options(kind, given):
+        raise InputError(f"{key} = {given[key]!r} is not allowed with target {target!r} (a {kind} target): it "
+                         f"applies to {applies_to(key)}.")
     require_extra("report", "contactlab report (figures)")
     from .render.build import check_report_dir
 
-    what = "out_dir" if out is None else "--out"
+    what = "out_dir" if out is None else what
     if kind == "paper":
         require_extra("fem", "contactlab report paper (the FEM validation)")
         from .documents.paper import report_paper_problem
 
         out_dir = DEFAULT_PAPER_OUT if out is None else Path(out)
         check_report_dir(out_dir, what=what)
-        return report_paper_problem(out_dir, quick=bool(getattr(args, "quick", False)), fmt=fmt, progress=progress)
+        return report_paper_problem(out_dir, quick=bool(quick), fmt=fmt, progress=progress)
     if kind == "scene":
-        return _report_scene(target, out, args, units=units, fmt=fmt, progress=progress)
+        return _report_scene(target, out, what, units=units, fmt=fmt, progress=progress,
+                             overrides=list(overrides or ()), allow_code=bool(allow_code),
+                             allow_outside_files=bool(allow_outside_files))
     out_dir = Path(target) / "report" if out is None else Path(out)
     check_report_dir(out_dir, what=what)
     if kind == "studies":
@@ -137,7 +156,7 @@ def build_from_args(args, progress=None):
     return report_results_dir(target, out_dir, units=units, fmt=fmt, progress=progress)
 
 
-def _report_scene(target, out, args, *, units, fmt, progress):
+def _report_scene(target, out, what, *, units, fmt, progress, overrides, allow_code, allow_outside_files):
     """Run a scene into ``results/NAME`` and report it into ``out`` (default ``results/NAME/report``)."""
     from validation.run import check_result_dir, run_scene
     from validation.scene import load_scene
@@ -146,24 +165,24 @@ def _report_scene(target, out, args, *, units, fmt, progress):
     from .documents.sections import report_results_dir
     from .render.build import check_report_dir
 
-    scene = load_scene(target, overrides=getattr(args, "overrides", None) or None,
-                       allow_code=bool(getattr(args, "allow_code", False)),
-                       allow_outside_files=bool(getattr(args, "allow_outside_files", False)))
+    scene = load_scene(target, overrides=overrides or None, allow_code=allow_code,
+                       allow_outside_files=allow_outside_files)
     refuse_study(scene, "a report of a scene")
     result_dir = Path("results") / scene.name
     out_dir = result_dir / "report" if out is None else Path(out)
     check_result_dir(result_dir, what="scene.name", value=scene.name)
-    check_report_dir(out_dir, what="scene.name" if out is None else "--out", value=scene.name if out is None else None)
+    check_report_dir(out_dir, what="scene.name" if out is None else what, value=scene.name if out is None else None)
     if progress is not None:
         progress("running the scene", 0, 1)
     run_scene(scene, result_dir)
     return report_results_dir(result_dir, out_dir, units=units, fmt=fmt, progress=progress)
 
 
-def main(args):
-    """Write the report of ``args.target`` (:func:`build_from_args`); returns the exit status 0."""
-    built = build_from_args(args)
+def main(target, **options):
+    """Write the report of ``target`` (:func:`build`, with its keyword ``options``), log where, and
+    return it."""
+    built = build(target, **options)
     log.info("report written: %s and %s (%d figures)", built.html, built.markdown, len(built.figures))
     for note in getattr(built, "notes", ()):
         log.info("note: %s", note)
-    return 0
+    return built

@@ -15,7 +15,8 @@ import time
 import numpy as np
 
 from ..provenance import provenance
-from ..scene import paper
+from ..progress import stages_of
+from .calibrate import resolve_layer
 from .result import SCHEMA, _history
 
 __all__ = ["execute_periodic", "contact_spots", "periodic_result"]
@@ -123,11 +124,14 @@ def execute_periodic(scene, *, progress=None):
     """Solve a periodic scene (:func:`bem.solve_periodic`); returns a :class:`validation.run.RunOutcome`.
 
     ``load.force`` is the force on one cell, solved as the mean pressure ``force / (Lx Ly)``.
-    ``progress`` as for :func:`validation.run.execute_scene` (stages ``"bem"``).
+    ``progress``: a :class:`validation.progress.Progress` holding the stage ``"bem"``, or a callback
+    (:mod:`validation.progress`).
     """
     import bem
 
-    from .runner import RunOutcome, _notify
+    from .runner import RunOutcome
+
+    stages = stages_of(progress, ["bem"])
 
     t0 = time.perf_counter()
     messages = []
@@ -140,22 +144,21 @@ def execute_periodic(scene, *, progress=None):
     if lattice.stretch_large:
         messages.append(f"the lattice stretches the surface along y by {lattice.stretch_y:.4f}: choose bem.cell_nodes "
                         "for which the cell's rows fit (docs/rough.md)")
-    layer, layer_info = paper.resolve_layer(scene.layer_spec, step=lattice.step, E_star=scene.E_star, solve=None,
-                                            layer=scene.layer)
+    layer, layer_info = resolve_layer(scene.layer_spec, step=lattice.step, E_star=scene.E_star, solve=None,
+                                      layer=scene.layer)
     area = lattice.size[0] * lattice.size[1]
     mean_pressure = load.get("mean_pressure") or (None if load["force"] is None else load["force"] / area)
     kw = {k: v for k, v in opts.items() if k not in _CELL_KEYS}  # the solver options
 
     def callback(k, _p):
-        _notify(progress, "bem", "iteration", iteration=k)
+        stages.note(f"iteration {k}")
 
-    _notify(progress, "bem", "start")
+    stages("bem")
     t = time.perf_counter()
     res = bem.solve_periodic(lattice.gap(), step=lattice.step, E_star=scene.E_star, mean_pressure=mean_pressure,
                              approach=load["approach"], layer=layer,
-                             callback=callback if progress is not None else None, **kw)
+                             callback=callback if stages.callback is not None else None, **kw)
     times = {"bem": time.perf_counter() - t}
-    _notify(progress, "bem", "done", converged=res.converged)
     if not res.converged:
         messages.append(f"BEM did not converge: {res.message}")
     spots = contact_spots(res.p.reshape(res.lattice.shape) > 0)

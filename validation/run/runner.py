@@ -20,12 +20,14 @@ from bem.layers import beyond_table
 
 from ..compare import compare
 from ..io import atomic_directory, atomic_write_json, check_output_dir, output_errors, recover_output_dir
-from ..scene import paper
+from ..progress import Progress, stages_of
+from ..scene.paper import needs_calibration
 from ..scene.checks import SceneError
 from ..scene.load import Scene, load_scene
 from ..scene.study import refuse_study
 from ..scene.trust import refuse_code
-from ..scene.sizing import DOMAIN_MARGIN, SOLVER_KEYS, inner_domain
+from ..scene.sizing import SOLVER_KEYS, inner_domain, region_limit
+from .calibrate import CalibrationError, resolve_layer
 from .result import build_result
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES", "RESULT_NAMES",
@@ -55,16 +57,9 @@ class RunOutcome:
     spots: object = None  # periodic scenes: the contact-spot label of each node (validation.run.periodic)
 
 
-def _notify(progress, stage, status, **info):
-    if progress is not None:
-        progress(stage, status, info)
-
-
 def planned_stages(scene, *, write=False):
     """Stage names :func:`run_scene` will report for ``scene`` (for progress bars)."""
-    spec = scene.layer_spec
-    calibrated = paper.is_paper_law(spec) and ("alpha_a" in spec or spec["law"] == "root")
-    wanted = {"layer": calibrated,
+    wanted = {"layer": needs_calibration(scene.layer_spec),
               "bem": True,
               "fem": scene.fem is not None,
               "compare": scene.fem is not None or scene.analytic is not None,
@@ -91,7 +86,7 @@ class _BemRunner:
     def __call__(self, layer, callback=None):
         res = self._solve(layer, callback)
         if self.calibration and not res.converged:
-            raise paper.CalibrationError(
+            raise CalibrationError(
                 f"the calibration of the layer law ({layer!r}) did not converge with method 'newton': "
                 f"{res.message}. The run stops: the layer parameters would be wrong.")
         return res
@@ -105,7 +100,7 @@ class _BemRunner:
                 if not self.scene.bem["extent_auto"]:
                     raise
                 hx, hy = inner_domain(self.scene.gap)
-                limit = ((1 - DOMAIN_MARGIN) * hx, (1 - DOMAIN_MARGIN) * hy)
+                limit = region_limit(self.scene.gap)
                 grown = tuple(min(_GROW * e, lim) for e, lim in zip(self.extent, limit))
                 if attempt == _MAX_GROW or grown == self.extent:
                     if any(e >= lim for e, lim in zip(self.extent, limit)):
@@ -142,9 +137,11 @@ def execute_scene(scene, *, progress=None, overrides=None):
     ----------
     scene : Scene, str, path-like or dict
         A validated scene, a built-in name, a TOML path or a scene dict.
-    progress : callable, optional
-        ``progress(stage, status, info)``: ``stage`` in :func:`planned_stages`, ``status`` one
-        of ``"start"``, ``"iteration"`` (BEM, ``info["iteration"]``), ``"done"``.
+    progress : callable or validation.progress.Progress, optional
+        ``progress(label, done, total)`` (:mod:`validation.progress`) at the start of each stage of
+        :func:`planned_stages` (``label`` the stage), after each BEM iteration (``"bem: iteration k"``)
+        and at the end (``"done"``); a :class:`~validation.progress.Progress` of a caller's job that
+        holds these stages is told them and not the end.
     overrides : dict or list of str, optional
         Dotted-key overrides (:func:`validation.scene.load.apply_overrides`), validated first.
     """
@@ -154,32 +151,34 @@ def execute_scene(scene, *, progress=None, overrides=None):
     refuse_study(scene, "a run of the solvers")
     if scene.unimported:
         raise SceneError(refuse_code(*scene.unimported[0]))
+    stages = stages_of(progress, planned_stages(scene))
     if scene.bem.get("periodic"):
         from .periodic import execute_periodic
 
-        return execute_periodic(scene, progress=progress)
+        outcome = execute_periodic(scene, progress=stages)
+        if stages is not progress:
+            stages.done()
+        return outcome
     messages, times = [], {"bem": None, "fem": None, "layer_reference": None}
     if "fem" in scene.skipped:
         messages.append("FEM reference skipped: the scene's [fem] was not run (no_fem).")
     solve, calibrate = _BemRunner(scene, messages), _BemRunner(scene, messages, calibration=True)
     if "layer" in planned_stages(scene):
-        _notify(progress, "layer", "start")
+        stages("layer")
     t = time.perf_counter()
-    layer, layer_info = paper.resolve_layer(scene.layer_spec, step=scene.bem["step"], E_star=scene.E_star,
-                                            solve=calibrate, layer=scene.layer)
+    layer, layer_info = resolve_layer(scene.layer_spec, step=scene.bem["step"], E_star=scene.E_star,
+                                      solve=calibrate, layer=scene.layer)
     if calibrate.solves:
         times["layer_reference"] = time.perf_counter() - t
         solve.extent = calibrate.extent
-        _notify(progress, "layer", "done")
-    _notify(progress, "bem", "start")
+    stages("bem")
 
     def callback(k, _p):
-        _notify(progress, "bem", "iteration", iteration=k)
+        stages.note(f"iteration {k}")
 
     t = time.perf_counter()
-    res = solve(layer, callback=callback if progress is not None else None)
+    res = solve(layer, callback=callback if stages.callback is not None else None)
     times["bem"] = time.perf_counter() - t
-    _notify(progress, "bem", "done", converged=res.converged)
     asked = scene.bem["method"]
     if res.method != asked and asked != "newton":  # a paper method on a quadratic problem: the QP solved it
         messages.append(f"bem.method = {asked!r} ran as Kalker's QP ({res.method!r}): "
@@ -196,10 +195,9 @@ def execute_scene(scene, *, progress=None, overrides=None):
     if scene.fem is not None:
         import fem_reference
 
-        _notify(progress, "fem", "start")
+        stages("fem")
         fem = fem_reference.solve(scene.gap, **scene.materials, **scene.load, layer=layer, **scene.fem)
         times["fem"] = fem.wall_time_s
-        _notify(progress, "fem", "done", converged=fem.converged)
         if not fem.converged:
             messages.append(f"FEM did not converge: {fem.message}")
         elif (note := beyond_table(layer, fem.p_max)) is not None:
@@ -207,17 +205,15 @@ def execute_scene(scene, *, progress=None, overrides=None):
     if scene.analytic is not None:
         ref = _analytic(scene, layer)
     if fem is not None or ref is not None:
-        _notify(progress, "compare", "start")
+        stages("compare")
         metrics = compare(res, fem=fem, analytic=ref)
-        _notify(progress, "compare", "done")
     stress = None
     if scene.stress is not None:
         from .stress import run_stress
 
-        _notify(progress, "stress", "start")
+        stages("stress")
         stress = run_stress(scene, res, fem)
         times["stress"] = stress.wall_time_s
-        _notify(progress, "stress", "done")
     times["total"] = time.perf_counter() - t0
     result = build_result(scene, res, layer_info, fem=fem, analytic=ref, metrics=metrics, times=times,
                           messages=messages, extent=solve.extent)
@@ -226,6 +222,8 @@ def execute_scene(scene, *, progress=None, overrides=None):
         from .stress import stress_summary
 
         result["stress"] = to_jsonable(stress_summary(stress))
+    if stages is not progress:
+        stages.done()
     return RunOutcome(scene=scene, result=result, bem=res, fem=fem, analytic=ref, layer=layer, stress=stress)
 
 
@@ -247,9 +245,10 @@ def write_outputs(outcome, out_dir, *, progress=None, what="out_dir"):
     """Write the result directory of ``outcome`` atomically (whole or not at all); returns its path.
 
     ``out_dir`` must be new, empty or a result directory (:func:`check_result_dir`); errors name
-    it as ``what``.
+    it as ``what``. ``progress`` as for :func:`execute_scene`, of the stage ``"write"``.
     """
-    _notify(progress, "write", "start")
+    stages = stages_of(progress, ["write"])
+    stages("write")
     res, scene = outcome.bem, outcome.scene
     absent = {"fem_field": outcome.fem is None, "stress_field": outcome.stress is None}
     files = {key: name for key, name in FILES.items() if not absent.get(key, False)}
@@ -267,7 +266,7 @@ def write_outputs(outcome, out_dir, *, progress=None, what="out_dir"):
                              lower=outcome.stress.bodies.get("body2"))
         write_text(tmp / files["scene"], tomli_w.dumps(scene.raw))
         atomic_write_json(tmp / files["result"], outcome.result)
-    _notify(progress, "write", "done")
+    stages.done()
     return out_dir
 
 
@@ -305,7 +304,13 @@ def run_scene(scene, out_dir=None, *, progress=None, overrides=None):
     """
     if out_dir is not None:
         check_result_dir(out_dir)
-    outcome = execute_scene(scene, progress=progress, overrides=overrides)
+    if not isinstance(scene, Scene) or overrides:
+        scene = load_scene(scene, overrides=overrides)
+    refuse_study(scene, "a run of the solvers")
+    stages = Progress(planned_stages(scene, write=out_dir is not None), progress)
+    outcome = execute_scene(scene, progress=stages)
     if out_dir is not None:
-        write_outputs(outcome, out_dir, progress=progress)
+        write_outputs(outcome, out_dir, progress=stages)
+    else:
+        stages.done()
     return outcome.result

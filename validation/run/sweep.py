@@ -293,7 +293,8 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
     scheduler_timeout : float, optional
         Seconds allowed to reach the scheduler, > 0.
     progress : callable, optional
-        ``progress(done, total, row)`` after each point of ``values`` (reused points included).
+        ``progress(label, done, total)`` (:mod:`validation.progress`) after each point of ``values``
+        (reused points included); ``label`` is ``"KEY = VALUE: STATUS"`` of that point.
     overrides : dict or list of str, optional
         Applied to the base scene before sweeping.
 
@@ -343,7 +344,7 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
             rows.append(_row(point.index, point.value, cached["file"], cached["result"], computed=False))
             done += 1
             if progress is not None:
-                progress(done, len(points), rows[-1])
+                progress(f"{key} = {rows[-1]['value']}: {rows[-1]['status']}", done, len(points))
         else:
             jobs.append(point)
     log.info("sweep of %s over %d values: %d on disk, %d to run, %d more from earlier runs", key, len(points),
@@ -363,7 +364,7 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
             rows.append(_row(point.index, point.value, point.file, result, computed=True, error=error))
             done += 1
             if progress is not None:
-                progress(done, len(points), rows[-1])
+                progress(f"{key} = {rows[-1]['value']}: {rows[-1]['status']}", done, len(points))
     finally:
         if client is not None and client[1]:
             client[0].close()

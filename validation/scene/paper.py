@@ -24,26 +24,23 @@ the layer laws are those of Fig. 4 b-d, given relative to quantities of the disc
   ``alpha_b = p_max^root / p_max^lambda`` is reported as an output. Given ``alpha_b``
   instead, ``lam_r`` is found (root of ``p_max^root(lam_r) = alpha_b p_max^lambda``,
   a few extra solves) so that a family of root laws can be swept by ``alpha_b``.
+
+This module parses and checks those parameters; the solves that calibrate a law are the run's
+(:mod:`validation.run.calibrate`).
 """
 
 from __future__ import annotations
 
-import logging
 import math
 
-from bem.layers import LAWS, Bilinear, ElasticRigid, Linear, Root, from_dict
+from bem.layers import LAWS, Bilinear, ElasticRigid, Linear, Root
 from bem.operator import diagonal_coefficient
 
 from .checks import SceneError, in_range, positive, string, table, unknown_keys
 
-__all__ = ["CalibrationError", "c_nn", "check_layer", "resolve_layer", "is_paper_law", "paper_keys",
+__all__ = ["c_nn", "check_layer", "paper_law", "is_paper_law", "needs_calibration", "paper_keys",
            "reference_compliance", "PAPER_LAWS", "PAPER_KEYS", "EXCLUSIVE", "ALIASES"]
 
-log = logging.getLogger(__name__)
-
-
-class CalibrationError(RuntimeError):
-    """A solve that calibrates a layer law (``alpha_a``, ``alpha_b``, the root law's reference) failed."""
 
 #: law -> {constructor parameter: (direct key, paper key)}
 PAPER_LAWS = {
@@ -59,8 +56,6 @@ EXCLUSIVE = (("lam", "lam_over_cnn"), ("lam1", "lam_over_cnn"), ("p_cr", "alpha_
 #: sweep parameter short names
 ALIASES = {"alpha_a": "layer.alpha_a", "alpha_b": "layer.alpha_b", "alpha_c": "layer.alpha_c"}
 
-_ALPHA_B_XTOL = 1e-5  # relative tolerance on lam_r when targeting alpha_b
-
 
 c_nn = diagonal_coefficient  # ``C_nn = c / (pi E*) w_t(0, 0)``, defined once in bem.operator
 
@@ -68,6 +63,13 @@ c_nn = diagonal_coefficient  # ``C_nn = c / (pi E*) w_t(0, 0)``, defined once in
 def is_paper_law(spec):
     """Whether a validated ``[layer]`` spec is given by the paper's parameters (resolved by solves)."""
     return spec is not None and spec["law"] in PAPER_LAWS and any(k in spec for k in PAPER_KEYS)
+
+
+def needs_calibration(spec):
+    """Whether a validated ``[layer]`` spec needs solves before its law is known: ``alpha_a`` (a
+    threshold relative to ``p_max^lambda``) or the root law (``lam_r`` from ``p_max^lambda``, or from
+    ``alpha_b``); :func:`validation.run.calibrate.resolve_layer` runs them."""
+    return is_paper_law(spec) and ("alpha_a" in spec or spec["law"] == "root")
 
 
 def paper_keys(law):
@@ -167,36 +169,6 @@ def check_layer(d, path="layer"):
     return dict(d)
 
 
-def _root_for_alpha_b(alpha_b, p_lambda, lam_r0, solve):
-    """``lam_r`` with ``p_max(Root(lam_r)) = alpha_b p_lambda``: bracket in log, then Brent."""
-    from scipy.optimize import brentq
-
-    target = alpha_b * p_lambda
-    cache = {}
-
-    def f(t):
-        if t not in cache:
-            cache[t] = math.log(solve(Root(math.exp(t))).p_max / target)
-        return cache[t]
-
-    t0 = math.log(lam_r0)
-    step = 2.0 if f(t0) > 0 else -2.0  # p_max decreases as lam_r grows
-    t1 = t0
-    for _ in range(12):
-        t1 = t1 + step
-        if (f(t1) > 0) != (f(t0) > 0):
-            break
-        t0 = t1
-    else:
-        raise SceneError(
-            f"layer.alpha_b = {alpha_b!r} is not allowed: no root law reaches p_max = alpha_b p_max^lambda "
-            f"(p_max^lambda = {p_lambda:.6g}); the root law's peak ranges from near 0 (soft) up to the "
-            "smooth contact's peak (stiff): choose alpha_b between those.")
-    lo, hi = sorted((t0, t1))
-    t = brentq(f, lo, hi, xtol=_ALPHA_B_XTOL)
-    return math.exp(t), len(cache)
-
-
 def paper_law(law, lam, p_lambda=None, *, alpha_a=None, alpha_c=None, p_cr=None, p_star=None, lam2=None):
     """A layer law of the paper's section 6 from its parameters.
 
@@ -220,62 +192,3 @@ def paper_law(law, lam, p_lambda=None, *, alpha_a=None, alpha_c=None, p_cr=None,
     if law == "root":
         return Root(lam * math.sqrt(p_lambda))
     raise SceneError(f"layer.law = {law!r} is not allowed: it must be one of {sorted(PAPER_LAWS)}.")
-
-
-def resolve_layer(spec, *, step, E_star, solve, layer=None):
-    """The layer law of a validated spec, solving the linear reference first if needed.
-
-    Parameters
-    ----------
-    spec : dict or None
-        Output of :func:`check_layer`.
-    step : float
-        BEM step ``c`` [length] of the lattice in use (for the reported ``c_nn``; the layer
-        does not depend on it).
-    E_star : float
-        Effective modulus [pressure].
-    solve : callable
-        ``solve(layer) -> bem.ContactResult`` of the scene's problem with that layer.
-    layer : bem.layers.Layer, optional
-        The law the scene already built from a spec of direct parameters (used as it is).
-
-    Returns
-    -------
-    layer : bem.layers.Layer or None
-    info : dict
-        ``law`` and, when the paper's parameters are used, ``c_nn`` (of the lattice in use),
-        ``lam_ref`` (the linear reference compliance), ``lam_over_cnn`` (``lam_ref / c_nn``: how
-        soft the layer is on the scale of one node of this lattice), ``p_max_lambda``, ``alpha_a``,
-        ``alpha_c``, ``alpha_b_target``, ``reference_solves``; ``parameters`` (the resolved
-        law's ``to_dict()``).
-    """
-    if spec is None:
-        return None, {"law": "none", "parameters": None}
-    law = spec["law"]
-    info = {"law": law}
-    if not is_paper_law(spec):
-        layer = from_dict(spec) if layer is None else layer
-        return layer, dict(info, parameters=layer.to_dict())
-    cnn = c_nn(step, E_star)
-    lam_ref = reference_compliance(spec, E_star)
-    info.update(c_nn=cnn, lam_over_cnn=lam_ref / cnn, lam_ref=lam_ref)
-    p_lambda = None
-    if "alpha_a" in spec or law == "root":
-        p_lambda = solve(Linear(lam_ref)).p_max
-        info.update(p_max_lambda=p_lambda, reference_solves=1)
-        log.info("linear reference layer lam = %.6g: p_max^lambda = %.6g", lam_ref, p_lambda)
-    layer = paper_law(law, lam_ref, p_lambda, alpha_a=spec.get("alpha_a"), alpha_c=spec.get("alpha_c"),
-                      p_cr=spec.get("p_cr"), p_star=spec.get("p_star"), lam2=spec.get("lam2"))
-    if law in ("elastic_rigid", "bilinear"):
-        info["alpha_a"] = spec.get("alpha_a")
-    if law == "bilinear":
-        lam2 = spec["lam2"] if "lam2" in spec else lam_ref * math.tan(spec["alpha_c"])
-        info["alpha_c"] = math.atan2(lam2, lam_ref)
-    if law == "root" and "alpha_b" in spec:
-        info["alpha_b_target"] = spec["alpha_b"]
-        lam_r, n = _root_for_alpha_b(spec["alpha_b"], p_lambda, layer.lam, solve)
-        info["reference_solves"] += n
-        layer = Root(lam_r)
-    if layer is None:
-        log.info("%s layer with a zero threshold: smooth contact (no layer), as in the paper", law)
-    return layer, dict(info, parameters=None if layer is None else layer.to_dict())

@@ -30,8 +30,8 @@ from .rough import PERIODIC_KEYS, ROUGH_TYPES, rough_gap
 from .sizing import KEYS as BEM_KEYS
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic", "report", "sweep_spec",
-           "stress_options", "stress_depth_bound", "scene_keys", "KEYS", "report_sections", "ANALYTIC_KINDS",
-           "DEFAULT_UNITS", "BODY_KEYS", "Unimported"]
+           "stress_options", "stress_depth_bound", "scene_keys", "KEYS", "report_sections", "REPORT_SECTIONS",
+           "ANALYTIC_KINDS", "DEFAULT_UNITS", "BODY_KEYS", "Unimported"]
 
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
@@ -61,12 +61,16 @@ def _gap_parameters(cls):
     return {name: p for name, p in inspect.signature(cls.__init__).parameters.items() if name != "self"}
 
 
-def report_sections():
-    """The names a scene's ``[report] sections`` may list: the keys of the report's registry
-    (:data:`validation.report.documents.sections.SECTIONS`), read when a ``[report]`` is checked."""
-    from ..report.documents.sections import SECTIONS
+#: the sections of a run's report in their default order, the names a scene's ``[report] sections``
+#: may list; the report registers one function for each
+#: (:data:`validation.report.documents.sections.SECTIONS`)
+REPORT_SECTIONS = ("scene", "layer_law", "summary", "timings", "profile", "pressure_map", "convergence",
+                   "fem_field", "stress", "comparison", "sweep", "rough")
 
-    return tuple(SECTIONS)
+
+def report_sections():
+    """The names a scene's ``[report] sections`` may list (:data:`REPORT_SECTIONS`)."""
+    return REPORT_SECTIONS
 
 
 def scene_keys():

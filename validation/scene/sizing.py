@@ -7,7 +7,7 @@ expected contact: ``bem.nodes_across`` nodes across its smaller diameter and
 callables and measured surfaces have none, and such a scene gives ``bem.step`` and
 ``bem.extent``). A layer given by the paper's parameters is sized by its linear reference
 layer. An estimate only sizes the region: the runner enlarges an automatic region when the
-contact reaches its border.
+contact reaches its border (:mod:`validation.run.runner`, up to :func:`region_limit`).
 
 The solver options are checked by the BEM itself (:func:`bem.options.check_options`: one rule,
 one message), and the option names come from :data:`bem.options.OPTIONS`.
@@ -26,8 +26,8 @@ from bem.options import OPTIONS, check_options, solver_for
 from . import checks as ck
 from .paper import is_paper_law, reference_compliance
 
-__all__ = ["bem_options", "inner_domain", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "DOMAIN_MARGIN", "DEFAULT_NODES_ACROSS",
-           "DEFAULT_EXTENT_FACTOR"]
+__all__ = ["bem_options", "inner_domain", "region_limit", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "DOMAIN_MARGIN",
+           "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
 
 #: An automatic extent stays this fraction inside a bounded gap domain.
 DOMAIN_MARGIN = 1e-3
@@ -45,6 +45,13 @@ def inner_domain(gap):
     """Largest half-widths ``(hx, hy)`` of a centred rectangle inside ``gap.domain`` (may be inf)."""
     (x0, x1), (y0, y1) = gap.domain
     return min(-x0, x1), min(-y0, y1)
+
+
+def region_limit(gap):
+    """The largest half-widths ``(ex, ey)`` [length] of an automatic region: :data:`DOMAIN_MARGIN` inside
+    :func:`inner_domain` (may be inf). The sizing and the runner's enlargement both stop there."""
+    hx, hy = inner_domain(gap)
+    return (1 - DOMAIN_MARGIN) * hx, (1 - DOMAIN_MARGIN) * hy
 
 
 def _axes(gap, layer, E_star, load):
@@ -93,7 +100,8 @@ def _extent(d, gap, axes):
     if "extent" not in d:
         fx, fy = ck.number_or_pair("bem.extent_factor", d.get("extent_factor", DEFAULT_EXTENT_FACTOR),
                                    lambda p, v: ck.in_range(p, v, 1.0, 100.0))
-        return (min(fx * axes[0], (1 - DOMAIN_MARGIN) * hx), min(fy * axes[1], (1 - DOMAIN_MARGIN) * hy)), True
+        lx, ly = region_limit(gap)
+        return (min(fx * axes[0], lx), min(fy * axes[1], ly)), True
     ex, ey = ck.number_or_pair("bem.extent", d["extent"], ck.positive)
     if hasattr(gap, "check_region"):  # measured data: their own rule (bem.gaps.Measured.check_region)
         with ck.scene_errors():

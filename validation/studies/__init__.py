@@ -8,11 +8,15 @@
 - :mod:`~validation.studies.robustness`: the layer methods over 12 decades of layer compliance,
   every converged answer checked against the KKT conditions with the dense influence matrix;
 - :mod:`~validation.studies.two_scale`: a fully resolved rough sphere against the smooth sphere
-  with the layer law of its roughness and Greenwood-Tripp.
+  with the layer law of its roughness and Greenwood-Tripp;
+- :mod:`~validation.studies.paper_problem`: the paper's test problem (section 6) on one lattice,
+  its cases, sweeps and methods, which the paper report draws (``contactlab report paper``).
 
-Each has ``main(args)`` for ``contactlab study error-time | stability | robustness | two-scale``. This module
-holds what they share: running a scene (:func:`attempt`, :func:`timed`), the status of an outcome
-(:func:`classify`) and the files (:func:`save`).
+The first four have ``main(out=..., scene=..., quick=..., progress=...)`` for ``contactlab study
+error-time | stability | robustness | two-scale``: it writes the study's JSON file (``STEM + ".json"``)
+and returns a :class:`StudyRun`, which the report renders (:mod:`validation.report.documents.studies`).
+This module holds what they share: running a scene (:func:`attempt`, :func:`timed`), the status of an
+outcome (:func:`classify`) and the files (:func:`save`).
 """
 
 from __future__ import annotations
@@ -21,21 +25,36 @@ import json
 import math
 import statistics
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from bem.checks import InputError
 from bem.files import write_text
 
 from ..run import execute_scene
 from ..scene import load_scene
 
-__all__ = ["attempt", "timed", "classify", "finite", "save", "write_json", "fmt", "STATUSES"]
+__all__ = ["StudyRun", "attempt", "timed", "classify", "finite", "save", "write_json", "fmt", "no_scene", "STATUSES"]
 
 #: status of an outcome (:func:`classify`)
 STATUSES = ("converged", "reported failure", "wrong")
 #: errors a run may raise to report a failure (anything else is a bug and propagates)
 _REPORTED = (ValueError, ArithmeticError, RuntimeError)
+
+
+@dataclass
+class StudyRun:
+    """What a study's ``main`` wrote: ``path`` (``<stem>.json``), ``data`` (its content as written),
+    ``status`` (the exit status: 1 if any outcome is wrong) and ``fields`` (nodal fields the study
+    kept for its figures, or ``None``)."""
+
+    stem: str
+    path: Path
+    data: object
+    status: int = 0
+    fields: object = None
 
 
 def attempt(scene, overrides=None):
@@ -97,18 +116,18 @@ def write_json(path, data):
     return write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
 
 
-def save(args, stem, data):
-    """Write ``<stem>.json`` and its tables as ``<stem>.md`` to ``args.out`` (default: the current directory).
+def save(out, stem, data, *, status=0, fields=None):
+    """Write ``data`` as ``<stem>.json`` into the folder ``out`` (``None``: the current directory), whole
+    or not at all; returns the :class:`StudyRun` (its ``data`` read back from the file)."""
+    path = write_json(Path(out or ".") / f"{stem}.json", data)
+    return StudyRun(stem, path, json.loads(path.read_text(encoding="utf-8")), status, fields)
 
-    The Markdown is that of the studies report without its figures, made from the JSON as
-    written (:func:`validation.report.documents.studies.study_markdown`); returns it.
-    """
-    from ..report.documents.studies import study_markdown
 
-    out = Path(getattr(args, "out", None) or ".")
-    text = study_markdown(f"{stem}.json", json.loads(write_json(out / f"{stem}.json", data).read_text()))
-    write_text(out / f"{stem}.md", text)
-    return text
+def no_scene(study, scene):
+    """Refuse a ``scene`` for a study that builds its own problems (``None`` passes)."""
+    if scene is not None:
+        raise InputError(f"scene = {scene!r} is not allowed: the {study} study takes no scene (it builds its own "
+                         "problems; --quick chooses the short run).")
 
 
 def fmt(value, spec=".2e"):

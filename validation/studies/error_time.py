@@ -25,11 +25,15 @@ from dataclasses import asdict, dataclass, field
 from bem.checks import InputError, check_choice, check_positive
 
 from ..compare import pair_metrics, relative_l2
+from ..progress import each
 from ..run import execute_scene
 from . import fmt, save, timed, write_json
 from .problems import ERROR_TIME_PROBLEMS, get_problem, methods
 
-__all__ = ["method_label", "ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "LADDERS", "TARGETS"]
+__all__ = ["method_label", "ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "STEM", "LADDERS", "TARGETS"]
+
+#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
+STEM = "error_time"
 
 #: resolution ladders: BEM steps across the contact diameter, FEM elements across the radius
 LADDERS = {"full": {"bem": (10, 20, 40, 80, 160), "fem": (4, 8, 16, 32)},
@@ -215,7 +219,7 @@ def _climb(study, problem, method, ladder, reference, opts):
 
 
 def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=None, repeats=3, slow_s=2.0,
-                   time_budget_s=60.0, relaxations=None, fem=True, progress=False):
+                   time_budget_s=60.0, relaxations=None, fem=True, progress=None):
     """Run the error-time study.
 
     Parameters
@@ -235,15 +239,13 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
         Relaxations of the augmented gap method, tried in turn (default ``(1, 0.5, 0.2)``, quick ``(1, 0.3)``).
     fem : bool
         Run the FEM ladder.
-    progress : bool
-        Show a tqdm progress bar (stderr), one step per ladder.
+    progress : callable, optional
+        ``progress(label, done, total)`` (:mod:`validation.progress`), one step per ladder.
 
     Returns
     -------
     ErrorTimeStudy
     """
-    from tqdm import tqdm
-
     mode = "quick" if quick else "full"
     bem_ladder = tuple(LADDERS[mode]["bem"] if bem_ladder is None else bem_ladder)
     fem_ladder = tuple(LADDERS[mode]["fem"] if fem_ladder is None else fem_ladder) if fem else ()
@@ -256,7 +258,7 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
                                      **opts, "relaxations": list(relaxations)})
     ladders = [(p, m, fem_ladder if m == "fem" else bem_ladder) for p in problems
                for m in (methods(p) if "layer" in p else ("kalker",)) + (("fem",) if fem_ladder else ())]
-    for problem, method, ladder in tqdm(ladders, desc="error-time", unit="ladder", disable=not progress):
+    for problem, method, ladder in each(ladders, progress, lambda t: f"{t[0]['scene']['title']} {t[1]}"):
         name = problem["scene"]["title"]
         if name not in study.references:
             reference, study.references[name] = _reference(problem, max(bem_ladder))
@@ -267,15 +269,13 @@ def run_error_time(problems=None, *, quick=False, bem_ladder=None, fem_ladder=No
     return study
 
 
-def main(args):
-    """``contactlab study error-time [SCENE] [--out DIR] [--quick]``: the problem ``args.scene`` (a name of
-    :data:`~validation.studies.problems.ERROR_TIME_PROBLEMS`; ``None``: all); writes ``error_time.json``
-    and ``error_time.md`` to ``args.out`` (default: the current directory) and prints the markdown. Returns 0."""
+def main(*, out=None, scene=None, quick=False, progress=None):
+    """``contactlab study error-time``: the problem ``scene`` (a name of
+    :data:`~validation.studies.problems.ERROR_TIME_PROBLEMS`; ``None``: all), a short ladder when
+    ``quick``; writes ``error_time.json`` into the folder ``out`` (``None``: the current directory)
+    (:class:`~validation.studies.StudyRun`, status 0). ``progress(label, done, total)``: :mod:`validation.progress`."""
     from ..extras import require
 
     require("fem", "contactlab study error-time (the FEM reference)")
-    scene = getattr(args, "scene", None)
-    study = run_error_time(None if scene is None else [scene], quick=bool(getattr(args, "quick", False)),
-                           progress=not getattr(args, "no_progress", False))
-    print(save(args, "error_time", study.to_dict()))
-    return 0
+    study = run_error_time(None if scene is None else [scene], quick=bool(quick), progress=progress)
+    return save(out, STEM, study.to_dict())

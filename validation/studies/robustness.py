@@ -25,12 +25,16 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..progress import each
 from ..scene import load_scene
-from . import attempt, classify, finite, fmt, save
+from . import attempt, classify, finite, fmt, no_scene, save
 from .problems import robustness_scene
 
 __all__ = ["RobustnessRow", "run_robustness", "summary_table", "matrix_table", "failure_table",
-           "rows_from_json", "main", "EXPONENTS", "COMPLIANCES", "MODULI", "LAYER_METHODS", "SETTING"]
+           "rows_from_json", "main", "STEM", "EXPONENTS", "COMPLIANCES", "MODULI", "LAYER_METHODS", "SETTING"]
+
+#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
+STEM = "robustness"
 
 EXPONENTS = (0.05, 0.2, 0.5, 1.0, 2.0, 3.0, 10.0)
 COMPLIANCES = (1e-6, 1e-3, 1.0, 1e3, 1e6)
@@ -85,21 +89,19 @@ def _row(point, control, method, run):
 
 
 def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODULI, methods=LAYER_METHODS,
-                   progress=False):
+                   progress=None):
     """Run the grid; returns the list of :class:`RobustnessRow`.
 
     Every run of a point has the lattice step of its force-controlled scene; approach control
     uses the approach of the force-controlled Newton run (the same discrete problem), or, if that
-    failed, the layer-only closed form.
+    failed, the layer-only closed form. ``progress(label, done, total)``: :mod:`validation.progress`.
     """
-    from tqdm import tqdm
-
     from bem.layers import Power
     from bem.reference import rigid_layer_paraboloid
 
     rows = []
-    for point in tqdm(list(itertools.product(exponents, compliances, moduli)), disable=not progress,
-                      desc="robustness", unit="point"):
+    for point in each(itertools.product(exponents, compliances, moduli), progress,
+                      lambda p: "s = {:g}, k = {:g}, E* = {:g}".format(*p)):
         scene = load_scene(robustness_scene(*point, nodes_across=NODES_ACROSS, extent_factor=1.5, rtol=RTOL))
         approach = None
         for control in ("force", "approach"):
@@ -164,12 +166,12 @@ def _json_row(row):
     return out
 
 
-def main(args):
-    """``contactlab study robustness [--out DIR] [--quick]``: writes ``robustness.json`` and ``robustness.md``
-    to ``args.out`` (default: the current directory) and prints the markdown. Returns 1 if any outcome is
-    wrong, else 0."""
-    quick = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
-    rows = run_robustness(progress=not getattr(args, "no_progress", False),
-                          **(quick if getattr(args, "quick", False) else {}))
-    print(save(args, "robustness", [_json_row(r) for r in rows]), end="")
-    return 1 if any(r.status == "wrong" for r in rows) else 0
+def main(*, out=None, scene=None, quick=False, progress=None):
+    """``contactlab study robustness``: the whole grid, or a small one when ``quick``; writes
+    ``robustness.json`` into the folder ``out`` (``None``: the current directory). Returns the
+    :class:`~validation.studies.StudyRun`, status 1 if any outcome is wrong, else 0. The study takes
+    no ``scene``; ``progress(label, done, total)``: :mod:`validation.progress`."""
+    no_scene("robustness", scene)
+    quick_grid = dict(exponents=(0.05, 1.0, 10.0), compliances=(1e-6, 1.0, 1e6), moduli=(1e-3, 1e12))
+    rows = run_robustness(progress=progress, **(quick_grid if quick else {}))
+    return save(out, STEM, [_json_row(r) for r in rows], status=int(any(r.status == "wrong" for r in rows)))

@@ -24,6 +24,7 @@ answer called converged makes :meth:`StabilityStudy.check` raise :class:`Stabili
 
 from __future__ import annotations
 
+import logging
 import math
 from collections import Counter
 from dataclasses import asdict, dataclass, field
@@ -31,11 +32,17 @@ from dataclasses import asdict, dataclass, field
 from bem.reference import hertz_sphere
 
 from ..compare import pair_metrics
-from . import STATUSES, attempt, classify, finite, fmt, save
+from ..progress import each
+from . import STATUSES, attempt, classify, finite, fmt, no_scene, save
 from .problems import LIMIT_TOL, methods, stability_cases
 
-__all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main",
+__all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main", "STEM",
            "METHOD_TOL", "FEM_TOL", "STATUSES"]
+
+#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
+STEM = "stability"
+
+log = logging.getLogger(__name__)
 
 #: agreement required of a method with Newton on the same lattice
 METHOD_TOL = 1e-6
@@ -177,7 +184,7 @@ def _run_case(case, limit):
     return rows
 
 
-def run_stability(cases=None, *, quick=False, check=True, progress=False):
+def run_stability(cases=None, *, quick=False, check=True, progress=None):
     """Run the stability study.
 
     Parameters
@@ -189,32 +196,32 @@ def run_stability(cases=None, *, quick=False, check=True, progress=False):
     check : bool
         Raise :class:`StabilityFailure` when any outcome is wrong (a NaN anywhere, or a wrong answer
         called converged).
-    progress : bool
-        Show a tqdm progress bar (stderr).
+    progress : callable, optional
+        ``progress(label, done, total)`` (:mod:`validation.progress`), one step per case.
 
     Returns
     -------
     StabilityStudy
     """
-    from tqdm import tqdm
-
     cases = stability_cases(quick) if cases is None else list(cases)
     study = StabilityStudy(settings={"mode": "quick" if quick else "full", "method_tol": METHOD_TOL,
                                      "fem_tol": FEM_TOL, "cases": [c["scene"]["title"] for c, _ in cases]})
-    for case, limit in tqdm(cases, desc="stability", unit="case", disable=not progress):
+    for case, limit in each(cases, progress, lambda c: c[0]["scene"]["title"]):
         study.rows += _run_case(case, limit)
     return study.check() if check else study
 
 
-def main(args):
-    """``contactlab study stability [--out DIR] [--quick]``: writes ``stability.json`` and ``stability.md``
-    to ``args.out`` (default: the current directory), prints the markdown, then raises
-    :class:`StabilityFailure` if any outcome is wrong. Returns 0."""
+def main(*, out=None, scene=None, quick=False, progress=None):
+    """``contactlab study stability``: every case, or a short list when ``quick``; writes
+    ``stability.json`` into the folder ``out`` (``None``: the current directory). Returns the
+    :class:`~validation.studies.StudyRun`, status 1 if any outcome is wrong (logged as an error with
+    the :class:`StabilityFailure` message), else 0. The study takes no ``scene``;
+    ``progress(label, done, total)``: :mod:`validation.progress`."""
     from ..extras import require
 
+    no_scene("stability", scene)
     require("fem", "contactlab study stability (the FEM cases)")
-    study = run_stability(quick=bool(getattr(args, "quick", False)), check=False,
-                          progress=not getattr(args, "no_progress", False))
-    print(save(args, "stability", study.to_dict()))
-    study.check()
-    return 0
+    study = run_stability(quick=bool(quick), check=False, progress=progress)
+    if study.wrong():
+        log.error("%s", StabilityFailure(study.wrong(), study))
+    return save(out, STEM, study.to_dict(), status=int(bool(study.wrong())))

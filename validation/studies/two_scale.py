@@ -34,14 +34,18 @@ import time
 
 import numpy as np
 
-from . import fmt, save
+from ..progress import each
+from . import fmt, no_scene, save
 from .two_scale_models import (TiledRoughness, greenwood_tripp_law, nominal_radius, spectral_moments,
                                windowed)
 
-__all__ = ["SETTINGS", "QUICK", "make_surface", "run_case", "run_two_scale", "refinement", "write_study",
-           "summary_lines", "OUTPUT_NAMES", "main"]
+__all__ = ["SETTINGS", "QUICK", "make_surface", "run_case", "run_two_scale", "refinement", "summary_lines",
+           "OUTPUT_NAMES", "main", "STEM"]
 
-#: the files :func:`write_study` writes
+#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
+STEM = "two_scale"
+
+#: the files of the study: its JSON (:func:`main`), Markdown and figures (the report)
 OUTPUT_NAMES = ("two_scale.json", "two_scale.md", "two_scale_map.png", "two_scale_profile.png")
 
 #: the full study (SI units)
@@ -158,11 +162,12 @@ def run_case(s, surface, laws, ratio, load_factor):
 def run_two_scale(settings=None, *, quick=False, keep=False, progress=None):
     """Run the two-scale check; returns a JSON-ready dict (``rows``, ``refinement``, ``settings``,
     ``figure``: what the figures of the first case draw,
-    :func:`validation.report.figures.two_scale.figure_data`).
+    :func:`validation.studies.two_scale_figure.figure_data`).
 
-    ``keep``: also return the fields of the first case (for the figures) under ``"fields"``.
+    ``keep``: also return the fields of the first case (for the figures) under ``"fields"``;
+    ``progress(label, done, total)`` (:mod:`validation.progress`): one step per case.
     """
-    from ..report.figures.two_scale import figure_data
+    from .two_scale_figure import figure_data
 
     s = dict(QUICK if quick else SETTINGS, **(settings or {}))
     surface = make_surface(s)
@@ -171,13 +176,11 @@ def run_two_scale(settings=None, *, quick=False, keep=False, progress=None):
     p_max = 1.5 * 3 * s["load_ratio"] * P1 / (2 * math.pi * a**2)
     laws = layer_laws(s, surface, 4 * p_max)
     rows, fields = [], None
-    for ratio in s["ratios"]:
-        for factor in (1.0, s["load_ratio"]):
-            row, f = run_case(s, surface, (laws[0].law, laws[1]), ratio, factor)
-            rows.append(row)
-            fields = fields or f
-            if progress:
-                progress(row)
+    cases = [(ratio, factor) for ratio in s["ratios"] for factor in (1.0, s["load_ratio"])]
+    for ratio, factor in each(cases, progress, lambda c: "a_H/lambda_L = {:g}, P = {:g} P1".format(*c)):
+        row, f = run_case(s, surface, (laws[0].law, laws[1]), ratio, factor)
+        rows.append(row)
+        fields = fields or f
     out = {"study": "two_scale", "mode": "quick" if quick else "full",
            "settings": {k: list(v) if isinstance(v, tuple) else v for k, v in s.items()},
            "surface": surface.stats.as_dict(), "first_touch_gap": float(laws[0].first_touch_gap),
@@ -230,25 +233,6 @@ def table(data):
     return heads, rows
 
 
-def write_study(out, *, quick=False):
-    """Run the check and write :data:`OUTPUT_NAMES` into the folder ``out``: the JSON, its tables as
-    Markdown and the two figures of the first case (needs the ``rough`` and ``report`` extras).
-
-    Returns ``(data, markdown, figure files)``.
-    """
-    from types import SimpleNamespace
-
-    from ..extras import require
-    from ..report.figures.two_scale import plot_two_scale
-
-    require("rough", "the two-scale check (the self-affine surface)")
-    require("report", "the two-scale check (its figures)")
-    data = run_two_scale(quick=quick, keep=True)
-    fields = data.pop("fields")
-    text = save(SimpleNamespace(out=str(out)), "two_scale", data)
-    return data, text, plot_two_scale(data, fields, out)
-
-
 def summary_lines(data):
     """The key errors of the layer model and of Greenwood-Tripp per case: lines for a terminal."""
     lines = []
@@ -261,18 +245,16 @@ def summary_lines(data):
     return lines
 
 
-def main(args):
-    """``contactlab study two-scale [--quick] [--out DIR]``: writes ``two_scale.json``, ``two_scale.md``
-    and the two figures of the first case (needs the ``rough`` and ``report`` extras); prints the Markdown."""
-    from pathlib import Path
+def main(*, out=None, scene=None, quick=False, progress=None):
+    """``contactlab study two-scale``: the full check, or the small run ``rough_sphere_two_scale`` when
+    ``quick``; writes ``two_scale.json`` into the folder ``out`` (``None``: the current directory) and
+    returns the :class:`~validation.studies.StudyRun` with the fields of the first case (for its
+    figures, :func:`validation.report.documents.studies.write_study_outputs`). Needs the ``rough``
+    extra; the study takes no ``scene``."""
+    from ..extras import require
 
-    from bem.checks import InputError
-
-    if getattr(args, "scene", None):
-        raise InputError(f"scene = {args.scene!r} is not allowed: the two-scale study takes no scene "
-                         "(--quick chooses the small run).")
-    _, text, files = write_study(Path(getattr(args, "out", None) or "."), quick=bool(getattr(args, "quick", False)))
-    print(text)
-    for path in files:
-        print(f"figure: {path}")
-    return 0
+    no_scene("two-scale", scene)
+    require("rough", "the two-scale check (the self-affine surface)")
+    data = run_two_scale(quick=bool(quick), keep=True, progress=progress)
+    fields = data.pop("fields")
+    return save(out, STEM, data, fields=fields)

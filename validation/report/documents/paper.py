@@ -1,6 +1,6 @@
 """The report of the paper's test problem: analogues of Fig. 4-11, the stresses and the validation.
 
-:func:`report_paper_problem` runs the cases (:mod:`validation.report.documents.paper_runs`) and
+:func:`report_paper_problem` runs the cases (:mod:`validation.studies.paper_problem`) and
 writes the report. Pressures are divided by Hertz's peak ``p0`` and lengths by Hertz's radius
 ``a_H`` of the smooth problem; the validation figures are those of a run's report
 (:data:`validation.report.figures.FIGURES`) of the cases run with the FEM reference.
@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ...studies.paper_problem import AG_RELAXATION, ALPHA_A_ITERATIONS, RTOL, SCENES, SOLVE_STAGES, run_paper_problem
 from ..figures import run as run_figures
 from ..render import Figure, Progress, Section, Table, draw_and_build, problem_section
 from ..render.style import method_text
-from .paper_runs import AG_RELAXATION, ALPHA_A_ITERATIONS, RTOL, SCENES, SOLVE_STAGES, run_paper_problem
 from .results import results_of
 
 __all__ = ["report_paper_problem", "paper_sections", "expected_stalls", "STAGES", "TITLE"]
@@ -341,7 +341,7 @@ def _validation(res, work):
 
 
 def paper_sections(res, work):
-    """The report sections of :class:`validation.report.documents.paper_runs.PaperRuns`; figures go to ``work``."""
+    """The report sections of :class:`validation.studies.paper_problem.PaperRuns`; figures go to ``work``."""
     work = Path(work)
     sections = [_problem(res, work), _distributions(res, work), _stresses(res, work), _iterations(res, work),
                 _sweeps(res, work), _stability(res)]

@@ -235,7 +235,8 @@ def _figures_only(title, kind):
     return lambda res, work: Section(title, kind=kind)
 
 
-#: section name -> function(results, work) -> Section or None, in the default order of a report
+#: section name -> function(results, work) -> Section or None, in the default order of a report; the
+#: names are those a scene may list (:data:`validation.scene.schema.REPORT_SECTIONS`)
 SECTIONS = {
     "scene": scene_section,
     "layer_law": _figures_only("Interface layer law", "problem"),
@@ -296,7 +297,7 @@ def report_results_dir(directory, out_dir=None, *, title=None, units="auto", fmt
     fmt : {"png", "svg", "pdf"}
         Figure files (:func:`validation.report.render.style.figure_format`).
     progress : callable, optional
-        ``progress(stage, done, total)`` (:class:`validation.report.render.Progress`).
+        ``progress(stage, done, total)`` (:class:`validation.progress.Progress`).
 
     Returns
     -------

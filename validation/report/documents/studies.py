@@ -17,7 +17,8 @@ from ..render import Figure, Progress, Section, Table, draw_and_build, table_fro
 from .results import read_json
 from .two_scale import two_scale_sections
 
-__all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "study_markdown", "report_studies_dir"]
+__all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "study_markdown", "write_study_outputs",
+           "report_studies_dir"]
 
 STUDY_FILES = ("error_time.json", "stability.json", "robustness.json", "two_scale.json")
 
@@ -143,12 +144,33 @@ def study_markdown(name, data):
     return render_markdown(_SECTIONS[name](data, None), title=title, names={})
 
 
+def write_study_outputs(run):
+    """Beside the JSON file of a study's run (:class:`validation.studies.StudyRun`), its tables as
+    ``<stem>.md`` and, for the two-scale check with its fields, the two figures of its first case.
+
+    Returns ``(markdown, figure files)``; the Markdown is made from the JSON as written.
+    """
+    from bem.files import write_text
+
+    text = study_markdown(run.path.name, run.data)
+    write_text(run.path.with_suffix(".md"), text)
+    figures = []
+    if run.stem == "two_scale" and run.fields is not None:
+        from ...extras import require
+        from ..figures.two_scale import plot_two_scale
+
+        require("report", "the two-scale check (its figures)")
+
+        figures = plot_two_scale(run.data, run.fields, run.path.parent)
+    return text, figures
+
+
 def report_studies_dir(directory, out_dir=None, *, title="contactlab validation studies", fmt="png", progress=None):
     """Report of the study files in ``directory`` (default ``out_dir``: ``directory/report``).
 
     ``fmt`` (``"png"``, ``"svg"``, ``"pdf"``) chooses the figure files
     (:func:`validation.report.render.style.figure_format`); ``progress(stage, done, total)``
-    hears the stages (:class:`validation.report.render.Progress`).
+    hears the stages (:class:`validation.progress.Progress`).
     """
     from .sections import STAGES
 

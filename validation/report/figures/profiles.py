@@ -12,25 +12,11 @@ import numpy as np
 
 from bem.checks import InputError, check_positive
 
+from ...compare import axial_section
 from ..render.style import SOLVER_COLORS, axis_labels, color_for, new_figure, save_figure
 
 __all__ = ["axial_section", "section_of", "radial", "contact_edge", "auto_xlim", "curve_style",
            "plot_pressure_profiles", "plot_profile_comparison", "plot_layer_laws", "measured_points"]
-
-
-def axial_section(x, y, values, *, tol=None):
-    """``(xs, vs)``: the nodes ``(x, y)`` [length] on the line ``y = 0`` (``|y| <= tol``, default
-    ``1e-9 max|x|``), sorted by ``x``, and their ``values`` (any unit)."""
-    x, y, values = (np.asarray(v, dtype=float) for v in (x, y, values))
-    if not (x.shape == y.shape == values.shape):
-        raise InputError(f"x, y, values have shapes {x.shape}, {y.shape}, {values.shape} which is not allowed: "
-                         "they must be equal.")
-    tol = 1e-9 * float(np.abs(x).max(initial=1.0)) if tol is None else tol
-    on = np.abs(y) <= tol
-    if not on.any():
-        raise InputError("x, y have no node on the axial section y = 0: the section needs nodes with |y| <= tol.")
-    order = np.argsort(x[on], kind="stable")
-    return x[on][order], values[on][order]
 
 
 def section_of(data, values=None):

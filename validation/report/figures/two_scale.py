@@ -7,8 +7,8 @@
   one roll-off wavelength, the layer model's nodal pressure and its window averages, and
   Greenwood and Tripp's.
 
-:func:`figure_data` keeps what the two figures draw, small enough for ``two_scale.json``
-(a binned map and the profiles); :func:`plot_two_scale_data` draws them from it (the studies report).
+:func:`validation.studies.two_scale_figure.figure_data` keeps what the two figures draw, small
+enough for ``two_scale.json``; :func:`plot_two_scale_data` draws them from it (the studies report).
 """
 
 from __future__ import annotations
@@ -17,35 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ...studies.two_scale_figure import binned_map, nodal, profile_curves
 from ..render.style import color_for, new_figure, save_figure
 
-__all__ = ["binned_map", "window_row", "plot_pressure_map", "plot_pressure_image", "plot_windowed_profile",
-           "plot_profile_curves", "plot_two_scale", "figure_data", "plot_two_scale_data"]
-
-#: pixels across the pressure map kept in ``two_scale.json``
-JSON_PIXELS = 96
-
-
-def binned_map(x, y, p, extent, pixels=400):
-    """``(edges, image)``: the mean of the nodal ``p`` in ``pixels x pixels`` squares over ``[-extent, extent]^2``.
-
-    ``image[i, j]`` is the square ``i`` along y, ``j`` along x; NaN where no node falls.
-    """
-    edges = np.linspace(-extent, extent, pixels + 1)
-    total, _, _ = np.histogram2d(y, x, bins=(edges, edges), weights=p)
-    count, _, _ = np.histogram2d(y, x, bins=(edges, edges))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return edges, np.where(count > 0, total / np.maximum(count, 1), np.nan)
-
-
-def window_row(x, y, p, width):
-    """``(centres, means)`` of the windows of side ``width`` on the row through ``y = 0`` (sorted by x)."""
-    from validation.studies.two_scale_models import windowed
-
-    ix, iy, mean, _ = windowed(x, y, p, width)
-    row = iy == 0
-    order = np.argsort(ix[row])
-    return ix[row][order] * width, mean[row][order]
+__all__ = ["plot_pressure_map", "plot_pressure_image", "plot_windowed_profile", "plot_profile_curves",
+           "plot_two_scale", "plot_two_scale_data"]
 
 
 def plot_pressure_map(x, y, p, *, extent, radius, layer_radius, path, title=None):
@@ -81,21 +57,6 @@ def plot_pressure_image(edges, image, *, radius, layer_radius, path, title=None)
         ax.set_ylabel("y [um]")
         ax.legend(loc="upper right", fontsize="small")
         return save_figure(fig, path)
-
-
-def profile_curves(resolved, layer, gt, *, width, wide=None):
-    """The curves of the windowed profile along ``y = 0``: ``{name: (x [m], p [Pa])}``.
-
-    ``resolved`` (window means of ``width``, and of ``wide`` when given), ``layer`` (nodal),
-    ``layer_windows`` (its window means), ``gt`` (nodal); each argument an ``(x, y, p)`` of nodal values.
-    """
-    from .profiles import axial_section
-
-    out = {"resolved": window_row(*resolved, width)}
-    if wide:
-        out["resolved_wide"] = window_row(*resolved, wide)
-    out.update(layer=axial_section(*layer), layer_windows=window_row(*layer, width), gt=axial_section(*gt))
-    return out
 
 
 def plot_windowed_profile(resolved, layer, gt, *, width, path, title=None, wide=None):
@@ -141,7 +102,7 @@ def plot_two_scale(data, fields, out):
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    res, lay, gt = _nodal(fields["resolved"]), _nodal(fields["layer"]), _nodal(fields["gt"])
+    res, lay, gt = nodal(fields["resolved"]), nodal(fields["layer"]), nodal(fields["gt"])
     case = _case(fields)
     return [plot_pressure_map(*res, extent=fields["extent"], radius=nominal_radius(*res),
                               layer_radius=nominal_radius(*lay), path=out / "two_scale_map.png",
@@ -150,40 +111,8 @@ def plot_two_scale(data, fields, out):
                                   title=f"Pressure along y = 0, {case}", wide=fields.get("wide"))]
 
 
-def _nodal(r):
-    return tuple(np.asarray(r[k] if isinstance(r, dict) else getattr(r, k)) for k in ("x", "y", "p"))
-
-
 def _case(f):
     return f"a_H/lambda_L = {f['ratio']:g}, P = {f['load_factor']:g} P1"
-
-
-def _short(values):
-    """Floats rounded to 4 significant digits, NaN as None (JSON)."""
-    a = np.asarray(values, dtype=float)
-    return [None if not np.isfinite(v) else float(f"{v:.4g}") for v in a.ravel()] if a.ndim == 1 else \
-        [_short(row) for row in a]
-
-
-def figure_data(fields, pixels=JSON_PIXELS):
-    """What the two figures of the case in ``fields`` draw, JSON-ready and modest in size.
-
-    ``map``: the resolved pressure [Pa] binned on ``pixels x pixels`` squares over
-    ``[-extent, extent]^2``, at most ``pixels`` and about two lattice steps across (``image[i][j]``: row ``i`` along y; ``None`` where no node falls);
-    ``radius``, ``layer_radius``: the nominal radii [m]; ``profile``: the curves of
-    :func:`profile_curves`, each ``[x [m], p [Pa]]``; ``width``, ``wide`` [m]; 4 significant digits.
-    """
-    from validation.studies.two_scale_models import nominal_radius
-
-    res, lay, gt = _nodal(fields["resolved"]), _nodal(fields["layer"]), _nodal(fields["gt"])
-    extent = float(fields["extent"])
-    step = np.sqrt(4 * extent**2 / max(res[0].size, 1))  # about the node spacing: pixels of two steps or more
-    _, image = binned_map(*res, extent, pixels=int(min(pixels, max(8, extent / step))))
-    curves = profile_curves(res, lay, gt, width=fields["width"], wide=fields.get("wide"))
-    return dict(ratio=fields["ratio"], load_factor=fields["load_factor"], extent=extent,
-                width=float(fields["width"]), wide=fields.get("wide"), radius=nominal_radius(*res),
-                layer_radius=nominal_radius(*lay), map=_short(image),
-                profile={k: [_short(x), _short(p)] for k, (x, p) in curves.items()})
 
 
 def plot_two_scale_data(figure, out):

@@ -19,6 +19,7 @@ from pathlib import Path
 from bem.checks import InputError
 
 from ...io import atomic_directory, check_output_dir, output_errors, recover_output_dir
+from ...progress import Progress
 from ...provenance import report_footer
 from .content import Figure, Section
 from .html import render_html
@@ -44,26 +45,6 @@ class BuiltReport:
     markdown: Path
     figures: tuple
     notes: tuple = ()
-
-
-class Progress:
-    """The stages of a report build, told to ``callback(stage, done, total)``.
-
-    Calling the object with a stage name reports its start (``done``: the stages before
-    it); :meth:`done` reports the end (``"done", total, total``). Without a callback
-    nothing happens.
-    """
-
-    def __init__(self, stages, callback=None):
-        self.stages, self.callback = list(stages), callback
-
-    def __call__(self, stage):
-        if self.callback is not None:
-            self.callback(stage, self.stages.index(stage), len(self.stages))
-
-    def done(self):
-        if self.callback is not None:
-            self.callback("done", len(self.stages), len(self.stages))
 
 
 def draw_and_build(make_sections, out_dir, *, title, subtitle="", fmt="png", notify=None):

@@ -1,4 +1,5 @@
-"""The paper's test problem (section 6, Fig. 4-11) as scenes, run by the runner for the paper report.
+"""The paper's test problem (section 6, Fig. 4-11) as scenes, run by the runner: the study the paper
+report draws (:mod:`validation.report.documents.paper`).
 
 Every case is a built-in scene (``paper_smooth``, ``paper_linear``, ``paper_elastic_rigid``,
 ``paper_root``, ``paper_bilinear``: the problem and the paper's layer parameters, see
@@ -25,7 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["PaperRuns", "run_paper_problem", "SCENES", "SOLVE_STAGES", "AG_RELAXATION", "ALPHA_A_ITERATIONS"]
+__all__ = ["PaperRuns", "CaseRunner", "run_paper_problem", "SCENES", "SOLVE_STAGES", "AG_RELAXATION",
+           "ALPHA_A_ITERATIONS"]
 
 log = logging.getLogger(__name__)
 
@@ -130,7 +132,7 @@ class PaperRuns:
         return {k: (o.bem, o.fem) for k, o in self.validation.items()}
 
 
-class _Runner:
+class CaseRunner:
     """Runs the paper's cases on one lattice: ``run(case, **overrides)`` -> :class:`validation.run.RunOutcome`."""
 
     def __init__(self, nodes_per_radius):
@@ -145,23 +147,24 @@ class _Runner:
         self.a = hertz_sphere(smooth.gap.R, smooth.E_star, **smooth.load).contact_radius
         self.bem = {"step": self.a / nodes_per_radius, "extent": EXTENT * self.a, "rtol": RTOL}
 
-    def __call__(self, case, *, analytic=False, **changes):
-        """Run ``case``; ``section__key=value`` overrides a key, ``section=dict`` sets a whole section."""
+    def __call__(self, case, overrides=None, *, analytic=False, **sections):
+        """Run ``case`` with dotted-key ``overrides`` (``{"bem.method": "newton"}``, as a scene's
+        ``--set``: :func:`validation.scene.load.apply_overrides`); ``section=dict`` sets a whole section."""
         from validation.run import execute_scene
 
         raw = copy.deepcopy(self.raw[case])
         raw["bem"] = dict(self.bem)
         if not analytic:
             raw.pop("analytic", None)
-        raw.update({k: v for k, v in changes.items() if "__" not in k})
-        return execute_scene(raw, overrides={k.replace("__", "."): v for k, v in changes.items() if "__" in k})
+        raw.update(sections)
+        return execute_scene(raw, overrides=dict(overrides or {}))
 
 
 def _cases(run, res, quick):
     depths = {"stress": {"depths": list(STRESS_DEPTHS * run.a), "bodies": ["body1"]}}
     for case in SCENES:
         res.outcomes[case] = run(case, analytic=True, **depths)
-    res.outcomes["bilinear, variable compliance"] = run("bilinear", bem__method="variable_compliance")
+    res.outcomes["bilinear, variable compliance"] = run("bilinear", {"bem.method": "variable_compliance"})
     scales = res.outcomes["smooth"].result["scales"]
     res.p0, res.a, res.approach = scales["p_hertz"], scales["a_hertz"], scales["approach_hertz"]
 
@@ -169,7 +172,7 @@ def _cases(run, res, quick):
 def _sweeps(run, res, quick):
     alphas = (0.2, 0.5, 0.8) if quick else (0.05, *np.round(np.linspace(0.1, 0.9, 9), 2), 0.95)
     res.sweep_a = [(0.0, res.base["smooth"])] + [
-        (float(al), run("elastic-rigid", layer__alpha_a=float(al)).bem) for al in alphas] + [
+        (float(al), run("elastic-rigid", {"layer.alpha_a": float(al)}).bem) for al in alphas] + [
         (1.0, res.base["linear Winkler"])]
     lam_b = res.laws["root"].lam
     for f in (0.5, 2.0) if quick else (0.25, 0.5, 1.0, 2.0, 4.0):
@@ -177,7 +180,7 @@ def _sweeps(run, res, quick):
         res.sweep_b.append((f, r.p_max / res.p_lin, r))
     angles = (0.0, math.pi / 4, 1.3) if quick else (0.0, math.atan(0.1), math.atan(0.3), math.pi / 4, math.atan(3.0),
                                                    math.atan(10.0))
-    res.sweep_c = [(float(t), run("bilinear", layer__alpha_c=float(t)).bem) for t in angles]
+    res.sweep_c = [(float(t), run("bilinear", {"layer.alpha_c": float(t)}).bem) for t in angles]
 
 
 class _AugmentedGapWarnings(logging.Filter):
@@ -202,26 +205,26 @@ def _stability_runs():
 
 def _methods(run, res, quick):
     """Iteration histories (Fig. 6, 8, 10, 11) and the stability table."""
-    er = {"layer__alpha_a": ALPHA_A_ITERATIONS}
-    relaxed = {"bem__method": "augmented_gap", "bem__relaxation": AG_RELAXATION, "bem__maxiter": 400}
-    vc, newton = {"bem__method": "variable_compliance"}, {"bem__method": "newton", "bem__nested": False}
+    er, record = {"layer.alpha_a": ALPHA_A_ITERATIONS}, {"bem.record": True}
+    relaxed = {"bem.method": "augmented_gap", "bem.relaxation": AG_RELAXATION, "bem.maxiter": 400}
+    vc, newton = {"bem.method": "variable_compliance"}, {"bem.method": "newton", "bem.nested": False}
     it = res.iterations
-    it["elastic-rigid, variable compliance"] = run("elastic-rigid", bem__record=True, **er, **vc).bem
-    it["elastic-rigid, augmented gap"] = run("elastic-rigid", bem__record=True, **er, **relaxed).bem
-    it["elastic-rigid, Newton"] = run("elastic-rigid", bem__record=True, **er, **newton).bem
-    it["root, variable compliance"] = run("root", bem__record=True, **vc).bem
-    it["root, Newton"] = run("root", bem__record=True, **newton).bem
+    it["elastic-rigid, variable compliance"] = run("elastic-rigid", {**record, **er, **vc}).bem
+    it["elastic-rigid, augmented gap"] = run("elastic-rigid", {**record, **er, **relaxed}).bem
+    it["elastic-rigid, Newton"] = run("elastic-rigid", {**record, **er, **newton}).bem
+    it["root, variable compliance"] = run("root", {**record, **vc}).bem
+    it["root, Newton"] = run("root", {**record, **newton}).bem
     laws = [(f"elastic-rigid (alpha_a = {ALPHA_A_ITERATIONS})", "elastic-rigid", er), ("root", "root", {})]
     if not quick:
         alpha_c = res.outcomes["bilinear"].result["layer"]["alpha_c"]
         laws.append((f"bilinear (alpha_c = {alpha_c:.3f})", "bilinear", {}))
     methods = [("Newton", {}), ("variable compliance", vc), ("augmented gap, omega = 1 (paper)",
-                                                            {"bem__method": "augmented_gap"}),
+                                                            {"bem.method": "augmented_gap"}),
                (f"augmented gap, omega = {AG_RELAXATION}", relaxed)]
     for law, case, params in laws:
         for label, opts in methods:
             with _stability_runs():
-                r = run(case, **params, **opts).bem
+                r = run(case, {**params, **opts}).bem
             res.stability.append({"law": law, "method": label, "status": r.status, "iterations": r.iterations,
                                   "p_max/p0": r.p_max / res.p0, "kkt_residual": r.kkt_residual,
                                   "wall_time_s": r.wall_time_s, "message": r.message})
@@ -241,12 +244,12 @@ def _validation(run, res, quick):
     n_fem = 8 if quick else 24
     for case in ("smooth", "linear Winkler", "elastic-rigid", "root"):
         res.validation[case] = run(case, analytic=True, fem={"n_contact": n_fem})
-    res.work_precision += [_work_point(lambda: run("smooth", bem__step=res.a / m, bem__nested=True), "bem", res.p0,
-                                       solver="BEM", method="Kalker QP", resolution=f"a/c = {m}")
+    res.work_precision += [_work_point(lambda: run("smooth", {"bem.step": res.a / m, "bem.nested": True}), "bem",
+                                       res.p0, solver="BEM", method="Kalker QP", resolution=f"a/c = {m}")
                            for m in ((4, 8) if quick else (5, 10, 20, 40, 80))]
     # the BEM of these runs on a coarse lattice: only the FEM is timed
-    res.work_precision += [_work_point(lambda: run("smooth", bem__step=res.a / 4, fem={"n_contact": n}), "fem", res.p0,
-                                       solver="FEM", method="P2 axisymmetric", resolution=f"{n} el./a")
+    res.work_precision += [_work_point(lambda: run("smooth", {"bem.step": res.a / 4}, fem={"n_contact": n}), "fem",
+                                       res.p0, solver="FEM", method="P2 axisymmetric", resolution=f"{n} el./a")
                            for n in ((4, 8) if quick else (8, 16, 32))]
 
 
@@ -260,22 +263,28 @@ def run_paper_problem(*, quick=False, fem=True, progress=None):
         sweep values (seconds instead of minutes).
     fem : bool
         Also run the FEM reference and the resolution study.
-    progress : callable, optional
-        ``progress(stage)`` at the start of each stage of :data:`SOLVE_STAGES` (the FEM stage
-        only with ``fem``).
+    progress : callable or validation.progress.Progress, optional
+        ``progress(label, done, total)`` (:mod:`validation.progress`) at the start of each stage of
+        :data:`SOLVE_STAGES` (the FEM stage only with ``fem``) and at the end (``"done"``); a
+        :class:`~validation.progress.Progress` of a caller's job that holds these stages is told them
+        and not the end.
 
     Returns
     -------
     PaperRuns
     """
-    notify = progress or (lambda stage: None)
+    from ..progress import stages_of
+
+    notify = stages_of(progress, [s for s in SOLVE_STAGES if fem or s != SOLVE_STAGES[3]])
     t0 = time.perf_counter()
     n = 8 if quick else 20
-    run, res = _Runner(n), PaperRuns(quick=quick, nodes_per_radius=n)
+    run, res = CaseRunner(n), PaperRuns(quick=quick, nodes_per_radius=n)
     for stage, step in zip(SOLVE_STAGES, (_cases, _sweeps, _methods, _validation)):
         if stage != SOLVE_STAGES[3] or fem:
             notify(stage)
             step(run, res, quick)
+    if notify is not progress:
+        notify.done()
     res.wall_time_s = time.perf_counter() - t0
     log.info("paper problem run in %.1f s", res.wall_time_s)
     return res
