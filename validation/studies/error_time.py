@@ -3,7 +3,7 @@
 Each problem (:data:`validation.studies.problems.ERROR_TIME_PROBLEMS`: ``"hertz"``,
 ``"paper-root"``) runs with every applicable solver on a ladder of resolutions: the BEM at
 ``bem.nodes_across`` steps across the expected contact diameter (10, 20, 40, 80, 160; a method
-stops climbing after a run longer than ``time_budget_s``), the FEM at ``fem.n_contact`` elements
+stops climbing after a run longer than ``time_budget_s``), the FEM at ``fem.n_contact_elements`` elements
 across the contact radius (4, 8, 16, 32). The errors, at the solver's own nodes
 (:func:`validation.compare.pair_metrics`), are ``error_l2`` (relative L2 error of the pressure
 over the contact) and ``error_peak`` (``|p_max / p_max,ref - 1|``) against the run's closed form
@@ -193,7 +193,7 @@ def _climb(study, problem, method, ladder, reference, opts):
     for i, n in enumerate(ladder):
         for omega in relaxations:
             if part == "fem":
-                over = {"fem.n_contact": n, "bem.nodes_across": opts["coarsest"]}
+                over = {"fem.n_contact_elements": n, "bem.nodes_across": opts["coarsest"]}
             else:
                 over = {"bem.nodes_across": n, "bem.method": method}
                 over.update({} if omega is None else {"bem.relaxation": omega})
