@@ -256,8 +256,8 @@ def test_a_failed_run_logs_one_warning(caplog):
 # --- one meaning per name: a solver's displacement is C p, whatever the layer ---------------------
 
 @pytest.mark.parametrize("lam", [0.0, 0.3, "per node"])
-def test_the_qp_displacement_is_the_elastic_closure(lam):
-    """QPSolution.displacement = C p, the elastic closure, whatever the layer (as for Newton)."""
+def test_the_qp_displacement_is_the_elastic_displacement(lam):
+    """QPSolution.displacement = C p, the elastic displacement, whatever the layer (as for Newton)."""
     from bem.kalker import solve_qp
 
     lattice = bem.Lattice.from_extent(0.1, 1.2)

@@ -30,7 +30,7 @@ from bem.files import write_text
 from ..run import execute_scene
 from ..scene import load_scene
 
-__all__ = ["attempt", "timed", "classify", "finite", "save", "write_json", "fmt", "STATUSES"]
+__all__ = ["attempt", "timed", "classify", "finite", "save", "write_json", "STATUSES"]
 
 #: status of an outcome (:func:`classify`)
 STATUSES = ("converged", "reported failure", "wrong")
@@ -111,12 +111,3 @@ def save(args, stem, data):
     return text
 
 
-def fmt(value, spec=".2e"):
-    """A table cell: ``-`` for ``None``, ``yes``/``no`` for booleans, numbers with ``spec``."""
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, float):
-        return format(value, spec) if math.isfinite(value) else str(value)
-    return str(value)

@@ -26,7 +26,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..scene import load_scene
-from . import attempt, classify, finite, fmt, save
+from ..labels import fmt
+from . import attempt, classify, finite, save
 from .problems import robustness_scene
 
 __all__ = ["RobustnessRow", "run_robustness", "summary_table", "matrix_table", "failure_table",

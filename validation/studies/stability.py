@@ -31,7 +31,8 @@ from dataclasses import asdict, dataclass, field
 from bem.reference import hertz_sphere
 
 from ..compare import pair_metrics
-from . import STATUSES, attempt, classify, finite, fmt, save
+from ..labels import fmt
+from . import STATUSES, attempt, classify, finite, save
 from .problems import LIMIT_TOL, methods, stability_cases
 
 __all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main",
@@ -48,8 +49,8 @@ class StabilityFailure(RuntimeError):
 
     def __init__(self, rows, study=None):
         self.rows, self.study = list(rows), study
-        lines = [f"{r.case} / {r.solver} {r.method}: error {fmt(r.error_vs_reference)} > tol {fmt(r.tolerance)} "
-                 f"({r.message})" for r in self.rows]
+        lines = [f"{r.case} / {r.solver} {r.method}: error {fmt(r.error_vs_reference, '.2e')} > "
+                 f"tol {fmt(r.tolerance, '.2e')} ({r.message})" for r in self.rows]
         super().__init__(f"{len(self.rows)} wrong outcome(s) in the stability study:\n  " + "\n  ".join(lines))
 
 

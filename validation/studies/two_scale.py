@@ -34,7 +34,8 @@ import time
 
 import numpy as np
 
-from . import fmt, save
+from ..labels import fmt
+from . import save
 from .two_scale_models import (TiledRoughness, greenwood_tripp_law, nominal_radius, spectral_moments,
                                windowed)
 
