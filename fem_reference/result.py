@@ -193,7 +193,8 @@ class FemResult:
         return {
             "p_max": float(self.p_max), "force": float(self.force), "approach": float(self.approach),
             "edge_radius": float(self.edge_radius), "converged": bool(self.converged),
-            "status": self.status, "message": self.message, "iterations": int(self.iterations), "n_dofs": int(self.n_dofs),
+            "status": self.status, "message": self.message, "iterations": int(self.iterations),
+            "n_dofs": int(self.n_dofs),
             "n_elements": int(self.n_elements),
             "n_elements_across_contact": float(self.n_elements_across_contact),
             "timings": {k: float(v) for k, v in self.timings.items()},

@@ -108,8 +108,8 @@ def _one_mesh(amesh, gap, materials, E_star, layer, penalty, force, approach, tr
 
 
 def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est=None,
-          n_contact_elements=24, domain_factor=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5, truncation_correction=True,
-          remesh=True, rtol=1e-9, maxiter=60):
+          n_contact_elements=24, domain_factor=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5,
+          truncation_correction=True, remesh=True, rtol=1e-9, maxiter=60):
     """Axisymmetric FEM reference solution of the layered contact of two elastic bodies.
 
     Body 1 (``E1, nu1``) is the upper body ``z >= 0``, body 2 the lower one; the interface

@@ -107,7 +107,8 @@ def test_gmsh_finalized_on_error(monkeypatch):
 
 @pytest.mark.parametrize("kwargs, name", [
     ({"a_est": -1.0}, "a_est"), ({"a_est": 1.0, "n_contact_elements": 1}, "n_contact_elements"),
-    ({"a_est": 1.0, "n_contact_elements": 4.5}, "n_contact_elements"), ({"a_est": 1.0, "domain_factor": 2.0}, "domain_factor"),
+    ({"a_est": 1.0, "n_contact_elements": 4.5}, "n_contact_elements"),
+    ({"a_est": 1.0, "domain_factor": 2.0}, "domain_factor"),
     ({"a_est": float("nan")}, "a_est"), ({"a_est": 1.0, "growth": 0.0}, "growth"),
 ])
 def test_bad_mesh_input(kwargs, name):

@@ -273,7 +273,8 @@ def test_check_lists_misspelled_keys_with_the_other_errors_and_suggests_the_key(
     lines = err.strip().splitlines()
     assert code == 2 and out == ""
     expected = {"bodies.nu1": "", "load.force": "", "bem.nodes_acros": "Did you mean 'nodes_across'?",
-                "bem.extent_factr": "Did you mean 'extent_factor'?", "fem.n_contct": "Did you mean 'n_contact_elements'?",
+                "bem.extent_factr": "Did you mean 'extent_factor'?",
+                "fem.n_contct": "Did you mean 'n_contact_elements'?",
                 "stress.depht": "Did you mean 'depths'?", "reprot": "Did you mean 'report'?"}
     assert sorted(line.split()[2] for line in lines) == sorted(expected)
     for line in lines:

@@ -245,8 +245,8 @@ def _validation(run, res, quick):
                                        solver="BEM", method="Kalker QP", resolution=f"a/c = {m}")
                            for m in ((4, 8) if quick else (5, 10, 20, 40, 80))]
     # the BEM of these runs on a coarse lattice: only the FEM is timed
-    res.work_precision += [_work_point(lambda: run("smooth", bem__step=res.a / 4, fem={"n_contact_elements": n}), "fem", res.p0,
-                                       solver="FEM", method="P2 axisymmetric", resolution=f"{n} el./a")
+    res.work_precision += [_work_point(lambda: run("smooth", bem__step=res.a / 4, fem={"n_contact_elements": n}),
+                                       "fem", res.p0, solver="FEM", method="P2 axisymmetric", resolution=f"{n} el./a")
                            for n in ((4, 8) if quick else (8, 16, 32))]
 
 
