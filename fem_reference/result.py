@@ -30,8 +30,8 @@ def axis_pressure(r, p):
 def edge_radius(r, p, g, *, smooth):
     """Radius of the edge of the loaded zone ``p > 0``, interpolated between the nodes [length].
 
-    Not the area-equivalent radius ``sqrt(A / pi)`` of :attr:`bem.ContactResult.contact_radius`:
-    a comparison of the two names both estimators.
+    Not the area-equivalent radius ``sqrt(A / pi)`` of ``bem.ContactResult.contact_radius``:
+    the two are different estimators of the size of the contact.
 
     Definition: let ``k`` be the outermost interface node with ``p_k > 0``; the edge lies in
     ``[r_k, r_{k+1}]``:

@@ -40,10 +40,10 @@ def status_class(status):
 
 
 def fmt_distinct(values, digits=4, most=9):
-    """Cells of values compared side by side (one row of solvers): :func:`validation.labels.fmt` with the fewest
-    significant digits, from ``digits`` up to ``most``, at which values that differ print
-    differently (``1.3713e+09`` and ``1.3708e+09``, not ``1.371e+09`` twice); not numbers
-    and ``None`` as :func:`validation.labels.fmt`."""
+    """Cells of values compared side by side (one row of solvers): :func:`validation.labels.fmt`
+    with the fewest significant digits, from ``digits`` up to ``most``, at which values that
+    differ print differently (``1.3713e+09`` and ``1.3708e+09``, not ``1.371e+09`` twice); not
+    numbers and ``None`` as :func:`validation.labels.fmt`."""
     numbers = sorted({float(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool)
                       and math.isfinite(v)})
     for n in range(digits, most + 1):
