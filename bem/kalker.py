@@ -30,7 +30,7 @@ _RECOMPUTE_EVERY = 20  # exact C p every so many incremental updates
 class QPSolution:
     """Outcome of :func:`solve_qp` and of every solver built on it (brick arrays on the operator's lattice).
 
-    ``displacement`` is the elastic closure ``C p`` [length], the same for every solver (the
+    ``displacement`` is the elastic displacement ``C p`` [length], the same for every solver (the
     layer's closure ``lam p`` or ``w(p)`` is not in it); ``None`` where a solver did not keep it.
     The arrays are in the namespace of the operator's device.
     """

@@ -29,7 +29,7 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
     gap : ndarray
         Deformed gap ``(C p + w(p) + h - delta)`` at the same nodes [length].
     displacement_scale : float
-        Scale of the gap [length]: the largest total surface closure
+        Scale of the gap [length]: the largest elastic displacement plus layer closure
         ``max |C p + w(p)|``.
     force : float, optional
         Target force [force] under force control; then the force balance
@@ -73,7 +73,7 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None):
     op : bem.operator.InfluenceOperator
         Supplies the lattice (node area, candidate mask).
     h, p, u : ndarray
-        Gap [length], pressure [pressure] and elastic closure ``C p`` [length]
+        Initial gap [length], pressure [pressure] and elastic displacement ``C p`` [length]
         as brick arrays.
     layer : bem.layers.Layer or None
         Interface law ``w(p)``.

@@ -28,7 +28,8 @@ class ContactResult:
     p : ndarray, shape (N,)
         Nodal pressures [pressure] (pyramid amplitudes).
     displacement : ndarray, shape (N,)
-        Elastic closure ``(C p)_n`` of the two half-spaces [length].
+        Elastic displacement ``(C p)_n`` [length]: the normal surface displacements of the
+        two half-spaces, summed (the layer's closure is not in it).
     closure : ndarray, shape (N,)
         Layer closure ``w(p_n)`` [length] (zeros without a layer).
     gap : ndarray, shape (N,)

@@ -89,7 +89,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     rtol : float
         Tolerance on the KKT residual ``r`` (:func:`bem.kkt.kkt_residual`) of the
         returned state, the same for every method: ``converged`` means ``r <= rtol``.
-        ``r`` is relative (gap violations over the largest surface closure, force balance
+        ``r`` is relative (gap violations over the largest ``|C p + w(p)|``, force balance
         over ``P``), so ``rtol`` lies in ``(0, 1e-2]`` (:data:`bem.checks.RTOL_MAX`).
     maxiter : int, optional
         Iteration limit of the solver that runs (CG iterations of the QP, Newton steps,

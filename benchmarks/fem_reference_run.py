@@ -30,14 +30,14 @@ def report(label, res, exact=None):
     print(f"  time [s]: mesh={t['mesh']:.2f} assembly={t['assembly']:.2f} solve={t['solve']:.2f} "
           f"(factorize={t['factorize']:.2f} compliance={t['compliance']:.2f} newton={t['newton']:.3f} "
           f"recover={t['recover']:.3f}) total={t['total']:.2f}")
-    print(f"  p_max={res.p_max:.2f} MPa  a={res.contact_radius:.5f} mm  delta={res.approach:.6f} mm  "
+    print(f"  p_max={res.p_max:.2f} MPa  a={res.edge_radius:.5f} mm  delta={res.approach:.6f} mm  "
           f"force={res.force:.4f} N (reactions {res.force_reaction:.4f} N)")
     print(f"  penalty: factor={res.penalty['factor']:.0e}, relative penetration="
           f"{res.penalty['relative_penetration']:.1e}; truncation correction dc*P="
           f"{res.truncation['correction']:.3e} mm ({res.truncation['correction'] / res.approach:.2%} of delta)")
     if exact is not None:
         a, p0, delta = exact
-        print(f"  vs Hertz: p_max {res.p_max / p0 - 1:+.3%}, a {res.contact_radius / a - 1:+.3%}, "
+        print(f"  vs Hertz: p_max {res.p_max / p0 - 1:+.3%}, a {res.edge_radius / a - 1:+.3%}, "
               f"delta {res.approach / delta - 1:+.3%}")
 
 

@@ -1,6 +1,6 @@
 """The interface traction law of the FEM: the layer law as a penalty, regularised for Newton.
 
-The closure of an interface node pair is (docs/method.md section 1, eq. 14)::
+The overlap of an interface node pair is (docs/method.md section 1, eq. 14)::
 
     g = delta - h(r) - d,     d = u_z^upper - u_z^lower + delta_far   (elastic part)
 
@@ -12,7 +12,7 @@ that is left after the elastic deformation: ``g = w(p)`` in contact. The tractio
 - where ``w'(p) = inf`` (root / power ``s < 1`` at ``p = 0``) the tangent is 0;
 - where ``w'(p) = 0`` or ``1/w'(p)`` exceeds ``k_pen`` (power ``s > 1`` near ``p = 0``) it is
   capped at ``k_pen``: only the Newton matrix changes, not the equations;
-- a rigid branch (``inverse = inf`` beyond the closure ``g_lim`` the law can reach) is
+- a rigid branch (``inverse = inf`` beyond the overlap ``g_lim`` the law can reach) is
   continued by the penalty ``p = p_lim + k_pen (g - g_lim)``.
 
 Without a layer (smooth bodies) the law is the pure penalty ``p = k_pen max(g, 0)``, i.e.
@@ -53,7 +53,7 @@ class InterfaceLaw:
 
     # -- rigid branch -----------------------------------------------------------------
     def _rigid_limit(self, g_inf):
-        """``(g_lim, p_lim, Psi_lim)``: largest closure with a finite inverse, by bisection."""
+        """``(g_lim, p_lim, Psi_lim)``: largest overlap with a finite inverse, by bisection."""
         if self._rigid is None:
             lo, hi = 0.0, float(g_inf)
             for _ in range(_BISECTIONS):
@@ -82,7 +82,7 @@ class InterfaceLaw:
 
     # -- public -----------------------------------------------------------------------
     def pressure(self, g):
-        """Traction ``p(g) >= 0`` [pressure] at closures ``g`` [length]."""
+        """Traction ``p(g) >= 0`` [pressure] at overlaps ``g`` [length]."""
         g = np.asarray(g, dtype=float)
         if self.layer is None:
             return self.k_pen * np.maximum(g, 0.0)

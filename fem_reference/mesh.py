@@ -16,7 +16,7 @@ so the two sides of the interface get the same 1-D mesh; the nodes on it are
 then duplicated (each body gets its own copy), which makes two separate bodies
 with MATCHING interface nodes. Elements are quadratic triangles (gmsh order 2,
 6 nodes, straight edges: the mid-edge nodes are the edge midpoints), graded
-from ``a_est / n_contact`` in the contact zone to coarse far away by a
+from ``a_est / n_contact_elements`` in the contact zone to coarse far away by a
 Distance/Threshold size field around the first point of contact (r, z) = (0, 0).
 
 gmsh physical groups: surfaces ``upper``, ``lower``; curves ``interface``,
@@ -76,8 +76,8 @@ class AxiMesh:
     a_est : float
         Contact radius the sizes were set from [length].
     h_fine : float
-        Element size in the contact zone, ``a_est / n_contact`` [length].
-    n_contact : int
+        Element size in the contact zone, ``a_est / n_contact_elements`` [length].
+    n_contact_elements : int
         Elements across ``a_est``.
     radius, depth : float
         Domain width ``R`` and depth ``H`` of each body [length].
@@ -95,7 +95,7 @@ class AxiMesh:
     cells6: np.ndarray
     a_est: float
     h_fine: float
-    n_contact: int
+    n_contact_elements: int
     radius: float
     depth: float
     fine_radius: float
@@ -242,17 +242,17 @@ def _to_skfem(xy, parts):
     return mesh, body, np.hstack(n6_blocks), np.hstack(c6_blocks)
 
 
-def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None):
+def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None):
     """Mesh the two bodies with gmsh and convert the mesh to scikit-fem.
 
     Parameters
     ----------
     a_est : float
         Expected contact radius [length] (see :func:`bem.reference.estimate_contact_radius`).
-    n_contact : int
-        Elements across ``a_est`` in the contact zone: ``h_fine = a_est / n_contact``.
-    extent_factor : float
-        Domain width and depth of each body in units of ``a_est``: ``R = H = extent_factor a_est``.
+    n_contact_elements : int
+        Elements across ``a_est`` in the contact zone: ``h_fine = a_est / n_contact_elements``.
+    domain_factor : float
+        Domain width and depth of each body in units of ``a_est``: ``R = H = domain_factor a_est``.
     fine_radius : float
         Radius of the uniformly fine zone in units of ``a_est``.
     growth : float
@@ -266,15 +266,15 @@ def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, grow
     """
     t0 = time.perf_counter()
     a_est = check_positive("a_est", a_est)
-    n_contact = check_int("n_contact", n_contact, minimum=2)
-    extent_factor = check_positive("extent_factor", extent_factor)
+    n_contact_elements = check_int("n_contact_elements", n_contact_elements, minimum=2)
+    domain_factor = check_positive("domain_factor", domain_factor)
     fine_radius = check_positive("fine_radius", fine_radius)
     growth = check_positive("growth", growth)
-    if extent_factor < 4.0 * fine_radius:
-        raise InputError(f"extent_factor = {extent_factor!r} is not allowed: it must be >= 4 * fine_radius = "
+    if domain_factor < 4.0 * fine_radius:
+        raise InputError(f"domain_factor = {domain_factor!r} is not allowed: it must be >= 4 * fine_radius = "
                          f"{4 * fine_radius!r}.")
-    R = H = extent_factor * a_est
-    h_fine = a_est / int(n_contact)
+    R = H = domain_factor * a_est
+    h_fine = a_est / int(n_contact_elements)
     h_coarse = R / 8.0 if h_coarse is None else check_positive("h_coarse", h_coarse)
     h_coarse = max(h_coarse, h_fine)
 
@@ -295,6 +295,6 @@ def build_mesh(a_est, *, n_contact=16, extent_factor=40.0, fine_radius=1.5, grow
     elapsed = time.perf_counter() - t0
     log.info("mesh: %d triangles, h_fine = %.3g, R = H = %.3g (%.2f s)", body.size, h_fine, R, elapsed)
     return AxiMesh(mesh=mesh, body=body, nodes6=nodes6, cells6=cells6, a_est=a_est, h_fine=h_fine,
-                   n_contact=int(n_contact), radius=R, depth=H, fine_radius=fine_radius * a_est,
+                   n_contact_elements=int(n_contact_elements), radius=R, depth=H, fine_radius=fine_radius * a_est,
                    h_coarse=h_coarse, mesh_time_s=elapsed,
                    physical_groups={k: v[0] for k, v in groups.items()})

@@ -1,15 +1,15 @@
 """Newton's method for the condensed interface problem (approach or force control).
 
-After static condensation (:mod:`fem_reference.model`) the unknowns are the closures
+After static condensation (:mod:`fem_reference.model`) the unknowns are the overlaps
 ``g`` of the ``n`` interface node pairs (and the approach ``delta`` under force
 control). With the interface compliance ``C`` [length/force], the lumped ring areas
-``A`` [length^2] and the gap ``h`` at the nodes, equilibrium of the penalised FEM
+``A`` [length^2] and the initial gap ``h`` at the nodes, equilibrium of the penalised FEM
 model reads::
 
     F1(g, delta) = g + C (A * p(g)) + h - delta = 0        [length]
     F2(g)        = sum(A * p(g)) - P = 0                    [force]   (force control)
 
-(the elastic part of the closure ``d = delta - h - g`` equals ``C f`` with the nodal
+(the elastic part of the approach ``d = delta - h - g`` equals ``C f`` with the nodal
 forces ``f = A p``). They are the stationarity conditions of the convex functional::
 
     Pi(g, delta) = 1/2 d^T C^{-1} d + sum(A * Psi(g)) - P delta
@@ -49,7 +49,7 @@ class InterfaceSolution:
     Attributes
     ----------
     g, p : ndarray, shape (n,)
-        Closures [length] and pressures [pressure] at the interface pairs.
+        Overlaps [length] and pressures [pressure] at the interface pairs.
     delta : float
         Approach [length] (the ``delta`` of ``C``'s frame; see :func:`solve_interface`).
     converged : bool
@@ -62,7 +62,7 @@ class InterfaceSolution:
         Newton steps taken.
     history : dict
         Per-iteration ``residual`` (``max|F1| / scale``), ``force_residual``, ``step`` (line
-        search factor) and ``n_contact``.
+        search factor) and ``n_contact`` (node pairs with ``g > 0``).
     """
 
     g: np.ndarray
@@ -94,7 +94,7 @@ def solve_interface(C, A, h, law, *, force=None, approach=None, delta0=None, g0=
     delta0 : float, optional
         Starting approach under force control [length].
     g0 : ndarray, optional
-        Starting closures; default ``max(delta0 - h, 0)`` (rigid bodies).
+        Starting overlaps [length]; default ``max(delta0 - h, 0)`` (rigid bodies).
     rtol : float
         Relative tolerance of the stopping rule (module docstring).
     maxiter : int

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["FemResult", "STATUSES", "axis_pressure", "contact_radius"]
+__all__ = ["FemResult", "STATUSES", "axis_pressure", "edge_radius"]
 
 #: The outcomes the FEM reference reports in ``status``: the stopping rule was met
 #: (``"converged"``), the Newton budget ran out (``"maxiter"``), the line search found no
@@ -20,20 +20,23 @@ def axis_pressure(r, p):
     """Pressure at the axis node from the next two nodes, ``p(r) ~ p0 + c r^2`` [pressure].
 
     The ring area of the axis node is 0 in the r-weighted lumped rule, so that node carries
-    no force and its own closure is not constrained; the pressure there is the even
+    no force and its own overlap is not constrained; the pressure there is the even
     (``p(-r) = p(r)``) quadratic through the next two nodes.
     """
     r1, r2 = r[1] ** 2, r[2] ** 2
     return max((r2 * p[1] - r1 * p[2]) / (r2 - r1), 0.0)
 
 
-def contact_radius(r, p, g, *, smooth):
-    """Radius of the edge of the loaded zone ``p > 0`` [length].
+def edge_radius(r, p, g, *, smooth):
+    """Radius of the edge of the loaded zone ``p > 0``, interpolated between the nodes [length].
+
+    Not the area-equivalent radius ``sqrt(A / pi)`` of ``bem.ContactResult.contact_radius``:
+    the two are different estimators of the size of the contact.
 
     Definition: let ``k`` be the outermost interface node with ``p_k > 0``; the edge lies in
     ``[r_k, r_{k+1}]``:
 
-    - with a layer, the closure ``g`` crosses zero linearly there (``p = w^{-1}(g)`` and ``g``
+    - with a layer, the overlap ``g`` crosses zero linearly there (``p = w^{-1}(g)`` and ``g``
       is smooth across the edge): ``r_k + (r_{k+1} - r_k) g_k / (g_k - g_{k+1})``;
     - smooth bodies (penalty only): ``g`` inside is just the penalty penetration, while the
       pressure has Hertz's square-root edge, so ``p^2`` is extrapolated linearly from the
@@ -70,9 +73,10 @@ class FemResult:
         Radii of the interface node pairs, increasing [length].
     p : ndarray, shape (n,)
         Contact pressure at those nodes [pressure] (axis node: :func:`axis_pressure`).
-    closure : ndarray, shape (n,)
-        Closure ``g = delta - h - d`` (``w(p)`` in contact, ``< 0`` open) [length].
-    gap : ndarray, shape (n,)
+    overlap : ndarray, shape (n,)
+        Overlap ``g = delta - h - d`` of the node pairs [length]: the layer closure ``w(p)``
+        in contact, minus the deformed gap where open (``< 0``).
+    initial_gap : ndarray, shape (n,)
         Initial gap ``h(r, 0)`` at the nodes [length].
     approach : float
         Half-space approach ``delta`` [length] (truncation-corrected, see ``truncation``).
@@ -82,8 +86,9 @@ class FemResult:
         Force from the reactions of the top boundary, ``-sum (K u)_top,z`` [force].
     p_max : float
         Largest nodal pressure [pressure].
-    contact_radius : float
-        Edge of the loaded zone [length], see :func:`contact_radius`.
+    edge_radius : float
+        Edge of the loaded zone, interpolated between the nodes [length], see
+        :func:`edge_radius`.
     converged : bool
         Whether Newton's stopping rule was met (and the contact stays inside the domain):
         ``status == "converged"``.
@@ -105,33 +110,39 @@ class FemResult:
     n_interface_nodes : int
         Interface node pairs.
     n_elements_across_contact : float
-        Interface elements between the axis and ``contact_radius``.
+        Interface elements between the axis and ``edge_radius``.
     penalty : dict
         ``factor`` (``k_pen a_est / E*``), ``stiffness`` ``k_pen`` [pressure/length],
-        ``max_penetration`` (largest closure beyond what the layer law itself allows: the
-        whole closure without a layer, the part past a rigid branch with one) [length],
+        ``max_penetration`` (largest overlap beyond what the layer law itself allows: the
+        whole overlap without a layer, the part past a rigid branch with one) [length],
         ``relative_penetration`` (that over ``approach``).
     truncation : dict
         ``compliance`` ``dc`` [length/force], ``approach_far`` (the top displacement
         ``delta_far = delta - dc P``) [length], ``correction`` (``dc P``) [length],
         ``applied`` (bool), ``radius``, ``depth`` [length].
     mesh : dict
-        ``a_est``, ``h_fine``, ``n_contact``, ``extent_factor``, ``remeshed``.
+        ``a_est`` [length], ``h_fine`` [length], ``n_contact_elements`` (elements across
+        ``a_est``), ``domain_factor`` (domain radius over ``a_est``), ``remeshed`` (bool).
     history : dict
         Newton history (last mesh).
     E_star : float
         Effective modulus [pressure].
+    model : fem_reference.model.AxiModel
+        The assembled model of the last mesh.
+    displacement_dofs : ndarray
+        Displacement degrees of freedom of both bodies, the finite-element solution vector
+        [length] (not the BEM's ``displacement``, the normal elastic displacement at the nodes).
     """
 
     r: np.ndarray
     p: np.ndarray
-    closure: np.ndarray
-    gap: np.ndarray
+    overlap: np.ndarray
+    initial_gap: np.ndarray
     approach: float
     force: float
     force_reaction: float
     p_max: float
-    contact_radius: float
+    edge_radius: float
     converged: bool
     message: str
     iterations: int
@@ -146,7 +157,7 @@ class FemResult:
     E_star: float
     history: dict = field(default_factory=dict)
     model: object = field(default=None, repr=False)
-    displacement: np.ndarray = field(default=None, repr=False)
+    displacement_dofs: np.ndarray = field(default=None, repr=False)
     status: str = ""
 
     def __post_init__(self):
@@ -175,14 +186,15 @@ class FemResult:
         """
         from .fields import field_mesh
 
-        return field_mesh(self.model, self.displacement, self.p)
+        return field_mesh(self.model, self.displacement_dofs, self.p)
 
     def summary(self):
         """Scalars as a JSON-ready dict."""
         return {
             "p_max": float(self.p_max), "force": float(self.force), "approach": float(self.approach),
-            "contact_radius": float(self.contact_radius), "converged": bool(self.converged),
-            "status": self.status, "message": self.message, "iterations": int(self.iterations), "n_dofs": int(self.n_dofs),
+            "edge_radius": float(self.edge_radius), "converged": bool(self.converged),
+            "status": self.status, "message": self.message, "iterations": int(self.iterations),
+            "n_dofs": int(self.n_dofs),
             "n_elements": int(self.n_elements),
             "n_elements_across_contact": float(self.n_elements_across_contact),
             "timings": {k: float(v) for k, v in self.timings.items()},

@@ -1,6 +1,6 @@
 """The public entry point :func:`solve` of the axisymmetric FEM reference.
 
-Truncation of the half-spaces. The FEM bodies are finite (``R = H = extent_factor a_est``)
+Truncation of the half-spaces. The FEM bodies are finite (``R = H = domain_factor a_est``)
 and supported far away, so they are stiffer than half-spaces: the displacement of the
 top relative to the bottom (``delta_far``) is smaller than the half-space approach
 ``delta`` (the displacement of the contact relative to points at infinity) by a term
@@ -12,12 +12,12 @@ the centre displacement under a smooth reference load against its closed-form
 half-space value), and the interface compliance used by Newton is
 ``C + dc 1 1^T``: ``delta`` is then the half-space approach the BEM computes, and
 the top is moved by ``delta_far = delta - dc P``. Measured (Hertz, 16 elements
-across ``a``): the raw ``delta_far`` is 2.8 % (``extent_factor = 15``) and 1.04 % (``extent_factor = 40``)
+across ``a``): the raw ``delta_far`` is 2.8 % (``domain_factor = 15``) and 1.04 % (``domain_factor = 40``)
 below Hertz's approach, i.e. ``~0.42 a / R``; the corrected ``delta`` is within 0.003 % and
 0.012 %. Under force control the correction only shifts ``delta`` (the pressure is
 identical); under approach control without it the force would come out ~1.5 % high
 (``P ~ delta^(3/2)``). The truncation changes the peak pressure by < 1e-4
-(extent_factor 15 vs 40).
+(domain_factor 15 vs 40).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from .interface import InterfaceLaw
 from .mesh import AxiMesh, build_mesh
 from .model import AxiModel, check_materials
 from .newton import solve_interface
-from .result import FemResult, axis_pressure, contact_radius
+from .result import FemResult, axis_pressure, edge_radius
 
 __all__ = ["solve"]
 
@@ -85,9 +85,9 @@ def _one_mesh(amesh, gap, materials, E_star, layer, penalty, force, approach, tr
     return model, sol, h, law, dc, timings
 
 
-def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est=None, n_contact=24,
-          extent_factor=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5, truncation_correction=True,
-          remesh=True, rtol=1e-9, maxiter=60):
+def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est=None,
+          n_contact_elements=24, domain_factor=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5,
+          truncation_correction=True, remesh=True, rtol=1e-9, maxiter=60):
     """Axisymmetric FEM reference solution of the layered contact of two elastic bodies.
 
     Body 1 (``E1, nu1``) is the upper body ``z >= 0``, body 2 the lower one; the interface
@@ -108,7 +108,7 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     a_est : float, optional
         Expected contact radius [length] that sizes the mesh; default
         :func:`bem.reference.estimate_contact_radius`.
-    n_contact, extent_factor, fine_radius, growth : optional
+    n_contact_elements, domain_factor, fine_radius, growth : optional
         Mesh options of :func:`fem_reference.build_mesh` (elements across ``a_est``, domain
         size and fine-zone radius in units of ``a_est``, size grading).
     mesh : fem_reference.mesh.AxiMesh, optional
@@ -158,8 +158,8 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     remeshed, mesh_time = False, 0.0
     for attempt in range(2):
         if mesh is None or remeshed:
-            amesh = build_mesh(a_est, n_contact=n_contact, extent_factor=extent_factor, fine_radius=fine_radius,
-                               growth=growth)
+            amesh = build_mesh(a_est, n_contact_elements=n_contact_elements, domain_factor=domain_factor,
+                               fine_radius=fine_radius, growth=growth)
         else:
             amesh = mesh
         mesh_time += amesh.mesh_time_s if (mesh is None or remeshed) else 0.0
@@ -168,7 +168,7 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
             truncation_correction, rtol, maxiter)
         p = sol.p.copy()
         p[0] = axis_pressure(model.r, p)
-        a_c = contact_radius(model.r, p, sol.g, smooth=layer is None)
+        a_c = edge_radius(model.r, p, sol.g, smooth=layer is None)
         if (attempt == 0 and remesh and mesh is None and sol.converged
                 and not (_LOW * a_est <= a_c <= _HIGH * a_est) and a_c > 0):
             log.info("contact radius %.4g is outside [%.2f, %.2f] a_est (a_est = %.4g): re-meshing",
@@ -192,8 +192,8 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     converged, message, status = sol.converged, sol.message, sol.status
     if p[-1] > 0:
         converged, status = False, "boundary"
-        message = "the contact reaches the outer boundary r = R: increase extent_factor"
-    g = sol.g[A > 0]  # the axis node (ring area 0) carries no force: its closure is free
+        message = "the contact reaches the outer boundary r = R: increase domain_factor"
+    g = sol.g[A > 0]  # the axis node (ring area 0) carries no force: its overlap is free
     if layer is None:
         penetration = float(max(g.max(), 0.0))
     elif law.rigid_limit() is not None:
@@ -206,8 +206,8 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
     timings.pop("model_total")
     timings["total"] = time.perf_counter() - t_start
     result = FemResult(
-        r=model.r.copy(), p=p, closure=sol.g.copy(), gap=h, approach=float(sol.delta), force=force,
-        force_reaction=reaction, p_max=float(p.max()), contact_radius=a_c, converged=converged,
+        r=model.r.copy(), p=p, overlap=sol.g.copy(), initial_gap=h, approach=float(sol.delta), force=force,
+        force_reaction=reaction, p_max=float(p.max()), edge_radius=a_c, converged=converged,
         message=message, status=status, iterations=sol.iterations, timings=timings, n_dofs=model.n_dofs,
         n_elements=amesh.n_elements, n_interface_nodes=int(model.r.size),
         n_elements_across_contact=float(np.interp(a_c, corner_r, np.arange(corner_r.size))),
@@ -215,9 +215,9 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
                  "relative_penetration": penetration / abs(sol.delta) if sol.delta else math.inf},
         truncation={"compliance": dc, "correction": dc * force, "approach_far": delta_far,
                     "applied": bool(dc != 0.0), "radius": amesh.radius, "depth": amesh.depth},
-        mesh={"a_est": amesh.a_est, "h_fine": amesh.h_fine, "n_contact": amesh.n_contact,
-              "extent_factor": amesh.radius / amesh.a_est, "remeshed": remeshed},
-        E_star=E_star, history=sol.history, model=model, displacement=u,
+        mesh={"a_est": amesh.a_est, "h_fine": amesh.h_fine, "n_contact_elements": amesh.n_contact_elements,
+              "domain_factor": amesh.radius / amesh.a_est, "remeshed": remeshed},
+        E_star=E_star, history=sol.history, model=model, displacement_dofs=u,
     )
     if not converged:
         log.warning("FEM reference did not converge: %s", message)

@@ -126,8 +126,8 @@ def _paths(obj, prefix="", *, leaves):
 def real_results(tmp_path_factory):
     """result.json of runs that together write every kind of field."""
     tmp = tmp_path_factory.mktemp("results")
-    runs = [("hertz", ["bem.nodes_across=16", "fem.n_contact=8"]),           # FEM, Hertz, report, files
-            ("paper_bilinear", ["bem.nodes_across=16", "fem.n_contact=8"]),  # paper layer: alpha_a, alpha_c
+    runs = [("hertz", ["bem.nodes_across=16", "fem.n_contact_elements=8"]),           # FEM, Hertz, report, files
+            ("paper_bilinear", ["bem.nodes_across=16", "fem.n_contact_elements=8"]),  # paper layer: alpha_a, alpha_c
             ("paper_root", ["bem.nodes_across=16", "layer.alpha_b=0.9"]),    # alpha_b target and result
             ("elliptic", ["bem.nodes_across=16"]),                          # hertz_elliptic, not axisymmetric
             ("rough_flat", ["gap.grid=32", "bem.cell_nodes=32"])]           # a periodic cell

@@ -10,8 +10,12 @@ Three kinds of pressure source are compared:
   :class:`~bem.reference.RigidLayerParaboloid`, the non-axisymmetric
   :class:`~bem.reference.HertzElliptic`).
 
-All three share the names ``pressure(x, y)``, ``p_max``, ``contact_radius``, ``approach`` and
-``force``, so each is compared the same way.
+All three share the names ``pressure(x, y)``, ``p_max``, ``approach`` and ``force``, so each is
+compared the same way. Their radii are two estimators with two names: the BEM's and the closed
+forms' ``contact_radius`` (``sqrt(A / pi)``, the radius of the circle of the contact area; a
+closed form's exact radius) and the FEM's ``edge_radius`` (the edge of the loaded zone,
+interpolated between its nodes). A pair with the FEM on either side compares them as
+``edge_radius_rel``, any other pair as ``contact_radius_rel``.
 
 Relative L2 error of a candidate ``a`` against a reference ``b`` at the candidate's nodes
 ``n`` with quadrature weights ``A_n``::
@@ -35,10 +39,13 @@ from bem.result import ContactResult
 from fem_reference.result import FemResult
 
 __all__ = ["axial_section", "ring_weights", "relative_l2", "pair_metrics", "compare",
-           "PAIR_KEYS"]
+           "PAIR_KEYS", "RADIUS_KEYS"]
 
-#: keys of one pair of :func:`pair_metrics` / :func:`compare`
-PAIR_KEYS = ("l2_rel", "max_rel", "peak_rel", "contact_radius_rel", "approach_rel", "force_rel", "n_points")
+#: keys every pair of :func:`pair_metrics` / :func:`compare` holds, besides one of :data:`RADIUS_KEYS`
+PAIR_KEYS = ("l2_rel", "max_rel", "peak_rel", "approach_rel", "force_rel", "n_points")
+#: the radius comparison of a pair: ``contact_radius_rel`` (``sqrt(A / pi)`` or a closed form's
+#: radius on both sides) or ``edge_radius_rel`` (the FEM's interpolated edge on one side)
+RADIUS_KEYS = ("contact_radius_rel", "edge_radius_rel")
 
 
 def axial_section(x, y, values, *, tol=None):
@@ -88,12 +95,18 @@ def relative_l2(p, p_ref, weights=None):
 
 def _check_source(name, obj):
     """Every result and closed form shares the names read here (``bem.reference``)."""
-    if not all(hasattr(obj, k) for k in ("pressure", "p_max", "contact_radius", "approach", "force")):
+    radius = "edge_radius" if isinstance(obj, FemResult) else "contact_radius"
+    if not all(hasattr(obj, k) for k in ("pressure", "p_max", radius, "approach", "force")):
         raise InputError(
             f"{name} = {type(obj).__name__} is not allowed: it must be a bem.ContactResult, a "
             "fem_reference.FemResult or a bem.reference closed form (pressure, p_max, contact_radius, "
             "approach, force).")
     return obj
+
+
+def _radius(obj):
+    """The radius a source gives: the FEM's ``edge_radius``, any other's ``contact_radius`` [length]."""
+    return obj.edge_radius if isinstance(obj, FemResult) else obj.contact_radius
 
 
 def _nodes(obj):
@@ -119,8 +132,9 @@ def pair_metrics(candidate, reference):
     dict
         ``l2_rel`` (module docstring; at the BEM nodes equal weights, at the FEM nodes ring
         areas), ``max_rel`` = ``max |p_a - p_b| / max p_b``, and the signed relative
-        differences ``(a - b) / b`` of the peak pressure ``peak_rel``, contact radius
-        ``contact_radius_rel`` (BEM: radius of the circle of the contact area), approach
+        differences ``(a - b) / b`` of the peak pressure ``peak_rel``, the radius
+        (``edge_radius_rel`` when either side is an FEM result: its interpolated edge against the
+        other's radius; else ``contact_radius_rel``; module docstring), approach
         ``approach_rel`` and total force ``force_rel``; ``n_points``: nodes in the union
         of the contact zones. ``None`` marks an undefined value (reference 0).
     """
@@ -134,11 +148,12 @@ def pair_metrics(candidate, reference):
     union = (p > 0) | (p_ref > 0)
     diff = np.abs(p - p_ref)
     scale = float(p_ref.max(initial=0.0))
+    radius_key = RADIUS_KEYS[isinstance(a, FemResult) or isinstance(b, FemResult)]
     return {
         "l2_rel": relative_l2(p[union], p_ref[union], None if w is None else w[union]),
         "max_rel": float(diff.max(initial=0.0)) / scale if scale > 0 else None,
         "peak_rel": _rel(a.p_max, b.p_max),
-        "contact_radius_rel": _rel(a.contact_radius, b.contact_radius),
+        radius_key: _rel(_radius(a), _radius(b)),
         "approach_rel": _rel(a.approach, b.approach),
         "force_rel": _rel(a.force, b.force),
         "n_points": int(union.sum()),
@@ -171,7 +186,7 @@ def compare(bem_result, *, fem=None, analytic=None, force=None):
           (only for an axisymmetric closed form);
         - ``"force_balance"``: ``{"target": P, "bem": |F - P| / P, "fem": ...}``.
 
-        Each pair holds :data:`PAIR_KEYS` (:func:`pair_metrics`).
+        Each pair holds :data:`PAIR_KEYS` and one of :data:`RADIUS_KEYS` (:func:`pair_metrics`).
     """
     if not isinstance(bem_result, ContactResult):
         raise InputError(f"result = {type(bem_result).__name__} is not allowed: it must be a bem.ContactResult.")

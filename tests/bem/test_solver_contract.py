@@ -113,15 +113,15 @@ def test_rtol_is_the_kkt_tolerance_of_every_method():
             assert res.kkt_residual > 1e-9, method
 
 
-def test_fem_reference_extent_factor_is_relative_to_the_contact_and_extent_is_refused():
+def test_fem_reference_domain_factor_is_relative_to_the_contact_and_extent_is_refused():
     """``extent`` is an absolute half-width in bem.solve; the FEM's domain size is relative to the
     expected contact radius and has its own name."""
     import fem_reference
 
-    kw = dict(E1=2.0, nu1=0.3, E2=2.0, nu2=0.3, force=1.0, n_contact=3)
+    kw = dict(E1=2.0, nu1=0.3, E2=2.0, nu2=0.3, force=1.0, n_contact_elements=3)
     radius = {}
     for factor in (10.0, 20.0):
-        res = fem_reference.solve(Paraboloid(1.0), extent_factor=factor, **kw)
+        res = fem_reference.solve(Paraboloid(1.0), domain_factor=factor, **kw)
         radius[factor] = res.field()["points"][:, 0].max()
     a_est = radius[10.0] / 10.0
     assert radius[20.0] == pytest.approx(20.0 * a_est, rel=1e-9)
@@ -256,8 +256,8 @@ def test_a_failed_run_logs_one_warning(caplog):
 # --- one meaning per name: a solver's displacement is C p, whatever the layer ---------------------
 
 @pytest.mark.parametrize("lam", [0.0, 0.3, "per node"])
-def test_the_qp_displacement_is_the_elastic_closure(lam):
-    """QPSolution.displacement = C p, the elastic closure, whatever the layer (as for Newton)."""
+def test_the_qp_displacement_is_the_elastic_displacement(lam):
+    """QPSolution.displacement = C p, the elastic displacement, whatever the layer (as for Newton)."""
     from bem.kalker import solve_qp
 
     lattice = bem.Lattice.from_extent(0.1, 1.2)

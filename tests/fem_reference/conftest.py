@@ -21,4 +21,4 @@ def coarse_mesh(hertz_same):
     """A coarse mesh sized for the same-material Hertz problem (8 elements across a)."""
     from fem_reference import build_mesh
 
-    return build_mesh(hertz_same[0], n_contact=8, extent_factor=30.0)
+    return build_mesh(hertz_same[0], n_contact_elements=8, domain_factor=30.0)

@@ -6,7 +6,7 @@ from .fem_cases import E, E_SOFT, NU, NU_SOFT, P, R, e_star, hertz, hertz_pressu
 
 import fem_reference as fr
 
-COARSE = {"n_contact": 8, "extent_factor": 30.0}
+COARSE = {"n_contact_elements": 8, "domain_factor": 30.0}
 
 
 @pytest.fixture(scope="module")
@@ -24,7 +24,7 @@ def test_hertz_peak_radius_approach(gap, same, lower):
     a, p0, delta = hertz(P, R, Es)
     assert res.converged, res.message
     assert res.p_max == pytest.approx(p0, rel=0.02)
-    assert res.contact_radius == pytest.approx(a, rel=0.02)
+    assert res.edge_radius == pytest.approx(a, rel=0.02)
     assert res.approach == pytest.approx(delta, rel=0.02)
     assert res.force == pytest.approx(P, rel=1e-9)
     assert res.force_reaction == pytest.approx(P, rel=1e-8)
@@ -40,9 +40,9 @@ def test_mesh_convergence(gap, hertz_same):
     a, p0, _ = hertz_same
     errors = []
     for n in (4, 8, 16):
-        res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, n_contact=n, extent_factor=30.0)
+        res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, n_contact_elements=n, domain_factor=30.0)
         assert res.converged
-        assert res.contact_radius == pytest.approx(a, rel=0.02)
+        assert res.edge_radius == pytest.approx(a, rel=0.02)
         errors.append(abs(res.p_max / p0 - 1))
     assert errors[0] > 2 * errors[1] > 4 * errors[2]
     assert errors[0] < 0.02
@@ -76,7 +76,7 @@ def test_truncation_correction(gap, coarse_mesh, hertz_same, same):
     assert same.truncation["approach_far"] == pytest.approx(raw.approach, rel=2e-3)
     # pressure and radius barely notice
     assert same.p_max == pytest.approx(raw.p_max, rel=2e-3)
-    assert same.contact_radius == pytest.approx(raw.contact_radius, rel=5e-3)
+    assert same.edge_radius == pytest.approx(raw.edge_radius, rel=5e-3)
 
 
 def test_approach_control_inverts_force_control(gap, coarse_mesh):
@@ -89,7 +89,7 @@ def test_approach_control_inverts_force_control(gap, coarse_mesh):
 
 def test_bad_estimate_is_remeshed(gap, hertz_same):
     a, p0, _ = hertz_same
-    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=3 * a, n_contact=8, extent_factor=30.0)
+    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=3 * a, n_contact_elements=8, domain_factor=30.0)
     assert res.converged and res.mesh["remeshed"]
     assert res.mesh["a_est"] == pytest.approx(a, rel=0.1)
     assert res.p_max == pytest.approx(p0, rel=0.02)
@@ -98,7 +98,7 @@ def test_bad_estimate_is_remeshed(gap, hertz_same):
 
 def test_contact_reaching_the_outer_boundary_is_not_an_answer(gap, hertz_same):
     a = hertz_same[0]
-    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=a / 25, n_contact=3, extent_factor=20.0,
+    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=a / 25, n_contact_elements=3, domain_factor=20.0,
                    remesh=False)
     assert not res.converged and res.status == res.summary()["status"] == "boundary"
     assert np.all(np.isfinite(res.p))

@@ -78,15 +78,15 @@ def test_grading_fine_at_contact_coarse_far(coarse_mesh):
     far = L[dist > 0.5 * coarse_mesh.radius]
     assert near.max() < 1.6 * coarse_mesh.h_fine and near.mean() > 0.5 * coarse_mesh.h_fine
     assert far.mean() > 10 * coarse_mesh.h_fine
-    # interface elements across a_est: about n_contact
+    # interface elements across a_est: about n_contact_elements
     iface = np.sort(np.unique(mesh.p[0, mesh.facets[:, mesh.boundaries["interface_upper"]]]))
     across = np.count_nonzero(iface[1:] <= coarse_mesh.a_est * (1 + 1e-9))
-    assert abs(across - coarse_mesh.n_contact) <= 2
+    assert abs(across - coarse_mesh.n_contact_elements) <= 2
 
 
 def test_mesh_keeps_the_physical_groups_and_writes_no_file(tmp_path, monkeypatch, hertz_same):
     monkeypatch.chdir(tmp_path)
-    mesh = build_mesh(hertz_same[0], n_contact=3, extent_factor=20.0)
+    mesh = build_mesh(hertz_same[0], n_contact_elements=3, domain_factor=20.0)
     assert {"upper", "lower", "interface", "axis", "top", "bottom", "outer"} <= set(mesh.physical_groups)
     assert not list(tmp_path.iterdir())  # fem_reference returns data; writes no files
 
@@ -101,13 +101,14 @@ def test_gmsh_finalized_on_error(monkeypatch):
 
     monkeypatch.setattr(mesh_module, "_extract", boom)
     with pytest.raises(RuntimeError, match="simulated"):
-        build_mesh(1.0, n_contact=3, extent_factor=20.0)
+        build_mesh(1.0, n_contact_elements=3, domain_factor=20.0)
     assert gmsh.isInitialized() == 0
 
 
 @pytest.mark.parametrize("kwargs, name", [
-    ({"a_est": -1.0}, "a_est"), ({"a_est": 1.0, "n_contact": 1}, "n_contact"),
-    ({"a_est": 1.0, "n_contact": 4.5}, "n_contact"), ({"a_est": 1.0, "extent_factor": 2.0}, "extent_factor"),
+    ({"a_est": -1.0}, "a_est"), ({"a_est": 1.0, "n_contact_elements": 1}, "n_contact_elements"),
+    ({"a_est": 1.0, "n_contact_elements": 4.5}, "n_contact_elements"),
+    ({"a_est": 1.0, "domain_factor": 2.0}, "domain_factor"),
     ({"a_est": float("nan")}, "a_est"), ({"a_est": 1.0, "growth": 0.0}, "growth"),
 ])
 def test_bad_mesh_input(kwargs, name):

@@ -84,7 +84,7 @@ def test_not_converged_says_so_without_nan(gap, coarse_mesh):
     res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, mesh=coarse_mesh, layer=Root(1e-3),
                    maxiter=1, rtol=1e-14)
     assert res.converged is False and res.status == "maxiter"
-    for value in (res.p, res.closure, [res.approach, res.force, res.p_max, res.contact_radius]):
+    for value in (res.p, res.overlap, [res.approach, res.force, res.p_max, res.edge_radius]):
         assert np.all(np.isfinite(value))
 
 
@@ -126,7 +126,7 @@ def test_bad_input_names_the_argument(gap, kwargs, name, value):
 def test_bad_gap():
     with pytest.raises(InputError, match=r"^gap = 'sphere' is not allowed: it must be callable\.$"):
         fr.solve("sphere", E1=E, nu1=NU, E2=E, nu2=NU, force=P)
-    kw = dict(E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=0.2, n_contact=3, extent_factor=20.0)
+    kw = dict(E1=E, nu1=NU, E2=E, nu2=NU, force=P, a_est=0.2, n_contact_elements=3, domain_factor=20.0)
     with pytest.raises(InputError, match=r"^gap\(x, y\) = nan at \(x, y\) = \(0, 0\) is not allowed: the gap "
                                          r"must be finite on the interface\.$"):
         fr.solve(lambda x, y: np.full_like(x, np.nan), **kw)

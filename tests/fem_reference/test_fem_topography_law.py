@@ -26,23 +26,23 @@ def topography_law():
 
 
 def test_fem_and_bem_agree_on_the_sphere_with_a_topography_law(gap, topography_law, caplog):
-    """Measured (n_contact = 12, BEM step a/25): approach 7.8e-5, p_max 6.1e-4, contact radius 9.4e-4
+    """Measured (n_contact_elements = 12, BEM step a/25): approach 7.8e-5, p_max 6.1e-4, contact radius 9.4e-4
     apart (relative); the law moves the approach by +24 % and the peak by -12 % from the smooth contact."""
     law = topography_law.law
     with caplog.at_level(logging.WARNING):
-        fem = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=law, n_contact=12,
-                       extent_factor=30.0)
+        fem = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=law, n_contact_elements=12,
+                       domain_factor=30.0)
         assert fem.converged, fem.message
-        kw = dict(E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, step=fem.contact_radius / 25,
-                  extent=1.3 * fem.contact_radius)
+        kw = dict(E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, step=fem.edge_radius / 25,
+                  extent=1.3 * fem.edge_radius)
         ref = bem.solve(gap, layer=law, **kw)
     assert ref.converged
     assert ref.approach == pytest.approx(fem.approach, rel=0.01)
     assert ref.p_max == pytest.approx(fem.p_max, rel=0.01)
-    assert ref.contact_radius == pytest.approx(fem.contact_radius, rel=0.02)
+    assert ref.contact_radius == pytest.approx(fem.edge_radius, rel=0.02)
     assert max(fem.p_max, ref.p_max) < topography_law.mean_pressure[-1]
     assert [r for r in caplog.records if r.levelno >= logging.WARNING] == []  # within the table's range
-    smooth = bem.solve(gap, **dict(kw, extent=1.5 * fem.contact_radius))
+    smooth = bem.solve(gap, **dict(kw, extent=1.5 * fem.edge_radius))
     assert ref.approach > 1.1 * smooth.approach and ref.p_max < 0.95 * smooth.p_max  # the layer takes part
 
 
@@ -50,7 +50,7 @@ def test_fem_beyond_the_table_warns_with_the_range(gap, topography_law, caplog):
     p, w = topography_law.mean_pressure[:3], topography_law.closure[:3]
     with caplog.at_level(logging.WARNING):
         fem = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=bem.layers.Tabulated(p, w),
-                       n_contact=8, extent_factor=30.0)
+                       n_contact_elements=8, domain_factor=30.0)
     assert fem.converged and fem.p_max > p[-1]
     (message,) = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
     assert message.startswith(f"FEM reference: the peak pressure p_max = {fem.p_max:.6g} exceeds the tabulated "

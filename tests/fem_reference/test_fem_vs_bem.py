@@ -26,11 +26,11 @@ CASES = {
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_fem_matches_bem(gap, name):
     layer = CASES[name]
-    fem = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=layer, n_contact=12,
-                   extent_factor=30.0)
+    fem = fr.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=layer, n_contact_elements=12,
+                   domain_factor=30.0)
     assert fem.converged, fem.message
     ref = bem.solve(gap, E1=E, nu1=NU, E2=E_SOFT, nu2=NU_SOFT, force=P, layer=layer,
-                    step=fem.contact_radius / 25, extent=1.3 * fem.contact_radius)
+                    step=fem.edge_radius / 25, extent=1.3 * fem.edge_radius)
     assert ref.converged
     scale = fem.p_max
     r = np.hypot(ref.x, ref.y)
@@ -39,6 +39,6 @@ def test_fem_matches_bem(gap, name):
     l2 = np.sqrt(np.mean((ref.p[zone] - p_fem[zone]) ** 2))
     assert l2 <= 0.02 * scale
     assert abs(ref.p_max - fem.p_max) <= 0.02 * scale
-    assert ref.contact_radius == pytest.approx(fem.contact_radius, rel=0.02)
+    assert ref.contact_radius == pytest.approx(fem.edge_radius, rel=0.02)
     assert ref.approach == pytest.approx(fem.approach, rel=0.01)
     assert ref.force == pytest.approx(fem.force, rel=1e-6)

@@ -11,14 +11,14 @@ from validation.cli import main
 
 #: --set overrides that keep every built-in scene fast (BEM < 0.2 s, FEM < 1 s here).
 SMALL = {
-    "hertz": ["bem.nodes_across=24", "fem.n_contact=8"],
-    "paper_smooth": ["bem.nodes_across=24", "fem.n_contact=8"],
-    "paper_linear": ["bem.nodes_across=24", "fem.n_contact=8"],
-    "paper_elastic_rigid": ["bem.nodes_across=24", "fem.n_contact=8"],
-    "paper_bilinear": ["bem.nodes_across=24", "fem.n_contact=8"],
-    "paper_root": ["bem.nodes_across=24", "fem.n_contact=8"],
-    "rough_sphere": ["bem.nodes_across=24", "fem.n_contact=8"],
-    "punch": ["bem.nodes_across=48", "fem.n_contact=16"],  # the edge peak needs a finer FEM mesh
+    "hertz": ["bem.nodes_across=24", "fem.n_contact_elements=8"],
+    "paper_smooth": ["bem.nodes_across=24", "fem.n_contact_elements=8"],
+    "paper_linear": ["bem.nodes_across=24", "fem.n_contact_elements=8"],
+    "paper_elastic_rigid": ["bem.nodes_across=24", "fem.n_contact_elements=8"],
+    "paper_bilinear": ["bem.nodes_across=24", "fem.n_contact_elements=8"],
+    "paper_root": ["bem.nodes_across=24", "fem.n_contact_elements=8"],
+    "rough_sphere": ["bem.nodes_across=24", "fem.n_contact_elements=8"],
+    "punch": ["bem.nodes_across=48", "fem.n_contact_elements=16"],  # the edge peak needs a finer FEM mesh
     "roller": ["bem.nodes_across=16"],
     "elliptic": ["bem.nodes_across=24"],
 }

@@ -52,7 +52,7 @@ def test_check_ok():
 
 def test_run_prints_a_summary(tmp_path):
     code, out, err = cli("run", "paper_root", "--out", tmp_path / "r", "--set", "bem.nodes_across=16",
-                         "--set", "fem.n_contact=8")
+                         "--set", "fem.n_contact_elements=8")
     assert code == 0, err
     result = json.loads((tmp_path / "r" / "result.json").read_text())
     for label in ("p_max", "contact", "approach", "converged  yes", "time", "files", "alpha_b", "FEM"):
@@ -63,7 +63,7 @@ def test_run_prints_a_summary(tmp_path):
 
 def test_run_not_converged_exits_1_and_writes(tmp_path):
     code, out, _ = cli("run", "rough_sphere", "--out", tmp_path / "r", "--set", "bem.nodes_across=16",
-                       "--set", "bem.maxiter=1", "--set", "fem.n_contact=8")
+                       "--set", "bem.maxiter=1", "--set", "fem.n_contact_elements=8")
     assert code == 1
     assert json.loads((tmp_path / "r" / "result.json").read_text())["converged"] is False
     assert "converged  NO" in out

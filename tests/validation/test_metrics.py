@@ -13,7 +13,7 @@ from bem.checks import InputError
 from bem.gaps import EllipticParaboloid, Paraboloid
 from fem_reference.result import FemResult
 from bem.reference import hertz_elliptic, hertz_sphere
-from validation.compare import PAIR_KEYS, compare, pair_metrics, relative_l2, ring_weights
+from validation.compare import PAIR_KEYS, RADIUS_KEYS, compare, pair_metrics, relative_l2, ring_weights
 
 H = hertz_sphere(1.0, 1.0, force=1.0)
 H_A = H.contact_radius
@@ -36,8 +36,8 @@ def _with_p(res, p, **kw):
 
 def _fem(r, p, **kw):
     """A FemResult holding the profile ``p(r)``."""
-    fields = dict(r=r, p=p, closure=np.zeros_like(r), gap=r**2 / 2, approach=H.approach, force=H.force,
-                  force_reaction=H.force, p_max=float(p.max()), contact_radius=H_A, converged=True, message="",
+    fields = dict(r=r, p=p, overlap=np.zeros_like(r), initial_gap=r**2 / 2, approach=H.approach, force=H.force,
+                  force_reaction=H.force, p_max=float(p.max()), edge_radius=H_A, converged=True, message="",
                   status="converged",
                   iterations=1, timings={"total": 0.0}, n_dofs=0, n_elements=0, n_interface_nodes=r.size,
                   n_elements_across_contact=0.0, penalty={}, truncation={}, mesh={}, E_star=1.0)
@@ -79,7 +79,7 @@ def test_local_bump_and_pressure_outside_the_contact_count_in_the_union(base):
 def test_bem_against_fem_profile_interpolated_in_r(base):
     r_fem = np.sort(np.append(np.linspace(0.0, 3.0, 61), H_A))  # a node at the kink r = a
     cone = np.maximum(1.0 - r_fem / H_A, 0.0)
-    fem = _fem(r_fem, cone, approach=0.5, force=2.0, contact_radius=H_A)
+    fem = _fem(r_fem, cone, approach=0.5, force=2.0, edge_radius=H_A)
     p_bem = (1 + EPS) * np.maximum(1.0 - _radius(base) / H_A, 0.0)
     fake = _with_p(base, p_bem, approach=0.55)
     out = compare(fake, fem=fem, force=2.0)
@@ -90,6 +90,17 @@ def test_bem_against_fem_profile_interpolated_in_r(base):
     assert out["force_balance"] == {"target": 2.0, "bem": pytest.approx(abs(fake.force - 2) / 2),
                                     "fem": pytest.approx(0.0)}
     assert "bem_vs_analytic" not in out and "fem_vs_analytic" not in out
+
+
+def test_the_bem_area_radius_against_the_fem_edge_is_named_edge_radius_rel(base):
+    """BEM sqrt(A / pi) against the FEM's interpolated edge: two estimators, a key naming both."""
+    r_fem = np.linspace(0.0, 3.0, 61)
+    fem = _fem(r_fem, H.pressure(r_fem), edge_radius=1.1 * H_A)
+    out = compare(base, fem=fem, analytic=H)
+    assert out["bem_vs_fem"]["edge_radius_rel"] == pytest.approx(base.contact_radius / (1.1 * H_A) - 1, rel=1e-12)
+    assert out["fem_vs_analytic"]["edge_radius_rel"] == pytest.approx(0.1, rel=1e-12)
+    assert out["bem_vs_analytic"]["contact_radius_rel"] == pytest.approx(base.contact_radius / H_A - 1, rel=1e-12)
+    assert "contact_radius_rel" not in out["bem_vs_fem"] and "edge_radius_rel" not in out["bem_vs_analytic"]
 
 
 def test_fem_against_analytic_uses_ring_area_weights():
@@ -139,7 +150,7 @@ def test_small_bem_solve_against_hertz_and_fem(base):
     assert out["bem_vs_fem"]["l2_rel"] == pytest.approx(a["l2_rel"], rel=0.05)
     json.dumps(out, allow_nan=False)
     for pair in ("bem_vs_fem", "bem_vs_analytic", "fem_vs_analytic"):
-        assert set(out[pair]) == set(PAIR_KEYS)
+        assert set(out[pair]) - set(PAIR_KEYS) == {RADIUS_KEYS[pair != "bem_vs_analytic"]}
         assert all(v is None or type(v) in (float, int) for v in out[pair].values())
 
 

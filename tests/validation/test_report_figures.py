@@ -346,21 +346,21 @@ def test_von_mises_png(tmp_path, drawn):
 
     e_body = 2.0 * (1.0 - 0.09)
     fem = fem_reference.solve(bem.gaps.Paraboloid(1.0), E1=e_body, nu1=0.3, E2=e_body, nu2=0.3, force=1.0,
-                              n_contact=6)
+                              n_contact_elements=6)
     r, z, tri, vm = von_mises_of(fem)
     # Hertz (Johnson 1985, Fig. 4.4 / eq. 3.73-3.74, nu = 0.3): max von Mises ~0.62 p0 at z ~ 0.48 a on the axis
     k = int(np.argmax(vm))
     assert vm[k] / P0 == pytest.approx(0.62, abs=0.03)
     assert abs(z[k]) / A == pytest.approx(0.48, abs=0.12) and r[k] / A < 0.25
     check_png(plot_section_field(r, z, tri, vm, tmp_path / "vm.png", a=A, scale=P0, label="von Mises",
-                                 contact_radius=fem.contact_radius), section_field_size())
+                                 contact_radius=fem.edge_radius), section_field_size())
     ax = next(ax for ax in drawn[-1].axes if ax.collections)  # the (r, z) map (beside a 3-D view with [3d])
     shown = ax.collections[0].get_array()
     assert shown.max() == pytest.approx(vm.max() / P0, rel=1e-12)  # the FEM's von Mises stress / p0
     assert np.all(shown >= 0) and ax.get_xlim() == (-3.0, 3.0) and ax.get_ylim() == (-3.0, 3.0)
     (label, (xc, zc)), = lines_of(ax).items()  # the contact, marked on the interface
     assert label.startswith("contact") and np.all(zc == 0.0)
-    np.testing.assert_allclose(xc, np.array([-1.0, 1.0]) * fem.contact_radius / A)
+    np.testing.assert_allclose(xc, np.array([-1.0, 1.0]) * fem.edge_radius / A)
 
 
 # ---------------------------------------------------------------- inputs untouched, atomic writes

@@ -28,8 +28,8 @@ from .conftest import e_star, hertz
 from .test_report_build import assert_valid_offline_html
 
 SMALL = {
-    "hertz": ["bem.nodes_across=16", "fem.n_contact=6"],  # FEM + closed form
-    "paper_elastic_rigid": ["bem.nodes_across=16", "fem.n_contact=6"],  # layer + FEM
+    "hertz": ["bem.nodes_across=16", "fem.n_contact_elements=6"],  # FEM + closed form
+    "paper_elastic_rigid": ["bem.nodes_across=16", "fem.n_contact_elements=6"],  # layer + FEM
     "elliptic": ["bem.nodes_across=16"],  # BEM only + closed form, not axisymmetric
     "roller": ["bem.nodes_across=12"],  # BEM only, no reference, elongated
 }

@@ -26,7 +26,7 @@ def test_short_values_stay_short_and_other_cells_pass_through():
 
 def test_results_table_tells_bem_fem_and_closed_form_apart():
     data = {"p_max": 1.37134e9, "force": 100.0, "approach": 3.4821e-6, "contact_radius": 1.8566e-4,
-            "fem": {"p_max": 1.37121e9, "force": 100.0, "approach": 3.4853e-6, "contact_radius": 1.8574e-4},
+            "fem": {"p_max": 1.37121e9, "force": 100.0, "approach": 3.4853e-6, "edge_radius": 1.8574e-4},
             "analytic": {"p_max": 1.37108e9, "force": 100.0, "approach": 3.4829e-6, "contact_radius": 1.8663e-4},
             "scales": {"p_hertz": 1.37108e9, "a_hertz": 1.8663e-4, "approach_hertz": 3.4829e-6},
             "unit_symbols": {"length": "m", "pressure": "Pa", "force": "N"}, "units": "SI"}
@@ -48,7 +48,7 @@ def test_one_length_unit_and_one_pressure_unit_in_the_figures_and_stress_tables(
     from validation.report.documents.sections import report_results_dir
     from validation.run import run_scene
 
-    run_scene("hertz", tmp_path / "r", overrides=["bem.nodes_across=16", "fem.n_contact=6"])
+    run_scene("hertz", tmp_path / "r", overrides=["bem.nodes_across=16", "fem.n_contact_elements=6"])
     built = report_results_dir(tmp_path / "r", tmp_path / "rep")
     md = built.markdown.read_text(encoding="utf-8")
     stress = md[md.index("## Subsurface stresses"):]

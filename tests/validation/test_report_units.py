@@ -13,8 +13,8 @@ from validation.report.documents.sections import run_sections
 from validation.report.render import build_report
 from validation.run import run_scene
 
-SCENES = {"hertz": ["bem.nodes_across=16", "fem.n_contact=6"],  # FEM, closed form, subsurface stresses
-          "paper_elastic_rigid": ["bem.nodes_across=16", "fem.n_contact=6"]}  # a layer: its closure w(p)
+SCENES = {"hertz": ["bem.nodes_across=16", "fem.n_contact_elements=6"],  # FEM, closed form, subsurface stresses
+          "paper_elastic_rigid": ["bem.nodes_across=16", "fem.n_contact_elements=6"]}  # a layer: its closure w(p)
 #: the units each choice of a report gives an SI scene: (pressure, length)
 EXPECTED = {"auto": ({"MPa"}, {"mm"}), "scene": ({"Pa"}, {"m"}), "dimensionless": ({"p_H"}, {"a_H"})}
 _KIND = {"pressure": re.compile(r"^(?:[kMG]?Pa|p_H|p_0|p_\{?max\}?)$"),

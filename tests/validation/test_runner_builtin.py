@@ -49,7 +49,8 @@ def test_bem_matches_fem_within_2_percent(builtin_runs, name):
                                                 abs=1e-15)
     assert cmp["force_rel"] == pytest.approx((r["force"] - fem["force"]) / fem["force"], rel=1e-9, abs=1e-15)
     assert 0 <= cmp["l2_rel"] <= 0.05 and cmp["n_points"] > 0
-    assert r["contact_radius"] == pytest.approx(fem["contact_radius"], rel=0.03)
+    assert r["contact_radius"] == pytest.approx(fem["edge_radius"], rel=0.03)
+    assert cmp["edge_radius_rel"] == pytest.approx(r["contact_radius"] / fem["edge_radius"] - 1, rel=1e-9)
     assert r["approach"] == pytest.approx(fem["approach"], rel=0.01)
     assert r["force"] == pytest.approx(fem["force"], rel=1e-6)
 

@@ -124,7 +124,7 @@ def test_lattice_triangles_tile_the_region():
 def test_scene_file_in_the_result_reruns_identically(tmp_path):
     from bem.files import file_mode
 
-    first = run_scene("paper_bilinear", tmp_path / "a", overrides=["bem.nodes_across=16", "fem.n_contact=8"])
+    first = run_scene("paper_bilinear", tmp_path / "a", overrides=["bem.nodes_across=16", "fem.n_contact_elements=8"])
     files = sorted(p.name for p in (tmp_path / "a").iterdir())
     assert files == [".contactlab", "bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
     for name in files:  # every file has the permissions of a new file (umask), fem_field.vtu too
@@ -138,7 +138,7 @@ def test_progress_reports_every_planned_stage(tmp_path):
     """The run tells progress(label, done, total) (validation.progress): each stage at its start, the
     BEM iterations within their stage, then the end; with a result directory, its writing too."""
     events = []
-    scene = load_scene("paper_elastic_rigid", overrides=["bem.nodes_across=16", "fem.n_contact=8"])
+    scene = load_scene("paper_elastic_rigid", overrides=["bem.nodes_across=16", "fem.n_contact_elements=8"])
     execute_scene(scene, progress=lambda *a: events.append(a))
     stages = runner.planned_stages(scene)
     assert stages == ["layer", "bem", "fem", "compare"]
@@ -152,7 +152,7 @@ def test_progress_reports_every_planned_stage(tmp_path):
 
 
 def test_not_converged_is_flagged_and_written(tmp_path):
-    r = run_scene("rough_sphere", tmp_path / "r", overrides=["bem.nodes_across=16", "fem.n_contact=8",
+    r = run_scene("rough_sphere", tmp_path / "r", overrides=["bem.nodes_across=16", "fem.n_contact_elements=8",
                                                              "bem.maxiter=1"])
     assert r["converged"] is False and r["bem"]["converged"] is False
     assert any("did not converge" in m for m in r["messages"])

@@ -119,12 +119,12 @@ CASES = {
                                 "bem.extent_factor"),
     "lattice_too_large": (BASE.replace("nodes_across = 16", "step = 1e-8\nextent = 5e-4"), "bem.step"),
     "table_gap_without_lattice": (TABLE_GAP, "bem.step"),
-    "fem_for_elliptic_gap": (ELLIPTIC + "\n[fem]\nn_contact = 8\n", "fem"),
+    "fem_for_elliptic_gap": (ELLIPTIC + "\n[fem]\nn_contact_elements = 8\n", "fem"),
     "fem_with_E_star": (BASE.replace(BODIES, "\n[bodies]\nE_star = 1e11\n") + "\n[fem]\n", "fem"),
-    "fem_too_few_elements": (BASE + "\n[fem]\nn_contact = 1\n", "fem.n_contact"),
+    "fem_too_few_elements": (BASE + "\n[fem]\nn_contact_elements = 1\n", "fem.n_contact_elements"),
     "unknown_fem_key": (BASE + "\n[fem]\nmesh_size = 1e-5\n", "fem.mesh_size"),
-    "fem_domain_inside_its_fine_zone": (BASE + "\n[fem]\nextent_factor = 5.0\nfine_radius = 1.5\n",
-                                        "fem.extent_factor"),
+    "fem_domain_inside_its_fine_zone": (BASE + "\n[fem]\ndomain_factor = 5.0\nfine_radius = 1.5\n",
+                                        "fem.domain_factor"),
     "unknown_analytic_kind": (BASE + '\n[analytic]\nkind = "exact"\n', "analytic.kind"),
     "hertz_with_layer": (PAPER_ER + '\n[analytic]\nkind = "hertz"\n', "analytic.kind"),
     "hertz_on_flat_punch": (BASE.replace('type = "paraboloid"\nR = 0.01', 'type = "flat_punch"\na = 1e-4\n'
@@ -273,11 +273,25 @@ def test_check_lists_misspelled_keys_with_the_other_errors_and_suggests_the_key(
     lines = err.strip().splitlines()
     assert code == 2 and out == ""
     expected = {"bodies.nu1": "", "load.force": "", "bem.nodes_acros": "Did you mean 'nodes_across'?",
-                "bem.extent_factr": "Did you mean 'extent_factor'?", "fem.n_contct": "Did you mean 'n_contact'?",
+                "bem.extent_factr": "Did you mean 'extent_factor'?",
+                "fem.n_contct": "Did you mean 'n_contact_elements'?",
                 "stress.depht": "Did you mean 'depths'?", "reprot": "Did you mean 'report'?"}
     assert sorted(line.split()[2] for line in lines) == sorted(expected)
     for line in lines:
         assert line.endswith(expected[line.split()[2]])
+
+
+@pytest.mark.parametrize("key, value, known", [("extent_factor", "30.0", "domain_factor"),
+                                              ("n_contact", "8", "n_contact_elements")])
+def test_fem_keys_named_like_bem_quantities_are_refused_with_their_fem_names(tmp_path, key, value, known):
+    """``[fem]`` sizes its domain by ``domain_factor`` and its mesh by ``n_contact_elements``:
+    ``extent_factor`` (the BEM's candidate region) and ``n_contact`` (nodes in contact) are unknown
+    there, and the message points to the FEM's key."""
+    with pytest.raises(SceneError) as info:
+        load_scene(_write(tmp_path, BASE + f"\n[fem]\n{key} = {value}\n"))
+    message = str(info.value)
+    assert message.startswith(f"fem.{key} = {value} is not allowed: [fem] has no key {key!r}")
+    assert message.endswith(f"Did you mean {known!r}?")
 
 
 @pytest.mark.parametrize("content, rule", [

@@ -50,7 +50,7 @@ def test_only_what_is_named_is_present():
     roller = load_scene("roller")
     assert roller.fem is None and roller.analytic is None and roller.sweep is None
     hz = load_scene("hertz")
-    assert hz.fem == {"n_contact": 16} and hz.analytic == {"kind": "hertz"}
+    assert hz.fem == {"n_contact_elements": 16} and hz.analytic == {"kind": "hertz"}
 
 
 def test_bodies_give_johnson_modulus():

@@ -26,11 +26,11 @@ A_H, P0, _ = hertz(P, R, ES)
 @pytest.fixture(scope="module")
 def solutions():
     layer = Root(A_H / ES * math.sqrt(P0))  # closes like the bodies themselves near the peak
-    fem = fr.solve(Paraboloid(R), E1=E1, nu1=NU1, E2=E2, nu2=NU2, force=P, layer=layer, n_contact=16,
-                   extent_factor=30.0)
+    fem = fr.solve(Paraboloid(R), E1=E1, nu1=NU1, E2=E2, nu2=NU2, force=P, layer=layer, n_contact_elements=16,
+                   domain_factor=30.0)
     assert fem.converged, fem.message
     res = bem.solve(Paraboloid(R), E1=E1, nu1=NU1, E2=E2, nu2=NU2, force=P, layer=layer,
-                    step=fem.contact_radius / 25, extent=1.3 * fem.contact_radius)
+                    step=fem.edge_radius / 25, extent=1.3 * fem.edge_radius)
     assert res.converged
     depths = np.linspace(0.0, 1.5, 31) * A_H
     stresses = {name: bem.subsurface_stress(res, depths, nu=nu) for name, nu in (("body1", NU1), ("body2", NU2))}

@@ -97,7 +97,7 @@ def test_scenes_lists_and_check_validates_the_study_scene():
     ('[study]\nname = "two-scale"\nquik = true\n', "study.quik = True", "Did you mean 'quick'?"),
     ('[study]\nname = "two-scale"\nquick = 1\n', "study.quick = 1", "true or false"),
     ('[study]\nname = "two-scale"\n[bem]\nnodes_across = 30\n', "bem.nodes_across = 30", "ignores [bem]"),
-    ('[study]\nname = "two-scale"\n[fem]\nn_contact = 8\n', "fem.n_contact = 8", "ignores [fem]"),
+    ('[study]\nname = "two-scale"\n[fem]\nn_contact_elements = 8\n', "fem.n_contact_elements = 8", "ignores [fem]"),
     ('[study]\nquick = true\n', "study", "name"),
 ])
 def test_bad_study_section_is_refused_naming_the_key(tmp_path, body, key, hint):

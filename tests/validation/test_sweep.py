@@ -105,7 +105,7 @@ def test_failed_point_is_reported_and_retried(tmp_path, monkeypatch):
 
 
 def test_paper_alpha_a_sweep_spans_smooth_to_linear(tmp_path):
-    small = ["bem.nodes_across=16", "fem.n_contact=8"]
+    small = ["bem.nodes_across=16", "fem.n_contact_elements=8"]
     summary = run_sweep("paper_elastic_rigid", tmp_path, parameter="alpha_a", values=[0.0, 0.5, 1.0],
                         workers=1, overrides=small)
     p = [row["p_max"] for row in summary["points"]]

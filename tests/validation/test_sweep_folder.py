@@ -155,7 +155,7 @@ def test_values_are_typed_as_the_key():
 
 
 def test_cli_sweeps_a_string_key(tmp_path):
-    small = ["bem.nodes_across=16", "fem.n_contact=8"]
+    small = ["bem.nodes_across=16", "fem.n_contact_elements=8"]
     args = ["sweep", "paper_linear", "--param", "layer.law", "--values", "linear,none", "--workers", "1",
             "--out", tmp_path]
     code, out, err = cli(*args, *(a for s in small for a in ("--set", s)))

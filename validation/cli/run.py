@@ -15,7 +15,7 @@ PARSER = {"help": "run a scene and write its result directory",
           "epilog": "examples:\n  contactlab run hertz                         writes results/hertz/\n"
                     "  contactlab run my.toml --out out/my --set bem.method=\"augmented_gap\"\n"
                     "                                               writes out/my/result.json, ...\n"
-                    "  contactlab run punch --set fem.n_contact=32\n"
+                    "  contactlab run punch --set fem.n_contact_elements=32\n"
                     "  contactlab run rough_sphere_two_scale       the small two-scale check (a [study] scene)"}
 
 

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from bem.checks import InputError
 
+from ..labels import fmt
 from ..run.cluster import DEFAULT_TIMEOUT
 from ..scene.checks import MAX_SWEEP_POINTS
 from .common import ProgressBar, add_set, add_trust, trust
@@ -71,10 +72,9 @@ def run(args):
     print(f"sweep of {summary['key']} over {len(summary['points'])} values of scene {summary['scene']} "
           f"[units {summary['units']}]")
     print(f"{'value':>12} {'status':>14} {'p_max':>14} {'contact_r':>12} {'approach':>12}")
-    fmt = (lambda v: f"{v:.6g}" if isinstance(v, float) else "-")
     for r in summary["points"]:
-        print(f"{r['value']!s:>12} {r['status']:>14} {fmt(r.get('p_max')):>14} "
-              f"{fmt(r.get('contact_radius')):>12} {fmt(r.get('approach')):>12}")
+        print(f"{r['value']!s:>12} {r['status']:>14} {fmt(r.get('p_max'), 6):>14} "
+              f"{fmt(r.get('contact_radius'), 6):>12} {fmt(r.get('approach'), 6):>12}")
     kept = f", {len(summary['kept'])} more from earlier runs" if summary["kept"] else ""
     print(f"computed {len(summary['computed'])}, reused {len(summary['reused'])}, failed {len(summary['failed'])}"
           f"{kept}; files {out}/ (summary.json, summary.csv, points/)")

@@ -94,7 +94,7 @@ def fem_body_stresses(fem):
     """Recovered nodal stresses of each FEM body by name (:func:`fem_reference.fields.body_stresses`)."""
     from fem_reference.fields import body_stresses
 
-    return dict(zip(BODIES, body_stresses(fem.model, fem.displacement)))
+    return dict(zip(BODIES, body_stresses(fem.model, fem.displacement_dofs)))
 
 
 def peak_fit(depth, values, band=_BAND):

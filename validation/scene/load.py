@@ -13,7 +13,7 @@ A scene file has the sections (units: those of ``[scene] units``, SI by default)
     [bem]      step [m] or nodes_across; extent [m] or extent_factor; method, rtol, maxiter,
                precondition, nested, relaxation; a rough gap (validation.scene.rough):
                periodic = true, cell_nodes
-    [fem]      only when an FEM reference is wanted (axisymmetric gaps): n_contact, extent, ...
+    [fem]      only when an FEM reference is wanted (axisymmetric gaps): n_contact_elements, domain_factor, ...
     [analytic] only when wanted: kind = "hertz" | "hertz_elliptic" | "rigid_layer"
     [sweep]    only when wanted: parameter, values
     [report]   only when wanted: sections, format

@@ -37,8 +37,8 @@ ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 BODY_KEYS = ("E1", "nu1", "E2", "nu2")
 #: the ``[fem]`` options and their checks, in the order they are checked
-_FEM_OPTIONS = {"n_contact": partial(ck.integer, minimum=4, maximum=400),
-                **dict.fromkeys(("extent_factor", "fine_radius", "growth", "penalty", "rtol"), ck.positive),
+_FEM_OPTIONS = {"n_contact_elements": partial(ck.integer, minimum=4, maximum=400),
+                **dict.fromkeys(("domain_factor", "fine_radius", "growth", "penalty", "rtol"), ck.positive),
                 "maxiter": partial(ck.integer, minimum=1), "remesh": ck.boolean, "truncation_correction": ck.boolean}
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
 KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS),
@@ -222,9 +222,9 @@ def fem_options(d, shape, materials):
             raise ck.SceneError(f"bodies.{key} = {materials[key]!r} is not allowed with [fem]: it must be "
                                 "<= 0.499 (the displacement FEM locks).")
     out = ck.options("fem", d, _FEM_OPTIONS)
-    extent, fine = out.get("extent_factor", 40.0), out.get("fine_radius", 1.5)
-    if extent < 4 * fine:
-        raise ck.SceneError(f"fem.extent_factor = {extent!r} is not allowed: it must be >= 4 * fem.fine_radius = "
+    domain, fine = out.get("domain_factor", 40.0), out.get("fine_radius", 1.5)
+    if domain < 4 * fine:
+        raise ck.SceneError(f"fem.domain_factor = {domain!r} is not allowed: it must be >= 4 * fem.fine_radius = "
                             f"{4 * fine!r} (domain size in expected contact radii).")
     return out
 

@@ -36,7 +36,7 @@ from bem.files import write_text
 from ..run import execute_scene
 from ..scene import load_scene
 
-__all__ = ["StudyRun", "attempt", "timed", "classify", "finite", "save", "write_json", "fmt", "no_scene", "STATUSES"]
+__all__ = ["StudyRun", "attempt", "timed", "classify", "finite", "save", "write_json", "no_scene", "STATUSES"]
 
 #: status of an outcome (:func:`classify`)
 STATUSES = ("converged", "reported failure", "wrong")
@@ -130,12 +130,3 @@ def no_scene(study, scene):
                          "problems; --quick chooses the short run).")
 
 
-def fmt(value, spec=".2e"):
-    """A table cell: ``-`` for ``None``, ``yes``/``no`` for booleans, numbers with ``spec``."""
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, float):
-        return format(value, spec) if math.isfinite(value) else str(value)
-    return str(value)

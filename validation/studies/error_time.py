@@ -3,7 +3,7 @@
 Each problem (:data:`validation.studies.problems.ERROR_TIME_PROBLEMS`: ``"hertz"``,
 ``"paper-root"``) runs with every applicable solver on a ladder of resolutions: the BEM at
 ``bem.nodes_across`` steps across the expected contact diameter (10, 20, 40, 80, 160; a method
-stops climbing after a run longer than ``time_budget_s``), the FEM at ``fem.n_contact`` elements
+stops climbing after a run longer than ``time_budget_s``), the FEM at ``fem.n_contact_elements`` elements
 across the contact radius (4, 8, 16, 32). The errors, at the solver's own nodes
 (:func:`validation.compare.pair_metrics`), are ``error_l2`` (relative L2 error of the pressure
 over the contact) and ``error_peak`` (``|p_max / p_max,ref - 1|``) against the run's closed form
@@ -27,10 +27,11 @@ from bem.checks import InputError, check_choice, check_positive
 from ..compare import pair_metrics, relative_l2
 from ..progress import each
 from ..run import execute_scene
-from . import fmt, save, timed, write_json
+from ..labels import fmt
+from . import save, timed, write_json
 from .problems import ERROR_TIME_PROBLEMS, get_problem, methods
 
-__all__ = ["method_label", "ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "STEM", "LADDERS", "TARGETS"]
+__all__ = ["method_with_relaxation", "ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "STEM", "LADDERS", "TARGETS"]
 
 #: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
 STEM = "error_time"
@@ -43,8 +44,12 @@ TARGETS = (1e-2, 1e-3)
 _METRICS = ("error_l2", "error_peak")
 
 
-def method_label(method, relaxation=None):
-    """The method with its relaxation when one was set, e.g. ``augmented_gap (omega=1)``."""
+def method_with_relaxation(method, relaxation=None):
+    """The method's key with its relaxation when one was set, e.g. ``augmented_gap (omega=1)``.
+
+    The run's identity in a study's rows; the readable name of a method for figures is
+    ``validation.report.render.style.method_label``.
+    """
     return method if relaxation is None else f"{method} (omega={relaxation:g})"
 
 
@@ -79,8 +84,8 @@ class ErrorTimeRow:
 
     @property
     def label(self):
-        """Method name with its relaxation (:func:`method_label`)."""
-        return method_label(self.method, self.relaxation)
+        """Method name with its relaxation (:func:`method_with_relaxation`)."""
+        return method_with_relaxation(self.method, self.relaxation)
 
 
 @dataclass
@@ -183,8 +188,9 @@ def _reference(problem, finest):
     ref, check = levels[-1], _richardson(*levels)
     desc = (f"BEM Newton at {4 * finest} steps across the contact ({ref.p.size} nodes, KKT residual "
             f"{ref.kkt_residual:.1e}); Richardson from {finest}/{2 * finest}/{4 * finest}: peak order "
-            f"{fmt(check['order_peak'], '.2f')}, estimated reference error peak {fmt(check['error_peak_estimate'])}, "
-            f"L2 order {fmt(check['order_l2'], '.2f')}, estimated reference error L2 {fmt(check['error_l2_estimate'])}")
+            f"{fmt(check['order_peak'], '.2f')}, estimated reference error peak "
+            f"{fmt(check['error_peak_estimate'], '.2e')}, L2 order {fmt(check['order_l2'], '.2f')}, "
+            f"estimated reference error L2 {fmt(check['error_l2_estimate'], '.2e')}")
     return ref, {"kind": "bem-newton", "title": title, "description": desc, "resolution": 4 * finest,
                  "n": int(ref.p.size), "converged": bool(ref.converged), **check}
 
@@ -197,7 +203,7 @@ def _climb(study, problem, method, ladder, reference, opts):
     for i, n in enumerate(ladder):
         for omega in relaxations:
             if part == "fem":
-                over = {"fem.n_contact": n, "bem.nodes_across": opts["coarsest"]}
+                over = {"fem.n_contact_elements": n, "bem.nodes_across": opts["coarsest"]}
             else:
                 over = {"bem.nodes_across": n, "bem.method": method}
                 over.update({} if omega is None else {"bem.relaxation": omega})

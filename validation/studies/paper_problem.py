@@ -8,7 +8,7 @@ lattice for all, ``bem.step = a_H / n`` (Hertz's radius ``a_H`` of the smooth pr
 candidate region ``|x|, |y| <= 1.9 a_H``, the iteration histories with ``bem.record``, the
 methods with ``bem.method`` and their options, the sweeps with ``layer.alpha_a``,
 ``layer.alpha_c`` and the root coefficient ``layer.lam``, the subsurface stresses with
-``[stress] depths``, the FEM reference with ``[fem] n_contact``. The scenes give the layer
+``[stress] depths``, the FEM reference with ``[fem] n_contact_elements``. The scenes give the layer
 compliance in physical units (the paper's ``10 C_nn`` at the step ``a_H / 20``), so the quick
 preview (``n = 8``) and the full report (``n = 20``) solve the same problem on two lattices.
 """
@@ -243,12 +243,12 @@ def _work_point(solve, part, p0, **row):
 def _validation(run, res, quick):
     n_fem = 8 if quick else 24
     for case in ("smooth", "linear Winkler", "elastic-rigid", "root"):
-        res.validation[case] = run(case, analytic=True, fem={"n_contact": n_fem})
+        res.validation[case] = run(case, analytic=True, fem={"n_contact_elements": n_fem})
     res.work_precision += [_work_point(lambda: run("smooth", {"bem.step": res.a / m, "bem.nested": True}), "bem",
                                        res.p0, solver="BEM", method="Kalker QP", resolution=f"a/c = {m}")
                            for m in ((4, 8) if quick else (5, 10, 20, 40, 80))]
     # the BEM of these runs on a coarse lattice: only the FEM is timed
-    res.work_precision += [_work_point(lambda: run("smooth", {"bem.step": res.a / 4}, fem={"n_contact": n}), "fem",
+    res.work_precision += [_work_point(lambda: run("smooth", {"bem.step": res.a / 4}, fem={"n_contact_elements": n}), "fem",
                                        res.p0, solver="FEM", method="P2 axisymmetric", resolution=f"{n} el./a")
                            for n in ((4, 8) if quick else (8, 16, 32))]
 

@@ -67,7 +67,7 @@ def paraboloids(name, description, *, layer=None, E=None, nu=(NU, NU), E_star=No
     if analytic is not None:
         scene["analytic"] = {"kind": analytic}
     if fem:
-        scene["fem"] = {"n_contact": 16}
+        scene["fem"] = {"n_contact_elements": 16}
     return scene
 
 

@@ -27,7 +27,8 @@ import numpy as np
 
 from ..progress import each
 from ..scene import load_scene
-from . import attempt, classify, finite, fmt, no_scene, save
+from ..labels import fmt
+from . import attempt, classify, finite, no_scene, save
 from .problems import robustness_scene
 
 __all__ = ["RobustnessRow", "run_robustness", "summary_table", "matrix_table", "failure_table",

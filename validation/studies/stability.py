@@ -32,8 +32,9 @@ from dataclasses import asdict, dataclass, field
 from bem.reference import hertz_sphere
 
 from ..compare import pair_metrics
+from ..labels import fmt
 from ..progress import each
-from . import STATUSES, attempt, classify, finite, fmt, no_scene, save
+from . import STATUSES, attempt, classify, finite, no_scene, save
 from .problems import LIMIT_TOL, methods, stability_cases
 
 __all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main", "STEM",
@@ -55,8 +56,8 @@ class StabilityFailure(RuntimeError):
 
     def __init__(self, rows, study=None):
         self.rows, self.study = list(rows), study
-        lines = [f"{r.case} / {r.solver} {r.method}: error {fmt(r.error_vs_reference)} > tol {fmt(r.tolerance)} "
-                 f"({r.message})" for r in self.rows]
+        lines = [f"{r.case} / {r.solver} {r.method}: error {fmt(r.error_vs_reference, '.2e')} > "
+                 f"tol {fmt(r.tolerance, '.2e')} ({r.message})" for r in self.rows]
         super().__init__(f"{len(self.rows)} wrong outcome(s) in the stability study:\n  " + "\n  ".join(lines))
 
 

@@ -34,8 +34,9 @@ import time
 
 import numpy as np
 
+from ..labels import fmt
 from ..progress import each
-from . import fmt, no_scene, save
+from . import no_scene, save
 from .two_scale_models import (TiledRoughness, greenwood_tripp_law, nominal_radius, spectral_moments,
                                windowed)
 

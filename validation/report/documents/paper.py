@@ -311,14 +311,15 @@ def _validation(res, work):
         items += run_figures.profiles(results_of(outcome, units="dimensionless", hertz_peak="p_0"), folder)
         b, f = outcome.bem, outcome.fem
         rows.append((case, b.p_max / res.p0, f.p_max / res.p0, f"{(b.p_max - f.p_max) / f.p_max:+.2%}",
-                     b.contact_radius / res.a, f.contact_radius / res.a, b.approach / res.approach,
+                     b.contact_radius / res.a, f.edge_radius / res.a, b.approach / res.approach,
                      f.approach / res.approach, b.wall_time_s, f.wall_time_s,
                      "converged" if (b.converged and f.converged) else "failed"))
     items.append(Table(("case", "BEM p_max / p_0", "FEM p_max / p_0", "rel. difference", "BEM r_c / a_H",
-                        "FEM r_c / a_H", "BEM delta / delta_H", "FEM delta / delta_H", "BEM time [s]", "FEM time [s]",
+                        "FEM r_edge / a_H", "BEM delta / delta_H", "FEM delta / delta_H", "BEM time [s]", "FEM time [s]",
                         "status"), tuple(rows), status_column="status",
                        caption="BEM against FEM (Hertz: p_max / p_0 = 1, r_c / a_H = 1, delta / delta_H = 1). BEM r_c "
-                               "= sqrt(A/pi) from the loaded nodes; FEM r_c from the closure crossing zero."))
+                               "= sqrt(A/pi) from the loaded nodes; FEM r_edge: the edge of the loaded zone, "
+                               "interpolated between the interface nodes."))
     smooth = results_of(res.validation["smooth"], units="dimensionless", hertz_peak="p_0")
     items.append(run_figures.fem_von_mises(smooth, work / "validation_smooth"))
     wp = plot_work_precision(res.work_precision, work / "fig_work_precision.png",

@@ -35,7 +35,8 @@ STAGES = ("reading", "figures", "writing")
 #: rows of the results table: (key in result.json / fem / analytic, label, unit kind)
 _QUANTITIES = (("p_max", "peak pressure p_max", "pressure"), ("force", "total force P", "force"),
                ("approach", "approach delta", "length"), ("contact_area", "contact area A", "area"),
-               ("contact_radius", "contact radius r_c", "length"))
+               ("contact_radius", "contact radius r_c", "length"),
+               ("edge_radius", "edge radius of the loaded zone r_edge", "length"))
 #: ratio rows: (key, label, key in result["scales"])
 _RATIOS = (("p_max", "p_max / p_H (Hertz peak)", "p_hertz"), ("contact_radius", "r_c / a_H (Hertz radius)", "a_hertz"),
            ("approach", "delta / delta_H (Hertz approach)", "approach_hertz"))
@@ -48,6 +49,7 @@ _FEM_TIMES = (("mesh", "mesh generation"), ("assembly", "assembly"), ("factorize
               ("recover", "stress recovery"), ("total", "total"))
 _METRICS = {"l2_rel": "relative L2 error of p", "max_rel": "max |p - p_ref| / max p_ref",
             "peak_rel": "peak pressure (a - b) / b", "contact_radius_rel": "contact radius (a - b) / b",
+            "edge_radius_rel": "radius (a - b) / b: BEM sqrt(A/pi) vs FEM interpolated edge",
             "approach_rel": "approach (a - b) / b", "force_rel": "force (a - b) / b",
             "n_points": "nodes compared (union of contacts)"}
 
@@ -98,8 +100,9 @@ def summary(res, work):
         text.append("Run messages: " + "; ".join(map(str, res.data["messages"])) + ".")
     caption = "Key results, in the report's units (problem statement)."
     if res.axisymmetric:
-        caption += " BEM: r_c = sqrt(A / pi), A = loaded node count times the node area" + (
-            "; FEM: edge of the loaded zone, interpolated between the interface nodes." if res.fem is not None else ".")
+        caption += " r_c = sqrt(A / pi), A = loaded node count times the node area" + (
+            "; r_edge (FEM): edge of the loaded zone, interpolated between the interface nodes."
+            if res.fem is not None else ".")
     else:
         caption += " Half-widths: the farthest loaded node along each axis."
     if res.get("scales"):
@@ -141,7 +144,7 @@ def fem_field(res, work):
             ("elements", fmt(fem.get("n_elements")), "-"),
             ("elements across the contact radius", fmt(fem.get("n_elements_across_contact"), 3), "-")]
     optional = ((mesh, "h_fine", "element size at the contact", length),
-                (mesh, "extent_factor", "mesh half-size / estimated contact radius", res.display("-")),
+                (mesh, "domain_factor", "mesh half-size / estimated contact radius", res.display("-")),
                 (penalty, "relative_penetration", "penalty: largest penetration / approach", res.display("-")))
     rows += [(label, fmt(part[key] / unit.factor), unit.name) for part, key, label, unit in optional
              if is_number(part.get(key))]

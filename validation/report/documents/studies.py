@@ -29,9 +29,9 @@ def is_study_dir(directory):
 
 
 def _label(row):
-    from validation.studies.error_time import method_label
+    from validation.studies.error_time import method_with_relaxation
 
-    return method_label(row["method"], row.get("relaxation"))
+    return method_with_relaxation(row["method"], row.get("relaxation"))
 
 
 def _error_time_sections(data, work):

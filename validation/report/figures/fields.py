@@ -125,10 +125,10 @@ def von_mises_of(fem_result):
     from fem_reference.fields import nodal_stresses
 
     model = getattr(fem_result, "model", None)
-    if model is None or getattr(fem_result, "displacement", None) is None:
-        raise InputError("fem_result has no model/displacement: it must come from fem_reference.solve.")
+    if model is None or getattr(fem_result, "displacement_dofs", None) is None:
+        raise InputError("fem_result has no model/displacement_dofs: it must come from fem_reference.solve.")
     basis = model.scalar_basis
-    vm = nodal_stresses(model, fem_result.displacement)["von_mises"]
+    vm = nodal_stresses(model, fem_result.displacement_dofs)["von_mises"]
     return basis.mesh.p[0], basis.mesh.p[1], basis.mesh.t.T, vm[basis.nodal_dofs[0]]
 
 

@@ -294,7 +294,7 @@ def fem_von_mises(res, work):
     if res.fem_field is None:
         return None
     r, z, tri, vm = res.fem_field
-    rc = float(res.fem.get("contact_radius") or res.data.get("contact_radius") or 0.0)
+    rc = float(res.fem.get("edge_radius") or res.data.get("contact_radius") or 0.0)
     (a, l_name, normalised), (p0, s_name, _) = scale(res, "length"), scale(res, "pressure")
     hertz = normalised and l_name == "a_H"  # the figure's default labels
     labels = None if hertz else {k: axis_label(k, (a, l_name, normalised)) for k in ("r", "z")}

@@ -14,6 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from bem.checks import InputError
+from validation.labels import fmt
 
 __all__ = ["Figure", "Table", "Section", "KINDS", "status_class", "fmt", "fmt_distinct", "problem_section",
            "table_from_rows"]
@@ -43,23 +44,11 @@ def status_class(status):
     return "other"
 
 
-def fmt(value, digits=4):
-    """A cell of a table: floats with ``digits`` significant digits (``%g``), ints as they are,
-    booleans as yes/no, ``None`` as "-"."""
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, float) and math.isfinite(value):
-        return f"{value:.{digits}g}"
-    return str(value)
-
-
 def fmt_distinct(values, digits=4, most=9):
-    """Cells of values compared side by side (one row of solvers): :func:`fmt` with the fewest
-    significant digits, from ``digits`` up to ``most``, at which values that differ print
-    differently (``1.3713e+09`` and ``1.3708e+09``, not ``1.371e+09`` twice); not numbers
-    and ``None`` as :func:`fmt`."""
+    """Cells of values compared side by side (one row of solvers): :func:`validation.labels.fmt`
+    with the fewest significant digits, from ``digits`` up to ``most``, at which values that
+    differ print differently (``1.3713e+09`` and ``1.3708e+09``, not ``1.371e+09`` twice); not
+    numbers and ``None`` as :func:`validation.labels.fmt`."""
     numbers = sorted({float(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool)
                       and math.isfinite(v)})
     for n in range(digits, most + 1):
@@ -99,7 +88,7 @@ class Figure:
 
 @dataclass(frozen=True)
 class Table:
-    """A table; cells are formatted with :func:`fmt`.
+    """A table; cells are formatted with :func:`validation.labels.fmt`.
 
     Attributes
     ----------
