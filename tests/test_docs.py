@@ -157,7 +157,7 @@ _FILE_TABLE = ("result.json", "scene.toml", "bem_field.vtu", "fem_field.vtu", "s
 def test_results_doc_units_of_the_main_fields():
     rows = _table_rows((DOCS / "results.md").read_text())
     units = {"p_max": "Pa", "force": "N", "approach": "m", "contact_area": "m^2", "contact_radius": "m",
-             "wall_time_s.bem": "s", "fem.p_max": "Pa", "layer.c_nn": "m/Pa", "layer.alpha_c": "rad"}
+             "wall_time_s_by_part.bem": "s", "fem.p_max": "Pa", "layer.c_nn": "m/Pa", "layer.alpha_c": "rad"}
     for key, unit in units.items():
         assert rows[key][2] == unit, key
     text = (DOCS / "results.md").read_text()

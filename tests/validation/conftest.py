@@ -2,12 +2,12 @@
 
 import contextlib
 import io
-import json
 import math
 
 import pytest
 
 from validation.cli import main
+from validation.run.record import RunResult
 
 #: --set overrides that keep every built-in scene fast (BEM < 0.2 s, FEM < 1 s here).
 SMALL = {
@@ -56,6 +56,6 @@ def builtin_runs(tmp_path_factory):
         for s in small:
             args += ["--set", s]
         code, stdout, stderr = cli(*args)
-        result = json.loads((out / "result.json").read_text()) if (out / "result.json").exists() else None
+        result = RunResult.read(out / "result.json") if (out / "result.json").exists() else None
         runs[name] = {"code": code, "stdout": stdout, "stderr": stderr, "result": result, "dir": out}
     return runs

@@ -7,6 +7,7 @@ import types
 import pytest
 
 from validation.cli import build_parser, main
+from validation.run.record import RunResult
 
 from .conftest import cli
 
@@ -235,9 +236,9 @@ def test_no_fem_runs_a_builtin_scene_on_a_core_install(tmp_path, core_install):
     assert code == 2 and "install contactlab[fem]" in err and not (tmp_path / "fem").exists()
     code, out, err = cli("run", "hertz", "--no-fem", "--out", tmp_path / "r", *small)
     assert code == 0, err
-    result = json.loads((tmp_path / "r" / "result.json").read_text())
-    assert result["converged"] and "fem" not in result and result["analytic"]["kind"] == "hertz"
-    assert "FEM reference skipped" in out and "FEM reference skipped" in " ".join(result["messages"])
+    result = RunResult.read(tmp_path / "r" / "result.json")
+    assert result.converged and result.fem is None and result.analytic.kind == "hertz"
+    assert "FEM reference skipped" in out and "FEM reference skipped" in " ".join(result.messages)
     assert "[fem]" not in (tmp_path / "r" / "scene.toml").read_text()
     code, out, err = cli("sweep", "hertz", "--no-fem", "--param", "load.force", "--values", "50,100",
                          "--workers", "1", "--out", tmp_path / "s", *small)
@@ -247,16 +248,18 @@ def test_no_fem_runs_a_builtin_scene_on_a_core_install(tmp_path, core_install):
 
 
 def test_run_summary_prints_any_value_of_a_result():
-    from validation.cli.run import _summary
+    from dataclasses import replace
 
-    result = {"scene": "s", "title": "t", "units": "SI", "unit_symbols": {"length": "m", "pressure": "Pa",
-                                                                          "force": "N"},
-              "p_max": None, "fem": {"p_max": 0.0}, "analytic": {"kind": "hertz", "p_max": None},
-              "contact_radius": None, "contact_area": 1e308, "force": 100.0, "approach": None,
-              "alpha_b": None, "converged": False, "method": "newton", "iterations": 3, "kkt_residual": None,
-              "wall_time_s": {"bem": 0.5, "fem": None}, "messages": ["BEM did not converge"],
-              "stress": {"bodies": {"body1": {"location_of_max": [0.0, 0.0, 1e308], "max_von_mises": None,
-                                              "max_tresca": None}}}, "files": {"result": "result.json"}}
+    from validation.cli.run import _summary
+    from validation.run import run_scene
+
+    base = run_scene("hertz", overrides=["bem.nodes_across=12", "fem.n_contact=6"])
+    body = replace(base.stress.bodies["body1"], location_of_max=[0.0, 0.0, 1e308], max_von_mises=None,
+                   max_tresca=None)
+    result = replace(base, p_max=None, fem=replace(base.fem, p_max=0.0), analytic=replace(base.analytic, p_max=None),
+                     contact_area=1e308, approach=None, kkt_residual=None, converged=False,
+                     wall_time_s_by_part={"bem": 0.5, "fem": None}, messages=["BEM did not converge"],
+                     stress=replace(base.stress, bodies={"body1": body}), files={"result": "result.json"})
     text = _summary(result, "out")
     assert "p_max      - Pa   (FEM 0)   (hertz -)" in text and "approach - m" in text
     assert "area 1e+308 m^2" in text and "at depth 1e+308 m" in text and "KKT residual -" in text

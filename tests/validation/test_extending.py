@@ -47,9 +47,9 @@ def test_a_new_gap_type_is_checked_sized_and_solved_by_the_scenes(registered, tm
     # sized by the generic axisymmetric estimate, the paraboloid through the contact edge: 8 E* a h(a) = 3 P
     assert scene.bem["expected"][0] == pytest.approx(math.sqrt(3 * FORCE / (8 * E_STAR * SLOPE)), rel=1e-9)
     result = run_scene(scene, tmp_path / "cone")
-    assert result["converged"] and (tmp_path / "cone" / "bem_field.vtu").is_file()
-    assert result["contact_radius"] == pytest.approx(a, abs=2 * scene.bem["step"])
-    assert result["approach"] == pytest.approx(math.pi * a * SLOPE / 2, rel=1e-3)  # measured 3.9e-5
+    assert result.converged and (tmp_path / "cone" / "bem_field.vtu").is_file()
+    assert result.contact_radius == pytest.approx(a, abs=2 * scene.bem["step"])
+    assert result.approach == pytest.approx(math.pi * a * SLOPE / 2, rel=1e-3)  # measured 3.9e-5
     # the report's problem statement describes the shape by its docstring, with its parameter
     from validation.report import report_results_dir
 

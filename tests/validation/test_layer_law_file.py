@@ -40,7 +40,7 @@ def test_a_scene_loads_a_topography_law_file_and_solves_as_the_inline_table(topo
     assert by_file.bem.approach == inline.bem.approach
     assert np.array_equal(by_file.bem.p, inline.bem.p)
     assert by_file.bem.closure.max() > 0.3 * topography_law.closure[0]  # the layer takes part
-    assert by_file.result["layer"]["parameters"] == topography_law.layer_table()
+    assert by_file.result.layer["parameters"] == topography_law.layer_table()
 
 
 def test_the_law_file_is_hashed_as_a_file_the_scene_names(topography_law, tmp_path):
@@ -95,11 +95,11 @@ def test_a_scene_loaded_beyond_its_law_file_notes_it_in_the_result_messages(topo
                                                                   "w": w.tolist()}}))
     run = execute_scene(load_scene(_scene_file(tmp_path, {"law": "tabulated", "file": "short.toml"})))
     assert run.bem.converged and run.bem.p_max > p[-1]
-    notes = [m for m in run.result["messages"] if "exceeds the tabulated layer law's range" in m]
+    notes = [m for m in run.result.messages if "exceeds the tabulated layer law's range" in m]
     assert len(notes) == 1 and notes[0].startswith("BEM: the peak pressure")
     assert f"0 <= p <= {p[-1]:.6g}" in notes[0] and f"p_max = {run.bem.p_max:.6g}" in notes[0]
     inline = execute_scene(load_scene(_scene_file(tmp_path, topography_law.layer_table(), "inline.toml")))
-    assert not any("exceeds" in m for m in inline.result["messages"])
+    assert not any("exceeds" in m for m in inline.result.messages)
 
 
 def test_set_layer_file_replaces_an_inline_table_and_back(topography_law, tmp_path):

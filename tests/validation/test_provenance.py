@@ -50,7 +50,7 @@ def test_result_json_records_provenance(elliptic_dir):
 
 def test_fem_run_records_the_fem_packages(tmp_path):
     result = run_scene("hertz", overrides=["bem.nodes_across=12", "fem.n_contact_elements=6"])
-    packages = result["provenance"]["packages"]
+    packages = result.provenance["packages"]
     assert packages["gmsh"] == metadata.version("gmsh") and packages["skfem"] == metadata.version("scikit-fem")
 
 

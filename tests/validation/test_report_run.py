@@ -107,7 +107,7 @@ def test_problem_statement_of_the_layer_scene(reports):
     assert float(rows[label][0]) * 1e6 == pytest.approx(es, rel=1e-3) and rows[label][1] == "MPa"
     assert rows["gap R"] == ("10", "mm") and rows["load: total force P (force control)"] == ("100", "N")
     assert rows["interface layer"][0].startswith("elastic-rigid")
-    params = rep["res"].data["layer"]["parameters"]
+    params = rep["res"].result.layer["parameters"]
     assert float(rows["layer p_cr"][0]) * 1e6 == pytest.approx(params["p_cr"], rel=1e-3)
     assert rows["layer p_cr"][1] == "MPa" and rows["layer lam"][1] == "mm/MPa"
     assert float(rows["layer lam"][0]) * 1e-3 / 1e6 == pytest.approx(params["lam"], rel=1e-3)  # mm/MPa -> m/Pa
@@ -129,8 +129,8 @@ def test_profile_window_holds_the_contact_normalised(reports):
     scene = rep["scene"]
     b = scene["bodies"]
     a_h, p_h, _ = hertz(scene["load"]["force"], scene["gap"]["R"], e_star(b["E1"], b["nu1"], b["E2"], b["nu2"]))
-    prof = rep["res"].data["profile"]
-    x, p = np.array(prof["x"]), np.array(prof["p"])
+    prof = rep["res"].result.profile
+    x, p = np.array(prof.x), np.array(prof.p)
     assert not profile_view(rep["res"], [(x, p)]).normalised  # an SI scene is drawn in mm and MPa by default
     view = profile_view(load_results(rep["dir"], units="dimensionless"), [(x, p)])
     assert view.x_label == r"$x\,/\,a_H$" and view.p_label == r"contact pressure $p\,/\,p_H$"
@@ -144,8 +144,8 @@ def test_profile_window_holds_the_contact_normalised(reports):
 
 def test_profile_window_holds_the_contact_in_scene_units(reports):
     rep = reports["roller"]
-    prof = rep["res"].data["profile"]
-    for key, line in (("x", prof), ("y", prof["y_axis"])):
+    prof = rep["res"].result.profile
+    for key, line in (("x", {"x": prof.x, "p": prof.p}), ("y", prof.y_axis)):
         s, p = np.array(line[key]), np.array(line["p"])
         view = profile_view(rep["res"], [(s, p)], axis=key)
         assert not view.normalised
@@ -155,19 +155,19 @@ def test_profile_window_holds_the_contact_in_scene_units(reports):
         assert view.x_factor == 1e-3 and view.p_factor == 1e6  # SI scene: mm and MPa
         assert "[mm]" in view.x_label and "[MPa]" in view.p_label
     # dimensionless: divided by the peak pressure and the contact half-width (no Hertz scale for a roller)
-    view = profile_view(load_results(rep["dir"], units="dimensionless"), [(np.array(prof["x"]), np.array(prof["p"]))])
-    assert view.normalised and view.p_factor == pytest.approx(rep["res"].data["p_max"])
-    assert view.x_factor == pytest.approx(rep["res"].data["contact_extent"]["x"])
+    view = profile_view(load_results(rep["dir"], units="dimensionless"), [(np.array(prof.x), np.array(prof.p))])
+    assert view.normalised and view.p_factor == pytest.approx(rep["res"].result.p_max)
+    assert view.x_factor == pytest.approx(rep["res"].result.contact_extent["x"])
     assert view.x_label == r"$x\,/\,a_c$" and view.p_label == r"contact pressure $p\,/\,p_{max}$"
     length = rep["scene"]["gap"]["length"]
-    x_edge = np.abs(np.array(prof["x"])[np.array(prof["p"]) > 0]).max()
+    x_edge = np.abs(np.array(prof.x)[np.array(prof.p) > 0]).max()
     assert 0.8 * length / 2 < x_edge <= length / 2  # the crowned roller loads nearly its whole length
 
 
 def test_sections_follow_the_data(reports):
     titles = {name: [s.title for s in rep["sections"]] for name, rep in reports.items()}
     for name, rep in reports.items():  # comparison metrics exactly when the run recorded them
-        assert (titles[name][-1] == "Comparison metrics") == bool(rep["res"].data.get("comparison")), name
+        assert (titles[name][-1] == "Comparison metrics") == (rep["res"].result.comparison is not None), name
         assert rep["sections"][-1].kind == "validation" or titles[name][-1] != "Comparison metrics"
         if titles[name][-1] == "Comparison metrics":
             titles[name].pop()
@@ -198,7 +198,7 @@ def test_bem_only_report_has_no_fem(reports, name):
 
 def test_fem_section_and_columns(reports):
     rep = reports["hertz"]
-    data = rep["res"].data
+    data = rep["res"].result
     html = rep["built"].html.read_text(encoding="utf-8")
     assert_valid_offline_html(html)
     assert 'class="kind-fem"' in html
@@ -206,28 +206,28 @@ def test_fem_section_and_columns(reports):
     assert table.columns == ("quantity", "BEM", "FEM", "closed form", "unit")
     fem_sec = next(s for s in rep["sections"] if s.kind == "fem")
     fem_rows = {r[0]: r[1] for r in fem_sec.items[0].rows}
-    assert fem_rows["degrees of freedom"] == str(data["fem"]["n_dofs"])
-    assert float(fem_rows["wall time: total"]) == pytest.approx(data["fem"]["timings"]["total"], rel=1e-2)
+    assert fem_rows["degrees of freedom"] == str(data.fem.n_dofs)
+    assert float(fem_rows["wall time: total"]) == pytest.approx(data.fem.timings["total"], rel=1e-2)
     # ratios to Hertz: independent closed form
     scene = rep["scene"]
     b = scene["bodies"]
     a_h, p_h, d_h = hertz(scene["load"]["force"], scene["gap"]["R"], e_star(b["E1"], b["nu1"], b["E2"], b["nu2"]))
     ratio = _row(table, "p_max / p_H (Hertz peak)")
-    assert float(ratio[1]) == pytest.approx(data["p_max"] / p_h, rel=1e-3)
+    assert float(ratio[1]) == pytest.approx(data.p_max / p_h, rel=1e-3)
     assert float(ratio[3]) == pytest.approx(1.0, rel=1e-3)  # the closed form is Hertz
     assert float(_row(table, "delta / delta_H (Hertz approach)")[3]) == pytest.approx(1.0, rel=1e-3)
     run_rows = {r[0]: r[1] for r in next(s for s in rep["sections"] if s.title == "Solver and timings").items[0].rows}
-    assert run_rows["iterations (finest lattice)"] == str(data["iterations"])
-    assert float(run_rows["lattice step c"]) * 1e-3 == pytest.approx(data["bem"]["step"], rel=1e-3)  # mm
+    assert run_rows["iterations (finest lattice)"] == str(data.iterations)
+    assert float(run_rows["lattice step c"]) * 1e-3 == pytest.approx(data.bem.step, rel=1e-3)  # mm
 
 
 def test_comparison_metrics_when_recorded(reports, tmp_path):
     d = tmp_path / "run"
     shutil.copytree(reports["hertz"]["dir"], d)
     data = json.loads((d / "result.json").read_text())
-    pair = {"l2_rel": 0.0123, "max_rel": 0.02, "peak_rel": -0.0004, "contact_radius_rel": 0.003,
-            "approach_rel": 1e-5, "force_rel": 0.0, "n_points": 321}
-    data["comparison"] = {"bem_vs_fem": pair, "bem_vs_analytic": dict(pair, l2_rel=0.5),
+    pair = {"l2_rel": 0.0123, "max_rel": 0.02, "peak_rel": -0.0004, "contact_radius_rel": None,
+            "edge_radius_rel": 0.003, "approach_rel": 1e-5, "force_rel": 0.0, "n_points": 321}
+    data["comparison"] = {"bem_vs_fem": pair, "bem_vs_analytic": dict(pair, l2_rel=0.5), "fem_vs_analytic": None,
                           "force_balance": {"target": 100.0, "bem": 1e-12, "fem": 2e-4}}
     (d / "result.json").write_text(json.dumps(data))
     sections = run_sections(load_results(d), tmp_path / "fig")
@@ -277,9 +277,9 @@ def test_units_parsing_and_display():
 
 def test_report_does_not_modify_the_results(reports, tmp_path):
     res = reports["paper_elastic_rigid"]["res"]
-    before = copy.deepcopy(res.data), copy.deepcopy(res.scene), [a.copy() for a in res.bem_field]
+    before = copy.deepcopy(res.result), copy.deepcopy(res.scene), [a.copy() for a in res.bem_field]
     run_sections(res, tmp_path, SECTIONS)
-    assert res.data == before[0] and res.scene == before[1]
+    assert res.result == before[0] and res.scene == before[1]
     assert all(np.array_equal(a, b) for a, b in zip(res.bem_field, before[2]))
     files = sorted(p.name for p in reports["paper_elastic_rigid"]["dir"].iterdir())
     assert files == [".contactlab", "bem_field.vtu", "fem_field.vtu", "result.json", "scene.toml"]
@@ -287,10 +287,10 @@ def test_report_does_not_modify_the_results(reports, tmp_path):
 
 def test_captions_say_how(reports, tmp_path):
     rep = reports["hertz"]
-    data = rep["res"].data
+    data = rep["res"].result
     captions = [i.caption for s in rep["sections"] for i in s.items if isinstance(i, Figure)]
     profile = next(c for c in captions if c.startswith("Contact pressure along"))
-    assert "Kalker QP" in profile and "tolerance 1e-10" in profile and f"{data['bem']['n_nodes']} candidate" in profile
+    assert "Kalker QP" in profile and "tolerance 1e-10" in profile and f"{data.bem.n_nodes} candidate" in profile
     assert re.search(r"FEM: axisymmetric quadratic triangles, [\d.]+ elements across", profile)
     assert "p_H = " not in profile  # drawn in mm and MPa
     sections = run_sections(load_results(rep["dir"], units="dimensionless"), tmp_path)

@@ -10,6 +10,7 @@ import pytest
 
 from validation.report import FIGURES, SECTIONS, report_results_dir
 from validation.report.documents.results import load_results
+from validation.run.record import ResultFileError
 from validation.report.documents.sections import run_sections
 from validation.report.render import Figure, Section, Table
 from validation.run import run_scene
@@ -28,9 +29,7 @@ def _with_report(src, dst, report):
     """A copy of the result directory ``src`` whose result.json holds ``report`` (None: no [report])."""
     shutil.copytree(src, dst)
     data = json.loads((dst / "result.json").read_text())
-    data.pop("report", None)
-    if report is not None:
-        data["report"] = report
+    data["report"] = report
     (dst / "result.json").write_text(json.dumps(data))
     return dst
 
@@ -68,8 +67,8 @@ def test_without_report_every_supported_section(elliptic_dir, tmp_path):
 def test_a_new_section_and_a_new_figure_are_one_function_and_one_line_each(elliptic_dir, tmp_path, monkeypatch):
     def toy_section(res, work):
         """A section of its own: a table of two numbers of the results."""
-        return Section("Toy section", items=(Table(("quantity", "value"), (("toy p_max", res.data["p_max"]),
-                                                                            ("toy force", res.data["force"]))),))
+        return Section("Toy section", items=(Table(("quantity", "value"), (("toy p_max", res.result.p_max),
+                                                                            ("toy force", res.result.force))),))
 
     def toy_figure(res, work):
         """A figure placed in the Results section."""
@@ -105,8 +104,8 @@ def test_scene_schema_names_the_registered_sections():
 
 
 def test_units_are_the_recorded_symbols(elliptic_dir, tmp_path):
-    """The report draws in result.json's unit_symbols; only a result written before they were recorded
-    has its units label parsed."""
+    """The report draws in result.json's unit_symbols, whatever its units label says; a result without
+    them is refused, naming the missing field."""
     d = _with_report(elliptic_dir, tmp_path / "symbols", None)
     data = json.loads((d / "result.json").read_text())
     assert data["unit_symbols"] == {"length": "m", "pressure": "Pa", "force": "N"}
@@ -114,8 +113,8 @@ def test_units_are_the_recorded_symbols(elliptic_dir, tmp_path):
     (d / "result.json").write_text(json.dumps(data))
     res = load_results(d)
     assert (res.units.length, res.units.pressure, res.units.force) == ("m", "Pa", "N")
-    del data["unit_symbols"]  # an older result: the label is all there is
-    (d / "result.json").write_text(json.dumps(data))
-    res = load_results(d)
-    assert (res.units.length, res.units.pressure, res.units.force) == ("mm", "MPa", "N")
     assert [r[-1] for r in run_sections(res, tmp_path / "w", ["summary"])[0].items[0].rows][:2] == ["MPa", "N"]
+    del data["unit_symbols"]
+    (d / "result.json").write_text(json.dumps(data))
+    with pytest.raises(ResultFileError, match=r"result\.unit_symbols is missing in .*result\.json"):
+        load_results(d)

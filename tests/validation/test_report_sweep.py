@@ -65,12 +65,12 @@ def test_sweep_figures_show_every_point(sweep_dir, tmp_path, drawn):
     assert len(ax.get_lines()) == len(FORCES)
     np.testing.assert_allclose(bar.get_yticks(), FORCES)
     for ln, (_row, res) in zip(ax.get_lines(), points):
-        assert ln.get_ydata().max() * 1e6 == pytest.approx(res.data["p_max"], rel=0.02)  # MPa, as labelled
+        assert ln.get_ydata().max() * 1e6 == pytest.approx(res.result.p_max, rel=0.02)  # MPa, as labelled
     assert "MPa" in ax.get_ylabel()
     p_panel = scalars.axes[0]
     (line,) = p_panel.get_lines()
     np.testing.assert_allclose(line.get_xdata(), FORCES)
-    np.testing.assert_allclose(line.get_ydata() * 1e6, [res.data["p_max"] for _, res in points])
+    np.testing.assert_allclose(line.get_ydata() * 1e6, [res.result.p_max for _, res in points])
     assert "MPa" in p_panel.get_ylabel() and scalars.axes[-1].get_xlabel()
 
 
@@ -101,4 +101,4 @@ def test_report_stages_reach_the_progress_callback(tmp_path):
     report_results_dir(tmp_path / "run", tmp_path / "rep", progress=lambda *a: calls.append(a))
     assert calls == [(s, k, len(STAGES)) for k, s in enumerate(STAGES)] + [("done", len(STAGES), len(STAGES))]
     res = load_results(tmp_path / "run")
-    assert not res.dimensionless and np.isfinite(res.data["p_max"])
+    assert not res.dimensionless and np.isfinite(res.result.p_max)

@@ -97,15 +97,14 @@ def test_one_unit_per_quantity_in_every_table_caption_and_axis(runs, tmp_path, m
 
 
 @pytest.mark.parametrize(("length_unit", "spacing_mm"), [("um", 0.002), (1e-6, 0.002), ("mm", 2.0)])
-def test_a_measured_gaps_spacing_is_shown_in_the_reports_length_unit(tmp_path, length_unit, spacing_mm):
+def test_a_measured_gaps_spacing_is_shown_in_the_reports_length_unit(runs, tmp_path, length_unit, spacing_mm):
     """A measured file's spacing, given in the file's length unit (a symbol or the factor to the
     scene's unit), is shown in the report's length unit like every other length."""
-    from pathlib import Path
+    from dataclasses import replace
 
     from validation.report.documents.problem import scene_section
-    from validation.report.documents.results import RunResults
 
     scene = {"gap": {"type": "measured", "file": "surface.csv", "spacing": 2.0, "length_unit": length_unit}}
-    res = RunResults(directory=Path("."), data={"units": "SI (m, Pa, N)"}, scene=scene)
+    res = replace(load_results(runs / "hertz"), scene=scene)
     rows = {r[0]: r[1:] for r in scene_section(res, tmp_path).items[0].rows}
     assert rows["gap spacing"][1] == "mm" and float(rows["gap spacing"][0]) == pytest.approx(spacing_mm, rel=1e-12)

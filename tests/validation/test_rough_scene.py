@@ -14,6 +14,7 @@ import pytest
 
 from validation.run import run_scene
 from validation.run.periodic import contact_spots
+from validation.run.record import RunResult
 from validation.scene import SceneError, load_scene, parse_scene
 from validation.scene.load import read_toml
 from validation.scene.source import builtin_path
@@ -150,11 +151,11 @@ def test_surface_file_outside_the_scene_folder_is_refused(tmp_path):
 
 def test_force_on_one_cell_is_the_mean_pressure_times_the_cell():
     by_pressure = run_scene(_base())
-    lx, ly = by_pressure["bem"]["size"]
-    by_force = run_scene(_base(), overrides={"load.force": by_pressure["mean_pressure"] * lx * ly})  # replaces it
-    assert by_force["mean_pressure"] == pytest.approx(by_pressure["mean_pressure"], rel=1e-12)
-    assert by_force["contact_fraction"] == by_pressure["contact_fraction"]
-    assert by_force["approach"] == pytest.approx(by_pressure["approach"], rel=1e-8)
+    lx, ly = by_pressure.bem.size
+    by_force = run_scene(_base(), overrides={"load.force": by_pressure.periodic.mean_pressure * lx * ly})  # replaces it
+    assert by_force.periodic.mean_pressure == pytest.approx(by_pressure.periodic.mean_pressure, rel=1e-12)
+    assert by_force.periodic.contact_fraction == by_pressure.periodic.contact_fraction
+    assert by_force.approach == pytest.approx(by_pressure.approach, rel=1e-8)
 
 
 @pytest.fixture(scope="module")
@@ -182,25 +183,25 @@ def drawn(monkeypatch):
 
 def test_run_rough_flat_records_what_its_field_shows(rough_run):
     out, stdout = rough_run
-    r = json.loads((out / "result.json").read_text())
+    r = RunResult.read(out / "result.json")
     points, _, data, _, _ = read_vtu(out / "bem_field.vtu")
     p, gap = data["p"], data["gap"]
-    n_cols, n_rows = r["bem"]["cell"]
-    step = r["bem"]["step"]
-    assert p.size == n_cols * n_rows == r["bem"]["n_nodes"]
+    n_cols, n_rows = r.bem.cell
+    step = r.bem.step
+    assert p.size == n_cols * n_rows == r.bem.n_nodes
     lx, ly = n_cols * step, n_rows * step * SQRT3 / 2
-    assert r["converged"] and r["periodic"]
-    assert r["contact_fraction"] == np.count_nonzero(p > 0) / p.size
-    assert 0.01 < r["contact_fraction"] < 0.2
-    assert r["mean_pressure"] == pytest.approx(SQRT3 / 2 * step**2 * p.sum() / (lx * ly), rel=1e-12)
-    assert r["mean_pressure"] == pytest.approx(read_toml(builtin_path("rough_flat"))["load"]["mean_pressure"],
+    assert r.converged and r.periodic is not None
+    assert r.periodic.contact_fraction == np.count_nonzero(p > 0) / p.size
+    assert 0.01 < r.periodic.contact_fraction < 0.2
+    assert r.periodic.mean_pressure == pytest.approx(SQRT3 / 2 * step**2 * p.sum() / (lx * ly), rel=1e-12)
+    assert r.periodic.mean_pressure == pytest.approx(read_toml(builtin_path("rough_flat"))["load"]["mean_pressure"],
                                                rel=1e-8)
-    assert r["mean_gap"] == pytest.approx(gap.mean(), rel=1e-12)
+    assert r.periodic.mean_gap == pytest.approx(gap.mean(), rel=1e-12)
     reference, count = _flood_fill(points[:, 0], points[:, 1], p > 0, (lx, ly), step)
-    assert r["n_spots"] == r["spots"]["count"] == count > 10
+    assert r.periodic.n_spots == r.periodic.spots.count == count > 10
     assert _same_partition(data["contact_spot"], reference)
     assert np.all(data["contact_spot"][p <= 0] == -1)
-    s = r["surface"]
+    s = r.periodic.surface
     assert s["rms_slope"] == pytest.approx(0.1, rel=1e-12)  # the scene's rms_slope
     assert s["stretch_y"] == pytest.approx(ly / s["size"][1], rel=1e-12)
     h = data["initial_gap"]
@@ -224,27 +225,27 @@ def test_report_maps_show_the_pressure_and_the_spots(rough_run, drawn):
     out, _ = rough_run
     code, _, stderr = cli("report", out)
     assert code == 0, stderr
-    r = json.loads((out / "result.json").read_text())
+    r = RunResult.read(out / "result.json")
     md = (out / "report" / "report.md").read_text()
-    assert "Rough surface on a flat: the periodic cell" in md and "| contact spots | " + str(r["n_spots"]) in md
+    assert "Rough surface on a flat: the periodic cell" in md and "| contact spots | " + str(r.periodic.n_spots) in md
     assert "| load: mean pressure over the cell | 200 | MPa |" in md and "| gap long_cutoff | 0.25 | mm |" in md
     (fig,) = drawn
     ax_p, ax_s, bar = fig.axes
     image = ax_p.images[0].get_array()
-    assert image.max() == pytest.approx(r["p_max"] / 1e6)  # MPa, as every pressure of the report
-    assert np.count_nonzero(~np.ma.getmaskarray(image)) == r["bem"]["n_contact"]
+    assert image.max() == pytest.approx(r.p_max / 1e6)  # MPa, as every pressure of the report
+    assert np.count_nonzero(~np.ma.getmaskarray(image)) == r.bem.n_contact
     assert "MPa" in bar.get_ylabel()
-    lx, ly = r["bem"]["size"]
+    lx, ly = r.bem.size
     for ax in (ax_p, ax_s):
         assert ax.get_xlabel() == "$x$ [mm]" and ax.get_ylabel() == "$y$ [mm]"
         assert ax.get_xlim() == pytest.approx((0.0, lx * 1e3)) and ax.get_ylim() == pytest.approx((0.0, ly * 1e3))
         assert ax.get_aspect() == 1.0
-    assert ax_s.get_title().startswith(f"{r['n_spots']} contact spots")
+    assert ax_s.get_title().startswith(f"{r.periodic.n_spots} contact spots")
     rgb = ax_s.images[0].get_array()
     white = np.all(rgb == 1.0, axis=-1)
-    assert np.count_nonzero(~white) == r["bem"]["n_contact"]
+    assert np.count_nonzero(~white) == r.bem.n_contact
     n_colours = len({tuple(c) for c in rgb[~white]})
-    assert min(r["n_spots"], 10) <= n_colours <= r["n_spots"]
+    assert min(r.periodic.n_spots, 10) <= n_colours <= r.periodic.n_spots
 
 
 def test_sweep_of_the_mean_pressure_draws_the_load_curves(tmp_path, drawn):
@@ -255,17 +256,18 @@ def test_sweep_of_the_mean_pressure_draws_the_load_curves(tmp_path, drawn):
     assert code == 0, stderr
     code, _, stderr = cli("report", tmp_path / "sw")
     assert code == 0, stderr
-    points = [json.loads(f.read_text())["result"] for f in sorted((tmp_path / "sw" / "points").glob("point-*.json"))]
-    points.sort(key=lambda p: p["mean_pressure"])
+    points = [RunResult.from_json(json.loads(f.read_text())["result"])
+              for f in sorted((tmp_path / "sw" / "points").glob("point-*.json"))]
+    points.sort(key=lambda p: p.periodic.mean_pressure)
     (fig,) = drawn
     ax_a, ax_g = fig.axes
     (area, hyun), (gap,) = ax_a.get_lines(), ax_g.get_lines()
     assert area.get_xdata() == pytest.approx([v / 1e6 for v in values])  # MPa
-    assert area.get_ydata() == pytest.approx([p["contact_fraction"] for p in points])
+    assert area.get_ydata() == pytest.approx([p.periodic.contact_fraction for p in points])
     assert np.all(np.diff(area.get_ydata()) > 0)
-    slope_modulus = points[0]["bem"]["E_star"] * points[0]["surface"]["rms_slope"]
+    slope_modulus = points[0].bem.E_star * points[0].periodic.surface["rms_slope"]
     assert hyun.get_ydata() == pytest.approx([2 * v / slope_modulus for v in values])
-    assert gap.get_xdata() == pytest.approx([p["mean_gap"] / 1e-3 for p in points])  # mm, as every length
+    assert gap.get_xdata() == pytest.approx([p.periodic.mean_gap / 1e-3 for p in points])  # mm, as every length
     assert np.all(np.diff(gap.get_xdata()) < 0)
     assert "MPa" in ax_a.get_xlabel() and "A/A_0" in ax_a.get_ylabel()
     assert "mm" in ax_g.get_xlabel() and "MPa" in ax_g.get_ylabel()

@@ -22,10 +22,10 @@ def test_rigid_bodies_on_a_winkler_layer():
     r = run_scene(RIGID_LAYER)
     lam, R, P = 1e-12, 0.01, 100.0
     delta = math.sqrt(P * lam / (math.pi * R))
-    assert r["analytic"]["p_max"] == pytest.approx(delta / lam, rel=1e-12)
-    assert r["p_max"] == pytest.approx(delta / lam, rel=0.01)
-    assert r["approach"] == pytest.approx(delta, rel=0.01)
-    assert r["contact_radius"] == pytest.approx(math.sqrt(2 * R * delta), rel=0.03)
+    assert r.analytic.p_max == pytest.approx(delta / lam, rel=1e-12)
+    assert r.p_max == pytest.approx(delta / lam, rel=0.01)
+    assert r.approach == pytest.approx(delta, rel=0.01)
+    assert r.contact_radius == pytest.approx(math.sqrt(2 * R * delta), rel=0.03)
 
 
 def test_hertz_elliptic_on_a_paraboloid_is_the_circle():
@@ -33,9 +33,9 @@ def test_hertz_elliptic_on_a_paraboloid_is_the_circle():
                  analytic={"kind": "hertz_elliptic"})
     scene.pop("layer")
     r = run_scene(scene, overrides=["bem.nodes_across=24"])
-    ref = r["analytic"]
-    assert ref["a"] == pytest.approx(ref["b"], rel=1e-9)
-    assert r["p_max"] == pytest.approx(ref["p_max"], rel=0.01)
+    ref = r.analytic
+    assert ref.a == pytest.approx(ref.b, rel=1e-9)
+    assert r.p_max == pytest.approx(ref.p_max, rel=0.01)
 
 
 def test_hertz_on_a_round_elliptic_paraboloid():
@@ -44,5 +44,5 @@ def test_hertz_on_a_round_elliptic_paraboloid():
     scene.pop("layer")
     r = run_scene(scene, overrides=["bem.nodes_across=24"])
     a = (3 * 100.0 * 0.01 / (4 * 210e9 / (2 * (1 - 0.09)))) ** (1 / 3)
-    assert r["analytic"]["contact_radius"] == pytest.approx(a, rel=1e-12)
-    assert r["contact_radius"] == pytest.approx(a, rel=0.03)
+    assert r.analytic.contact_radius == pytest.approx(a, rel=1e-12)
+    assert r.contact_radius == pytest.approx(a, rel=0.03)

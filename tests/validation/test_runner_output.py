@@ -50,7 +50,7 @@ def test_failed_rerun_keeps_the_previous_result(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError):
         run_scene("elliptic", out, overrides=["bem.nodes_across=20"])
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
-    assert json.loads((out / "result.json").read_text())["p_max"] == first["p_max"]
+    assert json.loads((out / "result.json").read_text())["p_max"] == first.p_max
     assert _leftovers(tmp_path) == []
 
 
@@ -58,7 +58,7 @@ def test_successful_rerun_replaces_the_result(tmp_path):
     out = tmp_path / "res"
     run_scene("elliptic", out, overrides=FAST)
     second = run_scene("elliptic", out, overrides=["bem.nodes_across=20"])
-    assert json.loads((out / "result.json").read_text())["bem"]["step"] == second["bem"]["step"]
+    assert json.loads((out / "result.json").read_text())["bem"]["step"] == second.bem.step
     assert _leftovers(tmp_path) == []
 
 
@@ -130,8 +130,8 @@ def test_scene_file_in_the_result_reruns_identically(tmp_path):
     for name in files:  # every file has the permissions of a new file (umask), fem_field.vtu too
         assert ((tmp_path / "a" / name).stat().st_mode & 0o777) == file_mode(), name
     second = run_scene(tmp_path / "a" / "scene.toml")
-    assert second["p_max"] == first["p_max"] and second["approach"] == first["approach"]
-    assert second["fem"]["p_max"] == first["fem"]["p_max"]
+    assert second.p_max == first.p_max and second.approach == first.approach
+    assert second.fem.p_max == first.fem.p_max
 
 
 def test_progress_reports_every_planned_stage(tmp_path):
@@ -154,16 +154,16 @@ def test_progress_reports_every_planned_stage(tmp_path):
 def test_not_converged_is_flagged_and_written(tmp_path):
     r = run_scene("rough_sphere", tmp_path / "r", overrides=["bem.nodes_across=16", "fem.n_contact_elements=8",
                                                              "bem.maxiter=1"])
-    assert r["converged"] is False and r["bem"]["converged"] is False
-    assert any("did not converge" in m for m in r["messages"])
+    assert r.converged is False and r.bem.converged is False
+    assert any("did not converge" in m for m in r.messages)
     assert json.loads((tmp_path / "r" / "result.json").read_text())["converged"] is False
 
 
 def test_automatic_region_grows_when_the_estimate_is_short():
     """An extent_factor of 1.0 on the root law (wider than its estimate) is enlarged, not refused."""
     r = run_scene("paper_root", overrides=["bem.nodes_across=16", "bem.extent_factor=1.0"])
-    assert r["converged"]
-    assert any("enlarged" in m for m in r["messages"])
+    assert r.converged
+    assert any("enlarged" in m for m in r.messages)
 
 
 @pytest.mark.parametrize("scene_name, overrides", [

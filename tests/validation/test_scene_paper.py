@@ -129,7 +129,7 @@ def test_paper_layer_is_ten_c_nn_at_the_reference_step_in_physical_units():
     assert load_scene("paper_linear").layer.lam == pytest.approx(lam, rel=1e-4)  # 4 digits in the scene
     r = run_scene(_bem_only("paper_linear"), overrides=SMALL + ["layer.lam_over_cnn=10.0",
                                                                  f"layer.cnn_step={a_h / 20!r}"])
-    assert r["layer"]["parameters"]["lam"] == pytest.approx(lam, rel=1e-12)
+    assert r.layer["parameters"]["lam"] == pytest.approx(lam, rel=1e-12)
 
 
 @pytest.mark.parametrize("name", ["paper_linear", "paper_root"])
@@ -141,18 +141,18 @@ def test_paper_layered_scene_converges_under_refinement(name):
     converges too but not monotonically (its differences stay within 2 steps)."""
     outs = [execute_scene(_bem_only(name), overrides={"bem.nodes_across": n}) for n in (20, 40, 80, 160)]
     assert all(o.bem.converged for o in outs)
-    lams = [o.result["layer"]["lam_ref" if name == "paper_root" else "parameters"] for o in outs]
+    lams = [o.result.layer["lam_ref" if name == "paper_root" else "parameters"] for o in outs]
     lams = [x if isinstance(x, float) else x["lam"] for x in lams]
     assert lams == [lams[0]] * 4
     sc = outs[0].scene
     hz = hertz_sphere(sc.gap.R, sc.E_star, **sc.load)
     for key, scale in (("p_max", hz.p_max), ("approach", hz.approach)):
-        values = np.array([o.result[key] for o in outs]) / scale
+        values = np.array([getattr(o.result, key) for o in outs]) / scale
         diffs = np.abs(np.diff(values))
         orders = np.log2(diffs[:-1] / diffs[1:])
         assert np.all(orders > 1.5), (key, values, orders)
-    radii = np.array([o.result["contact_radius"] for o in outs])
-    steps = np.array([o.result["bem"]["step"] for o in outs])
+    radii = np.array([o.result.contact_radius for o in outs])
+    steps = np.array([o.result.bem.step for o in outs])
     assert np.all(np.abs(np.diff(radii)) <= 2 * steps[:-1])
     assert abs(radii[-1] - radii[-2]) < 0.01 * radii[-1]
 
@@ -160,15 +160,15 @@ def test_paper_layered_scene_converges_under_refinement(name):
 def test_alpha_b_target_is_reached():
     """lam_r found for alpha_b = 0.9; checked by an independent solve of that root law."""
     r = run_scene("paper_root", overrides=SMALL + ["alpha_b=0.9"])
-    assert r["alpha_b"] == pytest.approx(0.9, rel=1e-3)
-    lam_r = r["layer"]["parameters"]["lam"]
+    assert r.alpha_b == pytest.approx(0.9, rel=1e-3)
+    lam_r = r.layer["parameters"]["lam"]
     Es = e_star(STEEL_E, STEEL_NU, STEEL_E, STEEL_NU)
     gap = bem.gaps.Paraboloid(0.01)
-    kw = dict(E_star=Es, force=100.0, step=r["bem"]["step"], extent=r["bem"]["extent"])
-    p_lambda = bem.solve(gap, layer=Linear(r["layer"]["lam_ref"]), **kw).p_max
+    kw = dict(E_star=Es, force=100.0, step=r.bem.step, extent=r.bem.extent)
+    p_lambda = bem.solve(gap, layer=Linear(r.layer["lam_ref"]), **kw).p_max
     p_root = bem.solve(gap, layer=Root(lam_r), **kw).p_max
     assert p_root / p_lambda == pytest.approx(0.9, rel=1e-3)
-    assert r["layer"]["p_max_lambda"] == pytest.approx(p_lambda, rel=1e-8)
+    assert r.layer["p_max_lambda"] == pytest.approx(p_lambda, rel=1e-8)
 
 
 def test_alpha_b_out_of_reach_is_refused():

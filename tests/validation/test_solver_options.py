@@ -44,8 +44,8 @@ def test_calibration_does_not_depend_on_the_method():
     lam = {}
     for method in ("newton", "augmented_gap"):
         out = runner.execute_scene(load_scene(_scene("paper_root"), overrides=[f'bem.method="{method}"']))
-        lam[method] = out.result["layer"]["parameters"]["lam"]
-        assert out.result["layer"]["reference_solves"] >= 1
+        lam[method] = out.result.layer["parameters"]["lam"]
+        assert out.result.layer["reference_solves"] >= 1
     assert lam["augmented_gap"] == pytest.approx(lam["newton"], rel=1e-12)
 
 
@@ -66,8 +66,8 @@ def test_a_calibration_that_fails_stops_the_run(monkeypatch):
 @pytest.mark.parametrize("method, note", [("augmented_gap", True), ("variable_compliance", True), ("newton", False)])
 def test_a_paper_method_on_a_smooth_scene_notes_the_solver_that_ran(method, note):
     out = runner.execute_scene(load_scene("hertz", overrides=[f'bem.method="{method}"', "bem.nodes_across=16"]))
-    assert out.result["method"] == "kalker"
-    notes = [m for m in out.result["messages"] if "ran as Kalker's QP" in m]
+    assert out.result.method == "kalker"
+    notes = [m for m in out.result.messages if "ran as Kalker's QP" in m]
     assert notes == ([f"bem.method = {method!r} ran as Kalker's QP ('kalker'): the scene has no layer, so the "
                       "problem is a QP and the QP solves it directly."] if note else [])
 

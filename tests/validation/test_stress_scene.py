@@ -82,7 +82,7 @@ def test_no_section_no_stresses(tmp_path):
     scene = load_scene(tomllib.loads(BASE))
     assert scene.stress is None and "stress" not in planned_stages(scene)
     result = run_scene(scene, tmp_path / "r")
-    assert "stress" not in result and not (tmp_path / "r" / "stress_field.vtu").exists()
+    assert result.stress is None and not (tmp_path / "r" / "stress_field.vtu").exists()
 
 
 @pytest.fixture(scope="module")
@@ -98,20 +98,20 @@ def stress_run(tmp_path_factory):
 
 def test_result_json_holds_the_maxima_per_body(stress_run):
     outcome, out = stress_run
-    block = outcome.result["stress"]
-    assert set(block["bodies"]) == {"body1", "body2"}
-    assert block["depths"] == [0.0, 2e-5, 5e-5, 8e-5, 1.2e-4, 2e-4]
+    block = outcome.result.stress
+    assert set(block.bodies) == {"body1", "body2"}
+    assert block.depths == [0.0, 2e-5, 5e-5, 8e-5, 1.2e-4, 2e-4]
     for name, nu in (("body1", 0.3), ("body2", 0.2)):
-        body = block["bodies"][name]
-        direct = bem.subsurface_stress(outcome.bem, block["depths"], nu=nu)
-        assert body["nu"] == nu
-        assert body["max_von_mises"] == pytest.approx(direct.max_von_mises, rel=1e-12)
-        assert body["max_tresca"] == pytest.approx(direct.max_tresca, rel=1e-12)
-        assert body["depth_of_max"] == pytest.approx(direct.depth_of_max, rel=1e-12)
-        assert body["location_of_max"] == pytest.approx(list(direct.location_of_max), rel=1e-12, abs=1e-15)
-        assert len(body["axis"]["von_mises"]) == 6 and len(body["section"]["x"]) > 10
-    assert outcome.result["wall_time_s"]["stress"] > 0
-    assert (out / "result.json").is_file() and outcome.result["files"]["stress_field"] == "stress_field.vtu"
+        body = block.bodies[name]
+        direct = bem.subsurface_stress(outcome.bem, block.depths, nu=nu)
+        assert body.nu == nu
+        assert body.max_von_mises == pytest.approx(direct.max_von_mises, rel=1e-12)
+        assert body.max_tresca == pytest.approx(direct.max_tresca, rel=1e-12)
+        assert body.depth_of_max == pytest.approx(direct.depth_of_max, rel=1e-12)
+        assert body.location_of_max == pytest.approx(list(direct.location_of_max), rel=1e-12, abs=1e-15)
+        assert len(body.axis["von_mises"]) == 6 and len(body.section["x"]) > 10
+    assert outcome.result.wall_time_s_by_part["stress"] > 0
+    assert (out / "result.json").is_file() and outcome.result.files["stress_field"] == "stress_field.vtu"
 
 
 def test_stress_field_file_is_documented(stress_run):
@@ -176,12 +176,12 @@ def test_report_has_the_stress_section(stress_run, tmp_path):
 def test_builtin_hertz_scene_reports_the_hertz_maximum(builtin_runs):
     """The built-in hertz scene has [stress]: 0.62 p_H at 0.48 a_H (Johnson), BEM within 1 % and FEM within 2 %."""
     r = builtin_runs["hertz"]["result"]
-    p0, a = r["analytic"]["p_max"], r["analytic"]["contact_radius"]
-    for body in r["stress"]["bodies"].values():
-        assert body["max_von_mises"] / p0 == pytest.approx(0.620, rel=0.01)
-        assert body["max_tresca"] / p0 == pytest.approx(0.310, rel=0.01)
-        assert body["depth_of_max"] / a == pytest.approx(0.481, abs=0.02)
-        fem = body["fem"]
-        assert abs(fem["max_von_mises_rel"]) <= 0.02 and abs(fem["axis_depth_of_max_rel"]) <= 0.02 and fem["on_axis"]
+    p0, a = r.analytic.p_max, r.analytic.contact_radius
+    for body in r.stress.bodies.values():
+        assert body.max_von_mises / p0 == pytest.approx(0.620, rel=0.01)
+        assert body.max_tresca / p0 == pytest.approx(0.310, rel=0.01)
+        assert body.depth_of_max / a == pytest.approx(0.481, abs=0.02)
+        fem = body.fem
+        assert abs(fem.max_von_mises_rel) <= 0.02 and abs(fem.axis_depth_of_max_rel) <= 0.02 and fem.on_axis
     assert (builtin_runs["hertz"]["dir"] / "stress_field.vtu").is_file()
-    assert math.isfinite(r["wall_time_s"]["stress"])
+    assert math.isfinite(r.wall_time_s_by_part["stress"])

@@ -114,7 +114,7 @@ def test_paper_alpha_a_sweep_spans_smooth_to_linear(tmp_path):
                        step=point["bem"]["step"], extent=point["bem"]["extent"])  # the same lattice
     linear = run_scene("paper_linear", overrides=small)
     assert p[0] == pytest.approx(smooth.p_max, rel=1e-9)  # alpha_a = 0: smooth bodies
-    assert p[2] == pytest.approx(linear["p_max"], rel=1e-6)  # alpha_a = 1: the linear layer
+    assert p[2] == pytest.approx(linear.p_max, rel=1e-6)  # alpha_a = 1: the linear layer
     assert p[0] > p[1] > p[2]
 
 

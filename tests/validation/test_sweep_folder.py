@@ -163,7 +163,7 @@ def test_cli_sweeps_a_string_key(tmp_path):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["values"] == ["linear", "none"]
     smooth = run_scene("paper_linear", overrides=[*small, "layer.law=none"])
-    assert summary["points"][1]["p_max"] == pytest.approx(smooth["p_max"], rel=1e-12)
+    assert summary["points"][1]["p_max"] == pytest.approx(smooth.p_max, rel=1e-12)
     assert summary["points"][0]["p_max"] < summary["points"][1]["p_max"]  # the layer lowers the peak
 
 

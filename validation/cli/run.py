@@ -44,51 +44,52 @@ def _relative(value, reference):
 
 
 def _summary(result, out_dir):
-    """The lines ``contactlab run`` prints: the result's numbers with their units, and its files.
+    """The lines ``contactlab run`` prints: the :class:`validation.run.record.RunResult`'s numbers with their
+    units, and its files.
 
     Any number may be ``None`` (a non-finite value in ``result.json``): it prints as ``-``.
     """
-    L, Pa, N = ((result.get("unit_symbols") or {}).get(k, "") for k in ("length", "pressure", "force"))
-    lines = [f"scene      {result['scene']}: {result['title']}   [units {result['units']}]"]
-    p_line = f"p_max      {_g(result['p_max'])} {Pa}"
-    for ref in (result.get("fem"), result.get("analytic")):
-        if ref is not None:  # the closed form names its kind, the FEM summary has none
-            f = ref["p_max"]
-            p_line += f"   ({ref.get('kind', 'FEM')} {_g(f)}{_relative(result['p_max'], f)})"
+    L, Pa, N = (result.unit_symbols[k] or "" for k in ("length", "pressure", "force"))
+    lines = [f"scene      {result.scene}: {result.title}   [units {result.units}]"]
+    p_line = f"p_max      {_g(result.p_max)} {Pa}"
+    for name, ref in (("FEM", result.fem), (None, result.analytic)):
+        if ref is not None:  # the closed form names its kind
+            p_line += f"   ({name or ref.kind} {_g(ref.p_max)}{_relative(result.p_max, ref.p_max)})"
     lines.append(p_line)
-    if result.get("periodic"):
-        lines += _periodic_lines(result, L, Pa)
-    elif "contact_radius" in result:
-        lines.append(f"contact    radius {_g(result['contact_radius'])} {L}, area {_g(result['contact_area'])} {L}^2")
+    if result.periodic is not None:
+        lines += _periodic_lines(result.periodic, L, Pa)
+    elif result.contact_radius is not None:
+        lines.append(f"contact    radius {_g(result.contact_radius)} {L}, area {_g(result.contact_area)} {L}^2")
     else:
-        ext = result["contact_extent"]
+        ext = result.contact_extent
         lines.append(f"contact    |x| <= {_g(ext['x'])} {L}, |y| <= {_g(ext['y'])} {L}, "
-                     f"area {_g(result['contact_area'])} {L}^2")
-    on = " on one cell" if result.get("periodic") else ""
-    lines.append(f"load       force {_g(result['force'])} {N}{on}, approach {_g(result['approach'])} {L}")
-    if "alpha_b" in result:
-        lines.append(f"layer      alpha_b = p_max^root / p_max^lambda = {_g(result['alpha_b'], '.4f')}")
-    conv = "yes" if result["converged"] else "NO"
-    lines.append(f"converged  {conv} ({result['method']}, {result['iterations']} iterations, "
-                 f"KKT residual {_g(result['kkt_residual'], '.2e')})")
-    times = ", ".join(f"{k} {_g(v, '.2f')} s" for k, v in result["wall_time_s"].items() if v is not None)
+                     f"area {_g(result.contact_area)} {L}^2")
+    on = " on one cell" if result.periodic is not None else ""
+    lines.append(f"load       force {_g(result.force)} {N}{on}, approach {_g(result.approach)} {L}")
+    if result.alpha_b is not None:
+        lines.append(f"layer      alpha_b = p_max^root / p_max^lambda = {_g(result.alpha_b, '.4f')}")
+    conv = "yes" if result.converged else "NO"
+    lines.append(f"converged  {conv} ({result.method}, {result.iterations} iterations, "
+                 f"KKT residual {_g(result.kkt_residual, '.2e')})")
+    times = ", ".join(f"{k} {_g(v, '.2f')} s" for k, v in result.wall_time_s_by_part.items() if v is not None)
     lines.append(f"time       {times}")
-    for name, body in (result.get("stress") or {}).get("bodies", {}).items():
-        x, y, z = body["location_of_max"]
-        lines.append(f"stress     {name}: max von Mises {_g(body['max_von_mises'])} {Pa} at depth {_g(z)} {L} "
-                     f"(x {_g(x, '.3g')}, y {_g(y, '.3g')}), max shear {_g(body['max_tresca'])} {Pa}")
-    lines += [f"note       {msg}" for msg in result["messages"]]
+    for name, body in ({} if result.stress is None else result.stress.bodies).items():
+        x, y, z = body.location_of_max
+        lines.append(f"stress     {name}: max von Mises {_g(body.max_von_mises)} {Pa} at depth {_g(z)} {L} "
+                     f"(x {_g(x, '.3g')}, y {_g(y, '.3g')}), max shear {_g(body.max_tresca)} {Pa}")
+    lines += [f"note       {msg}" for msg in result.messages]
     if out_dir is not None:
-        lines.append(f"files      {out_dir}/ ({', '.join(result['files'].values())})")
+        lines.append(f"files      {out_dir}/ ({', '.join(result.files.values())})")
     return "\n".join(lines)
 
 
-def _periodic_lines(result, L, Pa):
-    """The lines of a periodic cell: contact fraction, spots, mean gap and the surface's statistics."""
-    s, sp = result["surface"], result["spots"]
-    lines = [f"cell       mean pressure {_g(result['mean_pressure'])} {Pa}, contact fraction "
-             f"{_g(result['contact_fraction'], '.4f')}, {result['n_spots']} contact spots (largest "
-             f"{_g(sp['largest_area'], '.4g')} {L}^2), mean gap {_g(result['mean_gap'], '.4g')} {L}",
+def _periodic_lines(cell, L, Pa):
+    """The lines of a periodic cell (:class:`validation.run.record.PeriodicPart`): contact fraction, spots,
+    mean gap and the surface's statistics."""
+    s, sp = cell.surface, cell.spots
+    lines = [f"cell       mean pressure {_g(cell.mean_pressure)} {Pa}, contact fraction "
+             f"{_g(cell.contact_fraction, '.4f')}, {cell.n_spots} contact spots (largest "
+             f"{_g(sp.largest_area, '.4g')} {L}^2), mean gap {_g(cell.mean_gap, '.4g')} {L}",
              f"surface    rms height {_g(s['rms_height'], '.4g')} {L}, rms slope {_g(s['rms_slope'], '.4g')}, "
              f"edge jump {_g(s['edge_jump'], '.4g')} {L}{' (LARGE)' if s['edge_jump_large'] else ''}, "
              f"stretch_y {_g(s['stretch_y'], '.5f')}"]
@@ -141,4 +142,4 @@ def run(args):
     finally:
         bar.close()
     print(_summary(outcome.result, out_dir))
-    return 0 if outcome.result["converged"] else 1
+    return 0 if outcome.result.converged else 1

@@ -1,10 +1,10 @@
 """Run a periodic scene: the cell of a rough surface pressed by a flat (:func:`bem.solve_periodic`).
 
 :func:`execute_periodic` solves the scene's cell (:mod:`validation.scene.rough`) and returns a
-:class:`validation.run.RunOutcome` whose result dict holds the contract of ``result.json``
-(:data:`validation.run.result.CONTRACT_KEYS`) and the periodic quantities: ``mean_pressure``,
-``contact_fraction``, ``mean_gap``, ``n_spots`` (the contact spots, :func:`contact_spots`),
-``spots`` and ``surface`` (docs/results.md).
+:class:`validation.run.RunOutcome` whose :class:`validation.run.record.RunResult` holds the
+periodic quantities in its ``periodic`` part: ``mean_pressure``, ``contact_fraction``,
+``mean_gap``, ``n_spots`` (the contact spots, :func:`contact_spots`), ``spots`` and ``surface``
+(docs/results.md).
 """
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ import numpy as np
 from ..provenance import provenance
 from ..progress import stages_of
 from .calibrate import resolve_layer
-from .result import SCHEMA, _history
+from .record import PeriodicPart, RunResult, SpotSummary
+from .result import bem_part, unit_symbols
 
 __all__ = ["execute_periodic", "contact_spots", "periodic_result"]
 
@@ -95,29 +96,31 @@ def _spot_summary(labels, n, node_area):
 
 
 def periodic_result(scene, res, layer_info, *, times, messages, spots):
-    """The JSON-ready result dict of a periodic run (module docstring; docs/results.md)."""
+    """The :class:`validation.run.record.RunResult` of a periodic run (module docstring; docs/results.md)."""
     from ..io import to_jsonable
 
     cell, lattice, stats = res.lattice, scene.gap.lattice, scene.gap.surface.stats
     labels, n = spots
     surface = dict(stats.as_dict(), stretch_y=lattice.stretch_y, stretch_large=bool(lattice.stretch_large))
-    bem_part = dict(res.summary(), E_star=scene.E_star, step=cell.step, size=list(cell.size), n_nodes=int(res.p.size),
-                    n_contact=int(np.count_nonzero(res.p > 0)), history=_history(res))
-    out = {
-        "schema": SCHEMA, "scene": scene.name, "title": scene.title, "units": scene.units.label,
-        "unit_symbols": scene.units.as_dict(), "source": scene.source, "overrides": list(scene.overrides),
-        "method": res.method, "periodic": True,
+    bem = bem_part(res, E_star=scene.E_star, step=cell.step, size=list(cell.size), n_nodes=int(res.p.size),
+                   n_contact=int(np.count_nonzero(res.p > 0)))
+    periodic = PeriodicPart(mean_pressure=res.mean_pressure, contact_fraction=res.contact_fraction,
+                            mean_gap=res.mean_gap, n_spots=n,
+                            spots=SpotSummary(**_spot_summary(labels, n, cell.node_area)), surface=surface)
+    top = to_jsonable({
+        "scene": scene.name, "title": scene.title, "units": scene.units.label,
+        "unit_symbols": unit_symbols(scene.units), "source": scene.source, "overrides": list(scene.overrides),
+        "method": res.method,
         "p_max": res.p_max, "force": res.force, "approach": res.approach, "contact_area": res.contact_area,
-        "mean_pressure": res.mean_pressure, "contact_fraction": res.contact_fraction, "mean_gap": res.mean_gap,
-        "n_spots": n, "spots": _spot_summary(labels, n, cell.node_area), "surface": surface,
+        "contact_radius": None, "contact_extent": None,
         "iterations": res.iterations, "converged": bool(res.converged), "kkt_residual": res.kkt_residual,
-        "message": res.message, "messages": list(messages), "wall_time_s": dict(times),
-        "bem": bem_part, "layer": layer_info,
-    }
-    if scene.report is not None:
-        out["report"] = scene.report
-    out["provenance"] = provenance()
-    return to_jsonable(out)
+        "message": res.message, "messages": list(messages), "wall_time_s_by_part": dict(times),
+        "layer": layer_info, "alpha_b": None, "report": scene.report, "provenance": provenance(),
+    })
+    parts = {"bem": bem, "periodic": periodic}
+    parts = {k: type(v).from_json(v.to_json(), where=k, source="the run") for k, v in parts.items()}
+    return RunResult(**top, **parts, fem=None, fem_profile=None, analytic=None, comparison=None, scales=None,
+                     profile=None, stress=None)
 
 
 def execute_periodic(scene, *, progress=None):
@@ -158,7 +161,7 @@ def execute_periodic(scene, *, progress=None):
     res = bem.solve_periodic(lattice.gap(), step=lattice.step, E_star=scene.E_star, mean_pressure=mean_pressure,
                              approach=load["approach"], layer=layer,
                              callback=callback if stages.callback is not None else None, **kw)
-    times = {"bem": time.perf_counter() - t}
+    times = {"bem": time.perf_counter() - t, "fem": None, "layer_reference": None, "stress": None}
     if not res.converged:
         messages.append(f"BEM did not converge: {res.message}")
     spots = contact_spots(res.p.reshape(res.lattice.shape) > 0)

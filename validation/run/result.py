@@ -1,25 +1,22 @@
-"""The result dictionary of a scene run (the content of ``result.json``).
+"""Make the :class:`validation.run.record.RunResult` of a scene run (the content of ``result.json``).
 
-Every field and its unit: docs/results.md. Contract: ``p_max``, ``force``, ``approach``, ``contact_area``,
-``contact_radius`` (axisymmetric scenes), ``iterations``, ``converged``, ``kkt_residual``,
-``wall_time_s`` per part, and the comparison metrics when a comparison was asked. The scalars
-at the top level are the BEM's (the product); ``converged`` is true only when every part that
-ran converged. Units are those of the scene (``units``). ``provenance`` records what made the
-result (:mod:`validation.provenance`).
+Every field and its unit: docs/results.md. The scalars at the top level are the BEM's (the
+product); ``converged`` is true only when every part that ran converged; the parts that did
+not run are ``None``. Units are those of the scene (``units``). ``provenance`` records what
+made the result (:mod:`validation.provenance`).
 """
 
 from __future__ import annotations
 
+from dataclasses import fields
+
 import numpy as np
 
 from ..provenance import provenance
+from .record import (SCHEMA, AxialProfile, BemPart, ClosedForm, Comparison, FemMesh, FemPart, FemProfile, ForceBalance,
+                     PairMetrics, RunResult, Scales, StressPart)
 
-__all__ = ["build_result", "axial_profile", "SCHEMA", "CONTRACT_KEYS"]
-
-SCHEMA = "contactlab.result/1"
-#: Keys every result.json holds (contact_radius: axisymmetric scenes only).
-CONTRACT_KEYS = ("scene", "units", "method", "p_max", "force", "approach", "contact_area", "iterations",
-                 "converged", "kkt_residual", "wall_time_s", "messages")
+__all__ = ["build_result", "bem_part", "unit_symbols", "axial_profile", "SCHEMA"]
 
 
 def axial_profile(res):
@@ -41,6 +38,11 @@ def axial_profile(res):
     return {"x": x, "p": p, "closure": closure, "y_axis": {"y": y, "p": p_y}}
 
 
+def unit_symbols(units):
+    """``{"length", "pressure", "force"}`` symbols of :class:`validation.units.Units` (``None``: not known)."""
+    return {"length": units.length, "pressure": units.pressure, "force": units.force}
+
+
 def _history(res):
     """Per-iteration scalar lists of the BEM history (iterates left out)."""
     out = {}
@@ -56,12 +58,10 @@ def _history(res):
 def _analytic_summary(kind, ref, lattice):
     """Scalars of the closed-form reference (:mod:`bem.reference`, shared names), and its pressure
     along the x and y axes over the candidate region (801 points each), which the reports draw."""
+    elliptic = kind == "hertz_elliptic"
     out = {"kind": kind, "force": ref.force, "approach": ref.approach, "p_max": ref.p_max,
-           "contact_area": ref.contact_area}
-    if kind == "hertz_elliptic":
-        out.update(a=ref.a, b=ref.b)
-    else:
-        out["contact_radius"] = ref.contact_radius
+           "contact_area": ref.contact_area, "contact_radius": None if elliptic else ref.contact_radius,
+           "a": ref.a if elliptic else None, "b": ref.b if elliptic else None}
     x = np.linspace(lattice.x.min(), lattice.x.max(), 801)
     y = np.linspace(lattice.y.min(), lattice.y.max(), 801)
     out["profile"] = {"x": x, "p": ref.pressure(x, 0.0), "y": y, "p_y": ref.pressure(0.0, y)}
@@ -78,44 +78,84 @@ def _scales(scene):
     return {"p_hertz": hz.p_max, "a_hertz": hz.contact_radius, "approach_hertz": hz.approach, "force_hertz": hz.force}
 
 
-def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=None, times, messages, extent):
-    """Assemble the JSON-ready result dict of a run (see the module docstring)."""
-    converged = bool(res.converged) and (fem is None or bool(fem.converged))
-    bem_part = dict(res.summary(), E_star=scene.E_star, extent=list(extent), n_nodes=int(res.p.size),
-                    nodes_across_contact=(2 * res.contact_radius / res.step), history=_history(res))
-    out = {
-        "schema": SCHEMA,
-        "scene": scene.name, "title": scene.title, "units": scene.units.label,
-        "unit_symbols": scene.units.as_dict(), "source": scene.source,
-        "overrides": list(scene.overrides), "method": res.method,
-        "p_max": res.p_max, "force": res.force, "approach": res.approach, "contact_area": res.contact_area,
-    }
-    if scene.axisymmetric:
-        out["contact_radius"] = res.contact_radius
-    out.update({
-        "contact_extent": {axis: float(np.abs(coord[res.p > 0]).max(initial=0.0))
-                           for axis, coord in (("x", res.x), ("y", res.y))},
-        "iterations": res.iterations, "converged": converged, "kkt_residual": res.kkt_residual,
-        "message": res.message, "messages": list(messages),
-        "wall_time_s": dict(times),
-        "bem": bem_part, "layer": layer_info,
-    })
-    if "alpha_b" in layer_info:
-        out["alpha_b"] = layer_info["alpha_b"]
-    if fem is not None:
-        out["fem"] = fem.summary()
-        out["fem_profile"] = {"r": fem.r, "p": fem.p}
-    if analytic is not None:
-        out["analytic"] = _analytic_summary(scene.analytic["kind"], analytic, res.lattice)
-    if metrics is not None:
-        out["comparison"] = metrics
-    scales = _scales(scene)
-    if scales is not None:
-        out["scales"] = scales
-    out["profile"] = axial_profile(res)
-    if scene.report is not None:
-        out["report"] = scene.report
-    out["provenance"] = provenance()
+def _pair(metrics, *, edge):
+    """:class:`PairMetrics` of :func:`validation.compare.pair_metrics`; ``edge``: a side is the FEM, whose
+    radius is its interpolated edge (``edge_radius_rel``), else both sides give ``sqrt(A / pi)`` or an
+    exact radius (``contact_radius_rel``)."""
+    if metrics is None:
+        return None
+    out = {k: v for k, v in metrics.items() if k != "contact_radius_rel"}
+    radius = metrics["contact_radius_rel"]
+    return PairMetrics(**out, contact_radius_rel=None if edge else radius, edge_radius_rel=radius if edge else None)
+
+
+def _comparison(metrics):
+    if metrics is None:
+        return None
+    balance = metrics.get("force_balance")
+    return Comparison(bem_vs_fem=_pair(metrics.get("bem_vs_fem"), edge=True),
+                      bem_vs_analytic=_pair(metrics.get("bem_vs_analytic"), edge=False),
+                      fem_vs_analytic=_pair(metrics.get("fem_vs_analytic"), edge=True),
+                      force_balance=None if balance is None else ForceBalance(
+                          target=balance["target"], bem=balance["bem"], fem=balance.get("fem")))
+
+
+def _fem_part(fem):
+    """:class:`FemPart` of a :class:`fem_reference.FemResult` (its interpolated edge: ``edge_radius``)."""
+    mesh = fem.mesh
+    return FemPart(p_max=float(fem.p_max), force=float(fem.force), approach=float(fem.approach),
+                   edge_radius=float(fem.contact_radius), converged=bool(fem.converged), status=fem.status,
+                   message=fem.message, iterations=int(fem.iterations), n_dofs=int(fem.n_dofs),
+                   n_elements=int(fem.n_elements), n_elements_across_contact=float(fem.n_elements_across_contact),
+                   timings={k: float(v) for k, v in fem.timings.items()}, penalty=dict(fem.penalty),
+                   truncation=dict(fem.truncation),
+                   mesh=FemMesh(a_est=mesh["a_est"], h_fine=mesh["h_fine"], n_contact_elements=mesh["n_contact"],
+                                domain_factor=mesh["extent_factor"], remeshed=mesh["remeshed"]))
+
+
+def bem_part(res, **extra):
+    """:class:`BemPart` of a BEM result: its :meth:`summary` with ``extra`` (``E_star``, the lattice)."""
+    names = {f.name for f in fields(BemPart)}
+    data = {"contact_radius": None, **res.summary(), **extra, "history": _history(res)}
+    return BemPart(**{k: v for k, v in data.items() if k in names})
+
+
+def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=None, times, messages, extent,
+                 stress=None):
+    """The :class:`validation.run.record.RunResult` of a run (see the module docstring), JSON-ready.
+
+    ``stress``: the ``stress`` block (:func:`validation.run.stress.stress_summary`) of a scene with ``[stress]``.
+    """
     from ..io import to_jsonable
 
-    return to_jsonable(out)
+    converged = bool(res.converged) and (fem is None or bool(fem.converged))
+    bem = bem_part(res, E_star=scene.E_star, extent=list(extent),
+                   nodes_across_contact=(2 * res.contact_radius / res.step))
+    parts = {
+        "bem": bem,
+        "fem": None if fem is None else _fem_part(fem),
+        "fem_profile": None if fem is None else FemProfile(r=fem.r, p=fem.p),
+        "analytic": None if analytic is None else ClosedForm(
+            **_analytic_summary(scene.analytic["kind"], analytic, res.lattice)),
+        "comparison": _comparison(metrics),
+        "scales": None if (scales := _scales(scene)) is None else Scales(**scales),
+        "profile": AxialProfile(**axial_profile(res)),
+        "stress": None if stress is None else StressPart.from_json(to_jsonable(stress), where="stress",
+                                                                     source="the run"),
+    }
+    parts = {k: None if v is None else type(v).from_json(v.to_json(), where=k, source="the run")
+             for k, v in parts.items()}  # JSON-ready values: a result equals itself read back
+    extent_xy = {axis: float(np.abs(coord[res.p > 0]).max(initial=0.0)) for axis, coord in (("x", res.x), ("y", res.y))}
+    top = to_jsonable({
+        "scene": scene.name, "title": scene.title, "units": scene.units.label,
+        "unit_symbols": unit_symbols(scene.units), "source": scene.source,
+        "overrides": list(scene.overrides), "method": res.method,
+        "p_max": res.p_max, "force": res.force, "approach": res.approach, "contact_area": res.contact_area,
+        "contact_radius": res.contact_radius if scene.axisymmetric else None,
+        "contact_extent": extent_xy,
+        "iterations": res.iterations, "converged": converged, "kkt_residual": res.kkt_residual,
+        "message": res.message, "messages": list(messages), "wall_time_s_by_part": dict(times),
+        "layer": layer_info, "alpha_b": layer_info.get("alpha_b"), "report": scene.report,
+        "provenance": provenance(),
+    })
+    return RunResult(**top, **parts, periodic=None)

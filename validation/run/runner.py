@@ -1,6 +1,6 @@
 """Run a scene: the BEM always; the FEM reference, closed form, comparisons, stresses only when named.
 
-:func:`run_scene` returns the JSON-ready result dict and, given ``out_dir``, writes it whole or
+:func:`run_scene` returns the :class:`validation.run.record.RunResult` and, given ``out_dir``, writes it whole or
 not at all (:mod:`validation.io`) with the BEM nodal field and, when the FEM ran, its
 field (ParaView ``.vtu``, both by :func:`bem.files.write_vtu`). gmsh and scikit-fem (the
 ``[fem]`` extra) are imported only by the FEM reference, so a BEM-only scene never loads them.
@@ -19,7 +19,7 @@ from bem.files import write_result_vtu, write_stress_vtu, write_text, write_vtu
 from bem.layers import beyond_table
 
 from ..compare import compare
-from ..io import atomic_directory, atomic_write_json, check_output_dir, output_errors, recover_output_dir
+from ..io import atomic_directory, check_output_dir, output_errors, recover_output_dir
 from ..progress import Progress, stages_of
 from ..scene.paper import needs_calibration
 from ..scene.checks import SceneError
@@ -28,6 +28,7 @@ from ..scene.study import refuse_study
 from ..scene.trust import refuse_code
 from ..scene.sizing import SOLVER_KEYS, inner_domain, region_limit
 from .calibrate import CalibrationError, resolve_layer
+from .record import RunResult
 from .result import build_result
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES", "RESULT_NAMES",
@@ -45,10 +46,10 @@ _GROW, _MAX_GROW = 1.5, 3  # automatic region: enlarge x1.5, at most 3 times
 
 @dataclass
 class RunOutcome:
-    """Everything a run produced: the result dict and the solver objects behind it."""
+    """Everything a run produced: its :class:`validation.run.record.RunResult` and the solver objects behind it."""
 
     scene: Scene
-    result: dict
+    result: RunResult
     bem: object
     fem: object = None
     analytic: object = None
@@ -159,7 +160,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
         if stages is not progress:
             stages.done()
         return outcome
-    messages, times = [], {"bem": None, "fem": None, "layer_reference": None}
+    messages, times = [], {"bem": None, "fem": None, "layer_reference": None, "stress": None}
     if "fem" in scene.skipped:
         messages.append("FEM reference skipped: the scene's [fem] was not run (no_fem).")
     solve, calibrate = _BemRunner(scene, messages), _BemRunner(scene, messages, calibration=True)
@@ -215,13 +216,13 @@ def execute_scene(scene, *, progress=None, overrides=None):
         stress = run_stress(scene, res, fem)
         times["stress"] = stress.wall_time_s
     times["total"] = time.perf_counter() - t0
-    result = build_result(scene, res, layer_info, fem=fem, analytic=ref, metrics=metrics, times=times,
-                          messages=messages, extent=solve.extent)
+    stress_block = None
     if stress is not None:
-        from ..io import to_jsonable
         from .stress import stress_summary
 
-        result["stress"] = to_jsonable(stress_summary(stress))
+        stress_block = stress_summary(stress)
+    result = build_result(scene, res, layer_info, fem=fem, analytic=ref, metrics=metrics, times=times,
+                          messages=messages, extent=solve.extent, stress=stress_block)
     if stages is not progress:
         stages.done()
     return RunOutcome(scene=scene, result=result, bem=res, fem=fem, analytic=ref, layer=layer, stress=stress)
@@ -252,7 +253,7 @@ def write_outputs(outcome, out_dir, *, progress=None, what="out_dir"):
     res, scene = outcome.bem, outcome.scene
     absent = {"fem_field": outcome.fem is None, "stress_field": outcome.stress is None}
     files = {key: name for key, name in FILES.items() if not absent.get(key, False)}
-    outcome.result["files"] = files
+    outcome.result.files = files
     with atomic_directory(out_dir, "result", RESULT_NAMES, what=what) as tmp:
         if outcome.spots is None:
             write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
@@ -265,7 +266,7 @@ def write_outputs(outcome, out_dir, *, progress=None, what="out_dir"):
             write_stress_vtu(tmp / files["stress_field"], res, upper=outcome.stress.bodies.get("body1"),
                              lower=outcome.stress.bodies.get("body2"))
         write_text(tmp / files["scene"], tomli_w.dumps(scene.raw))
-        atomic_write_json(tmp / files["result"], outcome.result)
+        outcome.result.write(tmp, files["result"])
     stages.done()
     return out_dir
 
@@ -290,8 +291,8 @@ def run_scene(scene, out_dir=None, *, progress=None, overrides=None):
 
     Returns
     -------
-    dict
-        The JSON-ready result (the content of ``result.json``).
+    validation.run.record.RunResult
+        The typed result (the content of ``result.json``).
 
     Raises
     ------

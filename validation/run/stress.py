@@ -168,7 +168,6 @@ def stress_summary(run):
                         "tresca": 0.5 * (principal[:, 0] - principal[:, 2]), "sigma_zz": st.sigma[:, n, 2],
                         "sigma_xx": st.sigma[:, n, 0]}
         body["section"] = {"x": st.x[row], "y": float(st.y[row[0]]), "z": st.z, "von_mises": st.von_mises[:, row]}
-        if name in run.fem:
-            body["fem"] = run.fem[name]
+        body["fem"] = run.fem.get(name)  # None: the FEM did not run
         out["bodies"][name] = body
     return out

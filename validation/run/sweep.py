@@ -44,6 +44,7 @@ from ..scene.paper import ALIASES
 from ..scene.study import refuse_study
 from .cluster import DEFAULT_TIMEOUT, dask_client, scheduler_address
 from .pool import worker_pool
+from .record import RunResult
 from .sweep_folder import SWEPT, earlier_points, file_digests, fingerprint, keyed, other_point
 
 __all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values", "SWEEP_NAMES"]
@@ -196,7 +197,7 @@ def _solve_point(raw, source, trust):
     ``trust`` is :attr:`Scene.trust` of the point."""
     from .runner import run_scene
 
-    return run_scene(parse_scene(raw, source=source, **trust))
+    return run_scene(parse_scene(raw, source=source, **trust)).to_json()
 
 
 def _ordered(values):
@@ -211,15 +212,15 @@ def _row(index, value, file, result, *, computed, error=None):
     if error is not None:
         row.update(status="error", error=error, file=None)
         return row
-    layer = result.get("layer") or {}
-    wall = result.get("wall_time_s") or {}
+    result = RunResult.from_json(result, source=row["file"])
+    wall = result.wall_time_s_by_part
     row.update(
-        status="ok" if result["converged"] else "not_converged",
-        p_max=result["p_max"], force=result["force"], approach=result["approach"],
-        contact_radius=result.get("contact_radius"), contact_area=result["contact_area"],
-        converged=result["converged"], iterations=result["iterations"], kkt_residual=result["kkt_residual"],
-        alpha_b=result.get("alpha_b"), p_max_lambda=layer.get("p_max_lambda"),
-        wall_time_bem=wall.get("bem"), wall_time_fem=wall.get("fem"))
+        status="ok" if result.converged else "not_converged",
+        p_max=result.p_max, force=result.force, approach=result.approach,
+        contact_radius=result.contact_radius, contact_area=result.contact_area,
+        converged=result.converged, iterations=result.iterations, kkt_residual=result.kkt_residual,
+        alpha_b=result.alpha_b, p_max_lambda=result.layer.get("p_max_lambda"),
+        wall_time_bem=wall["bem"], wall_time_fem=wall["fem"])
     return row
 
 

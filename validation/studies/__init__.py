@@ -81,7 +81,7 @@ def timed(scene, part="bem", *, overrides=None, repeats=3, slow_s=2.0):
     times = []
     for k in range(max(1, repeats)):
         outcome = execute_scene(scene)
-        times.append(outcome.result["wall_time_s"][part])
+        times.append(outcome.result.wall_time_s_by_part[part])
         if k == 0 and (times[0] > slow_s or not getattr(outcome, part).converged):
             break
     return outcome, statistics.median(times), times

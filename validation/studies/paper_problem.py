@@ -60,7 +60,7 @@ class PaperRuns:
         ``a_H / c`` of the lattice.
     p0, a, approach : float
         Hertz's peak [pressure], radius and approach [length] of the smooth problem
-        (``result["scales"]``): the scales of every figure.
+        (``result.scales``): the scales of every figure.
     outcomes : dict
         Case -> outcome of Fig. 5 (Newton; ``"bilinear, variable compliance"`` too), with stresses.
     iterations : dict
@@ -119,7 +119,7 @@ class PaperRuns:
         from validation.scene.paper import c_nn
 
         o = self.outcomes["linear Winkler"]
-        return self.lam / c_nn(o.result["bem"]["step"], o.scene.E_star)
+        return self.lam / c_nn(o.result.bem.step, o.scene.E_star)
 
     @property
     def stress(self):
@@ -165,8 +165,8 @@ def _cases(run, res, quick):
     for case in SCENES:
         res.outcomes[case] = run(case, analytic=True, **depths)
     res.outcomes["bilinear, variable compliance"] = run("bilinear", {"bem.method": "variable_compliance"})
-    scales = res.outcomes["smooth"].result["scales"]
-    res.p0, res.a, res.approach = scales["p_hertz"], scales["a_hertz"], scales["approach_hertz"]
+    scales = res.outcomes["smooth"].result.scales
+    res.p0, res.a, res.approach = scales.p_hertz, scales.a_hertz, scales.approach_hertz
 
 
 def _sweeps(run, res, quick):
@@ -216,7 +216,7 @@ def _methods(run, res, quick):
     it["root, Newton"] = run("root", {**record, **newton}).bem
     laws = [(f"elastic-rigid (alpha_a = {ALPHA_A_ITERATIONS})", "elastic-rigid", er), ("root", "root", {})]
     if not quick:
-        alpha_c = res.outcomes["bilinear"].result["layer"]["alpha_c"]
+        alpha_c = res.outcomes["bilinear"].result.layer["alpha_c"]
         laws.append((f"bilinear (alpha_c = {alpha_c:.3f})", "bilinear", {}))
     methods = [("Newton", {}), ("variable compliance", vc), ("augmented gap, omega = 1 (paper)",
                                                             {"bem.method": "augmented_gap"}),

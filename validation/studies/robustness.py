@@ -86,7 +86,7 @@ def _row(point, control, method, run):
     kkt = _dense_kkt(outcome) if finite(res) else math.inf
     status, _ = classify(res, converged=res.converged, error=kkt if res.converged else None, tolerance=2 * RTOL)
     return RobustnessRow(*point, control, method, status, bool(res.converged), kkt, int(res.iterations),
-                         outcome.result["wall_time_s"]["bem"], res.message, res.status)
+                         outcome.result.wall_time_s_by_part["bem"], res.message, res.status)
 
 
 def run_robustness(*, exponents=EXPONENTS, compliances=COMPLIANCES, moduli=MODULI, methods=LAYER_METHODS,

@@ -121,7 +121,7 @@ def _part(run, part):
     outcome, seconds, raised = run
     if outcome is None:
         return None, seconds, f"raised {raised}"
-    return getattr(outcome, part), outcome.result["wall_time_s"][part], ""
+    return getattr(outcome, part), outcome.result.wall_time_s_by_part[part], ""
 
 
 def _good(part):

@@ -46,7 +46,7 @@ def _problem(res, work):
 
     from ..figures.profiles import plot_layer_laws
 
-    smooth, info = res.outcomes["smooth"].scene, res.outcomes["elastic-rigid"].result["layer"]
+    smooth, info = res.outcomes["smooth"].scene, res.outcomes["elastic-rigid"].result.layer
     u, laws = smooth.units.as_dict(), res.laws
     pf, wf = res.p0, res.a  # as every pressure and length of the report: over p_0 and a_H
     path = plot_layer_laws([(k, v and run_figures.Scaled(v, pf, wf)) for k, v in laws.items()],
@@ -72,7 +72,7 @@ def _problem(res, work):
         f"p_cr = alpha_a p_max^lambda, alpha_a = {info['alpha_a']:g}; root w = lam_b sqrt(p) with lam_b = lam "
         "sqrt(p_max^lambda) (root and linear laws close equally at p_max^lambda); bilinear with slope lam up to "
         "p* = alpha_a p_max^lambda and lam tan(alpha_c) beyond, alpha_c = "
-        f"{res.outcomes['bilinear'].result['layer']['alpha_c']:.4f} rad.")
+        f"{res.outcomes['bilinear'].result.layer['alpha_c']:.4f} rad.")
     fig = Figure(path, "The layer laws w(p) of the test problem (analogue of the paper's Fig. 4 b-d), drawn from "
                        "the bem.layers objects the runs used; the dotted line marks p_cr = p*.")
     return problem_section(gap=smooth.gap, materials=m, load={"force": smooth.load["force"]}, units=u,
@@ -83,7 +83,7 @@ def _distributions(res, work):
     from ..figures.profiles import plot_pressure_profiles
     from ..figures.surfaces import plot_contact_map
 
-    b, prof = res.base, res.outcomes["smooth"].result["analytic"]["profile"]
+    b, prof = res.base, res.outcomes["smooth"].result.analytic.profile
     path = plot_pressure_profiles(list(b.items()), work / "fig05_pressure_profiles.png", p0=res.p0, a=res.a,
                                   hertz=(prof["x"], prof["p"]),
                                   title="contact pressure in the axial section (paper Fig. 5)")

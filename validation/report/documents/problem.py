@@ -1,7 +1,7 @@
 """The problem statement of a run's report (the section ``scene``): gap, materials, layer law, load, units.
 
 Everything is read from the effective scene (``scene.toml``) and the run's ``result.json``: the
-layer is the one the solver used (``result["layer"]["parameters"]``), with the paper's relative
+layer is the one the solver used (``result.layer["parameters"]``), with the paper's relative
 parameters (``lam_over_cnn``, ``alpha_a``, ...) shown next to the values they resolved to. Values
 are shown in the report's units (:meth:`validation.report.documents.results.RunResults.display`),
 which the section's text states once.
@@ -15,9 +15,9 @@ from bem.gaps import GAPS
 
 from ...scene.rough import GAP_UNITS as ROUGH_GAP_UNITS
 from ...units import METRES
+from .results import is_number
 from ..render.content import Section, Table, fmt
 from ..render.style import method_text
-from .results import is_number
 
 __all__ = ["scene_section"]
 
@@ -55,8 +55,8 @@ def _param_kind(law, key, params):
 
 def _layer_rows(res):
     """Rows of the layer: its law, the parameters used, and the paper's relative ones."""
-    info = res.get("layer") or {}
-    params = info.get("parameters") if isinstance(info.get("parameters"), Mapping) else {}
+    info = res.result.layer
+    params = info["parameters"] or {}
     law = params.get("law") or info.get("law") or res.section("layer").get("law")
     if law in (None, "none"):
         return [("interface layer", "none (smooth bodies, w = 0)", "-")]
@@ -128,10 +128,8 @@ def _material_rows(res):
     rows = [(label, fmt(float(bodies[key])), "-") if key.startswith("nu") else
             (label, fmt(res.shown(float(bodies[key]), "pressure")), pressure.name)
             for key, label in _MATERIALS if key in bodies]
-    e_star = res.bem.get("E_star", bodies.get("E_star"))
-    if e_star is not None:
-        rows.append(("effective modulus E* = 1 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)",
-                     fmt(res.shown(float(e_star), "pressure")), pressure.name))
+    rows.append(("effective modulus E* = 1 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2)",
+                 fmt(res.shown(float(res.bem.E_star), "pressure")), pressure.name))
     return rows
 
 
@@ -156,9 +154,9 @@ def scene_section(res, work):
     text.append("Frictionless normal contact of two elastic half-spaces whose surfaces are separated by the "
                 "initial gap h(x, y)" + (", with an interface layer between them whose closure w(p) depends "
                                          "on the contact pressure p." if law else " (no interface layer).")
-                + f" Solved by the BEM: {method_text(res.data.get('method'), law)}.")
-    if res.data.get("overrides"):
-        text.append("Scene overrides of this run: " + ", ".join(map(str, res.data["overrides"])) + ".")
+                + f" Solved by the BEM: {method_text(res.result.method, law)}.")
+    if res.result.overrides:
+        text.append("Scene overrides of this run: " + ", ".join(map(str, res.result.overrides)) + ".")
     text.append(res.units_text())
     rows = _gap_rows(res) + _material_rows(res) + _layer_rows(res) + _load_rows(res)
     return Section("Problem statement", kind="problem", text=tuple(text), items=(

@@ -4,17 +4,17 @@ What is read (names from ``result.json["files"]``, else :data:`validation.run.ru
 list of the files a run writes):
 
 ``result.json`` (required)
-    The run's result (:func:`validation.run.result.build_result`, docs/results.md): the BEM
-    scalars, ``bem``, ``layer``, ``profile``, ``scales``, ``unit_symbols``, and only when they
-    ran ``fem`` / ``fem_profile``, ``analytic`` (with its ``profile``), ``comparison``,
-    ``stress``; ``report`` when the scene had a ``[report]``.
+    The run's :class:`validation.run.record.RunResult` (docs/results.md): the BEM scalars,
+    ``bem``, ``layer``, ``profile``, ``scales``, ``unit_symbols``, and, ``None`` unless they
+    ran, ``fem`` / ``fem_profile``, ``analytic`` (with its ``profile``), ``comparison``,
+    ``stress``, ``periodic``; ``report`` when the scene had a ``[report]``. A file of another
+    schema is refused (:class:`validation.run.record.ResultFileError`).
 ``scene.toml``
     The effective scene (overrides applied): bodies, gap, layer, load, options.
 ``bem_field.vtu``, ``fem_field.vtu``
     The BEM nodal pressure ``p`` and the FEM's (r, z) von Mises field.
 
-Units are the symbols the run recorded (``unit_symbols``); a result written before they were
-recorded has its units label read by :func:`validation.units.parse_units`. A report shows each
+Units are the symbols the run recorded (``unit_symbols``). A report shows each
 quantity in one unit, in every table, caption and figure (:meth:`RunResults.display`): the
 report's ``units`` (:data:`UNIT_CHOICES`) choose them.
 """
@@ -34,6 +34,7 @@ import numpy as np
 from bem.checks import InputError, check_choice
 
 from ...run.runner import FILES
+from ...run.record import RunResult
 from ...units import Units, parse_units
 from ..render.content import fmt
 from ..render.style import report_unit
@@ -70,16 +71,13 @@ class Shown(tuple):
 
 
 def is_number(value):
-    """True for an int or a float of ``result.json`` (not a bool)."""
+    """True for an int or a float of a scene (``scene.toml``) or a sweep's ``summary.json`` (not a bool)."""
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def units_of(data, label=None):
-    """The :class:`validation.units.Units` of a result: its ``unit_symbols``, else its units label parsed."""
-    label = data.get("units") or label
-    if isinstance(data.get("unit_symbols"), Mapping):
-        return Units.from_dict(label, data["unit_symbols"])
-    return parse_units(label)
+def units_of(result):
+    """The :class:`validation.units.Units` a :class:`validation.run.record.RunResult` recorded."""
+    return Units.from_dict(result.units, result.unit_symbols)
 
 
 @dataclass
@@ -89,8 +87,8 @@ class RunResults:
     Attributes
     ----------
     directory : Path
-    data : dict
-        ``result.json``.
+    result : validation.run.record.RunResult or None
+        ``result.json`` (``None``: results that only carry units, a sweep without computed points).
     scene : dict
         ``scene.toml`` (empty when missing).
     units : validation.units.Units
@@ -113,7 +111,7 @@ class RunResults:
     """
 
     directory: Path
-    data: dict
+    result: RunResult | None
     scene: dict = field(default_factory=dict)
     units: Units = field(default_factory=lambda: parse_units(None))
     bem_field: tuple | None = None
@@ -128,44 +126,43 @@ class RunResults:
         value = self.scene.get(name)
         return value if isinstance(value, Mapping) else {}
 
-    def get(self, key, default=None):
-        """A top-level entry of ``result.json`` that is a dict (``default`` otherwise)."""
-        value = self.data.get(key)
-        return value if isinstance(value, Mapping) else default
-
     @property
     def name(self):
-        return str(self.data.get("scene") or self.section("scene").get("name") or self.directory.name)
+        return self.result.scene
 
     @property
     def title(self):
-        return str(self.data.get("title") or self.section("scene").get("title") or self.name)
+        return self.result.title
 
     @property
     def bem(self):
-        return self.get("bem", {})
+        """The BEM part (:class:`validation.run.record.BemPart`)."""
+        return self.result.bem
 
     @property
     def fem(self):
-        """The FEM summary, or ``None`` when the FEM did not run."""
-        return self.get("fem")
+        """The FEM part (:class:`validation.run.record.FemPart`), or ``None`` when the FEM did not run."""
+        return self.result.fem
 
     @property
     def contact_size(self):
-        """The contact radius, else the half-width along x (``None`` when neither was recorded)."""
-        return self.data.get("contact_radius") or (self.get("contact_extent") or {}).get("x")
+        """The contact radius, else the half-width along x (``None`` for a periodic cell)."""
+        r = self.result
+        if r.contact_radius is not None:
+            return r.contact_radius
+        return None if r.contact_extent is None else r.contact_extent["x"]
 
     @property
     def axisymmetric(self):
         """Axisymmetric scenes record ``contact_radius``."""
-        return self.data.get("contact_radius") is not None
+        return self.result.axisymmetric
 
     @functools.cached_property
     def layer(self):
         """The :class:`bem.layers.Layer` the run used, or ``None`` (smooth bodies or not rebuildable)."""
         from bem.layers import from_dict
 
-        params = (self.get("layer") or {}).get("parameters")
+        params = self.result.layer["parameters"]
         if not isinstance(params, Mapping):
             params = self.section("layer") if self.section("layer").get("law") not in (None, "none") else None
         try:
@@ -182,11 +179,10 @@ class RunResults:
         """
         if not self.dimensionless:
             return None
-        sc = self.get("scales") or {}
-        p0, a = sc.get("p_hertz"), sc.get("a_hertz")
-        if p0 and a and p0 > 0 and a > 0:
-            return float(p0), float(a), self.hertz_peak, "a_H"
-        p0, a = self.data.get("p_max"), self.contact_size
+        sc = self.result.scales
+        if sc is not None and sc.p_hertz > 0 and sc.a_hertz > 0:
+            return float(sc.p_hertz), float(sc.a_hertz), self.hertz_peak, "a_H"
+        p0, a = self.result.p_max, self.contact_size
         return (float(p0), float(a), "p_{max}", "a_c") if p0 and a and p0 > 0 and a > 0 else None
 
 
@@ -218,8 +214,8 @@ class RunResults:
         return Shown(factor, name or "-", False)
 
     def shown(self, value, kind, power=1.0):
-        """``value`` [scene unit of ``kind``] as :meth:`display` shows it (non-numbers unchanged)."""
-        return value / self.display(kind, power).factor if is_number(value) else value
+        """``value`` [scene unit of ``kind``] as :meth:`display` shows it (``None``: not computed, unchanged)."""
+        return None if value is None else value / self.display(kind, power).factor
 
     def engineering(self, kind):
         """``(factor, name)`` of ``kind`` (``"length"``, ``"pressure"``, ``"force"``) in units, never
@@ -324,7 +320,8 @@ def load_results(directory, *, units="auto"):
     Raises
     ------
     bem.InputError
-        ``directory`` is not a directory or has no readable ``result.json`` holding an object.
+        ``directory`` is not a directory or has no ``result.json`` of the schema
+        :data:`validation.run.record.SCHEMA` (:class:`validation.run.record.ResultFileError`).
     """
     from ..figures.fields import section_field_from_vtu
 
@@ -335,19 +332,14 @@ def load_results(directory, *, units="auto"):
     if not main.is_file():
         raise InputError(f"directory = {str(directory)!r} is not allowed: it has no result.json "
                          "(run the scene first: contactlab run SCENE --out DIR).")
-    data = read_json(main)
-    if not isinstance(data, Mapping):
-        raise InputError(f"{main} is not allowed: it must hold a JSON object.")
-    if not str(data.get("schema", "")).startswith("contactlab.result/"):
-        log.warning("%s has schema %r: it was not written by contactlab run; parts may be missing",
-                    main, data.get("schema"))
-    stored = data.get("files") if isinstance(data.get("files"), Mapping) else {}
+    result = RunResult.read(main)
+    stored = result.files or {}
     files = {k: file_inside(directory, v, f"files.{k}" if k in stored else k)
              for k, v in {**FILES, **{k: str(v) for k, v in stored.items()}}.items()}
     scene = _read_scene(files["scene"]) if files["scene"] is not None else {}
-    parsed = units_of(data, (scene.get("scene") or {}).get("units"))
-    fem = _field(files["fem_field"], section_field_from_vtu) if isinstance(data.get("fem"), Mapping) else None
-    return RunResults(directory=directory, data=dict(data), scene=scene, units=parsed,
+    parsed = units_of(result)
+    fem = _field(files["fem_field"], section_field_from_vtu) if result.fem is not None else None
+    return RunResults(directory=directory, result=result, scene=scene, units=parsed,
                       bem_field=_field(files["bem_field"], _bem_field), fem_field=fem,
                       files={k: p for k, p in files.items() if p is not None and p.is_file()},
                       dimensionless=dimensionless_for(units, parsed), scene_units=units == "scene")
@@ -359,7 +351,7 @@ def results_of(outcome, *, units="auto", directory=".", hertz_peak="p_H"):
     from ..figures.fields import von_mises_of
 
     res = outcome.bem
-    return RunResults(directory=Path(directory), data=outcome.result, scene=outcome.scene.raw,
+    return RunResults(directory=Path(directory), result=outcome.result, scene=outcome.scene.raw,
                       units=outcome.scene.units, bem_field=(res.x, res.y, res.p),
                       fem_field=None if outcome.fem is None else von_mises_of(outcome.fem),
                       dimensionless=dimensionless_for(units, outcome.scene.units), scene_units=units == "scene",

@@ -11,7 +11,6 @@ A report contains the sections ``result.json["report"]["sections"]`` lists (the 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from pathlib import Path
 
 from bem.checks import InputError
@@ -24,7 +23,6 @@ from ..render.content import fmt_distinct
 from ..render.style import method_text
 from .periodic import rough_section
 from .problem import scene_section
-from .results import is_number
 from .sweep import sweep_section
 
 __all__ = ["SECTIONS", "STAGES", "run_sections", "report_results_dir", "results_rows"]
@@ -32,12 +30,13 @@ __all__ = ["SECTIONS", "STAGES", "run_sections", "report_results_dir", "results_
 #: the stages of :func:`report_results_dir`, as reported to its ``progress``
 STAGES = ("reading", "figures", "writing")
 
-#: rows of the results table: (key in result.json / fem / analytic, label, unit kind)
+#: rows of the results table: (field of the result / FEM / closed form, label, unit kind); the FEM's radius
+#: is its interpolated edge (``edge_radius``), a row of its own
 _QUANTITIES = (("p_max", "peak pressure p_max", "pressure"), ("force", "total force P", "force"),
                ("approach", "approach delta", "length"), ("contact_area", "contact area A", "area"),
                ("contact_radius", "contact radius r_c", "length"),
                ("edge_radius", "edge radius of the loaded zone r_edge", "length"))
-#: ratio rows: (key, label, key in result["scales"])
+#: ratio rows: (key, label, field of result.scales)
 _RATIOS = (("p_max", "p_max / p_H (Hertz peak)", "p_hertz"), ("contact_radius", "r_c / a_H (Hertz radius)", "a_hertz"),
            ("approach", "delta / delta_H (Hertz approach)", "approach_hertz"))
 _BEM_COUNTS = (("n_nodes", "candidate nodes"), ("n_contact", "nodes in contact"),
@@ -55,39 +54,45 @@ _METRICS = {"l2_rel": "relative L2 error of p", "max_rel": "max |p - p_ref| / ma
 
 
 def _timed(times, names, prefix="wall time: "):
-    """``(label, seconds, "s")`` rows of the numeric entries of ``times``."""
-    times = times if isinstance(times, Mapping) else {}
-    return [(prefix + label, fmt(times[key], 3), "s") for key, label in names if is_number(times.get(key))]
+    """``(label, seconds, "s")`` rows of the parts of ``times`` that ran (``None``: did not run)."""
+    return [(prefix + label, fmt(times[key], 3), "s") for key, label in names if times.get(key) is not None]
+
+
+def _value(part, key):
+    """Field ``key`` of a part of the results table; ``None`` where the part has no such quantity (the FEM
+    gives no area and no ``sqrt(A / pi)`` radius, only the FEM gives an edge radius)."""
+    return getattr(part, key, None)
 
 
 def results_rows(res):
     """``(columns, rows)`` of the results table: one column per solver that ran, then the unit."""
-    parts = [("BEM", res.data)] + ([("FEM", res.fem)] if res.fem is not None else []) + (
-        [("closed form", res.get("analytic"))] if res.get("analytic") else [])
+    r = res.result
+    parts = [("BEM", r)] + ([("FEM", r.fem)] if r.fem is not None else []) + (
+        [("closed form", r.analytic)] if r.analytic is not None else [])
 
     def cells(key, scale=1.0):
         """The solvers' values of ``key``, with the digits that tell them apart (:func:`fmt_distinct`)."""
-        return fmt_distinct([float(p.get(key)) / scale if is_number(p.get(key)) else "-" for _, p in parts])
+        return fmt_distinct([float(v) / scale if (v := _value(p, key)) is not None else "-" for _, p in parts])
 
     rows = [(label, *cells(key, res.display(kind).factor), res.display(kind).name) for key, label, kind in _QUANTITIES
-            if any(is_number(p.get(key)) for _, p in parts)]
-    ext = res.get("contact_extent")
+            if any(_value(p, key) is not None for _, p in parts)]
+    ext = r.contact_extent
     if ext and not res.axisymmetric:
-        ref = res.get("analytic") or {}
+        ref = r.analytic
 
         def pair(a, b):
             return f"{fmt(res.shown(a, 'length'))}, {fmt(res.shown(b, 'length'))}"
 
-        closed = {"closed form": pair(ref.get("a"), ref.get("b"))} if is_number(ref.get("a")) else {}
-        rows.append(("contact half-widths along x, y", pair(ext.get("x"), ext.get("y")),
+        closed = {"closed form": pair(ref.a, ref.b)} if ref is not None and ref.a is not None else {}
+        rows.append(("contact half-widths along x, y", pair(ext["x"], ext["y"]),
                      *(closed.get(name, "-") for name, _ in parts[1:]), res.display("length").name))
-    scales = res.get("scales") or {}
+    scales = r.scales
     drawn_over = {"p_hertz": res.display("pressure").name == res.hertz_peak,  # a ratio the table shows already
-                  "a_hertz": res.display("length").name == "a_H"}
-    rows += [(label, *cells(key, scales[skey]), "-") for key, label, skey in _RATIOS
-             if is_number(scales.get(skey)) and scales[skey] > 0 and not drawn_over.get(skey)]
-    if is_number(res.data.get("alpha_b")):
-        rows.append(("alpha_b = p_max / p_max^lambda", fmt(res.data["alpha_b"]), *("-" for _ in parts[1:]), "-"))
+                  "a_hertz": res.display("length").name == "a_H", "approach_hertz": False}
+    rows += [(label, *cells(key, getattr(scales, skey)), "-") for key, label, skey in _RATIOS
+             if scales is not None and getattr(scales, skey) > 0 and not drawn_over[skey]]
+    if r.alpha_b is not None:
+        rows.append(("alpha_b = p_max / p_max^lambda", fmt(r.alpha_b), *("-" for _ in parts[1:]), "-"))
     return ("quantity", *(name for name, _ in parts), "unit"), tuple(rows)
 
 
@@ -95,9 +100,9 @@ def summary(res, work):
     """The key results of every solver that ran, and their ratios to Hertz's."""
     columns, rows = results_rows(res)
     text = [f"Computed: {', '.join(columns[1:-1])}. "
-            + ("The run converged." if res.data.get("converged") else "The run did NOT converge.")]
-    if res.data.get("messages"):
-        text.append("Run messages: " + "; ".join(map(str, res.data["messages"])) + ".")
+            + ("The run converged." if res.result.converged else "The run did NOT converge.")]
+    if res.result.messages:
+        text.append("Run messages: " + "; ".join(map(str, res.result.messages)) + ".")
     caption = "Key results, in the report's units (problem statement)."
     if res.axisymmetric:
         caption += " r_c = sqrt(A / pi), A = loaded node count times the node area" + (
@@ -105,7 +110,7 @@ def summary(res, work):
             if res.fem is not None else ".")
     else:
         caption += " Half-widths: the farthest loaded node along each axis."
-    if res.get("scales"):
+    if res.result.scales is not None:
         caption += (" Ratios: to Hertz's peak, radius and approach of the smooth paraboloid at the same load "
                     "(the scale of the figures).")
     return Section("Results", kind="results", text=tuple(text), items=(Table(columns, rows, caption=caption),))
@@ -113,19 +118,18 @@ def summary(res, work):
 
 def timings(res, work):
     """How the BEM ran: method, lattice, iterations, residual, wall times."""
-    d, b, length = res.data, res.bem, res.display("length")
-    rows = [("method", method_text(d.get("method"), getattr(res.layer, "law", None)), "-"),
-            ("status", "converged" if d.get("converged") else "not converged", "-"),
-            ("solver message", str(d.get("message", "-")), "-"),
-            ("iterations (finest lattice)", fmt(d.get("iterations")), "-"),
-            ("KKT residual", fmt(d.get("kkt_residual")), "-")]
-    if is_number(b.get("step")):
-        rows.append(("lattice step c", fmt(b["step"] / length.factor), length.name))
-    if isinstance(b.get("extent"), list) and len(b["extent"]) == 2:
+    d, b, length = res.result, res.bem, res.display("length")
+    rows = [("method", method_text(d.method, getattr(res.layer, "law", None)), "-"),
+            ("status", "converged" if d.converged else "not converged", "-"),
+            ("solver message", str(d.message), "-"),
+            ("iterations (finest lattice)", fmt(d.iterations), "-"),
+            ("KKT residual", fmt(d.kkt_residual), "-"),
+            ("lattice step c", fmt(b.step / length.factor), length.name)]
+    if b.extent is not None:
         rows.append(("candidate region |x| <= X, |y| <= Y (X, Y)",
-                     ", ".join(fmt(v / length.factor) for v in b["extent"]), length.name))
-    rows += [(label, fmt(b[key], 3), "-") for key, label in _BEM_COUNTS if is_number(b.get(key))]
-    rows += _timed(res.get("wall_time_s"), _TIMES)
+                     ", ".join(fmt(v / length.factor) for v in b.extent), length.name))
+    rows += [(label, fmt(getattr(b, key), 3), "-") for key, label in _BEM_COUNTS if getattr(b, key) is not None]
+    rows += _timed(d.wall_time_s_by_part, _TIMES)
     return Section("Solver and timings", kind="results", items=(
         Table(("quantity", "value", "unit"), tuple(rows), caption="How the BEM solution was computed."),))
 
@@ -135,22 +139,18 @@ def fem_field(res, work):
     fem, length = res.fem, res.display("length")
     if fem is None:
         return None
-    mesh, penalty, trunc = ((fem.get(k) if isinstance(fem.get(k), Mapping) else {})
-                            for k in ("mesh", "penalty", "truncation"))
-    rows = [("status", "converged" if fem.get("converged") else "not converged", "-"),
-            ("stopping reason", str(fem.get("message", "-")), "-"),
-            ("contact iterations", fmt(fem.get("iterations")), "-"),
-            ("degrees of freedom", fmt(fem.get("n_dofs")), "-"),
-            ("elements", fmt(fem.get("n_elements")), "-"),
-            ("elements across the contact radius", fmt(fem.get("n_elements_across_contact"), 3), "-")]
-    optional = ((mesh, "h_fine", "element size at the contact", length),
-                (mesh, "domain_factor", "mesh half-size / estimated contact radius", res.display("-")),
-                (penalty, "relative_penetration", "penalty: largest penetration / approach", res.display("-")))
-    rows += [(label, fmt(part[key] / unit.factor), unit.name) for part, key, label, unit in optional
-             if is_number(part.get(key))]
-    if "applied" in trunc:
-        rows.append(("far-field (truncation) correction applied", fmt(bool(trunc["applied"])), "-"))
-    rows += _timed(fem.get("timings"), _FEM_TIMES)
+    rows = [("status", "converged" if fem.converged else "not converged", "-"),
+            ("stopping reason", str(fem.message), "-"),
+            ("contact iterations", fmt(fem.iterations), "-"),
+            ("degrees of freedom", fmt(fem.n_dofs), "-"),
+            ("elements", fmt(fem.n_elements), "-"),
+            ("elements across the contact radius", fmt(fem.n_elements_across_contact, 3), "-"),
+            ("element size at the contact", fmt(fem.mesh.h_fine / length.factor), length.name),
+            ("mesh half-size / estimated contact radius", fmt(fem.mesh.domain_factor), "-")]
+    if fem.penalty["relative_penetration"] is not None:
+        rows.append(("penalty: largest penetration / approach", fmt(fem.penalty["relative_penetration"]), "-"))
+    rows.append(("far-field (truncation) correction applied", fmt(bool(fem.truncation["applied"])), "-"))
+    rows += _timed(fem.timings, _FEM_TIMES)
     return Section("FEM reference", kind="fem", items=(Table(
         ("quantity", "value", "unit"), tuple(rows),
         caption="FEM reference (fem_reference, axisymmetric, quadratic triangles): mesh, solver and time split. "
@@ -159,23 +159,23 @@ def fem_field(res, work):
 
 def stress(res, work):
     """The subsurface stresses of a scene with ``[stress]``: maxima per body, and against the FEM."""
-    block = res.get("stress")
-    if not block or not block.get("bodies"):
+    block = res.result.stress
+    if block is None or not block.bodies:
         return None
     a, s, l_name, s_name, _ = stress_view(res)
-    rows = [(name, fmt(b["nu"]), fmt(b["max_von_mises"] / s), fmt(b["depth_of_max"] / a),
-             f"{fmt(b['location_of_max'][0] / a)}, {fmt(b['location_of_max'][1] / a)}", fmt(b["max_tresca"] / s),
-             fmt(b["depth_of_max_tresca"] / a)) for name, b in block["bodies"].items()]
+    rows = [(name, fmt(b.nu), fmt(b.max_von_mises / s), fmt(b.depth_of_max / a),
+             f"{fmt(b.location_of_max[0] / a)}, {fmt(b.location_of_max[1] / a)}", fmt(b.max_tresca / s),
+             fmt(b.depth_of_max_tresca / a)) for name, b in block.bodies.items()]
     items = [Table(("body", "nu", f"max von Mises / {s_name}", f"its depth / {l_name}", f"at x, y / {l_name}",
                     f"max shear / {s_name}", f"its depth / {l_name}"), tuple(rows),
                    caption="Largest von Mises stress and largest maximum shear (s1 - s3)/2 of each body over all "
                            "candidate nodes and depths, refined in depth by a parabola through the largest sample and "
                            f"its neighbours.{_scales_text(res, a, s, l_name, s_name)}")]
-    fem_rows = [(name, fmt(f["max_von_mises"] / s), f"{100 * f['max_von_mises_rel']:+.2f} %", fmt(f["max_tresca"] / s),
-                 f"{100 * f['max_tresca_rel']:+.2f} %", fmt(f["axis_depth_of_max"] / a),
-                 fmt(f["bem_axis_depth_of_max"] / a), f"{100 * f['axis_depth_of_max_rel']:+.2f} %",
-                 "yes" if f["on_axis"] else "no")
-                for name, b in block["bodies"].items() if (f := b.get("fem"))]
+    fem_rows = [(name, fmt(f.max_von_mises / s), f"{100 * f.max_von_mises_rel:+.2f} %", fmt(f.max_tresca / s),
+                 f"{100 * f.max_tresca_rel:+.2f} %", fmt(f.axis_depth_of_max / a),
+                 fmt(f.bem_axis_depth_of_max / a), f"{100 * f.axis_depth_of_max_rel:+.2f} %",
+                 "yes" if f.on_axis else "no")
+                for name, b in block.bodies.items() if (f := b.fem) is not None]
     if fem_rows:
         items.append(Table(
             ("body", f"FEM max von Mises / {s_name}", "BEM - FEM", f"FEM max shear / {s_name}", "BEM - FEM",
@@ -190,8 +190,7 @@ def stress(res, work):
     text = ("The contact pressure matters for the strength of the parts through the stresses it causes below the "
             "surface: yielding starts where the von Mises stress (or the maximum shear) is largest, below the "
             "surface for a smooth contact.")
-    if is_number(block.get("wall_time_s")):
-        text += f" Computed in {fmt(float(block['wall_time_s']), 3)} s."
+    text += f" Computed in {fmt(float(block.wall_time_s), 3)} s."
     return Section("Subsurface stresses", kind="results", text=(text,), items=tuple(items))
 
 
@@ -205,29 +204,34 @@ def _scales_text(res, a, s, l_name, s_name):
 
 
 def _metric_cell(key, value):
-    if not is_number(value):
-        return "-" if value is None else str(value)
+    if value is None:
+        return "-"
     return str(value) if key == "n_points" or isinstance(value, int) else f"{100.0 * value:.3g} %"
 
 
 def comparison(res, work):
     """The comparison metrics the run recorded: one column per compared pair (per cent), then the force balance."""
     names = {"bem": "BEM", "fem": "FEM", "analytic": "closed form"}
-    metrics = res.get("comparison") or {}
-    pairs = {k: v for k, v in metrics.items() if isinstance(v, Mapping) and k != "force_balance"}
+    metrics = res.result.comparison
+    if metrics is None:
+        return None
+    pairs = metrics.pairs()
     tables = []
     if pairs:
-        keys = dict.fromkeys(k for v in pairs.values() for k, x in v.items() if not isinstance(x, (Mapping, list)))
+        # a radius row only where a pair compares that radius (the FEM's is its interpolated edge)
+        keys = [k for k in _METRICS if k not in ("contact_radius_rel", "edge_radius_rel")
+                or any(getattr(v, k) is not None for v in pairs.values())]
         tables.append(Table(
-            ("metric", *(" vs ".join(names.get(p, p.replace("_", " ")) for p in k.split("_vs_")) for k in pairs)),
-            tuple((_METRICS.get(k, k), *(_metric_cell(k, v.get(k)) for v in pairs.values())) for k in keys),
+            ("metric", *(" vs ".join(names[p] for p in k.split("_vs_")) for k in pairs)),
+            tuple((_METRICS[k], *(_metric_cell(k, getattr(v, k)) for v in pairs.values())) for k in keys),
             caption="Comparison metrics of the run (candidate vs reference at the candidate's nodes; signed "
                     "differences are (candidate - reference) / reference)."))
-    balance = metrics.get("force_balance") if isinstance(metrics.get("force_balance"), Mapping) else {}
-    rows = [("target force P", fmt(res.shown(v, "force")), res.display("force").name) if k == "target" else
-            (f"force balance |F - P| / P ({k.upper()})", _metric_cell(k, v), "-")
-            for k, v in balance.items() if is_number(v)]
-    rows += [(k, _metric_cell(k, v), "-") for k, v in metrics.items() if is_number(v)]
+    balance = metrics.force_balance
+    rows = [] if balance is None else [("target force P", fmt(res.shown(balance.target, "force")),
+                                        res.display("force").name)]
+    rows += [(f"force balance |F - P| / P ({k.upper()})", _metric_cell(k, v), "-")
+             for k, v in (("bem", None if balance is None else balance.bem),
+                          ("fem", None if balance is None else balance.fem)) if v is not None]
     if rows:
         tables.append(Table(("quantity", "value", "unit"), tuple(rows), caption="Force balance of the solvers."))
     return Section("Comparison metrics", kind="validation", items=tuple(tables)) if tables else None
@@ -278,7 +282,7 @@ def run_sections(res, work, names=None):
     (the scene's ``[report] sections``) when present, else every name of :data:`SECTIONS`.
     """
     if names is None:
-        names = (res.get("report") or {}).get("sections") or tuple(SECTIONS)
+        names = tuple(SECTIONS) if res.result.report is None else res.result.report["sections"]
     return [sec for name in names if (sec := build_section(name, res, Path(work))) is not None]
 
 
@@ -311,7 +315,7 @@ def report_results_dir(directory, out_dir=None, *, title=None, units="auto", fmt
     notify = Progress(STAGES, progress)
     notify("reading")
     res = load_results(directory, units=units)
-    source = res.data.get("source")
+    source = res.result.source
     subtitle = (f"Scene '{res.name}'" + (f" ({source})" if source else "")
                 + f"; results read from {display_path(directory)}")
     return draw_and_build(lambda work: run_sections(res, work), Path(directory) / "report" if out_dir is None

@@ -21,6 +21,8 @@ import numpy as np
 from bem.checks import InputError, check_choice
 
 from ...provenance import display_path
+from ...run.record import RunResult
+from ...units import Units
 from ..figures.run import PAD, axis_label, contact_edge, scale
 from ..render import Figure, Progress, Section, Table, draw_and_build, fmt
 from .problem import scene_section
@@ -69,9 +71,9 @@ def load_sweep(directory, *, units="auto"):
         path = file_inside(directory, row["file"], f"points[{i}].file") if row.get("file") else None
         if path is not None and path.is_file():
             point = read_json(path)
-            data = dict(point.get("result") or {})
-            u = units_of(data, summary.get("units"))
-            res = RunResults(directory=directory, data=data, scene=dict(point.get("scene") or {}), units=u,
+            result = RunResult.from_json(point["result"], source=str(path))
+            u = units_of(result)
+            res = RunResults(directory=directory, result=result, scene=dict(point.get("scene") or {}), units=u,
                              dimensionless=dimensionless_for(units, u), scene_units=units == "scene")
         points.append((row, res))
     return Sweep(summary, points)
@@ -80,7 +82,8 @@ def load_sweep(directory, *, units="auto"):
 def _units(summary, points):
     """The first computed point's results (their units), or results holding only the summary's units."""
     return next((res for _, res in points if res is not None),
-                RunResults(directory=Path("."), data={}, units=units_of(summary)))
+                RunResults(directory=Path("."), result=None,
+                           units=Units.from_dict(summary.get("units"), summary.get("unit_symbols"))))
 
 
 def _table(summary, points):
@@ -124,9 +127,10 @@ def _figures(summary, points, work):
     from ..figures.periodic import sweep_curves
     from ..figures.sweeps import plot_sweep, plot_sweep_scalars
 
-    if any(res is not None and res.data.get("periodic") for _, res in points):  # a rough surface's cell
+    if any(res is not None and res.result.periodic is not None for _, res in points):  # a rough surface's cell
         return sweep_curves(points, work, str(summary.get("key", "value")))
-    done = [(row, res) for row, res in points if res is not None and (res.get("profile") or {}).get("x")]
+    done = [(row, res) for row, res in points if res is not None and res.result.profile is not None
+            and res.result.profile.x]
     if not done:
         return []
     values = [row["value"] for row, _ in done]
@@ -138,8 +142,8 @@ def _figures(summary, points, work):
     x_scale, p_scale = scale(first, "length"), scale(first, "pressure")
     xf, pf = x_scale[0], p_scale[0]
     # each point divided by its own scales, drawn with the first's
-    curves = [(a_i, np.asarray(res.get("profile")["x"], float) * xf / scale(res, "length")[0],
-               np.asarray(res.get("profile")["p"], float) * pf / scale(res, "pressure")[0])
+    curves = [(a_i, np.asarray(res.result.profile.x, float) * xf / scale(res, "length")[0],
+               np.asarray(res.result.profile.p, float) * pf / scale(res, "pressure")[0])
               for a_i, (_, res) in zip(alpha, done)]
     edge = contact_edge([(x / xf, p) for _, x, p in curves])
     path = plot_sweep(curves, work / "sweep_profiles.png", p0=pf, a=xf, name=name, ticklabels=ticks,
@@ -151,12 +155,12 @@ def _figures(summary, points, work):
     def series(get, factor):
         return np.array([get(res) / factor if get(res) is not None else math.nan for _, res in done])
 
-    scalars = [(f"$p_{{max}}$ [{pu}]" if pu else "$p_{max}$", series(lambda r: r.data.get("p_max"), pfac)),
+    scalars = [(f"$p_{{max}}$ [{pu}]" if pu else "$p_{max}$", series(lambda r: r.result.p_max, pfac)),
                (f"contact size [{lu}]" if lu else "contact size", series(lambda r: r.contact_size, lf)),
-               (f"approach [{lu}]" if lu else "approach", series(lambda r: r.data.get("approach"), lf))]
+               (f"approach [{lu}]" if lu else "approach", series(lambda r: r.result.approach, lf))]
     path2 = plot_sweep_scalars(alpha, scalars, work / "sweep_scalars.png", name=name, ticklabels=ticks,
                                title=f"results against {key}")
-    how = (f"{len(done)} computed points of {len(points)}; BEM method {first.data.get('method', '?')}, "
+    how = (f"{len(done)} computed points of {len(points)}; BEM method {first.result.method}, "
            "each point a complete run of the scene with the swept key set (points/point-*.json).")
     return [Figure(path, "Contact pressure on the axial section y = 0 of every computed point, coloured by "
                          f"{key}. " + ("Each point divided by its own scales. " if first.scales() else "") + how),

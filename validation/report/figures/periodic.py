@@ -22,9 +22,9 @@ _SPOT_MAPS = ("tab10", "Dark2")  # strong colours on white; spots cycle through 
 
 def brick(res, values):
     """Nodal values of a periodic result as a brick array ``(n_rows, n_cols)`` (``bem.cell``), or None."""
-    cell = res.bem.get("cell")
+    cell = res.bem.cell
     values = np.asarray(values)
-    if not (isinstance(cell, list) and len(cell) == 2 and values.size == cell[0] * cell[1]):
+    if cell is None or values.size != cell[0] * cell[1]:
         return None
     return values.reshape(cell[1], cell[0])
 
@@ -118,43 +118,43 @@ def cell_maps(res, work):
     """The pressure and spot maps of a periodic result, or None for other results."""
     from ...run.periodic import contact_spots
 
-    if not res.data.get("periodic") or res.bem_field is None:
+    if res.result.periodic is None or res.bem_field is None:
         return None
     p = brick(res, res.bem_field[2])
     if p is None:
         return None
     labels, n = contact_spots(p > 0)
-    size = res.bem.get("size")
+    size = res.bem.size
     kw = _units(res)
     (lf, lu), (pf, pu) = res.engineering("length"), res.engineering("pressure")
     path = plot_cell_maps(p, labels, size, work / "cell_maps.png", **kw)
     return Figure(path, f"Contact pressure (left) and the {n} contact spots (right) over the periodic cell "
-                        f"({res.bem['cell'][0]} x {res.bem['cell'][1]} nodes of step {fmt(res.bem.get('step') / lf)} "
+                        f"({res.bem.cell[0]} x {res.bem.cell[1]} nodes of step {fmt(res.bem.step / lf)} "
                         f"{lu}; bem_field.vtu), each node drawn as one cell of its row, odd rows "
                         "shifted by half a step in the lattice. A spot is a set of nodes in contact connected "
                         "through the lattice's six nearest neighbours, across the cell's edges too (the cell "
                         "repeats): a spot cut by an edge has one colour on both sides. "
-                        f"Mean pressure {fmt(res.data.get('mean_pressure') / pf)} {pu}, contact "
-                        f"fraction {fmt(res.data.get('contact_fraction'))}.")
+                        f"Mean pressure {fmt(res.result.periodic.mean_pressure / pf)} {pu}, contact "
+                        f"fraction {fmt(res.result.periodic.contact_fraction)}.")
 
 
 def sweep_curves(points, work, key):
     """The load-area and load-gap curves of a sweep of periodic runs (``[]`` with fewer than two points)."""
     keys = ("mean_pressure", "contact_fraction", "mean_gap")
-    done = [res for _, res in points if res is not None and res.data.get("periodic")
-            and all(isinstance(res.data.get(k), (int, float)) for k in keys)]
+    done = [res for _, res in points if res is not None and res.result.periodic is not None
+            and all(getattr(res.result.periodic, k) is not None for k in keys)]
     if len(done) < 2:
         return []
-    p, a, g = (np.array([r.data[k] for r in done], float) for k in keys)
+    p, a, g = (np.array([getattr(r.result.periodic, k) for r in done], float) for k in keys)
     kw = _units(done[0])
-    e_star, slope = done[0].bem.get("E_star"), (done[0].get("surface") or {}).get("rms_slope")
-    if isinstance(e_star, (int, float)) and isinstance(slope, (int, float)) and e_star * slope > 0:
+    e_star, slope = done[0].bem.E_star, done[0].result.periodic.surface["rms_slope"]
+    if slope is not None and e_star * slope > 0:
         kw["slope_modulus"] = e_star * slope
     path = plot_load_curves(p, a, g, work / "load_curves.png", **kw)
     pf, lf = kw["p_factor"], kw["l_factor"]
     table = Table((f"mean pressure [{kw['p_unit']}]", "contact fraction A/A0", f"mean gap [{kw['l_unit']}]",
-                   "contact spots"), tuple((fmt(r.data["mean_pressure"] / pf), fmt(r.data["contact_fraction"]),
-                                            fmt(r.data["mean_gap"] / lf), fmt(r.data.get("n_spots"))) for r in done),
+                   "contact spots"), tuple((fmt(c.mean_pressure / pf), fmt(c.contact_fraction), fmt(c.mean_gap / lf),
+                                            fmt(c.n_spots)) for c in (r.result.periodic for r in done)),
                   caption="The periodic cell at each computed point (result.json of each point).")
     return [table, Figure(path, f"Real contact fraction A/A0 against the mean pressure (left) and the mean pressure "
                          f"against the mean gap, the mean-plane separation (right), over the {len(done)} computed "

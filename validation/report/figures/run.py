@@ -104,27 +104,26 @@ def profile_view(res, curves, *, axis="x"):
 
 
 def _tolerance(res):
-    """The KKT tolerance of the run, ``bem.rtol`` (None where the result does not record it)."""
-    tol = res.bem.get("rtol")
-    return float(tol) if isinstance(tol, (int, float)) and math.isfinite(tol) else None
+    """The KKT tolerance of the run, ``bem.rtol``."""
+    return float(res.bem.rtol)
 
 
 def how(res):
     """One sentence: how the BEM solution was computed."""
     b, tol, length = res.bem, _tolerance(res), res.display("length")
-    text = (f"BEM: {method_text(res.data.get('method'), getattr(res.layer, 'law', None), short=True)}; lattice step "
-            f"c = {fmt(res.shown(b.get('step'), 'length'))} {length.name}, {b.get('n_nodes', '?')} candidate nodes, "
-            f"{b.get('n_contact', '?')} in contact")
-    if b.get("nodes_across_contact"):
-        text += f" ({b['nodes_across_contact']:.0f} across the contact)"
-    return text + f"; KKT residual {fmt(res.data.get('kkt_residual'))}" + (f" (tolerance {fmt(tol)})." if tol else ".")
+    text = (f"BEM: {method_text(res.result.method, getattr(res.layer, 'law', None), short=True)}; lattice step "
+            f"c = {fmt(res.shown(b.step, 'length'))} {length.name}, {b.n_nodes} candidate nodes, "
+            f"{b.n_contact} in contact")
+    if b.nodes_across_contact:
+        text += f" ({b.nodes_across_contact:.0f} across the contact)"
+    return text + f"; KKT residual {fmt(res.result.kkt_residual)}" + (f" (tolerance {fmt(tol)})." if tol else ".")
 
 
 def _fem_how(res):
-    fem, h = res.fem, res.shown((res.fem.get("mesh") or {}).get("h_fine"), "length")
-    return (f"FEM: axisymmetric quadratic triangles, {fmt(fem.get('n_elements_across_contact'), 3)} elements "
+    fem, h = res.fem, res.shown(res.fem.mesh.h_fine, "length")
+    return (f"FEM: axisymmetric quadratic triangles, {fmt(fem.n_elements_across_contact, 3)} elements "
             f"across the contact radius (h = {fmt(h)} {res.display('length').name} "
-            f"there), {fem.get('n_dofs', '?')} DOFs, interface nodal pressures.")
+            f"there), {fem.n_dofs} DOFs, interface nodal pressures.")
 
 
 class Scaled:
@@ -151,14 +150,14 @@ def layer_law(res, work):
     if res.layer is None:
         return None
     params = res.layer.to_dict()
-    p_top = 1.25 * max(float(res.data.get("p_max") or 0.0), *(float(params.get(k) or 0.0) for k in ("p_cr", "p_star")))
+    p_top = 1.25 * max(float(res.result.p_max or 0.0), *(float(params.get(k) or 0.0) for k in ("p_cr", "p_star")))
     if p_top <= 0:
         return None
     pressure, length = res.display("pressure"), res.display("length")  # the closure w is a length
     pf, wf = pressure.factor, length.factor
     # "= 0.74 p_H" or "= 1370 MPa"
     unit = rf" ${pressure.name}$" if pressure.normalised else f" {pressure.name}".replace(" -", "")
-    marks = [(rf"$p_{{max}}$ (BEM) = {fmt(res.data['p_max'] / pf, 3)}{unit}", res.data["p_max"] / pf)]
+    marks = [(rf"$p_{{max}}$ (BEM) = {fmt(res.result.p_max / pf, 3)}{unit}", res.result.p_max / pf)]
     marks += [(f"{name} = {fmt(params[key] / pf, 3)}{unit}", params[key] / pf)
               for key, name in (("p_cr", r"$p_{cr}$"), ("p_star", r"$p^*$")) if params.get(key)]
     path = plot_layer_laws([(params["law"].replace("_", "-"), Scaled(res.layer, pf, wf))], work / "layer_law.png",
@@ -174,23 +173,25 @@ def layer_law(res, work):
 
 def _reference(res, axis):
     """``(label, s, p)``: the closed form's pressure along ``axis`` as the run recorded it, or None."""
-    ref = res.get("analytic") or {}
-    prof = ref.get("profile") or {}
-    s, p = (prof.get("x"), prof.get("p")) if axis == "x" else (prof.get("y"), prof.get("p_y"))
-    if not s or not p:
+    ref = res.result.analytic
+    if ref is None:
         return None
-    return _REFERENCE.get(ref.get("kind"), "closed form"), np.asarray(s, float), np.asarray(p, float)
+    s, p = (ref.profile["x"], ref.profile["p"]) if axis == "x" else (ref.profile["y"], ref.profile["p_y"])
+    return _REFERENCE.get(ref.kind, "closed form"), np.asarray(s, float), np.asarray(p, float)
 
 
 def profiles(res, work):
     """Pressure along x (and along y for non-axisymmetric scenes), against the references."""
     from .profiles import plot_pressure_profiles, plot_profile_comparison
 
-    figures, fem = [], res.get("fem_profile") if res.axisymmetric else None
-    prof = res.get("profile") or {}
+    figures, fem = [], res.result.fem_profile if res.axisymmetric else None
+    prof = res.result.profile
+    if prof is None:
+        return figures
+    fem = None if fem is None else {"r": fem.r, "p": fem.p}
     for axis in ("x",) if res.axisymmetric else ("x", "y"):
-        line = prof if axis == "x" else prof.get("y_axis") or {}
-        if not line.get(axis) or not line.get("p") or not np.any(np.asarray(line["p"]) > 0):
+        line = {"x": prof.x, "p": prof.p} if axis == "x" else prof.y_axis
+        if not line[axis] or not line["p"] or not np.any(np.asarray(line["p"]) > 0):
             continue
         data = np.asarray(line[axis], dtype=float), np.asarray(line["p"], dtype=float)
         ref = _reference(res, axis)
@@ -238,9 +239,9 @@ def pressure_map(res, work):
     x, y, p = res.bem_field
     view = profile_view(res, [(np.hypot(x, y) if res.axisymmetric else np.maximum(abs(x), abs(y)), p)])
     labels = {"x": view.x_label, "y": axis_label("y", scale(res, "length")), "p": view.p_label}
-    p_cr = ((res.get("layer") or {}).get("parameters") or {}).get("p_cr")
+    p_cr = (res.result.layer["parameters"] or {}).get("p_cr")
     levels = [(r"$p = p_{cr}$", p_cr)] if p_cr else []
-    circle = res.data.get("contact_radius") if res.axisymmetric else None
+    circle = res.result.contact_radius if res.axisymmetric else None
     kw = dict(a=view.x_factor, labels=labels)
     ex, ey = contact_edge([(x, p)]), contact_edge([(y, p)])
     elongated = not view.normalised and min(ex, ey) > 0 and max(ex, ey) > ELONGATED * min(ex, ey)
@@ -268,11 +269,11 @@ def convergence(res, work):
     """Peak pressure and KKT residual per iteration, or None without a history."""
     from .iterations import plot_convergence
 
-    hist = res.bem.get("history") or {}
+    hist = res.bem.history
     if not hist.get("p_max"):
         return None
     sc = scale(res, "pressure")
-    name = method_text(res.data.get("method"), getattr(res.layer, "law", None), short=True)
+    name = method_text(res.result.method, getattr(res.layer, "law", None), short=True)
     path = plot_convergence([(f"BEM: {name}", hist)], work / "convergence.png", p0=sc[0], tol=_tolerance(res),
                             p_label=axis_label(r"\max\,p" if sc[2] else "p_{max}", sc, "max. pressure "),
                             title="BEM iterations: peak pressure and KKT residual")
@@ -294,7 +295,7 @@ def fem_von_mises(res, work):
     if res.fem_field is None:
         return None
     r, z, tri, vm = res.fem_field
-    rc = float(res.fem.get("edge_radius") or res.data.get("contact_radius") or 0.0)
+    rc = float(res.fem.edge_radius or res.result.contact_radius or 0.0)
     (a, l_name, normalised), (p0, s_name, _) = scale(res, "length"), scale(res, "pressure")
     hertz = normalised and l_name == "a_H"  # the figure's default labels
     labels = None if hertz else {k: axis_label(k, (a, l_name, normalised)) for k in ("r", "z")}
@@ -326,10 +327,10 @@ def stress_view(res):
 
 def _hertz_axis(res, z, nu):
     """Hertz's von Mises stress on the axis (Johnson 1985, eq. 3.45) [pressure], or None."""
-    sc = res.get("scales") or {}
-    p0, a = sc.get("p_hertz"), sc.get("a_hertz")
-    if (res.get("analytic") or {}).get("kind") != "hertz" or not (p0 and a):
+    sc, ref = res.result.scales, res.result.analytic
+    if ref is None or ref.kind != "hertz" or sc is None or not (sc.p_hertz and sc.a_hertz):
         return None
+    p0, a = sc.p_hertz, sc.a_hertz
     zeta = np.maximum(np.asarray(z, dtype=float) / a, 1e-12)
     s_r = -(1.0 + nu) * (1.0 - zeta * np.arctan(1.0 / zeta)) + 0.5 / (1.0 + zeta**2)
     return p0 * np.abs(-1.0 / (1.0 + zeta**2) - s_r)
@@ -339,45 +340,45 @@ def stress_figures(res, work):
     """The x-z section map of the von Mises stress and the stresses on the axis, or None without stresses."""
     from .fields import plot_depth_profiles, plot_stress_section
 
-    block = res.get("stress")
-    if not block or not block.get("bodies"):
+    block = res.result.stress
+    if block is None or not block.bodies:
         return None
-    bodies = block["bodies"]
+    bodies = block.bodies
     a, s, l_name, s_name, normalised = stress_view(res)
     length = (a, l_name, normalised)
     z_label, s_label = axis_label("z", length), axis_label(r"\sigma", (s, s_name, normalised))
-    panels = [({"body1": 1.0, "body2": -1.0}[name], b["section"]["x"], b["section"]["z"], b["section"]["von_mises"])
+    panels = [({"body1": 1.0, "body2": -1.0}[name], b.section["x"], b.section["z"], b.section["von_mises"])
               for name, b in bodies.items()]
     section = plot_stress_section(panels, work / "stress_section.png", a=a, scale=s,
                                   label="von Mises " + s_label.replace(r"\sigma", r"\sigma_{vM}"),
-                                  contact_radius=res.data.get("contact_radius"), fem=res.fem_field,
+                                  contact_radius=res.result.contact_radius, fem=res.fem_field,
                                   labels={"x": axis_label("x", length), "z": z_label},
                                   title="von Mises stress in the section y = 0")
     curves, marks = [], []
     for i, (name, b) in enumerate(bodies.items()):
-        ax, key = b["axis"], ("bem", "fem")[i % 2] if i else "bem"
-        curves += [{"label": f"{name} (nu = {fmt(b['nu'])}): von Mises", "z": ax["z"], "values": ax["von_mises"],
+        ax, key = b.axis, ("bem", "fem")[i % 2] if i else "bem"
+        curves += [{"label": f"{name} (nu = {fmt(b.nu)}): von Mises", "z": ax["z"], "values": ax["von_mises"],
                     "key": key, "ls": "-"},
                    {"label": f"{name}: max shear", "z": ax["z"], "values": ax["tresca"], "key": key, "ls": ":"}]
-        marks.append((b["depth_of_max"], b["max_von_mises"], "black"))
-        if b.get("fem"):
-            curves.append({"label": f"{name}: FEM von Mises", "z": b["fem"]["axis"]["z"],
-                           "values": b["fem"]["axis"]["von_mises"], "key": "analytic", "ls": "none", "marker": "x"})
+        marks.append((b.depth_of_max, b.max_von_mises, "black"))
+        if b.fem is not None:
+            curves.append({"label": f"{name}: FEM von Mises", "z": b.fem.axis["z"],
+                           "values": b.fem.axis["von_mises"], "key": "analytic", "ls": "none", "marker": "x"})
         depths = np.linspace(0.0, float(np.max(ax["z"])), 200)
-        hertz = _hertz_axis(res, depths, float(b["nu"])) if i == 0 else None
+        hertz = _hertz_axis(res, depths, float(b.nu)) if i == 0 else None
         if hertz is not None:
-            curves.append({"label": f"Hertz, Johnson eq. 3.45 (nu = {fmt(b['nu'])})", "z": depths, "values": hertz,
+            curves.append({"label": f"Hertz, Johnson eq. 3.45 (nu = {fmt(b.nu)})", "z": depths, "values": hertz,
                            "key": "smooth", "ls": "--"})
     profiles_ = plot_depth_profiles(curves, work / "stress_profiles.png", a=a, scale=s, stress_label=s_label,
                                     depth_label=z_label.replace("$z", "depth $z"), marks=marks,
                                     title="stresses on the axis x = y = 0")
-    depths = np.asarray(block["depths"], dtype=float)
+    depths = np.asarray(block.depths, dtype=float)
     text = (f"{depths.size} depths from {fmt(depths.min() / a)} to {fmt(depths.max() / a)} {l_name}"
-            f" (down to {fmt(depths.max() / block['scale'])} contact half-widths), every candidate node; "
+            f" (down to {fmt(depths.max() / block.scale)} contact half-widths), every candidate node; "
             "bem.subsurface_stress: the BEM pressure (pyramids on the lattice) convolved with the stresses "
             "under one pyramid, frictionless, each body with its own Poisson ratio.")
     overlay = " Dashed: the FEM reference's von Mises stress at the same levels." if res.fem_field is not None else ""
-    crosses = " Crosses: FEM axis nodes." if any(b.get("fem") for b in bodies.values()) else ""
+    crosses = " Crosses: FEM axis nodes." if any(b.fem is not None for b in bodies.values()) else ""
     return [Figure(section, "Von Mises stress of the BEM solution in the x-z section through the axis (lattice row "
                             "y = 0), body 1 above and body 2 below the interface; the thick line marks the contact."
                    + overlay + " " + text),
