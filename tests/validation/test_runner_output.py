@@ -175,7 +175,7 @@ def test_an_enlarged_region_is_the_estimate_times_1_5_and_solves_as_if_given(sce
     region itself: the calibration and the solve both use it."""
     from validation.scene.sizing import region_limit
 
-    scene = load_scene(scene_name, overrides=["bem.nodes_across=16", "fem.n_contact=8", *overrides])
+    scene = load_scene(scene_name, overrides=["bem.nodes_across=16", "fem.n_contact_elements=8", *overrides])
     grown = execute_scene(scene).result
     limit = region_limit(scene.gap)
     ex, ey = grown["bem"]["extent"]
