@@ -21,6 +21,7 @@ DOCS = ROOT / "docs"
 #: the modules of the API reference (docs/api/)
 DOCUMENTED = ("bem", "bem.options", "bem.checks", "bem.files", "bem.fft", "bem.backend", "bem.gaps", "bem.layers",
               "bem.periodic", "bem.rough", "bem.reference", "fem_reference", "validation.scene", "validation.run",
+              "validation.run.parts",
               "validation.compare", "validation.io", "validation.extras", "validation.units", "validation.labels",
               "validation.provenance",
               "validation.studies", "validation.layer_law", "validation.report")

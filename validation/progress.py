@@ -1,6 +1,6 @@
 """The one progress protocol of the library: a callback ``progress(label, done, total)``.
 
-``label`` (str) says what runs now; ``done`` of ``total`` steps are finished. The runner, the
+``label`` (str) names the step under way; ``done`` of ``total`` steps are finished. The runner, the
 sweeps, the studies and the reports call it; the command line draws it as a bar. A job of named
 stages tells it through :class:`Progress`.
 """

@@ -253,7 +253,7 @@ def test_run_summary_prints_any_value_of_a_result():
     from validation.cli.run import _summary
     from validation.run import run_scene
 
-    base = run_scene("hertz", overrides=["bem.nodes_across=12", "fem.n_contact=6"])
+    base = run_scene("hertz", overrides=["bem.nodes_across=12", "fem.n_contact_elements=6"])
     body = replace(base.stress.bodies["body1"], location_of_max=[0.0, 0.0, 1e308], max_von_mises=None,
                    max_tresca=None)
     result = replace(base, p_max=None, fem=replace(base.fem, p_max=0.0), analytic=replace(base.analytic, p_max=None),

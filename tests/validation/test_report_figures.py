@@ -448,6 +448,5 @@ def test_the_tolerance_in_a_caption_is_the_recorded_bem_rtol_never_read_from_the
 
     from validation.report.figures.run import _tolerance
 
-    quoted = {"message": "KKT residual 1e-12 <= rtol 1.0e-03"}
-    assert _tolerance(SimpleNamespace(bem={"rtol": 1e-8}, data=quoted)) == 1e-8
-    assert _tolerance(SimpleNamespace(bem={}, data=quoted)) is None
+    bem = SimpleNamespace(rtol=1e-8, message="KKT residual 1e-12 <= rtol 1.0e-03")
+    assert _tolerance(SimpleNamespace(bem=bem)) == 1e-8

@@ -10,14 +10,14 @@ from validation.report.documents.results import RunResults
 from validation.report.documents.sections import results_rows
 from validation.report.render.content import fmt_distinct
 from validation.run import run_scene
-from validation.run.record import Scales
+from validation.run.parts import Scales
 from validation.units import Units
 
 
 @pytest.fixture(scope="module")
 def hertz_result():
     """A small hertz run: the BEM, the FEM and the closed form (its numbers are replaced by the tests)."""
-    return run_scene("hertz", overrides=["bem.nodes_across=12", "fem.n_contact=6", "stress.n_depths=4"])
+    return run_scene("hertz", overrides=["bem.nodes_across=12", "fem.n_contact_elements=6", "stress.n_depths=4"])
 
 
 @pytest.mark.parametrize("values", [[1.37134e9, 1.37121e9, 1.37108e9], [0.99968, 1.0005, 1.0], [100.0, 100.0, 1e2],

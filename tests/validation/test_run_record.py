@@ -18,7 +18,7 @@ from validation.run.record import SCHEMA, ResultFileError, RunResult
 
 from .conftest import cli
 
-SMALL = ["bem.nodes_across=12", "fem.n_contact=6", "stress.n_depths=4"]
+SMALL = ["bem.nodes_across=12", "fem.n_contact_elements=6", "stress.n_depths=4"]
 
 
 @pytest.fixture(scope="module")
@@ -53,12 +53,12 @@ def test_the_written_result_holds_the_solvers_numbers(hertz_run):
     assert (r.p_max, r.force, r.approach, r.contact_area) == (bem.p_max, bem.force, bem.approach, bem.contact_area)
     assert r.contact_radius == bem.contact_radius and r.bem.n_nodes == bem.p.size
     assert r.bem.n_contact == np.count_nonzero(bem.p > 0) and r.iterations == bem.iterations
-    assert r.fem.edge_radius == fem.contact_radius and r.fem.p_max == fem.p_max
+    assert r.fem.edge_radius == fem.edge_radius and r.fem.p_max == fem.p_max
     assert r.fem_profile.r == fem.r.tolist() and r.fem_profile.p == fem.p.tolist()
     assert r.analytic.kind == "hertz" and r.analytic.p_max == ref.p_max and r.analytic.a is None
     # the BEM radius sqrt(A / pi) against the FEM's interpolated edge, against Hertz's radius
-    assert r.comparison.bem_vs_fem.edge_radius_rel == pytest.approx(bem.contact_radius / fem.contact_radius - 1)
-    assert r.comparison.bem_vs_fem.contact_radius_rel is None
+    assert r.comparison.bem_vs_fem.edge_radius_rel == pytest.approx(bem.contact_radius / fem.edge_radius - 1)
+    assert r.comparison.bem_vs_fem.edge_radius_rel is None
     assert r.comparison.bem_vs_analytic.contact_radius_rel == pytest.approx(bem.contact_radius / ref.contact_radius - 1)
     assert r.comparison.bem_vs_analytic.edge_radius_rel is None
     assert r.periodic is None and set(r.stress.bodies) == {"body1", "body2"}
@@ -118,4 +118,4 @@ def test_the_report_of_a_written_result_equals_the_report_of_the_run(hertz_run, 
     assert float(peak[1]) == pytest.approx(outcome.bem.p_max / 1e6, rel=1e-3)  # MPa, 4 digits
     assert float(peak[2]) == pytest.approx(outcome.fem.p_max / 1e6, rel=1e-3)
     radius = next(row for row in results if row[0] == "contact radius r_c")
-    assert float(radius[2]) == pytest.approx(outcome.fem.contact_radius * 1e3, rel=1e-3)  # the FEM's edge, mm
+    assert float(radius[2]) == pytest.approx(outcome.fem.edge_radius * 1e3, rel=1e-3)  # the FEM's edge, mm

@@ -178,21 +178,21 @@ def test_an_enlarged_region_is_the_estimate_times_1_5_and_solves_as_if_given(sce
     scene = load_scene(scene_name, overrides=["bem.nodes_across=16", "fem.n_contact_elements=8", *overrides])
     grown = execute_scene(scene).result
     limit = region_limit(scene.gap)
-    ex, ey = grown["bem"]["extent"]
-    assert any("enlarged" in m for m in grown["messages"])
+    ex, ey = grown.bem.extent
+    assert any("enlarged" in m for m in grown.messages)
     assert (ex, ey) == tuple(min(1.5 * e, lim) for e, lim in zip(scene.bem["extent"], limit))
     given = execute_scene(scene, overrides=[f"bem.extent=[{ex!r}, {ey!r}]"]).result
-    assert not any("enlarged" in m for m in given["messages"])
+    assert not any("enlarged" in m for m in given.messages)
     for key in ("p_max", "approach", "contact_area", "iterations"):
-        assert given[key] == grown[key], key
-    assert given["layer"]["parameters"] == grown["layer"]["parameters"]
+        assert getattr(given, key) == getattr(grown, key), key
+    assert given.layer["parameters"] == grown.layer["parameters"]
 
 
 def test_planned_stages_hold_the_calibration_exactly_when_it_solves():
     """The "layer" stage is planned for the scenes whose layer needs calibration solves, and only those."""
     for name in ("paper_linear", "paper_root", "paper_elastic_rigid", "paper_bilinear", "hertz"):
         scene = load_scene(name, overrides=["bem.nodes_across=12"], no_fem=True)
-        solves = execute_scene(scene).result["layer"].get("reference_solves", 0)
+        solves = execute_scene(scene).result.layer.get("reference_solves", 0)
         assert ("layer" in runner.planned_stages(scene)) == (solves > 0), name
 
 

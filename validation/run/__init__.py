@@ -3,7 +3,8 @@
 - :mod:`validation.run.runner`: :func:`run_scene` / :func:`execute_scene`, the one place that
   solves a scene (BEM always; FEM, closed form, comparison, stresses when named);
 - :mod:`validation.run.record`: :class:`RunResult`, the typed content of ``result.json`` (its
-  JSON reading and writing, the schema version); :mod:`validation.run.result` makes it;
+  JSON reading and writing, the schema version), its parts in :mod:`validation.run.parts`;
+  :mod:`validation.run.result` makes it;
 - :mod:`validation.run.stress`: the ``[stress]`` part of a run;
 - :mod:`validation.run.sweep`: one scene over a list of values of a parameter.
 """

@@ -17,7 +17,8 @@ import numpy as np
 from ..provenance import provenance
 from ..progress import stages_of
 from .calibrate import resolve_layer
-from .record import PeriodicPart, RunResult, SpotSummary
+from .parts import PeriodicPart, SpotSummary
+from .record import RunResult
 from .result import bem_part, unit_symbols
 
 __all__ = ["execute_periodic", "contact_spots", "periodic_result"]

@@ -12,9 +12,11 @@ from dataclasses import fields
 
 import numpy as np
 
+from ..compare import RADIUS_KEYS
 from ..provenance import provenance
-from .record import (SCHEMA, AxialProfile, BemPart, ClosedForm, Comparison, FemMesh, FemPart, FemProfile, ForceBalance,
-                     PairMetrics, RunResult, Scales, StressPart)
+from .parts import (SCHEMA, AxialProfile, BemPart, ClosedForm, Comparison, FemMesh, FemPart, FemProfile, ForceBalance,
+                    PairMetrics, Scales, StressPart)
+from .record import RunResult
 
 __all__ = ["build_result", "bem_part", "unit_symbols", "axial_profile", "SCHEMA"]
 
@@ -78,24 +80,21 @@ def _scales(scene):
     return {"p_hertz": hz.p_max, "a_hertz": hz.contact_radius, "approach_hertz": hz.approach, "force_hertz": hz.force}
 
 
-def _pair(metrics, *, edge):
-    """:class:`PairMetrics` of :func:`validation.compare.pair_metrics`; ``edge``: a side is the FEM, whose
-    radius is its interpolated edge (``edge_radius_rel``), else both sides give ``sqrt(A / pi)`` or an
-    exact radius (``contact_radius_rel``)."""
+def _pair(metrics):
+    """:class:`PairMetrics` of :func:`validation.compare.pair_metrics`, which gives one of the radius
+    comparisons (:data:`validation.compare.RADIUS_KEYS`); the other is ``None``."""
     if metrics is None:
         return None
-    out = {k: v for k, v in metrics.items() if k != "contact_radius_rel"}
-    radius = metrics["contact_radius_rel"]
-    return PairMetrics(**out, contact_radius_rel=None if edge else radius, edge_radius_rel=radius if edge else None)
+    return PairMetrics(**({key: None for key in RADIUS_KEYS} | metrics))
 
 
 def _comparison(metrics):
     if metrics is None:
         return None
     balance = metrics.get("force_balance")
-    return Comparison(bem_vs_fem=_pair(metrics.get("bem_vs_fem"), edge=True),
-                      bem_vs_analytic=_pair(metrics.get("bem_vs_analytic"), edge=False),
-                      fem_vs_analytic=_pair(metrics.get("fem_vs_analytic"), edge=True),
+    return Comparison(bem_vs_fem=_pair(metrics.get("bem_vs_fem")),
+                      bem_vs_analytic=_pair(metrics.get("bem_vs_analytic")),
+                      fem_vs_analytic=_pair(metrics.get("fem_vs_analytic")),
                       force_balance=None if balance is None else ForceBalance(
                           target=balance["target"], bem=balance["bem"], fem=balance.get("fem")))
 
@@ -104,13 +103,13 @@ def _fem_part(fem):
     """:class:`FemPart` of a :class:`fem_reference.FemResult` (its interpolated edge: ``edge_radius``)."""
     mesh = fem.mesh
     return FemPart(p_max=float(fem.p_max), force=float(fem.force), approach=float(fem.approach),
-                   edge_radius=float(fem.contact_radius), converged=bool(fem.converged), status=fem.status,
+                   edge_radius=float(fem.edge_radius), converged=bool(fem.converged), status=fem.status,
                    message=fem.message, iterations=int(fem.iterations), n_dofs=int(fem.n_dofs),
                    n_elements=int(fem.n_elements), n_elements_across_contact=float(fem.n_elements_across_contact),
                    timings={k: float(v) for k, v in fem.timings.items()}, penalty=dict(fem.penalty),
                    truncation=dict(fem.truncation),
-                   mesh=FemMesh(a_est=mesh["a_est"], h_fine=mesh["h_fine"], n_contact_elements=mesh["n_contact"],
-                                domain_factor=mesh["extent_factor"], remeshed=mesh["remeshed"]))
+                   mesh=FemMesh(a_est=mesh["a_est"], h_fine=mesh["h_fine"], n_contact_elements=mesh["n_contact_elements"],
+                                domain_factor=mesh["domain_factor"], remeshed=mesh["remeshed"]))
 
 
 def bem_part(res, **extra):

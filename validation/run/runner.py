@@ -28,7 +28,7 @@ from ..scene.study import refuse_study
 from ..scene.trust import refuse_code
 from ..scene.sizing import SOLVER_KEYS, inner_domain, region_limit
 from .calibrate import CalibrationError, resolve_layer
-from .record import RunResult
+from .record import FILE_NAME, RunResult
 from .result import build_result
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES", "RESULT_NAMES",
@@ -37,7 +37,7 @@ __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned
 log = logging.getLogger(__name__)
 
 #: Names of the files of a result directory.
-FILES = {"result": "result.json", "scene": "scene.toml", "bem_field": "bem_field.vtu",
+FILES = {"result": FILE_NAME, "scene": "scene.toml", "bem_field": "bem_field.vtu",
          "fem_field": "fem_field.vtu", "stress_field": "stress_field.vtu"}
 #: What a result directory may hold besides its marker: its files and its default report folder.
 RESULT_NAMES = (*FILES.values(), "report")
