@@ -316,7 +316,7 @@ def test_the_paper_study_takes_the_scenes_override_syntax():
     run = CaseRunner(6)
     short = run("elastic-rigid", {"alpha_a": 0.3}).result
     dotted = run("elastic-rigid", {"layer.alpha_a": 0.3}).result
-    assert short["layer"]["alpha_a"] == dotted["layer"]["alpha_a"] == 0.3
-    assert short["p_max"] == dotted["p_max"] and short["layer"]["parameters"] == dotted["layer"]["parameters"]
+    assert short.layer["alpha_a"] == dotted.layer["alpha_a"] == 0.3
+    assert short.p_max == dotted.p_max and short.layer["parameters"] == dotted.layer["parameters"]
     with pytest.raises(SceneError, match="bem.methd"):
         run("smooth", {"bem.methd": "newton"})

@@ -41,14 +41,14 @@ def test_the_report_finds_every_file_of_the_run(hertz_run):
 
 
 def test_the_report_finds_the_files_without_the_stored_list(hertz_run, tmp_path):
-    """A result.json without its ``files`` entry: the report falls back to the same list."""
+    """A result.json whose ``files`` is null: the report falls back to the same list."""
     import json
     import shutil
 
     copy = tmp_path / "copy"
     shutil.copytree(hertz_run[0], copy)
     data = json.loads((copy / "result.json").read_text())
-    del data["files"]
+    data["files"] = None
     (copy / "result.json").write_text(json.dumps(data))
     res = load_results(copy)
     assert {key: path.name for key, path in res.files.items()} == FILES
