@@ -175,7 +175,7 @@ def test_every_study_outcome_colours_its_cell():
 
 
 def test_status_and_format():
-    assert [status_class(s) for s in ("converged", "stalled", "not converged", "reported failure", "pending")] \
+    assert [status_class(s) for s in ("converged", "stalled", "error", "reported failure", "pending")] \
         == ["ok", "warn", "bad", "bad", "other"]
     # a cell is a status word or nothing: a message that merely contains one colours nothing
     assert [status_class(s) for s in ("Converged (KKT 1e-9)", "diverged: x", "no", "maxiter reached")] \

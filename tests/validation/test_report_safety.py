@@ -88,7 +88,7 @@ def _sweep_dir(run_dir, tmp_path, file):
     (tmp_path / "outside.json").write_text(json.dumps({"scene": scene, "result": result}))
     (d / "points" / "point-000.json").write_text(json.dumps({"scene": scene, "result": result}))
     summary = {"key": "load.force", "scene": "elliptic", "values": [1.0],
-               "points": [{"value": 1.0, "status": "ok", "file": file, "p_max": result.get("p_max")}]}
+               "points": [{"value": 1.0, "status": "converged", "file": file, "p_max": result.get("p_max")}]}
     (d / "summary.json").write_text(json.dumps(summary))
     return d
 

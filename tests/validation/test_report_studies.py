@@ -17,8 +17,10 @@ def _rows():
         for k, n in enumerate((10, 20, 40)):
             rows.append({"problem": "hertz", "solver": solver, "method": method, "resolution": n, "n": 100 * 4**k,
                          "error_l2": 0.02 / 4**k, "error_peak": 0.01 / 4**k, "wall_time_s": base * 0.01 * 4**k,
-                         "iterations": 10, "converged": True, "relaxation": None, "runs": 3, "message": "ok"})
-    rows.append({**rows[0], "method": "augmented_gap", "relaxation": 0.5, "converged": False, "error_l2": 2.0})
+                         "iterations": 10, "converged": True, "solver_status": "converged", "relaxation": None,
+                         "runs": 3, "message": "KKT residual below rtol"})
+    rows.append({**rows[0], "method": "augmented_gap", "relaxation": 0.5, "converged": False,
+                 "solver_status": "stalled", "error_l2": 2.0})
     return rows
 
 

@@ -37,7 +37,7 @@ def test_report_of_a_sweep_directory_from_the_cli(sweep_dir, tmp_path):
     assert md.startswith("# Elliptic Hertz contact: sweep of load.force")
     rows = [line for line in md.splitlines() if line.startswith("| 50 |") or line.startswith("| 100 |")
             or line.startswith("| 200 |")]
-    assert len(rows) == 3 and all("| ok |" in r for r in rows)
+    assert len(rows) == 3 and all("| converged |" in r for r in rows)
     for png in sorted((tmp_path / "rep" / "figures").glob("*.png")):
         check_png(png)
 
@@ -92,7 +92,7 @@ def test_sweep_dir_with_a_failed_point(sweep_dir, tmp_path):
     (d / "summary.json").write_text(json.dumps(summary))
     sections = sweep_sections(*load_sweep(d), tmp_path / "w")
     assert any("failed" in t and "100" in t for t in sections[1].text)
-    assert [r[1] for r in sections[1].items[0].rows] == ["ok", "error", "ok"]
+    assert [r[1] for r in sections[1].items[0].rows] == ["converged", "error", "converged"]
 
 
 def test_report_stages_reach_the_progress_callback(tmp_path):

@@ -57,7 +57,7 @@ def test_sweep_tells_its_progress_as_label_done_total(tmp_path):
     calls = []
     _sweep(tmp_path, progress=lambda *a: calls.append(a))
     assert sorted(c[1] for c in calls) == [1, 2, 3] and {c[2] for c in calls} == {3}
-    assert {c[0] for c in calls} == {f"load.force = {f}: ok" for f in FORCES}
+    assert {c[0] for c in calls} == {f"load.force = {f}: converged" for f in FORCES}
 
 
 def test_sweep_resumes_recomputing_only_missing_points(tmp_path):

@@ -78,5 +78,5 @@ def run(args):
     kept = f", {len(summary['kept'])} more from earlier runs" if summary["kept"] else ""
     print(f"computed {len(summary['computed'])}, reused {len(summary['reused'])}, failed {len(summary['failed'])}"
           f"{kept}; files {out}/ (summary.json, summary.csv, points/)")
-    bad = summary["failed"] or any(r["status"] != "ok" for r in summary["points"])
+    bad = summary["failed"] or any(r["status"] != "converged" for r in summary["points"])
     return 1 if bad else 0

@@ -207,6 +207,15 @@ def _ordered(values):
     return {i: pos for pos, i in enumerate(order)}
 
 
+def point_status(result):
+    """The status of a sweep point's :class:`~validation.run.record.RunResult`: ``"converged"`` when
+    every part that ran converged, else the status of the first that did not (the BEM's, then the
+    FEM's; :data:`bem.STATUSES`, :data:`fem_reference.STATUSES`). A point that raised is ``"error"``."""
+    if result.converged:
+        return "converged"
+    return result.bem.status if not result.bem.converged else result.fem.status
+
+
 def _row(index, value, file, result, *, computed, error=None):
     row = {"index": index, "value": value, "computed": computed, "file": f"points/{file}"}
     if error is not None:
@@ -215,7 +224,7 @@ def _row(index, value, file, result, *, computed, error=None):
     result = RunResult.from_json(result, source=row["file"])
     wall = result.wall_time_s_by_part
     row.update(
-        status="ok" if result.converged else "not_converged",
+        status=point_status(result),
         p_max=result.p_max, force=result.force, approach=result.approach,
         contact_radius=result.contact_radius, contact_area=result.contact_area,
         converged=result.converged, iterations=result.iterations, kkt_residual=result.kkt_residual,

@@ -92,7 +92,7 @@ def _distributions(res, work):
                                 levels=[(r"$p = p_{cr}$ (region I | II)", er.layer.p_cr)],
                                 title=rf"elastic-rigid layer, $\alpha_a$ = {er.layer.p_cr / res.p_lin:g}")
     rows = tuple((k, _method(r), r.p_max / res.p0, r.contact_radius / res.a, r.approach / res.approach,
-                  r.iterations, r.kkt_residual, r.wall_time_s, "converged" if r.converged else "not converged")
+                  r.iterations, r.kkt_residual, r.wall_time_s, r.status)
                  for k, r in b.items())
     table = Table(("case", "method", "p_max / p_0", "r_c / a_H", "approach / delta_H", "iterations", "KKT residual",
                    "time [s]", "status"), rows, status_column="status",
@@ -313,7 +313,7 @@ def _validation(res, work):
         rows.append((case, b.p_max / res.p0, f.p_max / res.p0, f"{(b.p_max - f.p_max) / f.p_max:+.2%}",
                      b.contact_radius / res.a, f.edge_radius / res.a, b.approach / res.approach,
                      f.approach / res.approach, b.wall_time_s, f.wall_time_s,
-                     "converged" if (b.converged and f.converged) else "failed"))
+                     f.status if b.converged else b.status))
     items.append(Table(("case", "BEM p_max / p_0", "FEM p_max / p_0", "rel. difference", "BEM r_c / a_H",
                         "FEM r_edge / a_H", "BEM delta / delta_H", "FEM delta / delta_H", "BEM time [s]", "FEM time [s]",
                         "status"), tuple(rows), status_column="status",

@@ -120,7 +120,7 @@ def timings(res, work):
     """How the BEM ran: method, lattice, iterations, residual, wall times."""
     d, b, length = res.result, res.bem, res.display("length")
     rows = [("method", method_text(d.method, getattr(res.layer, "law", None)), "-"),
-            ("status", "converged" if d.converged else "not converged", "-"),
+            ("status", d.bem.status, "-"),
             ("solver message", str(d.message), "-"),
             ("iterations (finest lattice)", fmt(d.iterations), "-"),
             ("KKT residual", fmt(d.kkt_residual), "-"),
@@ -139,7 +139,7 @@ def fem_field(res, work):
     fem, length = res.fem, res.display("length")
     if fem is None:
         return None
-    rows = [("status", "converged" if fem.converged else "not converged", "-"),
+    rows = [("status", fem.status, "-"),
             ("stopping reason", str(fem.message), "-"),
             ("contact iterations", fmt(fem.iterations), "-"),
             ("degrees of freedom", fmt(fem.n_dofs), "-"),

@@ -62,7 +62,7 @@ def _error_time_sections(data, work):
         items.append(Table(
             ("solver", "method", "resolution", "N", "L2 error", "peak error", "time [s]", "iterations", "status"),
             tuple((r["solver"], _label(r), r["resolution"], r["n"], r["error_l2"], r["error_peak"], r["wall_time_s"],
-                   r["iterations"], "converged" if r["converged"] else "failed") for r in mine),
+                   r["iterations"], r["solver_status"]) for r in mine),
             caption=f"Every run of the {problem} ladder.", status_column="status"))
         text = [f"Reference: {ref_text}."] if ref_text else []
         sections.append(Section(f"Error against run time: {problem}", "validation", text, items))

@@ -27,10 +27,9 @@ KINDS = ("problem", "results", "iterations", "sweeps", "validation", "fem", "sta
 #: (:data:`validation.studies.STATUSES`), a sweep point's status and the reports' own
 #: "converged" / "not converged" / "failed"; compared whole, never searched in a message
 _STATUS = {
-    "ok": ("ok", "converged"),
+    "ok": ("converged",),
     "warn": ("maxiter", "stalled"),
-    "bad": ("diverged", "nonfinite", "singular", "boundary", "not converged", "not_converged", "failed", "error",
-            "reported failure", "wrong"),
+    "bad": ("diverged", "nonfinite", "singular", "boundary", "error", "reported failure", "wrong"),
 }
 
 
