@@ -61,7 +61,7 @@ def test_measured_layer_example_follows_the_table():
 def test_sweep_example_scales_as_hertz(tmp_path):
     summary = runpy.run_path(str(EXAMPLES / "sweep.py"), run_name="example")["main"](tmp_path / "sweep")
     rows = summary["points"]
-    assert [r["status"] for r in rows] == ["ok"] * 4
+    assert [r["status"] for r in rows] == ["converged"] * 4
     for row in rows:
         expected = rows[0]["p_max"] * (row["value"] / rows[0]["value"]) ** (1 / 3)
         assert row["p_max"] == pytest.approx(expected, rel=1e-3)
