@@ -15,6 +15,7 @@ from ..options import METHODS, check_options, solver_for
 from ..result import ContactResult
 from .cell import PeriodicCell
 from .influence import PeriodicOperator
+from .qp import solve_periodic_qp
 
 __all__ = ["solve_periodic", "PeriodicContactResult"]
 
@@ -203,7 +204,10 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
         if maxiter is not None:
             kw["maxiter"] = maxiter
         op = PeriodicOperator(lat, E_star, device=backend)
-        sol = _run(solver, op, h_lat, layer, precondition, kw, options)
+        if solver == "kalker" and precondition and backend.is_numpy:  # the QP in the Fourier basis
+            sol = solve_periodic_qp(op, h_lat, lam=0.0 if layer is None else layer.lam, **kw, **options)
+        else:
+            sol = _run(solver, op, h_lat, layer, precondition, kw, options)
         if not finest:
             guess = levels[level + 1][0].prolong(sol.p)
     p = sol.p

@@ -1,0 +1,196 @@
+"""Kalker's QP on a periodic cell: the conjugate gradients of :func:`bem.kalker.solve_qp` in the Fourier basis.
+
+The same iteration as :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active
+set, Polonsky & Keer 1999, with the FFT preconditioner, the same restarts, Jacobi cap and
+stopping rule), specialised to :class:`bem.periodic.PeriodicOperator` on NumPy, where ``C`` is
+diagonal in the Fourier basis of the cell (a 2 x 2 block per frequency, one block row per row
+parity) and every node is a candidate:
+
+- the iteration keeps the spectrum ``U`` of ``u = (C + lam) p``; ``u`` is one inverse transform
+  of it. After a step without a change of the contact set ``U`` is updated by the spectrum of
+  the product ``(C + lam) t`` of the search direction, otherwise recomputed from the spectrum
+  of the new ``p``, one forward transform, instead of a whole product;
+- the curvature ``t.(C + lam) t`` is a sum over the spectrum (Parseval), so the product of
+  the search direction needs no inverse transform;
+- the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
+  the products, the gap and the KKT check stay in double precision.
+
+A step costs four or five FFTs of the cell (the general loop: four or six).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+
+from ..kalker import _RECOMPUTE_EVERY, QPSolution, _initial
+
+__all__ = ["solve_periodic_qp"]
+
+log = logging.getLogger(__name__)
+
+
+def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
+                      callback=None):
+    """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell (NumPy).
+
+    Parameters
+    ----------
+    op : bem.periodic.PeriodicOperator
+        ``C`` on the cell, on the ``"cpu"`` device.
+    h : ndarray
+        Gap at the nodes, brick array [length].
+    force, approach : float
+        Exactly one: total force on the cell ``P`` [force] or approach ``delta`` [length].
+    lam : float
+        Uniform linear layer compliance [length/pressure], >= 0.
+    x0 : ndarray, optional
+        Initial pressure (brick array); negative entries are clipped.
+    rtol : float
+        Tolerance on the KKT residual (the rule of :func:`bem.kalker.solve_qp`, checked on an
+        exactly recomputed ``C p``).
+    maxiter : int, optional
+        Iteration limit (default ``max(200, 10 * sqrt(N))``).
+    callback : callable, optional
+        ``callback(k, p)`` after every iteration.
+
+    Returns
+    -------
+    bem.kalker.QPSolution
+        As :func:`bem.kalker.solve_qp` with its FFT preconditioner; ``op.n_matvec`` counts the
+        products ``(C + lam) v`` (spectral multiplications).
+    """
+    lat = op.lattice
+    a = lat.node_area
+    lam = float(lam)
+    h = np.asarray(h, dtype=float)
+    if maxiter is None:
+        maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
+    target = None if force is None else force / a
+    p = _initial(op, h, lam, force, approach, x0)
+    if target is not None:
+        p = p if float(p.sum()) > 0 else np.ones(lat.shape)
+        p *= target / float(p.sum())
+    A = op.symbol(lam)  # C + lam I
+    M = tuple(s.astype(np.float32 if s.dtype.kind == "f" else np.complex64) for s in op.symbol(lam, inverse=True))
+    jacobi = 1.0 / (op.diagonal + lam)
+
+    def product(v):
+        op.n_matvec += 1
+        x = op.spectrum(v)
+        return op.mix(x, A, out=x, work=work)
+
+    work = None
+    U = product(p)
+    work = np.empty_like(U)
+    u, stale = op.brick(U), 0
+    t = np.zeros(lat.shape)
+    g = np.empty(lat.shape)
+    r32 = np.empty(lat.shape, dtype=np.float32)
+    gf, tf = g.reshape(-1), t.reshape(-1)
+    gz_old, restart = 1.0, True
+    hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
+    converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
+    prev_contact = p > 0
+    for k in range(1, maxiter + 1):
+        contact = p > 0
+        pf = p.reshape(-1)
+        idx = np.flatnonzero(contact)
+        np.add(u, h, out=g)
+        if force is not None:
+            delta = float(np.mean(gf[idx])) if idx.size else math.nan
+        g -= delta
+        scale = max(float(u.max()), -float(u.min()))
+        g_c, p_c0 = gf[idx], pf[idx]
+        parts = [float(np.abs(g_c).max(initial=0.0)), -float(g.min()), 0.0]
+        kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) \
+            / (scale if scale > 0 else float(np.abs(g).max()) or 1.0)
+        if force is not None:
+            kkt = max(kkt, abs(a * float(p_c0.sum()) - force) / force)
+        if not math.isfinite(kkt):
+            kkt = np.inf
+        if kkt <= rtol and stale:
+            U = product(p)  # confirm on an exact product
+            u, stale = op.brick(U), 0
+            continue
+        changes = int(np.count_nonzero(contact != prev_contact))
+        prev_contact = contact
+        hist["residual"].append(kkt)
+        hist["p_max"].append(float(p_c0.max(initial=0.0)))
+        hist["n_contact"].append(int(idx.size))
+        hist["changes"].append(changes)
+        if not math.isfinite(kkt):
+            message, status = "the iteration produced a non-finite value", "nonfinite"
+            break
+        if kkt <= rtol:
+            converged, message, status = True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}", "converged"
+            break
+        if idx.size == 0 and float(g.min()) >= 0:  # no contact at this approach: p = 0 is the solution
+            converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
+            break
+        np.multiply(g, contact, out=r32, casting="unsafe")  # the gap on the contact, single precision
+        x32 = op.spectrum(r32)
+        z = op.brick(op.mix(x32, M, out=x32), overwrite=True).reshape(-1)[idx].astype(float)
+        if force is not None:
+            z -= z.mean()
+        gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
+        beta = 0.0 if restart else gz / gz_old
+        t_c = z
+        t_c += beta * tf[idx]
+        if force is not None:  # nodes that left the contact broke the zero sum of t
+            t_c -= t_c.mean()
+        t.fill(0.0)
+        tf[idx] = t_c
+        gz_old = gz
+        T = op.spectrum(t)
+        op.n_matvec += 1
+        R = op.mix(T, A, work=work)
+        tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
+        if not np.any(t_c):
+            tau = 0.0  # a single contact node under force control: only entering nodes can move
+        elif tt <= 0 or not math.isfinite(tt):
+            message, status = f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
+            break
+        else:
+            tau = gz / tt
+        p_c = p_c0 - tau * t_c
+        clipped = p_c < 0
+        p_c[clipped] = 0.0
+        p_new = np.zeros(lat.shape)
+        nf = p_new.reshape(-1)
+        nf[idx] = p_c
+        # re-entering nodes (p_new = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi estimate
+        low = np.flatnonzero(g < 0)
+        overlap = low[nf[low] == 0]
+        if overlap.size:
+            nf[overlap] = -gf[overlap] * (min(tau, jacobi) if tau > 0 else jacobi)
+        restart = bool(overlap.size)
+        s = 1.0
+        if target is not None:
+            total = float(p_c.sum()) + float(nf[overlap].sum())
+            if not total > 0:  # every node left the contact and none entered: no force to rescale
+                message, status = "the iteration produced a non-finite value", "nonfinite"
+                break
+            s = target / total
+            p_new *= s
+        if bool(clipped.any()) or restart or stale >= _RECOMPUTE_EVERY:
+            U, stale = product(p_new), 0
+        else:
+            R *= tau
+            U -= R
+            if s != 1.0:
+                U *= s
+            stale += 1
+        u = op.brick(U)
+        p = p_new
+        if callback is not None:
+            callback(k, p)
+    else:
+        message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
+    if not converged:
+        log.debug("Kalker QP (periodic): %s", message)
+    elastic = u - lam * p if lam else u  # C p: the layer's closure is not a displacement
+    return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
+                      message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)
