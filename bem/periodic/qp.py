@@ -1,10 +1,18 @@
 """Kalker's QP on a periodic cell: the conjugate gradients of :func:`bem.kalker.solve_qp` in the Fourier basis.
 
-The same iteration as :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active
-set, Polonsky & Keer 1999, with the FFT preconditioner, the same restarts, Jacobi cap and
+The iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active
+set, Polonsky & Keer 1999, with the FFT preconditioner, the same entering rule, Jacobi cap and
 stopping rule), specialised to :class:`bem.periodic.PeriodicOperator` on NumPy, where ``C`` is
 diagonal in the Fourier basis of the cell (a 2 x 2 block per frequency, one block row per row
-parity) and every node is a candidate:
+parity) and every node is a candidate. It does not restart the conjugate directions when nodes
+enter the contact: the new direction is ``t = z + beta t_old`` on the current contact with the
+Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)``, and the step is the
+minimum along ``t``, ``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the contact does not
+change, the conjugate-gradient step); where ``g.t <= 0`` the step falls back to ``t = z``. On a
+rough surface, whose contact set changes at most iterations until it settles, the general loop
+restarts at every change and degrades to preconditioned steepest descent
+(``tests/bem/test_periodic_qp.py``: 88 iterations against 62 on a 256 x 256 self-affine cell).
+Further:
 
 - the iteration keeps the spectrum ``U`` of ``u = (C + lam) p``; ``u`` is one inverse transform
   of it. After a step without a change of the contact set ``U`` is updated by the spectrum of
@@ -89,8 +97,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     t = np.zeros(lat.shape)
     g = np.empty(lat.shape)
     r32 = np.empty(lat.shape, dtype=np.float32)
-    gf, tf = g.reshape(-1), t.reshape(-1)
-    gz_old, restart = 1.0, True
+    z_prev = np.zeros(lat.shape)
+    gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
+    gz_old = 1.0
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
     converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
     prev_contact = p > 0
@@ -136,11 +145,16 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if force is not None:
             z -= z.mean()
         gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
-        beta = 0.0 if restart else gz / gz_old
-        t_c = z
-        t_c += beta * tf[idx]
+        # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
+        beta = 0.0 if k == 1 else max(0.0, (gz - float(np.einsum("i,i->", g_c, zf[idx]))) / gz_old)
+        z_prev.fill(0.0)
+        zf[idx] = z
+        t_c = z + beta * tf[idx]
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= t_c.mean()
+        gt = float(np.einsum("i,i->", g_c, t_c))
+        if not gt > 0:  # no descent along t after a change of the contact: steepest descent
+            t_c, gt = z, gz
         t.fill(0.0)
         tf[idx] = t_c
         gz_old = gz
@@ -154,7 +168,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             message, status = f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
             break
         else:
-            tau = gz / tt
+            tau = gt / tt  # the minimum along t (gt = gz when the contact has not changed)
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
         p_c[clipped] = 0.0
@@ -166,7 +180,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         overlap = low[nf[low] == 0]
         if overlap.size:
             nf[overlap] = -gf[overlap] * (min(tau, jacobi) if tau > 0 else jacobi)
-        restart = bool(overlap.size)
+        entered = bool(overlap.size)
         s = 1.0
         if target is not None:
             total = float(p_c.sum()) + float(nf[overlap].sum())
@@ -175,7 +189,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 break
             s = target / total
             p_new *= s
-        if bool(clipped.any()) or restart or stale >= _RECOMPUTE_EVERY:
+        if bool(clipped.any()) or entered or stale >= _RECOMPUTE_EVERY:
             U, stale = product(p_new), 0
         else:
             R *= tau
