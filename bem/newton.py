@@ -7,8 +7,8 @@ non-decreasing ``w``. Each Newton step minimises its local quadratic model
 (and ``a sum q = P`` under force control),
 
 with ``D = diag(w'(p))``, by the same constrained conjugate gradients that
-solve Kalker's QP (:func:`bem.kalker.solve_qp`), matrix-free with FFT
-products. The model has the gradient of ``Phi`` at ``p``, so for any positive
+solve Kalker's QP (:func:`bem.kalker.solve_qp`; on a periodic cell
+:func:`bem.periodic.qp.solve_periodic_qp`), matrix-free with FFT products. The model has the gradient of ``Phi`` at ``p``, so for any positive
 ``D`` the step ``d = q - p`` is a feasible descent direction, and an exact line
 search on ``Phi(p + t d)``, ``t in (0, 1]``, makes the method globally
 convergent; with ``D = w'`` it converges quadratically where ``w'`` is
@@ -118,6 +118,23 @@ def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
         taylor = layer.w(pp) * dp + 0.5 * bk.asarray(layer.dw(pp)) * dp * dp
         direct = layer.energy(xp.maximum(pp + dp, 0.0)) - layer.energy(pp)
     return lin + float(xp.sum(xp.where(small, taylor, direct)))
+
+
+def _model_qp(op, b, D, contact, precondition, **kw):
+    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one).
+
+    On a periodic cell on NumPy the QP in the Fourier basis (:func:`bem.periodic.qp.solve_periodic_qp`,
+    the same preconditioner), else :func:`bem.kalker.solve_qp` with
+    :func:`bem.kalker.compliance_preconditioner`.
+    """
+    from .periodic import PeriodicOperator
+
+    if precondition and isinstance(op, PeriodicOperator) and op.backend.is_numpy:
+        from .periodic.qp import solve_periodic_qp
+
+        return solve_periodic_qp(op, b, lam=D, **kw)
+    return solve_qp(op, b, lam=D, preconditioner=compliance_preconditioner(op, D, contact) if precondition else None,
+                    **kw)
 
 
 def _count_inner(hist, sub):
@@ -278,9 +295,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         # the model starts at p with the product u Newton carries, and Newton checks every step on
         # its own residual: no product to start or to confirm the inner solve (root layer, 1M
         # nodes: 18 products on the finest level instead of 28)
-        sub = solve_qp(op, b, force=force, approach=approach, lam=D, x0=p, rtol=inner, maxiter=inner_maxiter,
-                       preconditioner=compliance_preconditioner(op, D, contact) if precondition else None,
-                       u0=u, confirm=False)
+        sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p, rtol=inner,
+                        maxiter=inner_maxiter, u0=u, confirm=False)
         _count_inner(hist, sub)
         d = sub.p - p
         cd = sub.displacement - u
@@ -289,10 +305,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             scale = float(xp.max(xp.abs(u + xp.where(mask, layer.w(p), 0.0))))
             D = _majorant(op, layer, p, sub.p, D, mask)
             b = h + xp.where(mask, layer.w(p), 0.0) - D * p
-            sub = solve_qp(op, b, force=force, approach=approach, lam=D, x0=p, rtol=max(rtol / 3, 1e-3 * kkt),
-                           maxiter=4 * inner_maxiter, scale=scale,
-                           preconditioner=compliance_preconditioner(op, D, contact) if precondition else None,
-                           u0=u, confirm=False)
+            sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p,
+                            rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False)
             _count_inner(hist, sub)
             d = sub.p - p
             cd = sub.displacement - u

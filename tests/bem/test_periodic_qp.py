@@ -129,3 +129,30 @@ def test_periodic_qp_keeps_its_conjugate_directions_when_the_contact_changes():
     assert sum(ref.history["changes"]) > 50 * ref.iterations  # the contact set moves a lot
     assert np.abs(fast.p - ref.p).max() <= 1e-8 * ref.p.max()
     assert fast.iterations <= 0.75 * ref.iterations
+
+
+@pytest.mark.parametrize("control", ["force", "approach"])
+def test_periodic_qp_with_a_compliance_per_node_equals_the_general_qp(control):
+    """Newton's model QP: a compliance per node, some nodes soft (Jacobi), started from the caller's iterate and product."""
+    from bem.kalker import compliance_preconditioner
+
+    cell = CELL
+    h = _rough(cell, seed=11)
+    op = PeriodicOperator(cell, E_STAR)
+    rng = np.random.default_rng(4)
+    D = op.diagonal * np.where(rng.random(cell.shape) < 0.2, 30.0, 0.5) * rng.uniform(0.5, 2.0, cell.shape)
+    kw = dict(force=0.03 * cell.area) if control == "force" else dict(approach=float(np.quantile(h, 0.3)))
+    x0 = np.where(h < np.quantile(h, 0.3), 1.0, 0.0)
+    if control == "force":
+        x0 *= kw["force"] / cell.node_area / x0.sum()
+    ref = solve_qp(op, h, lam=D, x0=x0, preconditioner=compliance_preconditioner(op, D, x0 > 0), rtol=1e-10, **kw)
+    fast = solve_periodic_qp(op, h, lam=D, x0=x0, u0=op.matvec(x0), rtol=1e-10, **kw)
+    assert ref.converged and fast.converged
+    assert 0.05 < np.mean(fast.p > 0) < 0.95 and np.any((D > 4 * op.diagonal) & (fast.p > 0))
+    assert np.abs(fast.p - ref.p).max() <= 1e-8 * ref.p.max()
+    u = op.dense() @ fast.p.ravel()
+    np.testing.assert_allclose(fast.displacement.ravel(), u, rtol=0, atol=1e-12 * np.abs(u).max())
+    g = u + D.ravel() * fast.p.ravel() + h.ravel() - fast.approach
+    kkt = kkt_residual(fast.p.ravel(), g, displacement_scale=float(np.abs(u + D.ravel() * fast.p.ravel()).max()),
+                       force=kw.get("force"), node_area=cell.node_area)
+    assert kkt <= 1e-10
