@@ -152,11 +152,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         pf = p.reshape(-1)
         idx = np.flatnonzero(contact)
         np.add(u, h, out=g)
-        if force is not None:
-            delta = float(np.mean(gf[idx])) if idx.size else math.nan
-        g -= delta
-        scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
         g_c, p_c0 = gf[idx], pf[idx]
+        if force is not None:
+            delta = float(np.mean(g_c)) if idx.size else math.nan
+        g -= delta
+        g_c -= delta
+        scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
         parts = [float(np.abs(g_c).max(initial=0.0)), -float(g.min()), 0.0]
         kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) \
             / (scale if scale > 0 else float(np.abs(g).max()) or 1.0)
