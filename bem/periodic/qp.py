@@ -26,7 +26,7 @@ Further:
 With a compliance per node (the model of a Newton step, :mod:`bem.newton`) ``U`` is the spectrum
 of ``C p`` alone, ``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner is
 that of :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique
-projection under force control.
+projection under force control (by ``M 1`` of the starting contact).
 
 A step costs four or five FFTs of the cell (the general loop: four or six, or up to eight with a
 compliance per node in double precision).
@@ -142,7 +142,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     r32 = np.empty(lat.shape, dtype=np.float32)
     z_prev = np.zeros(lat.shape)
     gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
-    gz_old, m_one = 1.0, None
+    gz_old, m_one, m_full = 1.0, None, None
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
     converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
     prev_contact = p > 0
@@ -192,10 +192,15 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if force is not None and soft is None:
             z -= z.mean()
         elif force is not None:
-            # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1)
-            if m_one is None or changes:
+            # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
+            # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
+            if m_full is None:
                 np.multiply(contact, stiff, out=r32, casting="unsafe")
-                m_one = precondition(r32, idx, np.ones(idx.size))
+                m_full = np.empty(lat.n_nodes)
+                m_full[:] = precondition(r32, np.arange(lat.n_nodes), np.ones(lat.n_nodes))
+            m_one = m_full[idx]
+            if not m_one.sum() > 0:  # a contact far from the starting one: the mean instead
+                m_one = np.ones(idx.size)
             z -= m_one * (z.sum() / m_one.sum())
         gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
