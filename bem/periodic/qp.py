@@ -260,7 +260,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             stale += 1
         u = op.brick(U)
         if per_node:
-            u += D * p_new
+            u += np.multiply(D, p_new, out=g)  # g is recomputed from u at the next iteration
         p = p_new
         if callback is not None:
             callback(k, p)
