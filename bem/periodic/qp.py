@@ -140,6 +140,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     t = np.zeros(lat.shape)
     g = np.empty(lat.shape)
     r32 = np.empty(lat.shape, dtype=np.float32)
+    r32f = r32.reshape(-1)
     z_prev = np.zeros(lat.shape)
     gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
     gz_old, m_one, m_full = 1.0, None, None
@@ -187,7 +188,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
             break
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        np.multiply(g, contact if soft is None else contact & stiff, out=r32, casting="unsafe")
+        if soft is None:
+            r32.fill(0.0)
+            r32f[idx] = g_c
+        else:
+            np.multiply(g, contact & stiff, out=r32, casting="unsafe")
         z = precondition(r32, idx, g_c)
         if force is not None and soft is None:
             z -= z.mean()
