@@ -133,7 +133,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     else:  # C x0 from the caller, confirmed like an incremental update
         U, stale = op.spectrum(np.asarray(u0, dtype=float)), 1
     work = np.empty_like(U)
-    u = op.brick(U)
+    u = op.brick(U) if u0 is None else np.array(u0, dtype=float)
     if per_node:
         u += D * p
         softf, jacf = (None if soft is None else soft.reshape(-1)), jacobi.reshape(-1)
