@@ -8,7 +8,8 @@ non-decreasing ``w``. Each Newton step minimises its local quadratic model
 
 with ``D = diag(w'(p))``, by the same constrained conjugate gradients that
 solve Kalker's QP (:func:`bem.kalker.solve_qp`; on a periodic cell
-:func:`bem.periodic.qp.solve_periodic_qp`), matrix-free with FFT products. The model has the gradient of ``Phi`` at ``p``, so for any positive
+:func:`bem.periodic.qp.solve_periodic_qp`), matrix-free with FFT products.
+The model has the gradient of ``Phi`` at ``p``, so for any positive
 ``D`` the step ``d = q - p`` is a feasible descent direction, and an exact line
 search on ``Phi(p + t d)``, ``t in (0, 1]``, makes the method globally
 convergent; with ``D = w'`` it converges quadratically where ``w'`` is

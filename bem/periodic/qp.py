@@ -273,6 +273,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
     if not converged:
         log.debug("Kalker QP (periodic): %s", message)
-    elastic = u - (D if per_node else lam) * p if per_node or lam else u  # C p: the layer's closure is not a displacement
+    # C p: the layer's closure is not a displacement
+    elastic = u - (D if per_node else lam) * p if per_node or lam else u
     return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
                       message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)

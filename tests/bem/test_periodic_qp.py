@@ -133,7 +133,8 @@ def test_periodic_qp_keeps_its_conjugate_directions_when_the_contact_changes():
 
 @pytest.mark.parametrize("control", ["force", "approach"])
 def test_periodic_qp_with_a_compliance_per_node_equals_the_general_qp(control):
-    """Newton's model QP: a compliance per node, some nodes soft (Jacobi), started from the caller's iterate and product."""
+    """Newton's model QP: a compliance per node, some nodes soft (Jacobi), started from the caller's
+    iterate and its product."""
     from bem.kalker import compliance_preconditioner
 
     cell = CELL
