@@ -188,11 +188,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
             break
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
+        r32.fill(0.0)
         if soft is None:
-            r32.fill(0.0)
             r32f[idx] = g_c
         else:
-            np.multiply(g, contact & stiff, out=r32, casting="unsafe")
+            on = ~softf[idx]
+            r32f[idx[on]] = g_c[on]
         z = precondition(r32, idx, g_c)
         if force is not None and soft is None:
             z -= z.mean()
