@@ -151,18 +151,20 @@ class PeriodicCell:
         if coarse is None or values.shape != coarse.shape:
             fail("values", f"<array of shape {values.shape}>",
                  f"nodal values of the coarse cell, shape {None if coarse is None else coarse.shape}")
-        r = np.arange(self.n_rows)[:, None]
-        q = np.arange(self.n_cols)[None, :]
-        i, j = q - r // 2, np.broadcast_to(r, self.shape)  # lattice coordinates of the fine nodes
-        a, b = i // 2, j // 2
-        ei, ej = i % 2, j % 2
-
-        def at(ic, jc):  # coarse value at coarse lattice node (ic, jc), periodic
-            return values[np.mod(jc, coarse.n_rows), np.mod(ic + np.floor_divide(jc, 2), coarse.n_cols)]
-
-        first = at(a + (ei & ej), b)  # (a, b), or (a + 1, b) for the e2 - e1 edge
-        second = at(a + (ei & (1 - ej)), b + ej)  # (a + 1, b) along e1, (a, b + 1) along e2 and e2 - e1
-        return 0.5 * (first + second)
+        # by slices: coarse row k lies on fine row 2k at the columns of parity k mod 2, the other
+        # columns are midpoints along e1; fine row 2k + 1 holds the midpoints of the edges between
+        # coarse rows k and k + 1, the means of neighbouring columns of those rows interleaved
+        out = np.empty(self.shape)
+        even, nxt = out[0::2], np.roll(values, -1, axis=0)
+        even[0::2, 0::2] = values[0::2]
+        even[1::2, 1::2] = values[1::2]
+        even[0::2, 1::2] = 0.5 * (values[0::2] + np.roll(values[0::2], -1, axis=1))
+        even[1::2, 0::2] = 0.5 * (values[1::2] + np.roll(values[1::2], 1, axis=1))
+        both = np.empty_like(even)  # coarse row k at its columns, row k + 1 at the others
+        both[:, 0::2] = np.where((np.arange(coarse.n_rows) % 2 == 0)[:, None], values, nxt)
+        both[:, 1::2] = np.where((np.arange(coarse.n_rows) % 2 == 1)[:, None], values, nxt)
+        out[1::2] = 0.5 * (both + np.roll(both, -1, axis=1))
+        return out
 
     def interpolate(self, values, x, y):
         """The piecewise-linear field ``sum values_n pyr_n`` at the points ``(x, y)`` [length], periodic.

@@ -114,9 +114,21 @@ def _real_part(n_rows, n_cols, alpha):
     return out - math.sqrt(3 * math.pi) / (alpha * area)
 
 
+def _sin_over(x):
+    """``sin(x) / x`` (1 at 0), the factor of :func:`pyramid_transform` without ``np.sinc``'s scalings."""
+    out = np.sin(x)
+    nonzero = x != 0
+    np.divide(out, x, out=out, where=nonzero)
+    out[~nonzero] = 1.0
+    return out
+
+
 def _fourier_part(n_rows, n_cols, alpha):
     """``W_F`` at every node of the cell, brick array ``(n_rows, n_cols)``."""
+    import scipy.fft as sfft
     from scipy.special import erfc
+
+    from .. import fft
 
     half = n_rows // 2
     lx, ly = float(n_cols), n_rows * _SQRT3 / 2
@@ -124,24 +136,32 @@ def _fourier_part(n_rows, n_cols, alpha):
     m_max, n_max = int(g_cut * lx / (2 * math.pi)) + 1, int(g_cut * ly / (2 * math.pi)) + 1
     m = np.arange(-m_max, m_max + 1)
     gx = 2 * math.pi * m / lx
+    sinc_x = np.sinc(gx / (2 * math.pi))  # the factor of pyramid_transform that depends on m only
+    phase_x = np.exp(1j * math.pi * m / n_cols)
     sums = np.zeros((2, half * n_cols), dtype=complex)
-    for n0 in range(-n_max, n_max + 1, 256):  # blocks of rows keep the temporaries small
+    # the terms of G and -G are complex conjugates (the summand is even in G, the parity phase
+    # conjugates), and only the real part of the sum is kept: half the plane (n > 0, or n = 0 and
+    # m > 0), counted twice
+    for n0 in range(0, n_max + 1, 256):  # blocks of rows keep the temporaries small
         n = np.arange(n0, min(n0 + 256, n_max + 1))[:, None]
         gy = 2 * math.pi * n / ly
         k = np.sqrt(gx * gx + gy * gy)
-        keep = (k <= g_cut) & (k > 0)
+        keep = (k <= g_cut) & ((n > 0) | (m > 0))
         rows, cols = np.nonzero(keep)
         kk = k[keep]
-        f = 2 * math.pi / kk * erfc(kk / (2 * alpha)) * pyramid_transform(gx[cols], gy[rows, 0])
+        s2 = (gx[cols] / 2 + gy[rows, 0] * (_SQRT3 / 2)) / 2  # pyramid_transform by its three factors
+        hat = sinc_x[cols] * _sin_over(s2) * _sin_over(s2 - gx[cols] / 2)
+        f = (2 * _SQRT3 * math.pi) / kk * erfc(kk / (2 * alpha)) * hat  # twice 2 pi / k erfc (sqrt3 / 2) hat
         # node of parity s = 1: phase exp(i pi (m / n_cols + 2 n / n_rows)) relative to parity 0
-        phase = np.exp(1j * math.pi * (m[cols] / n_cols + 2 * n[rows, 0] / n_rows))
+        phase = phase_x[cols] * np.exp(2j * math.pi * n[:, 0] / n_rows)[rows]
         index = np.mod(n[rows, 0], half) * n_cols + np.mod(m[cols], n_cols)
         for s, weight in ((0, f), (1, f * phase)):
             sums[s] += np.bincount(index, weights=weight.real, minlength=sums.shape[1])
             if s:
                 sums[s] += 1j * np.bincount(index, weights=weight.imag, minlength=sums.shape[1])
     # W_F(s)[k, q] = (1/A) sum A_s(n0, m0) exp(2 pi i (m0 q / n_cols + n0 k / half))
-    nodes = np.fft.ifft2(sums.reshape(2, half, n_cols), axes=(-2, -1)).real * (half * n_cols / (lx * ly))
+    nodes = sfft.ifft2(sums.reshape(2, half, n_cols), axes=(-2, -1), overwrite_x=True, workers=fft.threads()).real
+    nodes *= half * n_cols / (lx * ly)
     out = np.empty((n_rows, n_cols))
     out[0::2], out[1::2] = nodes[0], nodes[1]
     return out

@@ -1,0 +1,280 @@
+"""Kalker's QP on a periodic cell: the conjugate gradients of :func:`bem.kalker.solve_qp` in the Fourier basis.
+
+The iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active
+set, Polonsky & Keer 1999, with the FFT preconditioner, the same entering rule, Jacobi cap and
+stopping rule), specialised to :class:`bem.periodic.PeriodicOperator` on NumPy, where ``C`` is
+diagonal in the Fourier basis of the cell (a 2 x 2 block per frequency, one block row per row
+parity) and every node is a candidate. It does not restart the conjugate directions when nodes
+enter the contact: the new direction is ``t = z + beta t_old`` on the current contact with the
+Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)``, and the step is the
+minimum along ``t``, ``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the contact does not
+change, the conjugate-gradient step); where ``g.t <= 0`` the step falls back to ``t = z``. On a
+rough surface, whose contact set changes at most iterations until it settles, the general loop
+restarts at every change and degrades to preconditioned steepest descent
+(``tests/bem/test_periodic_qp.py``: 88 iterations against 62 on a 256 x 256 self-affine cell).
+Further:
+
+- the iteration keeps the spectrum ``U`` of ``u = (C + lam) p``; ``u`` is one inverse transform
+  of it. After a step without a change of the contact set ``U`` is updated by the spectrum of
+  the product ``(C + lam) t`` of the search direction, otherwise recomputed from the spectrum
+  of the new ``p``, one forward transform, instead of a whole product;
+- the curvature ``t.(C + lam) t`` is a sum over the spectrum (Parseval), so the product of
+  the search direction needs no inverse transform;
+- the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
+  the products, the gap and the KKT check stay in double precision.
+
+With a compliance per node (the model of a Newton step, :mod:`bem.newton`) ``U`` is the spectrum
+of ``C p`` alone, ``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner is
+that of :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique
+projection under force control (by ``M 1`` of the starting contact).
+
+A step costs four or five FFTs of the cell (the general loop: four or six, or up to eight with a
+compliance per node in double precision).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+
+from ..kalker import _RECOMPUTE_EVERY, QPSolution, _initial
+
+__all__ = ["solve_periodic_qp"]
+
+log = logging.getLogger(__name__)
+
+
+def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
+                      callback=None, scale=None, u0=None, confirm=True, threshold=4.0):
+    """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell (NumPy).
+
+    Parameters
+    ----------
+    op : bem.periodic.PeriodicOperator
+        ``C`` on the cell, on the ``"cpu"`` device.
+    h : ndarray
+        Gap at the nodes, brick array [length].
+    force, approach : float
+        Exactly one: total force on the cell ``P`` [force] or approach ``delta`` [length].
+    lam : float or ndarray
+        Linear layer compliance [length/pressure], >= 0: uniform, or per node (brick array; Newton's
+        model compliance ``D``, with the preconditioner of :func:`bem.kalker.compliance_preconditioner`
+        on the contact of ``x0``).
+    x0 : ndarray, optional
+        Initial pressure (brick array); negative entries are clipped.
+    rtol : float
+        Tolerance on the KKT residual (the rule of :func:`bem.kalker.solve_qp`, checked on an
+        exactly recomputed ``C p`` unless ``confirm`` is False).
+    maxiter : int, optional
+        Iteration limit (default ``max(200, 10 * sqrt(N))``).
+    callback : callable, optional
+        ``callback(k, p)`` after every iteration.
+    scale, u0, confirm
+        As for :func:`bem.kalker.solve_qp`: the displacement scale of the KKT residual [length],
+        ``C x0`` where the caller has it (the iterate then starts from ``x0`` as given), and
+        whether to confirm the stopping check on an exact product.
+    threshold : float
+        With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner,
+        as in :func:`bem.kalker.compliance_preconditioner`.
+
+    Returns
+    -------
+    bem.kalker.QPSolution
+        As :func:`bem.kalker.solve_qp` with its FFT preconditioner; ``op.n_matvec`` counts the
+        products ``(C + lam) v`` (spectral multiplications).
+    """
+    lat = op.lattice
+    a = lat.node_area
+    per_node = np.ndim(lam) > 0
+    D = np.asarray(lam, dtype=float) if per_node else None
+    lam = 0.0 if per_node else float(lam)
+    h = np.asarray(h, dtype=float)
+    if maxiter is None:
+        maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
+    target = None if force is None else force / a
+    if u0 is None or x0 is None:
+        p = _initial(op, h, D if per_node else lam, force, approach, x0)
+        if target is not None:
+            p = p if float(p.sum()) > 0 else np.ones(lat.shape)
+            p *= target / float(p.sum())
+        u0 = None
+    else:  # the caller's iterate and its product, as they are
+        p = np.array(x0, dtype=float)
+    A = op.symbol(lam)  # C + lam I
+    soft = None
+    if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
+        stiff = D <= threshold * op.diagonal
+        sel = stiff & (p > 0)
+        lam_pc = float(np.median(D[sel])) if bool(sel.any()) else 0.0
+        jacobi = 1.0 / (op.diagonal + D)
+        soft = None if bool(stiff.all()) else ~stiff
+    else:
+        lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
+    M = tuple(s.astype(np.float32 if s.dtype.kind == "f" else np.complex64) for s in op.symbol(lam_pc, inverse=True))
+
+    def product(v):
+        op.n_matvec += 1
+        x = op.spectrum(v)
+        return op.mix(x, A, out=x, work=work)
+
+    def precondition(r32, idx, r_c):  # M r at the nodes idx: r_c = r there, r32 = r (float32) at the stiff nodes
+        x = op.spectrum(r32)
+        z = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1)[idx].astype(float)
+        if soft is not None:
+            out = softf[idx]
+            z[out] = jacf[idx[out]] * r_c[out]
+        return z
+
+    work = None
+    if u0 is None:
+        U, stale = product(p), 0
+    else:  # C x0 from the caller, confirmed like an incremental update
+        U, stale = op.spectrum(np.asarray(u0, dtype=float)), 1
+    work = np.empty_like(U)
+    u = op.brick(U) if u0 is None else np.array(u0, dtype=float)
+    if per_node:
+        u += D * p
+        softf, jacf = (None if soft is None else soft.reshape(-1)), jacobi.reshape(-1)
+    t = np.zeros(lat.shape)
+    g = np.empty(lat.shape)
+    r32 = np.empty(lat.shape, dtype=np.float32)
+    r32f = r32.reshape(-1)
+    z_prev = np.zeros(lat.shape)
+    gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
+    gz_old, m_one, m_full = 1.0, None, None
+    hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
+    converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
+    prev_contact = p > 0
+    fixed_scale = scale
+    for k in range(1, maxiter + 1):
+        contact = p > 0
+        pf = p.reshape(-1)
+        idx = np.flatnonzero(contact)
+        np.add(u, h, out=g)
+        g_c, p_c0 = gf[idx], pf[idx]
+        if force is not None:
+            delta = float(np.mean(g_c)) if idx.size else math.nan
+        g -= delta
+        g_c -= delta
+        scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
+        parts = [float(np.abs(g_c).max(initial=0.0)), -float(g.min()), 0.0]
+        kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) \
+            / (scale if scale > 0 else float(np.abs(g).max()) or 1.0)
+        if force is not None:
+            kkt = max(kkt, abs(a * float(p_c0.sum()) - force) / force)
+        if not math.isfinite(kkt):
+            kkt = np.inf
+        if kkt <= rtol and stale and confirm:
+            U = product(p)  # confirm on an exact product
+            u, stale = op.brick(U), 0
+            if per_node:
+                u += D * p
+            continue
+        changes = int(np.count_nonzero(contact != prev_contact))
+        prev_contact = contact
+        hist["residual"].append(kkt)
+        hist["p_max"].append(float(p_c0.max(initial=0.0)))
+        hist["n_contact"].append(int(idx.size))
+        hist["changes"].append(changes)
+        if not math.isfinite(kkt):
+            message, status = "the iteration produced a non-finite value", "nonfinite"
+            break
+        if kkt <= rtol:
+            converged, message, status = True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}", "converged"
+            break
+        if idx.size == 0 and float(g.min()) >= 0:  # no contact at this approach: p = 0 is the solution
+            converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
+            break
+        # the gap on the contact, single precision (on its stiff part with a per-node compliance)
+        r32.fill(0.0)
+        if soft is None:
+            r32f[idx] = g_c
+        else:
+            on = ~softf[idx]
+            r32f[idx[on]] = g_c[on]
+        z = precondition(r32, idx, g_c)
+        if force is not None and soft is None:
+            z -= z.mean()
+        elif force is not None:
+            # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
+            # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
+            if m_full is None:
+                np.multiply(contact, stiff, out=r32, casting="unsafe")
+                m_full = np.empty(lat.n_nodes)
+                m_full[:] = precondition(r32, np.arange(lat.n_nodes), np.ones(lat.n_nodes))
+            m_one = m_full[idx]
+            if not m_one.sum() > 0:  # a contact far from the starting one: the mean instead
+                m_one = np.ones(idx.size)
+            z -= m_one * (z.sum() / m_one.sum())
+        gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
+        # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
+        beta = 0.0 if k == 1 else max(0.0, (gz - float(np.einsum("i,i->", g_c, zf[idx]))) / gz_old)
+        z_prev.fill(0.0)
+        zf[idx] = z
+        t_c = z + beta * tf[idx]
+        if force is not None:  # nodes that left the contact broke the zero sum of t
+            t_c -= m_one * (t_c.sum() / m_one.sum()) if m_one is not None else t_c.mean()
+        gt = float(np.einsum("i,i->", g_c, t_c))
+        if not gt > 0:  # no descent along t after a change of the contact: steepest descent
+            t_c, gt = z, gz
+        t.fill(0.0)
+        tf[idx] = t_c
+        gz_old = gz
+        T = op.spectrum(t)
+        op.n_matvec += 1
+        R = op.mix(T, A, work=work)
+        tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
+        if per_node:
+            tt += float(np.einsum("i,i,i->", D.reshape(-1)[idx], t_c, t_c))
+        if not np.any(t_c):
+            tau = 0.0  # a single contact node under force control: only entering nodes can move
+        elif tt <= 0 or not math.isfinite(tt):
+            message, status = f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
+            break
+        else:
+            tau = gt / tt  # the minimum along t (gt = gz when the contact has not changed)
+        p_c = p_c0 - tau * t_c
+        clipped = p_c < 0
+        p_c[clipped] = 0.0
+        p_new = np.zeros(lat.shape)
+        nf = p_new.reshape(-1)
+        nf[idx] = p_c
+        # re-entering nodes (p_new = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi estimate
+        low = np.flatnonzero(g < 0)
+        overlap = low[nf[low] == 0]
+        if overlap.size:
+            cap = jacf[overlap] if per_node else jacobi
+            nf[overlap] = -gf[overlap] * ((np.minimum(tau, cap) if per_node else min(tau, cap)) if tau > 0 else cap)
+        entered = bool(overlap.size)
+        s = 1.0
+        if target is not None:
+            total = float(p_c.sum()) + float(nf[overlap].sum())
+            if not total > 0:  # every node left the contact and none entered: no force to rescale
+                message, status = "the iteration produced a non-finite value", "nonfinite"
+                break
+            s = target / total
+            p_new *= s
+        if bool(clipped.any()) or entered or stale >= _RECOMPUTE_EVERY:
+            U, stale = product(p_new), 0
+        else:
+            R *= tau
+            U -= R
+            if s != 1.0:
+                U *= s
+            stale += 1
+        u = op.brick(U)
+        if per_node:
+            u += np.multiply(D, p_new, out=g)  # g is recomputed from u at the next iteration
+        p = p_new
+        if callback is not None:
+            callback(k, p)
+    else:
+        message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
+    if not converged:
+        log.debug("Kalker QP (periodic): %s", message)
+    # C p: the layer's closure is not a displacement
+    elastic = u - (D if per_node else lam) * p if per_node or lam else u
+    return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
+                      message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)

@@ -1,0 +1,159 @@
+"""Kalker's QP on a periodic cell in the Fourier basis (bem.periodic.qp) against the general loop
+(bem.kalker.solve_qp), a dense solve and the KKT conditions; the spectral pieces of the periodic
+operator against its dense matrix."""
+
+import math
+
+import numpy as np
+import pytest
+
+from bem.kalker import solve_qp
+from bem.kkt import kkt_residual
+from bem.periodic import PeriodicCell, PeriodicOperator
+from bem.periodic.qp import solve_periodic_qp
+
+E_STAR = 1.0
+
+
+def _rough(cell, seed=5):
+    rng = np.random.default_rng(seed)
+    lx, ly = cell.size
+    h = np.zeros(cell.shape)
+    for m in range(1, 5):
+        for n in range(-4, 5):
+            amp = rng.standard_normal() / (m * m + n * n)
+            h += amp * np.cos(2 * math.pi * (m * cell.x / lx + n * cell.y / ly) + rng.uniform(0, 2 * math.pi))
+    return 0.02 * (h - h.min())
+
+
+CELL = PeriodicCell(1.0 / 32, 32, 24)
+
+
+@pytest.mark.parametrize("lam_over_cnn", [0.0, 2.0])
+@pytest.mark.parametrize("control", ["force", "approach"])
+def test_periodic_qp_equals_the_general_qp_and_meets_the_kkt_conditions(lam_over_cnn, control):
+    cell = CELL
+    h = _rough(cell)
+    op = PeriodicOperator(cell, E_STAR)
+    lam = lam_over_cnn * op.diagonal
+    kw = dict(force=0.03 * cell.area) if control == "force" else dict(approach=float(np.quantile(h, 0.3)))
+    ref = solve_qp(op, h, lam=lam, preconditioner=op.preconditioner(lam=lam), rtol=1e-10, **kw)
+    fast = solve_periodic_qp(op, h, lam=lam, rtol=1e-10, **kw)
+    assert ref.converged and fast.converged
+    p = fast.p
+    assert 0.05 < np.mean(p > 0) < 0.95
+    assert np.abs(p - ref.p).max() <= 1e-8 * ref.p.max()
+    assert fast.approach == pytest.approx(ref.approach, rel=1e-8, abs=1e-12 * float(np.ptp(h)))
+    u = op.dense() @ p.ravel()  # the displacement, checked against the dense matrix
+    np.testing.assert_allclose(fast.displacement.ravel(), u, rtol=0, atol=1e-12 * np.abs(u).max())
+    g = u + lam * p.ravel() + h.ravel() - fast.approach
+    force = kw.get("force")
+    kkt = kkt_residual(p.ravel(), g, displacement_scale=float(np.abs(u + lam * p.ravel()).max()), force=force,
+                       node_area=cell.node_area)
+    assert kkt <= 1e-10
+
+
+def test_periodic_qp_solves_the_dense_system_on_its_contact_set():
+    """On the contact set of the answer, C_cc p_c = delta - h_c with the force as the extra equation."""
+    cell = CELL
+    h = _rough(cell, seed=9)
+    op = PeriodicOperator(cell, E_STAR)
+    force = 0.03 * cell.area
+    res = solve_periodic_qp(op, h, force=force, rtol=1e-12)
+    assert res.converged
+    c = res.p.ravel() > 0
+    C = op.dense()[np.ix_(c, c)]
+    n = int(c.sum())
+    kkt = np.zeros((n + 1, n + 1))
+    kkt[:n, :n], kkt[:n, n], kkt[n, :n] = C, -1.0, cell.node_area
+    x = np.linalg.solve(kkt, np.concatenate([-h.ravel()[c], [force]]))
+    assert np.abs(res.p.ravel()[c] - x[:n]).max() <= 1e-9 * x[:n].max()
+    assert res.approach == pytest.approx(x[n], rel=1e-9)
+
+
+def test_the_spectral_pieces_of_the_periodic_operator_are_its_dense_matrix():
+    cell = PeriodicCell(1.0 / 12, 12, 10)
+    op = PeriodicOperator(cell, E_STAR)
+    rng = np.random.default_rng(3)
+    v, w = rng.standard_normal(cell.shape), rng.standard_normal(cell.shape)
+    dense = op.dense()
+    lam = 0.7 * op.diagonal
+    X = op.spectrum(v)
+    out = op.brick(op.mix(X, op.symbol(lam)))
+    np.testing.assert_allclose(out.ravel(), dense @ v.ravel() + lam * v.ravel(), rtol=0, atol=1e-13 * np.abs(out).max())
+    assert op.inner(X, op.spectrum(w)) == pytest.approx(float(np.sum(v * w)), rel=1e-13)
+    odd = PeriodicCell(1.0 / 11, 11, 10)  # an odd number of columns: no Nyquist column in the spectrum
+    op_odd = PeriodicOperator(odd, E_STAR)
+    v_odd, w_odd = rng.standard_normal(odd.shape), rng.standard_normal(odd.shape)
+    assert op_odd.inner(op_odd.spectrum(v_odd), op_odd.spectrum(w_odd)) == pytest.approx(float(np.sum(v_odd * w_odd)),
+                                                                                         rel=1e-13)
+    z = op.brick(op.mix(op.spectrum(v), op.symbol(lam, inverse=True)))  # (C + lam)^-1 on zero-mean vectors
+    v0 = v - v.mean()
+    z0 = op.brick(op.mix(op.spectrum(v0), op.symbol(lam, inverse=True)))
+    np.testing.assert_allclose(dense @ z0.ravel() + lam * z0.ravel(), v0.ravel(), rtol=0, atol=1e-11 * np.abs(v0).max())
+    np.testing.assert_allclose(z, op.preconditioner(lam=lam)(v), rtol=0, atol=1e-13 * np.abs(z).max())
+
+
+def _self_affine(cell, seed=2026, hurst=0.8, rolloff=4, cutoff=128):
+    """Gap of a seeded self-affine surface (rms slope 0.1) at the nodes: one Fourier series per row parity."""
+    rng = np.random.default_rng(seed)
+    lx, ly = cell.size
+    m, n = np.meshgrid(np.arange(-cutoff, cutoff + 1), np.arange(-cutoff, cutoff + 1))
+    gx, gy = 2 * math.pi * m / lx, 2 * math.pi * n / ly
+    g = np.hypot(gx, gy)
+    q_r, q_s = 2 * math.pi * rolloff / lx, 2 * math.pi * cutoff / lx
+    amp = np.maximum(g, q_r) ** -(1 + hurst) * ((g > 0) & (g <= q_s))
+    z = amp * (rng.standard_normal(g.shape) + 1j * rng.standard_normal(g.shape))
+    z *= 0.1 / math.sqrt(0.5 * np.sum(np.abs(z) ** 2 * g * g))
+    out = np.empty(cell.shape)
+    half = (cell.n_rows // 2, cell.n_cols)
+    for parity in (0, 1):  # odd rows are shifted by (c/2, c sqrt3/2)
+        shift = np.exp(1j * parity * (gx * cell.step / 2 + gy * cell.step * math.sqrt(3) / 2))
+        grid = np.zeros(half, dtype=complex)
+        np.add.at(grid, (np.mod(n, half[0]), np.mod(m, half[1])), z * shift)
+        out[parity::2] = np.fft.ifft2(grid).real * grid.size
+    return out.max() - out
+
+
+def test_periodic_qp_keeps_its_conjugate_directions_when_the_contact_changes():
+    """On a rough cell whose contact set changes over most of the iterations, the QP reaches the
+    answer of the general loop (which restarts the conjugate gradients at every change) in far
+    fewer iterations."""
+    cell = PeriodicCell(1.0 / 256, 256, 256)
+    h = _self_affine(cell)
+    op = PeriodicOperator(cell, E_STAR)
+    force = 0.03 * cell.area
+    ref = solve_qp(op, h, force=force, preconditioner=op.preconditioner(), rtol=1e-10)
+    fast = solve_periodic_qp(op, h, force=force, rtol=1e-10)
+    assert ref.converged and fast.converged
+    assert sum(ref.history["changes"]) > 50 * ref.iterations  # the contact set moves a lot
+    assert np.abs(fast.p - ref.p).max() <= 1e-8 * ref.p.max()
+    assert fast.iterations <= 0.75 * ref.iterations
+
+
+@pytest.mark.parametrize("control", ["force", "approach"])
+def test_periodic_qp_with_a_compliance_per_node_equals_the_general_qp(control):
+    """Newton's model QP: a compliance per node, some nodes soft (Jacobi), started from the caller's
+    iterate and its product."""
+    from bem.kalker import compliance_preconditioner
+
+    cell = CELL
+    h = _rough(cell, seed=11)
+    op = PeriodicOperator(cell, E_STAR)
+    rng = np.random.default_rng(4)
+    D = op.diagonal * np.where(rng.random(cell.shape) < 0.2, 30.0, 0.5) * rng.uniform(0.5, 2.0, cell.shape)
+    kw = dict(force=0.03 * cell.area) if control == "force" else dict(approach=float(np.quantile(h, 0.3)))
+    x0 = np.where(h < np.quantile(h, 0.3), 1.0, 0.0)
+    if control == "force":
+        x0 *= kw["force"] / cell.node_area / x0.sum()
+    ref = solve_qp(op, h, lam=D, x0=x0, preconditioner=compliance_preconditioner(op, D, x0 > 0), rtol=1e-10, **kw)
+    fast = solve_periodic_qp(op, h, lam=D, x0=x0, u0=op.matvec(x0), rtol=1e-10, **kw)
+    assert ref.converged and fast.converged
+    assert 0.05 < np.mean(fast.p > 0) < 0.95 and np.any((D > 4 * op.diagonal) & (fast.p > 0))
+    assert np.abs(fast.p - ref.p).max() <= 1e-8 * ref.p.max()
+    u = op.dense() @ fast.p.ravel()
+    np.testing.assert_allclose(fast.displacement.ravel(), u, rtol=0, atol=1e-12 * np.abs(u).max())
+    g = u + D.ravel() * fast.p.ravel() + h.ravel() - fast.approach
+    kkt = kkt_residual(fast.p.ravel(), g, displacement_scale=float(np.abs(u + D.ravel() * fast.p.ravel()).max()),
+                       force=kw.get("force"), node_area=cell.node_area)
+    assert kkt <= 1e-10
