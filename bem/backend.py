@@ -25,7 +25,6 @@ Node selections
 
 from __future__ import annotations
 
-import contextlib
 
 import numpy as np
 
@@ -74,8 +73,9 @@ class Backend:
         return to_host(x)
 
     def errstate(self, **kw):
-        """``numpy.errstate`` on the CPU; other namespaces do not warn on floating-point events."""
-        return np.errstate(**kw) if self.is_numpy else contextlib.nullcontext()
+        """``numpy.errstate``: it covers NumPy and the namespaces that compute with NumPy (such as
+        ``array_api_strict``); CuPy does not warn on floating-point events."""
+        return np.errstate(**kw)
 
     # -- FFTs ---------------------------------------------------------------------------------------
 
