@@ -93,6 +93,16 @@ def _per_node(lam):
     return getattr(lam, "ndim", 0) > 0
 
 
+def _stopping(kkt, rtol):
+    """``(converged, message, status)`` of the QP's stopping rule at the KKT residual ``kkt``
+    (non-finite: ``nonfinite``; ``kkt <= rtol``: ``converged``), ``None`` to go on."""
+    if not math.isfinite(kkt):
+        return False, "the iteration produced a non-finite value", "nonfinite"
+    if kkt <= rtol:
+        return True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}", "converged"
+    return None
+
+
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
              maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
@@ -233,11 +243,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         hist["p_max"].append(bk.max0(p_c0))
         hist["n_contact"].append(n_idx)
         hist["changes"].append(changes)
-        if not math.isfinite(kkt):
-            message, status = "the iteration produced a non-finite value", "nonfinite"
-            break
-        if kkt <= rtol:
-            converged, message, status = True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}", "converged"
+        if (stop := _stopping(kkt, rtol)) is not None:
+            converged, message, status = stop
             break
         if n_idx == 0:
             if float(xp.min(g)) >= 0:  # no contact at this approach: p = 0 is the solution

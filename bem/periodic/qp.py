@@ -39,7 +39,7 @@ import math
 
 import numpy as np
 
-from ..kalker import _RECOMPUTE_EVERY, QPSolution, _initial
+from ..kalker import _RECOMPUTE_EVERY, QPSolution, _initial, _stopping
 
 __all__ = ["solve_periodic_qp"]
 
@@ -178,11 +178,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         hist["p_max"].append(float(p_c0.max(initial=0.0)))
         hist["n_contact"].append(int(idx.size))
         hist["changes"].append(changes)
-        if not math.isfinite(kkt):
-            message, status = "the iteration produced a non-finite value", "nonfinite"
-            break
-        if kkt <= rtol:
-            converged, message, status = True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}", "converged"
+        if (stop := _stopping(kkt, rtol)) is not None:
+            converged, message, status = stop
             break
         if idx.size == 0 and float(g.min()) >= 0:  # no contact at this approach: p = 0 is the solution
             converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
