@@ -6,9 +6,8 @@ non-decreasing ``w``. Each Newton step minimises its local quadratic model
 ``m(q) = 1/2 q.(C + D) q + q.(h + w(p) - D p)``  over ``q >= 0``
 (and ``a sum q = P`` under force control),
 
-with ``D = diag(w'(p))``, by the same constrained conjugate gradients that
-solve Kalker's QP (:func:`bem.kalker.solve_qp`; on a periodic cell
-:func:`bem.periodic.qp.solve_periodic_qp`), matrix-free with FFT products.
+with ``D = diag(w'(p))``, by the constrained conjugate gradients of Kalker's QP (:func:`bem.kalker.solve_qp`;
+on a periodic cell :func:`bem.periodic.qp.solve_periodic_qp`), matrix-free with FFT products.
 The model has the gradient of ``Phi`` at ``p``, so for any positive
 ``D`` the step ``d = q - p`` is a feasible descent direction, and an exact line
 search on ``Phi(p + t d)``, ``t in (0, 1]``, makes the method globally
@@ -37,10 +36,8 @@ __all__ = ["solve_newton"]
 
 log = logging.getLogger(__name__)
 
-# Largest forcing term of the inexact Newton method (the inner QP of a step is solved to this
-# fraction of the current KKT residual). Near the solution of a root or power law a step lowers
-# the residual by about a decade whatever the inner accuracy (w' is unbounded at the nodes of tiny
-# pressure), so a tighter inner solve buys no step (benchmarks/periodic_rough.py).
+# Largest forcing term of the inexact Newton method (inner QP tolerance / KKT residual): near the solution
+# of a root or power law a step gains about a decade whatever the inner accuracy (benchmarks/periodic_rough.py).
 _FORCING = 0.1
 
 
