@@ -26,8 +26,8 @@ import logging
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
+from ._brent import brent_root
 from .backend import backend_of, operator_backend
 from .layers.device import device_layer
 from .kalker import QPSolution, compliance_preconditioner, solve_qp
@@ -101,7 +101,7 @@ def _line_search(bk, layer, p, d, u, cd, h, delta, mask):
         return 0.0
     if s1 <= 0:
         return 1.0
-    return brentq(slope, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps)
+    return brent_root(slope, 0.0, 1.0, s0, s1, xtol=1e-14, rtol=4 * np.finfo(float).eps)
 
 
 def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
