@@ -1,4 +1,4 @@
-"""Brent's root finder of the line searches (bem._brent) against SciPy's brentq and exact roots."""
+"""Brent's root finder of the line searches (bem.brent) against SciPy's brentq and exact roots."""
 
 import math
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from bem._brent import brent_root
+from bem.brent import brent_root
 
 EPS = 4 * np.finfo(float).eps
 ROOT = 0.3141592653589793

@@ -34,6 +34,7 @@ def brent_root(f, xa, xb, fa, fb, *, xtol, rtol, maxiter=100):
     float
     """
     xpre, xcur, fpre, fcur = float(xa), float(xb), float(fa), float(fb)
+    xtol, rtol = float(xtol), float(rtol)  # Python floats throughout: f may take no NumPy scalar
     if fpre == 0:
         return xpre
     if fcur == 0:
