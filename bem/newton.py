@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from ._brent import brent_root
+from .brent import brent_root
 from .backend import backend_of, operator_backend
 from .layers.device import device_layer
 from .kalker import QPSolution, compliance_preconditioner, solve_qp
@@ -50,15 +50,28 @@ _FORCING = 0.1
 
 
 def _tangent(bk, layer, p, gap, p_ref):
-    """Per-node model compliance ``D``: ``w'(p)`` where finite, else a secant."""
+    """Per-node model compliance ``D``: ``w'(p)`` where finite, else a secant (each on its nodes only)."""
     xp = bk.xp
+    pos = p > 0
+    contact, rest = bk.select(pos), bk.select(~pos)
+    out = xp.empty_like(p)
     with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        d = bk.asarray(layer.dw(p))
-        # the pressure at which the layer alone closes the gap, w^-1(-g); p_ref where it has none
-        reach = bk.asarray(layer.inverse(xp.maximum(-gap, 0.0)))
-        reach = xp.where((reach > 0) & xp.isfinite(reach), xp.minimum(reach, 1e6 * p_ref), p_ref)
-        secant = bk.asarray(layer.w(reach)) / reach
-    return xp.where(xp.isfinite(d) & (p > 0), d, secant)
+        d = bk.asarray(layer.dw(bk.take(p, contact)))
+        finite = xp.isfinite(d)
+        bk.put(out, contact, d)
+        bk.put(out, rest, _secant(bk, layer, bk.take(gap, rest), p_ref))
+        if not bool(xp.all(finite)):
+            bad = bk.subset(contact, ~finite)
+            bk.put(out, bad, _secant(bk, layer, bk.take(gap, bad), p_ref))
+    return out
+
+
+def _secant(bk, layer, gap, p_ref):
+    """``w(r) / r`` at the pressure ``r = w^-1(-g)`` at which the layer alone closes the gap ``g``; ``p_ref`` where it has none."""
+    xp = bk.xp
+    reach = bk.asarray(layer.inverse(xp.maximum(-gap, 0.0)))
+    reach = xp.where((reach > 0) & xp.isfinite(reach), xp.minimum(reach, 1e6 * p_ref), p_ref)
+    return bk.asarray(layer.w(reach)) / reach
 
 
 def _majorant(op, layer, p, q, D, mask):
@@ -90,8 +103,8 @@ def _line_search(bk, layer, p, d, u, cd, h, delta, mask):
 
     Under force control ``sum d = 0``, so ``delta`` drops out of the derivative.
     """
-    sel = mask & (d != 0)
-    ps, ds, us, cds, hs = p[sel], d[sel], u[sel], cd[sel], h[sel]
+    sel = bk.select(mask & (d != 0))
+    ps, ds, us, cds, hs = (bk.take(x, sel) for x in (p, d, u, cd, h))
 
     def slope(t):
         return bk.dot(ds, us + t * cds + layer.w(bk.xp.maximum(ps + t * ds, 0.0)) + hs - delta)
@@ -265,11 +278,17 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         hist["p"] = []
     converged, message, status, exact = False, "", "maxiter", True
     prev = p > 0
+    full = bool(xp.all(mask))  # every node a candidate (a periodic cell): no masking
+
+    def masked(x):
+        return x if full else xp.where(mask, x, 0.0)
+
     for k in range(maxiter + 1):
-        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach)
+        wp = masked(bk.asarray(layer.w(p)))  # the closure w(p)
+        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp)
         if kkt <= rtol and not exact:  # confirm on an exact product before stopping
             u, exact = op.matvec(p), True
-            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach)
+            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp)
         contact = p > 0
         hist["residual"].append(kkt)
         hist["p_max"].append(float(xp.max(p)))
@@ -288,8 +307,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             message = f"no convergence in maxiter = {maxiter} Newton steps (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
             break
         p_ref = float(xp.mean(p[contact])) if bool(xp.any(contact)) else 1.0
-        D = xp.where(mask, _tangent(bk, layer, p, gap, p_ref), 0.0)
-        b = h + xp.where(mask, layer.w(p), 0.0) - D * p
+        D = masked(_tangent(bk, layer, p, gap, p_ref))
+        b = h + wp - D * p
         # forcing term: 0.1, or the last step's reduction of the residual where that is smaller
         eta = min(_FORCING, kkt / hist["residual"][-2]) if len(hist["residual"]) > 1 else _FORCING
         inner = max(rtol / 3, min(1e-2, eta * kkt))
@@ -303,9 +322,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         cd = sub.displacement - u
         t = _line_search(bk, layer, p, d, u, cd, h, delta, mask)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
-            scale = float(xp.max(xp.abs(u + xp.where(mask, layer.w(p), 0.0))))
+            scale = float(xp.max(xp.abs(u + wp)))
             D = _majorant(op, layer, p, sub.p, D, mask)
-            b = h + xp.where(mask, layer.w(p), 0.0) - D * p
+            b = h + wp - D * p
             sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p,
                             rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False)
             _count_inner(hist, sub)
