@@ -53,13 +53,14 @@ def _tangent(bk, layer, p, gap, p_ref):
     """Per-node model compliance ``D``: ``w'(p)`` where finite, else a secant (each on its nodes only)."""
     xp = bk.xp
     pos = p > 0
-    contact, rest = bk.select(pos), bk.select(~pos)
-    out = xp.empty_like(p)
+    contact, shut = bk.select(pos), bk.select(~pos & ~(gap >= 0))  # shut: no pressure, a closed gap (or NaN)
     with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        # an open gap: the secant at the closure 0, one value
+        out = xp.full_like(p, float(_secant(bk, layer, xp.zeros(1, dtype=p.dtype), p_ref)[0]))
         d = bk.asarray(layer.dw(bk.take(p, contact)))
         finite = xp.isfinite(d)
         bk.put(out, contact, d)
-        bk.put(out, rest, _secant(bk, layer, bk.take(gap, rest), p_ref))
+        bk.put(out, shut, _secant(bk, layer, bk.take(gap, shut), p_ref))
         if not bool(xp.all(finite)):
             bad = bk.subset(contact, ~finite)
             bk.put(out, bad, _secant(bk, layer, bk.take(gap, bad), p_ref))

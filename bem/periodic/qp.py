@@ -114,7 +114,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         soft = None if bool(stiff.all()) else ~stiff
     else:
         lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
-    M = tuple(s.astype(np.float32 if s.dtype.kind == "f" else np.complex64) for s in op.symbol(lam_pc, inverse=True))
+    M = op.symbol(lam_pc, inverse=True, single=True)
 
     def product(v):
         op.n_matvec += 1
@@ -202,8 +202,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
             if m_full is None:
                 np.multiply(contact, stiff, out=r32, casting="unsafe")
-                m_full = np.empty(lat.n_nodes)
-                m_full[:] = precondition(r32, np.arange(lat.n_nodes), np.ones(lat.n_nodes))
+                x = op.spectrum(r32)  # M (contact & stiff), and the Jacobi estimate at the soft nodes
+                m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1).astype(float)
+                m_full[softf] = jacf[softf]
             m_one = m_full[idx]
             if not m_one.sum() > 0:  # a contact far from the starting one: the mean instead
                 m_one = np.ones(idx.size)
