@@ -126,8 +126,10 @@ def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
     itself are still measured with their sign.
     """
     xp = bk.xp
-    dp, pp = delta_p[mask], p[mask]
-    lin = bk.dot(dp, u[mask] + h[mask] - delta) + 0.5 * bk.dot(dp, c_dp[mask])
+    # the nodes that move or carry pressure: every other node adds exactly 0
+    sel = bk.select(mask & ((delta_p != 0) | (p > 0)))
+    dp, pp = bk.take(delta_p, sel), bk.take(p, sel)
+    lin = bk.dot(dp, bk.take(u, sel) + bk.take(h, sel) - delta) + 0.5 * bk.dot(dp, bk.take(c_dp, sel))
     small = xp.abs(dp) < 1e-4 * pp
     with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
         taylor = layer.w(pp) * dp + 0.5 * bk.asarray(layer.dw(pp)) * dp * dp
