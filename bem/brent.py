@@ -3,7 +3,7 @@
 The iteration of ``scipy.optimize.brentq`` (Brent 1973, in the form of SciPy's ``brentq.c``:
 inverse quadratic interpolation or secant, safeguarded by bisection), in Python: the solvers
 call it a few times per solve, on functions that cost a pass over the nodes, and it spares the
-import of :mod:`scipy.optimize` (about 0.15 s) and the two end-point evaluations its caller has.
+import of :mod:`scipy.optimize` (docs/performance.md) and the two end-point evaluations its caller has.
 """
 
 from __future__ import annotations
