@@ -71,7 +71,10 @@ def _tangent(bk, layer, p, gap, p_ref):
 
 
 def _secant(bk, layer, gap, p_ref):
-    """``w(r) / r`` at the pressure ``r = w^-1(-g)`` at which the layer alone closes the gap ``g``; ``p_ref`` where it has none."""
+    """``w(r) / r`` at ``r = w^-1(-g)``, the pressure at which the layer alone closes the gap ``g``.
+
+    ``p_ref`` [pressure] stands for ``r`` where there is none.
+    """
     xp = bk.xp
     reach = bk.asarray(layer.inverse(xp.maximum(-gap, 0.0)))
     reach = xp.where((reach > 0) & xp.isfinite(reach), xp.minimum(reach, 1e6 * p_ref), p_ref)
