@@ -65,7 +65,7 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
     return max(parts)
 
 
-def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None):
+def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, closure=None):
     """Deformed gap, approach and KKT residual of a pressure with a layer.
 
     Parameters
@@ -82,6 +82,8 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None):
         ``C p + w(p) + h`` over the contact nodes (the multiplier of eq. 9).
     mask : ndarray of bool, optional
         Nodes of the problem (default: the lattice's candidate nodes).
+    closure : ndarray, optional
+        ``w(p)`` (0 off ``mask``) where the caller has it [length].
 
     Returns
     -------
@@ -96,8 +98,17 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None):
     bk, op_mask = operator_backend(op)
     xp = bk.xp
     mask = op_mask if mask is None else mask
-    closure = xp.zeros_like(p) if layer is None else xp.where(mask, layer.w(p), 0.0)
+    if closure is None:
+        closure = xp.zeros_like(p) if layer is None else xp.where(mask, layer.w(p), 0.0)
     total = u + closure
+    if bool(xp.all(mask)):  # every node of the lattice (a periodic cell): the same numbers without the masking
+        contact = p > 0
+        gap = total + h
+        delta = float(approach) if force is None else float(xp.mean(gap[contact])) if bool(xp.any(contact)) else 0.0
+        gap -= delta
+        kkt = kkt_residual(p, gap, displacement_scale=float(xp.max(xp.abs(total))), force=force,
+                           node_area=lat.node_area)
+        return gap, delta, kkt
     contact = mask & (p > 0)
     if force is not None:
         delta = float(xp.mean(total[contact] + h[contact])) if bool(xp.any(contact)) else 0.0

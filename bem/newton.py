@@ -25,20 +25,22 @@ import logging
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
+from .brent import brent_root
 from .backend import backend_of, operator_backend
 from .layers.device import device_layer
 from .kalker import QPSolution, compliance_preconditioner, solve_qp
 from .kkt import layered_state
+from .newton_model import majorant, tangent
 
 __all__ = ["solve_newton"]
 
 log = logging.getLogger(__name__)
 
-# Largest forcing term of the inexact Newton method (inner QP tolerance / KKT residual): near the solution
-# of a root or power law a step gains about a decade whatever the inner accuracy (benchmarks/periodic_rough.py).
-_FORCING = 0.1
+# Largest forcing term of the inexact Newton method (inner QP tolerance / KKT residual). Near the solution of
+# a root or power law a step gains about a decade whatever the inner accuracy; while the contact set changes it
+# gains less, and 0.3 costs one step more than 0.1 but fewer products (benchmarks/periodic_rough.py).
+_FORCING = 0.3
 
 
 # Dot products go through Backend.dot: on NumPy np.einsum, because np.dot and np.vdot call the
@@ -46,49 +48,13 @@ _FORCING = 0.1
 # when the other cores are busy; np.einsum is not (docs/performance.md, "The FFT back end").
 
 
-def _tangent(bk, layer, p, gap, p_ref):
-    """Per-node model compliance ``D``: ``w'(p)`` where finite, else a secant."""
-    xp = bk.xp
-    with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        d = bk.asarray(layer.dw(p))
-        # the pressure at which the layer alone closes the gap, w^-1(-g); p_ref where it has none
-        reach = bk.asarray(layer.inverse(xp.maximum(-gap, 0.0)))
-        reach = xp.where((reach > 0) & xp.isfinite(reach), xp.minimum(reach, 1e6 * p_ref), p_ref)
-        secant = bk.asarray(layer.w(reach)) / reach
-    return xp.where(xp.isfinite(d) & (p > 0), d, secant)
-
-
-def _majorant(op, layer, p, q, D, mask):
-    """``D`` raised where the quadratic model underestimates ``W`` on the move ``p -> q``.
-
-    The curvature that makes the model exact at ``q``,
-    ``D_maj = 2 [W(q) - W(p) - w(p) (q - p)] / (q - p)^2``, replaces ``D`` where it is
-    larger. For a concave law (``s < 1``) the tangent at ``p`` is too soft for a pressure
-    that falls towards 0, and a secant is too soft for a node entering the contact: the
-    model then drives such nodes to or from almost zero, where ``w'`` is huge, and the
-    step finds no descent. The raised ``D`` majorises ``W`` on the move.
-    """
-    # a move much smaller than the pressure itself loses the curvature to cancellation in
-    # W(q) - W(p) - w(p)(q - p); the tangent is exact to O(step^3) there and is kept
-    bk, _ = operator_backend(op)
-    xp = bk.xp
-    moves = mask & (xp.abs(q - p) > 1e-6 * xp.maximum(xp.abs(p), xp.abs(q)))
-    qq, pp = xp.maximum(q[moves], 0.0), p[moves]
-    step = qq - pp
-    with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        d_maj = 2.0 * (layer.energy(qq) - layer.energy(pp) - layer.w(pp) * step) / (step * step)
-    out = bk.copy(D)
-    raise_ = xp.isfinite(d_maj) & (d_maj > D[moves])
-    return bk.put(out, bk.subset(bk.select(moves), raise_), d_maj[raise_])
-
-
 def _line_search(bk, layer, p, d, u, cd, h, delta, mask):
     """Exact minimiser of ``Phi(p + t d)`` on ``(0, 1]``: root of ``d.grad Phi(p + t d)``.
 
     Under force control ``sum d = 0``, so ``delta`` drops out of the derivative.
     """
-    sel = mask & (d != 0)
-    ps, ds, us, cds, hs = p[sel], d[sel], u[sel], cd[sel], h[sel]
+    sel = bk.select(mask & (d != 0))
+    ps, ds, us, cds, hs = (bk.take(x, sel) for x in (p, d, u, cd, h))
 
     def slope(t):
         return bk.dot(ds, us + t * cds + layer.w(bk.xp.maximum(ps + t * ds, 0.0)) + hs - delta)
@@ -98,7 +64,7 @@ def _line_search(bk, layer, p, d, u, cd, h, delta, mask):
         return 0.0
     if s1 <= 0:
         return 1.0
-    return brentq(slope, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps)
+    return brent_root(slope, 0.0, 1.0, s0, s1, xtol=1e-14, rtol=4 * np.finfo(float).eps)
 
 
 def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
@@ -109,8 +75,10 @@ def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
     itself are still measured with their sign.
     """
     xp = bk.xp
-    dp, pp = delta_p[mask], p[mask]
-    lin = bk.dot(dp, u[mask] + h[mask] - delta) + 0.5 * bk.dot(dp, c_dp[mask])
+    # the nodes that move or carry pressure: every other node adds exactly 0
+    sel = bk.select(mask & ((delta_p != 0) | (p > 0)))
+    dp, pp = bk.take(delta_p, sel), bk.take(p, sel)
+    lin = bk.dot(dp, bk.take(u, sel) + bk.take(h, sel) - delta) + 0.5 * bk.dot(dp, bk.take(c_dp, sel))
     small = xp.abs(dp) < 1e-4 * pp
     with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
         taylor = layer.w(pp) * dp + 0.5 * bk.asarray(layer.dw(pp)) * dp * dp
@@ -232,7 +200,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     solution releases (``q_n = 0``) are set to 0 when that lowers ``Phi``. The inner
     QP of step ``k`` is solved to ``min(1e-2, eta_k r_k)``, never below ``rtol / 3``
     (``r_k`` the current KKT residual): an inexact Newton method with the forcing term
-    ``eta_k = min(0.1, r_k / r_(k-1))``, which follows the convergence of the outer
+    ``eta_k = min(0.3, r_k / r_(k-1))``, which follows the convergence of the outer
     iteration: about a decade per step near the solution of a root or power law (the
     layer's ``w'`` is unbounded at small pressures), faster for piecewise linear laws.
     """
@@ -262,11 +230,17 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         hist["p"] = []
     converged, message, status, exact = False, "", "maxiter", True
     prev = p > 0
+    full = bool(xp.all(mask))  # every node a candidate (a periodic cell): no masking
+
+    def masked(x):
+        return x if full else xp.where(mask, x, 0.0)
+
     for k in range(maxiter + 1):
-        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach)
+        wp = masked(bk.asarray(layer.w(p)))  # the closure w(p)
+        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp)
         if kkt <= rtol and not exact:  # confirm on an exact product before stopping
             u, exact = op.matvec(p), True
-            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach)
+            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp)
         contact = p > 0
         hist["residual"].append(kkt)
         hist["p_max"].append(float(xp.max(p)))
@@ -285,9 +259,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             message = f"no convergence in maxiter = {maxiter} Newton steps (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
             break
         p_ref = float(xp.mean(p[contact])) if bool(xp.any(contact)) else 1.0
-        D = xp.where(mask, _tangent(bk, layer, p, gap, p_ref), 0.0)
-        b = h + xp.where(mask, layer.w(p), 0.0) - D * p
-        # forcing term: 0.1, or the last step's reduction of the residual where that is smaller
+        D = masked(tangent(bk, layer, p, gap, p_ref))
+        b = h + wp - D * p
+        # forcing term: _FORCING, or the last step's reduction of the residual where that is smaller
         eta = min(_FORCING, kkt / hist["residual"][-2]) if len(hist["residual"]) > 1 else _FORCING
         inner = max(rtol / 3, min(1e-2, eta * kkt))
         # the model starts at p with the product u Newton carries, and Newton checks every step on
@@ -300,9 +274,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         cd = sub.displacement - u
         t = _line_search(bk, layer, p, d, u, cd, h, delta, mask)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
-            scale = float(xp.max(xp.abs(u + xp.where(mask, layer.w(p), 0.0))))
-            D = _majorant(op, layer, p, sub.p, D, mask)
-            b = h + xp.where(mask, layer.w(p), 0.0) - D * p
+            scale = float(xp.max(xp.abs(u + wp)))
+            D = majorant(op, layer, p, sub.p, D, mask)
+            b = h + wp - D * p
             sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p,
                             rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False)
             _count_inner(hist, sub)

@@ -132,23 +132,26 @@ class PeriodicOperator:
             total -= dot(x[..., -1], y[..., -1])
         return total / (n_rows // 2 * n_cols)
 
-    def symbol(self, lam=0.0, inverse=False):
+    def symbol(self, lam=0.0, inverse=False, single=False):
         """The 2 x 2 block symbol of ``C + lam I``, or of :meth:`preconditioner` (``inverse``), for :meth:`mix`.
 
         NumPy only. ``(D, B)``: the diagonal blocks are real (the kernel of a parity on itself is
-        even), ``D`` holds their real parts, ``B`` the off-diagonal blocks.
+        even), ``D`` holds their real parts, ``B`` the off-diagonal blocks. ``single``: in single
+        precision (float32, complex64; ``inverse`` only), rounded from the double-precision blocks.
         """
         if inverse:
-            return self._pack(*self._inverse_blocks(lam))
+            return self._pack(*self._inverse_blocks(lam), single=single)
         if self._symbol is None:
             self._symbol = self._pack(self._s00, self._s01, self._s10, self._s00)
         d, b = self._symbol
         return (d + lam, b) if lam else (d, b)
 
     @staticmethod
-    def _pack(s00, s01, s10, s11):
-        return (np.ascontiguousarray(np.stack([s00.real, s11.real], axis=1)),
-                np.ascontiguousarray(np.stack([s01, s10], axis=1)))
+    def _pack(s00, s01, s10, s11, single=False):
+        d = np.empty((s00.shape[0], 2, s00.shape[1]), dtype=np.float32 if single else np.float64)
+        b = np.empty(d.shape, dtype=np.complex64 if single else np.complex128)
+        d[:, 0], d[:, 1], b[:, 0], b[:, 1] = s00.real, s11.real, s01, s10
+        return d, b
 
     def _apply(self, v, s00, s01, s10, s11):
         """``out_a = sum_b S_ab v_b`` by the spectra ``S`` of a 2 x 2 block symbol (NumPy: ``s00`` is ``(D, B)``)."""

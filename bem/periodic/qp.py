@@ -102,6 +102,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         u0 = None
     else:  # the caller's iterate and its product, as they are
         p = np.array(x0, dtype=float)
+    p = np.array(p, dtype=float)  # updated in place below
+    pf = p.reshape(-1)
     A = op.symbol(lam)  # C + lam I
     soft = None
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
@@ -112,7 +114,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         soft = None if bool(stiff.all()) else ~stiff
     else:
         lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
-    M = tuple(s.astype(np.float32 if s.dtype.kind == "f" else np.complex64) for s in op.symbol(lam_pc, inverse=True))
+    M = op.symbol(lam_pc, inverse=True, single=True)
 
     def product(v):
         op.n_matvec += 1
@@ -136,7 +138,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     u = op.brick(U) if u0 is None else np.array(u0, dtype=float)
     if per_node:
         u += D * p
-        softf, jacf = (None if soft is None else soft.reshape(-1)), jacobi.reshape(-1)
+        softf, jacf, Df = (None if soft is None else soft.reshape(-1)), jacobi.reshape(-1), D.reshape(-1)
     t = np.zeros(lat.shape)
     g = np.empty(lat.shape)
     r32 = np.empty(lat.shape, dtype=np.float32)
@@ -147,21 +149,21 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
     converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
     prev_contact = p > 0
+    n_prev = int(np.count_nonzero(prev_contact))
     fixed_scale = scale
     for k in range(1, maxiter + 1):
         contact = p > 0
-        pf = p.reshape(-1)
         idx = np.flatnonzero(contact)
-        np.add(u, h, out=g)
+        np.add(u, h, out=g)  # the gap is g - delta: delta is subtracted on the contact only
         g_c, p_c0 = gf[idx], pf[idx]
         if force is not None:
             delta = float(np.mean(g_c)) if idx.size else math.nan
-        g -= delta
         g_c -= delta
         scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
-        parts = [float(np.abs(g_c).max(initial=0.0)), -float(g.min()), 0.0]
+        g_min = float(g.min()) - delta
+        parts = [float(np.abs(g_c).max(initial=0.0)), -g_min, 0.0]
         kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) \
-            / (scale if scale > 0 else float(np.abs(g).max()) or 1.0)
+            / (scale if scale > 0 else float(np.abs(g - delta).max()) or 1.0)
         if force is not None:
             kkt = max(kkt, abs(a * float(p_c0.sum()) - force) / force)
         if not math.isfinite(kkt):
@@ -172,8 +174,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             if per_node:
                 u += D * p
             continue
-        changes = int(np.count_nonzero(contact != prev_contact))
-        prev_contact = contact
+        kept = int(np.count_nonzero(prev_contact.reshape(-1)[idx]))  # nodes in both contacts
+        changes = (idx.size - kept) + (n_prev - kept)
+        prev_contact, n_prev = contact, idx.size
         hist["residual"].append(kkt)
         hist["p_max"].append(float(p_c0.max(initial=0.0)))
         hist["n_contact"].append(int(idx.size))
@@ -181,7 +184,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if (stop := _stopping(kkt, rtol)) is not None:
             converged, message, status = stop
             break
-        if idx.size == 0 and float(g.min()) >= 0:  # no contact at this approach: p = 0 is the solution
+        if idx.size == 0 and g_min >= 0:  # no contact at this approach: p = 0 is the solution
             converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
             break
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
@@ -199,8 +202,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
             if m_full is None:
                 np.multiply(contact, stiff, out=r32, casting="unsafe")
-                m_full = np.empty(lat.n_nodes)
-                m_full[:] = precondition(r32, np.arange(lat.n_nodes), np.ones(lat.n_nodes))
+                x = op.spectrum(r32)  # M (contact & stiff), and the Jacobi estimate at the soft nodes
+                m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1).astype(float)
+                m_full[softf] = jacf[softf]
             m_one = m_full[idx]
             if not m_one.sum() > 0:  # a contact far from the starting one: the mean instead
                 m_one = np.ones(idx.size)
@@ -224,7 +228,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         R = op.mix(T, A, work=work)
         tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
         if per_node:
-            tt += float(np.einsum("i,i,i->", D.reshape(-1)[idx], t_c, t_c))
+            D_c = Df[idx]
+            tt += float(np.einsum("i,i,i->", D_c, t_c, t_c))
         if not np.any(t_c):
             tau = 0.0  # a single contact node under force control: only entering nodes can move
         elif tt <= 0 or not math.isfinite(tt):
@@ -235,26 +240,31 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
         p_c[clipped] = 0.0
-        p_new = np.zeros(lat.shape)
-        nf = p_new.reshape(-1)
-        nf[idx] = p_c
-        # re-entering nodes (p_new = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi estimate
-        low = np.flatnonzero(g < 0)
-        overlap = low[nf[low] == 0]
+        pf[idx] = p_c  # p is 0 off idx
+        # re-entering nodes (p = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi estimate
+        low = np.flatnonzero(g < delta)
+        overlap = low[pf[low] == 0]
+        p_o = None
         if overlap.size:
             cap = jacf[overlap] if per_node else jacobi
-            nf[overlap] = -gf[overlap] * ((np.minimum(tau, cap) if per_node else min(tau, cap)) if tau > 0 else cap)
+            p_o = -(gf[overlap] - delta) * ((np.minimum(tau, cap) if per_node else min(tau, cap)) if tau > 0 else cap)
         entered = bool(overlap.size)
         s = 1.0
         if target is not None:
-            total = float(p_c.sum()) + float(nf[overlap].sum())
+            total = float(p_c.sum()) + (float(p_o.sum()) if entered else 0.0)
             if not total > 0:  # every node left the contact and none entered: no force to rescale
+                pf[idx] = p_c0
                 message, status = "the iteration produced a non-finite value", "nonfinite"
                 break
             s = target / total
-            p_new *= s
+            p_c *= s
+            pf[idx] = p_c
+        if entered:
+            if s != 1.0:
+                p_o *= s
+            pf[overlap] = p_o
         if bool(clipped.any()) or entered or stale >= _RECOMPUTE_EVERY:
-            U, stale = product(p_new), 0
+            U, stale = product(p), 0
         else:
             R *= tau
             U -= R
@@ -262,11 +272,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 U *= s
             stale += 1
         u = op.brick(U)
-        if per_node:
-            u += np.multiply(D, p_new, out=g)  # g is recomputed from u at the next iteration
-        p = p_new
+        if per_node:  # u += D p, on the nodes where p > 0
+            uf = u.reshape(-1)
+            uf[idx] += D_c * p_c
+            if entered:
+                uf[overlap] += Df[overlap] * p_o
         if callback is not None:
-            callback(k, p)
+            callback(k, p.copy())
     else:
         message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
     if not converged:

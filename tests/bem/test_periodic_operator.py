@@ -76,6 +76,18 @@ def test_periodic_preconditioner_inverts_c_plus_lam_on_zero_mean_vectors():
         assert np.abs((dense + lam * np.eye(cell.n_nodes)) @ z.ravel() - r.ravel()).max() <= 1e-13
 
 
+def test_single_precision_preconditioner_symbol_applies_the_preconditioner_to_single_precision():
+    op = PeriodicOperator(PeriodicCell(0.1, 12, 8), 2.0)
+    r = np.random.default_rng(7).standard_normal(op.lattice.shape)
+    for lam in (0.0, 0.4):
+        single = op.symbol(lam, inverse=True, single=True)
+        assert single[0].dtype == np.float32 and single[1].dtype == np.complex64
+        x = op.spectrum(r.astype(np.float32))
+        z = op.brick(op.mix(x, single, out=x))
+        exact = op.preconditioner(lam)(r)
+        assert np.abs(z - exact).max() <= 1e-5 * np.abs(exact).max()
+
+
 def test_periodic_template_matches_the_free_template_where_images_are_far():
     # a large cell: near the source the images add a smooth, almost uniform field, so the
     # second difference of W equals that of w_t to the curvature of the image field
