@@ -227,3 +227,12 @@ def test_cli_sweep(tmp_path):
 def test_cli_sweep_param_without_values(tmp_path):
     code, _out, err = cli("sweep", "elliptic", "--param", "load.force", "--out", tmp_path)
     assert code == 2 and "--values" in err
+
+
+def test_a_point_that_did_not_converge_carries_its_solvers_status(tmp_path):
+    """A sweep point's status is the run's: the BEM's own status word where it stopped early."""
+    summary = _sweep(tmp_path, overrides=FAST + ["bem.maxiter=2"])
+    rows = summary["points"]
+    assert [r["status"] for r in rows] == ["maxiter"] * 3 and not any(r["converged"] for r in rows)
+    point = json.loads(_point(tmp_path, summary, 0).read_text())
+    assert point["result"]["bem"]["status"] == "maxiter"
