@@ -15,6 +15,11 @@ Back end
     per shape (every support window has its own); with ``FFTW_ESTIMATE`` it is slower
     than pocketfft, which plans in microseconds and caches its plans.
 
+Element-wise work
+    :func:`in_parts` runs an element-wise kernel on :func:`threads` contiguous parts of an
+    array on a pool of threads (NumPy's ufuncs release the GIL), as the transforms use
+    ``workers``; arrays below ``2**17`` entries stay in the calling thread.
+
 Pruned transforms
     :func:`forward` and :func:`inverse` are the two halves of a zero-padded
     (non-periodic) convolution of a batch of real 2-D arrays. The real FFT
@@ -28,13 +33,16 @@ Pruned transforms
 from __future__ import annotations
 
 import os
+from concurrent.futures import ThreadPoolExecutor
 
 import scipy.fft as _sfft
 
-__all__ = ["threads", "set_threads", "fast_length", "forward", "inverse"]
+__all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "in_parts"]
 
 _ENV = "CONTACTLAB_THREADS"
 _override = None
+_PARTS_MIN = 1 << 17  # entries below which in_parts runs in the calling thread
+_pool = None
 
 
 def _available_cpus():
@@ -88,6 +96,31 @@ def set_threads(n):
             fail("n", n, "an integer >= 1 or None")
     previous, _override = _override, n
     return previous
+
+
+def in_parts(kernel, n, size):
+    """Call ``kernel(part)`` on contiguous slices ``part`` of ``range(n)``, on :func:`threads` threads.
+
+    Parameters
+    ----------
+    kernel : callable
+        ``kernel(part)`` with ``part`` a ``slice``; the calls must touch disjoint data.
+    n : int
+        Length of the axis that is split (the first axis of the caller's arrays).
+    size : int
+        Entries of the caller's arrays: below ``2**17``, or with one thread, ``kernel``
+        runs once on the whole axis in the calling thread.
+    """
+    global _pool
+    k = min(threads(), n)
+    if k < 2 or size < _PARTS_MIN:
+        kernel(slice(0, n))
+        return
+    if _pool is None or _pool._max_workers < k:
+        _pool = ThreadPoolExecutor(max_workers=k, thread_name_prefix="contactlab")
+    bounds = [n * i // k for i in range(k + 1)]
+    for f in [_pool.submit(kernel, slice(lo, hi)) for lo, hi in zip(bounds[:-1], bounds[1:])]:
+        f.result()
 
 
 def fast_length(n, real):

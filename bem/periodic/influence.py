@@ -108,14 +108,21 @@ class PeriodicOperator:
         """``out_a = sum_b S_ab X_b`` on a spectrum ``X`` of :meth:`spectrum`'s layout.
 
         ``symbol = (D, B)`` in the same layout: ``D[:, a] = S_aa`` (real) and ``B[:, a] = S_a(1-a)``
-        (:meth:`symbol`, :meth:`inverse_symbol`), so that ``out = D X + B X'`` with ``X'`` the
-        spectrum with its parities swapped: three passes over contiguous arrays. ``out`` (default:
-        a new array) may be ``spectrum`` itself; ``work``, an array like ``spectrum``, is a buffer.
+        (:meth:`symbol`), so that ``out = D X + B X'`` with ``X'`` the
+        spectrum with its parities swapped: three passes over contiguous arrays, on
+        :func:`bem.fft.in_parts` threads. ``out`` (default: a new array) may be ``spectrum``
+        itself; ``work``, an array like ``spectrum``, is a buffer.
         """
         d, b = symbol
-        work = np.multiply(b, spectrum[:, ::-1, :], out=work)
-        out = np.multiply(d, spectrum, out=out)
-        out += work
+        out = np.empty_like(spectrum) if out is None else out
+        work = np.empty_like(spectrum) if work is None else work
+
+        def part(s):  # rows s of every array: the parity swap stays inside a row
+            np.multiply(b[s], spectrum[s, ::-1, :], out=work[s])
+            np.multiply(d[s], spectrum[s], out=out[s])
+            np.add(out[s], work[s], out=out[s])
+
+        fft.in_parts(part, spectrum.shape[0], spectrum.size)
         return out
 
     def inner(self, x, y):
@@ -123,10 +130,11 @@ class PeriodicOperator:
         n_rows, n_cols = self.lattice.shape
 
         def dot(a, b):  # Re sum conj(a) b of two small arrays
-            return float(np.sum(a.real * b.real + a.imag * b.imag))
+            return float(np.sum(a.real * b.real + a.imag * b.imag, dtype=np.float64))
 
         # the rfft holds the columns m and n_cols - m once: weight 2, but for m = 0 and n_cols / 2
-        total = 2.0 * float(np.einsum("i,i->", x.view(np.float64).reshape(-1), y.view(np.float64).reshape(-1)))
+        real = x.real.dtype  # float32 for complex64 spectra, summed in double precision
+        total = 2.0 * float(np.einsum("i,i->", x.view(real).reshape(-1), y.view(real).reshape(-1), dtype=np.float64))
         total -= dot(x[..., 0], y[..., 0])
         if n_cols % 2 == 0:
             total -= dot(x[..., -1], y[..., -1])
@@ -137,14 +145,15 @@ class PeriodicOperator:
 
         NumPy only. ``(D, B)``: the diagonal blocks are real (the kernel of a parity on itself is
         even), ``D`` holds their real parts, ``B`` the off-diagonal blocks. ``single``: in single
-        precision (float32, complex64; ``inverse`` only), rounded from the double-precision blocks.
+        precision (float32, complex64), rounded from the double-precision blocks.
         """
         if inverse:
             return self._pack(*self._inverse_blocks(lam), single=single)
         if self._symbol is None:
             self._symbol = self._pack(self._s00, self._s01, self._s10, self._s00)
         d, b = self._symbol
-        return (d + lam, b) if lam else (d, b)
+        d = d + lam if lam else d
+        return (d.astype(np.float32), b.astype(np.complex64)) if single else (d, b)
 
     @staticmethod
     def _pack(s00, s01, s10, s11, single=False):
@@ -208,16 +217,22 @@ class PeriodicOperator:
         return apply
 
     def _inverse_blocks(self, lam):
-        """The blocks ``(I00, I01, I10, I11)`` of the symbol of :meth:`preconditioner`."""
-        a, d = self._s00 + lam, self._s00 + lam
-        b, c = self.backend.copy(self._s01), self.backend.copy(self._s10)
+        """The blocks ``(I00, I01, I10, I11)`` of the symbol of :meth:`preconditioner`.
+
+        ``C`` is symmetric, so its symbol is Hermitian: ``S_11 = S_00`` is real and
+        ``S_10 = conj(S_01)``. The determinant ``S_00^2 - |S_01|^2`` is then real, ``I00 = I11``
+        is real and ``I10 = conj(I01)``.
+        """
+        xp = self.backend.xp
+        a = xp.real(self._s00) + lam
+        b = self.backend.copy(self._s01)
         shift = 0.5 * self.diagonal  # the constant mode (1, 1) / sqrt 2 of frequency 0 gets eigenvalue C_nn + lam
         a[0, 0] += shift
-        d[0, 0] += shift
         b[0, 0] += shift
-        c[0, 0] += shift
-        det = a * d - b * c
-        return d / det, -b / det, -c / det, a / det
+        det = a * a - (xp.real(b) ** 2 + xp.imag(b) ** 2)
+        b /= -det
+        a /= det
+        return a, b, xp.conj(b), a
 
     def dense(self):
         """The dense matrix ``C`` over the flattened nodes (small cells only), from :attr:`kernel` by offsets."""

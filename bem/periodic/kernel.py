@@ -155,10 +155,10 @@ def _fourier_part(n_rows, n_cols, alpha):
         # node of parity s = 1: phase exp(i pi (m / n_cols + 2 n / n_rows)) relative to parity 0
         phase = phase_x[cols] * np.exp(2j * math.pi * n[:, 0] / n_rows)[rows]
         index = np.mod(n[rows, 0], half) * n_cols + np.mod(m[cols], n_cols)
-        for s, weight in ((0, f), (1, f * phase)):
-            sums[s] += np.bincount(index, weights=weight.real, minlength=sums.shape[1])
-            if s:
-                sums[s] += 1j * np.bincount(index, weights=weight.imag, minlength=sums.shape[1])
+        odd = f * phase
+        sums[0].real += np.bincount(index, weights=f, minlength=sums.shape[1])
+        sums[1].real += np.bincount(index, weights=odd.real, minlength=sums.shape[1])
+        sums[1].imag += np.bincount(index, weights=odd.imag, minlength=sums.shape[1])
     # W_F(s)[k, q] = (1/A) sum A_s(n0, m0) exp(2 pi i (m0 q / n_cols + n0 k / half))
     nodes = sfft.ifft2(sums.reshape(2, half, n_cols), axes=(-2, -1), overwrite_x=True, workers=fft.threads()).real
     nodes *= half * n_cols / (lx * ly)

@@ -21,7 +21,14 @@ Further:
 - the curvature ``t.(C + lam) t`` is a sum over the spectrum (Parseval), so the product of
   the search direction needs no inverse transform;
 - the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
-  the products, the gap and the KKT check stay in double precision.
+- so do the products while the KKT residual is above ``1e-4`` (:data:`SINGLE_ABOVE`), in a
+  solve that starts above ``1e-2`` (:data:`SINGLE_START` times that), where
+  the rounding of single precision (a relative ``1e-7`` of ``C p``) is far below what the
+  iteration resolves: halved transforms in the early iterations, where the contact set
+  settles. At the first residual below it (or at ``rtol`` when the stopping check is
+  confirmed) ``C p`` is recomputed in double precision, and the iteration goes on in double
+  precision from there; the stopping check, when confirmed, is always on a double-precision
+  product.
 
 With a compliance per node (the model of a Newton step, :mod:`bem.newton`) ``U`` is the spectrum
 of ``C p`` alone, ``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner is
@@ -41,9 +48,12 @@ import numpy as np
 
 from ..kalker import _RECOMPUTE_EVERY, QPSolution, _initial, _stopping
 
-__all__ = ["solve_periodic_qp"]
+__all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
 log = logging.getLogger(__name__)
+
+SINGLE_ABOVE = 1e-4  # KKT residual above which the products run in single precision
+SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_ABOVE
 
 
 def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
@@ -115,9 +125,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     else:
         lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
     M = op.symbol(lam_pc, inverse=True, single=True)
+    A32, work, work32 = op.symbol(lam, single=True), None, None
 
     def product(v):
         op.n_matvec += 1
+        if single:
+            x = op.spectrum(v.astype(np.float32))
+            return op.mix(x, A32, out=x, work=work32)
         x = op.spectrum(v)
         return op.mix(x, A, out=x, work=work)
 
@@ -129,12 +143,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             z[out] = jacf[idx[out]] * r_c[out]
         return z
 
-    work = None
+    single = False  # the first product in double precision: it sets the scale of the KKT residual
     if u0 is None:
         U, stale = product(p), 0
     else:  # C x0 from the caller, confirmed like an incremental update
         U, stale = op.spectrum(np.asarray(u0, dtype=float)), 1
-    work = np.empty_like(U)
+    work, work32 = np.empty_like(U), np.empty(U.shape, dtype=np.complex64)
     u = op.brick(U) if u0 is None else np.array(u0, dtype=float)
     if per_node:
         u += D * p
@@ -155,7 +169,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         contact = p > 0
         idx = np.flatnonzero(contact)
         np.add(u, h, out=g)  # the gap is g - delta: delta is subtracted on the contact only
-        g_c, p_c0 = gf[idx], pf[idx]
+        g_c, p_c0 = np.take(gf, idx), np.take(pf, idx)
         if force is not None:
             delta = float(np.mean(g_c)) if idx.size else math.nan
         g_c -= delta
@@ -168,11 +182,17 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             kkt = max(kkt, abs(a * float(p_c0.sum()) - force) / force)
         if not math.isfinite(kkt):
             kkt = np.inf
-        if kkt <= rtol and stale and confirm:
-            U = product(p)  # confirm on an exact product
+        if k == 1:  # single precision pays for its closing product only well above SINGLE_ABOVE
+            single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
+        if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
+            single = False  # confirm on an exact product, or go on in double precision
+            U = product(p)
             u, stale = op.brick(U), 0
             if per_node:
                 u += D * p
+            if t.dtype != u.dtype:
+                t = t.astype(float)
+                tf = t.reshape(-1)
             continue
         kept = int(np.count_nonzero(prev_contact.reshape(-1)[idx]))  # nodes in both contacts
         changes = (idx.size - kept) + (n_prev - kept)
@@ -211,21 +231,24 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             z -= m_one * (z.sum() / m_one.sum())
         gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
-        beta = 0.0 if k == 1 else max(0.0, (gz - float(np.einsum("i,i->", g_c, zf[idx]))) / gz_old)
+        beta = 0.0 if k == 1 else max(0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
         z_prev.fill(0.0)
         zf[idx] = z
-        t_c = z + beta * tf[idx]
+        t_c = z + beta * np.take(tf, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (t_c.sum() / m_one.sum()) if m_one is not None else t_c.mean()
         gt = float(np.einsum("i,i->", g_c, t_c))
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
+        if single and t.dtype != np.float32:
+            t = t.astype(np.float32)
+            tf = t.reshape(-1)
         t.fill(0.0)
         tf[idx] = t_c
         gz_old = gz
         T = op.spectrum(t)
         op.n_matvec += 1
-        R = op.mix(T, A, work=work)
+        R = op.mix(T, A32, work=work32) if single else op.mix(T, A, work=work)
         tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
         if per_node:
             D_c = Df[idx]
@@ -284,6 +307,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     if not converged:
         log.debug("Kalker QP (periodic): %s", message)
     # C p: the layer's closure is not a displacement
-    elastic = u - (D if per_node else lam) * p if per_node or lam else u
+    elastic = u - (D if per_node else lam) * p if per_node or lam else u.astype(float, copy=False)
     return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
                       message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)

@@ -37,3 +37,44 @@ def test_forward_inverse_is_a_zero_padded_circular_pair():
     shape = (fft.fast_length(11, real=False), fft.fast_length(15, real=True))
     back = fft.inverse(fft.forward(x, shape), shape, (5, 7)) / (shape[0] * shape[1])
     np.testing.assert_allclose(back, x, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("n_threads, size, parts", [(2, 1 << 17, 2), (3, 1 << 20, 3), (1, 1 << 20, 1), (2, 1000, 1)])
+def test_in_parts_covers_the_axis_once_in_contiguous_parts(monkeypatch, n_threads, size, parts):
+    monkeypatch.setattr(fft, "_override", n_threads)
+    n = 512
+    seen = []
+    hits = np.zeros(n, dtype=int)
+
+    def kernel(part):
+        seen.append(part)
+        hits[part] += 1
+
+    fft.in_parts(kernel, n, size)
+    assert len(seen) == parts
+    assert np.all(hits == 1)  # every index once: the parts are disjoint and cover the axis
+    assert all(s.step is None and s.start < s.stop for s in seen)
+
+
+def test_in_parts_gives_the_numbers_of_one_thread(monkeypatch):
+    """The threaded 2 x 2 block product of the periodic operator is the one-thread product, bit for bit,
+    and both are the direct formula ``out_a = S_aa X_a + S_a(1-a) X_(1-a)``."""
+    from bem.periodic import PeriodicCell, PeriodicOperator
+
+    cell = PeriodicCell(1.0 / 512, 512, 512)  # a spectrum of 256 x 2 x 257 > 2**17 entries
+    op = PeriodicOperator(cell, 1.0)
+    X = op.spectrum(np.random.default_rng(1).standard_normal(cell.shape))
+    before = X.copy()
+    d, b = op.symbol(0.3 * op.diagonal)
+    monkeypatch.setattr(fft, "_override", 2)
+    two = op.mix(X, (d, b))
+    monkeypatch.setattr(fft, "_override", 1)
+    one = op.mix(X, (d, b))
+    np.testing.assert_array_equal(X, before)  # the input is not modified
+    np.testing.assert_array_equal(two, one)
+    direct = d * X + b * X[:, ::-1, :]
+    np.testing.assert_allclose(two, direct, rtol=1e-15, atol=1e-15 * np.abs(direct).max())
+    monkeypatch.setattr(fft, "_override", 2)
+    Y = X.copy()
+    assert op.mix(Y, (d, b), out=Y) is Y  # in place, as the solvers call it
+    np.testing.assert_array_equal(Y, one)

@@ -157,3 +157,36 @@ def test_periodic_qp_with_a_compliance_per_node_equals_the_general_qp(control):
     kkt = kkt_residual(fast.p.ravel(), g, displacement_scale=float(np.abs(u + D.ravel() * fast.p.ravel()).max()),
                        force=kw.get("force"), node_area=cell.node_area)
     assert kkt <= 1e-10
+
+
+@pytest.mark.parametrize("per_node", [False, True])
+def test_periodic_qp_runs_its_early_products_in_single_precision_and_ends_in_double(monkeypatch, per_node):
+    """A solve that starts far from the answer transforms in single precision until the KKT residual
+    falls below SINGLE_ABOVE, then in double precision: the answer is the all-double one, its
+    displacement is the double-precision product, and the KKT conditions hold to rtol."""
+    import bem.periodic.qp as qp
+
+    cell = PeriodicCell(1.0 / 128, 128, 128)
+    h = _self_affine(cell)
+    op = PeriodicOperator(cell, E_STAR)
+    force = 0.03 * cell.area
+    lam = op.diagonal * np.random.default_rng(2).uniform(0.2, 2.0, cell.shape) if per_node else 0.0
+    seen = []
+    spectrum = op.spectrum
+    monkeypatch.setattr(op, "spectrum", lambda v: seen.append(v.dtype) or spectrum(v))
+    res = solve_periodic_qp(op, h, force=force, lam=lam, rtol=1e-10)
+    assert res.converged
+    assert res.history["residual"][0] > qp.SINGLE_START * qp.SINGLE_ABOVE
+    # single-precision transforms beyond the preconditioner's (one per iteration), and double ones
+    assert seen.count(np.float32) > res.iterations + 3 and seen.count(np.float64) >= 3
+    monkeypatch.setattr(qp, "SINGLE_START", math.inf)  # double precision throughout
+    ref = solve_periodic_qp(PeriodicOperator(cell, E_STAR), h, force=force, lam=lam, rtol=1e-10)
+    assert ref.converged
+    assert np.abs(res.p - ref.p).max() <= 1e-8 * ref.p.max()
+    u = PeriodicOperator(cell, E_STAR).matvec(res.p)
+    assert res.displacement.dtype == np.float64
+    np.testing.assert_allclose(res.displacement, u, rtol=0, atol=1e-12 * np.abs(u).max())
+    g = (u + lam * res.p + h - res.approach).ravel()
+    kkt = kkt_residual(res.p.ravel(), g, displacement_scale=float(np.abs(u + lam * res.p).max()), force=force,
+                       node_area=cell.node_area)
+    assert kkt <= 1e-10
