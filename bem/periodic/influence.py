@@ -67,7 +67,7 @@ class PeriodicOperator:
         spectra = sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
         # spectra of K_00 = K_11, K_10 and K_01 (real kernels: the 1/N of the inverse FFT is applied there)
         self._s00, self._s10, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra)
-        self._symbol = None
+        self._symbol = self._symbol32 = None
 
     def _forward(self, v):
         """Spectra of the even and odd rows of a brick array: ``(2, n_rows/2, n_cols/2 + 1)``.
@@ -152,6 +152,10 @@ class PeriodicOperator:
         if self._symbol is None:
             self._symbol = self._pack(self._s00, self._s01, self._s10, self._s00)
         d, b = self._symbol
+        if single and not lam:  # the symbol of C alone, rounded once per operator
+            if self._symbol32 is None:
+                self._symbol32 = (d.astype(np.float32), b.astype(np.complex64))
+            return self._symbol32
         d = d + lam if lam else d
         return (d.astype(np.float32), b.astype(np.complex64)) if single else (d, b)
 

@@ -14,29 +14,32 @@ restarts at every change and degrades to preconditioned steepest descent
 (``tests/bem/test_periodic_qp.py``: 88 iterations against 62 on a 256 x 256 self-affine cell).
 Further:
 
-- the iteration keeps the spectrum ``U`` of ``u = (C + lam) p``; ``u`` is one inverse transform
-  of it. After a step without a change of the contact set ``U`` is updated by the spectrum of
-  the product ``(C + lam) t`` of the search direction, otherwise recomputed from the spectrum
-  of the new ``p``, one forward transform, instead of a whole product;
-- the curvature ``t.(C + lam) t`` is a sum over the spectrum (Parseval), so the product of
-  the search direction needs no inverse transform;
+- the iteration keeps ``u = (C + lam) p`` in double precision. After a step without a change
+  of the contact set it is updated by ``tau (C + lam) t``, the product of the search direction,
+  which runs in single precision: its rounding is a relative ``1e-7`` of the step, and the
+  step falls with the residual. After a change of the contact set, and after every 20 updates,
+  ``u`` is recomputed from ``p``;
+- the curvature ``t.(C + lam) t`` is a sum over the spectrum of that product (Parseval,
+  summed in double precision);
 - the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
-- so do the products while the KKT residual is above ``1e-4`` (:data:`SINGLE_ABOVE`), in a
-  solve that starts above ``1e-2`` (:data:`SINGLE_START` times that), where
-  the rounding of single precision (a relative ``1e-7`` of ``C p``) is far below what the
-  iteration resolves: halved transforms in the early iterations, where the contact set
-  settles. At the first residual below it (or at ``rtol`` when the stopping check is
-  confirmed) ``C p`` is recomputed in double precision, and the iteration goes on in double
-  precision from there; the stopping check, when confirmed, is always on a double-precision
-  product.
+- so does the recomputed ``u`` while the KKT residual is above ``1e-4`` (:data:`SINGLE_ABOVE`),
+  in a solve that starts above ``1e-2`` (:data:`SINGLE_START` times that), where the rounding
+  of single precision (a relative ``1e-7`` of ``C p``) is far below what the iteration
+  resolves: halved transforms in the early iterations, where the contact set settles. At the
+  first residual below it (or at ``rtol`` when the stopping check is confirmed) ``u`` is
+  recomputed in double precision, and so it is from there on; the stopping check, when
+  confirmed, is always on a double-precision product.
 
-With a compliance per node (the model of a Newton step, :mod:`bem.newton`) ``U`` is the spectrum
-of ``C p`` alone, ``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner is
-that of :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique
+With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are
+those of ``C`` alone, ``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner
+is that of :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique
 projection under force control (by ``M 1`` of the starting contact).
 
-A step costs four or five FFTs of the cell (the general loop: four or six, or up to eight with a
-compliance per node in double precision).
+A step costs four transforms of the cell in single precision while the contact set does not
+change (two for the preconditioner, one forward for the search direction, one inverse for its
+product), five where it changes, two of them in double precision once the residual is below
+``SINGLE_ABOVE`` (the general loop: four or six in double precision, or up to eight with a
+compliance per node).
 """
 
 from __future__ import annotations
@@ -125,7 +128,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     else:
         lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
     M = op.symbol(lam_pc, inverse=True, single=True)
-    A32, work, work32 = op.symbol(lam, single=True), None, None
+    A32 = op.symbol(lam, single=True)
+    spectral = (lat.n_rows // 2, 2, lat.n_cols // 2 + 1)  # the layout of PeriodicOperator.spectrum
+    work, work32, r_hat = np.empty(spectral, dtype=complex), np.empty(spectral, dtype=np.complex64), None
 
     def product(v):
         op.n_matvec += 1
@@ -146,14 +151,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     single = False  # the first product in double precision: it sets the scale of the KKT residual
     if u0 is None:
         U, stale = product(p), 0
+        u = op.brick(U, overwrite=True)
     else:  # C x0 from the caller, confirmed like an incremental update
-        U, stale = op.spectrum(np.asarray(u0, dtype=float)), 1
-    work, work32 = np.empty_like(U), np.empty(U.shape, dtype=np.complex64)
-    u = op.brick(U) if u0 is None else np.array(u0, dtype=float)
+        u, stale = np.array(u0, dtype=float), 1
     if per_node:
         u += D * p
         softf, jacf, Df = (None if soft is None else soft.reshape(-1)), jacobi.reshape(-1), D.reshape(-1)
-    t = np.zeros(lat.shape)
+    t = np.zeros(lat.shape, dtype=np.float32)  # the search direction, transformed in single precision
     g = np.empty(lat.shape)
     r32 = np.empty(lat.shape, dtype=np.float32)
     r32f = r32.reshape(-1)
@@ -186,13 +190,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
         if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
             single = False  # confirm on an exact product, or go on in double precision
-            U = product(p)
-            u, stale = op.brick(U), 0
+            u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:
                 u += D * p
-            if t.dtype != u.dtype:
-                t = t.astype(float)
-                tf = t.reshape(-1)
             continue
         kept = int(np.count_nonzero(prev_contact.reshape(-1)[idx]))  # nodes in both contacts
         changes = (idx.size - kept) + (n_prev - kept)
@@ -240,15 +240,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         gt = float(np.einsum("i,i->", g_c, t_c))
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
-        if single and t.dtype != np.float32:
-            t = t.astype(np.float32)
-            tf = t.reshape(-1)
         t.fill(0.0)
         tf[idx] = t_c
         gz_old = gz
         T = op.spectrum(t)
         op.n_matvec += 1
-        R = op.mix(T, A32, work=work32) if single else op.mix(T, A, work=work)
+        R = r_hat = op.mix(T, A32, out=r_hat, work=work32)  # (C + lam) t, single precision
         tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
         if per_node:
             D_c = Df[idx]
@@ -287,19 +284,22 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 p_o *= s
             pf[overlap] = p_o
         if bool(clipped.any()) or entered or stale >= _RECOMPUTE_EVERY:
-            U, stale = product(p), 0
-        else:
-            R *= tau
-            U -= R
+            u, stale = op.brick(product(p), overwrite=True), 0
+            if per_node:  # u += D p, on the nodes where p > 0
+                uf = u.reshape(-1)
+                uf[idx] += D_c * p_c
+                if entered:
+                    uf[overlap] += Df[overlap] * p_o
+        else:  # p = s (p - tau t) on the contact: u = s (u - tau (C + lam) t), plus D t per node
+            cr = op.brick(R, overwrite=True)
+            cr *= np.float32(tau)
+            u -= cr
+            if per_node:
+                uf = u.reshape(-1)
+                uf[idx] -= tau * (D_c * t_c)
             if s != 1.0:
-                U *= s
+                u *= s
             stale += 1
-        u = op.brick(U)
-        if per_node:  # u += D p, on the nodes where p > 0
-            uf = u.reshape(-1)
-            uf[idx] += D_c * p_c
-            if entered:
-                uf[overlap] += Df[overlap] * p_o
         if callback is not None:
             callback(k, p.copy())
     else:
