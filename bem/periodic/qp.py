@@ -87,7 +87,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     scale, u0, confirm
         As for :func:`bem.kalker.solve_qp`: the displacement scale of the KKT residual [length],
         ``C x0`` where the caller has it (the iterate then starts from ``x0`` as given), and
-        whether to confirm the stopping check on an exact product.
+        whether to confirm the stopping check on an exact product. Unconfirmed, a solve that
+        stops at ``rtol >= SINGLE_ABOVE`` returns ``C p`` to single precision.
     threshold : float
         With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner,
         as in :func:`bem.kalker.compliance_preconditioner`.
@@ -96,7 +97,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     -------
     bem.kalker.QPSolution
         As :func:`bem.kalker.solve_qp` with its FFT preconditioner; ``op.n_matvec`` counts the
-        products ``(C + lam) v`` (spectral multiplications).
+        products ``(C + lam) v`` (spectral multiplications, in single or double precision).
     """
     lat = op.lattice
     a = lat.node_area
@@ -150,8 +151,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
 
     single = False  # the first product in double precision: it sets the scale of the KKT residual
     if u0 is None:
-        U, stale = product(p), 0
-        u = op.brick(U, overwrite=True)
+        u, stale = op.brick(product(p), overwrite=True), 0
     else:  # C x0 from the caller, confirmed like an incremental update
         u, stale = np.array(u0, dtype=float), 1
     if per_node:
