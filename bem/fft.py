@@ -42,7 +42,7 @@ __all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "in_pa
 _ENV = "CONTACTLAB_THREADS"
 _override = None
 _PARTS_MIN = 1 << 17  # entries below which in_parts runs in the calling thread
-_pool = None
+_pool, _pool_size = None, 0
 
 
 def _available_cpus():
@@ -111,13 +111,13 @@ def in_parts(kernel, n, size):
         Entries of the caller's arrays: below ``2**17``, or with one thread, ``kernel``
         runs once on the whole axis in the calling thread.
     """
-    global _pool
+    global _pool, _pool_size
     k = min(threads(), n)
     if k < 2 or size < _PARTS_MIN:
         kernel(slice(0, n))
         return
-    if _pool is None or _pool._max_workers < k:
-        _pool = ThreadPoolExecutor(max_workers=k, thread_name_prefix="contactlab")
+    if _pool_size < k:
+        _pool, _pool_size = ThreadPoolExecutor(max_workers=k, thread_name_prefix="contactlab"), k
     bounds = [n * i // k for i in range(k + 1)]
     for f in [_pool.submit(kernel, slice(lo, hi)) for lo, hi in zip(bounds[:-1], bounds[1:])]:
         f.result()

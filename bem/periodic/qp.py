@@ -23,7 +23,8 @@ Further:
   summed in double precision);
 - the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
 - so does the recomputed ``u`` while the KKT residual is above ``1e-4`` (:data:`SINGLE_ABOVE`),
-  in a solve that starts above ``1e-2`` (:data:`SINGLE_START` times that), where the rounding
+  in a solve that starts above ``1e-2`` (:data:`SINGLE_START` times that) or stops above
+  ``1e-4`` (``rtol >= SINGLE_ABOVE``, a Newton step's model far from the answer), where the rounding
   of single precision (a relative ``1e-7`` of ``C p``) is far below what the iteration
   resolves: halved transforms in the early iterations, where the contact set settles. At the
   first residual below it (or at ``rtol`` when the stopping check is confirmed) ``u`` is

@@ -190,3 +190,33 @@ def test_periodic_qp_runs_its_early_products_in_single_precision_and_ends_in_dou
     kkt = kkt_residual(res.p.ravel(), g, displacement_scale=float(np.abs(u + lam * res.p).max()), force=force,
                        node_area=cell.node_area)
     assert kkt <= 1e-10
+
+
+def test_an_unconfirmed_loose_periodic_qp_stays_in_single_precision(monkeypatch):
+    """Newton's early model QPs (``confirm=False``, ``rtol >= SINGLE_ABOVE``) transform in single
+    precision after the caller's product; their displacement is ``C p`` to single precision and
+    their answer meets the KKT conditions to rtol on the exact product."""
+    import bem.periodic.qp as qp
+
+    cell = PeriodicCell(1.0 / 128, 128, 128)
+    h = _self_affine(cell)
+    op = PeriodicOperator(cell, E_STAR)
+    force = 0.03 * cell.area
+    x0 = np.where(h < np.quantile(h, 0.2), 1.0, 0.0)
+    x0 *= force / cell.node_area / x0.sum()
+    u0 = op.matvec(x0)
+    seen = []
+    spectrum = op.spectrum
+    monkeypatch.setattr(op, "spectrum", lambda v: seen.append(v.dtype) or spectrum(v))
+    rtol = 10 * qp.SINGLE_ABOVE
+    res = solve_periodic_qp(op, h, force=force, x0=x0, u0=u0, rtol=rtol, confirm=False)
+    assert res.converged and res.iterations >= 3
+    assert res.history["residual"][0] > rtol
+    assert set(seen) == {np.dtype(np.float32)}  # no double-precision transform at all
+    u = PeriodicOperator(cell, E_STAR).matvec(res.p)
+    error = np.abs(res.displacement - u).max() / np.abs(u).max()
+    assert 1e-12 < error < 1e-5  # single precision: not exact, far below rtol
+    g = (u + h - res.approach).ravel()
+    kkt = kkt_residual(res.p.ravel(), g, displacement_scale=float(np.abs(u).max()), force=force,
+                       node_area=cell.node_area)
+    assert kkt <= rtol
