@@ -9,18 +9,8 @@ and renamed into place at the end (:func:`atomic_directory`); an exception or an
 untouched. Result folders and report folders both use it; sweep folders, written point by
 point, are checked the same way (:func:`check_output_dir`).
 
-Every folder contactlab writes holds a marker file, :data:`MARKER` (``.contactlab``: JSON with
-the folder's ``kind``, ``"result"``, ``"report"``, ``"sweep"`` or ``"layer-law"``
-(:mod:`validation.layer_law`), and the contactlab
-``version``). contactlab writes only into a new or empty folder, or into a folder that holds
-the marker of the same kind and nothing but the files of that kind; any other folder is
-refused (:class:`OutputError`), so a user's files are never replaced.
-
-A process killed while it replaces a folder (``SIGKILL``, a power cut) leaves hidden folders
-``.contactlab-tmp-*`` (the new folder, incomplete) and ``.contactlab-old-*`` (the previous
-folder, moved aside) beside the target. The next write of the same target removes them and,
-when the target itself is missing, first moves the previous folder back
-(:func:`recover_output_dir`).
+The folder rule (which folder may be written, its marker :data:`MARKER`, the clean-up after a
+killed writer) is :mod:`validation.folders`.
 """
 
 from __future__ import annotations
@@ -28,8 +18,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import errno
-import glob
-import hashlib
 import json
 import logging
 import math
@@ -44,26 +32,18 @@ import numpy as np
 
 from bem.files import umask, write_text
 
-__all__ = ["atomic_write_json", "atomic_directory", "to_jsonable", "OutputError", "MARKER", "KINDS",
-           "write_marker", "marker_kind", "check_output_dir", "recover_output_dir", "output_errors"]
+from .folders import (KINDS, MARKER, NAME_MAX, OutputError, check_output_dir, leftover_prefixes, marked_files,
+                      marker_kind, recover_output_dir, remove_marked, write_marker)
+
+__all__ = ["atomic_write_json", "json_text", "atomic_directory", "to_jsonable", "OutputError", "MARKER", "KINDS",
+           "write_marker", "marker_kind", "marked_files", "check_output_dir", "recover_output_dir", "output_errors"]
 
 log = logging.getLogger(__name__)
 
-#: The marker file of every folder contactlab writes: JSON ``{"kind": ..., "version": ...}``.
-MARKER = ".contactlab"
-#: The kinds of folder contactlab writes.
-KINDS = ("result", "report", "sweep", "layer-law")
-#: Longest file or folder name in bytes when the file system does not say (POSIX ``NAME_MAX``).
-NAME_MAX = 255
-_TMP, _OLD = ".contactlab-tmp-", ".contactlab-old-"
 _REASONS = {errno.EROFS: "the file system is read-only", errno.ENOSPC: "the file system is full",
             errno.EDQUOT: "the disk quota is exhausted", errno.EACCES: "no permission to write there",
             errno.EPERM: "no permission to write there", errno.ENOTDIR: "a part of the path is a file",
             errno.ENAMETOOLONG: "a name is longer than the file system allows", errno.EEXIST: "it exists"}
-
-
-class OutputError(OSError):
-    """The output location cannot be used (a foreign folder, a file, an unwritable or full file system)."""
 
 
 def to_jsonable(obj):
@@ -91,171 +71,14 @@ def to_jsonable(obj):
     return obj
 
 
+def json_text(obj):
+    """``obj`` as indented JSON text (strict: NaN/inf written as null, :func:`to_jsonable`)."""
+    return json.dumps(to_jsonable(obj), indent=2, allow_nan=False) + "\n"
+
+
 def atomic_write_json(path, obj):
     """Write ``obj`` as indented JSON (strict: NaN/inf written as null) atomically."""
-    text = json.dumps(to_jsonable(obj), indent=2, allow_nan=False) + "\n"
-    return write_text(path, text)
-
-
-def _contactlab_version():
-    from importlib import metadata
-
-    try:
-        return metadata.version("contactlab")
-    except metadata.PackageNotFoundError:  # pragma: no cover - a source tree without installation
-        return "unknown"
-
-
-def write_marker(directory, kind):
-    """Write the marker file (:data:`MARKER`) of a ``kind`` folder into ``directory``; returns its path."""
-    if kind not in KINDS:
-        raise ValueError(f"kind = {kind!r} is not allowed: it must be one of {KINDS}.")
-    return atomic_write_json(Path(directory) / MARKER, {"kind": kind, "version": _contactlab_version()})
-
-
-def marker_kind(directory):
-    """The ``kind`` in the marker file of ``directory``, or None (no marker, or not one contactlab wrote)."""
-    try:
-        data = json.loads((Path(directory) / MARKER).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    kind = data.get("kind") if isinstance(data, dict) else None
-    return kind if kind in KINDS else None
-
-
-def _shown(value, target):
-    text = str(target) if value is None else str(value)
-    return repr(text if len(text) <= 200 else text[:40] + "..." + text[-20:])
-
-
-def _name_max(path):
-    """The file system's longest name in bytes, asked of the nearest existing ancestor of ``path``."""
-    for parent in path.parents:
-        try:
-            if parent.is_dir():
-                return os.pathconf(parent, "PC_NAME_MAX")
-        except (OSError, ValueError):
-            break
-    return NAME_MAX
-
-
-def check_output_dir(target, kind, names=(), *, what="out_dir", value=None):
-    """Refuse an output folder contactlab may not write.
-
-    ``target`` may be written when it does not exist (and no part of its path is a file), is an
-    empty folder, or holds the marker of a ``kind`` folder (:data:`MARKER`) and nothing but
-    ``names`` (the files contactlab writes into such a folder).
-
-    Parameters
-    ----------
-    target : path-like
-        The folder to write.
-    kind : str
-        What will be written there, one of :data:`KINDS`.
-    names : iterable of str
-        The names a ``kind`` folder holds.
-    what : str
-        The argument named in the message (``"--out"``, ``"scene.name"``).
-    value : optional
-        The value shown in the message (default: ``target``).
-
-    Raises
-    ------
-    OutputError
-        ``target`` is a file, lies under a file, has a name longer than the file system allows,
-        or is a folder holding anything contactlab did not write there.
-    """
-    target = Path(target).absolute()
-    shown = _shown(value, target)
-    limit = _name_max(target)
-    for part in target.parts:
-        size = len(os.fsencode(part))
-        if size > limit:
-            raise OutputError(f"{what} = {shown} is not allowed: the folder name {part[:20]!r}... is {size} bytes "
-                              f"long; the file system allows at most {limit} bytes per name: choose a shorter name"
-                              + (" or give --out." if what == "scene.name" else "."))
-    for parent in target.parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise OutputError(f"{what} = {shown} is not allowed: {str(parent)!r} is a file, not a folder.")
-            break
-    if not target.exists():
-        return
-    if not target.is_dir():
-        raise OutputError(f"{what} = {shown} is not allowed: it is a file; give a folder.")
-    entries = sorted(p.name for p in target.iterdir())
-    if not entries:
-        return
-    found = marker_kind(target)
-    if found is not None and found != kind:
-        reason = f"it is a contactlab {found} folder, not a {kind} folder"
-    else:
-        own = set(names) if found == kind else set()
-        # .NAME.* is the temporary file of an own file NAME (bem.files.atomic_path) a killed writer left
-        foreign = [name for name in entries if name != MARKER and name not in own
-                   and not any(name.startswith(f".{n}.") for n in own)]
-        if not foreign:
-            return
-        reason = (f"it holds files contactlab did not write ({', '.join(foreign[:4])}"
-                  f"{', ...' if len(foreign) > 4 else ''})")
-    raise OutputError(f"{what} = {shown} is not allowed: {reason}; contactlab writes only into a new or empty "
-                      f"folder or replaces a {kind} folder it wrote itself (marked by {MARKER}).")
-
-
-def _tag(name):
-    return hashlib.sha256(os.fsencode(name)).hexdigest()[:16]
-
-
-def _owner_alive(path):
-    """Whether the process that made the hidden folder ``path`` (its name holds the pid) still runs."""
-    if not path.name.startswith((_TMP, _OLD)):
-        return False
-    try:
-        pid = int(path.name.split("-")[3])
-    except (IndexError, ValueError):
-        return False
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:
-        return True
-    return True
-
-
-def recover_output_dir(target):
-    """Clean up after a process killed while it wrote ``target`` (:func:`atomic_directory`).
-
-    A previous folder moved aside is moved back when ``target`` is missing (the process was
-    killed between the two renames), else removed; incomplete new folders are removed. Hidden
-    folders of a process that still runs are left alone.
-
-    Returns
-    -------
-    bool
-        True when a previous folder was moved back to ``target``.
-    """
-    target = Path(target).absolute()
-    parent, tag = target.parent, _tag(target.name)
-    if not parent.is_dir():
-        return False
-    restored = False
-    legacy = glob.escape(f".{target.name}")  # also the form .NAME.tmp-*, .NAME.old-*
-    for old in sorted([*parent.glob(f"{_OLD}{tag}-*"), *parent.glob(f"{legacy}.old-*")]):
-        if _owner_alive(old):
-            continue
-        previous = old / "previous"
-        if previous.is_dir() and not os.path.lexists(target):
-            os.replace(previous, target)
-            restored = True
-            log.warning("restored %s: a process writing it was killed before it finished", target)
-        shutil.rmtree(old, ignore_errors=True)
-    for tmp in [*parent.glob(f"{_TMP}{tag}-*"), *parent.glob(f"{legacy}.tmp-*")]:
-        if not _owner_alive(tmp):
-            shutil.rmtree(tmp, ignore_errors=True)
-    return restored
+    return write_text(path, json_text(obj))
 
 
 @contextlib.contextmanager
@@ -277,7 +100,7 @@ def output_errors(target, what="out_dir"):
 
 
 @contextlib.contextmanager
-def atomic_directory(target, kind="result", names=(), *, what="out_dir"):
+def atomic_directory(target, kind="result", names=(), *, what="out_dir", keep=()):
     """Assemble a folder in a temporary place; move it to ``target`` only on success.
 
     Parameters
@@ -290,6 +113,10 @@ def atomic_directory(target, kind="result", names=(), *, what="out_dir"):
         The names such a folder holds (:func:`check_output_dir`).
     what : str
         The argument named in error messages.
+    keep : iterable of str
+        Files of an existing ``target`` (top-level names its marker lists) copied into the new
+        folder before the block runs: what a replacement keeps (the other studies of a study
+        folder).
 
     Yields
     ------
@@ -297,7 +124,8 @@ def atomic_directory(target, kind="result", names=(), *, what="out_dir"):
         The temporary folder (beside ``target``, permissions of a new folder). On success an
         existing ``target`` is replaced; on any exception the temporary folder is removed and
         ``target`` is left as it was. Leftovers of a killed earlier writer are cleaned up first
-        (:func:`recover_output_dir`).
+        (:func:`recover_output_dir`). The marker written at the end lists every file and folder
+        of the new folder.
 
     Raises
     ------
@@ -310,18 +138,23 @@ def atomic_directory(target, kind="result", names=(), *, what="out_dir"):
         recover_output_dir(target)
         check_output_dir(target, kind, names, what=what)
         target.parent.mkdir(parents=True, exist_ok=True)
-        prefix = f"{_TMP}{_tag(target.name)}-{os.getpid()}-"
+        prefix = f"{leftover_prefixes(target)[0]}{os.getpid()}-"
         tmp = Path(tempfile.mkdtemp(prefix=prefix, dir=target.parent))
     try:
         with output_errors(target, what):
+            write_marker(tmp, kind)  # marks the hidden folder as contactlab's (recover_output_dir)
             os.chmod(tmp, 0o777 & ~umask())  # mkdtemp creates 0700
+            listed = set(marked_files(target))
+            for name in keep:
+                if name in listed and (target / name).is_file():
+                    shutil.copy2(target / name, tmp / name)
             yield tmp
-            write_marker(tmp, kind)
-            _swap(tmp, target)
+            write_marker(tmp, kind, listed=True)
+            _swap(tmp, target, kind)
         log.info("written: %s", target)
     finally:
         if tmp.exists():
-            shutil.rmtree(tmp, ignore_errors=True)
+            remove_marked(tmp)
 
 
 @contextlib.contextmanager
@@ -346,7 +179,7 @@ def _signals_deferred():
                 os.kill(os.getpid(), signum)
 
 
-def _swap(tmp, target):
+def _swap(tmp, target, kind):
     """Move ``tmp`` onto ``target``; a previous ``target`` is moved aside first and removed after.
 
     An interrupt or ``SIGTERM`` is held back until the swap is over, so it never leaves the
@@ -355,7 +188,9 @@ def _swap(tmp, target):
     with _signals_deferred():
         old = None
         if target.exists():
-            old = Path(tempfile.mkdtemp(prefix=f"{_OLD}{_tag(target.name)}-{os.getpid()}-", dir=target.parent))
+            prefix = f"{leftover_prefixes(target)[1]}{os.getpid()}-"
+            old = Path(tempfile.mkdtemp(prefix=prefix, dir=target.parent))
+            write_marker(old, kind)  # marks the hidden folder as contactlab's (recover_output_dir)
         try:
             if old is not None:
                 os.replace(target, old / "previous")
@@ -368,4 +203,4 @@ def _swap(tmp, target):
             if old is not None and os.path.lexists(target):
                 with contextlib.suppress(OSError):  # "previous" names only a complete folder
                     os.replace(old / "previous", old / "discarded")
-                shutil.rmtree(old, ignore_errors=True)
+                remove_marked(old)

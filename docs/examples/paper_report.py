@@ -25,7 +25,8 @@ import sys
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="reports/paper", help="report directory (default: reports/paper)")
+    parser.add_argument("--out", default="results/paper/report",
+                        help="report directory (default: results/paper/report)")
     parser.add_argument("--quick", action="store_true", help="coarse lattice and short sweeps (preview)")
     parser.add_argument("--no-fem", action="store_true", help="skip the FEM reference and the resolution study")
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details (INFO), scikit-fem's too")

@@ -3,6 +3,7 @@
 import json
 import sys
 import types
+from pathlib import Path
 
 import pytest
 
@@ -108,19 +109,22 @@ def test_default_output_directory(tmp_path, monkeypatch):
 def test_study_dispatches_its_arguments(argv, module, monkeypatch, tmp_path):
     from validation.studies import save
 
+    monkeypatch.chdir(tmp_path)
     seen = {}
     fake = types.ModuleType(module)
+    fake.STEM = module.rsplit(".", 1)[1]
 
     def main(**kw):
         seen.update(kw)
-        return save(tmp_path, "stability", {"rows": []}, status=7)
+        return save(kw["out"], "stability", {"rows": []}, status=7)
 
     fake.main = main
     monkeypatch.setitem(sys.modules, module, fake)
     monkeypatch.setattr("validation.report.documents.studies.study_markdown", lambda name, data: "# tables\n")
     code, out, _err = cli(*argv)
-    assert code == 7 and out == "# tables\n" and (tmp_path / "stability.md").read_text() == "# tables\n"
-    assert seen["out"] == ("x" if "--out" in argv else None)
+    folder = tmp_path / ("x" if "--out" in argv else f"results/{argv[1]}")
+    assert code == 7 and out == "# tables\n" and (folder / "stability.md").read_text() == "# tables\n"
+    assert Path(seen["out"]).parent == folder.parent  # the hidden folder assembled beside it
     assert seen["scene"] == (argv[2] if len(argv) > 2 and not argv[2].startswith("-") else None)
     assert seen["quick"] == ("--quick" in argv)
 

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-import validation.io as vio
 import validation.run.runner as runner
-from validation.io import MARKER, recover_output_dir
+from validation.folders import leftover_prefixes
+from validation.io import MARKER, recover_output_dir, write_marker
 
 from .conftest import cli
 
@@ -182,21 +182,24 @@ def test_recovery_restores_a_previous_folder_moved_aside_by_a_killed_writer(tmp_
     target = tmp_path / "r"
     assert cli("run", "elliptic", "--out", target, *FAST)[0] == 0
     before = _tree(target)
-    tag, dead = vio._tag("r"), _dead_pid()
-    old = tmp_path / f".contactlab-old-{tag}-{dead}-abc"
-    old.mkdir()
+    (new, moved), dead = leftover_prefixes(target), _dead_pid()
+    old, tmp = tmp_path / f"{moved}{dead}-abc", tmp_path / f"{new}{dead}-def"
+    for folder in (old, tmp):  # the hidden folders as contactlab makes them: marked at once
+        folder.mkdir()
+        write_marker(folder, "result")
     os.replace(target, old / "previous")  # the state between the two renames of a replacement
-    (tmp_path / f".contactlab-tmp-{tag}-{dead}-def").mkdir()
     assert recover_output_dir(target) is True
     assert _tree(target) == before and _hidden(tmp_path) == []
 
 
 def test_recovery_leaves_the_folders_of_a_running_writer(tmp_path):
-    tag = vio._tag("r")
-    live = tmp_path / f".contactlab-tmp-{tag}-{os.getpid()}-abc"
+    new = leftover_prefixes(tmp_path / "r")[0]
+    live = tmp_path / f"{new}{os.getpid()}-abc"
     live.mkdir()
-    dead = tmp_path / f".contactlab-tmp-{tag}-{_dead_pid()}-def"
+    write_marker(live, "result")
+    dead = tmp_path / f"{new}{_dead_pid()}-def"
     (dead / "half").mkdir(parents=True)
+    write_marker(dead, "result")
     assert recover_output_dir(tmp_path / "r") is False
     assert _hidden(tmp_path) == [live.name]
 

@@ -135,9 +135,11 @@ def test_cli_runs_the_two_scale_study_and_refuses_a_scene(monkeypatch, tmp_path)
 
     from .conftest import cli
 
+    monkeypatch.chdir(tmp_path)
     seen = {}
     fake = types.ModuleType("validation.studies.two_scale")
-    fake.main = lambda **kw: seen.update(kw) or save(tmp_path, "robustness", [], status=7)
+    fake.STEM = "two_scale"
+    fake.main = lambda **kw: seen.update(kw) or save(kw["out"], "robustness", [], status=7)
     monkeypatch.setitem(sys.modules, "validation.studies.two_scale", fake)
     code, _, _ = cli("study", "two-scale", "--quick")
     assert code == 7 and seen["quick"]

@@ -72,14 +72,15 @@ examples:
 result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
 iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.toml (the
 effective scene, re-runnable), bem_field.vtu, fem_field.vtu and stress_field.vtu (open in ParaView).
-Written whole or not at all. --out DIR is always the directory written (result, sweep or
-report directory); contactlab writes only into a new or empty directory or one it wrote itself
-(marked by DIR/.contactlab). Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
+Written whole or not at all. --out DIR is always the directory written (result, sweep, report,
+layer-law or study directory); contactlab writes only into a new or empty directory or one it
+wrote itself (marked by DIR/.contactlab, which lists what it replaces). Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
 scene is listed), an unknown option or an unusable output directory, 130 interrupted (Ctrl-C),
 143 terminated (SIGTERM).
 
 A scene file is data: the Python code it names is imported only with --allow-code, and the
 files it names are read only inside its folder unless --allow-outside-files (docs/scenes.md).
+A result or sweep directory is data too: its report never imports the code it names.
 """
 
 

@@ -28,7 +28,7 @@ PARSER = {"help": "figures and an HTML/Markdown report",
 def add_args(p):
     p.add_argument("target", metavar="SCENE_OR_DIR",
                    help="'paper', a scene (built-in name or .toml), or a result, sweep or study directory")
-    p.add_argument("--out", metavar="DIR", help="the report directory written (default: reports/paper for "
+    p.add_argument("--out", metavar="DIR", help="the report directory written (default: results/paper/report for "
                                                 "'paper', DIR/report for a directory, results/NAME/report for "
                                                 "a scene)")
     p.add_argument("--format", choices=FORMATS, default="png",

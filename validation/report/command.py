@@ -13,8 +13,9 @@ __all__ = ["main", "build", "refused_options", "applies_to", "target_kind", "DEF
 
 log = logging.getLogger(__name__)
 
-#: where ``contactlab report paper`` writes without ``--out`` (relative to the working directory)
-DEFAULT_PAPER_OUT = Path("reports") / "paper"
+#: where ``contactlab report paper`` writes without ``--out`` (relative to the working directory): a
+#: report folder beside the result folders of ``contactlab run``, never the reports a repository keeps
+DEFAULT_PAPER_OUT = Path("results") / "paper" / "report"
 
 #: which targets each keyword of :func:`build` applies to: keyword -> (default, kinds)
 OPTIONS = {"quick": (False, ("paper",)),
@@ -84,7 +85,7 @@ def build(target, *, out=None, fmt="png", units=None, quick=False, overrides=(),
         (:mod:`validation.report.documents.sweep`) or a directory of study files
         (``error_time.json``, ``stability.json``: :mod:`validation.report.documents.studies`).
     out : path-like, optional
-        The report directory written, for every target (default ``reports/paper`` for ``paper``,
+        The report directory written, for every target (default ``results/paper/report`` for ``paper``,
         ``TARGET/report`` for a directory, ``results/NAME/report`` for a scene).
     fmt : {"png", "svg", "pdf"}
         The figure files.

@@ -35,9 +35,8 @@ import traceback
 from concurrent.futures import as_completed
 from pathlib import Path
 
-from bem.files import write_text
 
-from ..io import atomic_write_json, check_output_dir, write_marker
+from ..io import check_output_dir, json_text, write_marker
 from ..scene.checks import SceneError, sweep_size
 from ..scene.load import Scene, apply_overrides, load_scene, parse_scene
 from ..scene.paper import ALIASES
@@ -45,7 +44,8 @@ from ..scene.study import refuse_study
 from .cluster import DEFAULT_TIMEOUT, dask_client, scheduler_address
 from .pool import worker_pool
 from .record import RunResult
-from .sweep_folder import SWEPT, earlier_points, file_digests, fingerprint, keyed, other_point
+from .sweep_folder import (SWEPT, earlier_points, file_digests, fingerprint, keyed, other_point, remove_unfinished,
+                           write_file, write_point)
 
 __all__ = ["run_sweep", "sweep_points", "SweepPoint", "SUMMARY_COLUMNS", "parse_values", "SWEEP_NAMES"]
 
@@ -270,13 +270,13 @@ def _dask_map(jobs, client):
 
 def _write_summary(out, meta, rows):
     rows = sorted(rows, key=lambda r: r["index"])
-    atomic_write_json(out / "summary.json", dict(meta, points=rows))
+    write_file(out / "summary.json", json_text(dict(meta, points=rows)))
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore", lineterminator="\n")
     writer.writeheader()
     for row in rows:
         writer.writerow({k: "" if row.get(k) is None else row.get(k) for k in SUMMARY_COLUMNS})
-    write_text(out / "summary.csv", buf.getvalue())
+    write_file(out / "summary.csv", buf.getvalue())
     return rows
 
 
@@ -332,6 +332,7 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
         scheduler_address(scheduler)
     out = Path(out_dir)
     check_output_dir(out, "sweep", SWEEP_NAMES)  # new, empty or a sweep directory
+    remove_unfinished(out)
     earlier = earlier_points(out, points[0].sweep)
     mine = {p.fingerprint for p in points}
     kept = [d for fp, d in earlier.items() if fp not in mine]
@@ -366,7 +367,7 @@ def run_sweep(scene, out_dir, *, parameter=None, values=None, workers=None, sche
             results = _local_map(jobs, min(workers or os.cpu_count() or 1, max(len(jobs), 1)))
         for point, result, error in results if jobs else ():
             if error is None:
-                atomic_write_json(out / "points" / point.file, {
+                write_point(out / "points" / point.file, {
                     "parameter": parameter, "key": key, "value": point.value, "fingerprint": point.fingerprint,
                     "files": point.files, "sweep": point.sweep, "scene": point.scene.raw, "result": result})
             else:

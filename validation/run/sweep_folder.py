@@ -5,22 +5,38 @@ and of the contents of every file the scene names (every key ``file``, e.g. ``ga
 measured surface: the SHA-256 of the file's bytes, :func:`file_digests`). A sweep's identity
 is the same for its base scene: the scene with the swept key replaced by :data:`SWEPT`, with
 the key. A folder holds the points of one sweep identity (:func:`earlier_points`).
+
+A sweep folder is written in place, each file whole or not at all (:func:`write_file`): the
+temporary file of a write names the process writing it
+(``.point-<fingerprint>.json.<random>.<pid>.contactlab-tmp``), so that the next sweep into the
+folder removes what a killed sweep left (:func:`remove_unfinished`) and computes that point again.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
+import logging
+import os
 from pathlib import Path
 
-from ..io import OutputError
+from bem.files import atomic_path
 
-__all__ = ["SWEPT", "file_digests", "keyed", "fingerprint", "earlier_points", "other_point"]
+from ..folders import process_running
+from ..io import OutputError, json_text
+
+__all__ = ["SWEPT", "file_digests", "keyed", "fingerprint", "earlier_points", "other_point", "write_file",
+           "write_point", "remove_unfinished"]
+
+log = logging.getLogger(__name__)
 
 #: the swept key's place holder in the base scene of a sweep
 SWEPT = "<swept>"
 #: keys that do not change a point's result: left out of its fingerprint
 _NOT_KEYED = {"report": None, "scene": ("title", "description")}
+#: the end of the name of a file being written into a sweep folder (:func:`write_file`)
+_UNFINISHED = ".contactlab-tmp"
 _REMEDY = ("a sweep folder holds one parameter over one base scene and no point is overwritten: give another "
            "--out, or remove the folder to start again.")
 
@@ -136,3 +152,39 @@ def other_point(out, data, point):
                       f"{point.value!r} of another scene (points/{data['file']}: {_difference(old, new)}); {_REMEDY}")
 
 
+
+
+def write_file(path, text):
+    """Write ``text`` (UTF-8) to ``path`` in a sweep folder, whole or not at all
+    (:func:`bem.files.atomic_path`); the temporary file's name ends with the process id and
+    ``.contactlab-tmp``, what :func:`remove_unfinished` looks for. Returns the path."""
+    path = Path(path)
+    with atomic_path(path, suffix=f".{os.getpid()}{_UNFINISHED}") as tmp, open(tmp, "wb") as fh:
+        fh.write(text.encode("utf-8"))
+        fh.flush()
+        os.fsync(fh.fileno())
+    return path
+
+
+def write_point(path, data):
+    """Write the point file ``path`` (JSON of ``data``) whole or not at all (:func:`write_file`)."""
+    return write_file(path, json_text(data))
+
+
+def remove_unfinished(out):
+    """Remove the temporary files a killed sweep left in the sweep folder ``out`` (and its ``points``).
+
+    Only files named as :func:`write_file` names them, by a process that no longer runs: a point
+    whose write did not finish is computed again. Returns the names removed.
+    """
+    removed = []
+    for folder in (Path(out), Path(out) / "points"):
+        for path in sorted(folder.glob(f".*{_UNFINISHED}")) if folder.is_dir() else ():
+            pid = path.name[: -len(_UNFINISHED)].rsplit(".", 1)[-1]
+            if path.is_file() and not path.is_symlink() and not process_running(pid):
+                with contextlib.suppress(FileNotFoundError):
+                    path.unlink()
+                removed.append(path.name)
+    if removed:
+        log.warning("removed %d unfinished file(s) of a killed sweep from %s", len(removed), out)
+    return removed

@@ -159,12 +159,20 @@ class RunResults:
 
     @functools.cached_property
     def layer(self):
-        """The :class:`bem.layers.Layer` the run used, or ``None`` (smooth bodies or not rebuildable)."""
+        """The :class:`bem.layers.Layer` the run used, or ``None`` (smooth bodies, not rebuildable, or a
+        law that names Python code: a report reads a folder as data and never imports code)."""
         from bem.layers import from_dict
+
+        from ...scene.trust import code_names
 
         params = self.result.layer["parameters"]
         if not isinstance(params, Mapping):
             params = self.section("layer") if self.section("layer").get("law") not in (None, "none") else None
+        code = code_names({"layer": params})
+        if code:
+            log.warning("no w(p) plot: the layer of the run names Python code (%s = %r), and a report never imports "
+                        "the code a result names", *code[0])
+            return None
         try:
             return from_dict(dict(params)) if params else None
         except (ValueError, TypeError, KeyError) as exc:
