@@ -209,6 +209,7 @@ def test_a_mean_gap_that_rises_with_the_pressure_is_refused(monkeypatch):
     ({"pressures": [0.0, 0.1]}, r"pressures\[0\] = 0.0 is not allowed: it must be > 0"),
     ({"pressures": [0.1]}, "pressures has 1 entries"),
     ({"pressures": [0.1, 0.2], "rtol": 0}, "rtol = 0"),
+    ({"pressures": [0.1, 0.2], "rtol": 10.0}, r"rtol = 10.0 is not allowed: it must be in \(0, 0.01\]"),
     ({"pressures": [0.1, 0.2], "method": "cg"}, "method = 'cg'"),
     ({"pressures": [0.1, 0.2], "progress": 3}, "progress = 3"),
 ])

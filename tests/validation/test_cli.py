@@ -76,6 +76,13 @@ def test_run_bad_input_exits_2_and_writes_nothing(tmp_path):
     assert not (tmp_path / "r").exists()
 
 
+def test_sweep_names_its_own_option_in_a_bad_worker_count(tmp_path):
+    code, _, err = cli("sweep", "hertz", "--param", "load.force", "--values", "1,2", "--workers", 0,
+                       "--out", tmp_path / "s")
+    assert code == 2 and err.startswith("contactlab: error: --workers = 0 is not allowed"), err
+    assert not (tmp_path / "s").exists()
+
+
 def test_run_into_foreign_directory_exits_2(tmp_path):
     (tmp_path / "notes.txt").write_text("mine")
     code, _out, err = cli("run", "elliptic", "--out", tmp_path, "--set", "bem.nodes_across=16")

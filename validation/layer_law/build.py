@@ -128,7 +128,7 @@ def ladder(surface, E_star, *, pressures=None, relative=DEFAULT_RANGE, n=12):
         name, (low, high), unit = "relative", relative, E_star * surface.stats.rms_slope
     low, high = check_positive(f"{name}[0]", low), check_positive(f"{name}[1]", high)
     if high <= low:
-        fail(f"{name}[1]", high, f"> {name}[0] = {low!r}")
+        fail(name, (low, high), "increasing: (low, high) with low < high")
     return np.geomspace(low, high, n) * unit
 
 
