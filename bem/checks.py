@@ -9,6 +9,7 @@ the argument, shows the value and states the rule, e.g.::
 from __future__ import annotations
 
 import math
+import os
 from numbers import Real
 
 import numpy as np
@@ -29,6 +30,7 @@ __all__ = [
     "check_load",
     "check_scale",
     "check_rtol",
+    "check_file_name",
     "check_node_count",
     "check_layer",
     "check_gap_values",
@@ -98,6 +100,16 @@ def check_rtol(name, value):
         fail(name, value, f"in (0, {RTOL_MAX:g}]: it bounds the relative KKT residual (gap violations over "
                           "the largest surface closure, force balance over P), and a larger one accepts a "
                           "wrong answer as converged")
+    return value
+
+
+def check_file_name(name, value):
+    """Return ``value``; raise unless it is a file name (``str`` or ``os.PathLike``) without a NUL byte."""
+    if not isinstance(value, (str, os.PathLike)):
+        fail(name, value, "a file name (str or os.PathLike)")
+    text = os.fspath(value)
+    if ("\x00" if isinstance(text, str) else b"\x00") in text:
+        fail(name, text, "a file name without a NUL byte (no file system accepts one)")
     return value
 
 

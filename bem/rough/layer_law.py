@@ -248,9 +248,9 @@ def read_layer_law(path):
     path = Path(path)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
         raise InputError(f"path = {str(path)!r} is not allowed: it must be a readable TOML table file "
-                         f"({type(exc).__name__}).") from None
+                         f"({'nested too deep' if isinstance(exc, RecursionError) else type(exc).__name__}).") from None
     layer, topo = data.get("layer"), data.get("topography")
     if not isinstance(layer, dict) or layer.get("law") != "tabulated" or not isinstance(topo, dict):
         fail("path", str(path), "a layer law file with [layer] law = 'tabulated' and a [topography] table")

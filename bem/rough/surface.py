@@ -45,7 +45,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..checks import InputError, check_choice, check_finite_array, check_int, check_positive, check_range, fail
+from ..checks import (InputError, check_choice, check_finite_array, check_int, check_positive, check_range, check_scale,
+                      fail)
 from .lattice_heights import to_lattice
 
 __all__ = ["RoughSurface", "SurfaceStats", "self_affine", "from_heights", "combined", "DETRENDS", "EDGE_JUMP_LIMIT",
@@ -163,9 +164,10 @@ class RoughSurface:
 
 
 def _pair(name, value):
+    """A cell's size ``(Lx, Ly)``: two lengths, each a physical scale (:func:`bem.checks.check_scale`)."""
     if not isinstance(value, (list, tuple, np.ndarray)) or len(value) != 2:
         fail(name, value, "a pair (Lx, Ly) of lengths")
-    return check_positive(f"{name}[0]", value[0]), check_positive(f"{name}[1]", value[1])
+    return check_scale(f"{name}[0]", value[0]), check_scale(f"{name}[1]", value[1])
 
 
 def _edge_jump(z):

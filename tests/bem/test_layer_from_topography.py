@@ -218,6 +218,13 @@ def test_bad_arguments_are_refused_by_name(kwargs, match):
         rough.layer_from_topography(_sinusoid(32), E_STAR, n_cols=32, **kwargs)
 
 
+def test_a_law_file_nested_too_deep_is_refused_by_name(tmp_path):
+    path = tmp_path / "law.toml"
+    path.write_text("[layer]\nlaw = 'tabulated'\nx = " + "[" * 5000 + "]" * 5000 + "\n")
+    with pytest.raises(bem.InputError, match=r"^path = .* readable TOML table file \(nested too deep\)"):
+        rough.read_layer_law(path)
+
+
 def test_a_surface_must_be_a_rough_surface():
     with pytest.raises(bem.InputError, match="surface = 'ndarray' is not allowed"):
         rough.layer_from_topography(np.zeros((8, 8)), E_STAR, pressures=[0.1, 0.2], n_cols=8)

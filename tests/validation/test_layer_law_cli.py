@@ -127,6 +127,19 @@ def test_the_options_of_a_surface_file_are_named_as_written(surface_file, tmp_pa
     assert code == 2 and err.startswith("contactlab: error: " + match), err
 
 
+def test_a_surface_whose_header_states_an_impossible_size_exits_2(tmp_path):
+    """An x3p file with the grid step (its ``Increment``) 1e300 m: the size is no length a solve can take."""
+    import SurfaceTopography
+
+    z = np.random.default_rng(0).random((32, 32)) * 1e-6
+    SurfaceTopography.Topography(z, (32e300, 32e300), unit="m").to_x3p(str(tmp_path / "s.x3p"))
+    code, _, err = _run(tmp_path, tmp_path / "s.x3p")
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert err.startswith(f"contactlab: error: SURFACE = {str(tmp_path / 's.x3p')!r} is not allowed: the size it "
+                          "states times scale, (3.2e+301, 3.2e+301), must be two lengths in [1e-60, 1e+60]")
+    assert not (tmp_path / "law").exists()
+
+
 def test_n_pressures_and_the_output_folder_are_checked_before_solving(tmp_path):
     code, _, err = cli("layer-law", "--synthetic", SYNTHETIC, "--E-star", E_STAR, "--n-pressures", 1, "--out",
                        tmp_path / "law")

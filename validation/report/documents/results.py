@@ -257,7 +257,7 @@ def read_json(path):
     """The JSON content of ``path``; InputError when it cannot be read."""
     try:
         return json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, RecursionError) as exc:  # RecursionError: nested too deep
         raise InputError(f"{path} is not allowed: it must be a readable JSON file ({exc}).") from None
 
 
