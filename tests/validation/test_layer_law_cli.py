@@ -127,6 +127,13 @@ def test_the_options_of_a_surface_file_are_named_as_written(surface_file, tmp_pa
     assert code == 2 and err.startswith("contactlab: error: " + match), err
 
 
+def test_a_relative_ladder_of_a_flat_surface_names_the_option(tmp_path):
+    np.save(tmp_path / "flat.npy", np.zeros((32, 32)))
+    code, _, err = _run(tmp_path, tmp_path / "flat.npy", "--size", "1,1", "--scale", "1e-6")
+    assert code == 2 and err.startswith("contactlab: error: --p-range-rel = (0.003, 0.3) is not allowed: it must be "
+                                        "used with a surface of rms slope > 0"), err
+
+
 def test_a_surface_whose_header_states_an_impossible_size_exits_2(tmp_path):
     """An x3p file with the grid step (its ``Increment``) 1e300 m: the size is no length a solve can take."""
     import SurfaceTopography

@@ -129,6 +129,14 @@ def test_a_cell_size_beyond_the_physical_scales_is_refused_before_any_work(tmp_p
     assert err.startswith(f"contactlab: error: gap.size = {shown} is not allowed: it must be in [1e-60, 1e+60]")
 
 
+@pytest.mark.parametrize("override, key", [("gap.long_cutoff=1e300", "gap.long_cutoff = 1e+300"),
+                                           ("gap.short_cutoff=1e-300", "gap.short_cutoff = 1e-300"),
+                                           ("gap.rms_slope=1e300", "gap.rms_slope = 1e+300")])
+def test_a_length_of_the_self_affine_surface_beyond_the_physical_scales_is_refused(override, key):
+    code, out, err = cli("check", "rough_flat", "--set", override)
+    assert code == 2 and out == "" and err.startswith(f"contactlab: error: {key} is not allowed: it must be in [1e-60")
+
+
 @pytest.mark.parametrize("increment", [1e300, 1e-300])
 def test_an_instrument_file_whose_header_states_an_impossible_size_is_refused(tmp_path, increment):
     """An x3p file's ``Increment`` (the grid step) times its points is the cell size: 1e300 m or
