@@ -94,12 +94,13 @@ def check_scale(name, value):
 
 
 def check_rtol(name, value):
-    """Return ``float(value)``; raise unless ``0 < value <= RTOL_MAX`` (a relative KKT tolerance)."""
+    """Return ``float(value)``; raise unless ``0 < value <= RTOL_MAX``: the tolerance of every solver
+    (BEM, periodic cell, FEM) on its relative residual of the contact conditions."""
     value = check_positive(name, value)
     if value > RTOL_MAX:
-        fail(name, value, f"in (0, {RTOL_MAX:g}]: it bounds the relative KKT residual (gap violations over "
-                          "the largest surface closure, force balance over P), and a larger one accepts a "
-                          "wrong answer as converged")
+        fail(name, value, f"in (0, {RTOL_MAX:g}]: it bounds the relative residual of the contact conditions "
+                          "(gap violations, force balance over P), and a larger one accepts a wrong answer as "
+                          "converged")
     return value
 
 

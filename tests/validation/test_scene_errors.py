@@ -312,8 +312,9 @@ def test_files_that_are_not_utf8_toml_or_nest_too_deep_are_refused(tmp_path, con
     (LAYER_BASE + 'law = "power"\nlam = 1e-12\ns = 1e308\n', "layer.s = 1e+308"),
     (BASE + "\n[stress]\ndepths = [0.0, 1e308]\n", "stress.depths[1] = 1e+308"),
     (BASE.replace("nodes_across = 16", "step = 1e-300\nextent = 1e-299"), "bem.step = 1e-300"),
+    (BASE + "\n[fem]\nrtol = 10.0\n", "fem.rtol = 10.0"),
     (BASE.replace("nodes_across = 16", "step = 1e-5\nextent = 1e300"), "bem.extent = 1e+300"),
-], ids=["power-exponent", "stress-depth", "step", "extent"])
+], ids=["power-exponent", "stress-depth", "step", "fem-rtol", "extent"])
 def test_values_beyond_their_range_are_refused_at_load(tmp_path, text, key):
     code, out, err = cli("run", _write(tmp_path, text), "--out", tmp_path / "out")
     assert code == 2 and err.startswith(f"contactlab: error: {key} is not allowed") and out == ""
