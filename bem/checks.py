@@ -105,10 +105,13 @@ def check_rtol(name, value):
 
 
 def check_file_name(name, value):
-    """Return ``value``; raise unless it is a file name (``str`` or ``os.PathLike``) without a NUL byte."""
+    """Return ``value``; raise unless it is a file name (``str`` or ``os.PathLike``), not empty, without a
+    NUL byte."""
     if not isinstance(value, (str, os.PathLike)):
         fail(name, value, "a file name (str or os.PathLike)")
     text = os.fspath(value)
+    if not text:
+        fail(name, text, "a file name, not empty")
     if ("\x00" if isinstance(text, str) else b"\x00") in text:
         fail(name, text, "a file name without a NUL byte (no file system accepts one)")
     return value

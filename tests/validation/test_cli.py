@@ -98,6 +98,19 @@ def test_a_file_argument_with_a_nul_byte_exits_2_naming_it(argv, name, tmp_path,
     assert list(tmp_path.iterdir()) == []
 
 
+def test_an_empty_out_is_refused_not_taken_for_the_default(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = cli("run", "elliptic", "--out", "", "--set", "bem.nodes_across=8")
+    assert code == 2 and out == ""
+    assert err == "contactlab: error: --out = '' is not allowed: it must be a file name, not empty.\n"
+    assert list(tmp_path.iterdir()) == []  # not results/elliptic
+
+
+def test_sweep_names_the_param_option_it_was_given(tmp_path):
+    code, _, err = cli("sweep", "hertz", "--param", "nope", "--values", "1", "--out", tmp_path / "s")
+    assert code == 2 and err.startswith("contactlab: error: --param = 'nope' is not allowed: it must be alpha_a")
+
+
 @pytest.mark.parametrize("name", ["result.json", "summary.json"])
 def test_a_result_or_sweep_file_nested_too_deep_exits_2(name, tmp_path):
     folder = tmp_path / "received"

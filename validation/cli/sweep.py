@@ -55,7 +55,8 @@ def run(args):
         raise InputError("--param and --values are not allowed alone: give both (or neither, to use the "
                          "scene's [sweep]).")
     scene = load_scene(args.scene, overrides=args.overrides, no_fem=args.no_fem, **trust(args))
-    param, _key, points = sweep_points(scene, args.param, values)
+    with option_names({"sweep.parameter": "--param"} if args.param is not None else {}):
+        param, _key, points = sweep_points(scene, args.param, values)
     if args.out:
         out, what, value = Path(args.out), "--out", None
     else:
