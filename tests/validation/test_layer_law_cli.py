@@ -127,6 +127,20 @@ def test_the_options_of_a_surface_file_are_named_as_written(surface_file, tmp_pa
     assert code == 2 and err.startswith("contactlab: error: " + match), err
 
 
+@pytest.mark.parametrize("kwargs, match", [
+    ({"n": 1}, "n = 1 is not allowed: it must be >= 2"),
+    ({"pressures": (1e9, 1e8)}, "pressures = (1000000000.0, 100000000.0) is not allowed: it must be increasing"),
+    ({"relative": (0.0, 0.1)}, r"relative[0] = 0.0 is not allowed: it must be > 0"),
+])
+def test_the_ladder_names_its_keywords(kwargs, match):
+    from bem.checks import InputError
+
+    surface = synthetic_surface(hurst=0.8, size=1e-4, grid=16, rms_height=1e-6, seed=1)
+    with pytest.raises(InputError) as err:
+        ladder(surface, E_STAR, **kwargs)
+    assert str(err.value).startswith(match)
+
+
 def test_a_relative_ladder_of_a_flat_surface_names_the_option(tmp_path):
     np.save(tmp_path / "flat.npy", np.zeros((32, 32)))
     code, _, err = _run(tmp_path, tmp_path / "flat.npy", "--size", "1,1", "--scale", "1e-6")

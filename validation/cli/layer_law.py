@@ -41,7 +41,7 @@ SYNTHETIC = {"hurst": float, "rms_height": float, "rms_slope": float, "size": fl
 #: the library's arguments -> the options that set them, for the messages (:func:`.common.option_names`)
 _FILE_OPTIONS = {"file": "SURFACE", "scale": "--scale", "physical_sizes": "--size", "physical_sizes[0]": "--size LX",
                  "physical_sizes[1]": "--size LY"}
-_LADDER_OPTIONS = {"n_pressures": "--n-pressures", "pressures": "--p-range", "pressures[0]": "--p-range LOW",
+_LADDER_OPTIONS = {"n": "--n-pressures", "pressures": "--p-range", "pressures[0]": "--p-range LOW",
                    "pressures[1]": "--p-range HIGH", "relative": "--p-range-rel", "relative[0]": "--p-range-rel LOW",
                    "relative[1]": "--p-range-rel HIGH"}
 

@@ -121,7 +121,7 @@ def ladder(surface, E_star, *, pressures=None, relative=DEFAULT_RANGE, n=12):
     ``pressures = (low, high)`` [Pa] gives its ends; otherwise ``relative = (low, high)`` does,
     in units of ``E* h'_rms`` (``h'_rms = surface.stats.rms_slope``).
     """
-    n = check_int("n_pressures", n, minimum=2)
+    n = check_int("n", n, minimum=2)
     E_star = check_positive("E_star", E_star)
     if pressures is not None:
         name, (low, high), unit = "pressures", pressures, 1.0
