@@ -1,4 +1,5 @@
-"""What several subcommands share: the ``--set`` option and the scene permissions."""
+"""What several subcommands share: the ``--set`` option, the scene permissions, the progress bar and the
+options named in the library's messages."""
 
 from __future__ import annotations
 
