@@ -322,10 +322,9 @@ def subsurface_stress(result, z, *, nu, x=None, y=None, device="cpu"):
     Raises
     ------
     bem.InputError
-        ``result`` is not a ContactResult or is a periodic cell's (:func:`bem.solve_periodic`), ``nu`` out
-        of range, a depth negative, not finite or
-        deeper than :data:`Z_MAX_STEPS` lattice steps,
-        ``x``/``y`` of unequal shapes or outside the candidate region.
+        ``result`` is not a ContactResult or is a periodic cell's (:func:`bem.solve_periodic`),
+        ``nu`` out of range, a depth negative, not finite or deeper than :data:`Z_MAX_STEPS`
+        lattice steps, ``x``/``y`` of unequal shapes or outside the candidate region.
 
     Notes
     -----

@@ -155,7 +155,8 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, scale=
         _pair("size", size)
     except InputError:
         refuse(f"the size it states times scale, ({size[0]:.4g}, {size[1]:.4g}), must be two lengths in "
-               f"[{SCALE_RANGE[0]:g}, {SCALE_RANGE[1]:g}] (physical scales; the header's increments or scale are wrong)")
+               f"[{SCALE_RANGE[0]:g}, {SCALE_RANGE[1]:g}] (physical scales; the header's increments or scale "
+               "are wrong)")
     if detrend is not None:
         z = np.ma.getdata(topo.detrend(detrend).heights())
     periodic = bool(topo.is_periodic) and detrend in (None, "center")  # a plane taken off breaks a period

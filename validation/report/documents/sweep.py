@@ -200,14 +200,13 @@ def _layer_section(summary, points, work):
     else:  # readable units, the same for every point
         first, key = done[0][1], str(summary.get("key", "value"))
         (pf, pu), (lf, lu), (vf, _) = first.engineering("pressure"), first.engineering("length"), _key_unit(key, first)
-        top = 1.25 * max(max(float(res.result.p_max or 0.0), float(getattr(res.layer, "p_cr", 0.0) or 0.0),
-                             float(getattr(res.layer, "p_star", 0.0) or 0.0)) for _, res in laws.values())
+        top = 1.25 * max(float(v or 0.0) for _, res in laws.values()  # as the run's figure: peaks and kinks
+                         for v in (res.result.p_max, *map(res.layer.to_dict().get, ("p_cr", "p_star"))))
         drawn = [(f"{key} = {fmt(row['value'] / vf if is_number(row['value']) else row['value'])}",
                   Scaled(res.layer, pf, lf)) for row, res in laws.values()]
         for _, law in drawn:
             law.law = None  # coloured by point, not by the law's name (one name for all)
-        path = plot_layer_laws(drawn,
-                               work / "sweep_layer_laws.png", p_max=top / pf, p_unit=pu, w_unit=lu,
+        path = plot_layer_laws(drawn, work / "sweep_layer_laws.png", p_max=top / pf, p_unit=pu, w_unit=lu,
                                title=f"interface layer law w(p) as {key} varies")
         figure = Figure(path, f"The layer law w(p) of each computed point ({len(laws)} laws), rebuilt from the "
                               "points' results with bem.layers.from_dict, from 0 to 1.25 times the largest peak "
