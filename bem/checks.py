@@ -9,6 +9,7 @@ the argument, shows the value and states the rule, e.g.::
 from __future__ import annotations
 
 import math
+import os
 from numbers import Real
 
 import numpy as np
@@ -29,6 +30,7 @@ __all__ = [
     "check_load",
     "check_scale",
     "check_rtol",
+    "check_file_name",
     "check_node_count",
     "check_layer",
     "check_gap_values",
@@ -92,12 +94,26 @@ def check_scale(name, value):
 
 
 def check_rtol(name, value):
-    """Return ``float(value)``; raise unless ``0 < value <= RTOL_MAX`` (a relative KKT tolerance)."""
+    """Return ``float(value)``; raise unless ``0 < value <= RTOL_MAX``: the tolerance of every solver
+    (BEM, periodic cell, FEM) on its relative residual of the contact conditions."""
     value = check_positive(name, value)
     if value > RTOL_MAX:
-        fail(name, value, f"in (0, {RTOL_MAX:g}]: it bounds the relative KKT residual (gap violations over "
-                          "the largest surface closure, force balance over P), and a larger one accepts a "
-                          "wrong answer as converged")
+        fail(name, value, f"in (0, {RTOL_MAX:g}]: it bounds the relative residual of the contact conditions "
+                          "(gap violations, force balance over P), and a larger one accepts a wrong answer as "
+                          "converged")
+    return value
+
+
+def check_file_name(name, value):
+    """Return ``value``; raise unless it is a file name (``str`` or ``os.PathLike``), not empty, without a
+    NUL byte."""
+    if not isinstance(value, (str, os.PathLike)):
+        fail(name, value, "a file name (str or os.PathLike)")
+    text = os.fspath(value)
+    if not text:
+        fail(name, text, "a file name, not empty")
+    if ("\x00" if isinstance(text, str) else b"\x00") in text:
+        fail(name, text, "a file name without a NUL byte (no file system accepts one)")
     return value
 
 

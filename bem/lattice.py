@@ -20,7 +20,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .checks import InputError, check_node_count, check_positive
+from .checks import InputError, check_node_count, check_positive, check_scale
 
 __all__ = ["Lattice", "LatticeWindow", "SQRT3", "node_count", "extent_pair"]
 
@@ -77,13 +77,13 @@ class Lattice:
         Parameters
         ----------
         step : float
-            Lattice step ``c`` [length], > 0.
+            Lattice step ``c`` [length], a physical scale (:data:`bem.checks.SCALE_RANGE`).
         extent : float or (float, float)
             Half-width of the candidate region [length]: one number for a square,
             ``(ex, ey)`` for a rectangle. At least two steps each way, and at most
             :data:`bem.checks.MAX_NODES` nodes in all.
         """
-        step = check_positive("step", step)
+        step = check_scale("step", step)
         ex, ey = extent_pair("extent", extent)
         half_cols, half_rows = _half_counts(step, ex, ey)
         if half_cols < 2 or half_rows < 2:

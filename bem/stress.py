@@ -322,9 +322,9 @@ def subsurface_stress(result, z, *, nu, x=None, y=None, device="cpu"):
     Raises
     ------
     bem.InputError
-        ``result`` is not a ContactResult, ``nu`` out of range, a depth negative, not finite or
-        deeper than :data:`Z_MAX_STEPS` lattice steps,
-        ``x``/``y`` of unequal shapes or outside the candidate region.
+        ``result`` is not a ContactResult or is a periodic cell's (:func:`bem.solve_periodic`),
+        ``nu`` out of range, a depth negative, not finite or deeper than :data:`Z_MAX_STEPS`
+        lattice steps, ``x``/``y`` of unequal shapes or outside the candidate region.
 
     Notes
     -----
@@ -342,6 +342,12 @@ def subsurface_stress(result, z, *, nu, x=None, y=None, device="cpu"):
     if not isinstance(result, ContactResult):
         raise InputError(f"result = {type(result).__name__} is not allowed: it must be a bem.ContactResult "
                          "(the return value of bem.solve).")
+    from .periodic import PeriodicContactResult
+
+    if isinstance(result, PeriodicContactResult):
+        raise InputError("result = PeriodicContactResult is not allowed: it must be a bounded contact of bem.solve; "
+                         "the stresses below a periodic cell need the images of every other cell, which this "
+                         "sum over one candidate region does not hold.")
     nu = check_range("nu", nu, -1.0, 0.5, low_open=True)
     z = check_finite_array("z", z)
     if z.ndim > 1:

@@ -29,7 +29,7 @@ import time
 import numpy as np
 
 from bem.checks import (check_bool, check_callable, check_gap_values, check_int, check_layer, check_load,
-                        check_positive, fail)
+                        check_positive, check_rtol, fail)
 from bem.layers import beyond_table
 from bem.materials import effective_modulus
 from bem.reference import estimate_contact_radius
@@ -122,7 +122,8 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     remesh : bool
         Re-mesh once around the computed radius when it leaves ``[0.6, 1.25] a_est``.
     rtol : float
-        Newton stopping rule (:mod:`fem_reference.newton`).
+        Newton stopping rule (:mod:`fem_reference.newton`), in ``(0, bem.checks.RTOL_MAX]`` as for
+        :func:`bem.solve`: a looser one accepts a wrong answer as converged.
     maxiter : int
         Newton-step limit.
 
@@ -144,7 +145,7 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     force, approach = check_load(force, approach)
     layer = check_layer("layer", layer)
     penalty = check_positive("penalty", penalty)
-    rtol = check_positive("rtol", rtol)
+    rtol = check_rtol("rtol", rtol)
     maxiter = check_int("maxiter", maxiter)
     truncation_correction = check_bool("truncation_correction", truncation_correction)
     remesh = check_bool("remesh", remesh)

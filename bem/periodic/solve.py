@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_bool, check_choice, check_gap_values, check_int, check_positive, fail
+from ..checks import check_bool, check_choice, check_gap_values, check_int, check_positive, check_rtol, fail
 from ..errors import InputError
 from ..kkt import kkt_residual
 from ..options import METHODS, check_options, solver_for
@@ -180,7 +180,7 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
             fail("approach", approach, f"< the mean gap {float(h.mean()):.6g} without a layer (a full contact "
                  "leaves the mean pressure undetermined: give mean_pressure)")
     check_choice("method", method, METHODS)
-    rtol = check_positive("rtol", rtol)
+    rtol = check_rtol("rtol", rtol)
     if maxiter is not None:
         maxiter = check_int("maxiter", maxiter)
     precondition = check_bool("precondition", precondition)

@@ -20,7 +20,7 @@ import os
 
 import numpy as np
 
-from ..checks import InputError, check_choice, check_int, check_positive, fail
+from ..checks import SCALE_RANGE, InputError, check_choice, check_int, check_positive, fail
 from .surface import DETRENDS, MIN_POINTS, _pair, _surface, _surface_topography
 
 __all__ = ["read_surface", "formats"]
@@ -151,6 +151,12 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, scale=
     if not np.isfinite(z).all():
         refuse(f"it has {int((~np.isfinite(z)).sum())} heights that are not finite (NaN or inf)")
     size = tuple(float(s) * scale for s in topo.physical_sizes)
+    try:
+        _pair("size", size)
+    except InputError:
+        refuse(f"the size it states times scale, ({size[0]:.4g}, {size[1]:.4g}), must be two lengths in "
+               f"[{SCALE_RANGE[0]:g}, {SCALE_RANGE[1]:g}] (physical scales; the header's increments or scale "
+               "are wrong)")
     if detrend is not None:
         z = np.ma.getdata(topo.detrend(detrend).heights())
     periodic = bool(topo.is_periodic) and detrend in (None, "center")  # a plane taken off breaks a period

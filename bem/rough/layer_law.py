@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 import tomli_w
 
-from ..checks import InputError, check_choice, check_finite_array, check_positive, fail
+from ..checks import InputError, check_choice, check_finite_array, check_positive, check_rtol, fail
 from ..files import write_text
 from ..layers import Tabulated
 from ..options import METHODS
@@ -177,7 +177,7 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
     method : str
         A method of :func:`bem.solve_periodic` (``bem.METHODS``).
     rtol : float
-        The solver's KKT tolerance, ``> 0``.
+        The solver's KKT tolerance, in ``(0, bem.checks.RTOL_MAX]`` (as :func:`bem.solve`).
     maxiter : int, optional
         The solver's iteration limit per step (its default if ``None``).
     progress : callable, optional
@@ -202,7 +202,7 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
     E_star = check_positive("E_star", E_star)
     p = _ladder(pressures)
     check_choice("method", method, METHODS)
-    rtol = check_positive("rtol", rtol)
+    rtol = check_rtol("rtol", rtol)
     if progress is not None and not callable(progress):
         fail("progress", progress, "callable or None")
     lattice = surface.to_lattice(n_cols)
@@ -248,9 +248,9 @@ def read_layer_law(path):
     path = Path(path)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
         raise InputError(f"path = {str(path)!r} is not allowed: it must be a readable TOML table file "
-                         f"({type(exc).__name__}).") from None
+                         f"({'nested too deep' if isinstance(exc, RecursionError) else type(exc).__name__}).") from None
     layer, topo = data.get("layer"), data.get("topography")
     if not isinstance(layer, dict) or layer.get("law") != "tabulated" or not isinstance(topo, dict):
         fail("path", str(path), "a layer law file with [layer] law = 'tabulated' and a [topography] table")

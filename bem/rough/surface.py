@@ -45,7 +45,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..checks import InputError, check_choice, check_finite_array, check_int, check_positive, check_range, fail
+from ..checks import InputError, check_choice, check_finite_array, check_int, check_range, check_scale, fail
 from .lattice_heights import to_lattice
 
 __all__ = ["RoughSurface", "SurfaceStats", "self_affine", "from_heights", "combined", "DETRENDS", "EDGE_JUMP_LIMIT",
@@ -163,9 +163,10 @@ class RoughSurface:
 
 
 def _pair(name, value):
+    """A cell's size ``(Lx, Ly)``: two lengths, each a physical scale (:func:`bem.checks.check_scale`)."""
     if not isinstance(value, (list, tuple, np.ndarray)) or len(value) != 2:
         fail(name, value, "a pair (Lx, Ly) of lengths")
-    return check_positive(f"{name}[0]", value[0]), check_positive(f"{name}[1]", value[1])
+    return check_scale(f"{name}[0]", value[0]), check_scale(f"{name}[1]", value[1])
 
 
 def _edge_jump(z):
@@ -245,11 +246,12 @@ def self_affine(grid, size, *, hurst, rms_height=None, rms_slope=None, long_cuto
     grid : (int, int)
         ``(nx, ny)`` points, each ``>= 8``.
     size : (float, float)
-        The period ``(Lx, Ly)`` [length].
+        The period ``(Lx, Ly)`` [length]; each length here is a physical scale, in
+        :data:`bem.checks.SCALE_RANGE`.
     hurst : float
         Hurst exponent ``H``, ``0 < H <= 1``.
     rms_height, rms_slope : float
-        Exactly one: rms height [length] or rms slope [-], ``> 0``.
+        Exactly one: rms height [length] or rms slope [-], in :data:`bem.checks.SCALE_RANGE`.
     long_cutoff : float, optional
         Roll-off wavelength ``lambda_L`` [length], ``> short_cutoff``; default: none (power law
         down to the longest wavelength of the cell).
@@ -270,12 +272,12 @@ def self_affine(grid, size, *, hurst, rms_height=None, rms_slope=None, long_cuto
     hurst = check_range("hurst", hurst, 0.0, 1.0, low_open=True)
     if (rms_height is None) == (rms_slope is None):
         fail("(rms_height, rms_slope)", (rms_height, rms_slope), "exactly one given")
-    target = check_positive("rms_height" if rms_slope is None else "rms_slope",
-                            rms_height if rms_slope is None else rms_slope)
+    target = check_scale("rms_height" if rms_slope is None else "rms_slope",  # physical scales
+                         rms_height if rms_slope is None else rms_slope)
     if short_cutoff is not None:
-        short_cutoff = check_positive("short_cutoff", short_cutoff)
+        short_cutoff = check_scale("short_cutoff", short_cutoff)
     if long_cutoff is not None:
-        long_cutoff = check_positive("long_cutoff", long_cutoff)
+        long_cutoff = check_scale("long_cutoff", long_cutoff)
         if short_cutoff is not None and long_cutoff <= short_cutoff:
             fail("long_cutoff", long_cutoff, f"> short_cutoff = {short_cutoff!r}")
     rolloff = check_range("rolloff", rolloff, 0.0, 1.0)

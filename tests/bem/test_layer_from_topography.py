@@ -209,12 +209,20 @@ def test_a_mean_gap_that_rises_with_the_pressure_is_refused(monkeypatch):
     ({"pressures": [0.0, 0.1]}, r"pressures\[0\] = 0.0 is not allowed: it must be > 0"),
     ({"pressures": [0.1]}, "pressures has 1 entries"),
     ({"pressures": [0.1, 0.2], "rtol": 0}, "rtol = 0"),
+    ({"pressures": [0.1, 0.2], "rtol": 10.0}, r"rtol = 10.0 is not allowed: it must be in \(0, 0.01\]"),
     ({"pressures": [0.1, 0.2], "method": "cg"}, "method = 'cg'"),
     ({"pressures": [0.1, 0.2], "progress": 3}, "progress = 3"),
 ])
 def test_bad_arguments_are_refused_by_name(kwargs, match):
     with pytest.raises(bem.InputError, match=match):
         rough.layer_from_topography(_sinusoid(32), E_STAR, n_cols=32, **kwargs)
+
+
+def test_a_law_file_nested_too_deep_is_refused_by_name(tmp_path):
+    path = tmp_path / "law.toml"
+    path.write_text("[layer]\nlaw = 'tabulated'\nx = " + "[" * 5000 + "]" * 5000 + "\n")
+    with pytest.raises(bem.InputError, match=r"^path = .* readable TOML table file \(nested too deep\)"):
+        rough.read_layer_law(path)
 
 
 def test_a_surface_must_be_a_rough_surface():

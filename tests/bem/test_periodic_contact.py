@@ -280,6 +280,7 @@ def test_an_independent_periodic_solver_agrees_within_the_discretisation_differe
     (dict(gap=np.zeros((5, 8)), step=0.1, mean_pressure=0.1), "^n_rows = 5 is not allowed: it must be even"),
     (dict(gap=np.zeros((4, 8)), mean_pressure=0.1), "^step = None is not allowed"),
     (dict(gap=GAP, step=0.1, mean_pressure=0.1), "^cell = None is not allowed"),
+    (dict(gap=GAP, cell=CELL, mean_pressure=0.1, rtol=0.5), r"^rtol = 0.5 is not allowed: it must be in \(0, 0.01\]"),
 ])
 def test_solve_periodic_refuses_bad_input(kwargs, match):
     with pytest.raises(bem.InputError, match=match):

@@ -35,6 +35,8 @@ GOOD = dict(E_star=1.0, force=0.01, step=0.05, extent=0.5)
     (dict(force=None, approach=1e-308), r"approach = 1e-308 is not allowed"),
     (dict(E_star=None, E1=1e308, nu1=0.3, E2=2.0, nu2=0.3), r"E1 = 1e\+308 is not allowed"),
     (dict(step=1e-9), r"step = 1e-09 is not allowed: the candidate region would hold 1\.15e\+18 nodes"),
+    (dict(step=1e-300, extent=1e-299), r"^step = 1e-300 is not allowed: it must be in \[1e-60, 1e\+60\]"),
+    (dict(step=1e300, extent=1e301), r"^step = 1e\+300 is not allowed: it must be in \[1e-60, 1e\+60\]"),
 ])
 def test_bad_input_is_refused_naming_the_argument(change, name):
     kw = {**GOOD, **change}

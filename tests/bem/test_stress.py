@@ -236,6 +236,17 @@ def test_bad_input_raises_input_error_naming_the_argument(hertz_ladder, kwargs, 
         bem.subsurface_stress(args.pop("result"), args.pop("z"), **args)
 
 
+def test_a_periodic_cell_is_refused_by_name():
+    """The sum over one candidate region lacks the images of the other cells: refused, not summed wrongly."""
+    from bem.periodic import PeriodicCell, solve_periodic
+
+    res = solve_periodic(lambda x, y: 0.01 * (1 - np.cos(2 * np.pi * x)), cell=PeriodicCell(1 / 16, 16, 16),
+                         E_star=1.0, mean_pressure=0.01)
+    assert res.converged
+    with pytest.raises(bem.InputError, match="^result = PeriodicContactResult is not allowed: it must be a bounded"):
+        bem.subsurface_stress(res, [0.01], nu=0.3)
+
+
 @pytest.mark.parametrize("z, name", [(1e308, "z"), ([0.1, 1e308], r"z\[1\]"), (float("inf"), "z")])
 def test_a_depth_too_deep_for_float64_is_refused_by_name(hertz_ladder, z, name):
     res = hertz_ladder[8]

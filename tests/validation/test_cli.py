@@ -77,6 +77,53 @@ def test_run_bad_input_exits_2_and_writes_nothing(tmp_path):
     assert not (tmp_path / "r").exists()
 
 
+def test_sweep_names_its_own_option_in_a_bad_worker_count(tmp_path):
+    code, _, err = cli("sweep", "hertz", "--param", "load.force", "--values", "1,2", "--workers", 0,
+                       "--out", tmp_path / "s")
+    assert code == 2 and err.startswith("contactlab: error: --workers = 0 is not allowed"), err
+    assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize("argv, name", [
+    (("check", "a\x00b.toml"), "SCENE = 'a\\x00b.toml'"),
+    (("run", "elliptic", "--out", "o\x00ut"), "--out = 'o\\x00ut'"),
+    (("sweep", "elliptic", "--param", "load.force", "--values", "1,2", "--out", "s\x00"), "--out = 's\\x00'"),
+    (("report", "x\x00y"), "SCENE_OR_DIR = 'x\\x00y'"),
+    (("layer-law", "s\x00.npy", "--E-star", "1e9", "--out", "law"), "SURFACE = 's\\x00.npy'"),
+], ids=["check", "run", "sweep", "report", "layer-law"])
+def test_a_file_argument_with_a_nul_byte_exits_2_naming_it(argv, name, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = cli(*argv)
+    assert code == 2 and out == "" and err == (f"contactlab: error: {name} is not allowed: it must be a file name "
+                                               "without a NUL byte (no file system accepts one).\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_empty_out_is_refused_not_taken_for_the_default(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = cli("run", "elliptic", "--out", "", "--set", "bem.nodes_across=8")
+    assert code == 2 and out == ""
+    assert err == "contactlab: error: --out = '' is not allowed: it must be a file name, not empty.\n"
+    assert list(tmp_path.iterdir()) == []  # not results/elliptic
+
+
+def test_sweep_names_the_param_option_it_was_given(tmp_path):
+    code, _, err = cli("sweep", "hertz", "--param", "nope", "--values", "1", "--out", tmp_path / "s")
+    assert code == 2 and err.startswith("contactlab: error: --param = 'nope' is not allowed: it must be alpha_a")
+
+
+@pytest.mark.parametrize("name", ["result.json", "summary.json"])
+def test_a_result_or_sweep_file_nested_too_deep_exits_2(name, tmp_path):
+    folder = tmp_path / "received"
+    folder.mkdir()
+    if name == "summary.json":
+        (folder / "points").mkdir()
+    (folder / name).write_text("[" * 100_000 + "]" * 100_000)
+    code, out, err = cli("report", folder, "--out", tmp_path / "rep")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith(f"contactlab: error: {folder / name} is not allowed: it must be a readable JSON file")
+
+
 def test_run_into_foreign_directory_exits_2(tmp_path):
     (tmp_path / "notes.txt").write_text("mine")
     code, _out, err = cli("run", "elliptic", "--out", tmp_path, "--set", "bem.nodes_across=16")

@@ -90,11 +90,18 @@ def test_a_layer_law_folder_is_replaced_by_a_new_run(tmp_path):
     (("--synthetic", "hurst=0.8,size=1e-4"), "--synthetic grid is missing"),
     (("--synthetic", "hurst=0.8,size=1e-4,grid=64,colour=3"), "--synthetic 'colour=3' is not allowed"),
     (("--synthetic", "hurst=0.8,size=1e-4,grid=6.5"), "--synthetic grid = '6.5' is not allowed"),
-    (("--synthetic", SYNTHETIC, "--p-range", "1e9:1e8"), "pressures[1] = 100000000.0 is not allowed: it must be >"),
+    (("--synthetic", SYNTHETIC, "--p-range", "1e9:1e8"), "--p-range = (1000000000.0, 100000000.0) is not allowed"),
+    (("--synthetic", SYNTHETIC, "--p-range", "0:1e8"), "--p-range LOW = 0.0 is not allowed: it must be > 0"),
+    (("--synthetic", SYNTHETIC, "--p-range-rel", "0.1:-1"), "--p-range-rel HIGH = -1.0 is not allowed"),
+    (("--synthetic", SYNTHETIC.replace("seed=3", "seed=-1")), "--synthetic seed = -1 is not allowed"),
+    (("--synthetic", SYNTHETIC.replace("hurst=0.8", "hurst=2")), "--synthetic hurst = 2.0 is not allowed"),
+    (("--synthetic", SYNTHETIC.replace("size=1e-4", "size=-1")), "--synthetic size = -1.0 is not allowed"),
+    (("--synthetic", SYNTHETIC, "--rtol", "10"), "--rtol = 10.0 is not allowed: it must be in (0, 0.01]"),
+    (("--synthetic", SYNTHETIC, "--rtol", "1"), "--rtol = 1.0 is not allowed: it must be in (0, 0.01]"),
     (("--synthetic", SYNTHETIC, "--p-range", "1e9"), "--p-range = '1e9' is not allowed"),
     (("--synthetic", SYNTHETIC, "--scale", "1e-6"), "--scale = 1e-06 is not allowed with --synthetic"),
-    (("--synthetic", SYNTHETIC, "--n-cols", "0"), "n_cols"),
-    (("--synthetic", SYNTHETIC, "--rtol", "-1"), "rtol = -1.0 is not allowed"),
+    (("--synthetic", SYNTHETIC, "--n-cols", "0"), "--n-cols = 0 is not allowed"),
+    (("--synthetic", SYNTHETIC, "--rtol", "-1"), "--rtol = -1.0 is not allowed"),
     (("no_such_file.x3p",), "no_such_file.x3p"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, args, match):
@@ -107,13 +114,59 @@ def test_bad_input_exits_2_with_one_line(tmp_path, args, match):
 
 def test_a_file_without_a_length_unit_needs_scale(surface_file, tmp_path):
     code, _, err = _run(tmp_path, surface_file, "--size", f"{SIZE_UM},{SIZE_UM}")
-    assert code == 2 and "scale is missing" in err and "states no length unit" in err
+    assert code == 2 and err.startswith("contactlab: error: --scale is missing") and "states no length unit" in err
+
+
+@pytest.mark.parametrize("args, match", [
+    ((), "--size is missing: "),
+    (("--size", "100,-1", "--scale", "1e-6"), "--size LY = -1.0 is not allowed: it must be > 0"),
+    (("--size", "100,100", "--scale", "-1"), "--scale = -1.0 is not allowed: it must be > 0"),
+])
+def test_the_options_of_a_surface_file_are_named_as_written(surface_file, tmp_path, args, match):
+    code, _, err = _run(tmp_path, surface_file, *args)
+    assert code == 2 and err.startswith("contactlab: error: " + match), err
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"n": 1}, "n = 1 is not allowed: it must be >= 2"),
+    ({"pressures": (1e9, 1e8)}, "pressures = (1000000000.0, 100000000.0) is not allowed: it must be increasing"),
+    ({"relative": (0.0, 0.1)}, r"relative[0] = 0.0 is not allowed: it must be > 0"),
+])
+def test_the_ladder_names_its_keywords(kwargs, match):
+    from bem.checks import InputError
+
+    surface = synthetic_surface(hurst=0.8, size=1e-4, grid=16, rms_height=1e-6, seed=1)
+    with pytest.raises(InputError) as err:
+        ladder(surface, E_STAR, **kwargs)
+    assert str(err.value).startswith(match)
+
+
+def test_a_relative_ladder_of_a_flat_surface_names_the_option(tmp_path):
+    np.save(tmp_path / "flat.npy", np.zeros((32, 32)))
+    code, _, err = _run(tmp_path, tmp_path / "flat.npy", "--size", "1,1", "--scale", "1e-6")
+    assert code == 2 and err.startswith("contactlab: error: --p-range-rel = (0.003, 0.3) is not allowed: it must be "
+                                        "used with a surface of rms slope > 0"), err
+
+
+def test_a_surface_whose_header_states_an_impossible_size_exits_2(tmp_path):
+    """An x3p file with the grid step (its ``Increment``) 1e300 m: the size is no length a solve can take."""
+    import SurfaceTopography
+
+    z = np.random.default_rng(0).random((32, 32)) * 1e-6
+    SurfaceTopography.Topography(z, (32e300, 32e300), unit="m").to_x3p(str(tmp_path / "s.x3p"))
+    code, _, err = _run(tmp_path, tmp_path / "s.x3p")
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert err.startswith(f"contactlab: error: SURFACE = {str(tmp_path / 's.x3p')!r} is not allowed: the size it "
+                          "states times scale, (3.2e+301, 3.2e+301), must be two lengths in [1e-60, 1e+60]")
+    assert not (tmp_path / "law").exists()
 
 
 def test_n_pressures_and_the_output_folder_are_checked_before_solving(tmp_path):
     code, _, err = cli("layer-law", "--synthetic", SYNTHETIC, "--E-star", E_STAR, "--n-pressures", 1, "--out",
                        tmp_path / "law")
-    assert code == 2 and "n_pressures = 1 is not allowed" in err
+    assert code == 2 and "--n-pressures = 1 is not allowed: it must be >= 2" in err
+    code, _, err = cli("layer-law", "--synthetic", SYNTHETIC, "--E-star", -1, "--out", tmp_path / "law")
+    assert code == 2 and "--E-star = -1.0 is not allowed: it must be > 0" in err
     (tmp_path / "file").write_text("")
     code, _, err = _run(tmp_path, "--synthetic", SYNTHETIC, out="file")
     assert code == 2 and "--out = " in err and "it is a file" in err

@@ -64,7 +64,10 @@ def test_a_law_file_outside_the_scene_folder_is_refused_unless_allowed(topograph
 
 @pytest.mark.parametrize("layer, text, match", [
     ({"law": "tabulated", "file": "none.toml"}, None, r"layer.file = '.*none.toml' is not allowed: there is no such"),
-    ({"law": "tabulated", "file": "law.toml"}, "p = [", r"layer.file = .* readable TOML table file"),
+    ({"law": "tabulated", "file": "law.toml"}, "p = [", r"layer.file = .* is not valid TOML"),
+    ({"law": "tabulated", "file": "law.toml"}, "[layer]\nlaw = 'tabulated'\np = [0.0, 1.0]\nw = [0.0, 1e-6]\n"
+     "x = " + "[" * 5000 + "]" * 5000 + "\n", r"layer.file = .* nests arrays or tables more than 32 levels deep"),
+    ({"law": "tabulated", "file": "la\x00w.toml"}, None, r"layer.file = 'la\\x00w.toml' is not allowed: .* NUL byte"),
     ({"law": "tabulated", "file": "law.toml"}, "[layer]\nlaw = 'linear'\nlam = 1e-12\n",
      r"layer.file = .* a \[layer\] table with law = 'tabulated', p and w"),
     ({"law": "tabulated", "file": "law.toml", "p": [0.0, 1.0]}, "",

@@ -102,3 +102,57 @@ def test_report_stages_reach_the_progress_callback(tmp_path):
     assert calls == [(s, k, len(STAGES)) for k, s in enumerate(STAGES)] + [("done", len(STAGES), len(STAGES))]
     res = load_results(tmp_path / "run")
     assert not res.dimensionless and np.isfinite(res.result.p_max)
+
+
+@pytest.fixture(scope="module")
+def layered_sweep(tmp_path_factory):
+    """A sweep of the linear layer's compliance lam (two laws) of the paper's problem, without FEM."""
+    from validation.scene import load_scene
+
+    out = tmp_path_factory.mktemp("layered") / "sweep"
+    scene = load_scene("paper_linear", overrides=["bem.nodes_across=12"], no_fem=True)
+    run_sweep(scene, out, parameter="layer.lam", values=LAMS, workers=1)
+    return out
+
+
+LAMS = [4e-16, 8e-16]  # m/Pa
+
+
+def _problem_text(sections):
+    return " ".join(sections[0].text)
+
+
+def test_a_layered_sweep_states_its_layer_and_draws_each_points_law(layered_sweep, tmp_path, drawn):
+    summary, points = load_sweep(layered_sweep)
+    sections = sweep_sections(summary, points, tmp_path)
+    assert [s.title for s in sections] == ["Problem statement", "Interface layer law", "Sweep results"]
+    assert "with an interface layer" in _problem_text(sections) and "no interface layer" not in _problem_text(sections)
+    laws = drawn[0].axes[0]
+    assert "[MPa]" in laws.get_xlabel() and "[mm]" in laws.get_ylabel()
+    lines = [ln for ln in laws.get_lines() if not ln.get_label().startswith("_")]
+    assert [ln.get_label() for ln in lines] == [f"layer.lam = {lam * 1e9:g}" for lam in LAMS]  # mm/MPa
+    for ln, lam in zip(lines, LAMS):
+        p, w = (np.asarray(v, float) for v in ln.get_data())
+        np.testing.assert_allclose(w[1:] / p[1:], lam * 1e9, rtol=1e-12)  # w = lam p, in mm and MPa
+
+
+def test_a_layer_that_cannot_be_rebuilt_is_still_a_layer_in_the_sweep_report(layered_sweep, tmp_path):
+    """A custom law is never imported by a report: the problem statement names the layer and the
+    method the run used, from the record, and no w(p) is drawn."""
+    import json
+    import shutil
+
+    d = tmp_path / "copy"
+    shutil.copytree(layered_sweep, d)
+    for path in (d / "points").glob("*.json"):
+        point = json.loads(path.read_text())
+        custom = {"law": "custom", "w": "no_such_module_of_anyone:w", "p_scale": 1e8}
+        point["scene"]["layer"] = custom
+        point["result"]["layer"] = {"law": "custom", "parameters": custom}
+        point["result"]["bem"]["method"] = point["result"]["method"] = "newton"
+        path.write_text(json.dumps(point))
+    sections = sweep_sections(*load_sweep(d), tmp_path / "w")
+    assert [s.title for s in sections] == ["Problem statement", "Sweep results"]
+    text = _problem_text(sections)
+    assert "with an interface layer" in text and "no interface layer" not in text
+    assert "Solved by the BEM: Newton" in text and "quadratic programme" not in text

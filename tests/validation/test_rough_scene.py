@@ -118,6 +118,43 @@ def test_bad_periodic_keys_name_the_key(changes, key):
     assert key in str(err.value)
 
 
+@pytest.mark.parametrize("size, shown", [(1e-300, "1e-300"), (1e300, "1e+300"), ([1e-3, 1e-70], "1e-70")])
+def test_a_cell_size_beyond_the_physical_scales_is_refused_before_any_work(tmp_path, size, shown):
+    import tomli_w
+
+    path = tmp_path / "tiny.toml"
+    path.write_text(tomli_w.dumps(_base(gap__size=size)))
+    code, out, err = cli("check", path)
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith(f"contactlab: error: gap.size = {shown} is not allowed: it must be in [1e-60, 1e+60]")
+
+
+@pytest.mark.parametrize("override, key", [("gap.long_cutoff=1e300", "gap.long_cutoff = 1e+300"),
+                                           ("gap.short_cutoff=1e-300", "gap.short_cutoff = 1e-300"),
+                                           ("gap.rms_slope=1e300", "gap.rms_slope = 1e+300")])
+def test_a_length_of_the_self_affine_surface_beyond_the_physical_scales_is_refused(override, key):
+    code, out, err = cli("check", "rough_flat", "--set", override)
+    assert code == 2 and out == "" and err.startswith(f"contactlab: error: {key} is not allowed: it must be in [1e-60")
+
+
+@pytest.mark.parametrize("increment", [1e300, 1e-300])
+def test_an_instrument_file_whose_header_states_an_impossible_size_is_refused(tmp_path, increment):
+    """An x3p file's ``Increment`` (the grid step) times its points is the cell size: 1e300 m or
+    1e-300 m is no length a solve can take."""
+    import SurfaceTopography
+    import tomli_w
+
+    z = np.random.default_rng(0).random((32, 32)) * 1e-6
+    SurfaceTopography.Topography(z, (32 * increment, 32 * increment), unit="m").to_x3p(str(tmp_path / "s.x3p"))
+    raw = _base()
+    raw["gap"] = {"type": "surface", "file": "s.x3p"}
+    (tmp_path / "s.toml").write_text(tomli_w.dumps(raw))
+    code, out, err = cli("check", tmp_path / "s.toml")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith(f"contactlab: error: gap.file = {str(tmp_path / 's.x3p')!r} is not allowed: the size it "
+                          f"states times scale, ({32 * increment:.4g}, {32 * increment:.4g}), must be two lengths in")
+
+
 def test_periodic_keys_are_refused_outside_a_rough_scene():
     smooth = read_toml(builtin_path("elliptic"))
     for section, key, value in (("bem", "periodic", True), ("bem", "cell_nodes", 64), ("load", "mean_pressure", 1e6)):

@@ -311,8 +311,29 @@ def test_files_that_are_not_utf8_toml_or_nest_too_deep_are_refused(tmp_path, con
 @pytest.mark.parametrize("text, key", [
     (LAYER_BASE + 'law = "power"\nlam = 1e-12\ns = 1e308\n', "layer.s = 1e+308"),
     (BASE + "\n[stress]\ndepths = [0.0, 1e308]\n", "stress.depths[1] = 1e+308"),
-], ids=["power-exponent", "stress-depth"])
+    (BASE.replace("nodes_across = 16", "step = 1e-300\nextent = 1e-299"), "bem.step = 1e-300"),
+    (BASE + "\n[fem]\nrtol = 10.0\n", "fem.rtol = 10.0"),
+    (BASE.replace("nodes_across = 16", "step = 1e-5\nextent = 1e300"), "bem.extent = 1e+300"),
+], ids=["power-exponent", "stress-depth", "step", "fem-rtol", "extent"])
 def test_values_beyond_their_range_are_refused_at_load(tmp_path, text, key):
     code, out, err = cli("run", _write(tmp_path, text), "--out", tmp_path / "out")
     assert code == 2 and err.startswith(f"contactlab: error: {key} is not allowed") and out == ""
     assert not (tmp_path / "out").exists()
+
+
+NUL_RULE = "is not allowed: it must be a file name without a NUL byte"
+
+
+@pytest.mark.parametrize("text, key", [
+    (BASE.replace('type = "paraboloid"\nR = 0.01', 'type = "measured"\nfile = "h\\u0000.npy"\nspacing = 1e-6'),
+     "gap.file = 'h\\x00.npy'"),
+    (LAYER_BASE + 'law = "tabulated"\nfile = "la\\u0000w.toml"\n', "layer.file = 'la\\x00w.toml'"),
+], ids=["gap-file", "layer-file"])
+def test_a_file_name_with_a_nul_byte_is_refused_naming_the_key(tmp_path, text, key):
+    code, out, err = cli("check", _write(tmp_path, text))
+    assert code == 2 and out == "" and err == f"contactlab: error: {key} {NUL_RULE} (no file system accepts one).\n"
+
+
+def test_a_scene_name_with_a_nul_byte_is_refused():
+    with pytest.raises(SceneError, match="^scene = 'a\\\\x00b.toml' " + NUL_RULE):
+        load_scene("a\x00b.toml")

@@ -15,7 +15,7 @@ import signal
 import sys
 import threading
 
-from bem.checks import InputError
+from bem.checks import InputError, check_file_name
 
 from ..io import OutputError
 from ..run.calibrate import CalibrationError
@@ -138,6 +138,16 @@ def _log_to_stderr(verbose):
             lg.propagate = propagate
 
 
+#: the arguments that name files -> how the user wrote them
+_FILE_ARGUMENTS = {"scene": "SCENE", "surface": "SURFACE", "target": "SCENE_OR_DIR", "out": "--out"}
+
+
+def _check_file_names(args):
+    for dest, name in _FILE_ARGUMENTS.items():
+        if isinstance(getattr(args, dest, None), str):
+            check_file_name(name, getattr(args, dest))
+
+
 def main(argv=None):
     """Entry point of the ``contactlab`` console script; returns the exit code."""
     parser = build_parser()
@@ -146,6 +156,7 @@ def main(argv=None):
     except SystemExit as exc:
         return exc.code
     try:
+        _check_file_names(args)
         with _terminate_as_interrupt(), _log_to_stderr(args.verbose):
             return COMMANDS[args.command].run(args)
     except (InputError, OutputError) as exc:

@@ -1,8 +1,14 @@
-"""What several subcommands share: the ``--set`` option and the scene permissions."""
+"""What several subcommands share: the ``--set`` option, the scene permissions, the progress bar and the
+options named in the library's messages."""
 
 from __future__ import annotations
 
-__all__ = ["add_set", "add_trust", "trust"]
+import contextlib
+import re
+
+from bem.checks import InputError
+
+__all__ = ["add_set", "add_trust", "trust", "option_names"]
 
 
 def add_set(p, scope=""):
@@ -28,6 +34,25 @@ def trust(args):
     """The keywords of :func:`validation.scene.load_scene` that ``args`` give (:func:`add_trust`)."""
     return {"allow_code": bool(getattr(args, "allow_code", False)),
             "allow_outside_files": bool(getattr(args, "allow_outside_files", False))}
+
+
+@contextlib.contextmanager
+def option_names(names):
+    """Name the command's options in the library's messages.
+
+    ``names`` maps a library argument to the option the user wrote (``{"E_star": "--E-star"}``;
+    an entry of a pair as ``"physical_sizes[1]": "--size LY"``). An :class:`InputError` whose
+    message begins with such an argument (the form of :mod:`bem.checks`: ``"E_star = -1.0 is not
+    allowed: ..."``, ``"physical_sizes is missing: ..."``) is raised again beginning with the option.
+    """
+    try:
+        yield
+    except InputError as exc:
+        msg = str(exc)
+        for argument in sorted(names, key=len, reverse=True):  # "x[0]" before "x"
+            if re.match(re.escape(argument) + r"(?= |\[)", msg):
+                raise InputError(names[argument] + msg[len(argument):]) from None
+        raise
 
 
 class ProgressBar:

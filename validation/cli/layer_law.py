@@ -6,8 +6,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from bem.checks import InputError
-from .common import ProgressBar
+from bem.checks import InputError, check_positive, check_rtol
+from .common import ProgressBar, option_names
 
 PARSER = {
     "help": "the layer law w(p) of a rough surface: law file and figures",
@@ -38,6 +38,13 @@ PARSER = {
 SYNTHETIC = {"hurst": float, "rms_height": float, "rms_slope": float, "size": float, "grid": int,
              "long_cutoff": float, "short_cutoff": float, "rolloff": float, "seed": int}
 
+#: the library's arguments -> the options that set them, for the messages (:func:`.common.option_names`)
+_FILE_OPTIONS = {"file": "SURFACE", "scale": "--scale", "physical_sizes": "--size", "physical_sizes[0]": "--size LX",
+                 "physical_sizes[1]": "--size LY"}
+_LADDER_OPTIONS = {"n": "--n-pressures", "pressures": "--p-range", "pressures[0]": "--p-range LOW",
+                   "pressures[1]": "--p-range HIGH", "relative": "--p-range-rel", "relative[0]": "--p-range-rel LOW",
+                   "relative[1]": "--p-range-rel HIGH"}
+
 
 def add_args(p):
     p.add_argument("surface", nargs="?", metavar="SURFACE",
@@ -57,7 +64,8 @@ def add_args(p):
                    help="mean pressures in the ladder, geometrically spaced (default 12)")
     p.add_argument("--n-cols", type=int, metavar="N",
                    help="lattice nodes across the cell (default: the surface's grid points along x)")
-    p.add_argument("--rtol", type=float, default=1e-8, help="the solver's KKT tolerance (default 1e-8)")
+    p.add_argument("--rtol", type=float, default=1e-8,
+                   help="the solver's KKT tolerance, in (0, 1e-2] as for every solve (default 1e-8)")
     p.add_argument("--scale", type=float, metavar="M",
                    help="metres per length unit of SURFACE (default: from the unit the file states)")
     p.add_argument("--size", metavar="LX,LY", help="size of a SURFACE that does not state it, in its length unit")
@@ -115,6 +123,8 @@ def run(args):
 
     from ..layer_law import ladder, make_layer_law, surface_from_file, synthetic_surface
 
+    check_positive("--E-star", args.E_star)  # the options the library checks again, checked before any work
+    check_rtol("--rtol", args.rtol)
     if (args.surface is None) == (args.synthetic is None):
         raise InputError("SURFACE is missing: give a surface file or --synthetic (one of them)." if args.surface is None
                          else f"SURFACE = {args.surface!r} is not allowed together with --synthetic: give one.")
@@ -123,19 +133,24 @@ def run(args):
             if value is not None:
                 raise InputError(f"{option} = {value!r} is not allowed with --synthetic: it is for a SURFACE file "
                                  "(a synthetic surface is in m).")
-        surface = synthetic_surface(**_synthetic(args.synthetic))
+        with option_names({key: f"--synthetic {key}" for key in SYNTHETIC}):
+            surface = synthetic_surface(**_synthetic(args.synthetic))
     else:
         size = None if args.size is None else _pair("--size", args.size, ",")
-        surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size)
-    if args.p_range is not None:
-        pressures = ladder(surface, args.E_star, pressures=_pair("--p-range", args.p_range, ":"), n=args.n_pressures)
-    else:
-        pressures = ladder(surface, args.E_star, relative=_pair("--p-range-rel", args.p_range_rel, ":"),
-                           n=args.n_pressures)
+        with option_names(_FILE_OPTIONS):
+            surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size)
+    with option_names(_LADDER_OPTIONS):
+        if args.p_range is not None:
+            pressures = ladder(surface, args.E_star, pressures=_pair("--p-range", args.p_range, ":"),
+                               n=args.n_pressures)
+        else:
+            pressures = ladder(surface, args.E_star, relative=_pair("--p-range-rel", args.p_range_rel, ":"),
+                               n=args.n_pressures)
     bar = ProgressBar("layer law", "pressure", args.no_progress or None)
     try:
-        folder = make_layer_law(surface, args.out, E_star=args.E_star, pressures=pressures, n_cols=args.n_cols,
-                                rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out")
+        with option_names({"n_cols": "--n-cols"}):
+            folder = make_layer_law(surface, args.out, E_star=args.E_star, pressures=pressures, n_cols=args.n_cols,
+                                    rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out")
     except LadderNotConverged as exc:
         print(f"contactlab: error: {exc} (nothing was written)", file=sys.stderr)
         return 1

@@ -9,7 +9,7 @@ from bem.checks import InputError
 from ..labels import fmt
 from ..run.cluster import DEFAULT_TIMEOUT
 from ..scene.checks import MAX_SWEEP_POINTS
-from .common import ProgressBar, add_set, add_trust, trust
+from .common import ProgressBar, add_set, add_trust, option_names, trust
 
 PARSER = {"help": "sweep one scene parameter (resumable, parallel)",
           "description": "Run a scene for each value of one parameter. Finished points are saved "
@@ -55,7 +55,8 @@ def run(args):
         raise InputError("--param and --values are not allowed alone: give both (or neither, to use the "
                          "scene's [sweep]).")
     scene = load_scene(args.scene, overrides=args.overrides, no_fem=args.no_fem, **trust(args))
-    param, _key, points = sweep_points(scene, args.param, values)
+    with option_names({"sweep.parameter": "--param"} if args.param is not None else {}):
+        param, _key, points = sweep_points(scene, args.param, values)
     if args.out:
         out, what, value = Path(args.out), "--out", None
     else:
@@ -63,7 +64,7 @@ def run(args):
     check_output_dir(out, "sweep", SWEEP_NAMES, what=what, value=value)
     bar = ProgressBar(f"sweep {param}", "point", args.no_progress or None)
     try:
-        with output_errors(out, "--out" if args.out else "out_dir"):
+        with output_errors(out, "--out" if args.out else "out_dir"), option_names({"workers": "--workers"}):
             summary = run_sweep(scene, out, parameter=args.param, values=values, workers=args.workers,
                                 scheduler=args.scheduler, scheduler_timeout=args.scheduler_timeout,
                                 progress=bar)

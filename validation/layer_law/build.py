@@ -18,6 +18,7 @@ the law is used in: beyond it a tabulated law holds no data (:func:`bem.layers.b
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -120,15 +121,18 @@ def ladder(surface, E_star, *, pressures=None, relative=DEFAULT_RANGE, n=12):
     ``pressures = (low, high)`` [Pa] gives its ends; otherwise ``relative = (low, high)`` does,
     in units of ``E* h'_rms`` (``h'_rms = surface.stats.rms_slope``).
     """
-    n = check_int("n_pressures", n, minimum=2)
+    n = check_int("n", n, minimum=2)
     E_star = check_positive("E_star", E_star)
     if pressures is not None:
         name, (low, high), unit = "pressures", pressures, 1.0
     else:
         name, (low, high), unit = "relative", relative, E_star * surface.stats.rms_slope
+        if not 0 < unit < math.inf:
+            fail(name, relative, f"used with a surface of rms slope > 0 (this one's is {surface.stats.rms_slope!r}: "
+                                 "it is flat); give the pressures themselves")
     low, high = check_positive(f"{name}[0]", low), check_positive(f"{name}[1]", high)
     if high <= low:
-        fail(f"{name}[1]", high, f"> {name}[0] = {low!r}")
+        fail(name, (low, high), "increasing: (low, high) with low < high")
     return np.geomspace(low, high, n) * unit
 
 

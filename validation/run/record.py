@@ -112,7 +112,7 @@ class RunResult(_Part):
         """
         try:
             data = json.loads(Path(path).read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, RecursionError) as exc:  # RecursionError: nested too deep
             raise ResultFileError(f"{path} is not allowed: it must be a readable JSON file ({exc}).") from None
         return cls.from_json(data, source=str(path))
 

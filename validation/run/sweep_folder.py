@@ -123,7 +123,7 @@ def earlier_points(out, sweep):
         try:
             with open(path, encoding="utf-8") as fh:
                 data = json.load(fh)
-        except (OSError, ValueError):
+        except (OSError, ValueError, RecursionError):  # RecursionError: nested too deep
             data = None
         old = data.get("sweep") if isinstance(data, dict) else None
         ok = isinstance(old, dict) and old.get("fingerprint") == sweep["fingerprint"]

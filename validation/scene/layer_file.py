@@ -19,10 +19,10 @@ A sweep hashes the file's contents (every key ``file``, :mod:`validation.run.swe
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 
 from . import checks as ck
+from .source import read_toml
 
 __all__ = ["is_layer_file", "resolve_layer_file", "read_layer_file", "E_STAR_RTOL", "EXCLUSIVE"]
 
@@ -76,10 +76,7 @@ def read_layer_file(d, E_star=None):
     path = Path(file)
     if not path.is_file():
         _fail(file, "there is no such file (a relative name starts from the scene file's folder)")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        _fail(file, f"it must be a readable TOML table file ({type(exc).__name__})")
+    data = read_toml(path, f"layer.file = {file!r}")
     layer = data.get("layer")
     if not isinstance(layer, dict) or layer.get("law") != "tabulated" or not {"p", "w"} <= layer.keys():
         _fail(file, "it must hold a [layer] table with law = 'tabulated', p and w (a layer law file: "

@@ -92,7 +92,7 @@ def _self_affine(d):
     for key in ("size", "grid", "hurst", "seed"):
         ck.require("gap", d, key, "a self_affine gap needs size, grid, hurst, seed and rms_height or rms_slope")
     ck.exactly_one("gap", d, ("rms_height", "rms_slope"), "rms height [length] or rms slope [-]")
-    kw = {"size": _pair("gap.size", d["size"], ck.positive),
+    kw = {"size": _pair("gap.size", d["size"], ck.scale),
           "grid": _pair("gap.grid", d["grid"], partial(ck.integer, minimum=rough.MIN_POINTS, maximum=8192)),
           "seed": ck.integer("gap.seed", d["seed"], 0)}
     kw.update({k: d[k] for k in ("hurst", "rms_height", "rms_slope", "long_cutoff", "short_cutoff", "rolloff")

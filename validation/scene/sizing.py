@@ -102,7 +102,7 @@ def _extent(d, gap, axes):
                                    lambda p, v: ck.in_range(p, v, 1.0, 100.0))
         lx, ly = region_limit(gap)
         return (min(fx * axes[0], lx), min(fy * axes[1], ly)), True
-    ex, ey = ck.number_or_pair("bem.extent", d["extent"], ck.positive)
+    ex, ey = ck.number_or_pair("bem.extent", d["extent"], ck.scale)
     if hasattr(gap, "check_region"):  # measured data: their own rule (bem.gaps.Measured.check_region)
         with ck.scene_errors():
             gap.check_region(d["extent"], name="bem.extent")
@@ -148,7 +148,7 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
             raise ck.SceneError(f"bem.{a} = {d[a]!r} and bem.{b} = {d[b]!r} are not allowed together: "
                                 "give one of them.")
     out = solver_options(d, layer_spec)
-    step = ck.positive("bem.step", d["step"]) if "step" in d else None
+    step = ck.scale("bem.step", d["step"]) if "step" in d else None
     n_across = ck.integer("bem.nodes_across", d.get("nodes_across", DEFAULT_NODES_ACROSS), 4, 2000)
     axes = _expected(gap, layer_spec, layer, E_star, load)
     if axes is None and ("step" not in d or "extent" not in d):
@@ -163,7 +163,7 @@ def bem_options(d, gap, layer_spec, layer, E_star, load):
     extent, auto = _extent(d, gap, axes)
     n = node_count(step, extent)
     key = "step" if "step" in d else "nodes_across"
-    with ck.scene_errors():
+    with ck.scene_errors("bem."):
         check_node_count(f"bem.{key}", d.get(key, n_across), n)  # bem's memory guard, before building
         Lattice.from_extent(step, extent)
     out.update(step=step, extent=extent, extent_auto=auto, expected=axes,

@@ -7,7 +7,9 @@ from importlib import resources
 from pathlib import Path
 
 from ..provenance import display_path
-from .checks import SceneError
+from bem.checks import check_file_name
+
+from .checks import SceneError, scene_errors
 
 __all__ = ["builtin_dir", "builtin_scenes", "builtin_path", "read_toml", "read_source", "MAX_DEPTH"]
 
@@ -53,15 +55,16 @@ def _depth(value):
     return deepest
 
 
-def read_toml(path):
-    """The content of a scene file: UTF-8 TOML, arrays and tables nested at most :data:`MAX_DEPTH` deep.
+def read_toml(path, name=None):
+    """The content of a scene file (or a file it names): UTF-8 TOML, arrays and tables nested at most
+    :data:`MAX_DEPTH` deep; ``name`` is the file in messages (default ``"scene file 'path'"``).
 
     Raises
     ------
     SceneError
         An unreadable file, another encoding than UTF-8, invalid TOML or too deep a nesting.
     """
-    name = f"scene file {str(path)!r}"
+    name = f"scene file {str(path)!r}" if name is None else name
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
@@ -86,6 +89,8 @@ def read_toml(path):
 
 def read_source(source):
     """``(raw, label, folder)`` of a built-in name or a TOML file."""
+    with scene_errors():
+        check_file_name("scene", source)
     path = Path(source)
     if path.suffix == ".toml" or path.exists():
         if not path.is_file():

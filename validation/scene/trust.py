@@ -25,6 +25,9 @@ import re
 from collections.abc import Mapping
 from pathlib import Path
 
+from bem.checks import check_file_name
+
+from . import checks as ck
 from .checks import SceneError
 
 __all__ = ["code_names", "check_code_name", "refuse_code", "scene_file", "CODE_FLAG", "FILES_FLAG"]
@@ -95,6 +98,8 @@ def scene_file(key, name, base_dir, *, allow_outside=False):
         A name whose real path (symbolic links followed) leaves ``base_dir``, without
         ``allow_outside``.
     """
+    with ck.scene_errors():
+        check_file_name(key, name)
     base = Path(base_dir).absolute()
     if allow_outside:
         return str(base / Path(name).expanduser())

@@ -149,7 +149,7 @@ def _load_rows(res):
 
 def scene_section(res, work):
     """The problem statement: the effective scene's inputs (``work``: unused, no figure)."""
-    meta, law = res.section("scene"), getattr(res.layer, "law", None)
+    meta, law = res.section("scene"), res.law
     text = [str(meta["description"])] if meta.get("description") else []
     text.append("Frictionless normal contact of two elastic half-spaces whose surfaces are separated by the "
                 "initial gap h(x, y)" + (", with an interface layer between them whose closure w(p) depends "

@@ -157,6 +157,13 @@ class RunResults:
         """Axisymmetric scenes record ``contact_radius``."""
         return self.result.axisymmetric
 
+    @property
+    def law(self):
+        """The name of the layer law the run used, as it recorded it (``result.layer["law"]``), or ``None``
+        (smooth bodies): it holds when the law cannot be rebuilt (:attr:`layer` ``None``)."""
+        law = (getattr(self.result, "layer", None) or {}).get("law")
+        return None if law in (None, "none") else str(law)
+
     @functools.cached_property
     def layer(self):
         """The :class:`bem.layers.Layer` the run used, or ``None`` (smooth bodies, not rebuildable, or a
@@ -258,7 +265,7 @@ def read_json(path):
     """The JSON content of ``path``; InputError when it cannot be read."""
     try:
         return json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, RecursionError) as exc:  # RecursionError: nested too deep
         raise InputError(f"{path} is not allowed: it must be a readable JSON file ({exc}).") from None
 
 

@@ -2,8 +2,9 @@
 
 Reads ``summary.json`` (the table of points) and ``points/point-*.json`` (each point's scene
 and full result, the axial section included) and builds: the problem statement of the first
-point, a table of every point, the axial-section pressure of every point coloured by the swept
-value, and the peak pressure, contact size and approach against that value. Units as in a run's
+point, the layer law ``w(p)`` of a layered scene (every point's when the sweep changes it), a
+table of every point, the axial-section pressure of every point coloured by the swept value, and
+the peak pressure, contact size and approach against that value. Units as in a run's
 report (:meth:`validation.report.documents.results.RunResults.display`): readable ones (mm and
 MPa for SI scenes) or the scene's, one per quantity in every table and figure; a dimensionless
 report divides each point's profile by its own scales and shows the table, the swept values and
@@ -115,7 +116,7 @@ def _key_unit(key, res):
     kind = _KEY_KINDS.get(key.rsplit(".", 1)[-1])
     if kind == "compliance":
         power = {"root": 0.5, "power": float((res.section("layer") or {}).get("s", 1.0))}.get(
-            getattr(res.layer, "law", None), 1.0)
+            res.law, 1.0)
         (lf, lu), (pf, pu) = res.engineering("length"), res.engineering("pressure")
         factor, unit = lf / pf**power, f"{lu}/{pu}" + ("" if power == 1.0 else f"^{power:g}") if lu and pu else ""
     else:
@@ -184,10 +185,42 @@ def sweep_section(sweep, work):
                    items=(_table(summary, points), *_figures(summary, points, Path(work))))
 
 
+def _layer_section(summary, points, work):
+    """The section "Interface layer law" of a layered sweep: the first computed point's law ``w(p)``
+    as in a run's report, or, when the points' laws differ (a swept layer key), every point's law."""
+    from ..figures.profiles import plot_layer_laws
+    from ..figures.run import Scaled, layer_law
+
+    done = [(row, res) for row, res in points if res is not None and res.layer is not None]
+    if not done:
+        return None
+    laws = {repr(res.layer.to_dict()): (row, res) for row, res in done}
+    if len(laws) == 1:
+        figure = layer_law(done[0][1], work)
+    else:  # readable units, the same for every point
+        first, key = done[0][1], str(summary.get("key", "value"))
+        (pf, pu), (lf, lu), (vf, _) = first.engineering("pressure"), first.engineering("length"), _key_unit(key, first)
+        top = 1.25 * max(float(v or 0.0) for _, res in laws.values()  # as the run's figure: peaks and kinks
+                         for v in (res.result.p_max, *map(res.layer.to_dict().get, ("p_cr", "p_star"))))
+        drawn = [(f"{key} = {fmt(row['value'] / vf if is_number(row['value']) else row['value'])}",
+                  Scaled(res.layer, pf, lf)) for row, res in laws.values()]
+        for _, law in drawn:
+            law.law = None  # coloured by point, not by the law's name (one name for all)
+        path = plot_layer_laws(drawn, work / "sweep_layer_laws.png", p_max=top / pf, p_unit=pu, w_unit=lu,
+                               title=f"interface layer law w(p) as {key} varies")
+        figure = Figure(path, f"The layer law w(p) of each computed point ({len(laws)} laws), rebuilt from the "
+                              "points' results with bem.layers.from_dict, from 0 to 1.25 times the largest peak "
+                              "pressure or kink pressure of the points.")
+    return Section("Interface layer law", kind="problem", items=(figure,)) if figure is not None else None
+
+
 def sweep_sections(summary, points, work):
-    """The report sections of a loaded sweep: the first point's problem statement and the sweep."""
+    """The report sections of a loaded sweep: the first point's problem statement, the layer law(s) w(p)
+    of a layered scene, and the sweep."""
     first = next((res for _, res in points if res is not None), None)
-    return ([scene_section(first, work)] if first is not None else []) + [sweep_section(Sweep(summary, points), work)]
+    layer = _layer_section(summary, points, Path(work))
+    return (([scene_section(first, work)] if first is not None else []) + ([layer] if layer is not None else [])
+            + [sweep_section(Sweep(summary, points), work)])
 
 
 def report_sweep_dir(directory, out_dir=None, *, units="auto", fmt="png", progress=None):
