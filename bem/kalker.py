@@ -19,11 +19,13 @@ import numpy as np
 from .backend import operator_backend
 
 
-__all__ = ["QPSolution", "solve_qp", "compliance_preconditioner"]
+__all__ = ["QPSolution", "solve_qp", "constrained_cg", "compliance_preconditioner", "initial_pressure", "stopping_rule",
+           "entering_pressure", "RECOMPUTE_EVERY"]
 
 log = logging.getLogger(__name__)
 
-_RECOMPUTE_EVERY = 20  # exact C p every so many incremental updates
+#: An exactly recomputed ``C p`` every so many incremental updates of the constrained CG.
+RECOMPUTE_EVERY = 20
 
 
 @dataclass
@@ -67,7 +69,10 @@ def _median(bk, values):
     return float(v[n // 2]) if n % 2 else float(bk.xp.mean(v[n // 2 - 1 : n // 2 + 1]))
 
 
-def _initial(op, h, lam, force, approach, x0):
+def initial_pressure(op, h, lam, force, approach, x0):
+    """The starting pressure of the constrained CG (brick array): ``x0`` clipped at 0, or under force
+    control a uniform pressure on the quarter of the nodes with the smallest gap, or under approach
+    control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``."""
     lat = op.lattice
     bk, mask = operator_backend(op)
     xp = bk.xp
@@ -89,11 +94,18 @@ def _initial(op, h, lam, force, approach, x0):
     return p
 
 
+def entering_pressure(xp, g, tau, jacobi, per_node):
+    """Pressure of the nodes that enter the contact (``p = 0``, gap ``g < 0``): Polonsky-Keer's
+    ``-tau g``, capped by the Jacobi estimate ``-g / (C_nn + lam)`` (``jacobi = 1 / (C_nn + lam)``,
+    an array where ``per_node``) so that a node with a large layer compliance cannot overshoot."""
+    return -g * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi)
+
+
 def _per_node(lam):
     return getattr(lam, "ndim", 0) > 0
 
 
-def _stopping(kkt, rtol):
+def stopping_rule(kkt, rtol):
     """``(converged, message, status)`` of the QP's stopping rule at the KKT residual ``kkt``
     (non-finite: ``nonfinite``; ``kkt <= rtol``: ``converged``), ``None`` to go on."""
     if not math.isfinite(kkt):
@@ -171,7 +183,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
     if u0 is None or x0 is None:
-        p = xp.where(mask, _initial(op, h, lam, force, approach, x0), 0.0)
+        p = xp.where(mask, initial_pressure(op, h, lam, force, approach, x0), 0.0)
         if target is not None:
             p = p if float(xp.sum(p)) > 0 else xp.astype(mask, bk.float64)
             p *= target / float(xp.sum(p))
@@ -243,7 +255,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         hist["p_max"].append(bk.max0(p_c0))
         hist["n_contact"].append(n_idx)
         hist["changes"].append(changes)
-        if (stop := _stopping(kkt, rtol)) is not None:
+        if (stop := stopping_rule(kkt, rtol)) is not None:
             converged, message, status = stop
             break
         if n_idx == 0:
@@ -295,8 +307,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         n_overlap = bk.count(overlap)
         if n_overlap:
             lam_o = bk.take(lam, overlap) if per_node else lam
-            jacobi = 1.0 / (op.diagonal + lam_o)
-            bk.put(p_new, overlap, -bk.take(g, overlap) * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi))
+            bk.put(p_new, overlap, entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o), per_node))
         restart = bool(n_overlap)
         s = 1.0
         if target is not None:
@@ -307,7 +318,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 bk.put(p_new, idx, bk.take(p_new, idx) * s)
                 entering = bk.subset(overlap, ~bk.take(contact, overlap))  # a clipped contact node may re-enter
                 bk.put(p_new, entering, bk.take(p_new, entering) * s)
-        if bool(xp.any(clipped)) or restart or stale >= _RECOMPUTE_EVERY:
+        if bool(xp.any(clipped)) or restart or stale >= RECOMPUTE_EVERY:
             u, stale = apply(p_new), 0
         else:
             r *= tau
@@ -325,6 +336,20 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
                       message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)
+
+
+def constrained_cg(op, h, *, lam=0.0, precondition=True, contact=None, **kw):
+    """:func:`solve_qp` with the preconditioner of ``op``: the FFT inverse of ``C + lam``
+    (:meth:`bem.operator.InfluenceOperator.preconditioner`) for a uniform ``lam``, and
+    :func:`compliance_preconditioner` on ``contact`` for a ``lam`` per node; none unless
+    ``precondition``. The constrained-CG step of an operator without one of its own."""
+    if not precondition:
+        precond = None
+    elif _per_node(lam):
+        precond = compliance_preconditioner(op, lam, contact)
+    else:
+        precond = op.preconditioner(lam=lam)
+    return solve_qp(op, h, lam=lam, preconditioner=precond, **kw)
 
 
 def compliance_preconditioner(op, D, contact, threshold=4.0):

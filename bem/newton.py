@@ -29,7 +29,7 @@ import numpy as np
 from .brent import brent_root
 from .backend import backend_of, operator_backend
 from .layers.device import device_layer
-from .kalker import QPSolution, compliance_preconditioner, solve_qp
+from .kalker import QPSolution, solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 
@@ -87,20 +87,9 @@ def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
 
 
 def _model_qp(op, b, D, contact, precondition, **kw):
-    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one).
-
-    On a periodic cell on NumPy the QP in the Fourier basis (:func:`bem.periodic.qp.solve_periodic_qp`,
-    the same preconditioner), else :func:`bem.kalker.solve_qp` with
-    :func:`bem.kalker.compliance_preconditioner`.
-    """
-    from .periodic import PeriodicOperator
-
-    if precondition and isinstance(op, PeriodicOperator) and op.backend.is_numpy:
-        from .periodic.qp import solve_periodic_qp
-
-        return solve_periodic_qp(op, b, lam=D, **kw)
-    return solve_qp(op, b, lam=D, preconditioner=compliance_preconditioner(op, D, contact) if precondition else None,
-                    **kw)
+    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one):
+    the operator's own constrained-CG step (``op.qp``, :meth:`bem.operator.InfluenceOperator.qp`)."""
+    return op.qp(b, lam=D, precondition=precondition, contact=contact, **kw)
 
 
 def _count_inner(hist, sub):
