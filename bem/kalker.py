@@ -216,14 +216,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     # With a per-node compliance the preconditioner holds Jacobi blocks that differ by
     # decades, and plain mean subtraction would wreck it: project obliquely. For a uniform
     # compliance the FFT preconditioner is translation invariant and the mean is cheaper
-    # (measured on Hertz, 1,050,113 nodes: 15 iterations and 3.7 s against 21 and 6.6 s).
+    # (fewer iterations on the Hertz problem of benchmarks/bem_hertz.py).
     oblique = per_node
     # The conjugate-gradient vectors live on the contact set: they are kept compact, at the
     # flat indices idx of the contact nodes, and spread to brick arrays only for the FFT
     # products; full-array work is left to the gap, the KKT check, the overlap search and the
     # displacement update. Gathers and scatters go through the backend's node selections (on
-    # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: 0.1-0.3 ms on 86,000
-    # of 170,000 nodes against 0.9-1.9 ms through x.flat[idx]).
+    # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: several times faster
+    # than x.flat[idx]).
     for k in range(1, maxiter + 1):
         contact = p > 0
         idx = bk.select(contact)

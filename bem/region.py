@@ -149,7 +149,7 @@ class HalfSpaceRegion:
 
     def refine(self, coarse, p, fine):
         """The coarse solution interpolated onto the next finer lattice."""
-        return coarse.prolong(p, fine)  # = coarse.interpolate(p, fine.x, fine.y) * fine.mask, 5-20x faster
+        return coarse.prolong(p, fine)  # = coarse.interpolate(p, fine.x, fine.y) * fine.mask, by slices
 
     def check_solution(self, lattice, p):
         """Raise :class:`bem.RegionTooSmallError` when the contact reaches the border of the region."""
