@@ -95,3 +95,15 @@ def test_growth_stops_at_the_end_of_the_gaps_domain():
 def test_x0_is_refused_with_a_growing_region():
     with pytest.raises(bem.InputError, match="^x0 is not allowed with HalfSpaceRegion"):
         bem.solve(Paraboloid(1.0), domain=bem.HalfSpaceRegion(0.05), E_star=1.0, force=1e-3, x0=np.zeros(3))
+
+
+def test_the_checks_table_has_a_row_for_every_argument_of_solve():
+    """docs/method.md, "Checks of bem.solve": one row per keyword of bem.solve, and no other."""
+    import inspect
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "method.md").read_text(encoding="utf-8")
+    table = text.split("#### Checks of `bem.solve`", 1)[1].split("\n## ", 1)[0]
+    rows = {m.group(1) for m in re.finditer(r"^\| `([^`]+)` \|", table, re.M)}
+    assert rows == set(inspect.signature(bem.solve).parameters)
