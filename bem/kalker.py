@@ -20,7 +20,7 @@ from .backend import operator_backend
 
 
 __all__ = ["QPSolution", "solve_qp", "constrained_cg", "compliance_preconditioner", "initial_pressure", "stopping_rule",
-           "entering_pressure", "RECOMPUTE_EVERY"]
+           "entering_pressure", "iterate_residual", "RECOMPUTE_EVERY"]
 
 log = logging.getLogger(__name__)
 
@@ -103,6 +103,21 @@ def entering_pressure(xp, g, tau, jacobi, per_node):
 
 def _per_node(lam):
     return getattr(lam, "ndim", 0) > 0
+
+
+def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None):
+    """The KKT residual of an iterate (:func:`bem.kkt.kkt_residual` from its parts; non-finite: ``inf``).
+
+    ``max(max_contact |g|, (-min g)_+) / scale`` (every contact node has ``-g <= max_contact |g|``), with
+    ``contact_gap = max_contact |g|``, ``gap_min = min g``, ``scale`` the displacement scale and
+    ``gap_max()`` the largest ``|g|``, the scale where ``scale`` is not positive (or 1); under force
+    control the larger of that and ``force_error = |a sum p - P| / P``.
+    """
+    parts = [contact_gap, -gap_min, 0.0]
+    kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) / (scale if scale > 0 else gap_max() or 1.0)
+    if force_error is not None:
+        kkt = float(np.max([kkt, force_error]))
+    return kkt if math.isfinite(kkt) else np.inf
 
 
 def stopping_rule(kkt, rtol):
@@ -239,13 +254,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         # kkt_residual(p[mask], g[mask], ...) without the copies: p = g = 0 off the mask, p >= 0,
         # and max(max_contact |g|, max_free (-g)+) = max(max_contact |g|, (-min g)+) because
         # contact nodes have -g <= max_contact |g|
-        parts = [bk.max0(xp.abs(g_c)), -float(xp.min(g)), 0.0]
-        kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) \
-            / (scale if scale > 0 else float(xp.max(xp.abs(g))) or 1.0)
-        if force is not None:
-            kkt = float(np.max([kkt, abs(a * float(xp.sum(p_c0)) - force) / force]))
-        if not math.isfinite(kkt):
-            kkt = np.inf
+        kkt = iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(g)), scale, lambda: float(xp.max(xp.abs(g))),
+                               None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
         if kkt <= rtol and stale and confirm:
             u, stale = apply(p), 0  # confirm on an exact product
             continue

@@ -50,7 +50,7 @@ import math
 
 import numpy as np
 
-from ..kalker import RECOMPUTE_EVERY, QPSolution, entering_pressure, initial_pressure, stopping_rule
+from ..kalker import RECOMPUTE_EVERY, QPSolution, entering_pressure, initial_pressure, iterate_residual, stopping_rule
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -180,13 +180,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         g_c -= delta
         scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
         g_min = float(g.min()) - delta
-        parts = [float(np.abs(g_c).max(initial=0.0)), -g_min, 0.0]
-        kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) \
-            / (scale if scale > 0 else float(np.abs(g - delta).max()) or 1.0)
-        if force is not None:
-            kkt = max(kkt, abs(a * float(p_c0.sum()) - force) / force)
-        if not math.isfinite(kkt):
-            kkt = np.inf
+        kkt = iterate_residual(float(np.abs(g_c).max(initial=0.0)), g_min, scale, lambda: float(np.abs(g - delta).max()),
+                               None if force is None else abs(a * float(p_c0.sum()) - force) / force)
         if k == 1:  # single precision pays for its closing product only well above SINGLE_ABOVE
             single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
         if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
