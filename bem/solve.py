@@ -19,7 +19,7 @@ import numpy as np
 
 from .backend import to_host
 from .errors import InputError, RegionTooSmallError
-from .kalker import QPSolution
+from .cg_rules import QPSolution
 from .kkt import kkt_residual
 from .layers import beyond_table
 from .problem import check_problem, initial_guess

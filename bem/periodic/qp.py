@@ -45,16 +45,13 @@ compliance per node).
 
 from __future__ import annotations
 
-import logging
 import math
 
 import numpy as np
 
-from ..kalker import RECOMPUTE_EVERY, QPSolution, entering_pressure, initial_pressure, iterate_residual, stopping_rule
+from ..cg_rules import RECOMPUTE_EVERY, Record, entering_pressure, initial_pressure, iterate_residual
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
-
-log = logging.getLogger(__name__)
 
 SINGLE_ABOVE = 1e-4  # KKT residual above which the products run in single precision
 SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_ABOVE
@@ -96,7 +93,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
 
     Returns
     -------
-    bem.kalker.QPSolution
+    bem.cg_rules.QPSolution
         As :func:`bem.kalker.solve_qp` with its FFT preconditioner; ``op.n_matvec`` counts the
         products ``(C + lam) v`` (spectral multiplications, in single or double precision).
     """
@@ -165,8 +162,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     z_prev = np.zeros(lat.shape)
     gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
     gz_old, m_one, m_full = 1.0, None, None
-    hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
-    converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
+    record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     prev_contact = p > 0
     n_prev = int(np.count_nonzero(prev_contact))
     fixed_scale = scale
@@ -193,15 +189,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         kept = int(np.count_nonzero(prev_contact.reshape(-1)[idx]))  # nodes in both contacts
         changes = (idx.size - kept) + (n_prev - kept)
         prev_contact, n_prev = contact, idx.size
-        hist["residual"].append(kkt)
-        hist["p_max"].append(float(p_c0.max(initial=0.0)))
-        hist["n_contact"].append(int(idx.size))
-        hist["changes"].append(changes)
-        if (stop := stopping_rule(kkt, rtol)) is not None:
-            converged, message, status = stop
-            break
-        if idx.size == 0 and g_min >= 0:  # no contact at this approach: p = 0 is the solution
-            converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
+        if record.stops(kkt, float(p_c0.max(initial=0.0)), int(idx.size), changes, idx.size == 0 and g_min >= 0):
             break
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         r32.fill(0.0)
@@ -249,7 +237,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if not np.any(t_c):
             tau = 0.0  # a single contact node under force control: only entering nodes can move
         elif tt <= 0 or not math.isfinite(tt):
-            message, status = f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
+            record.fail(f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled")
             break
         else:
             tau = gt / tt  # the minimum along t (gt = gz when the contact has not changed)
@@ -270,7 +258,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             total = float(p_c.sum()) + (float(p_o.sum()) if entered else 0.0)
             if not total > 0:  # every node left the contact and none entered: no force to rescale
                 pf[idx] = p_c0
-                message, status = "the iteration produced a non-finite value", "nonfinite"
+                record.fail("the iteration produced a non-finite value", "nonfinite")
                 break
             s = target / total
             p_c *= s
@@ -298,11 +286,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             stale += 1
         if callback is not None:
             callback(k, p.copy())
-    else:
-        message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
-    if not converged:
-        log.debug("Kalker QP (periodic): %s", message)
     # C p: the layer's closure is not a displacement
     elastic = u - (D if per_node else lam) * p if per_node or lam else u.astype(float, copy=False)
-    return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
-                      message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)
+    return record.solution(p, delta, kkt, elastic, "Kalker QP (periodic)")
