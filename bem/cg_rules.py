@@ -14,12 +14,13 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass, field
+from typing import Callable, NamedTuple
 
 import numpy as np
 
 from .backend import operator_backend
 
-__all__ = ["QPSolution", "Record", "initial_pressure", "iterate_residual", "stopping_rule", "entering_pressure",
+__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule", "entering_pressure",
            "is_per_node", "RECOMPUTE_EVERY"]
 
 log = logging.getLogger(__name__)
@@ -174,3 +175,35 @@ class Record:
         return QPSolution(p=p, approach=float(delta), iterations=len(self.history["residual"]),
                           converged=self.converged, message=self.message, status=self.status,
                           kkt_residual=float(kkt), displacement=displacement, history=self.history)
+
+
+class CGStep(NamedTuple):
+    """The operations of one operator's constrained-CG step, in its own basis, for :func:`run_constrained_cg`."""
+
+    measure: Callable  # measure(k) -> the KKT residual of the current iterate (iterate_residual)
+    confirms: Callable  # confirms(kkt) -> True where C p was recomputed exactly and the iterate is measured again
+    observe: Callable  # observe() -> (p_max, n_contact, changes, no_contact) of the iterate, for Record.stops
+    advance: Callable  # advance(k) -> None after the step of iteration k, or (message, status) where no step can be taken
+    report: Callable  # report() -> the pressure for the callback
+
+
+def run_constrained_cg(step, record, maxiter, callback=None):
+    """The one loop of the constrained conjugate gradients of Kalker's QP (Polonsky & Keer 1999).
+
+    Each iteration measures the iterate (its KKT residual), confirms a residual at the tolerance on an
+    exact product, records it and stops by the one stopping rule (:meth:`Record.stops`), or takes a
+    step (``step.advance``) and reports the pressure to ``callback(k, p)``. Returns the last residual.
+    """
+    kkt = np.inf
+    for k in range(1, maxiter + 1):
+        kkt = step.measure(k)
+        if step.confirms(kkt):
+            continue
+        if record.stops(kkt, *step.observe()):
+            break
+        if (failure := step.advance(k)) is not None:
+            record.fail(*failure)
+            break
+        if callback is not None:
+            callback(k, step.report())
+    return kkt

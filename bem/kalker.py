@@ -5,7 +5,9 @@ force control (``a sum p = P``, eq. 9, ``delta`` is the multiplier) or approach
 control (``delta`` given). Solved by constrained conjugate gradients on the
 active set (Polonsky & Keer 1999, doi:10.1016/S0043-1648(99)00113-1), with an
 optional FFT preconditioner built from the inverse symbol of ``C + lam`` in
-the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005).
+the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005). :func:`solve_qp` is the step
+of the half-space operator (and of any operator on a device other than NumPy) in the one loop
+:func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
 """
 
 from __future__ import annotations
@@ -15,7 +17,8 @@ import math
 import numpy as np
 
 from .backend import operator_backend
-from .cg_rules import RECOMPUTE_EVERY, Record, entering_pressure, initial_pressure, is_per_node, iterate_residual
+from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, entering_pressure, initial_pressure, is_per_node, iterate_residual,
+                       run_constrained_cg)
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
@@ -137,7 +140,10 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     # displacement update. Gathers and scatters go through the backend's node selections (on
     # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: several times faster
     # than x.flat[idx]).
-    for k in range(1, maxiter + 1):
+    contact = idx = n_idx = g = g_c = p_c0 = changes = None
+
+    def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
+        nonlocal contact, idx, n_idx, g, delta, g_c, p_c0
         contact = p > 0
         idx = bk.select(contact)
         n_idx = bk.count(idx)
@@ -152,15 +158,24 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         # kkt_residual(p[mask], g[mask], ...) without the copies: p = g = 0 off the mask, p >= 0,
         # and max(max_contact |g|, max_free (-g)+) = max(max_contact |g|, (-min g)+) because
         # contact nodes have -g <= max_contact |g|
-        kkt = iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(g)), scale, lambda: float(xp.max(xp.abs(g))),
-                               None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
+        return iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(g)), scale, lambda: float(xp.max(xp.abs(g))),
+                                None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
+
+    def confirms(kkt):  # an incrementally updated C p at the tolerance: recompute it and measure again
+        nonlocal u, stale
         if kkt <= rtol and stale and confirm:
-            u, stale = apply(p), 0  # confirm on an exact product
-            continue
+            u, stale = apply(p), 0
+            return True
+        return False
+
+    def observe():
+        nonlocal changes, prev_contact
         changes = int(xp.count_nonzero(contact != prev_contact))
         prev_contact = contact
-        if record.stops(kkt, bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0):
-            break
+        return bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0
+
+    def advance(k):  # one step of the constrained CG; (message, status) where it cannot be taken
+        nonlocal m_one, gz_old, t, restart, u, stale, p
         if preconditioner is None:
             z = bk.copy(g_c)
             if force is not None:
@@ -191,8 +206,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             # force: only nodes entering the contact (below) can move the iterate
             tau = 0.0
         elif tt <= 0 or not math.isfinite(tt):
-            record.fail(f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled")
-            break
+            return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
         else:
             tau = gz / tt
         p_c = p_c0 - tau * t_c
@@ -226,8 +240,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 u *= s
             stale += 1
         p = p_new
-        if callback is not None:
-            callback(k, p)
+        return None
+
+    kkt = run_constrained_cg(CGStep(measure, confirms, observe, advance, lambda: p), record, maxiter, callback)
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return record.solution(p, delta, kkt, elastic, "Kalker QP")
 
