@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..checks import fail
+from ..checks import check_node_count, fail
 from ..errors import InputError
 from .cell import PeriodicCell
 from .result import PeriodicContactResult
@@ -54,6 +54,7 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
         shape = np.shape(gap)
         if len(shape) != 2:
             fail("gap", f"<array of shape {shape}>", "a brick array of shape (n_rows, n_cols) or a callable")
+        check_node_count("gap", f"<array of shape {shape}>", shape[0] * shape[1])
         if step is None:
             fail("step", step, "given with a gap array (the lattice step c)")
         cell = PeriodicCell(step, shape[1], shape[0])
