@@ -86,10 +86,17 @@ def initial_pressure(op, h, lam, force, approach, x0):
     return p
 
 
-def entering_pressure(xp, g, tau, jacobi, per_node):
-    """Pressure of the nodes that enter the contact (``p = 0``, gap ``g < 0``): Polonsky-Keer's
-    ``-tau g``, capped by the Jacobi estimate ``-g / (C_nn + lam)`` (``jacobi = 1 / (C_nn + lam)``,
-    an array where ``per_node``) so that a node with a large layer compliance cannot overshoot."""
+def entering_pressure(xp, g, tau, jacobi, per_node, preconditioned=False):
+    """Pressure of the nodes that enter the contact (``p = 0``, gap ``g < 0``), with ``jacobi = 1 / (C_nn + lam)``
+    (an array where ``per_node``) and ``tau`` the step of the iteration (0: none).
+
+    A step along the gap itself (``preconditioned`` False) gives Polonsky-Keer's ``-tau g``, capped by the
+    Jacobi estimate ``-g / (C_nn + lam)`` so that a node with a large layer compliance cannot overshoot.
+    A step along the preconditioned gap ``M g`` has a dimensionless ``tau``: the entering node takes
+    that step with the Jacobi estimate of ``M`` there, ``-min(tau, 1) g / (C_nn + lam)``.
+    """
+    if preconditioned:
+        return -g * jacobi * (min(tau, 1.0) if tau > 0 else 1.0)
     return -g * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi)
 
 
