@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_bool, check_choice, check_gap_values, check_int, check_positive, fail
+from ..checks import check_bool, check_choice, check_gap_values, check_int, check_node_count, check_positive, fail
 from ..errors import InputError
 from ..kkt import kkt_residual
 from ..options import METHODS, check_options, solver_for
@@ -88,6 +88,7 @@ def _cell_and_gap(gap, step, cell):
     h = np.asarray(gap, dtype=float) if not isinstance(gap, np.ndarray) else gap.astype(float, copy=False)
     if h.ndim != 2:
         fail("gap", f"<array of shape {h.shape}>", "a brick array of shape (n_rows, n_cols) or a callable")
+    check_node_count("gap", f"<array of shape {h.shape}>", h.size, what="the periodic cell")
     if step is None:
         fail("step", step, "given with a gap array (the lattice step c)")
     cell = PeriodicCell(step, h.shape[1], h.shape[0])
