@@ -56,8 +56,8 @@ class PeriodicCell:
     n_cols : int
         Nodes per row, >= 4.
     n_rows : int
-        Rows, even, >= 2; at most :data:`bem.checks.MAX_NODES` nodes in all (the limit of
-        :func:`bem.checks.check_node_count`, as for a half-space region).
+        Rows, even, >= 2; ``n_cols n_rows`` at most :data:`bem.checks.MAX_NODES` (the memory guard
+        of :func:`bem.solve`, as for a half-space region).
     """
 
     step: float
@@ -70,8 +70,8 @@ class PeriodicCell:
         n_rows = check_int("n_rows", self.n_rows, minimum=2)
         if n_rows % 2:
             fail("n_rows", n_rows, "even (the triangular lattice repeats every two rows)")
+        check_node_count("(n_cols, n_rows)", (self.n_cols, n_rows), self.n_cols * n_rows, what="the periodic cell")
         object.__setattr__(self, "n_rows", n_rows)
-        check_node_count("(n_cols, n_rows)", (self.n_cols, n_rows), self.n_cols * n_rows)
 
     @classmethod
     def from_size(cls, step, size):
@@ -82,7 +82,9 @@ class PeriodicCell:
         """
         step = check_positive("step", step)
         lx, ly = (check_positive("size", v) for v in (size if np.ndim(size) else (size, size)))
-        return cls(step, max(4, int(round(lx / step))), rows_for(step, ly))
+        n_cols, n_rows = max(4, int(round(lx / step))), rows_for(step, ly)
+        check_node_count("step", step, n_cols * n_rows, what="the periodic cell")
+        return cls(step, n_cols, n_rows)
 
     result_class = PeriodicContactResult
 

@@ -54,7 +54,7 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
         shape = np.shape(gap)
         if len(shape) != 2:
             fail("gap", f"<array of shape {shape}>", "a brick array of shape (n_rows, n_cols) or a callable")
-        check_node_count("gap", f"<array of shape {shape}>", shape[0] * shape[1])
+        check_node_count("gap", f"<array of shape {shape}>", shape[0] * shape[1], what="the periodic cell")
         if step is None:
             fail("step", step, "given with a gap array (the lattice step c)")
         cell = PeriodicCell(step, shape[1], shape[0])

@@ -93,7 +93,7 @@ def test_a_layer_law_folder_is_replaced_by_a_new_run(tmp_path):
     (("--synthetic", SYNTHETIC, "--p-range", "1e9:1e8"), "pressures[1] = 100000000.0 is not allowed: it must be >"),
     (("--synthetic", SYNTHETIC, "--p-range", "1e9"), "--p-range = '1e9' is not allowed"),
     (("--synthetic", SYNTHETIC, "--scale", "1e-6"), "--scale = 1e-06 is not allowed with --synthetic"),
-    (("--synthetic", SYNTHETIC, "--n-cols", "0"), "n_cols"),
+    (("--synthetic", SYNTHETIC, "--n-cols", "0"), "--n-cols = 0 is not allowed"),
     (("--synthetic", SYNTHETIC, "--rtol", "-1"), "rtol = -1.0 is not allowed"),
     (("no_such_file.x3p",), "no_such_file.x3p"),
 ])
