@@ -37,6 +37,7 @@ __all__ = [
     "RTOL_MAX",
     "SCALE_RANGE",
     "MAX_NODES",
+    "BYTES_PER_NODE",
 ]
 
 #: Loosest tolerance on the KKT residual (:func:`bem.kkt.kkt_residual`) that :func:`bem.solve`
@@ -47,10 +48,13 @@ RTOL_MAX = 1e-2
 #: the problem multiplies and divides them (``P R / E*``, ``C = c / (pi E*)``, ...), and beyond
 #: this range float64 overflows or underflows before an answer is reached.
 SCALE_RANGE = (1e-60, 1e60)
-#: Largest candidate region, in lattice nodes (a memory guard): a solve holds about 0.4 kB per
+#: Largest lattice, in nodes (a memory guard): a solve holds about :data:`BYTES_PER_NODE` per
 #: node at its peak (``python benchmarks/bem_hertz.py`` reports the peak RSS), so the limit is
-#: about 6.5 GB.
+#: about 6.4 GB. The one limit of :func:`bem.solve` (the candidate region) and
+#: :func:`bem.solve_periodic` (the cell), checked by :func:`check_node_count`.
 MAX_NODES = 16_000_000
+#: Peak memory of a solve per lattice node [bytes] (:data:`MAX_NODES`).
+BYTES_PER_NODE = 400
 
 
 def fail(name, value, rule):
@@ -117,13 +121,26 @@ def check_file_name(name, value):
     return value
 
 
-def check_node_count(name, value, n_nodes):
-    """Raise unless a candidate region of ``n_nodes`` nodes is at most :data:`MAX_NODES`;
-    ``name = value`` is the argument blamed (the step, or what set it)."""
+def check_node_count(name, value, n_nodes, *, what="the candidate region"):
+    """Return ``n_nodes``; raise unless it is at most :data:`MAX_NODES`: the memory guard of
+    :func:`bem.solve` and :func:`bem.solve_periodic`, checked before anything is built.
+
+    Parameters
+    ----------
+    name, value
+        The argument blamed, as the caller's user wrote it (``"step"``, ``"--n-cols"``,
+        ``"bem.cell_nodes"``), and its value.
+    n_nodes : int
+        The nodes that ``value`` gives, counted without building them.
+    what : str
+        What holds the nodes, for the message (``"the periodic cell"``).
+    """
     if n_nodes > MAX_NODES:
-        raise InputError(f"{name} = {value!r} is not allowed: the candidate region would hold {float(n_nodes):.3g} "
-                         f"nodes (limit {MAX_NODES:.3g}, about 0.4 kB each); make the lattice coarser or the region "
-                         "smaller.")
+        need, limit = (n * BYTES_PER_NODE / 1e9 for n in (float(n_nodes), MAX_NODES))
+        raise InputError(f"{name} = {value!r} is not allowed: {what} would hold {float(n_nodes):.3g} nodes "
+                         f"(limit {MAX_NODES:.3g}, about {BYTES_PER_NODE / 1e3:g} kB each), which need about "
+                         f"{need:.3g} GB of memory ({limit:.2g} GB at the limit); make the lattice coarser or "
+                         f"{what} smaller.")
     return n_nodes
 
 

@@ -29,6 +29,8 @@ boundaries split per body (``interface_upper``, ``interface_lower``,
 from __future__ import annotations
 
 import logging
+import signal
+import threading
 import time
 from dataclasses import dataclass, field
 
@@ -242,6 +244,29 @@ def _to_skfem(xy, parts):
     return mesh, body, np.hstack(n6_blocks), np.hstack(c6_blocks)
 
 
+def _start_gmsh(gmsh):
+    """``gmsh.initialize``, keeping the process's ``SIGINT`` and ``SIGTERM`` handlers.
+
+    The gmsh library installs handlers of its own when it starts (its ``SIGTERM`` handler ends the
+    process at once, with no clean-up); the Python handlers are put back, the two signals blocked
+    meanwhile so that one arriving then reaches them (main thread; another cannot set handlers).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
+        return
+    signums = {signal.SIGINT, signal.SIGTERM}
+    handlers = {signum: signal.getsignal(signum) for signum in signums}
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, signums) if hasattr(signal, "pthread_sigmask") else None
+    try:
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
+    finally:
+        for signum, handler in handlers.items():
+            if handler is not None:  # None: a handler not installed from Python, left as it is
+                signal.signal(signum, handler)
+        if blocked is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+
+
 def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None):
     """Mesh the two bodies with gmsh and convert the mesh to scikit-fem.
 
@@ -280,7 +305,7 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
 
     import gmsh
 
-    gmsh.initialize(readConfigFiles=False, interruptible=False)
+    _start_gmsh(gmsh)
     try:
         _options(gmsh, h_fine, h_coarse)
         gmsh.model.add("contactlab_axisymmetric")

@@ -39,10 +39,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_finite_array, check_int, check_positive, fail
+from ..checks import check_finite_array, check_int, check_node_count, check_positive, fail
 from ..periodic.cell import rows_for
 
-__all__ = ["LatticeHeights", "to_lattice", "MAX_STRETCH"]
+__all__ = ["LatticeHeights", "to_lattice", "cell_shape", "MAX_STRETCH"]
 
 log = logging.getLogger(__name__)
 
@@ -124,6 +124,21 @@ def _size(size):
     return check_positive("size[0]", size[0]), check_positive("size[1]", size[1])
 
 
+def cell_shape(size, n_cols):
+    """The shape ``(n_rows, n_cols)`` of the cell of :func:`to_lattice`, counted without building it.
+
+    Parameters
+    ----------
+    size : (float, float)
+        The period ``(Lx_d, Ly_d)`` of the height grid [length], each ``> 0``.
+    n_cols : int
+        Nodes of the cell along x, ``>= 2``.
+    """
+    lx, ly = _size(size)
+    n_cols = check_int("n_cols", n_cols, minimum=2)
+    return rows_for(lx / n_cols, ly), n_cols
+
+
 def to_lattice(heights, size, n_cols):
     """Resample one period of a height grid onto the periodic triangular lattice.
 
@@ -135,7 +150,8 @@ def to_lattice(heights, size, n_cols):
     size : (float, float)
         The period ``(Lx_d, Ly_d)`` [length], each ``> 0``.
     n_cols : int
-        Nodes of the cell along x, ``>= 2``; the step is ``c = Lx_d/n_cols``.
+        Nodes of the cell along x, ``>= 2``; the step is ``c = Lx_d/n_cols``. The cell holds at
+        most :data:`bem.checks.MAX_NODES` nodes (checked before it is built).
 
     Returns
     -------
@@ -152,9 +168,9 @@ def to_lattice(heights, size, n_cols):
     if min(z.shape) < 2:
         fail("heights.shape", z.shape, "at least (2, 2)")
     lx, ly = _size(size)
-    n_cols = check_int("n_cols", n_cols, minimum=2)
+    n_rows, n_cols = cell_shape((lx, ly), n_cols)
+    check_node_count("n_cols", n_cols, n_rows * n_cols, what="the periodic cell")
     step = lx / n_cols
-    n_rows = rows_for(step, ly)
     cell = (n_cols * step, n_rows * step * _SQRT3 / 2)
     stretch = cell[1] / ly
     large = abs(stretch - 1.0) > MAX_STRETCH

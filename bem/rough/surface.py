@@ -45,7 +45,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..checks import InputError, check_choice, check_finite_array, check_int, check_range, check_scale, fail
+from ..checks import (InputError, check_choice, check_finite_array, check_int, check_node_count, check_positive,
+                      check_range, check_scale, fail)
 from .lattice_heights import to_lattice
 
 __all__ = ["RoughSurface", "SurfaceStats", "self_affine", "from_heights", "combined", "DETRENDS", "EDGE_JUMP_LIMIT",
@@ -244,7 +245,7 @@ def self_affine(grid, size, *, hurst, rms_height=None, rms_slope=None, long_cuto
     Parameters
     ----------
     grid : (int, int)
-        ``(nx, ny)`` points, each ``>= 8``.
+        ``(nx, ny)`` points, each ``>= 8``, ``nx ny`` at most :data:`bem.checks.MAX_NODES`.
     size : (float, float)
         The period ``(Lx, Ly)`` [length]; each length here is a physical scale, in
         :data:`bem.checks.SCALE_RANGE`.
@@ -268,6 +269,7 @@ def self_affine(grid, size, *, hurst, rms_height=None, rms_slope=None, long_cuto
     if not isinstance(grid, (list, tuple, np.ndarray)) or len(grid) != 2:
         fail("grid", grid, "a pair (nx, ny) of integers")
     grid = (check_int("grid[0]", grid[0], minimum=MIN_POINTS), check_int("grid[1]", grid[1], minimum=MIN_POINTS))
+    check_node_count("grid", grid, grid[0] * grid[1], what="the surface grid")
     size = _pair("size", size)
     hurst = check_range("hurst", hurst, 0.0, 1.0, low_open=True)
     if (rms_height is None) == (rms_slope is None):

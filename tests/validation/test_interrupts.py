@@ -18,6 +18,8 @@ import pytest
 
 from validation.io import MARKER, recover_output_dir
 
+from .conftest import cli
+
 ROOT = Path(__file__).resolve().parents[2]
 RUN = ("run", "elliptic", "--set", "bem.nodes_across=16")
 
@@ -32,8 +34,17 @@ POINTS = {
 }
 
 
+#: the FEM stage, once gmsh has meshed: its library installs signal handlers of its own when it starts
+MESHED = ("gmsh", "model.mesh.generate", "True", "after")
+#: a run with the FEM reference (gmsh), small
+RUN_FEM = ("run", "hertz", "--set", "bem.nodes_across=16", "--set", "fem.n_contact_elements=8")
+TERMINATED = ["contactlab: terminated (no partial output was left)"]
+INTERRUPTED = ["contactlab: interrupted (no partial output was left)"]
+
+
 def _hook(tmp_path, point, signum):
-    module, name, condition, when = POINTS[point]
+    """A sitecustomize folder sending ``signum`` at ``point``: a key of :data:`POINTS` or such a tuple."""
+    module, name, condition, when = POINTS.get(point, point)
     hook = tmp_path / "hook"
     hook.mkdir(exist_ok=True)
     (hook / "sitecustomize.py").write_text(textwrap.dedent(f"""
@@ -203,3 +214,83 @@ def test_stopping_a_sweep_stops_its_workers(tmp_path, signum):
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+@pytest.mark.parametrize("point", ["meshed", "assembling"])
+def test_sigterm_after_gmsh_started_exits_cleanly(tmp_path, point):
+    """gmsh's library replaces the process's SIGTERM handler when it starts: the FEM stage puts it
+    back, so a SIGTERM in that stage, or while the result is assembled after it, still ends the run
+    with exit code 143, one line, and no temporary folder left."""
+    out = tmp_path / "r"
+    proc = _contactlab(tmp_path, *RUN_FEM, "--out", out,
+                       hook=_hook(tmp_path, MESHED if point == "meshed" else point, signal.SIGTERM))
+    assert proc.returncode == 128 + signal.SIGTERM, proc.stderr
+    assert proc.stderr.strip().splitlines() == TERMINATED
+    assert not out.exists() and _hidden(tmp_path) == []
+
+
+#: a sitecustomize that sends a signal while the command starts: when it first imports ``bem`` (the
+#: packages take seconds to import), or when argparse parses the command line
+STARTUP = textwrap.dedent("""
+    import argparse, os, sys
+    SIGNUM, WHEN = int(os.environ["SIGNUM"]), os.environ["WHEN"]
+    _parse = argparse.ArgumentParser.parse_args
+
+    def _parse_args(*args, **kwargs):
+        if WHEN == "parsing":
+            os.kill(os.getpid(), SIGNUM)
+        return _parse(*args, **kwargs)
+
+    class _OnImport:
+        def find_spec(self, name, path=None, target=None):
+            if WHEN == "importing" and name == "bem":
+                sys.meta_path.remove(self)
+                os.kill(os.getpid(), SIGNUM)
+
+    argparse.ArgumentParser.parse_args = _parse_args
+    sys.meta_path.insert(0, _OnImport())
+""")
+
+
+@pytest.mark.parametrize("when", ["importing", "parsing"])
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_command_starts_exits_with_one_line(tmp_path, monkeypatch, when, signum):
+    hook = tmp_path / "hook"
+    hook.mkdir()
+    (hook / "sitecustomize.py").write_text(STARTUP)
+    monkeypatch.setenv("SIGNUM", str(int(signum)))
+    monkeypatch.setenv("WHEN", when)
+    proc = _contactlab(tmp_path, *RUN, "--out", tmp_path / "r", hook=hook)
+    assert proc.returncode == 128 + signum, proc.stderr
+    assert proc.stderr.strip().splitlines() == (TERMINATED if signum == signal.SIGTERM else INTERRUPTED)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hook"]
+
+
+@pytest.mark.parametrize("argv", [("scenes",), (*RUN, "--no-fem", "--out", "r")])
+def test_a_closed_output_pipe_stops_the_command_quietly(tmp_path, argv):
+    """``contactlab ... | head``: the reader of stdout is gone before the command prints. It stops as a
+    process stopped by SIGPIPE (exit code 141), with nothing on stderr; what it wrote is whole."""
+    read, write = os.pipe()
+    os.close(read)  # the reader is gone: every write to the pipe fails
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    try:
+        proc = subprocess.run([sys.executable, "-m", "validation.cli", "--no-progress", *argv], cwd=tmp_path,
+                              env=env, stdout=write, stderr=subprocess.PIPE, text=True, timeout=300)
+    finally:
+        os.close(write)
+    assert proc.returncode == 128 + signal.SIGPIPE, proc.stderr
+    assert proc.stderr == ""
+    if argv[0] == "run":
+        assert _complete(tmp_path / "r") and _hidden(tmp_path) == []
+
+
+def test_a_broken_pipe_that_is_not_the_output_is_not_hidden(monkeypatch):
+    """Only a closed standard output stops quietly: a broken pipe to a worker is an error that shows."""
+    from validation.cli import scenes
+
+    def _lost_worker(args):
+        raise BrokenPipeError("a worker's pipe")
+
+    monkeypatch.setattr(scenes, "run", _lost_worker)
+    with pytest.raises(BrokenPipeError, match="a worker's pipe"):
+        cli("scenes")

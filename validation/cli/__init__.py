@@ -2,30 +2,30 @@
 
 Exit codes: 0 success; 1 a solver did not converge (results are still written, flagged
 ``converged = false``); 2 bad input (scene, option or output location); 130 interrupted
-(``SIGINT``, Ctrl-C); 143 terminated (``SIGTERM``). An interrupted or terminated command
-leaves the previous output or none, and stops its worker processes.
+(``SIGINT``, Ctrl-C); 143 terminated (``SIGTERM``); 141 the reader of the standard output went
+away (``contactlab run ... | head -3``: the command stops quietly, as a process stopped by
+``SIGPIPE``; files it had written are complete). An interrupted or terminated command leaves
+the previous output or none, and stops its worker processes; a signal while the command starts
+(its packages take seconds to import) stops it the same way, with one line.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib
 import logging
+import os
 import signal
 import sys
 import threading
 
-from bem.checks import InputError, check_file_name
-
-from ..io import OutputError
-from ..run.calibrate import CalibrationError
-from . import check, layer_law, report, run, scenes, study, sweep
-
 __all__ = ["main", "build_parser"]
 
-#: the subcommands, in the order ``--help`` lists them
-COMMANDS = {"run": run, "scenes": scenes, "check": check, "sweep": sweep, "study": study, "report": report,
-            "layer-law": layer_law}
+#: the subcommands and their modules, in the order ``--help`` lists them; the modules (and the
+#: packages they load) are imported by :func:`build_parser`, inside :func:`main`'s signal handling
+COMMANDS = {"run": "run", "scenes": "scenes", "check": "check", "sweep": "sweep", "study": "study",
+            "report": "report", "layer-law": "layer_law"}
 
 DESCRIPTION = """\
 contactlab: frictionless normal contact of two elastic bodies with a nonlinear interface
@@ -72,15 +72,14 @@ examples:
 result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
 iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.toml (the
 effective scene, re-runnable), bem_field.vtu, fem_field.vtu and stress_field.vtu (open in ParaView).
-Written whole or not at all. --out DIR is always the directory written (result, sweep, report,
-layer-law or study directory); contactlab writes only into a new or empty directory or one it
-wrote itself (marked by DIR/.contactlab, which lists what it replaces). Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
+Written whole or not at all. --out DIR is always the directory written (result, sweep or
+report directory); contactlab writes only into a new or empty directory or one it wrote itself
+(marked by DIR/.contactlab). Exit codes: 0 ok, 1 not converged, 2 bad input (every error of a
 scene is listed), an unknown option or an unusable output directory, 130 interrupted (Ctrl-C),
-143 terminated (SIGTERM).
+143 terminated (SIGTERM), 141 the reader of the output went away (contactlab ... | head: a quiet stop).
 
 A scene file is data: the Python code it names is imported only with --allow-code, and the
 files it names are read only inside its folder unless --allow-outside-files (docs/scenes.md).
-A result or sweep directory is data too: its report never imports the code it names.
 """
 
 
@@ -112,9 +111,15 @@ def build_parser():
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details (INFO)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name, module in COMMANDS.items():
+    for name in COMMANDS:
+        module = _command(name)
         module.add_args(sub.add_parser(name, formatter_class=fmt, **module.PARSER))
     return parser
+
+
+def _command(name):
+    """The module of the subcommand ``name``."""
+    return importlib.import_module(f".{COMMANDS[name]}", __name__)
 
 
 @contextlib.contextmanager
@@ -138,27 +143,49 @@ def _log_to_stderr(verbose):
             lg.propagate = propagate
 
 
+def _stdout_closed():
+    """Whether the standard output is a pipe that its reader has closed."""
+    import select
+
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # replaced by a stream without a file
+        return False
+    if not hasattr(select, "poll"):
+        return True
+    poll = select.poll()
+    poll.register(fd, select.POLLOUT)
+    return any(events & select.POLLERR for _, events in poll.poll(0))
+
+
 #: the arguments that name files -> how the user wrote them
 _FILE_ARGUMENTS = {"scene": "SCENE", "surface": "SURFACE", "target": "SCENE_OR_DIR", "out": "--out"}
 
 
 def _check_file_names(args):
+    from bem.checks import check_file_name
+
     for dest, name in _FILE_ARGUMENTS.items():
         if isinstance(getattr(args, dest, None), str):
             check_file_name(name, getattr(args, dest))
 
 
-def main(argv=None):
-    """Entry point of the ``contactlab`` console script; returns the exit code."""
-    parser = build_parser()
+def _run(argv):
+    """Parse ``argv``, run the subcommand and print its errors; returns the exit code."""
+    parser = build_parser()  # imports the subcommands
     try:  # argparse exits on --help (0) and on bad or unknown options (2): return the code instead
         args = parser.parse_args(argv)
     except SystemExit as exc:
         return exc.code
+    from bem.checks import InputError
+
+    from ..io import OutputError
+    from ..run.calibrate import CalibrationError
+
     try:
         _check_file_names(args)
-        with _terminate_as_interrupt(), _log_to_stderr(args.verbose):
-            return COMMANDS[args.command].run(args)
+        with _log_to_stderr(args.verbose):
+            return _command(args.command).run(args)
     except (InputError, OutputError) as exc:
         for message in getattr(exc, "errors", None) or (str(exc),):
             print(f"contactlab: error: {message}", file=sys.stderr)
@@ -166,9 +193,24 @@ def main(argv=None):
     except CalibrationError as exc:
         print(f"contactlab: error: {exc}", file=sys.stderr)
         return 1
+
+
+def main(argv=None):
+    """Entry point of the ``contactlab`` console script; returns the exit code (module docstring)."""
+    try:
+        with _terminate_as_interrupt():  # from the first import on: start-up is interrupted cleanly too
+            code = _run(argv)
+            sys.stdout.flush()  # a closed pipe shows here, not at the interpreter's exit
+            return code
     except Terminated:
         print("contactlab: terminated (no partial output was left)", file=sys.stderr)
         return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         print("contactlab: interrupted (no partial output was left)", file=sys.stderr)
         return 128 + signal.SIGINT
+    except BrokenPipeError:
+        if not _stdout_closed():
+            raise
+        # as a process stopped by SIGPIPE, quietly; what is left in the buffer goes nowhere
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 128 + signal.SIGPIPE

@@ -102,6 +102,28 @@ def _synthetic(text):
     return out
 
 
+def _check_size(args, synthetic=None, surface=None):
+    """bem's memory guard (:func:`bem.checks.check_node_count`) on ``--synthetic grid`` and the lattice cell
+    (``--n-cols``), named as the command line names them: before the surface is made (``synthetic``, the
+    parsed ``--synthetic``) or, for a surface file, before the cell is made."""
+    from bem.checks import check_int, check_node_count, check_positive
+    from bem.rough import MIN_POINTS
+    from bem.rough.lattice_heights import cell_shape
+
+    if synthetic is not None:
+        nx = check_int("--synthetic grid", synthetic["grid"], minimum=MIN_POINTS)
+        size = (check_positive("--synthetic size", synthetic["size"]),) * 2
+        check_node_count("--synthetic grid", nx, nx * nx, what="the surface grid")
+        default = "--synthetic grid"
+    else:
+        nx, size = surface.stats.grid[0], surface.size
+        default = "--n-cols (default: the surface's points along x)"
+    name = default if args.n_cols is None else "--n-cols"
+    n_cols = check_int(name, nx if args.n_cols is None else args.n_cols, minimum=2)
+    n_rows, n_cols = cell_shape(size, n_cols)
+    check_node_count(name, n_cols, n_rows * n_cols, what="the periodic cell")
+
+
 def _summary(folder):
     law, stats = folder.law, folder.law.stats
     p, w = law.mean_pressure, law.closure
@@ -134,11 +156,14 @@ def run(args):
                 raise InputError(f"{option} = {value!r} is not allowed with --synthetic: it is for a SURFACE file "
                                  "(a synthetic surface is in m).")
         with option_names({key: f"--synthetic {key}" for key in SYNTHETIC}):
-            surface = synthetic_surface(**_synthetic(args.synthetic))
+            synthetic = _synthetic(args.synthetic)
+            _check_size(args, synthetic=synthetic)
+            surface = synthetic_surface(**synthetic)
     else:
         size = None if args.size is None else _pair("--size", args.size, ",")
         with option_names(_FILE_OPTIONS):
             surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size)
+        _check_size(args, surface=surface)
     with option_names(_LADDER_OPTIONS):
         if args.p_range is not None:
             pressures = ladder(surface, args.E_star, pressures=_pair("--p-range", args.p_range, ":"),

@@ -38,6 +38,7 @@ import numpy as np
 
 from bem import InputError
 from bem.checks import check_node_count
+from bem.rough.lattice_heights import cell_shape
 
 from ..extras import require as require_extra
 from . import checks as ck
@@ -95,6 +96,8 @@ def _self_affine(d):
     kw = {"size": _pair("gap.size", d["size"], ck.scale),
           "grid": _pair("gap.grid", d["grid"], partial(ck.integer, minimum=rough.MIN_POINTS, maximum=8192)),
           "seed": ck.integer("gap.seed", d["seed"], 0)}
+    with ck.scene_errors():  # bem's memory guard, before the surface is made
+        check_node_count("gap.grid", d["grid"], kw["grid"][0] * kw["grid"][1], what="the surface grid")
     kw.update({k: d[k] for k in ("hurst", "rms_height", "rms_slope", "long_cutoff", "short_cutoff", "rolloff")
                if k in d})
     with ck.scene_errors("gap."):
@@ -155,10 +158,13 @@ def _periodic(d, gap, layer_spec, layer, load):
         raise ck.SceneError(f"layer.law = {layer_spec['law']!r} given by the paper's parameters is not allowed with "
                             "bem.periodic = true: give the law's own parameters (e.g. lam).")
     out = solver_options(d, layer_spec)
-    n_cols = ck.integer("bem.cell_nodes", d.get("cell_nodes", gap.surface.heights.shape[0]), 8, 8192)
+    name = "bem.cell_nodes" if "cell_nodes" in d else "bem.cell_nodes (default: the surface's nx)"
+    n_cols = ck.integer(name, d.get("cell_nodes", gap.surface.heights.shape[0]), 8, 8192)
+    with ck.scene_errors():  # bem's memory guard, before the cell is made
+        n_rows, _ = cell_shape(gap.surface.size, n_cols)
+        check_node_count(name, n_cols, n_rows * n_cols, what="the periodic cell")
     try:
         lattice = gap.surface.to_lattice(n_cols)
-        check_node_count("bem.cell_nodes", n_cols, lattice.n_rows * lattice.n_cols)
     except InputError as exc:
         raise ck.SceneError(f"bem.cell_nodes = {n_cols!r} is not allowed: {exc}") from None
     gap.lattice = lattice
