@@ -26,16 +26,21 @@ from bem.options import OPTIONS, check_options, solver_for
 from . import checks as ck
 from .paper import is_paper_law, reference_compliance
 
-__all__ = ["bem_options", "inner_domain", "region_limit", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "DOMAIN_MARGIN",
+__all__ = ["bem_options", "inner_domain", "region_limit", "solver_keywords", "KEYS", "SOLVER_KEYS", "OWN_KEYS",
+           "EXCLUSIVE", "DOMAIN_MARGIN",
            "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
 
 #: An automatic extent stays this fraction inside a bounded gap domain.
 DOMAIN_MARGIN = 1e-3
 DEFAULT_NODES_ACROSS = 40
 DEFAULT_EXTENT_FACTOR = 1.5
-#: solver options a scene may set: the common ones and each solver's own (bem.options.OPTIONS)
-SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested") + tuple(
-    sorted({k for keys in OPTIONS.values() for k in keys}))
+#: the options every solver of bem.solve takes, and their checks
+_COMMON = {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1), "precondition": ck.boolean,
+           "nested": ck.boolean}
+#: the options of one solver or another (bem.options.OPTIONS)
+OWN_KEYS = tuple(sorted({k for keys in OPTIONS.values() for k in keys}))
+#: solver options a scene may set: the method, the common options and each solver's own
+SOLVER_KEYS = ("method", *_COMMON, *OWN_KEYS)
 KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
 #: pairs of lattice keys of which a scene gives one (a ``--set`` of one drops the other)
 EXCLUSIVE = (("step", "nodes_across"), ("extent", "extent_factor"))
@@ -75,10 +80,15 @@ def solver_options(d, layer_spec):
     """``[bem]``'s method and the options of every solver, those of the one that will run checked
     by the BEM itself (shared by lattice and periodic scenes)."""
     out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
-    out.update(ck.options("bem", d, {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1),
-                                     "precondition": ck.boolean, "nested": ck.boolean}))
+    out.update(ck.options("bem", d, _COMMON))
     out.update(_own_options(d, out["method"], layer_spec))
     return out
+
+
+def solver_keywords(options):
+    """The keywords of :func:`bem.solve` (or :func:`bem.solve_periodic`) among a scene's checked ``bem``
+    options (:func:`bem_options`): the method and the solver options the scene gives (:data:`SOLVER_KEYS`)."""
+    return {k: options[k] for k in SOLVER_KEYS if k in options}
 
 
 def _own_options(d, method, layer_spec):
@@ -87,7 +97,7 @@ def _own_options(d, method, layer_spec):
     if method == "kalker" and kind == "nonlinear":
         raise ck.SceneError(f"bem.method = 'kalker' is not allowed with layer.law = {layer_spec['law']!r}: "
                             "Kalker's QP solves smooth bodies and linear layers; use 'newton'.")
-    own = {k: d[k] for k in SOLVER_KEYS[5:] if k in d}
+    own = {k: d[k] for k in OWN_KEYS if k in d}
     try:
         return check_options(method, solver_for(method, kind), own)
     except InputError as exc:
