@@ -4,17 +4,15 @@ from __future__ import annotations
 
 import importlib
 
-PARSER = {"help": "studies: error-time, stability, robustness, two-scale",
+from ..studies import STUDIES
+
+PARSER = {"help": "studies: " + ", ".join(STUDIES),
           "description": "Studies of the methods (validation.studies) on their built-in problems "
                          "(no scene keys to override).",
           "epilog": "examples:\n  contactlab study error-time hertz --out reports/studies\n"
                     "  contactlab study stability --quick\n"
                     "  contactlab study two-scale --quick    (rough_sphere_two_scale, the small two-scale check)\n"
                     "  contactlab report reports/studies      (work-precision plot and tables)"}
-
-#: study name -> module with ``main(out=, scene=, quick=, progress=)``
-STUDIES = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
-           "robustness": "validation.studies.robustness", "two-scale": "validation.studies.two_scale"}
 
 
 def add_args(p):

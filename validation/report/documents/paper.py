@@ -32,8 +32,8 @@ _KEYS = {case: scene.removeprefix("paper_") for case, scene in SCENES.items()}
 
 
 def _method(r):
-    """The method that ran: quadratic problems go to the Kalker QP whatever was asked."""
-    return method_text(r.method, None if r.layer is None or r.layer.is_linear else r.layer.law, short=True)
+    """The method that ran (``r.method``): quadratic problems go to the Kalker QP whatever was asked."""
+    return method_text(r.method, short=True)
 
 
 def _how(r, res):

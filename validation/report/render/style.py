@@ -130,10 +130,10 @@ def method_label(method):
     return METHOD_LABELS.get(method, str(method))
 
 
-def method_text(method, law, *, short=False):
-    """What the BEM solved, in words: Kalker's QP for quadratic problems (no layer or a linear
-    one: ``law`` in None, "none", "linear"), whatever was asked, else the named method."""
-    if method in ("newton", "kalker") and law in (None, "none", "linear"):
+def method_text(method, *, short=False):
+    """What the BEM solved, in words; ``method`` is the method that ran (``result.method``): a quadratic
+    problem (no layer or a linear one) runs as Kalker's QP whatever was asked (:func:`bem.options.solver_for`)."""
+    if method == "kalker":
         if short:
             return "Kalker QP (eq. 11, projected conjugate gradients)"
         return ("Kalker's quadratic programme (eq. 11), solved by projected conjugate gradients "
