@@ -3,8 +3,9 @@
 Boundary elements on the elastic half-space with piecewise-linear (pyramid)
 pressure on a regular triangular lattice, closed-form influence coefficients,
 FFT-fast products, and Kalker's variational principle generalised to a
-nonlinear interface layer (paper sections 4-5, docs/method.md); periodic cells of
-rough surfaces (:func:`solve_periodic`); the stresses below the
+nonlinear interface layer (paper sections 4-5, docs/method.md), solved by :func:`solve`
+over a domain: a region of the half-space (:class:`HalfSpaceRegion`) or a periodic cell of a
+rough surface (:class:`PeriodicCell`; :func:`solve_periodic` is an alias); the stresses below the
 surface under the computed pressure (:func:`subsurface_stress`).
 """
 
@@ -16,11 +17,12 @@ from .operator import InfluenceOperator, diagonal_coefficient
 from .result import STATUSES, ContactResult
 from .options import METHODS, OPTIONS
 from .periodic import PeriodicCell, PeriodicContactResult, PeriodicOperator, solve_periodic
+from .region import HalfSpaceRegion
 from .solve import solve
 from .stress import SubsurfaceStress, subsurface_stress
 from .template import template
 
-__all__ = ["solve", "solve_periodic", "PeriodicCell", "PeriodicOperator", "PeriodicContactResult",
+__all__ = ["solve", "solve_periodic", "HalfSpaceRegion", "PeriodicCell", "PeriodicOperator", "PeriodicContactResult",
            "subsurface_stress", "SubsurfaceStress", "template", "Lattice", "InfluenceOperator",
            "ContactResult", "STATUSES", "METHODS", "OPTIONS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
            "effective_modulus", "gaps", "layers"]

@@ -19,11 +19,13 @@ import numpy as np
 from .backend import operator_backend
 
 
-__all__ = ["QPSolution", "solve_qp", "compliance_preconditioner"]
+__all__ = ["QPSolution", "solve_qp", "constrained_cg", "compliance_preconditioner", "initial_pressure", "stopping_rule",
+           "entering_pressure", "iterate_residual", "RECOMPUTE_EVERY"]
 
 log = logging.getLogger(__name__)
 
-_RECOMPUTE_EVERY = 20  # exact C p every so many incremental updates
+#: An exactly recomputed ``C p`` every so many incremental updates of the constrained CG.
+RECOMPUTE_EVERY = 20
 
 
 @dataclass
@@ -67,7 +69,10 @@ def _median(bk, values):
     return float(v[n // 2]) if n % 2 else float(bk.xp.mean(v[n // 2 - 1 : n // 2 + 1]))
 
 
-def _initial(op, h, lam, force, approach, x0):
+def initial_pressure(op, h, lam, force, approach, x0):
+    """The starting pressure of the constrained CG (brick array): ``x0`` clipped at 0, or under force
+    control a uniform pressure on the quarter of the nodes with the smallest gap, or under approach
+    control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``."""
     lat = op.lattice
     bk, mask = operator_backend(op)
     xp = bk.xp
@@ -89,11 +94,33 @@ def _initial(op, h, lam, force, approach, x0):
     return p
 
 
+def entering_pressure(xp, g, tau, jacobi, per_node):
+    """Pressure of the nodes that enter the contact (``p = 0``, gap ``g < 0``): Polonsky-Keer's
+    ``-tau g``, capped by the Jacobi estimate ``-g / (C_nn + lam)`` (``jacobi = 1 / (C_nn + lam)``,
+    an array where ``per_node``) so that a node with a large layer compliance cannot overshoot."""
+    return -g * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi)
+
+
 def _per_node(lam):
     return getattr(lam, "ndim", 0) > 0
 
 
-def _stopping(kkt, rtol):
+def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None):
+    """The KKT residual of an iterate (:func:`bem.kkt.kkt_residual` from its parts; non-finite: ``inf``).
+
+    ``max(max_contact |g|, (-min g)_+) / scale`` (every contact node has ``-g <= max_contact |g|``), with
+    ``contact_gap = max_contact |g|``, ``gap_min = min g``, ``scale`` the displacement scale and
+    ``gap_max()`` the largest ``|g|``, the scale where ``scale`` is not positive (or 1); under force
+    control the larger of that and ``force_error = |a sum p - P| / P``.
+    """
+    parts = [contact_gap, -gap_min, 0.0]
+    kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) / (scale if scale > 0 else gap_max() or 1.0)
+    if force_error is not None:
+        kkt = float(np.max([kkt, force_error]))
+    return kkt if math.isfinite(kkt) else np.inf
+
+
+def stopping_rule(kkt, rtol):
     """``(converged, message, status)`` of the QP's stopping rule at the KKT residual ``kkt``
     (non-finite: ``nonfinite``; ``kkt <= rtol``: ``converged``), ``None`` to go on."""
     if not math.isfinite(kkt):
@@ -171,7 +198,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
     if u0 is None or x0 is None:
-        p = xp.where(mask, _initial(op, h, lam, force, approach, x0), 0.0)
+        p = xp.where(mask, initial_pressure(op, h, lam, force, approach, x0), 0.0)
         if target is not None:
             p = p if float(xp.sum(p)) > 0 else xp.astype(mask, bk.float64)
             p *= target / float(xp.sum(p))
@@ -204,14 +231,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     # With a per-node compliance the preconditioner holds Jacobi blocks that differ by
     # decades, and plain mean subtraction would wreck it: project obliquely. For a uniform
     # compliance the FFT preconditioner is translation invariant and the mean is cheaper
-    # (measured on Hertz, 1,050,113 nodes: 15 iterations and 3.7 s against 21 and 6.6 s).
+    # (fewer iterations on the Hertz problem of benchmarks/bem_hertz.py).
     oblique = per_node
     # The conjugate-gradient vectors live on the contact set: they are kept compact, at the
     # flat indices idx of the contact nodes, and spread to brick arrays only for the FFT
     # products; full-array work is left to the gap, the KKT check, the overlap search and the
     # displacement update. Gathers and scatters go through the backend's node selections (on
-    # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: 0.1-0.3 ms on 86,000
-    # of 170,000 nodes against 0.9-1.9 ms through x.flat[idx]).
+    # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: several times faster
+    # than x.flat[idx]).
     for k in range(1, maxiter + 1):
         contact = p > 0
         idx = bk.select(contact)
@@ -227,13 +254,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         # kkt_residual(p[mask], g[mask], ...) without the copies: p = g = 0 off the mask, p >= 0,
         # and max(max_contact |g|, max_free (-g)+) = max(max_contact |g|, (-min g)+) because
         # contact nodes have -g <= max_contact |g|
-        parts = [bk.max0(xp.abs(g_c)), -float(xp.min(g)), 0.0]
-        kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) \
-            / (scale if scale > 0 else float(xp.max(xp.abs(g))) or 1.0)
-        if force is not None:
-            kkt = float(np.max([kkt, abs(a * float(xp.sum(p_c0)) - force) / force]))
-        if not math.isfinite(kkt):
-            kkt = np.inf
+        kkt = iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(g)), scale, lambda: float(xp.max(xp.abs(g))),
+                               None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
         if kkt <= rtol and stale and confirm:
             u, stale = apply(p), 0  # confirm on an exact product
             continue
@@ -243,7 +265,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         hist["p_max"].append(bk.max0(p_c0))
         hist["n_contact"].append(n_idx)
         hist["changes"].append(changes)
-        if (stop := _stopping(kkt, rtol)) is not None:
+        if (stop := stopping_rule(kkt, rtol)) is not None:
             converged, message, status = stop
             break
         if n_idx == 0:
@@ -295,8 +317,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         n_overlap = bk.count(overlap)
         if n_overlap:
             lam_o = bk.take(lam, overlap) if per_node else lam
-            jacobi = 1.0 / (op.diagonal + lam_o)
-            bk.put(p_new, overlap, -bk.take(g, overlap) * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi))
+            bk.put(p_new, overlap, entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o), per_node))
         restart = bool(n_overlap)
         s = 1.0
         if target is not None:
@@ -307,7 +328,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 bk.put(p_new, idx, bk.take(p_new, idx) * s)
                 entering = bk.subset(overlap, ~bk.take(contact, overlap))  # a clipped contact node may re-enter
                 bk.put(p_new, entering, bk.take(p_new, entering) * s)
-        if bool(xp.any(clipped)) or restart or stale >= _RECOMPUTE_EVERY:
+        if bool(xp.any(clipped)) or restart or stale >= RECOMPUTE_EVERY:
             u, stale = apply(p_new), 0
         else:
             r *= tau
@@ -325,6 +346,20 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
                       message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)
+
+
+def constrained_cg(op, h, *, lam=0.0, precondition=True, contact=None, **kw):
+    """:func:`solve_qp` with the preconditioner of ``op``: the FFT inverse of ``C + lam``
+    (:meth:`bem.operator.InfluenceOperator.preconditioner`) for a uniform ``lam``, and
+    :func:`compliance_preconditioner` on ``contact`` for a ``lam`` per node; none unless
+    ``precondition``. The constrained-CG step of an operator without one of its own."""
+    if not precondition:
+        precond = None
+    elif _per_node(lam):
+        precond = compliance_preconditioner(op, lam, contact)
+    else:
+        precond = op.preconditioner(lam=lam)
+    return solve_qp(op, h, lam=lam, preconditioner=precond, **kw)
 
 
 def compliance_preconditioner(op, D, contact, threshold=4.0):

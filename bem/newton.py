@@ -29,7 +29,7 @@ import numpy as np
 from .brent import brent_root
 from .backend import backend_of, operator_backend
 from .layers.device import device_layer
-from .kalker import QPSolution, compliance_preconditioner, solve_qp
+from .kalker import QPSolution, solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 
@@ -87,20 +87,9 @@ def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
 
 
 def _model_qp(op, b, D, contact, precondition, **kw):
-    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one).
-
-    On a periodic cell on NumPy the QP in the Fourier basis (:func:`bem.periodic.qp.solve_periodic_qp`,
-    the same preconditioner), else :func:`bem.kalker.solve_qp` with
-    :func:`bem.kalker.compliance_preconditioner`.
-    """
-    from .periodic import PeriodicOperator
-
-    if precondition and isinstance(op, PeriodicOperator) and op.backend.is_numpy:
-        from .periodic.qp import solve_periodic_qp
-
-        return solve_periodic_qp(op, b, lam=D, **kw)
-    return solve_qp(op, b, lam=D, preconditioner=compliance_preconditioner(op, D, contact) if precondition else None,
-                    **kw)
+    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one):
+    the operator's own constrained-CG step (``op.qp``, :meth:`bem.operator.InfluenceOperator.qp`)."""
+    return op.qp(b, lam=D, precondition=precondition, contact=contact, **kw)
 
 
 def _count_inner(hist, sub):
@@ -124,10 +113,10 @@ def _release(op, layer, h, p, u, q, delta, *, force):
     to 0 is tried once per step and kept when the functional decreases; it costs one
     product with ``C``. Only nodes whose release alone lowers ``Phi``,
     ``p_n (u_n + h_n - delta) + W(p_n) - C_nn p_n^2 / 2 > 0`` (``delta`` the multiplier of
-    the current contact under force control), are moved: the model released 780 nodes on
-    the first step of the root-layer benchmark (1M nodes), releasing all raised ``Phi``,
-    the 450 of them that pass this test lowered it (5 Newton steps on that level instead
-    of 6; the others are released by the model of a later step).
+    the current contact under force control), are moved: on the root-layer problem of
+    ``benchmarks/side_by_side.py`` releasing every node the model releases raises ``Phi``,
+    releasing those that pass this test lowers it and saves a Newton step (the others are
+    released by the model of a later step).
     Returns ``(p, u)``.
     """
     bk, mask = operator_backend(op)
@@ -265,8 +254,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         eta = min(_FORCING, kkt / hist["residual"][-2]) if len(hist["residual"]) > 1 else _FORCING
         inner = max(rtol / 3, min(1e-2, eta * kkt))
         # the model starts at p with the product u Newton carries, and Newton checks every step on
-        # its own residual: no product to start or to confirm the inner solve (root layer, 1M
-        # nodes: 18 products on the finest level instead of 28)
+        # its own residual: no product to start or to confirm the inner solve (fewer products on
+        # the root-layer problem of benchmarks/side_by_side.py)
         sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p, rtol=inner,
                         maxiter=inner_maxiter, u0=u, confirm=False)
         _count_inner(hist, sub)
@@ -332,8 +321,6 @@ def _force_by_approach(op, h, layer, force, failed, *, rtol, **kw):
     nodes. Brent's method on ``delta``, each evaluation an approach-controlled Newton solve.
     Returns ``failed`` unchanged if an inner solve fails.
     """
-    from scipy.optimize import brentq
-
     a = op.lattice.node_area
     solved = {}
 
@@ -350,15 +337,16 @@ def _force_by_approach(op, h, layer, force, failed, *, rtol, **kw):
         step, other = 1e-3, None
         for _ in range(60):
             trial = delta * (1 + step) if f0 < 0 else delta / (1 + step)
-            if excess(trial) * f0 <= 0:
+            if (f_other := excess(trial)) * f0 <= 0:
                 other = trial
                 break
             step *= 2
         if other is None:
             return failed
-        root = brentq(excess, min(delta, other), max(delta, other), xtol=4 * np.finfo(float).eps * delta,
-                      rtol=4 * np.finfo(float).eps, maxiter=200)
-        excess(root)
+        root = brent_root(excess, delta, other, f0, f_other, xtol=4 * np.finfo(float).eps * delta,
+                          rtol=4 * np.finfo(float).eps, maxiter=200)
+        if root not in solved:
+            excess(root)
     except _ApproachFailed:
         return failed
     sol = solved[root]

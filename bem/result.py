@@ -70,6 +70,10 @@ class ContactResult:
         The candidate lattice; :meth:`grid` maps nodal arrays back onto it.
     E_star : float
         Effective modulus [pressure].
+    domain : bem.HalfSpaceRegion or bem.PeriodicCell
+        The domain solved on (a growing region: the one the contact fitted in).
+    notes : list of str
+        What the solve did besides iterating, for people (a region enlarged).
     """
 
     x: np.ndarray
@@ -95,6 +99,8 @@ class ContactResult:
     n_matvec: int = 0
     status: str = ""
     rtol: float = math.nan
+    domain: object = None
+    notes: list = field(default_factory=list)
 
     def __post_init__(self):
         if self.status not in STATUSES or self.converged != (self.status == "converged"):

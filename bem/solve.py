@@ -1,76 +1,68 @@
-"""The public entry point :func:`solve` of the half-space BEM."""
+"""The public entry point :func:`solve`: one driver over a domain (a half-space region or a periodic cell).
+
+The driver checks the problem once (:mod:`bem.problem`), resolves the domain, and loops over the
+domain's levels (nested iteration): each level is solved by the method's solver on the
+domain's influence operator, its solution interpolated onto the next finer level. A growing
+half-space region is enlarged when the contact reaches its border. The domain supplies the
+lattice, the nodal gap, the levels, the operator, the level solve (on a candidate window of a
+half-space region, :mod:`bem.windows`), the border check and the result class
+(:class:`bem.HalfSpaceRegion`, :class:`bem.PeriodicCell`).
+"""
 
 from __future__ import annotations
 
+import itertools
 import logging
 import time
 
 import numpy as np
 
-from .backend import get_backend, to_host
-from .checks import (check_bool, check_callable, check_choice, check_finite_array, check_gap_values, check_int,
-                     check_layer, check_load, check_rtol, check_scale)
+from .backend import to_host
 from .errors import InputError, RegionTooSmallError
 from .kalker import QPSolution
 from .kkt import kkt_residual
-from .lattice import Lattice
 from .layers import beyond_table
-from .materials import effective_modulus
-from .operator import InfluenceOperator
-from .options import METHODS, check_options, solver_for
-from .result import ContactResult
+from .problem import check_problem, initial_guess
+from .region import HalfSpaceRegion
 
 __all__ = ["solve"]
 
 log = logging.getLogger(__name__)
 
-_COARSEST_NODES = 4096  # nested iteration stops coarsening below this many nodes
-
-
-def _modulus(E_star, E1, nu1, E2, nu2):
-    given = [v is not None for v in (E1, nu1, E2, nu2)]
-    if E_star is not None:
-        if any(given):
-            raise InputError("E_star is not allowed together with E1, nu1, E2, nu2: give one or the other.")
-        return check_scale("E_star", E_star)
-    if not all(given):
-        raise InputError("E_star = None is not allowed without all of E1, nu1, E2, nu2: give E_star or all four.")
-    return effective_modulus(E1, nu1, E2, nu2)
-
-
-def _levels(lattice, nested):
-    """Lattices from coarsest to finest for nested iteration."""
-    levels = [lattice]
-    while nested:
-        coarse = levels[-1].coarsen()
-        if coarse is None or coarse.n_nodes < _COARSEST_NODES:
-            break
-        levels.append(coarse)
-    return levels[::-1]
-
 
 def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None, approach=None,
-          step, extent, layer=None, method="newton", rtol=1e-10, maxiter=None, x0=None,
-          nested=None, precondition=True, callback=None, device="cpu", **options):
-    """Frictionless normal contact of two elastic half-spaces with an interface layer.
+          mean_pressure=None, domain=None, step=None, extent=None, layer=None, method="newton", rtol=1e-10,
+          maxiter=None, x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
+    """Frictionless normal contact of two elastic half-spaces with an interface layer, over a domain.
 
     Minimises the generalised Kalker functional (eq. 11, 15)
     ``Phi(p) = a [1/2 p.C p + p.(h - delta)] + a sum W(p_n)`` over ``p >= 0``,
-    ``a = sqrt(3)/2 c^2``, on the triangular lattice of step ``c``.
+    ``a = sqrt(3)/2 c^2``, on the triangular lattice of step ``c`` of the domain: a
+    rectangular candidate region of the half-space (:class:`bem.HalfSpaceRegion`) or a
+    periodic cell (:class:`bem.PeriodicCell`, a rough surface patch; every node may touch and
+    the displacements have zero mean over the cell). The arguments are checked by one set of
+    rules for both domains (:mod:`bem.problem`; docs/method.md, "Checks of bem.solve").
 
     Parameters
     ----------
-    gap : callable
-        Initial gap ``h(x, y)`` [length] (a :mod:`bem.gaps` shape or any vectorised callable).
+    gap : callable or ndarray
+        Initial gap [length]: a vectorised ``h(x, y)`` (a :mod:`bem.gaps` shape or any
+        callable; on a cell it must be periodic, checked at the nodes), or, on a periodic
+        cell, a brick array of the cell's shape (node ``(q, r)`` at
+        ``x = (q + (r mod 2)/2) c``, ``y = r c sqrt3/2``).
     E_star : float, optional
         Effective modulus [pressure]; or give ``E1, nu1, E2, nu2`` instead.
-    force, approach : float
-        Exactly one: total force ``P`` [force] (force control, eq. 9) or the
-        approach ``delta`` [length] (approach control).
-    step : float
-        Lattice step ``c`` [length].
-    extent : float or (float, float)
-        Half-width of the rectangular candidate region [length]; the region holds at most
+    force, approach, mean_pressure : float
+        Exactly one: total force ``P`` [force] (force control, eq. 9; on a cell the force on one
+        cell), the approach ``delta`` [length] (approach control), or, on a cell, the mean
+        pressure ``pbar`` [pressure] (the force ``pbar Lx Ly``). On a cell without a layer the
+        approach must be below the mean gap (a full contact leaves the mean pressure
+        undetermined).
+    domain : bem.HalfSpaceRegion or bem.PeriodicCell, optional
+        Where contact may occur. Default: ``HalfSpaceRegion(step, extent)``.
+    step, extent : float
+        Shorthand for ``domain=HalfSpaceRegion(step, extent)`` (lattice step ``c`` [length],
+        half-widths of the region [length]), not with ``domain``. The region holds at most
         :data:`bem.checks.MAX_NODES` nodes (a memory guard, checked before anything is built).
         A gap with a ``check_region(extent)`` method (a measured surface's table,
         :meth:`bem.gaps.Measured.region`) refuses a region beyond its data.
@@ -95,14 +87,16 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         Iteration limit of the solver that runs (CG iterations of the QP, Newton steps,
         outer iterations of the paper's methods).
     x0 : ndarray, optional
-        Initial nodal pressures on the candidate nodes, shape ``(N,)``.
+        Initial nodal pressures: shape ``(N,)`` (the candidate nodes) or a brick array of the
+        lattice's shape; finite, negative entries clipped. Not with a growing region.
     nested : bool, optional
         Start from the solution on successively coarser lattices (step ``2c``,
         ``4c``, ...) interpolated onto the finer one. Each finer level is solved on
         the rectangular window of the nodes whose initial gap is below the approach
         (of the coarser level, with a margin): the others cannot close. Its solution
         is checked against the final approach, and the level solved again on the whole
-        lattice if a node outside the window could close. Default: on for
+        lattice if a node outside the window could close (a half-space region; a cell is
+        solved whole, needs ``n_cols`` even and ``n_rows`` a multiple of 4 per level). Default: on for
         ``"newton"`` and the QP, off for the paper's methods so that their
         iteration histories start as in the paper.
     precondition : bool
@@ -128,13 +122,15 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     Returns
     -------
     ContactResult
+        On a periodic cell a :class:`bem.PeriodicContactResult`; ``result.domain`` is the
+        domain solved on, ``result.notes`` says how a growing region grew.
 
     Raises
     ------
     bem.InputError
         Bad input (the message names the argument).
     RegionTooSmallError
-        The contact reaches the border of the candidate region.
+        The contact reaches the border of a region that does not grow (or cannot grow further).
 
     Notes
     -----
@@ -159,62 +155,92 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     (:func:`bem.layers.beyond_table`: the law is continued beyond its data).
     """
     t_start = time.perf_counter()
-    check_callable("gap", gap)
-    E_star = _modulus(E_star, E1, nu1, E2, nu2)
-    force, approach = check_load(force, approach)
-    check_choice("method", method, METHODS)
-    rtol = check_rtol("rtol", rtol)
-    if maxiter is not None:
-        maxiter = check_int("maxiter", maxiter)
-    precondition = check_bool("precondition", precondition)
-    if nested is not None:
-        nested = check_bool("nested", nested)
-    if callback is not None:
-        check_callable("callback", callback)
-    backend = get_backend(device)
-    lattice = Lattice.from_extent(step, extent)
-    if hasattr(gap, "check_region"):  # a gap known on a bounded region only (bem.gaps.RegionTable)
-        gap.check_region(extent)
-    _check_layer(layer, method)
-    solver = solver_for(method, layer)
-    options = check_options(method, solver, options)
-    if nested is None:
-        nested = solver in ("kalker", "newton")
-    guess = None
-    if solver != method and method != "newton":  # a paper method asked for a quadratic problem
+    domain = _domain(domain, step, extent)
+    domain.check_gap(gap)
+    problem = check_problem(domain, E_star=E_star, E1=E1, nu1=nu1, E2=E2, nu2=nu2, force=force, approach=approach,
+                            mean_pressure=mean_pressure, layer=layer, method=method, rtol=rtol, maxiter=maxiter,
+                            nested=nested, precondition=precondition, callback=callback, device=device,
+                            options=options)
+    region = domain.resolved(gap, E_star=problem.E_star, force=problem.force, approach=problem.approach, layer=layer)
+    if x0 is not None and getattr(region, "grow", False):
+        raise InputError(f"x0 is not allowed with {region!r}: its lattice changes as the region grows "
+                         "(give grow=False and a numeric extent).")
+    if problem.solver != method and method != "newton":  # a paper method asked for a quadratic problem
         log.info("method = %r runs as Kalker's QP (result.method = %r): %s, so the functional is quadratic",
-                 method, solver, "there is no layer" if layer is None else "the layer is linear")
-    if x0 is not None:
-        x0 = check_finite_array("x0", x0, ndim=1)
-        if x0.shape != (lattice.n_nodes,):
-            raise InputError(f"x0 has shape {x0.shape} which is not allowed: it must be ({lattice.n_nodes},).")
-        guess = np.zeros(lattice.shape)
-        guess[lattice.mask] = x0
-        nested = False
-    levels = _levels(lattice, nested)
-    delta = approach  # the approach, or under force control its estimate from the coarser level
-    for level, lat in enumerate(levels):
-        finest = level == len(levels) - 1
-        h = _gap_values(gap, lat)
-        kw = dict(force=force, approach=approach, x0=guess, rtol=rtol if finest else max(rtol, 1e-6),
-                  callback=callback if finest else None)
-        if maxiter is not None:
-            kw["maxiter"] = maxiter
-        window = _candidate_window(lat, h, delta) if nested else None
-        sol, ops = _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window, backend)
-        delta = sol.approach
-        if not finest:
-            guess = _prolong(lat, sol.p, levels[level + 1])
-    _check_border(lattice, sol.p, extent)
-    op = ops[-1] if ops[-1].lattice is lattice else InfluenceOperator(lattice, E_star, device=backend)
-    closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
-    result = _result(lattice, op, h, sol, closure, E_star, layer, solver, force, t_start, rtol,
-                     n_matvec=sum(o.n_matvec for o in ops if o is not op))
+                 method, problem.solver, "there is no layer" if layer is None else "the layer is linear")
+    notes = []
+    for attempt in itertools.count():
+        try:
+            result = _solve_on(region, gap, problem, x0, t_start)
+            break
+        except RegionTooSmallError:
+            bigger = region.grown(gap, attempt)
+            if bigger is None:
+                raise
+            note = (f"the contact reached the border of the automatic candidate region; extent enlarged from "
+                    f"({region.extent[0]:.4g}, {region.extent[1]:.4g}) to ({bigger.extent[0]:.4g}, "
+                    f"{bigger.extent[1]:.4g})")
+            log.info(note)
+            notes.append(note)
+            region = bigger
+    result.notes = notes
     if not result.converged:
-        log.warning("%s: %s%s", solver, result.message, _inner_summary(sol.history))
+        log.warning("%s: %s%s", problem.solver, result.message, _inner_summary(result.history))
     elif (note := beyond_table(layer, result.p_max)) is not None:
         log.warning("%s", note)
     return result
+
+
+def _domain(domain, step, extent):
+    """The domain: ``domain``, or the region of ``step`` and ``extent``."""
+    if domain is None:
+        if step is None or extent is None:
+            raise InputError(f"(domain, step, extent) = ({domain!r}, {step!r}, {extent!r}) is not allowed: give "
+                             "domain, or step and extent.")
+        return HalfSpaceRegion(step, extent, grow=False)
+    if step is not None or extent is not None:
+        raise InputError(f"step = {step!r} and extent = {extent!r} are not allowed with domain = {domain!r}: the "
+                         "domain has its lattice.")
+    if not all(hasattr(domain, name) for name in ("resolved", "levels", "operator", "solve_level")):
+        raise InputError(f"domain = {domain!r} is not allowed: it must be a bem.HalfSpaceRegion or a "
+                         "bem.PeriodicCell.")
+    return domain
+
+
+def _solve_on(region, gap, problem, x0, t_start):
+    """Nested iteration over the levels of the resolved domain ``region``; the result on its finest lattice."""
+    lattice = region.lattice()
+    h = region.nodal_gap(gap, lattice)
+    region.check_approach(problem.approach, h, problem.layer)
+    nested, guess = problem.nested, None
+    if x0 is not None:
+        guess, nested = initial_guess(x0, lattice), False
+    levels = region.levels(lattice, h, gap, nested)
+    coarse_rtol = region.coarse_rtol(problem.solver)
+
+    def make_op(lat):
+        return region.operator(lat, problem.E_star, problem.backend)
+
+    def run(op, h_lat, kw):
+        return _run(problem.solver, op, h_lat, problem.layer, problem.precondition, kw, problem.options)
+
+    rtol, delta = problem.rtol, problem.approach  # the approach, or under force control its coarser estimate
+    for level, (lat, h_lat) in enumerate(levels):
+        finest = level == len(levels) - 1
+        kw = dict(force=problem.force, approach=problem.approach, x0=guess,
+                  rtol=rtol if finest else max(rtol, coarse_rtol), callback=problem.callback if finest else None)
+        if problem.maxiter is not None:
+            kw["maxiter"] = problem.maxiter
+        sol, ops = region.solve_level(run, make_op, lat, h_lat, kw, delta if nested else None, problem.solver)
+        delta = sol.approach
+        if not finest:
+            guess = region.refine(lat, sol.p, levels[level + 1][0])
+    region.check_solution(lattice, sol.p)
+    op = ops[-1] if ops[-1].lattice is lattice else make_op(lattice)
+    layer = problem.layer
+    closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
+    return _result(region, lattice, op, h, sol, closure, problem, t_start,
+                   n_matvec=sum(o.n_matvec for o in ops if o is not op))
 
 
 def _inner_summary(history):
@@ -237,148 +263,32 @@ def _run(solver, op, h, layer, precondition, kw, options):
 
 
 def _dispatch(solver, op, h, layer, precondition, kw, options):
+    if solver == "kalker":  # the operator's own constrained-CG step
+        return op.qp(h, lam=0.0 if layer is None else layer.lam, precondition=precondition, **kw, **options)
     from .fixed_point import solve_augmented_gap, solve_variable_compliance
-    from .kalker import solve_qp
     from .newton import solve_newton
 
-    if solver == "kalker":
-        lam = 0.0 if layer is None else layer.lam
-        precond = op.preconditioner(lam=lam) if precondition else None
-        return solve_qp(op, h, lam=lam, preconditioner=precond, **kw, **options)
     run = {"newton": solve_newton, "augmented_gap": solve_augmented_gap,
            "variable_compliance": solve_variable_compliance}[solver]
     return run(op, h, layer=layer, precondition=precondition, **kw, **options)
 
 
-# Candidate windows. C p >= 0 and w(p) >= 0 for p >= 0, so the deformed gap of a node is
-# g_n >= h_n - delta: a node with h_n >= delta carries no pressure at the solution, whatever the
-# others do. Nested iteration knows delta (the approach, or under force control its value on the
-# coarser level), and each finer level is solved on the window of the brick array that holds
-# the nodes with h_n < delta + _WINDOW_MARGIN (delta - min h), padded by _WINDOW_PAD nodes; the
-# window's solution is the full one when every node outside it has h_n >= delta of that
-# solution, which is checked (otherwise the level is solved again on the full lattice from the
-# window's solution). Measured on the 1,048,703-node problem of benchmarks/side_by_side.py (root layer; the window
-# holds 16 % of the nodes), same process, alternating, load 1.1: 1.23 s against 2.89 s on the full
-# lattice; Hertz 0.88 s against 1.18 s. The full lattice still gets one product, for the result.
-_WINDOW_MARGIN = 0.25
-_WINDOW_PAD = 2
-_WINDOW_UP_TO = 0.6  # a window with more than this fraction of the brick array is not worth it
-
-
-def _candidate_window(lat, h, delta):
-    """The window of ``lat`` holding the nodes whose gap may close near the approach ``delta``, or None."""
-    if delta is None or not np.isfinite(delta):
-        return None
-    mask = lat.mask
-    h_min = float(np.min(h, where=mask, initial=np.inf))
-    if not delta > h_min:
-        return None
-    near = mask & (h < delta + _WINDOW_MARGIN * (delta - h_min))
-    rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
-    (n_rows, n_cols), pad = lat.shape, _WINDOW_PAD
-    r0, r1 = max(int(rows[0]) - pad, 0), min(int(rows[-1]) + 1 + pad, n_rows)
-    c0, c1 = max(int(cols[0]) - pad, 0), min(int(cols[-1]) + 1 + pad, n_cols)
-    if r1 - r0 < 4 or (r1 - r0) * (c1 - c0) > _WINDOW_UP_TO * n_rows * n_cols:
-        return None
-    return lat.window((r0, r1), (c0, c1))
-
-
-def _clear_outside(lat, window, h, delta):
-    """Whether every node of ``lat`` outside ``window`` has ``h >= delta`` (then ``g >= 0`` there at ``p = 0``)."""
-    outside = lat.mask.copy()
-    outside[window.index] = False
-    return bool(np.isfinite(delta)) and float(np.min(h, where=outside, initial=np.inf)) >= delta
-
-
-def _embedded(sol, window):
-    """A window's solution as one of its parent lattice (``displacement`` is not carried over)."""
-    hist = dict(sol.history)
-    if "p" in hist:  # recorded iterates: candidate nodes of the window -> of the parent
-        full = np.zeros(window.shape)
-        parent = window.parent
-
-        def lift(v):
-            full[window.mask] = v
-            return window.embed(full)[parent.mask]
-
-        hist["p"] = [lift(v) for v in hist["p"]]
-    return QPSolution(p=window.embed(sol.p), approach=sol.approach, iterations=sol.iterations,
-                      converged=sol.converged, message=sol.message, status=sol.status, kkt_residual=sol.kkt_residual,
-                      displacement=None, history=hist)
-
-
-def _run_level(solver, lat, E_star, h, layer, precondition, kw, options, window, backend):
-    """Solve one lattice level, on ``window`` where given; returns the solution and the operators used."""
-    ops = []
-    if window is not None:
-        op = InfluenceOperator(window, E_star, device=backend)
-        ops.append(op)
-        kw_w = dict(kw, x0=None if kw["x0"] is None else kw["x0"][window.index])
-        if kw["callback"] is not None:
-            kw_w["callback"] = lambda k, p, cb=kw["callback"]: cb(k, window.embed(p))
-        if solver == "kalker" and "maxiter" not in kw:  # the QP's default limit of the full lattice
-            kw_w["maxiter"] = max(200, int(10 * np.sqrt(lat.n_nodes)))
-        sol = _embedded(_run(solver, op, h[window.index], layer, precondition, kw_w, options), window)
-        if _clear_outside(lat, window, h, sol.approach):
-            return sol, ops
-        # rare: the approach grew past the margin. The full lattice starts from the window's
-        # solution; the result reports that solve's iterations.
-        log.debug("candidate window too small (approach %.6g): solving on the full lattice", sol.approach)
-        kw = dict(kw, x0=sol.p)
-    op = InfluenceOperator(lat, E_star, device=backend)
-    ops.append(op)
-    return _run(solver, op, h, layer, precondition, kw, options), ops
-
-
-def _prolong(coarse, p, fine):
-    return coarse.prolong(p, fine)  # = coarse.interpolate(p, fine.x, fine.y) * fine.mask, 5-20x faster
-
-
-def _check_layer(layer, method):
-    if check_layer("layer", layer) is None:
-        return
-    if method == "kalker" and not layer.is_linear:
-        raise InputError(
-            f"method = 'kalker' is not allowed with layer = {layer!r}: Kalker's QP solves smooth bodies "
-            "and linear layers only; use method='newton' (or a paper method) for a nonlinear layer."
-        )
-
-
-def _gap_values(gap, lattice):
-    x, y = lattice.x, lattice.y
-    h = check_gap_values(gap(x, y), {"x": x, "y": y}, mask=lattice.mask,
-                         region="over the candidate region (make extent smaller or fix the gap)")
-    return np.where(lattice.mask, h, 0.0)
-
-
-def _check_border(lattice, p, extent):
-    touching = lattice.border & (p > 0)
-    if touching.any():
-        n = int(touching.sum())
-        raise RegionTooSmallError(
-            f"extent = {extent!r} is not allowed for this load: the contact reaches the border of the "
-            f"candidate region at {n} node(s). Make extent larger (the contact must stay inside it) "
-            "or reduce the load. For a rough surface patch whose contact spreads over the whole region, "
-            "the model is a periodic cell: bem.solve_periodic."
-        )
-
-
-def _result(lattice, op, h, sol, closure, E_star, layer, method, force, t_start, rtol, n_matvec=0):
+def _result(region, lattice, op, h, sol, closure, problem, t_start, n_matvec=0):
     mask = lattice.mask
     p = sol.p
     u = to_host(op.matvec(p))
     g = u + closure + h - sol.approach
     a = lattice.node_area
     kkt = kkt_residual(p[mask], g[mask], displacement_scale=float(np.abs(u + closure).max()),
-                       force=force, node_area=a)
+                       force=problem.force, node_area=a)
     if not np.all(np.isfinite(p)):
-        raise FloatingPointError(f"{method}: the solver produced non-finite pressures ({sol.message})")
-    return ContactResult(
+        raise FloatingPointError(f"{problem.solver}: the solver produced non-finite pressures ({sol.message})")
+    return region.result_class(
         x=lattice.x[mask], y=lattice.y[mask], p=p[mask], displacement=u[mask],
         closure=closure[mask], gap=g[mask],
         approach=float(sol.approach), force=float(a * p.sum()), p_max=float(p.max()),
         contact_area=float(a * np.count_nonzero(p[mask] > 0)), converged=bool(sol.converged),
-        message=sol.message, status=sol.status, rtol=float(rtol), iterations=int(sol.iterations), kkt_residual=float(kkt), method=method,
-        wall_time_s=time.perf_counter() - t_start, lattice=lattice, E_star=E_star,
-        history=sol.history, layer=layer, n_matvec=n_matvec + op.n_matvec,
-    )
+        message=sol.message, status=sol.status, rtol=float(problem.rtol), iterations=int(sol.iterations),
+        kkt_residual=float(kkt), method=problem.solver, wall_time_s=time.perf_counter() - t_start, lattice=lattice,
+        E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=n_matvec + op.n_matvec,
+        domain=region)

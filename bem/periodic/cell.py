@@ -8,7 +8,8 @@ periods ``Lx = n_cols c`` and ``Ly = n_rows c sqrt3/2``. Node ``(q, r)``,
 
 and nodal values are stored as brick arrays of shape ``(n_rows, n_cols)`` (row ``r``,
 column ``q``), the storage of :class:`bem.lattice.Lattice`. Every node is a candidate: a
-periodic cell has no border. Node ``(q, r)`` is the lattice node ``i e1 + j e2`` with
+periodic cell has no border. A cell is a domain of :func:`bem.solve` (the methods below
+"the problem on the cell", as :class:`bem.HalfSpaceRegion` has them). Node ``(q, r)`` is the lattice node ``i e1 + j e2`` with
 ``j = r``, ``i = q - floor(r/2)``; ``n_rows`` even makes the lattice periodic in ``y``.
 """
 
@@ -21,10 +22,21 @@ from functools import cached_property
 import numpy as np
 
 from ..checks import check_int, check_positive, fail
+from .gap import cell_gap, check_cell_gap, coarse_gap
+from .influence import PeriodicOperator
+from .result import PeriodicContactResult
 
 __all__ = ["PeriodicCell"]
 
 _SQRT3 = math.sqrt(3.0)
+_COARSEST_NODES = 4096  # nested iteration stops coarsening below this many nodes
+# KKT residual to which the coarser cells of nested iteration are solved. The QP's iterations on
+# the finest cell do not fall with a tighter coarse solution while the coarse cells' own
+# iterations double from 1e-2 to 1e-6; Newton with a root layer takes one step more on the finest
+# cell from 1e-3 than from 1e-4 while its coarse cells cost a third less, so it solves them to
+# 1e-3; the other solvers keep 1e-6 (benchmarks/periodic_rough.py measures both).
+_COARSE_RTOL = {"kalker": 1e-2, "newton": 1e-3}
+_COARSE_RTOL_DEFAULT = 1e-6
 
 
 def rows_for(step, ly):
@@ -69,6 +81,67 @@ class PeriodicCell:
         step = check_positive("step", step)
         lx, ly = (check_positive("size", v) for v in (size if np.ndim(size) else (size, size)))
         return cls(step, max(4, int(round(lx / step))), rows_for(step, ly))
+
+    result_class = PeriodicContactResult
+
+    # -- the problem on the cell (the domain interface of bem.solve) ----------------------------
+
+    def check_gap(self, gap):
+        """Raise unless ``gap`` is a callable ``h(x, y)`` periodic over the cell or a brick array of its shape."""
+        check_cell_gap(gap, self)
+
+    def resolved(self, gap, **load):
+        """The cell itself (it has no automatic size)."""
+        return self
+
+    def lattice(self):
+        """The cell is its own lattice."""
+        return self
+
+    def nodal_gap(self, gap, cell):
+        """The initial gap at the nodes (brick array) [length], a callable checked periodic."""
+        return cell_gap(gap, cell)
+
+    def check_approach(self, approach, h, layer):
+        """Without a layer the approach must be below the mean gap: a full contact leaves the mean pressure undetermined."""
+        if approach is not None and layer is None and not approach < float(h.mean()):
+            fail("approach", approach, f"< the mean gap {float(h.mean()):.6g} without a layer (a full contact "
+                 "leaves the mean pressure undetermined: give mean_pressure)")
+
+    def levels(self, cell, h, gap, nested):
+        """``(cell, gap)`` pairs of nested iteration, from the coarsest cell to ``cell``."""
+        levels = [(cell, h)]
+        while nested:
+            fine, hf = levels[-1]
+            coarse = fine.coarsen()
+            if coarse is None or coarse.n_nodes < _COARSEST_NODES:
+                break
+            levels.append((coarse, coarse_gap(gap, fine, hf, coarse)))
+        return levels[::-1]
+
+    def coarse_rtol(self, solver):
+        """KKT residual to which the coarser cells of nested iteration are solved."""
+        return _COARSE_RTOL.get(solver, _COARSE_RTOL_DEFAULT)
+
+    def operator(self, cell, E_star, backend):
+        """The periodic influence operator on ``cell``."""
+        return PeriodicOperator(cell, E_star, device=backend)
+
+    def solve_level(self, run, make_op, cell, h, kw, delta, solver):
+        """One level of nested iteration, on the whole cell; the solution and the operator used."""
+        op = make_op(cell)
+        return run(op, h, kw), [op]
+
+    def refine(self, coarse, p, fine):
+        """The coarse solution interpolated onto the next finer cell."""
+        return fine.prolong(p)
+
+    def check_solution(self, cell, p):
+        """A cell has no border: every solution fits."""
+
+    def grown(self, gap, attempt):
+        """A cell does not grow."""
+        return None
 
     @property
     def shape(self):

@@ -11,7 +11,7 @@ As in :mod:`bem.operator`, the rows split by parity into two rectangular lattice
 ``u_a = sum_b K_ab * p_b`` is a 2 x 2 block convolution, here circular on arrays of
 ``(n_rows/2, n_cols)`` with no padding: two real FFTs of the cell per product. The operator
 has the interface the solvers use (``lattice``, ``matvec``, ``preconditioner``,
-``diagonal``, ``n_matvec``), so :func:`bem.kalker.solve_qp`, :func:`bem.newton.solve_newton`
+``diagonal``, ``n_matvec``, ``qp``), so :func:`bem.kalker.solve_qp`, :func:`bem.newton.solve_newton`
 and :mod:`bem.fixed_point` run on it unchanged.
 """
 
@@ -192,6 +192,20 @@ class PeriodicOperator:
         return self._apply(p, self._s00, self._s01, self._s10, self._s00)
 
     __call__ = matvec
+
+    def qp(self, h, *, lam=0.0, precondition=True, contact=None, **kw):
+        """The constrained-CG step of Kalker's QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``
+        on the cell: preconditioned on NumPy, in the Fourier basis
+        (:func:`bem.periodic.qp.solve_periodic_qp`, whose preconditioner for a ``lam`` per node
+        starts from the contact of ``x0``), else :func:`bem.kalker.constrained_cg`; a
+        :class:`bem.kalker.QPSolution`."""
+        if precondition and self.backend.is_numpy:
+            from .qp import solve_periodic_qp
+
+            return solve_periodic_qp(self, h, lam=lam, **kw)
+        from ..kalker import constrained_cg
+
+        return constrained_cg(self, h, lam=lam, precondition=precondition, contact=contact, **kw)
 
     def preconditioner(self, lam=0.0):
         """``z = (C + lam I)^-1 r`` on the whole cell, by the inverse 2 x 2 block symbol.

@@ -50,7 +50,7 @@ import math
 
 import numpy as np
 
-from ..kalker import _RECOMPUTE_EVERY, QPSolution, _initial, _stopping
+from ..kalker import RECOMPUTE_EVERY, QPSolution, entering_pressure, initial_pressure, iterate_residual, stopping_rule
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -110,7 +110,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
     if u0 is None or x0 is None:
-        p = _initial(op, h, D if per_node else lam, force, approach, x0)
+        p = initial_pressure(op, h, D if per_node else lam, force, approach, x0)
         if target is not None:
             p = p if float(p.sum()) > 0 else np.ones(lat.shape)
             p *= target / float(p.sum())
@@ -180,13 +180,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         g_c -= delta
         scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
         g_min = float(g.min()) - delta
-        parts = [float(np.abs(g_c).max(initial=0.0)), -g_min, 0.0]
-        kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) \
-            / (scale if scale > 0 else float(np.abs(g - delta).max()) or 1.0)
-        if force is not None:
-            kkt = max(kkt, abs(a * float(p_c0.sum()) - force) / force)
-        if not math.isfinite(kkt):
-            kkt = np.inf
+        kkt = iterate_residual(float(np.abs(g_c).max(initial=0.0)), g_min, scale, lambda: float(np.abs(g - delta).max()),
+                               None if force is None else abs(a * float(p_c0.sum()) - force) / force)
         if k == 1:  # single precision pays for its closing product only well above SINGLE_ABOVE
             single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
         if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
@@ -202,7 +197,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         hist["p_max"].append(float(p_c0.max(initial=0.0)))
         hist["n_contact"].append(int(idx.size))
         hist["changes"].append(changes)
-        if (stop := _stopping(kkt, rtol)) is not None:
+        if (stop := stopping_rule(kkt, rtol)) is not None:
             converged, message, status = stop
             break
         if idx.size == 0 and g_min >= 0:  # no contact at this approach: p = 0 is the solution
@@ -268,7 +263,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         p_o = None
         if overlap.size:
             cap = jacf[overlap] if per_node else jacobi
-            p_o = -(gf[overlap] - delta) * ((np.minimum(tau, cap) if per_node else min(tau, cap)) if tau > 0 else cap)
+            p_o = entering_pressure(np, gf[overlap] - delta, tau, cap, per_node)
         entered = bool(overlap.size)
         s = 1.0
         if target is not None:
@@ -284,7 +279,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             if s != 1.0:
                 p_o *= s
             pf[overlap] = p_o
-        if bool(clipped.any()) or entered or stale >= _RECOMPUTE_EVERY:
+        if bool(clipped.any()) or entered or stale >= RECOMPUTE_EVERY:
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:  # u += D p, on the nodes where p > 0
                 uf = u.reshape(-1)

@@ -12,6 +12,7 @@ from bem.lattice import Lattice
 from bem.operator import InfluenceOperator
 
 solve_module = importlib.import_module("bem.solve")
+windows_module = importlib.import_module("bem.windows")
 
 
 @pytest.mark.parametrize("rows, cols", [((3, 20), (5, 30)), ((4, 21), (6, 41)), ((0, 35), (0, 41)), ((1, 3), (0, 3)),
@@ -47,7 +48,7 @@ def test_window_gives_the_full_lattice_solution(monkeypatch, control, layer):
     load = {"force": 1e-3} if control == "force" else {"approach": 0.012}
     kw = dict(E_star=1.0, step=0.003, extent=0.3, layer=layer, **load)
     windowed = bem.solve(Paraboloid(1.0), **kw)
-    monkeypatch.setattr(solve_module, "_WINDOW_UP_TO", 0.0)  # no window
+    monkeypatch.setattr(windows_module, "_WINDOW_UP_TO", 0.0)  # no window
     full = bem.solve(Paraboloid(1.0), **kw)
     assert windowed.converged and full.converged
     assert windowed.kkt_residual <= 1e-10 and windowed.p.shape == full.p.shape
@@ -70,7 +71,7 @@ def test_window_is_used_and_its_solution_checked_outside(monkeypatch):
     assert set(calls) == {res.lattice.shape}  # the callback sees the full lattice
     # a window that misses nodes of the contact is detected, and the level solved on the full lattice
     used.clear()
-    monkeypatch.setattr(solve_module, "_WINDOW_MARGIN", -0.6)
+    monkeypatch.setattr(windows_module, "_WINDOW_MARGIN", -0.6)
     small = _root()
     assert small.converged and small.kkt_residual <= 1e-10
     assert type(used[-1]).__name__ == "Lattice" and type(used[-2]).__name__ == "LatticeWindow"
@@ -93,16 +94,16 @@ def test_window_off_centre_with_an_offset_gap(monkeypatch, layer):
 
     kw = dict(E_star=1.0, force=1e-3, step=0.003, extent=(0.45, 0.25), layer=layer)
     windowed = bem.solve(gap, **kw)
-    monkeypatch.setattr(solve_module, "_WINDOW_UP_TO", 0.0)
+    monkeypatch.setattr(windows_module, "_WINDOW_UP_TO", 0.0)
     full = bem.solve(gap, **kw)
     assert windowed.converged and windowed.kkt_residual <= 1e-10
     assert np.abs(windowed.p - full.p).max() <= 1e-8 * full.p.max()
 
 
 def test_qp_window_fallback(monkeypatch):
-    monkeypatch.setattr(solve_module, "_WINDOW_MARGIN", -0.6)
+    monkeypatch.setattr(windows_module, "_WINDOW_MARGIN", -0.6)
     small = bem.solve(Paraboloid(1.0), E_star=1.0, force=1e-3, step=0.003, extent=0.3)
-    monkeypatch.setattr(solve_module, "_WINDOW_UP_TO", 0.0)
+    monkeypatch.setattr(windows_module, "_WINDOW_UP_TO", 0.0)
     full = bem.solve(Paraboloid(1.0), E_star=1.0, force=1e-3, step=0.003, extent=0.3)
     assert small.converged and small.kkt_residual <= 1e-10
     assert np.abs(small.p - full.p).max() <= 1e-8 * full.p.max()

@@ -1,0 +1,107 @@
+"""The checks of :func:`bem.solve`, one set for every domain (docs/method.md, "Checks of bem.solve").
+
+:func:`check_problem` checks the arguments that do not depend on the domain's lattice, in the
+order of the signature, before anything is built; :func:`initial_guess` checks ``x0`` against
+the lattice. Each rule is that of :mod:`bem.checks` and the message names the keyword.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .backend import get_backend
+from .checks import (check_bool, check_callable, check_choice, check_finite_array, check_int, check_layer, check_load,
+                     check_rtol, check_scale, fail)
+from .errors import InputError
+from .materials import effective_modulus
+from .options import METHODS, check_options, solver_for
+
+__all__ = ["Problem", "check_problem", "initial_guess", "modulus"]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """The checked arguments of :func:`bem.solve` (``solver``: the one that runs, :func:`bem.options.solver_for`)."""
+
+    E_star: float
+    force: float | None
+    approach: float | None
+    layer: object
+    method: str
+    solver: str
+    rtol: float
+    maxiter: int | None
+    nested: bool
+    precondition: bool
+    callback: object
+    backend: object
+    options: dict
+
+
+def modulus(E_star, E1, nu1, E2, nu2):
+    """``E_star`` checked, or the effective modulus of ``E1, nu1, E2, nu2`` (one or the other given) [pressure]."""
+    given = [v is not None for v in (E1, nu1, E2, nu2)]
+    if E_star is not None:
+        if any(given):
+            raise InputError("E_star is not allowed together with E1, nu1, E2, nu2: give one or the other.")
+        return check_scale("E_star", E_star)
+    if not all(given):
+        raise InputError("E_star = None is not allowed without all of E1, nu1, E2, nu2: give E_star or all four.")
+    return effective_modulus(E1, nu1, E2, nu2)
+
+
+def _load(domain, force, approach, mean_pressure):
+    if mean_pressure is None:
+        return check_load(force, approach)
+    area = getattr(domain, "area", None)
+    if area is None:
+        fail("mean_pressure", mean_pressure, "given on a periodic cell only (a half-space region takes force)")
+    if force is not None or approach is not None:
+        fail("(force, approach, mean_pressure)", (force, approach, mean_pressure), "exactly one given")
+    return check_scale("mean_pressure", mean_pressure) * area, None
+
+
+def check_problem(domain, *, E_star, E1, nu1, E2, nu2, force, approach, mean_pressure, layer, method, rtol, maxiter,
+                  nested, precondition, callback, device, options):
+    """The checked :class:`Problem` (the keywords of :func:`bem.solve`); :class:`bem.InputError` naming the first
+    bad argument."""
+    E_star = modulus(E_star, E1, nu1, E2, nu2)
+    force, approach = _load(domain, force, approach, mean_pressure)
+    check_choice("method", method, METHODS)
+    rtol = check_rtol("rtol", rtol)
+    if maxiter is not None:
+        maxiter = check_int("maxiter", maxiter)
+    precondition = check_bool("precondition", precondition)
+    if nested is not None:
+        nested = check_bool("nested", nested)
+    if callback is not None:
+        check_callable("callback", callback)
+    backend = get_backend(device)
+    if check_layer("layer", layer) is not None and method == "kalker" and not layer.is_linear:
+        raise InputError(
+            f"method = 'kalker' is not allowed with layer = {layer!r}: Kalker's QP solves smooth bodies "
+            "and linear layers only; use method='newton' (or a paper method) for a nonlinear layer.")
+    solver = solver_for(method, layer)
+    options = check_options(method, solver, options)
+    if nested is None:
+        nested = solver in ("kalker", "newton")
+    return Problem(E_star=E_star, force=force, approach=approach, layer=layer, method=method, solver=solver,
+                   rtol=rtol, maxiter=maxiter, nested=nested, precondition=precondition, callback=callback,
+                   backend=backend, options=options)
+
+
+def initial_guess(x0, lattice):
+    """``x0`` as a brick array of ``lattice`` (0 off the candidate nodes): given as the ``(N,)`` values at the
+    candidate nodes or as a brick array of ``lattice.shape``; finite (negative entries are clipped by the solver)."""
+    x0 = check_finite_array("x0", x0)
+    n = int(np.count_nonzero(lattice.mask))
+    if x0.shape == (n,):
+        guess = np.zeros(lattice.shape)
+        guess[lattice.mask] = x0
+        return guess
+    if x0.shape == lattice.shape:
+        return np.where(lattice.mask, x0, 0.0)
+    raise InputError(f"x0 has shape {x0.shape} which is not allowed: it must be ({n},) (the candidate nodes) "
+                     f"or {lattice.shape} (a brick array).")
