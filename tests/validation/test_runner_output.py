@@ -173,7 +173,7 @@ def test_automatic_region_grows_when_the_estimate_is_short():
 def test_an_enlarged_region_is_the_estimate_times_1_5_and_solves_as_if_given(scene_name, overrides):
     """The region grows by 1.5 (up to the gap's domain) and the run is that of a scene giving the grown
     region itself: the calibration and the solve both use it."""
-    from validation.scene.sizing import region_limit
+    from bem.region import region_limit
 
     scene = load_scene(scene_name, overrides=["bem.nodes_across=16", "fem.n_contact_elements=8", *overrides])
     grown = execute_scene(scene).result

@@ -1,8 +1,9 @@
-"""The domain of a periodic scene: the cell of a rough surface pressed by a flat (:func:`bem.solve_periodic`).
+"""The domain of a periodic scene: the cell of a rough surface pressed by a flat (:class:`bem.PeriodicCell`).
 
 :class:`Cell` is one of the two domains of :func:`validation.run.execute_scene` (the other is
-the region of an isolated contact, :class:`validation.run.region.Region`): it solves the scene's
-cell (:mod:`validation.scene.rough`) and makes the ``periodic`` part of the run result:
+the region of an isolated contact, :class:`validation.run.region.Region`): it says what
+:func:`bem.solve` solves (the scene's cell, :mod:`validation.scene.rough`, its nodal gap and its
+load) and makes the ``periodic`` part of the run result:
 ``mean_pressure``, ``contact_fraction``, ``mean_gap``, ``n_spots`` (the contact spots,
 :func:`contact_spots`), ``spots`` and ``surface`` (docs/results.md).
 """
@@ -11,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..scene.sizing import solver_keywords
 from .parts import PeriodicPart, SpotSummary
 
 __all__ = ["Cell", "contact_spots"]
@@ -85,7 +85,7 @@ def _spot_summary(labels, n, node_area):
 
 
 class Cell:
-    """The periodic cell of a rough surface pressed by a flat (:func:`bem.solve_periodic`).
+    """The periodic cell of a rough surface pressed by a flat (:class:`bem.PeriodicCell`).
 
     ``load.force`` is the force on one cell, solved as the mean pressure ``force / (Lx Ly)``.
 
@@ -101,32 +101,30 @@ class Cell:
     ----------
     step : float
         Lattice step [length].
-    calibration_solves : int
-        Always 0: a periodic scene gives its layer's own parameters, there is nothing to calibrate.
+    gap : ndarray
+        The initial gap at the cell's nodes (brick array) [length].
+    load : dict
+        The load keywords of :func:`bem.solve`: ``mean_pressure`` and ``approach`` (one is ``None``).
+    bem_domain : bem.PeriodicCell
+        The cell of the scene's lattice (``bem.cell_nodes``).
     spots : ndarray of int or None
         The contact spot of each node (:func:`contact_spots`) of the last :meth:`parts`.
     """
 
-    calibrate = None
-    calibration_solves = 0
-
     def __init__(self, scene, messages):
-        self.scene = scene
-        self.lattice = scene.gap.lattice
-        self.step = self.lattice.step
-        self.spots = None
-        messages.extend(_surface_notes(scene))
-
-    def solve(self, layer, callback=None):
-        """:func:`bem.solve_periodic` of the scene's cell with ``layer`` and the scene's solver options."""
         import bem
 
-        lattice, load = self.lattice, self.scene.load
+        self.scene = scene
+        self.lattice = lattice = scene.gap.lattice
+        self.step = lattice.step
+        self.gap = lattice.gap()
+        load = scene.load
         area = lattice.size[0] * lattice.size[1]
         mean_pressure = load.get("mean_pressure") or (None if load["force"] is None else load["force"] / area)
-        return bem.solve_periodic(lattice.gap(), step=lattice.step, E_star=self.scene.E_star,
-                                  mean_pressure=mean_pressure, approach=load["approach"], layer=layer,
-                                  callback=callback, **solver_keywords(self.scene.bem))
+        self.load = {"mean_pressure": mean_pressure, "approach": load["approach"]}
+        self.bem_domain = bem.PeriodicCell(lattice.step, *self.gap.shape[::-1])
+        self.spots = None
+        messages.extend(_surface_notes(scene))
 
     def parts(self, res):
         """The parts of the run result that belong to a periodic cell (:func:`validation.run.result.build_result`).

@@ -26,7 +26,8 @@ from ..scene.checks import SceneError
 from ..scene.load import Scene, load_scene
 from ..scene.study import refuse_study
 from ..scene.trust import refuse_code
-from .calibrate import resolve_layer
+from ..scene.sizing import solver_keywords
+from .calibrate import CalibrationError, resolve_layer
 from .record import FILE_NAME, RunResult
 from .region import Region
 from .result import build_result
@@ -41,6 +42,9 @@ FILES = {"result": FILE_NAME, "scene": "scene.toml", "bem_field": "bem_field.vtu
          "fem_field": "fem_field.vtu", "stress_field": "stress_field.vtu"}
 #: What a result directory may hold besides its marker: its files and its default report folder.
 RESULT_NAMES = (*FILES.values(), "report")
+#: the options of the scene's ``[bem]`` that the calibration solves of a layer take over; they solve with
+#: ``method = "newton"`` and its defaults otherwise, whatever the scene's method
+CALIBRATION_KEYS = ("rtol", "precondition", "nested")
 
 
 @dataclass
@@ -75,13 +79,56 @@ def planned_stages(scene, *, write=False):
 
 
 def domain_of(scene, messages):
-    """The domain that solves ``scene``: its periodic cell (:class:`validation.run.periodic.Cell`) or its
-    region of the half-space (:class:`validation.run.region.Region`); ``messages``: the run's messages."""
+    """The domain of ``scene``: its periodic cell (:class:`validation.run.periodic.Cell`) or its region of
+    the half-space (:class:`validation.run.region.Region`); ``messages``: the run's messages."""
     if scene.bem.get("periodic"):
         from .periodic import Cell
 
         return Cell(scene, messages)
-    return Region(scene, messages)
+    return Region(scene)
+
+
+class _BemSolves:
+    """:func:`bem.solve` of the scene's problem on its domain for a given layer: the run's solve and the
+    calibration's. A region grown by one solve is where the next one starts (the calibration's region
+    carries over to the run's solve); ``messages`` gets the notes of each solve (how it grew)."""
+
+    def __init__(self, scene, domain, messages):
+        opts = scene.bem
+        self.domain, self.messages = domain, messages
+        self.bem_domain = domain.bem_domain
+        problem = dict(E_star=scene.E_star, **domain.load)
+        self.kw = dict(problem, **solver_keywords(opts))
+        self.calibration_kw = dict(problem, method="newton", **{k: opts[k] for k in CALIBRATION_KEYS if k in opts})
+        self.calibration_solves = 0
+
+    def __call__(self, layer, callback=None):
+        return self._solve(layer, callback, self.kw)
+
+    def calibrate(self, layer):
+        """A calibration solve (:func:`validation.run.calibrate.resolve_layer`) with the robust solver.
+
+        Raises
+        ------
+        validation.run.calibrate.CalibrationError
+            The solve did not converge (the layer's parameters would be wrong).
+        """
+        self.calibration_solves += 1
+        res = self._solve(layer, None, self.calibration_kw)
+        if not res.converged:
+            raise CalibrationError(
+                f"the calibration of the layer law ({layer!r}) did not converge with method 'newton': "
+                f"{res.message}. The run stops: the layer parameters would be wrong.")
+        return res
+
+    def _solve(self, layer, callback, kw):
+        try:
+            res = bem.solve(self.domain.gap, domain=self.bem_domain, layer=layer, callback=callback, **kw)
+        except bem.RegionTooSmallError as exc:  # the region of the scene's key bem.extent
+            raise bem.RegionTooSmallError(f"bem.{exc}") from None
+        self.messages.extend(res.notes)
+        self.bem_domain = res.domain
+        return res
 
 
 def _analytic(scene, layer):
@@ -121,14 +168,15 @@ def execute_scene(scene, *, progress=None, overrides=None):
     stages = stages_of(progress, planned_stages(scene))
     messages, times = [], {"bem": None, "fem": None, "layer_reference": None, "stress": None}
     domain = domain_of(scene, messages)
+    solve = _BemSolves(scene, domain, messages)
     if "fem" in scene.skipped:
         messages.append("FEM reference skipped: the scene's [fem] was not run (no_fem).")
     if "layer" in planned_stages(scene):
         stages("layer")
     t = time.perf_counter()
     layer, layer_info = resolve_layer(scene.layer_spec, step=domain.step, E_star=scene.E_star,
-                                      solve=domain.calibrate, layer=scene.layer)
-    if domain.calibration_solves:
+                                      solve=solve.calibrate, layer=scene.layer)
+    if solve.calibration_solves:
         times["layer_reference"] = time.perf_counter() - t
     stages("bem")
 
@@ -136,7 +184,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
         stages.note(f"iteration {k}")
 
     t = time.perf_counter()
-    res = domain.solve(layer, callback=callback if stages.callback is not None else None)
+    res = solve(layer, callback=callback if stages.callback is not None else None)
     times["bem"] = time.perf_counter() - t
     asked = scene.bem["method"]
     if res.method != asked and asked != "newton":  # a paper method on a quadratic problem: the QP solved it
