@@ -19,7 +19,7 @@ def add_args(p):
     p.add_argument("study", choices=tuple(STUDIES), metavar="{" + ",".join(STUDIES) + "}")
     p.add_argument("scene", nargs="?", metavar="SCENE",
                    help="problem for error-time: hertz or paper_root (default: both)")
-    p.add_argument("--quick", action="store_true", help="a short ladder / case list (minutes instead of ~5)")
+    p.add_argument("--quick", action="store_true", help="a short ladder / case list, a fraction of the full study's time")
     p.add_argument("--out", metavar="DIR")
 
 

@@ -357,7 +357,8 @@ def report_paper_problem(out_dir, *, quick=False, fem=True, fmt="png", progress=
     out_dir : path-like
         Report directory (``report.html``, ``report.md``, ``figures/``), written whole or not at all.
     quick : bool
-        Coarse lattice (a_H/c = 8) and short sweeps: seconds instead of about a minute.
+        Coarse lattice (a_H/c = 8) and short sweeps: a preview in a fraction of the full report's time
+        (measured times: docs/performance.md, "Studies and reports").
     fem : bool
         Include the FEM reference and the resolution study.
     fmt : {"png", "svg", "pdf"}

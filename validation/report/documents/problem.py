@@ -154,7 +154,7 @@ def scene_section(res, work):
     text.append("Frictionless normal contact of two elastic half-spaces whose surfaces are separated by the "
                 "initial gap h(x, y)" + (", with an interface layer between them whose closure w(p) depends "
                                          "on the contact pressure p." if law else " (no interface layer).")
-                + f" Solved by the BEM: {method_text(res.result.method)}.")
+                + f" Solved by the BEM: {method_text(res.result.method, law)}.")
     if res.result.overrides:
         text.append("Scene overrides of this run: " + ", ".join(map(str, res.result.overrides)) + ".")
     text.append(res.units_text())

@@ -119,7 +119,7 @@ def summary(res, work):
 def timings(res, work):
     """How the BEM ran: method, lattice, iterations, residual, wall times."""
     d, b, length = res.result, res.bem, res.display("length")
-    rows = [("method", method_text(d.method), "-"),
+    rows = [("method", method_text(d.method, getattr(res.layer, "law", None)), "-"),
             ("status", d.bem.status, "-"),
             ("solver message", str(d.message), "-"),
             ("iterations (finest lattice)", fmt(d.iterations), "-"),

@@ -111,7 +111,7 @@ def _tolerance(res):
 def how(res):
     """One sentence: how the BEM solution was computed."""
     b, tol, length = res.bem, _tolerance(res), res.display("length")
-    text = (f"BEM: {method_text(res.result.method, short=True)}; lattice step "
+    text = (f"BEM: {method_text(res.result.method, getattr(res.layer, 'law', None), short=True)}; lattice step "
             f"c = {fmt(res.shown(b.step, 'length'))} {length.name}, {b.n_nodes} candidate nodes, "
             f"{b.n_contact} in contact")
     if b.nodes_across_contact:
@@ -273,7 +273,7 @@ def convergence(res, work):
     if not hist.get("p_max"):
         return None
     sc = scale(res, "pressure")
-    name = method_text(res.result.method, short=True)
+    name = method_text(res.result.method, getattr(res.layer, "law", None), short=True)
     path = plot_convergence([(f"BEM: {name}", hist)], work / "convergence.png", p0=sc[0], tol=_tolerance(res),
                             p_label=axis_label(r"\max\,p" if sc[2] else "p_{max}", sc, "max. pressure "),
                             title="BEM iterations: peak pressure and KKT residual")
