@@ -37,7 +37,8 @@ import math
 import numpy as np
 
 from .backend import backend_of, operator_backend
-from .kalker import QPSolution, compliance_preconditioner, solve_qp
+from .cg_rules import QPSolution
+from .kalker import compliance_preconditioner, solve_qp
 from .kkt import layered_state
 from .layers.device import device_layer
 
@@ -138,7 +139,7 @@ def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rto
 
     Returns
     -------
-    bem.kalker.QPSolution
+    bem.cg_rules.QPSolution
 
     Notes
     -----
@@ -222,7 +223,7 @@ def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=Non
 
     Returns
     -------
-    bem.kalker.QPSolution
+    bem.cg_rules.QPSolution
 
     Notes
     -----

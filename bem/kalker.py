@@ -5,59 +5,22 @@ force control (``a sum p = P``, eq. 9, ``delta`` is the multiplier) or approach
 control (``delta`` given). Solved by constrained conjugate gradients on the
 active set (Polonsky & Keer 1999, doi:10.1016/S0043-1648(99)00113-1), with an
 optional FFT preconditioner built from the inverse symbol of ``C + lam`` in
-the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005).
+the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005). :func:`solve_qp` is the step
+of the half-space operator (and of any operator on a device other than NumPy) in the one loop
+:func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
 """
 
 from __future__ import annotations
 
-import logging
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .backend import operator_backend
+from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, entering_pressure, initial_pressure, is_per_node, iterate_residual,
+                       run_constrained_cg)
 
-
-__all__ = ["QPSolution", "solve_qp", "constrained_cg", "compliance_preconditioner", "initial_pressure", "stopping_rule",
-           "entering_pressure", "iterate_residual", "RECOMPUTE_EVERY"]
-
-log = logging.getLogger(__name__)
-
-#: An exactly recomputed ``C p`` every so many incremental updates of the constrained CG.
-RECOMPUTE_EVERY = 20
-
-
-@dataclass
-class QPSolution:
-    """Outcome of :func:`solve_qp` and of every solver built on it (brick arrays on the operator's lattice).
-
-    ``displacement`` is the elastic displacement ``C p`` [length], the same for every solver (the
-    layer's closure ``lam p`` or ``w(p)`` is not in it); ``None`` where a solver did not keep it.
-    The arrays are in the namespace of the operator's device.
-    """
-
-    p: np.ndarray
-    approach: float
-    iterations: int
-    converged: bool
-    message: str
-    kkt_residual: float
-    displacement: np.ndarray
-    status: str  # one of bem.result.STATUSES
-    history: dict = field(default_factory=dict)
-
-
-def _quantile(bk, values, q):
-    """``numpy.quantile(values, q)`` (linear interpolation) of a 1-D array, as a Python float."""
-    if bk.is_numpy:
-        return float(np.quantile(values, q))
-    v = bk.xp.sort(values)
-    pos = q * (v.shape[0] - 1)
-    lo = int(math.floor(pos))
-    hi = min(lo + 1, v.shape[0] - 1)
-    a, b, t = float(v[lo]), float(v[hi]), pos - lo
-    return a + (b - a) * t if t < 0.5 else b - (b - a) * (1 - t)
+__all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
 
 def _median(bk, values):
@@ -67,67 +30,6 @@ def _median(bk, values):
     v = bk.xp.sort(values)
     n = v.shape[0]
     return float(v[n // 2]) if n % 2 else float(bk.xp.mean(v[n // 2 - 1 : n // 2 + 1]))
-
-
-def initial_pressure(op, h, lam, force, approach, x0):
-    """The starting pressure of the constrained CG (brick array): ``x0`` clipped at 0, or under force
-    control a uniform pressure on the quarter of the nodes with the smallest gap, or under approach
-    control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``."""
-    lat = op.lattice
-    bk, mask = operator_backend(op)
-    xp = bk.xp
-    if x0 is not None:
-        p = xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
-    elif force is not None:
-        # rigid-punch-like start: pressure where the gap is smallest
-        hm = xp.where(mask, h, xp.inf)
-        level = _quantile(bk, hm[mask], 0.25)
-        p = xp.astype(mask & (hm <= level), bk.float64)
-    else:
-        p = xp.where(mask, xp.maximum(approach - h, 0.0), 0.0) / (op.diagonal + float(xp.max(lam) if _per_node(lam) else lam))
-    if force is not None:
-        total = float(xp.sum(p))
-        if total <= 0:
-            p = xp.astype(mask, bk.float64)
-            total = float(xp.sum(p))
-        p *= force / lat.node_area / total
-    return p
-
-
-def entering_pressure(xp, g, tau, jacobi, per_node):
-    """Pressure of the nodes that enter the contact (``p = 0``, gap ``g < 0``): Polonsky-Keer's
-    ``-tau g``, capped by the Jacobi estimate ``-g / (C_nn + lam)`` (``jacobi = 1 / (C_nn + lam)``,
-    an array where ``per_node``) so that a node with a large layer compliance cannot overshoot."""
-    return -g * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi)
-
-
-def _per_node(lam):
-    return getattr(lam, "ndim", 0) > 0
-
-
-def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None):
-    """The KKT residual of an iterate (:func:`bem.kkt.kkt_residual` from its parts; non-finite: ``inf``).
-
-    ``max(max_contact |g|, (-min g)_+) / scale`` (every contact node has ``-g <= max_contact |g|``), with
-    ``contact_gap = max_contact |g|``, ``gap_min = min g``, ``scale`` the displacement scale and
-    ``gap_max()`` the largest ``|g|``, the scale where ``scale`` is not positive (or 1); under force
-    control the larger of that and ``force_error = |a sum p - P| / P``.
-    """
-    parts = [contact_gap, -gap_min, 0.0]
-    kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) / (scale if scale > 0 else gap_max() or 1.0)
-    if force_error is not None:
-        kkt = float(np.max([kkt, force_error]))
-    return kkt if math.isfinite(kkt) else np.inf
-
-
-def stopping_rule(kkt, rtol):
-    """``(converged, message, status)`` of the QP's stopping rule at the KKT residual ``kkt``
-    (non-finite: ``nonfinite``; ``kkt <= rtol``: ``converged``), ``None`` to go on."""
-    if not math.isfinite(kkt):
-        return False, "the iteration produced a non-finite value", "nonfinite"
-    if kkt <= rtol:
-        return True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}", "converged"
-    return None
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
@@ -191,7 +93,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     bk, mask = operator_backend(op)
     xp = bk.xp
     a = lat.node_area
-    per_node = _per_node(lam)
+    per_node = is_per_node(lam)
     lam = xp.where(mask, lam, 0.0) if per_node else float(lam)
     h = xp.where(mask, bk.asarray(h), 0.0)
     if maxiter is None:
@@ -223,8 +125,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         u += lam * p
     t = xp.zeros(lat.shape, dtype=bk.float64)
     gz_old, restart = 1.0, True
-    hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
-    converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
+    record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     prev_contact = p > 0
     m_one = None
     fixed_scale = scale
@@ -239,7 +140,10 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     # displacement update. Gathers and scatters go through the backend's node selections (on
     # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: several times faster
     # than x.flat[idx]).
-    for k in range(1, maxiter + 1):
+    contact = idx = n_idx = g = g_c = p_c0 = changes = None
+
+    def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
+        nonlocal contact, idx, n_idx, g, delta, g_c, p_c0
         contact = p > 0
         idx = bk.select(contact)
         n_idx = bk.count(idx)
@@ -254,24 +158,24 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         # kkt_residual(p[mask], g[mask], ...) without the copies: p = g = 0 off the mask, p >= 0,
         # and max(max_contact |g|, max_free (-g)+) = max(max_contact |g|, (-min g)+) because
         # contact nodes have -g <= max_contact |g|
-        kkt = iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(g)), scale, lambda: float(xp.max(xp.abs(g))),
-                               None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
+        return iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(g)), scale, lambda: float(xp.max(xp.abs(g))),
+                                None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
+
+    def confirms(kkt):  # an incrementally updated C p at the tolerance: recompute it and measure again
+        nonlocal u, stale
         if kkt <= rtol and stale and confirm:
-            u, stale = apply(p), 0  # confirm on an exact product
-            continue
+            u, stale = apply(p), 0
+            return True
+        return False
+
+    def observe():
+        nonlocal changes, prev_contact
         changes = int(xp.count_nonzero(contact != prev_contact))
         prev_contact = contact
-        hist["residual"].append(kkt)
-        hist["p_max"].append(bk.max0(p_c0))
-        hist["n_contact"].append(n_idx)
-        hist["changes"].append(changes)
-        if (stop := stopping_rule(kkt, rtol)) is not None:
-            converged, message, status = stop
-            break
-        if n_idx == 0:
-            if float(xp.min(g)) >= 0:  # no contact at this approach: p = 0 is the solution
-                converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
-                break
+        return bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0
+
+    def advance(k):  # one step of the constrained CG; (message, status) where it cannot be taken
+        nonlocal m_one, gz_old, t, restart, u, stale, p
         if preconditioner is None:
             z = bk.copy(g_c)
             if force is not None:
@@ -302,8 +206,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             # force: only nodes entering the contact (below) can move the iterate
             tau = 0.0
         elif tt <= 0 or not math.isfinite(tt):
-            message, status = f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
-            break
+            return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
         else:
             tau = gz / tt
         p_c = p_c0 - tau * t_c
@@ -337,15 +240,11 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 u *= s
             stale += 1
         p = p_new
-        if callback is not None:
-            callback(k, p)
-    else:
-        message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
-    if not converged:
-        log.debug("Kalker QP: %s", message)
+        return None
+
+    kkt = run_constrained_cg(CGStep(measure, confirms, observe, advance, lambda: p), record, maxiter, callback)
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
-    return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
-                      message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)
+    return record.solution(p, delta, kkt, elastic, "Kalker QP")
 
 
 def constrained_cg(op, h, *, lam=0.0, precondition=True, contact=None, **kw):
@@ -355,7 +254,7 @@ def constrained_cg(op, h, *, lam=0.0, precondition=True, contact=None, **kw):
     ``precondition``. The constrained-CG step of an operator without one of its own."""
     if not precondition:
         precond = None
-    elif _per_node(lam):
+    elif is_per_node(lam):
         precond = compliance_preconditioner(op, lam, contact)
     else:
         precond = op.preconditioner(lam=lam)

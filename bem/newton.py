@@ -29,7 +29,8 @@ import numpy as np
 from .brent import brent_root
 from .backend import backend_of, operator_backend
 from .layers.device import device_layer
-from .kalker import QPSolution, solve_qp
+from .cg_rules import QPSolution
+from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 

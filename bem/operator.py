@@ -250,7 +250,7 @@ class InfluenceOperator:
     def qp(self, h, *, lam=0.0, precondition=True, contact=None, **kw):
         """The constrained-CG step of Kalker's QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``
         on this operator: :func:`bem.kalker.constrained_cg` (its arguments); a
-        :class:`bem.kalker.QPSolution`."""
+        :class:`bem.cg_rules.QPSolution`."""
         from .kalker import constrained_cg
 
         return constrained_cg(self, h, lam=lam, precondition=precondition, contact=contact, **kw)

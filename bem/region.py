@@ -107,7 +107,7 @@ class HalfSpaceRegion:
             region = HalfSpaceRegion(self.step, tuple(min(EXTENT_FACTOR * a, lim) for a, lim in zip(axes, limit)),
                                      grow=self.grow)
         if hasattr(gap, "check_region"):  # a gap known on a bounded region only (bem.gaps.RegionTable)
-            gap.check_region(region.extent)
+            gap.check_region(region._given)
         return region
 
     def lattice(self):

@@ -19,7 +19,7 @@ import numpy as np
 
 from .backend import to_host
 from .errors import InputError, RegionTooSmallError
-from .kalker import QPSolution
+from .cg_rules import QPSolution
 from .kkt import kkt_residual
 from .layers import beyond_table
 from .problem import check_problem, initial_guess
@@ -62,7 +62,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         Where contact may occur. Default: ``HalfSpaceRegion(step, extent)``.
     step, extent : float
         Shorthand for ``domain=HalfSpaceRegion(step, extent)`` (lattice step ``c`` [length],
-        half-widths of the region [length]), not with ``domain``. The region holds at most
+        half-widths of the region [length] or ``"auto"``, which grows), not with ``domain``. The region holds at most
         :data:`bem.checks.MAX_NODES` nodes (a memory guard, checked before anything is built).
         A gap with a ``check_region(extent)`` method (a measured surface's table,
         :meth:`bem.gaps.Measured.region`) refuses a region beyond its data.
@@ -197,7 +197,7 @@ def _domain(domain, step, extent):
         if step is None or extent is None:
             raise InputError(f"(domain, step, extent) = ({domain!r}, {step!r}, {extent!r}) is not allowed: give "
                              "domain, or step and extent.")
-        return HalfSpaceRegion(step, extent, grow=False)
+        return HalfSpaceRegion(step, extent)
     if step is not None or extent is not None:
         raise InputError(f"step = {step!r} and extent = {extent!r} are not allowed with domain = {domain!r}: the "
                          "domain has its lattice.")

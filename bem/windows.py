@@ -17,7 +17,7 @@ import logging
 
 import numpy as np
 
-from .kalker import QPSolution
+from .cg_rules import QPSolution
 
 __all__ = ["candidate_window", "solve_in_window"]
 

@@ -172,6 +172,38 @@ def test_circle_check_sees_function_level_imports(tmp_path):
     assert not all(c in KNOWN_CIRCLES for c in circles)
 
 
+#: private names of ``bem`` imported from a sibling module of the same concern (a gap shape from its
+#: readers, a closed form from its base, a surface from its readers); the solver's modules share none
+KNOWN_PRIVATE_IMPORTS = {("bem.gaps.measured", "_positive_pair"), ("bem.gaps.measured", "_refuse"),
+                         ("bem.gaps.measured", "_axis"), ("bem.reference.layer_limit", "_ClosedForm"),
+                         ("bem.rough.instrument_files", "_pair"), ("bem.rough.instrument_files", "_surface"),
+                         ("bem.rough.instrument_files", "_surface_topography")}
+
+
+def private_imports(modules, package):
+    """``(module, name)`` of every private name (``_x``) that a module of ``package`` imports from
+    another module, function-level imports included."""
+    found = set()
+    for name, path in modules.items():
+        if name.split(".")[0] != package:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module != "__future__":
+                found |= {(name, a.name) for a in node.names if a.name.startswith("_") and not a.name.startswith("__")}
+    return found
+
+
+def test_bem_imports_no_private_name_of_another_module_but_the_known_ones():
+    assert private_imports(_modules(), "bem") <= KNOWN_PRIVATE_IMPORTS, private_imports(_modules(), "bem")
+
+
+def test_private_import_check_sees_function_level_imports(tmp_path):
+    (tmp_path / "planted.py").write_text("def run():\n    from ..solve import _run\n    return _run\n",
+                                         encoding="utf-8")
+    modules = {**_modules(), "bem.periodic.planted": tmp_path / "planted.py"}
+    assert ("bem.periodic.planted", "_run") in private_imports(modules, "bem") - KNOWN_PRIVATE_IMPORTS
+
+
 def test_no_module_over_400_lines():
     long = {str(p.relative_to(ROOT)): n for p in _modules().values()
             if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_LINES}

@@ -21,7 +21,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..checks import check_int, check_positive, fail
+from ..checks import check_int, check_node_count, check_positive, fail
 from .gap import cell_gap, check_cell_gap, coarse_gap
 from .influence import PeriodicOperator
 from .result import PeriodicContactResult
@@ -56,7 +56,8 @@ class PeriodicCell:
     n_cols : int
         Nodes per row, >= 4.
     n_rows : int
-        Rows, even, >= 2.
+        Rows, even, >= 2; at most :data:`bem.checks.MAX_NODES` nodes in all (the limit of
+        :func:`bem.checks.check_node_count`, as for a half-space region).
     """
 
     step: float
@@ -70,6 +71,7 @@ class PeriodicCell:
         if n_rows % 2:
             fail("n_rows", n_rows, "even (the triangular lattice repeats every two rows)")
         object.__setattr__(self, "n_rows", n_rows)
+        check_node_count("(n_cols, n_rows)", (self.n_cols, n_rows), self.n_cols * n_rows)
 
     @classmethod
     def from_size(cls, step, size):

@@ -198,7 +198,7 @@ class PeriodicOperator:
         on the cell: preconditioned on NumPy, in the Fourier basis
         (:func:`bem.periodic.qp.solve_periodic_qp`, whose preconditioner for a ``lam`` per node
         starts from the contact of ``x0``), else :func:`bem.kalker.constrained_cg`; a
-        :class:`bem.kalker.QPSolution`."""
+        :class:`bem.cg_rules.QPSolution`."""
         if precondition and self.backend.is_numpy:
             from .qp import solve_periodic_qp
 

@@ -1,5 +1,8 @@
 """Kalker's QP on a periodic cell: the conjugate gradients of :func:`bem.kalker.solve_qp` in the Fourier basis.
 
+The step of the periodic operator (:meth:`bem.periodic.PeriodicOperator.qp`) in the one loop
+:func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
+
 The iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active
 set, Polonsky & Keer 1999, with the FFT preconditioner, the same entering rule, Jacobi cap and
 stopping rule), specialised to :class:`bem.periodic.PeriodicOperator` on NumPy, where ``C`` is
@@ -45,16 +48,14 @@ compliance per node).
 
 from __future__ import annotations
 
-import logging
 import math
 
 import numpy as np
 
-from ..kalker import RECOMPUTE_EVERY, QPSolution, entering_pressure, initial_pressure, iterate_residual, stopping_rule
+from ..cg_rules import (RECOMPUTE_EVERY, CGStep, Record, entering_pressure, initial_pressure, iterate_residual,
+                        run_constrained_cg)
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
-
-log = logging.getLogger(__name__)
 
 SINGLE_ABOVE = 1e-4  # KKT residual above which the products run in single precision
 SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_ABOVE
@@ -96,7 +97,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
 
     Returns
     -------
-    bem.kalker.QPSolution
+    bem.cg_rules.QPSolution
         As :func:`bem.kalker.solve_qp` with its FFT preconditioner; ``op.n_matvec`` counts the
         products ``(C + lam) v`` (spectral multiplications, in single or double precision).
     """
@@ -165,12 +166,14 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     z_prev = np.zeros(lat.shape)
     gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
     gz_old, m_one, m_full = 1.0, None, None
-    hist = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
-    converged, message, status, kkt, delta = False, "", "maxiter", np.inf, approach
+    record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     prev_contact = p > 0
     n_prev = int(np.count_nonzero(prev_contact))
     fixed_scale = scale
-    for k in range(1, maxiter + 1):
+    contact = idx = g_c = p_c0 = g_min = None
+
+    def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
+        nonlocal contact, idx, g_c, p_c0, delta, g_min, single
         contact = p > 0
         idx = np.flatnonzero(contact)
         np.add(u, h, out=g)  # the gap is g - delta: delta is subtracted on the contact only
@@ -184,25 +187,27 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                                None if force is None else abs(a * float(p_c0.sum()) - force) / force)
         if k == 1:  # single precision pays for its closing product only well above SINGLE_ABOVE
             single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
+        return kkt
+
+    def confirms(kkt):  # recompute C p exactly at the tolerance, or in double precision below SINGLE_ABOVE
+        nonlocal single, u, stale
         if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
             single = False  # confirm on an exact product, or go on in double precision
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:
                 u += D * p
-            continue
+            return True
+        return False
+
+    def observe():
+        nonlocal prev_contact, n_prev
         kept = int(np.count_nonzero(prev_contact.reshape(-1)[idx]))  # nodes in both contacts
         changes = (idx.size - kept) + (n_prev - kept)
         prev_contact, n_prev = contact, idx.size
-        hist["residual"].append(kkt)
-        hist["p_max"].append(float(p_c0.max(initial=0.0)))
-        hist["n_contact"].append(int(idx.size))
-        hist["changes"].append(changes)
-        if (stop := stopping_rule(kkt, rtol)) is not None:
-            converged, message, status = stop
-            break
-        if idx.size == 0 and g_min >= 0:  # no contact at this approach: p = 0 is the solution
-            converged, message, status, kkt = True, "no contact at this approach", "converged", 0.0
-            break
+        return float(p_c0.max(initial=0.0)), int(idx.size), changes, idx.size == 0 and g_min >= 0
+
+    def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
+        nonlocal m_full, m_one, gz_old, r_hat, u, stale
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         r32.fill(0.0)
         if soft is None:
@@ -249,8 +254,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if not np.any(t_c):
             tau = 0.0  # a single contact node under force control: only entering nodes can move
         elif tt <= 0 or not math.isfinite(tt):
-            message, status = f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
-            break
+            return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
         else:
             tau = gt / tt  # the minimum along t (gt = gz when the contact has not changed)
         p_c = p_c0 - tau * t_c
@@ -270,8 +274,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             total = float(p_c.sum()) + (float(p_o.sum()) if entered else 0.0)
             if not total > 0:  # every node left the contact and none entered: no force to rescale
                 pf[idx] = p_c0
-                message, status = "the iteration produced a non-finite value", "nonfinite"
-                break
+                return "the iteration produced a non-finite value", "nonfinite"
             s = target / total
             p_c *= s
             pf[idx] = p_c
@@ -296,13 +299,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             if s != 1.0:
                 u *= s
             stale += 1
-        if callback is not None:
-            callback(k, p.copy())
-    else:
-        message = f"no convergence in maxiter = {maxiter} iterations (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
-    if not converged:
-        log.debug("Kalker QP (periodic): %s", message)
+        return None
+
+    kkt = run_constrained_cg(CGStep(measure, confirms, observe, advance, p.copy), record, maxiter, callback)
     # C p: the layer's closure is not a displacement
     elastic = u - (D if per_node else lam) * p if per_node or lam else u.astype(float, copy=False)
-    return QPSolution(p=p, approach=float(delta), iterations=len(hist["residual"]), converged=converged,
-                      message=message, status=status, kkt_residual=float(kkt), displacement=elastic, history=hist)
+    return record.solution(p, delta, kkt, elastic, "Kalker QP (periodic)")

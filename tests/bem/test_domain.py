@@ -2,6 +2,7 @@
 of a region, and the alias solve_periodic."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -100,10 +101,16 @@ def test_x0_is_refused_with_a_growing_region():
 def test_the_checks_table_has_a_row_for_every_argument_of_solve():
     """docs/method.md, "Checks of bem.solve": one row per keyword of bem.solve, and no other."""
     import inspect
-    import re
     from pathlib import Path
 
     text = (Path(__file__).resolve().parents[2] / "docs" / "method.md").read_text(encoding="utf-8")
     table = text.split("#### Checks of `bem.solve`", 1)[1].split("\n## ", 1)[0]
     rows = {m.group(1) for m in re.finditer(r"^\| `([^`]+)` \|", table, re.M)}
     assert rows == set(inspect.signature(bem.solve).parameters)
+
+
+@pytest.mark.parametrize("build", [lambda: bem.HalfSpaceRegion(1e-4, 1.0), lambda: bem.PeriodicCell(1.0, 5000, 5000)],
+                         ids=["region", "cell"])
+def test_both_domains_refuse_more_nodes_than_the_limit_before_building_them(build):
+    with pytest.raises(bem.InputError, match=re.escape(f"nodes (limit {bem.checks.MAX_NODES:.3g},")):
+        build()

@@ -1,0 +1,209 @@
+"""The rules every constrained-CG step of Kalker's QP shares, whatever the operator's basis.
+
+The start (:func:`initial_pressure`), the KKT residual of an iterate (:func:`iterate_residual`),
+the stopping rule (:func:`stopping_rule`), the pressure of the nodes that enter the contact
+(:func:`entering_pressure`), the exact product every :data:`RECOMPUTE_EVERY` updates, and the
+record of the iteration and its outcome (:class:`Record`, :class:`QPSolution`). The steps are
+:func:`bem.kalker.solve_qp` (the general loop, any array namespace) and
+:func:`bem.periodic.qp.solve_periodic_qp` (a periodic cell in the Fourier basis); each
+operator picks its own (``op.qp``).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+from .backend import operator_backend
+
+__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule", "entering_pressure",
+           "is_per_node", "RECOMPUTE_EVERY"]
+
+log = logging.getLogger(__name__)
+
+#: An exactly recomputed ``C p`` every so many incremental updates of the constrained CG.
+RECOMPUTE_EVERY = 20
+
+
+@dataclass
+class QPSolution:
+    """Outcome of :func:`solve_qp` and of every solver built on it (brick arrays on the operator's lattice).
+
+    ``displacement`` is the elastic displacement ``C p`` [length], the same for every solver (the
+    layer's closure ``lam p`` or ``w(p)`` is not in it); ``None`` where a solver did not keep it.
+    The arrays are in the namespace of the operator's device.
+    """
+
+    p: np.ndarray
+    approach: float
+    iterations: int
+    converged: bool
+    message: str
+    kkt_residual: float
+    displacement: np.ndarray
+    status: str  # one of bem.result.STATUSES
+    history: dict = field(default_factory=dict)
+
+
+def _quantile(bk, values, q):
+    """``numpy.quantile(values, q)`` (linear interpolation) of a 1-D array, as a Python float."""
+    if bk.is_numpy:
+        return float(np.quantile(values, q))
+    v = bk.xp.sort(values)
+    pos = q * (v.shape[0] - 1)
+    lo = int(math.floor(pos))
+    hi = min(lo + 1, v.shape[0] - 1)
+    a, b, t = float(v[lo]), float(v[hi]), pos - lo
+    return a + (b - a) * t if t < 0.5 else b - (b - a) * (1 - t)
+
+
+def initial_pressure(op, h, lam, force, approach, x0):
+    """The starting pressure of the constrained CG (brick array): ``x0`` clipped at 0, or under force
+    control a uniform pressure on the quarter of the nodes with the smallest gap, or under approach
+    control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``."""
+    lat = op.lattice
+    bk, mask = operator_backend(op)
+    xp = bk.xp
+    if x0 is not None:
+        p = xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
+    elif force is not None:
+        # rigid-punch-like start: pressure where the gap is smallest
+        hm = xp.where(mask, h, xp.inf)
+        level = _quantile(bk, hm[mask], 0.25)
+        p = xp.astype(mask & (hm <= level), bk.float64)
+    else:
+        p = xp.where(mask, xp.maximum(approach - h, 0.0), 0.0) / (op.diagonal + float(xp.max(lam) if is_per_node(lam) else lam))
+    if force is not None:
+        total = float(xp.sum(p))
+        if total <= 0:
+            p = xp.astype(mask, bk.float64)
+            total = float(xp.sum(p))
+        p *= force / lat.node_area / total
+    return p
+
+
+def entering_pressure(xp, g, tau, jacobi, per_node):
+    """Pressure of the nodes that enter the contact (``p = 0``, gap ``g < 0``): Polonsky-Keer's
+    ``-tau g``, capped by the Jacobi estimate ``-g / (C_nn + lam)`` (``jacobi = 1 / (C_nn + lam)``,
+    an array where ``per_node``) so that a node with a large layer compliance cannot overshoot."""
+    return -g * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi)
+
+
+def is_per_node(lam):
+    """Whether the compliance ``lam`` is given per node (an array) rather than uniform."""
+    return getattr(lam, "ndim", 0) > 0
+
+
+def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None):
+    """The KKT residual of an iterate (:func:`bem.kkt.kkt_residual` from its parts; non-finite: ``inf``).
+
+    ``max(max_contact |g|, (-min g)_+) / scale`` (every contact node has ``-g <= max_contact |g|``), with
+    ``contact_gap = max_contact |g|``, ``gap_min = min g``, ``scale`` the displacement scale and
+    ``gap_max()`` the largest ``|g|``, the scale where ``scale`` is not positive (or 1); under force
+    control the larger of that and ``force_error = |a sum p - P| / P``.
+    """
+    parts = [contact_gap, -gap_min, 0.0]
+    kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) / (scale if scale > 0 else gap_max() or 1.0)
+    if force_error is not None:
+        kkt = float(np.max([kkt, force_error]))
+    return kkt if math.isfinite(kkt) else np.inf
+
+
+def stopping_rule(kkt, rtol):
+    """``(converged, message, status)`` of the QP's stopping rule at the KKT residual ``kkt``
+    (non-finite: ``nonfinite``; ``kkt <= rtol``: ``converged``), ``None`` to go on."""
+    if not math.isfinite(kkt):
+        return False, "the iteration produced a non-finite value", "nonfinite"
+    if kkt <= rtol:
+        return True, f"KKT residual {kkt:.2e} <= rtol {rtol:.1e}", "converged"
+    return None
+
+
+class Record:
+    """The history of a constrained CG (``residual``, ``p_max``, ``n_contact``, ``changes`` per
+    iteration) and its outcome under the one stopping rule.
+
+    Parameters
+    ----------
+    rtol : float
+        Tolerance on the KKT residual.
+    maxiter : int
+        Iteration limit (for the message of a run that reaches it).
+    """
+
+    def __init__(self, rtol, maxiter):
+        self.rtol, self.maxiter = rtol, maxiter
+        self.history = {"residual": [], "p_max": [], "n_contact": [], "changes": []}
+        self.converged, self.message, self.status = False, "", "maxiter"
+        self.stopped = self.empty = False
+
+    def stops(self, kkt, p_max, n_contact, changes, no_contact):
+        """Record an iterate; whether the iteration stops there: :func:`stopping_rule`, or no node in
+        contact and no gap closed (``no_contact``: ``p = 0`` is the solution, residual 0)."""
+        hist = self.history
+        hist["residual"].append(kkt)
+        hist["p_max"].append(p_max)
+        hist["n_contact"].append(n_contact)
+        hist["changes"].append(changes)
+        if (stop := stopping_rule(kkt, self.rtol)) is not None:
+            self.converged, self.message, self.status = stop
+        elif no_contact:
+            self.converged, self.message, self.status = True, "no contact at this approach", "converged"
+            self.empty = True
+        else:
+            return False
+        self.stopped = True
+        return True
+
+    def fail(self, message, status):
+        """Stop without convergence (``status`` one of :data:`bem.result.STATUSES`)."""
+        self.message, self.status, self.stopped = message, status, True
+
+    def solution(self, p, delta, kkt, displacement, name):
+        """The :class:`QPSolution` of the last iterate ``p`` (``kkt`` its residual; 0 where no contact was the answer)."""
+        if not self.stopped:
+            self.message = (f"no convergence in maxiter = {self.maxiter} iterations (KKT residual {kkt:.2e} > "
+                            f"rtol {self.rtol:.1e})")
+        if not self.converged:
+            log.debug("%s: %s", name, self.message)
+        if self.empty:
+            kkt = 0.0
+        return QPSolution(p=p, approach=float(delta), iterations=len(self.history["residual"]),
+                          converged=self.converged, message=self.message, status=self.status,
+                          kkt_residual=float(kkt), displacement=displacement, history=self.history)
+
+
+class CGStep(NamedTuple):
+    """The operations of one operator's constrained-CG step, in its own basis, for :func:`run_constrained_cg`."""
+
+    measure: Callable  # measure(k) -> the KKT residual of the current iterate (iterate_residual)
+    confirms: Callable  # confirms(kkt) -> True where C p was recomputed exactly and the iterate is measured again
+    observe: Callable  # observe() -> (p_max, n_contact, changes, no_contact) of the iterate, for Record.stops
+    advance: Callable  # advance(k) -> None after the step of iteration k, or (message, status) where no step can be taken
+    report: Callable  # report() -> the pressure for the callback
+
+
+def run_constrained_cg(step, record, maxiter, callback=None):
+    """The one loop of the constrained conjugate gradients of Kalker's QP (Polonsky & Keer 1999).
+
+    Each iteration measures the iterate (its KKT residual), confirms a residual at the tolerance on an
+    exact product, records it and stops by the one stopping rule (:meth:`Record.stops`), or takes a
+    step (``step.advance``) and reports the pressure to ``callback(k, p)``. Returns the last residual.
+    """
+    kkt = np.inf
+    for k in range(1, maxiter + 1):
+        kkt = step.measure(k)
+        if step.confirms(kkt):
+            continue
+        if record.stops(kkt, *step.observe()):
+            break
+        if (failure := step.advance(k)) is not None:
+            record.fail(*failure)
+            break
+        if callback is not None:
+            callback(k, step.report())
+    return kkt
