@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import bem
+
 import validation.run.runner as runner
 from bem.files import lattice_triangles
 from validation.io import OutputError, atomic_directory, atomic_write_json
@@ -173,7 +175,7 @@ def test_automatic_region_grows_when_the_estimate_is_short():
 def test_an_enlarged_region_is_the_estimate_times_1_5_and_solves_as_if_given(scene_name, overrides):
     """The region grows by 1.5 (up to the gap's domain) and the run is that of a scene giving the grown
     region itself: the calibration and the solve both use it."""
-    from validation.scene.sizing import region_limit
+    from bem.region import region_limit
 
     scene = load_scene(scene_name, overrides=["bem.nodes_across=16", "fem.n_contact_elements=8", *overrides])
     grown = execute_scene(scene).result
@@ -186,6 +188,14 @@ def test_an_enlarged_region_is_the_estimate_times_1_5_and_solves_as_if_given(sce
     for key in ("p_max", "approach", "contact_area", "iterations"):
         assert getattr(given, key) == getattr(grown, key), key
     assert given.layer["parameters"] == grown.layer["parameters"]
+
+
+def test_a_given_region_the_contact_outgrows_is_refused_by_its_scene_key():
+    """A region the scene gives does not grow: the error names the key as the scene writes it."""
+    scene = load_scene("paper_root", overrides=["bem.nodes_across=16", "bem.extent_factor=1.0"], no_fem=True)
+    ex, ey = scene.bem["extent"]  # the estimate, which the root law's contact outgrows (test above)
+    with pytest.raises(bem.RegionTooSmallError, match=r"^bem\.extent = .* the contact reaches the border"):
+        execute_scene(scene, overrides=[f"bem.extent=[{ex!r}, {ey!r}]"])
 
 
 def test_planned_stages_hold_the_calibration_exactly_when_it_solves():

@@ -64,8 +64,10 @@ def test_a_calibration_that_fails_stops_the_run(monkeypatch):
 
 
 @pytest.mark.parametrize("method, note", [("augmented_gap", True), ("variable_compliance", True), ("newton", False)])
-def test_a_paper_method_on_a_smooth_scene_notes_the_solver_that_ran(method, note):
-    out = runner.execute_scene(load_scene("hertz", overrides=[f'bem.method="{method}"', "bem.nodes_across=16"]))
+@pytest.mark.parametrize("name, size", [("hertz", "bem.nodes_across=16"), ("rough_flat", "bem.cell_nodes=32")])
+def test_a_paper_method_on_a_smooth_scene_notes_the_solver_that_ran(method, note, name, size):
+    """The same note on both domains: a region of the half-space and a periodic cell."""
+    out = runner.execute_scene(load_scene(name, overrides=[f'bem.method="{method}"', size]))
     assert out.result.method == "kalker"
     notes = [m for m in out.result.messages if "ran as Kalker's QP" in m]
     assert notes == ([f"bem.method = {method!r} ran as Kalker's QP ('kalker'): the scene has no layer, so the "

@@ -53,18 +53,13 @@ _FLAGS = {"quick": "--quick", "units": "--units", "overrides": "--set", "allow_c
 
 
 def run(args):
-    from bem.checks import InputError
-
     from ..report import command
 
     options = dict(quick=args.quick, units=args.units, overrides=args.overrides, **trust(args))
-    kind = command.target_kind(args.target)
-    for key in command.refused_options(kind, options):
-        raise InputError(f"{_FLAGS[key]} is not allowed with target {args.target!r} (a {kind} target): it applies "
-                         f"to {command.applies_to(key)}.")
     bar = ProgressBar("report", "stage", args.no_progress or None)
     try:
-        built = command.build(args.target, out=args.out, fmt=args.format, progress=bar, what="--out", **options)
+        built = command.build(args.target, out=args.out, fmt=args.format, progress=bar, what="--out", names=_FLAGS,
+                              **options)
     finally:
         bar.close()
     print(f"report written to {built.html}")

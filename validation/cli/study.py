@@ -5,7 +5,9 @@ from __future__ import annotations
 import importlib
 from pathlib import Path
 
-PARSER = {"help": "studies: error-time, stability, robustness, two-scale",
+from ..studies import STUDIES
+
+PARSER = {"help": "studies: " + ", ".join(STUDIES),
           "description": "Studies of the methods (validation.studies) on their built-in problems "
                          "(no scene keys to override).\n"
                          "--out DIR is the study folder written (default results/STUDY); it must be new,\n"
@@ -16,16 +18,12 @@ PARSER = {"help": "studies: error-time, stability, robustness, two-scale",
                     "  contactlab study two-scale --quick    (rough_sphere_two_scale, the small two-scale check)\n"
                     "  contactlab report reports/studies      (work-precision plot and tables)"}
 
-#: study name -> module with ``main(out=, scene=, quick=, progress=)``
-STUDIES = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
-           "robustness": "validation.studies.robustness", "two-scale": "validation.studies.two_scale"}
-
 
 def add_args(p):
     p.add_argument("study", choices=tuple(STUDIES), metavar="{" + ",".join(STUDIES) + "}")
     p.add_argument("scene", nargs="?", metavar="SCENE",
                    help="problem for error-time: hertz or paper_root (default: both)")
-    p.add_argument("--quick", action="store_true", help="a short ladder / case list (minutes instead of ~5)")
+    p.add_argument("--quick", action="store_true", help="a short ladder / case list, a fraction of the full study's time")
     p.add_argument("--out", metavar="DIR", help="the study folder written (default: results/STUDY)")
 
 

@@ -72,7 +72,7 @@ def applies_to(key):
 
 
 def build(target, *, out=None, fmt="png", units=None, quick=False, overrides=(), allow_code=False,
-          allow_outside_files=False, progress=None, what="out"):
+          allow_outside_files=False, progress=None, what="out", names=None):
     """Write the report of ``target`` and return it.
 
     Parameters
@@ -102,6 +102,9 @@ def build(target, *, out=None, fmt="png", units=None, quick=False, overrides=(),
         (:class:`validation.progress.Progress`).
     what : str
         How errors name ``out`` (the command line's ``--out``).
+    names : dict, optional
+        How errors name the keywords ``quick``, ``units``, ``overrides``, ``allow_code`` and
+        ``allow_outside_files`` (the command line's options); default ``"key = value"``.
 
     Returns
     -------
@@ -125,7 +128,8 @@ def build(target, *, out=None, fmt="png", units=None, quick=False, overrides=(),
     given = dict(quick=quick, units=units if units != "auto" else None, overrides=overrides, allow_code=allow_code,
                  allow_outside_files=allow_outside_files)
     for key in refused_options(kind, given):
-        raise InputError(f"{key} = {given[key]!r} is not allowed with target {target!r} (a {kind} target): it "
+        name = (names or {}).get(key) or f"{key} = {given[key]!r}"
+        raise InputError(f"{name} is not allowed with target {target!r} (a {kind} target): it "
                          f"applies to {applies_to(key)}.")
     require_extra("report", "contactlab report (figures)")
     from .render.build import check_report_dir

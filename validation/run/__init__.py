@@ -1,7 +1,10 @@
 """Running scenes: the runner, the typed result, the stresses and sweeps.
 
 - :mod:`validation.run.runner`: :func:`run_scene` / :func:`execute_scene`, the one place that
-  solves a scene (BEM always; FEM, closed form, comparison, stresses when named);
+  solves a scene (BEM always; FEM, closed form, comparison, stresses when named); the scene's
+  domain says what :func:`bem.solve` solves and makes the parts of the result that are its own: a
+  region of the half-space (:mod:`validation.run.region`) or a periodic cell
+  (:mod:`validation.run.periodic`);
 - :mod:`validation.run.record`: :class:`RunResult`, the typed content of ``result.json`` (its
   JSON reading and writing, the schema version), its parts in :mod:`validation.run.parts`;
   :mod:`validation.run.result` makes it;

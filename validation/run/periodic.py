@@ -1,32 +1,20 @@
-"""Run a periodic scene: the cell of a rough surface pressed by a flat (:func:`bem.solve_periodic`).
+"""The domain of a periodic scene: the cell of a rough surface pressed by a flat (:class:`bem.PeriodicCell`).
 
-:func:`execute_periodic` solves the scene's cell (:mod:`validation.scene.rough`) and returns a
-:class:`validation.run.RunOutcome` whose :class:`validation.run.record.RunResult` holds the
-periodic quantities in its ``periodic`` part: ``mean_pressure``, ``contact_fraction``,
-``mean_gap``, ``n_spots`` (the contact spots, :func:`contact_spots`), ``spots`` and ``surface``
-(docs/results.md).
+:class:`Cell` is one of the two domains of :func:`validation.run.execute_scene` (the other is
+the region of an isolated contact, :class:`validation.run.region.Region`): it says what
+:func:`bem.solve` solves (the scene's cell, :mod:`validation.scene.rough`, its nodal gap and its
+load) and makes the ``periodic`` part of the run result:
+``mean_pressure``, ``contact_fraction``, ``mean_gap``, ``n_spots`` (the contact spots,
+:func:`contact_spots`), ``spots`` and ``surface`` (docs/results.md).
 """
 
 from __future__ import annotations
 
-import logging
-import time
-
 import numpy as np
 
-from ..provenance import provenance
-from ..progress import stages_of
-from .calibrate import resolve_layer
 from .parts import PeriodicPart, SpotSummary
-from .record import RunResult
-from .result import bem_part, unit_symbols
 
-__all__ = ["execute_periodic", "contact_spots", "periodic_result"]
-
-log = logging.getLogger(__name__)
-#: the entries of a periodic scene's ``bem`` options that describe the cell, not the solver
-_CELL_KEYS = ("periodic", "cell_nodes", "step", "cell", "size", "extent", "extent_auto", "expected", "nodes_across",
-              "n_nodes")
+__all__ = ["Cell", "contact_spots"]
 
 
 def _neighbours(shape):
@@ -96,76 +84,82 @@ def _spot_summary(labels, n, node_area):
             "single_node": int(np.count_nonzero(sizes == 1))}
 
 
-def periodic_result(scene, res, layer_info, *, times, messages, spots):
-    """The :class:`validation.run.record.RunResult` of a periodic run (module docstring; docs/results.md)."""
-    from ..io import to_jsonable
-
-    cell, lattice, stats = res.lattice, scene.gap.lattice, scene.gap.surface.stats
-    labels, n = spots
-    surface = dict(stats.as_dict(), stretch_y=lattice.stretch_y, stretch_large=bool(lattice.stretch_large))
-    bem = bem_part(res, E_star=scene.E_star, step=cell.step, size=list(cell.size), n_nodes=int(res.p.size),
-                   n_contact=int(np.count_nonzero(res.p > 0)))
-    periodic = PeriodicPart(mean_pressure=res.mean_pressure, contact_fraction=res.contact_fraction,
-                            mean_gap=res.mean_gap, n_spots=n,
-                            spots=SpotSummary(**_spot_summary(labels, n, cell.node_area)), surface=surface)
-    top = to_jsonable({
-        "scene": scene.name, "title": scene.title, "units": scene.units.label,
-        "unit_symbols": unit_symbols(scene.units), "source": scene.source, "overrides": list(scene.overrides),
-        "method": res.method,
-        "p_max": res.p_max, "force": res.force, "approach": res.approach, "contact_area": res.contact_area,
-        "contact_radius": None, "contact_extent": None,
-        "iterations": res.iterations, "converged": bool(res.converged), "kkt_residual": res.kkt_residual,
-        "message": res.message, "messages": list(messages), "wall_time_s_by_part": dict(times),
-        "layer": layer_info, "alpha_b": None, "report": scene.report, "provenance": provenance(),
-    })
-    parts = {"bem": bem, "periodic": periodic}
-    parts = {k: type(v).from_json(v.to_json(), where=k, source="the run") for k, v in parts.items()}
-    return RunResult(**top, **parts, fem=None, fem_profile=None, analytic=None, comparison=None, scales=None,
-                     profile=None, stress=None)
-
-
-def execute_periodic(scene, *, progress=None):
-    """Solve a periodic scene (:func:`bem.solve_periodic`); returns a :class:`validation.run.RunOutcome`.
+class Cell:
+    """The periodic cell of a rough surface pressed by a flat (:class:`bem.PeriodicCell`).
 
     ``load.force`` is the force on one cell, solved as the mean pressure ``force / (Lx Ly)``.
-    ``progress``: a :class:`validation.progress.Progress` holding the stage ``"bem"``, or a callback
-    (:mod:`validation.progress`).
+
+    Parameters
+    ----------
+    scene : validation.scene.Scene
+        A validated periodic scene (:mod:`validation.scene.rough`).
+    messages : list of str
+        The run's messages; the notes on the surface's cell (a large edge jump, a stretched lattice)
+        are appended.
+
+    Attributes
+    ----------
+    step : float
+        Lattice step [length].
+    gap : ndarray
+        The initial gap at the cell's nodes (brick array) [length].
+    load : dict
+        The load keywords of :func:`bem.solve`: ``mean_pressure`` and ``approach`` (one is ``None``).
+    bem_domain : bem.PeriodicCell
+        The cell of the scene's lattice (``bem.cell_nodes``).
+    spots : ndarray of int or None
+        The contact spot of each node (:func:`contact_spots`) of the last :meth:`parts`.
     """
-    import bem
 
-    from .runner import RunOutcome
+    def __init__(self, scene, messages):
+        import bem
 
-    stages = stages_of(progress, ["bem"])
+        self.scene = scene
+        self.lattice = lattice = scene.gap.lattice
+        self.step = lattice.step
+        self.gap = lattice.gap()
+        load = scene.load
+        area = lattice.size[0] * lattice.size[1]
+        mean_pressure = load.get("mean_pressure") or (None if load["force"] is None else load["force"] / area)
+        self.load = {"mean_pressure": mean_pressure, "approach": load["approach"]}
+        self.bem_domain = bem.PeriodicCell(lattice.step, *self.gap.shape[::-1])
+        self.spots = None
+        messages.extend(_surface_notes(scene))
 
-    t0 = time.perf_counter()
-    messages = []
-    lattice, opts, load = scene.gap.lattice, scene.bem, scene.load
-    stats = scene.gap.surface.stats
+    def parts(self, res):
+        """The parts of the run result that belong to a periodic cell (:func:`validation.run.result.build_result`).
+
+        Returns
+        -------
+        dict
+            ``bem``: the cell's field of :class:`validation.run.parts.BemPart` (``size``);
+            ``periodic`` (:class:`validation.run.parts.PeriodicPart`: the spots, the surface's
+            statistics); ``contact_extent`` and ``profile`` (``None``).
+        """
+        cell, lattice, stats = res.lattice, self.lattice, self.scene.gap.surface.stats
+        labels, n = contact_spots(res.p.reshape(cell.shape) > 0)
+        self.spots = labels
+        surface = dict(stats.as_dict(), stretch_y=lattice.stretch_y, stretch_large=bool(lattice.stretch_large))
+        periodic = PeriodicPart(mean_pressure=res.mean_pressure, contact_fraction=res.contact_fraction,
+                                mean_gap=res.mean_gap, n_spots=n,
+                                spots=SpotSummary(**_spot_summary(labels, n, cell.node_area)), surface=surface)
+        return {"bem": {"size": list(cell.size)}, "contact_extent": None, "profile": None, "periodic": periodic}
+
+    def field(self, res):
+        """Extra nodal fields of ``bem_field.vtu`` (:func:`bem.files.write_result_vtu`): the initial gap and
+        the contact spot of each node (``-1``: no contact)."""
+        return {"initial_gap": self.scene.gap.nodal_gap(), "contact_spot": self.spots.ravel()}
+
+
+def _surface_notes(scene):
+    """What the run says about the surface's cell: a large edge jump, a lattice that stretches it."""
+    lattice, stats = scene.gap.lattice, scene.gap.surface.stats
+    notes = []
     if stats.edge_jump_large:
-        messages.append(f"the surface's cell has a large edge jump ({stats.edge_jump:.4g} against a grid step of "
-                        f"{stats.grid_step:.4g}, rms height {stats.rms_height:.4g}): its repetition has a step at "
-                        "the cell's edges")
+        notes.append(f"the surface's cell has a large edge jump ({stats.edge_jump:.4g} against a grid step of "
+                     f"{stats.grid_step:.4g}, rms height {stats.rms_height:.4g}): its repetition has a step at "
+                     "the cell's edges")
     if lattice.stretch_large:
-        messages.append(f"the lattice stretches the surface along y by {lattice.stretch_y:.4f}: choose bem.cell_nodes "
-                        "for which the cell's rows fit (docs/rough.md)")
-    layer, layer_info = resolve_layer(scene.layer_spec, step=lattice.step, E_star=scene.E_star, solve=None,
-                                      layer=scene.layer)
-    area = lattice.size[0] * lattice.size[1]
-    mean_pressure = load.get("mean_pressure") or (None if load["force"] is None else load["force"] / area)
-    kw = {k: v for k, v in opts.items() if k not in _CELL_KEYS}  # the solver options
-
-    def callback(k, _p):
-        stages.note(f"iteration {k}")
-
-    stages("bem")
-    t = time.perf_counter()
-    res = bem.solve_periodic(lattice.gap(), step=lattice.step, E_star=scene.E_star, mean_pressure=mean_pressure,
-                             approach=load["approach"], layer=layer,
-                             callback=callback if stages.callback is not None else None, **kw)
-    times = {"bem": time.perf_counter() - t, "fem": None, "layer_reference": None, "stress": None}
-    if not res.converged:
-        messages.append(f"BEM did not converge: {res.message}")
-    spots = contact_spots(res.p.reshape(res.lattice.shape) > 0)
-    times["total"] = time.perf_counter() - t0
-    result = periodic_result(scene, res, layer_info, times=times, messages=messages, spots=spots)
-    return RunOutcome(scene=scene, result=result, bem=res, layer=layer, spots=spots[0])
+        notes.append(f"the lattice stretches the surface along y by {lattice.stretch_y:.4f}: choose bem.cell_nodes "
+                     "for which the cell's rows fit (docs/rough.md)")
+    return notes

@@ -119,17 +119,21 @@ def bem_part(res, **extra):
     return BemPart(**{k: v for k, v in data.items() if k in names})
 
 
-def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=None, times, messages, extent,
+def build_result(scene, res, layer_info, *, domain_parts, fem=None, analytic=None, metrics=None, times, messages,
                  stress=None):
     """The :class:`validation.run.record.RunResult` of a run (see the module docstring), JSON-ready.
 
-    ``stress``: the ``stress`` block (:func:`validation.run.stress.stress_summary`) of a scene with ``[stress]``.
+    ``domain_parts``: the parts its domain makes (``parts(res)`` of :class:`validation.run.region.Region`
+    or :class:`validation.run.periodic.Cell`): the domain's fields of the ``bem`` part, ``contact_extent``,
+    ``profile`` and ``periodic``. ``stress``: the ``stress`` block
+    (:func:`validation.run.stress.stress_summary`) of a scene with ``[stress]``.
     """
     from ..io import to_jsonable
 
     converged = bool(res.converged) and (fem is None or bool(fem.converged))
-    bem = bem_part(res, E_star=scene.E_star, extent=list(extent),
-                   nodes_across_contact=(2 * res.contact_radius / res.step))
+    own = dict(domain_parts)
+    bem = bem_part(res, E_star=scene.E_star, **own.pop("bem"))
+    contact_extent = own.pop("contact_extent")
     parts = {
         "bem": bem,
         "fem": None if fem is None else _fem_part(fem),
@@ -138,23 +142,23 @@ def build_result(scene, res, layer_info, *, fem=None, analytic=None, metrics=Non
             **_analytic_summary(scene.analytic["kind"], analytic, res.lattice)),
         "comparison": _comparison(metrics),
         "scales": None if (scales := _scales(scene)) is None else Scales(**scales),
-        "profile": AxialProfile(**axial_profile(res)),
+        "profile": own["profile"],
         "stress": None if stress is None else StressPart.from_json(to_jsonable(stress), where="stress",
                                                                      source="the run"),
+        "periodic": own["periodic"],
     }
     parts = {k: None if v is None else type(v).from_json(v.to_json(), where=k, source="the run")
              for k, v in parts.items()}  # JSON-ready values: a result equals itself read back
-    extent_xy = {axis: float(np.abs(coord[res.p > 0]).max(initial=0.0)) for axis, coord in (("x", res.x), ("y", res.y))}
     top = to_jsonable({
         "scene": scene.name, "title": scene.title, "units": scene.units.label,
         "unit_symbols": unit_symbols(scene.units), "source": scene.source,
         "overrides": list(scene.overrides), "method": res.method,
         "p_max": res.p_max, "force": res.force, "approach": res.approach, "contact_area": res.contact_area,
         "contact_radius": res.contact_radius if scene.axisymmetric else None,
-        "contact_extent": extent_xy,
+        "contact_extent": contact_extent,
         "iterations": res.iterations, "converged": converged, "kkt_residual": res.kkt_residual,
         "message": res.message, "messages": list(messages), "wall_time_s_by_part": dict(times),
         "layer": layer_info, "alpha_b": layer_info.get("alpha_b"), "report": scene.report,
         "provenance": provenance(),
     })
-    return RunResult(**top, **parts, periodic=None)
+    return RunResult(**top, **parts)

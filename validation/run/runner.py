@@ -26,9 +26,10 @@ from ..scene.checks import SceneError
 from ..scene.load import Scene, load_scene
 from ..scene.study import refuse_study
 from ..scene.trust import refuse_code
-from ..scene.sizing import SOLVER_KEYS, inner_domain, region_limit
+from ..scene.sizing import solver_keywords
 from .calibrate import CalibrationError, resolve_layer
 from .record import FILE_NAME, RunResult
+from .region import Region
 from .result import build_result
 
 __all__ = ["run_scene", "execute_scene", "write_outputs", "RunOutcome", "planned_stages", "FILES", "RESULT_NAMES",
@@ -41,7 +42,9 @@ FILES = {"result": FILE_NAME, "scene": "scene.toml", "bem_field": "bem_field.vtu
          "fem_field": "fem_field.vtu", "stress_field": "stress_field.vtu"}
 #: What a result directory may hold besides its marker: its files and its default report folder.
 RESULT_NAMES = (*FILES.values(), "report")
-_GROW, _MAX_GROW = 1.5, 3  # automatic region: enlarge x1.5, at most 3 times
+#: the options of the scene's ``[bem]`` that the calibration solves of a layer take over; they solve with
+#: ``method = "newton"`` and its defaults otherwise, whatever the scene's method
+CALIBRATION_KEYS = ("rtol", "precondition", "nested")
 
 
 @dataclass
@@ -51,11 +54,17 @@ class RunOutcome:
     scene: Scene
     result: RunResult
     bem: object
+    domain: object  # validation.run.region.Region or validation.run.periodic.Cell
     fem: object = None
     analytic: object = None
     layer: object = None
     stress: object = None
-    spots: object = None  # periodic scenes: the contact-spot label of each node (validation.run.periodic)
+
+    @property
+    def spots(self):
+        """The contact spot of each node of a periodic cell (:func:`validation.run.periodic.contact_spots`),
+        ``None`` for a region."""
+        return getattr(self.domain, "spots", None)
 
 
 def planned_stages(scene, *, write=False):
@@ -69,53 +78,57 @@ def planned_stages(scene, *, write=False):
     return [stage for stage, on in wanted.items() if on]
 
 
-class _BemRunner:
-    """Solves the scene's BEM problem for a given layer; enlarges an automatic region if needed."""
+def domain_of(scene, messages):
+    """The domain of ``scene``: its periodic cell (:class:`validation.run.periodic.Cell`) or its region of
+    the half-space (:class:`validation.run.region.Region`); ``messages``: the run's messages."""
+    if scene.bem.get("periodic"):
+        from .periodic import Cell
 
-    def __init__(self, scene, messages, *, calibration=False):
-        self.scene, self.messages, self.calibration = scene, messages, calibration
+        return Cell(scene, messages)
+    return Region(scene)
+
+
+class _BemSolves:
+    """:func:`bem.solve` of the scene's problem on its domain for a given layer: the run's solve and the
+    calibration's. A region grown by one solve is where the next one starts (the calibration's region
+    carries over to the run's solve); ``messages`` gets the notes of each solve (how it grew)."""
+
+    def __init__(self, scene, domain, messages):
         opts = scene.bem
-        self.extent = tuple(opts["extent"])
-        self.kw = dict(E_star=scene.E_star, **scene.load, step=opts["step"],
-                       method="newton" if calibration else opts["method"])
-        # the calibration solves with the robust solver and its defaults, whatever the scene's method:
-        # only the tolerance and the lattice options carry over
-        keys = ("rtol", "precondition", "nested") if calibration else SOLVER_KEYS[1:]
-        self.kw.update({k: opts[k] for k in keys if k in opts})
-        self.solves = 0
+        self.domain, self.messages = domain, messages
+        self.bem_domain = domain.bem_domain
+        problem = dict(E_star=scene.E_star, **domain.load)
+        self.kw = dict(problem, **solver_keywords(opts))
+        self.calibration_kw = dict(problem, method="newton", **{k: opts[k] for k in CALIBRATION_KEYS if k in opts})
+        self.calibration_solves = 0
 
     def __call__(self, layer, callback=None):
-        res = self._solve(layer, callback)
-        if self.calibration and not res.converged:
+        return self._solve(layer, callback, self.kw)
+
+    def calibrate(self, layer):
+        """A calibration solve (:func:`validation.run.calibrate.resolve_layer`) with the robust solver.
+
+        Raises
+        ------
+        validation.run.calibrate.CalibrationError
+            The solve did not converge (the layer's parameters would be wrong).
+        """
+        self.calibration_solves += 1
+        res = self._solve(layer, None, self.calibration_kw)
+        if not res.converged:
             raise CalibrationError(
                 f"the calibration of the layer law ({layer!r}) did not converge with method 'newton': "
                 f"{res.message}. The run stops: the layer parameters would be wrong.")
         return res
 
-    def _solve(self, layer, callback):
-        for attempt in range(_MAX_GROW + 1):
-            try:
-                self.solves += 1
-                return bem.solve(self.scene.gap, layer=layer, extent=self.extent, callback=callback, **self.kw)
-            except bem.RegionTooSmallError:
-                if not self.scene.bem["extent_auto"]:
-                    raise
-                hx, hy = inner_domain(self.scene.gap)
-                limit = region_limit(self.scene.gap)
-                grown = tuple(min(_GROW * e, lim) for e, lim in zip(self.extent, limit))
-                if attempt == _MAX_GROW or grown == self.extent:
-                    if any(e >= lim for e, lim in zip(self.extent, limit)):
-                        raise bem.RegionTooSmallError(
-                            f"bem.extent = ({self.extent[0]:.6g}, {self.extent[1]:.6g}) cannot hold this load: "
-                            f"the contact reaches the end of the gap's domain (|x| < {hx:.6g}, |y| < {hy:.6g}); "
-                            "reduce the load or change the shape (e.g. a larger crown).") from None
-                    raise
-                msg = (f"the contact reached the border of the automatic candidate region; extent enlarged "
-                       f"from ({self.extent[0]:.4g}, {self.extent[1]:.4g}) to ({grown[0]:.4g}, {grown[1]:.4g})")
-                log.info(msg)
-                self.messages.append(msg)
-                self.extent = grown
-        raise AssertionError("unreachable")  # pragma: no cover
+    def _solve(self, layer, callback, kw):
+        try:
+            res = bem.solve(self.domain.gap, domain=self.bem_domain, layer=layer, callback=callback, **kw)
+        except bem.RegionTooSmallError as exc:  # the region of the scene's key bem.extent
+            raise bem.RegionTooSmallError(f"bem.{exc}") from None
+        self.messages.extend(res.notes)
+        self.bem_domain = res.domain
+        return res
 
 
 def _analytic(scene, layer):
@@ -153,25 +166,18 @@ def execute_scene(scene, *, progress=None, overrides=None):
     if scene.unimported:
         raise SceneError(refuse_code(*scene.unimported[0]))
     stages = stages_of(progress, planned_stages(scene))
-    if scene.bem.get("periodic"):
-        from .periodic import execute_periodic
-
-        outcome = execute_periodic(scene, progress=stages)
-        if stages is not progress:
-            stages.done()
-        return outcome
     messages, times = [], {"bem": None, "fem": None, "layer_reference": None, "stress": None}
+    domain = domain_of(scene, messages)
+    solve = _BemSolves(scene, domain, messages)
     if "fem" in scene.skipped:
         messages.append("FEM reference skipped: the scene's [fem] was not run (no_fem).")
-    solve, calibrate = _BemRunner(scene, messages), _BemRunner(scene, messages, calibration=True)
     if "layer" in planned_stages(scene):
         stages("layer")
     t = time.perf_counter()
-    layer, layer_info = resolve_layer(scene.layer_spec, step=scene.bem["step"], E_star=scene.E_star,
-                                      solve=calibrate, layer=scene.layer)
-    if calibrate.solves:
+    layer, layer_info = resolve_layer(scene.layer_spec, step=domain.step, E_star=scene.E_star,
+                                      solve=solve.calibrate, layer=scene.layer)
+    if solve.calibration_solves:
         times["layer_reference"] = time.perf_counter() - t
-        solve.extent = calibrate.extent
     stages("bem")
 
     def callback(k, _p):
@@ -221,11 +227,12 @@ def execute_scene(scene, *, progress=None, overrides=None):
         from .stress import stress_summary
 
         stress_block = stress_summary(stress)
-    result = build_result(scene, res, layer_info, fem=fem, analytic=ref, metrics=metrics, times=times,
-                          messages=messages, extent=solve.extent, stress=stress_block)
+    result = build_result(scene, res, layer_info, domain_parts=domain.parts(res), fem=fem, analytic=ref,
+                          metrics=metrics, times=times, messages=messages, stress=stress_block)
     if stages is not progress:
         stages.done()
-    return RunOutcome(scene=scene, result=result, bem=res, fem=fem, analytic=ref, layer=layer, stress=stress)
+    return RunOutcome(scene=scene, result=result, bem=res, domain=domain, fem=fem, analytic=ref, layer=layer,
+                      stress=stress)
 
 
 def check_result_dir(out_dir, *, what="out_dir", value=None):
@@ -255,11 +262,7 @@ def write_outputs(outcome, out_dir, *, progress=None, what="out_dir"):
     files = {key: name for key, name in FILES.items() if not absent.get(key, False)}
     outcome.result.files = files
     with atomic_directory(out_dir, "result", RESULT_NAMES, what=what) as tmp:
-        if outcome.spots is None:
-            write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap(res.x, res.y))
-        else:  # a periodic cell: its initial gap and contact spots (-1: no contact)
-            write_result_vtu(tmp / files["bem_field"], res, initial_gap=scene.gap.nodal_gap(),
-                             contact_spot=outcome.spots.ravel())
+        write_result_vtu(tmp / files["bem_field"], res, **outcome.domain.field(res))
         if outcome.fem is not None:
             write_vtu(tmp / files["fem_field"], **outcome.fem.field())
         if outcome.stress is not None:

@@ -12,7 +12,7 @@ import difflib
 import math
 from collections.abc import Mapping
 
-from bem import checks as v
+import bem.checks
 from bem.checks import InputError
 
 __all__ = ["SceneError", "scene_errors", "unknown_keys", "closest", "require", "exactly_one", "positive",
@@ -115,25 +115,25 @@ def exactly_one(path, d, keys, hint):
 
 
 def positive(path, value):
-    return _wrap(v.check_positive, path, value)
+    return _wrap(bem.checks.check_positive, path, value)
 
 
 def nonnegative(path, value):
-    return _wrap(v.check_nonnegative, path, value)
+    return _wrap(bem.checks.check_nonnegative, path, value)
 
 
 def scale(path, value):
     """A physical scale (modulus, load, length) in :data:`bem.checks.SCALE_RANGE`."""
-    return _wrap(v.check_scale, path, value)
+    return _wrap(bem.checks.check_scale, path, value)
 
 
 def rtol(path, value):
     """A KKT tolerance of the BEM (:func:`bem.checks.check_rtol`)."""
-    return _wrap(v.check_rtol, path, value)
+    return _wrap(bem.checks.check_rtol, path, value)
 
 
 def in_range(path, value, low, high, **kw):
-    return _wrap(v.check_range, path, value, low, high, **kw)
+    return _wrap(bem.checks.check_range, path, value, low, high, **kw)
 
 
 def integer(path, value, minimum, maximum=math.inf):
@@ -158,7 +158,7 @@ def string(path, value):
 
 def choice(path, value, choices):
     string(path, value)
-    return _wrap(v.check_choice, path, value, tuple(choices))
+    return _wrap(bem.checks.check_choice, path, value, tuple(choices))
 
 
 def options(path, d, rules):

@@ -6,8 +6,8 @@ expected contact: ``bem.nodes_across`` nodes across its smaller diameter and
 :meth:`bem.gaps.Gap.expected_semi_axes` (closed forms of :mod:`bem.reference`; tables,
 callables and measured surfaces have none, and such a scene gives ``bem.step`` and
 ``bem.extent``). A layer given by the paper's parameters is sized by its linear reference
-layer. An estimate only sizes the region: the runner enlarges an automatic region when the
-contact reaches its border (:mod:`validation.run.runner`, up to :func:`region_limit`).
+layer. An estimate only sizes the region: an automatic region grows when the contact reaches its
+border (:class:`bem.HalfSpaceRegion`, ``grow=True``, up to :func:`bem.region.region_limit`).
 
 The solver options are checked by the BEM itself (:func:`bem.options.check_options`: one rule,
 one message), and the option names come from :data:`bem.options.OPTIONS`.
@@ -22,36 +22,26 @@ from bem.checks import check_node_count
 from bem.lattice import Lattice, node_count
 from bem.layers import Linear
 from bem.options import OPTIONS, check_options, solver_for
+from bem.region import EXTENT_FACTOR, inner_domain, region_limit
 
 from . import checks as ck
 from .paper import is_paper_law, reference_compliance
 
-__all__ = ["bem_options", "inner_domain", "region_limit", "KEYS", "SOLVER_KEYS", "EXCLUSIVE", "DOMAIN_MARGIN",
-           "DEFAULT_NODES_ACROSS", "DEFAULT_EXTENT_FACTOR"]
+__all__ = ["bem_options", "solver_keywords", "KEYS", "SOLVER_KEYS", "OWN_KEYS", "EXCLUSIVE", "DEFAULT_NODES_ACROSS",
+           "DEFAULT_EXTENT_FACTOR"]
 
-#: An automatic extent stays this fraction inside a bounded gap domain.
-DOMAIN_MARGIN = 1e-3
 DEFAULT_NODES_ACROSS = 40
-DEFAULT_EXTENT_FACTOR = 1.5
-#: solver options a scene may set: the common ones and each solver's own (bem.options.OPTIONS)
-SOLVER_KEYS = ("method", "rtol", "maxiter", "precondition", "nested") + tuple(
-    sorted({k for keys in OPTIONS.values() for k in keys}))
+DEFAULT_EXTENT_FACTOR = EXTENT_FACTOR
+#: the options every solver of bem.solve takes, and their checks
+_COMMON = {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1), "precondition": ck.boolean,
+           "nested": ck.boolean}
+#: the options of one solver or another (bem.options.OPTIONS)
+OWN_KEYS = tuple(sorted({k for keys in OPTIONS.values() for k in keys}))
+#: solver options a scene may set: the method, the common options and each solver's own
+SOLVER_KEYS = ("method", *_COMMON, *OWN_KEYS)
 KEYS = ("step", "nodes_across", "extent", "extent_factor") + SOLVER_KEYS
 #: pairs of lattice keys of which a scene gives one (a ``--set`` of one drops the other)
 EXCLUSIVE = (("step", "nodes_across"), ("extent", "extent_factor"))
-
-
-def inner_domain(gap):
-    """Largest half-widths ``(hx, hy)`` of a centred rectangle inside ``gap.domain`` (may be inf)."""
-    (x0, x1), (y0, y1) = gap.domain
-    return min(-x0, x1), min(-y0, y1)
-
-
-def region_limit(gap):
-    """The largest half-widths ``(ex, ey)`` [length] of an automatic region: :data:`DOMAIN_MARGIN` inside
-    :func:`inner_domain` (may be inf). The sizing and the runner's enlargement both stop there."""
-    hx, hy = inner_domain(gap)
-    return (1 - DOMAIN_MARGIN) * hx, (1 - DOMAIN_MARGIN) * hy
 
 
 def _axes(gap, layer, E_star, load):
@@ -75,10 +65,15 @@ def solver_options(d, layer_spec):
     """``[bem]``'s method and the options of every solver, those of the one that will run checked
     by the BEM itself (shared by lattice and periodic scenes)."""
     out = {"method": ck.choice("bem.method", d.get("method", "newton"), METHODS)}
-    out.update(ck.options("bem", d, {"rtol": ck.rtol, "maxiter": partial(ck.integer, minimum=1),
-                                     "precondition": ck.boolean, "nested": ck.boolean}))
+    out.update(ck.options("bem", d, _COMMON))
     out.update(_own_options(d, out["method"], layer_spec))
     return out
+
+
+def solver_keywords(options):
+    """The keywords of :func:`bem.solve` (or :func:`bem.solve_periodic`) among a scene's checked ``bem``
+    options (:func:`bem_options`): the method and the solver options the scene gives (:data:`SOLVER_KEYS`)."""
+    return {k: options[k] for k in SOLVER_KEYS if k in options}
 
 
 def _own_options(d, method, layer_spec):
@@ -87,7 +82,7 @@ def _own_options(d, method, layer_spec):
     if method == "kalker" and kind == "nonlinear":
         raise ck.SceneError(f"bem.method = 'kalker' is not allowed with layer.law = {layer_spec['law']!r}: "
                             "Kalker's QP solves smooth bodies and linear layers; use 'newton'.")
-    own = {k: d[k] for k in SOLVER_KEYS[5:] if k in d}
+    own = {k: d[k] for k in OWN_KEYS if k in d}
     try:
         return check_options(method, solver_for(method, kind), own)
     except InputError as exc:

@@ -12,9 +12,10 @@
 - :mod:`~validation.studies.paper_problem`: the paper's test problem (section 6) on one lattice,
   its cases, sweeps and methods, which the paper report draws (``contactlab report paper``).
 
-The first four have ``main(out=..., scene=..., quick=..., progress=...)`` for ``contactlab study
-error-time | stability | robustness | two-scale``: it writes the study's JSON file (``STEM + ".json"``)
-and returns a :class:`StudyRun`, which the report renders (:mod:`validation.report.documents.studies`).
+The first four are the studies of :data:`STUDIES` (``contactlab study NAME``); each has
+``main(out=..., scene=..., quick=..., progress=...)``, which writes the study's JSON file
+(``STEM + ".json"``, :data:`STUDY_FILES`) and returns a :class:`StudyRun`, which the report renders
+(:mod:`validation.report.documents.studies`).
 This module holds what they share: running a scene (:func:`attempt`, :func:`timed`), the status of an
 outcome (:func:`classify`) and the files (:func:`save`).
 """
@@ -36,7 +37,15 @@ from bem.files import write_text
 from ..run import execute_scene
 from ..scene import load_scene
 
-__all__ = ["StudyRun", "attempt", "timed", "classify", "finite", "save", "write_json", "no_scene", "STATUSES"]
+__all__ = ["StudyRun", "attempt", "timed", "classify", "finite", "save", "write_json", "no_scene", "STATUSES",
+           "STUDIES", "STUDY_FILES"]
+
+#: the studies of ``contactlab study NAME``, in the order their reports show them: name -> the module
+#: that runs it (its ``main``); the study's file is named after the module (its ``STEM + ".json"``)
+STUDIES = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
+           "robustness": "validation.studies.robustness", "two-scale": "validation.studies.two_scale"}
+#: the file each study of :data:`STUDIES` writes, in the same order
+STUDY_FILES = tuple(f"{module.rpartition('.')[2]}.json" for module in STUDIES.values())
 
 #: status of an outcome (:func:`classify`)
 STATUSES = ("converged", "reported failure", "wrong")

@@ -33,8 +33,8 @@ from .problems import ERROR_TIME_PROBLEMS, get_problem, methods
 
 __all__ = ["method_with_relaxation", "ErrorTimeRow", "ErrorTimeStudy", "run_error_time", "main", "STEM", "LADDERS", "TARGETS"]
 
-#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
-STEM = "error_time"
+#: the study's file is ``STEM + ".json"``, named after this module (:data:`validation.studies.STUDY_FILES`)
+STEM = __name__.rpartition(".")[2]
 
 #: resolution ladders: BEM steps across the contact diameter, FEM elements across the radius
 LADDERS = {"full": {"bem": (10, 20, 40, 80, 160), "fem": (4, 8, 16, 32)},

@@ -260,7 +260,7 @@ def run_paper_problem(*, quick=False, fem=True, progress=None):
     ----------
     quick : bool
         Small version for tests and previews: 8 nodes per Hertz radius instead of 20, fewer
-        sweep values (seconds instead of minutes).
+        sweep values (measured times: docs/performance.md, "Studies and reports").
     fem : bool
         Also run the FEM reference and the resolution study.
     progress : callable or validation.progress.Progress, optional

@@ -34,8 +34,8 @@ from .problems import robustness_scene
 __all__ = ["RobustnessRow", "run_robustness", "summary_table", "matrix_table", "failure_table",
            "rows_from_json", "main", "STEM", "EXPONENTS", "COMPLIANCES", "MODULI", "LAYER_METHODS", "SETTING"]
 
-#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
-STEM = "robustness"
+#: the study's file is ``STEM + ".json"``, named after this module (:data:`validation.studies.STUDY_FILES`)
+STEM = __name__.rpartition(".")[2]
 
 EXPONENTS = (0.05, 0.2, 0.5, 1.0, 2.0, 3.0, 10.0)
 COMPLIANCES = (1e-6, 1e-3, 1.0, 1e3, 1e6)

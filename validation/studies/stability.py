@@ -40,8 +40,8 @@ from .problems import LIMIT_TOL, methods, stability_cases
 __all__ = ["StabilityRow", "StabilityStudy", "StabilityFailure", "run_stability", "classify", "main", "STEM",
            "METHOD_TOL", "FEM_TOL", "STATUSES"]
 
-#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
-STEM = "stability"
+#: the study's file is ``STEM + ".json"``, named after this module (:data:`validation.studies.STUDY_FILES`)
+STEM = __name__.rpartition(".")[2]
 
 log = logging.getLogger(__name__)
 

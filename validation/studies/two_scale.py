@@ -43,8 +43,8 @@ from .two_scale_models import (TiledRoughness, greenwood_tripp_law, nominal_radi
 __all__ = ["SETTINGS", "QUICK", "make_surface", "run_case", "run_two_scale", "refinement", "summary_lines",
            "OUTPUT_NAMES", "main", "STEM"]
 
-#: the study's file is ``STEM + ".json"`` (:data:`validation.report.documents.studies.STUDY_FILES`)
-STEM = "two_scale"
+#: the study's file is ``STEM + ".json"``, named after this module (:data:`validation.studies.STUDY_FILES`)
+STEM = __name__.rpartition(".")[2]
 
 #: the files of the study: its JSON (:func:`main`), Markdown and figures (the report)
 OUTPUT_NAMES = ("two_scale.json", "two_scale.md", "two_scale_map.png", "two_scale_profile.png")

@@ -32,8 +32,8 @@ _KEYS = {case: scene.removeprefix("paper_") for case, scene in SCENES.items()}
 
 
 def _method(r):
-    """The method that ran: quadratic problems go to the Kalker QP whatever was asked."""
-    return method_text(r.method, None if r.layer is None or r.layer.is_linear else r.layer.law, short=True)
+    """The method that ran (``r.method``): quadratic problems go to the Kalker QP whatever was asked."""
+    return method_text(r.method, short=True)
 
 
 def _how(r, res):
@@ -357,7 +357,8 @@ def report_paper_problem(out_dir, *, quick=False, fem=True, fmt="png", progress=
     out_dir : path-like
         Report directory (``report.html``, ``report.md``, ``figures/``), written whole or not at all.
     quick : bool
-        Coarse lattice (a_H/c = 8) and short sweeps: seconds instead of about a minute.
+        Coarse lattice (a_H/c = 8) and short sweeps: a preview in a fraction of the full report's time
+        (measured times: docs/performance.md, "Studies and reports").
     fem : bool
         Include the FEM reference and the resolution study.
     fmt : {"png", "svg", "pdf"}

@@ -13,14 +13,13 @@ from pathlib import Path
 from bem.checks import InputError
 
 from ...provenance import display_path
+from ...studies import STUDY_FILES
 from ..render import Figure, Progress, Section, Table, draw_and_build, table_from_rows
 from .results import read_json
 from .two_scale import two_scale_sections
 
 __all__ = ["STUDY_FILES", "is_study_dir", "study_sections", "study_markdown", "write_study_outputs",
            "report_studies_dir"]
-
-STUDY_FILES = ("error_time.json", "stability.json", "robustness.json", "two_scale.json")
 
 
 def is_study_dir(directory):
@@ -116,7 +115,8 @@ def _robustness_sections(data, work=None):
     return [Section("Robustness of the layer methods", "stability", [rb.SETTING], tuple(tables))]
 
 
-#: study file -> function(data, work) -> sections (``work``: the figures' folder, None for none)
+#: study file -> function(data, work) -> sections (``work``: the figures' folder, None for none), in the
+#: order of :data:`validation.studies.STUDIES`
 _SECTIONS = dict(zip(STUDY_FILES, (_error_time_sections, _stability_sections, _robustness_sections,
                                    two_scale_sections)))
 

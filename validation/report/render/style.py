@@ -130,14 +130,19 @@ def method_label(method):
     return METHOD_LABELS.get(method, str(method))
 
 
-def method_text(method, law, *, short=False):
-    """What the BEM solved, in words: Kalker's QP for quadratic problems (no layer or a linear
-    one: ``law`` in None, "none", "linear"), whatever was asked, else the named method."""
-    if method in ("newton", "kalker") and law in (None, "none", "linear"):
+def method_text(method, law=None, *, short=False):
+    """What the BEM solved, in words.
+
+    ``method`` is the method that ran (``result.method``): a quadratic problem (no layer or a linear
+    one) runs as Kalker's QP whatever was asked (:func:`bem.options.solver_for`); ``law`` is the
+    layer's law (``None`` or ``"none"``: no layer), which the long text names as the reason.
+    """
+    if method == "kalker":
         if short:
             return "Kalker QP (eq. 11, projected conjugate gradients)"
+        why = "no layer" if law in (None, "none") else f"{law} layer"
         return ("Kalker's quadratic programme (eq. 11), solved by projected conjugate gradients "
-                "(the functional is quadratic without a layer or with a linear one)")
+                f"(the functional is quadratic: {why})")
     if short or method not in _METHOD_TEXT:
         return method_label(method)
     return f"{method_label(method)}: {_METHOD_TEXT[method]}"
