@@ -9,7 +9,7 @@ The folder (a ``"layer-law"`` folder, :mod:`validation.io`) holds
   stiffness ``K(p)`` (:mod:`validation.layer_law.figures`).
 
 Units are SI: a surface file's lengths are converted to metres by the unit the file states
-(or by ``scale``), ``E*`` and the pressures are in Pa. The ladder of mean pressures is
+(``scale`` for a file that states none), ``E*`` and the pressures are in Pa. The ladder of mean pressures is
 geometric, by default from ``3e-3`` to ``0.3`` times ``E* h'_rms`` (``h'_rms`` the surface's
 rms slope, ``stats.rms_slope``): from a contact fraction of about 1 % to well into the
 exponential regime. Its last pressure must exceed the largest local pressure of the problems
@@ -26,7 +26,6 @@ import numpy as np
 from bem.checks import InputError, check_int, check_positive, fail
 
 from ..io import atomic_directory, check_output_dir, output_errors, recover_output_dir
-from ..units import METRES
 
 __all__ = ["make_layer_law", "surface_from_file", "synthetic_surface", "ladder", "LayerLawFolder", "KIND",
            "LAW_FILE", "FIGURE_NAMES", "NAMES", "DEFAULT_RANGE"]
@@ -61,7 +60,7 @@ class LayerLawFolder:
     figures: dict = field(default_factory=dict)
 
 
-def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height"):
+def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height", fill=None, names=None):
     """A measured surface in metres (:func:`bem.rough.read_surface`).
 
     Parameters
@@ -69,36 +68,26 @@ def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height"
     file : path-like
         An instrument or data file SurfaceTopography reads (``bem.rough.formats()``).
     scale : float, optional
-        Metres per length unit of the file. Default: from the unit the file states; a file
-        that states none (npy, plain text matrices) needs it.
+        Metres per length unit of a file that states none (npy, plain text matrices); the unit
+        a file states is always the one used (a ``scale`` that disagrees with it is refused).
     physical_sizes : (float, float), optional
         ``(Lx, Ly)`` in the file's length unit, for a file that does not state its size.
-    detrend : str or None
+    detrend, fill : str or None
         As :func:`bem.rough.read_surface`.
+    names : dict, optional
+        The names of the arguments in messages (:func:`bem.rough.read_surface`).
 
     Raises
     ------
     bem.InputError
         A file that cannot be read (:func:`bem.rough.read_surface`), or no ``scale`` for a file
-        that states no known length unit.
+        that states no length unit.
     """
     from bem import rough
 
-    given = scale
-    if scale is not None:
-        scale = check_positive("scale", scale)
-    surface = rough.read_surface(file, physical_sizes=physical_sizes, scale=1.0 if scale is None else scale,
-                                 detrend=detrend)
-    if given is not None:
-        return surface
-    unit = surface.stats.unit
-    if unit not in METRES:
-        raise InputError(f"scale is missing: {str(file)!r} states "
-                         + ("no length unit" if unit is None else f"the length unit {unit!r}, which is not known")
-                         + "; give the metres per length unit of the file (e.g. 1e-6 for a file in um).")
-    if METRES[unit] == 1.0:
-        return surface
-    return rough.read_surface(file, physical_sizes=physical_sizes, scale=METRES[unit], detrend=detrend)
+    names = {"unit": "scale", **(names or {})}
+    return rough.read_surface(file, physical_sizes=physical_sizes, unit=scale, detrend=detrend, fill=fill,
+                              names=names)
 
 
 def synthetic_surface(*, hurst, size, grid, rms_height=None, rms_slope=None, long_cutoff=None, short_cutoff=None,
@@ -186,7 +175,7 @@ def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="
     with output_errors(out_dir.absolute(), what):
         recover_output_dir(out_dir)
         check_output_dir(out_dir, KIND, NAMES, what=what)
-    n_cols = surface.stats.grid[0] if n_cols is None else n_cols
+    n_cols = surface.default_n_cols() if n_cols is None else n_cols
     step = None if progress is None else (
         lambda k, n, res: progress(f"A/A0 {res.contact_fraction:.3g}, {res.iterations} iterations", k, n))
     law = rough.layer_from_topography(surface, E_star, pressures=pressures, n_cols=n_cols, method=method, rtol=rtol,
