@@ -10,7 +10,7 @@ untouched. Result folders and report folders both use it; sweep folders, written
 point, are checked the same way (:func:`check_output_dir`).
 
 Every folder contactlab writes holds a marker file, :data:`MARKER` (``.contactlab``: JSON with
-the folder's ``kind``, ``"result"``, ``"report"``, ``"sweep"`` or ``"layer-law"``
+the folder's ``kind``, ``"result"``, ``"report"``, ``"sweep"``, ``"layer-law"`` or ``"surface"``
 (:mod:`validation.layer_law`), and the contactlab
 ``version``). contactlab writes only into a new or empty folder, or into a folder that holds
 the marker of the same kind and nothing but the files of that kind; any other folder is
@@ -52,7 +52,7 @@ log = logging.getLogger(__name__)
 #: The marker file of every folder contactlab writes: JSON ``{"kind": ..., "version": ...}``.
 MARKER = ".contactlab"
 #: The kinds of folder contactlab writes.
-KINDS = ("result", "report", "sweep", "layer-law")
+KINDS = ("result", "report", "sweep", "layer-law", "surface")
 #: Longest file or folder name in bytes when the file system does not say (POSIX ``NAME_MAX``).
 NAME_MAX = 255
 _TMP, _OLD = ".contactlab-tmp-", ".contactlab-old-"

@@ -12,11 +12,12 @@ height grid onto the lattice cell (both numpy only, no extra needed). docs/rough
 from .lattice_heights import MAX_STRETCH, LatticeHeights, to_lattice
 from .instrument_files import formats, read_surface
 from .spikes import SPIKE_MADS, Spikes, find_spikes
+from .summary import summary
 from .layer_law import LadderNotConverged, TopographyLaw, layer_from_topography, read_layer_law
 from .surface import (DETRENDS, EDGE_JUMP_LIMIT, MIN_POINTS, RoughSurface, SurfaceStats, combined, from_heights,
                       self_affine)
 
 __all__ = ["RoughSurface", "SurfaceStats", "LatticeHeights", "read_surface", "self_affine", "from_heights",
            "combined", "formats", "to_lattice", "layer_from_topography", "read_layer_law", "TopographyLaw",
-           "LadderNotConverged", "find_spikes", "Spikes", "SPIKE_MADS", "DETRENDS", "EDGE_JUMP_LIMIT", "MAX_STRETCH",
+           "LadderNotConverged", "summary", "find_spikes", "Spikes", "SPIKE_MADS", "DETRENDS", "EDGE_JUMP_LIMIT", "MAX_STRETCH",
            "MIN_POINTS"]

@@ -177,7 +177,7 @@ def _factor(path, stated, unit, length_unit, name):
     return _length(unit) / out if isinstance(unit, str) else unit
 
 
-def _missing(topo, fill, refuse):
+def _missing(topo, fill, refuse, name):
     """``(topography without missing points, points filled)`` (module docstring, Missing points)."""
     if not topo.has_undefined_data:
         return topo, 0
@@ -187,7 +187,7 @@ def _missing(topo, fill, refuse):
     if fraction > MAX_MISSING:
         refuse(f"{said}, more than {100 * MAX_MISSING:g} %: crop it to a measured part first")
     if fill is None:
-        refuse(f"{said}; fill them (fill = 'harmonic': interpolated from the points around them) or crop them")
+        refuse(f"{said}; fill them ({name('fill')} harmonic: interpolated from the points around them) or crop them")
     return topo.interpolate_undefined_data(fill), missing
 
 
@@ -287,7 +287,7 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, unit=N
         with handle, _quiet_readers():
             topo, stated = _read(st, handle, path, format, physical_sizes, channel, refuse, name)
     factor = _factor(path, stated, unit if unit is not None or stated is not None else unit_default, length_unit, name)
-    topo, filled = _missing(topo, fill, refuse)
+    topo, filled = _missing(topo, fill, refuse, name)
     z = np.ma.getdata(topo.heights())
     if not np.isfinite(z).all():
         refuse(f"it has {int((~np.isfinite(z)).sum())} heights that are not finite (NaN or inf)")

@@ -4,10 +4,10 @@
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 from bem.checks import InputError
 from .common import ProgressBar
+from .surface import OPTION_NAMES, add_file_args, pair, read
 
 PARSER = {
     "help": "the layer law w(p) of a rough surface: law file and figures",
@@ -18,7 +18,8 @@ PARSER = {
         "(the file beside the scene), and the figures closure.png (w(p), linear and log axes),\n"
         "contact_fraction.png (A/A0 against p/(E* h'_rms)) and stiffness.png (K = dp/dw).\n"
         "Units are SI: lengths in m, E* and pressures in Pa. A surface file's lengths are converted to m by\n"
-        "the unit it states, or by --scale. The ladder's last pressure must exceed the largest local\n"
+        "the unit it states (--scale and --size for a file that states neither unit nor size; --fill harmonic\n"
+        "fills missing points, at most 5 % of them). The ladder's last pressure must exceed the largest local\n"
         "pressure of the problems the law is used in: beyond it the law holds no data (a solve there warns).\n"
         "The law file needs the rough extra, the figures the report extra (or --no-figures).\n"
         "--out DIR must be new, empty or a layer-law folder contactlab wrote (marked by DIR/.contactlab)."),
@@ -56,23 +57,11 @@ def add_args(p):
     p.add_argument("--n-pressures", type=int, default=12, metavar="N",
                    help="mean pressures in the ladder, geometrically spaced (default 12)")
     p.add_argument("--n-cols", type=int, metavar="N",
-                   help="lattice nodes across the cell (default: the surface's grid points along x)")
+                   help="lattice nodes across the cell (default: Lx / max(dx, dy), the grid points along x of "
+                        "square pixels)")
     p.add_argument("--rtol", type=float, default=1e-8, help="the solver's KKT tolerance (default 1e-8)")
-    p.add_argument("--scale", type=float, metavar="M",
-                   help="metres per length unit of SURFACE (default: from the unit the file states)")
-    p.add_argument("--size", metavar="LX,LY", help="size of a SURFACE that does not state it, in its length unit")
+    add_file_args(p)
     p.add_argument("--no-figures", action="store_true", help="write the law file only (no report extra needed)")
-
-
-def _pair(option, text, sep):
-    parts = str(text).split(sep)
-    try:
-        values = tuple(float(v) for v in parts)
-    except ValueError:
-        values = ()
-    if len(values) != 2:
-        raise InputError(f"{option} = {text!r} is not allowed: it must be two numbers separated by '{sep}'.")
-    return values
 
 
 def _synthetic(text):
@@ -113,24 +102,23 @@ def _summary(folder):
 def run(args):
     from bem.rough import LadderNotConverged
 
-    from ..layer_law import ladder, make_layer_law, surface_from_file, synthetic_surface
+    from ..layer_law import ladder, make_layer_law, synthetic_surface
 
     if (args.surface is None) == (args.synthetic is None):
         raise InputError("SURFACE is missing: give a surface file or --synthetic (one of them)." if args.surface is None
                          else f"SURFACE = {args.surface!r} is not allowed together with --synthetic: give one.")
     if args.synthetic is not None:
-        for option, value in (("--scale", args.scale), ("--size", args.size)):
+        for option, value in (("--scale", args.scale), ("--size", args.size), ("--fill", args.fill)):
             if value is not None:
                 raise InputError(f"{option} = {value!r} is not allowed with --synthetic: it is for a SURFACE file "
                                  "(a synthetic surface is in m).")
         surface = synthetic_surface(**_synthetic(args.synthetic))
     else:
-        size = None if args.size is None else _pair("--size", args.size, ",")
-        surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size)
+        surface = read(args, names=dict(OPTION_NAMES, file="SURFACE"), file=args.surface)
     if args.p_range is not None:
-        pressures = ladder(surface, args.E_star, pressures=_pair("--p-range", args.p_range, ":"), n=args.n_pressures)
+        pressures = ladder(surface, args.E_star, pressures=pair("--p-range", args.p_range, ":"), n=args.n_pressures)
     else:
-        pressures = ladder(surface, args.E_star, relative=_pair("--p-range-rel", args.p_range_rel, ":"),
+        pressures = ladder(surface, args.E_star, relative=pair("--p-range-rel", args.p_range_rel, ":"),
                            n=args.n_pressures)
     bar = ProgressBar("layer law", "pressure", args.no_progress or None)
     try:

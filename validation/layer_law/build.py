@@ -60,7 +60,8 @@ class LayerLawFolder:
     figures: dict = field(default_factory=dict)
 
 
-def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height", fill=None, names=None):
+def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height", fill=None, format=None,
+                      channel=None, names=None):
     """A measured surface in metres (:func:`bem.rough.read_surface`).
 
     Parameters
@@ -72,7 +73,7 @@ def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height"
         a file states is always the one used (a ``scale`` that disagrees with it is refused).
     physical_sizes : (float, float), optional
         ``(Lx, Ly)`` in the file's length unit, for a file that does not state its size.
-    detrend, fill : str or None
+    detrend, fill, format, channel : optional
         As :func:`bem.rough.read_surface`.
     names : dict, optional
         The names of the arguments in messages (:func:`bem.rough.read_surface`).
@@ -87,7 +88,7 @@ def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height"
 
     names = {"unit": "scale", **(names or {})}
     return rough.read_surface(file, physical_sizes=physical_sizes, unit=scale, detrend=detrend, fill=fill,
-                              names=names)
+                              format=format, channel=channel, names=names)
 
 
 def synthetic_surface(*, hurst, size, grid, rms_height=None, rms_slope=None, long_cutoff=None, short_cutoff=None,
