@@ -40,18 +40,19 @@ def _refuse(path, rule):
     raise InputError(f"file = {path!r} is not allowed: {rule}.")
 
 
-def check_points(path, shape):
-    """Refuse a grid ``shape`` of more than :data:`bem.checks.MAX_NODES` points (a memory guard)."""
+def check_points(path, shape, shown=None):
+    """Refuse a grid ``shape`` of more than :data:`bem.checks.MAX_NODES` points (a memory guard);
+    ``shown``: the file's name in messages (default ``path``)."""
     n = int(np.prod([int(s) for s in shape]))
     try:
         check_node_count("file", path, n)
     except InputError:
-        _refuse(path, f"it declares {' x '.join(str(int(s)) for s in shape)} = {float(n):.3g} points, more than "
+        _refuse(shown or path, f"it declares {' x '.join(str(int(s)) for s in shape)} = {float(n):.3g} points, more than "
                       f"the {MAX_NODES:.3g} of the largest lattice; crop or subsample it first")
     return n
 
 
-def _npy_header(path):
+def _npy_header(path, shown):
     """``(shape, fortran_order, dtype, offset)`` of a ``.npy`` file, from its header alone."""
     with open(path, "rb") as f:
         try:
@@ -59,42 +60,43 @@ def _npy_header(path):
             read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
             shape, fortran, dtype = read(f)
         except Exception as exc:  # numpy's messages may quote the header
-            _refuse(path, f"it is not a readable .npy file ({type(exc).__name__})")
+            _refuse(shown, f"it is not a readable .npy file ({type(exc).__name__})")
         return shape, fortran, dtype, f.tell()
 
 
-def read_npy(path):
+def read_npy(path, shown=None):
     """The heights of a ``.npy`` file, checked against its header before they are read.
 
     SurfaceTopography's layout: ``z[ix, iy]`` (x first). Refuses arrays that are not 2-D real
     numbers, more points than the limit, and a file shorter than its header declares.
     """
-    shape, fortran, dtype, offset = _npy_header(path)
+    shown = shown or path
+    shape, fortran, dtype, offset = _npy_header(path, shown)
     if len(shape) != 2:
-        _refuse(path, f"it holds a {len(shape)}-D array; a 2-D height map is needed")
+        _refuse(shown, f"it holds a {len(shape)}-D array; a 2-D height map is needed")
     if dtype.kind not in "fiu" or dtype.hasobject:
-        _refuse(path, f"it holds {dtype.kind!r} values; real numbers are needed")
-    check_points(path, shape)
+        _refuse(shown, f"it holds {dtype.kind!r} values; real numbers are needed")
+    check_points(path, shape, shown)
     need = offset + int(np.prod(shape)) * dtype.itemsize
     if os.path.getsize(path) < need:
-        _refuse(path, f"it is shorter ({os.path.getsize(path)} bytes) than the {shape} array its header declares")
+        _refuse(shown, f"it is shorter ({os.path.getsize(path)} bytes) than the {shape} array its header declares")
     z = np.lib.format.open_memmap(path, mode="r")
     return np.array(z, dtype=float)
 
 
-def _x3p(path):
+def _x3p(path, shown):
     """Check an ``.x3p`` archive's header against its data member (module docstring)."""
     try:
         archive = zipfile.ZipFile(path)
     except (zipfile.BadZipFile, OSError, ValueError) as exc:
-        _refuse(path, f"it is not a readable x3p file (not a zip archive: {type(exc).__name__})")
+        _refuse(shown, f"it is not a readable x3p file (not a zip archive: {type(exc).__name__})")
     with archive:
         members = {info.filename: info for info in archive.infolist()}
         main = members.get("main.xml")
         if main is None:
-            _refuse(path, "it is not a readable x3p file (no main.xml in the archive)")
+            _refuse(shown, "it is not a readable x3p file (no main.xml in the archive)")
         if main.file_size > MAX_HEADER_BYTES:
-            _refuse(path, f"its main.xml declares {main.file_size} bytes (limit {MAX_HEADER_BYTES}): not an x3p header")
+            _refuse(shown, f"its main.xml declares {main.file_size} bytes (limit {MAX_HEADER_BYTES}): not an x3p header")
         try:
             root = ElementTree.fromstring(archive.read(main))
             dims = root.find("Record3/MatrixDimension")
@@ -102,31 +104,32 @@ def _x3p(path):
             kind = root.find("Record1/Axes/CZ/DataType").text.strip()
             link = root.find("Record3/DataLink/PointDataLink").text.strip()
         except Exception as exc:
-            _refuse(path, f"it is not a readable x3p file (main.xml lacks the sizes, data type or data link: "
+            _refuse(shown, f"it is not a readable x3p file (main.xml lacks the sizes, data type or data link: "
                           f"{type(exc).__name__})")
     if kind not in _X3P_ITEMSIZE or nx < 1 or ny < 1 or nz != 1:
-        _refuse(path, "it is not a readable x3p file (its main.xml declares no 2-D grid of I, L, F or D values)")
-    check_points(path, (nx, ny))
+        _refuse(shown, "it is not a readable x3p file (its main.xml declares no 2-D grid of I, L, F or D values)")
+    check_points(path, (nx, ny), shown)
     data = members.get(link)
     need = nx * ny * _X3P_ITEMSIZE[kind]
     if data is None or data.file_size != need:
         held = "no such member" if data is None else f"{data.file_size} bytes"
-        _refuse(path, f"its data does not match its header: main.xml declares {nx} x {ny} values of type {kind} "
+        _refuse(shown, f"its data does not match its header: main.xml declares {nx} x {ny} values of type {kind} "
                       f"({need} bytes), the data member holds {held}")
 
 
-def guard_file(path, format=None):
+def guard_file(path, format=None, shown=None):
     """Refuse ``path`` from its size and header before a reader sees it (module docstring).
 
     ``format``: the format asked for, or ``None`` (then the extension decides which header is
-    read).
+    read); ``shown``: the file's name in messages (default ``path``).
     """
+    shown = shown or path
     size = os.path.getsize(path)
     if size > MAX_BYTES_PER_POINT * MAX_NODES:
-        _refuse(path, f"it is {size / 2**30:.3g} GiB, more than a file of the largest lattice ({MAX_NODES:.3g} "
+        _refuse(shown, f"it is {size / 2**30:.3g} GiB, more than a file of the largest lattice ({MAX_NODES:.3g} "
                       f"points) needs; crop or subsample it first")
     kind = format or os.path.splitext(path)[1].lower().lstrip(".")
     if kind == "x3p":
-        _x3p(path)
+        _x3p(path, shown)
     elif kind == "npy":
-        check_points(path, _npy_header(path)[0])
+        check_points(path, _npy_header(path, shown)[0], shown)

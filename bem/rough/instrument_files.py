@@ -101,7 +101,7 @@ def _open(st, handle, path, format, refuse):
                "give format (bem.rough.formats()) or convert the file")
 
 
-def _read(st, handle, path, format, physical_sizes, channel, refuse, name):
+def _read(st, handle, path, shown, format, physical_sizes, channel, refuse, name):
     """``(topography, stated unit)`` of an open file, checked before its data is read (:func:`read_surface`)."""
     reader = _open(st, handle, path, format, refuse)
     channels = reader.channels
@@ -112,19 +112,32 @@ def _read(st, handle, path, format, physical_sizes, channel, refuse, name):
         refuse("its points are not on an evenly spaced grid (non-uniform); resample them onto a regular grid")
     if info.dim != 2:
         refuse(f"it holds a {info.dim}-D line scan; a 2-D height map is needed")
-    _check_grid(path, info.nb_grid_pts, refuse)
-    kwargs = _sizes(path, info.physical_sizes, physical_sizes, name)
+    _check_grid(shown, info.nb_grid_pts, refuse)
+    kwargs = _sizes(shown, info.physical_sizes, physical_sizes, name)
     try:
         return reader.topography(channel_index=info.index, **kwargs), info.unit
     except Exception as exc:
         refuse(f"SurfaceTopography cannot read its data ({type(exc).__name__})")
 
 
+@contextlib.contextmanager
+def _as_named(what):
+    """Name the file as the caller's user does in the messages of :mod:`bem.rough.file_guards`."""
+    try:
+        yield
+    except InputError as exc:
+        message = str(exc)
+        if what == "file" or not message.startswith("file = "):
+            raise
+        raise InputError(what + message[len("file"):]) from None
+
+
 def _check_grid(path, shape, refuse):
     if min(shape) < MIN_POINTS:
         refuse(f"it holds {shape[0]} x {shape[1]} points; at least {MIN_POINTS} x {MIN_POINTS} are needed "
                "(too small)")
-    check_points(path, shape)
+    with _as_named(refuse.what):
+        check_points(path, shape)
 
 
 def _sizes(path, stated, given, name):
@@ -138,11 +151,12 @@ def _sizes(path, stated, given, name):
     return {} if given is None else {"physical_sizes": given}
 
 
-def _npy(st, path, physical_sizes, refuse, name):
+def _npy(st, path, shown, physical_sizes, refuse, name):
     """``(topography, None)`` of a ``.npy`` file, read by numpy after its header is checked."""
-    z = read_npy(path)
-    _check_grid(path, z.shape, refuse)
-    kwargs = _sizes(path, None, physical_sizes, name)
+    with _as_named(refuse.what):
+        z = read_npy(path, shown)
+    _check_grid(shown, z.shape, refuse)
+    kwargs = _sizes(shown, None, physical_sizes, name)
     return st.Topography(np.ma.masked_invalid(z) if not np.isfinite(z).all() else z, kwargs["physical_sizes"]), None
 
 
@@ -187,7 +201,8 @@ def _missing(topo, fill, refuse, name):
     if fraction > MAX_MISSING:
         refuse(f"{said}, more than {100 * MAX_MISSING:g} %: crop it to a measured part first")
     if fill is None:
-        refuse(f"{said}; fill them ({name('fill')} harmonic: interpolated from the points around them) or crop them")
+        refuse(f"{said}; fill them (give {name('fill')} = 'harmonic': interpolated from the points around them) or "
+               "crop them")
     return topo.interpolate_undefined_data(fill), missing
 
 
@@ -268,25 +283,30 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, unit=N
     if not os.path.isfile(path):
         fail(name("file"), path, "an existing file" + ("" if os.path.isabs(path) else f" (relative to {os.getcwd()})"))
 
+    shown = path if source is None else str(source)
+
     def refuse(rule):
-        raise InputError(f"{name('file')} = {path!r} is not allowed: {rule}.")
+        raise InputError(f"{name('file')} = {shown!r} is not allowed: {rule}.")
+
+    refuse.what = name("file")
 
     st = _surface_topography()
     if format is not None:
         check_choice(name("format"), format, formats())
     if isinstance(unit, str) and _length(unit) is None:
         fail(name("unit"), unit, "a length unit (m, mm, um, nm, ...) or the returned lengths per file length")
-    guard_file(path, format)
+    with _as_named(name("file")):
+        guard_file(path, format, shown)
     if (format or os.path.splitext(path)[1].lower()) in ("npy", ".npy"):
-        topo, stated = _npy(st, path, physical_sizes, refuse, name)
+        topo, stated = _npy(st, path, shown, physical_sizes, refuse, name)
     else:
         try:
             handle = open(path, "rb")  # our handle: some readers leave the files they open open
         except OSError as exc:
             refuse(f"it cannot be opened ({type(exc).__name__})")
         with handle, _quiet_readers():
-            topo, stated = _read(st, handle, path, format, physical_sizes, channel, refuse, name)
-    factor = _factor(path, stated, unit if unit is not None or stated is not None else unit_default, length_unit, name)
+            topo, stated = _read(st, handle, path, shown, format, physical_sizes, channel, refuse, name)
+    factor = _factor(shown, stated, unit if unit is not None or stated is not None else unit_default, length_unit, name)
     topo, filled = _missing(topo, fill, refuse, name)
     z = np.ma.getdata(topo.heights())
     if not np.isfinite(z).all():
@@ -297,5 +317,5 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, unit=N
     periodic = bool(topo.is_periodic) and detrend in (None, "center")  # a plane taken off breaks a period
     said = stated if stated is not None else (unit if isinstance(unit, str) else None)
     return _surface(np.array(z, dtype=float) * factor, size, periodic=periodic, detrend=detrend,
-                    source=path if source is None else str(source), unit=said, filled=filled,
+                    source=shown, unit=said, filled=filled,
                     fill=fill if filled else None)

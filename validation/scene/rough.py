@@ -125,7 +125,7 @@ def _read_surface(file, d, units, detrend, source):
         given = length_factor(d, None)
     scene = None if units is None else units.metres
     kw = {k: d[k] for k in ("format", "channel", "physical_sizes", "fill") if k in d}
-    names = {"unit": "length_unit"}
+    names = {"unit": "gap.length_unit", "fill": "gap.fill"}
     with ck.scene_errors("gap."):
         if isinstance(given, str) and scene is None:
             length_factor(d, units)  # the error: no scene length unit to convert to
