@@ -2,7 +2,10 @@
 
 import lzma
 import shutil
+import zipfile
 from pathlib import Path
+
+import numpy as np
 
 FOLDER = Path(__file__).parent / "data" / "instrument"
 
@@ -17,3 +20,26 @@ def instrument_file(name, folder):
     else:
         shutil.copyfile(FOLDER / name, target)
     return target
+
+
+def write_x3p(path, grid=(16, 12), size=(1e-5, 2.5e-5), seed=0):
+    """A random height map [m] written as an .x3p (float64 data) by SurfaceTopography; returns the heights."""
+    import SurfaceTopography as st
+
+    z = np.random.default_rng(seed).normal(size=grid) * 1e-7
+    st.Topography(z, size).to_x3p(str(path))
+    return z
+
+
+def rewrite_x3p(path, main=None, data=None):
+    """Copy the x3p archive at ``path`` with its main.xml and data member replaced by ``main(text)`` and ``data``."""
+    with zipfile.ZipFile(path) as zin:
+        members = {i.filename: zin.read(i) for i in zin.infolist()}
+    link = next(k for k in members if k != "main.xml" and not k.endswith("/") and "valid" not in k.lower())
+    if main is not None:
+        members["main.xml"] = main(members["main.xml"].decode()).encode()
+    if data is not None:
+        members[link] = data
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zout:
+        for name, content in members.items():
+            zout.writestr(name, content)

@@ -6,7 +6,6 @@ in the file's unit) times the metres of the unit the file states, a table writte
 """
 
 import logging
-import zipfile
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ from scipy import ndimage
 import bem
 from bem import rough
 
-from ..instrument_data import instrument_file
+from ..instrument_data import instrument_file, rewrite_x3p, write_x3p
 
 st = pytest.importorskip("SurfaceTopography")
 
@@ -101,26 +100,6 @@ def test_a_real_file_with_too_few_points_is_refused(tmp_path):
 
 # --- headers checked before the data is read ------------------------------------------------------------
 
-def _x3p(path, grid=(16, 12), size=(1e-5, 2.5e-5), seed=0):
-    z = np.random.default_rng(seed).normal(size=grid) * 1e-7
-    st.Topography(z, size).to_x3p(str(path))
-    return z
-
-
-def _rewrite(path, main=None, data=None):
-    """Copy the x3p archive at ``path`` with its main.xml and data member replaced by ``main(text)`` and ``data``."""
-    with zipfile.ZipFile(path) as zin:
-        members = {i.filename: zin.read(i) for i in zin.infolist()}
-    link = next(k for k in members if k != "main.xml" and not k.endswith("/") and "valid" not in k.lower())
-    if main is not None:
-        members["main.xml"] = main(members["main.xml"].decode()).encode()
-    if data is not None:
-        members[link] = data
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zout:
-        for name, content in members.items():
-            zout.writestr(name, content)
-
-
 @pytest.fixture
 def no_reading(monkeypatch):
     """Fail the test if SurfaceTopography is asked to open a file."""
@@ -132,8 +111,8 @@ def no_reading(monkeypatch):
 
 def test_x3p_data_that_does_not_match_its_header_is_refused(tmp_path, no_reading):
     path = tmp_path / "patch.x3p"
-    _x3p(path)  # float64 data (DataType D)
-    _rewrite(path, main=lambda text: text.replace("<DataType>D</DataType>", "<DataType>I</DataType>"))
+    write_x3p(path)  # float64 data (DataType D)
+    rewrite_x3p(path, main=lambda text: text.replace("<DataType>D</DataType>", "<DataType>I</DataType>"))
     with pytest.raises(bem.InputError, match=r"data does not match its header: .* 16 x 12 values of type I "
                                              r"\(384 bytes\), the data member holds 1536 bytes"):
         rough.read_surface(path)
@@ -141,12 +120,12 @@ def test_x3p_data_that_does_not_match_its_header_is_refused(tmp_path, no_reading
 
 def test_an_x3p_that_would_inflate_beyond_its_header_is_refused_before_inflating(tmp_path, no_reading):
     path = tmp_path / "bomb.x3p"
-    _x3p(path)
-    _rewrite(path, data=bytes(20 * 2**20))  # 20 MiB of zeros in a 20 kB archive, declared 16 x 12
+    write_x3p(path)
+    rewrite_x3p(path, data=bytes(20 * 2**20))  # 20 MiB of zeros in a 20 kB archive, declared 16 x 12
     assert path.stat().st_size < 100_000
     with pytest.raises(bem.InputError, match=r"does not match its header: .* holds 20971520 bytes"):
         rough.read_surface(path)
-    _rewrite(path, main=lambda text: text.replace("<SizeX>16</SizeX>", "<SizeX>8000000</SizeX>"))
+    rewrite_x3p(path, main=lambda text: text.replace("<SizeX>16</SizeX>", "<SizeX>8000000</SizeX>"))
     with pytest.raises(bem.InputError, match=r"declares 8000000 x 12 = 9.6e\+07 points, more than the 1.6e\+07"):
         rough.read_surface(path)
 
@@ -170,7 +149,7 @@ def test_random_bytes_are_not_a_readable_file_of_their_extension(tmp_path, suffi
 
 def test_the_default_lattice_follows_the_coarser_pixel(tmp_path, caplog):
     path = tmp_path / "long_pixels.x3p"
-    _x3p(path, grid=(40, 40), size=(1e-5, 2.5e-5))  # dy = 2.5 dx, as x3p-2 of SurfaceTopography's data
+    write_x3p(path, grid=(40, 40), size=(1e-5, 2.5e-5))  # dy = 2.5 dx, as x3p-2 of SurfaceTopography's data
     with caplog.at_level(logging.ERROR):
         s = rough.read_surface(path)
     dx, dy = s.stats.pixel

@@ -8,7 +8,7 @@ import tomli_w
 
 from validation.scene import SceneError, load_scene
 
-from ..instrument_data import instrument_file
+from ..instrument_data import instrument_file, rewrite_x3p, write_x3p
 from .conftest import cli
 
 st = pytest.importorskip("SurfaceTopography")
@@ -17,9 +17,11 @@ SUR_SIZE_MM = (1.9614921, 1.6862561)  # sur-2.sur as SurfaceTopography reads it 
 
 
 def _scene(folder, gap, units="SI (m, Pa, N)", E_star=115.4e9, mean_pressure=2e6):
-    """A periodic scene of ``gap`` written to ``folder/scene.toml``, its file under ``folder/data``."""
+    """A periodic scene of ``gap`` written to ``folder/scene.toml``, its file under ``folder/data`` (copied from
+    the instrument files unless it is there)."""
     (folder / "data").mkdir(exist_ok=True)
-    instrument_file(gap["file"].split("/")[-1], folder / "data")
+    if not (folder / gap["file"]).is_file():
+        instrument_file(gap["file"].split("/")[-1], folder / "data")
     raw = {"scene": {"name": "measured", "units": units}, "bodies": {"E_star": E_star},
            "gap": {"type": "surface", **gap}, "load": {"mean_pressure": mean_pressure},
            "bem": {"periodic": True, "cell_nodes": 16}}
@@ -69,3 +71,15 @@ def test_a_run_records_the_points_filled_and_the_file_relative_to_the_scene(tmp_
     assert surface["size"] == pytest.approx([SUR_SIZE_MM[0] * 1e-3, SUR_SIZE_MM[1] * 1e-3], rel=1e-7)
     assert str(tmp_path) not in text and str(tmp_path) not in err  # warnings name data/sur-2.sur too
     assert "data/sur-2.sur" in err  # the edge-jump warning of this patch
+
+
+def test_check_refuses_an_x3p_that_would_inflate_beyond_its_header(tmp_path, monkeypatch):
+    (tmp_path / "data").mkdir()
+    write_x3p(tmp_path / "data" / "bomb.x3p")
+    rewrite_x3p(tmp_path / "data" / "bomb.x3p", data=bytes(20 * 2**20))  # declared 16 x 12 float64 values
+    monkeypatch.setattr(st, "open_topography", lambda *a, **k: pytest.fail("the file was handed to a reader"))
+    code, _, err = cli("check", _scene(tmp_path, {"file": "data/bomb.x3p"}))
+    assert code == 2 and err.count("\n") == 1
+    assert err.startswith("contactlab: error: gap.file = 'data/bomb.x3p' is not allowed: its data does not match its "
+                          "header: main.xml declares 16 x 12 values of type D (1536 bytes), the data member holds "
+                          "20971520 bytes")
