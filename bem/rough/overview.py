@@ -11,33 +11,33 @@ read, its spikes (:func:`bem.rough.find_spikes`), its seam (the edge jump of the
 from __future__ import annotations
 
 from ..periodic.cell import rows_for
-from .spikes import SPIKE_MADS, find_spikes
+from .outliers import SPIKE_THRESHOLD, find_spikes
 
 __all__ = ["summary"]
 
 
-def summary(surface, *, mads=SPIKE_MADS):
+def summary(surface, *, threshold=SPIKE_THRESHOLD):
     """The numbers of a rough surface as plain JSON values (module docstring).
 
     Parameters
     ----------
     surface : bem.rough.RoughSurface
         The surface, as read (lengths in its unit, metres from :func:`bem.rough.read_surface`).
-    mads : float
-        The spike threshold (:func:`bem.rough.find_spikes`).
+    threshold : float
+        The spike threshold in robust standard deviations (:func:`bem.rough.find_spikes`).
 
     Returns
     -------
     dict
         ``stats`` (:meth:`bem.rough.SurfaceStats.as_dict`), ``pixel`` ``(dx, dy)``,
-        ``spikes`` (:meth:`bem.rough.Spikes.as_dict`), ``lattice`` (``n_cols``, ``n_rows``,
+        ``spikes`` (:meth:`bem.rough.Spikes.as_dict` and ``count``), ``lattice`` (``n_cols``, ``n_rows``,
         ``step``, ``nodes``: the default cell) and ``data_points`` (``nx ny``).
     """
     stats = surface.stats
     n_cols = surface.default_n_cols()
     step = surface.size[0] / n_cols
     n_rows = rows_for(step, surface.size[1])
-    return {"stats": stats.as_dict(), "pixel": list(stats.pixel),
-            "spikes": find_spikes(surface.heights, mads=mads).as_dict(),
+    spikes = find_spikes(surface.heights, threshold=threshold)
+    return {"stats": stats.as_dict(), "pixel": list(stats.pixel), "spikes": dict(spikes.as_dict(), count=spikes.count),
             "lattice": {"n_cols": n_cols, "n_rows": n_rows, "step": step, "nodes": n_cols * n_rows},
             "data_points": stats.grid[0] * stats.grid[1]}

@@ -100,12 +100,12 @@ def test_a_missing_file_is_named_without_importing_surfacetopography(tmp_path):
 def test_the_default_lattice_of_long_pixels_does_not_oversample(tmp_path):
     z = np.random.default_rng(2).normal(size=(40, 40)) * 1e-7
     st.Topography(z, (1e-5, 2.5e-5)).to_x3p(str(tmp_path / "long.x3p"))  # dy = 2.5 dx
-    code, out, _ = cli("surface", tmp_path / "long.x3p", "--detrend", "none", "--spike-mads", "4")
+    code, out, _ = cli("surface", tmp_path / "long.x3p", "--detrend", "none", "--spike-threshold", "4")
     assert code == 0
     lattice = next(line for line in out.splitlines() if line.startswith("lattice"))
     assert lattice.startswith("lattice        16 x 46 nodes")  # not 40 x 116
-    code, _, err = cli("surface", tmp_path / "long.x3p", "--spike-mads", "0")
-    assert code == 2 and err.startswith("contactlab: error: --spike-mads = 0.0 is not allowed")
+    code, _, err = cli("surface", tmp_path / "long.x3p", "--spike-threshold", "0")
+    assert code == 2 and err.startswith("contactlab: error: --spike-threshold = 0.0 is not allowed")
 
 
 def test_the_shared_reader_of_file_options_returns_metres(tmp_path):

@@ -19,8 +19,8 @@ PARSER = {
     "description": (
         "Read a surface file as layer-law and scenes read it (bem.rough.read_surface) and print what it holds:\n"
         "rms height, rms slope and rms curvature in SI units, the grid and pixel size, the missing points\n"
-        "(refused unless --fill; above 5 % of the points refused in any case), the spikes (points beyond\n"
-        "--spike-mads scaled median absolute deviations from the median), the seam of the periodic cell\n"
+        "(refused unless --fill; above 5 % of the points refused in any case), the spikes (regions reaching\n"
+        "beyond --spike-threshold robust standard deviations of the median), the seam of the periodic cell\n"
         "(edge jump against a grid step) and the default lattice cell of layer-law and [bem] cell_nodes.\n"
         "A file's lengths are converted to m by the unit it states; --scale (m per unit) and --size are\n"
         "for a file that states none (npy, plain text matrices).\n"
@@ -70,8 +70,8 @@ def add_args(p):
     p.add_argument("--channel", type=int, metavar="N", help="data channel of a multi-channel file")
     p.add_argument("--detrend", default="height", choices=("height", "center", "slope", "curvature", "none"),
                    help="what is taken off before the statistics (default: the plane of least rms height)")
-    p.add_argument("--spike-mads", dest="spike_mads", type=float, default=6.0, metavar="K",
-                   help="spike threshold in scaled median absolute deviations (default 6)")
+    p.add_argument("--spike-threshold", dest="spike_threshold", type=float, default=10.0, metavar="K",
+                   help="robust standard deviations (1.4826 MAD) beyond which a point is a spike (default 10)")
     p.add_argument("--out", metavar="DIR", help="write surface.json, heights.png and psd.png into DIR")
 
 
@@ -98,8 +98,9 @@ def _lines(info):
             f"rms height     {s['rms_height']:.4g} m",
             f"rms slope      {s['rms_slope']:.4g}",
             f"rms curvature  {s['rms_curvature']:.4g} 1/m",
-            f"spikes         {sp['count']} points beyond {sp['mads']:g} MADs ({sp['above']} above, {sp['below']} "
-            f"below the median; the farthest {sp['largest']:.3g} MADs, 1 MAD = {sp['scale']:.4g} m)",
+            f"spikes         {sp['count']} points in {sp['n_spikes_high']} spikes above and {sp['n_spikes_low']} below "
+            f"the median ({sp['n_high']} and {sp['n_low']} points) beyond {sp['threshold']:g} sigma_r = "
+            f"{sp['robust_sigma']:.4g} m; the highest point {sp['top_score']:.3g} sigma_r above the median",
             f"seam           edge jump {s['edge_jump']:.4g} m against a grid step of {s['grid_step']:.4g} m: {seam}",
             f"lattice        {lat['n_cols']} x {lat['n_rows']} nodes, step {lat['step']:.4g} m (the default of "
             "layer-law --n-cols and [bem] cell_nodes)"]
@@ -155,9 +156,9 @@ def run(args):
     if not Path(args.file).is_file():  # before SurfaceTopography is imported
         raise InputError(f"FILE = {args.file!r} is not allowed: there is no such file.")
     require_extra("rough", "contactlab surface (SurfaceTopography reads the file)")
-    mads = check_positive("--spike-mads", args.spike_mads)
+    threshold = check_positive("--spike-threshold", args.spike_threshold)
     surface = read(args)
-    info = summary(surface, mads=mads)
+    info = summary(surface, threshold=threshold)
     print("\n".join(_lines(info)))
     if args.out is not None:
         with atomic_directory(out, KIND, NAMES, what="--out") as tmp:
