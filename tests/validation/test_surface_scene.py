@@ -2,6 +2,9 @@
 points filled on request and recorded, the file named as the scene names it (never by its absolute path)."""
 
 import json
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 import tomli_w
@@ -13,6 +16,7 @@ from .conftest import cli
 
 st = pytest.importorskip("SurfaceTopography")
 
+ROOT = Path(__file__).resolve().parents[2]
 SUR_SIZE_MM = (1.9614921, 1.6862561)  # sur-2.sur as SurfaceTopography reads it (tests/data/instrument/README.md)
 
 
@@ -83,3 +87,15 @@ def test_check_refuses_an_x3p_that_would_inflate_beyond_its_header(tmp_path, mon
     assert err.startswith("contactlab: error: gap.file = 'data/bomb.x3p' is not allowed: its data does not match its "
                           "header: main.xml declares 16 x 12 values of type D (1536 bytes), the data member holds "
                           "20971520 bytes")
+
+
+def test_a_missing_file_is_named_as_the_scene_does_before_surfacetopography_is_imported(tmp_path):
+    path = _scene(tmp_path, {"file": "data/ibw-10x10.ibw"})
+    (tmp_path / "data" / "ibw-10x10.ibw").unlink()
+    code = ("import sys; from validation.cli import main; rc = main(['check', 'scene.toml']); "
+            "print(rc, 'SurfaceTopography' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], cwd=path.parent, env={"PYTHONPATH": str(ROOT)},
+                          capture_output=True, text=True, timeout=120)
+    assert done.stdout.split() == ["2", "False"], done.stderr
+    assert done.stderr.startswith("contactlab: error: gap.file = 'data/ibw-10x10.ibw' is not allowed: there is no "
+                                  "such file")

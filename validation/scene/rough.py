@@ -180,6 +180,9 @@ def rough_gap(d, *, units=None, base_dir=None):
     """
     kind = d["type"]
     ck.unknown_keys("gap", d, ("type", *GAP_KEYS[kind]))
+    if kind == "surface" and isinstance(d.get("file"), str) and not os.path.isfile(d["file"]):
+        raise ck.SceneError(f"gap.file = {_shown(d['file'], base_dir)!r} is not allowed: there is no such file "
+                            "(a relative name starts from the scene file's folder).")
     require_extra("rough", f"gap.type = {kind!r} (a rough surface)")
     surface = _self_affine(d) if kind == "self_affine" else _surface(d, units, base_dir)
     return dict(d), RoughGap(kind, surface)
