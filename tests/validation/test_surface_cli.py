@@ -113,5 +113,5 @@ def test_the_shared_reader_of_file_options_returns_metres(tmp_path):
     from validation.cli.surface import read
 
     path = instrument_file("top-1.top", tmp_path)
-    args = Namespace(file=str(path), size=None, scale=None, fill=None, detrend="none")
+    args = Namespace(file=str(path), size=None, scale=None, fill=None, detrend="none", channel=0)
     assert read(args).size == pytest.approx((6e-7, 6e-7), rel=1e-12)

@@ -4,10 +4,11 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from bem.checks import InputError
 from .common import ProgressBar
-from .surface import OPTION_NAMES, add_file_args, pair, read
+from .surface import OPTION_NAMES, add_file_args, pair, size_of
 
 PARSER = {
     "help": "the layer law w(p) of a rough surface: law file and figures",
@@ -102,7 +103,7 @@ def _summary(folder):
 def run(args):
     from bem.rough import LadderNotConverged
 
-    from ..layer_law import ladder, make_layer_law, synthetic_surface
+    from ..layer_law import ladder, make_layer_law, surface_from_file, synthetic_surface
 
     if (args.surface is None) == (args.synthetic is None):
         raise InputError("SURFACE is missing: give a surface file or --synthetic (one of them)." if args.surface is None
@@ -114,7 +115,8 @@ def run(args):
                                  "(a synthetic surface is in m).")
         surface = synthetic_surface(**_synthetic(args.synthetic))
     else:
-        surface = read(args, names=dict(OPTION_NAMES, file="SURFACE"), file=args.surface)
+        surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size_of(args), fill=args.fill,
+                                    names=dict(OPTION_NAMES, file="SURFACE"))
     if args.p_range is not None:
         pressures = ladder(surface, args.E_star, pressures=pair("--p-range", args.p_range, ":"), n=args.n_pressures)
     else:

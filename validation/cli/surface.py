@@ -75,15 +75,19 @@ def add_args(p):
     p.add_argument("--out", metavar="DIR", help="write surface.json, heights.png and psd.png into DIR")
 
 
-def read(args, names=OPTION_NAMES, file=None):
-    """The surface of ``args`` in metres (:func:`validation.layer_law.surface_from_file`)."""
-    from ..layer_law import surface_from_file
+def size_of(args):
+    """``--size LX,LY`` as a pair, or ``None``."""
+    return None if args.size is None else pair("--size", args.size, ",")
 
-    size = None if args.size is None else pair("--size", args.size, ",")
-    detrend = getattr(args, "detrend", "height")
+
+def read(args):
+    """The surface of ``args`` in metres (:func:`bem.rough.read_surface`), its options named in messages."""
+    from bem import rough
+
     kw = {k: getattr(args, k) for k in ("format", "channel") if getattr(args, k, None) is not None}
-    return surface_from_file(Path(args.file if file is None else file), scale=args.scale, physical_sizes=size,
-                             detrend=None if detrend == "none" else detrend, fill=args.fill, names=names, **kw)
+    return rough.read_surface(Path(args.file), unit=args.scale, physical_sizes=size_of(args),
+                              detrend=None if args.detrend == "none" else args.detrend, fill=args.fill,
+                              names=OPTION_NAMES, **kw)
 
 
 def _lines(info):

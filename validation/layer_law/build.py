@@ -9,7 +9,7 @@ The folder (a ``"layer-law"`` folder, :mod:`validation.io`) holds
   stiffness ``K(p)`` (:mod:`validation.layer_law.figures`).
 
 Units are SI: a surface file's lengths are converted to metres by the unit the file states
-(``scale`` for a file that states none), ``E*`` and the pressures are in Pa. The ladder of mean pressures is
+(or by ``scale``), ``E*`` and the pressures are in Pa. The ladder of mean pressures is
 geometric, by default from ``3e-3`` to ``0.3`` times ``E* h'_rms`` (``h'_rms`` the surface's
 rms slope, ``stats.rms_slope``): from a contact fraction of about 1 % to well into the
 exponential regime. Its last pressure must exceed the largest local pressure of the problems
@@ -60,8 +60,7 @@ class LayerLawFolder:
     figures: dict = field(default_factory=dict)
 
 
-def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height", fill=None, format=None,
-                      channel=None, names=None):
+def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height", fill=None, names=None):
     """A measured surface in metres (:func:`bem.rough.read_surface`).
 
     Parameters
@@ -73,7 +72,7 @@ def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height"
         a file states is always the one used (a ``scale`` that disagrees with it is refused).
     physical_sizes : (float, float), optional
         ``(Lx, Ly)`` in the file's length unit, for a file that does not state its size.
-    detrend, fill, format, channel : optional
+    detrend, fill : str or None
         As :func:`bem.rough.read_surface`.
     names : dict, optional
         The names of the arguments in messages (:func:`bem.rough.read_surface`).
@@ -88,7 +87,7 @@ def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height"
 
     names = {"unit": "scale", **(names or {})}
     return rough.read_surface(file, physical_sizes=physical_sizes, unit=scale, detrend=detrend, fill=fill,
-                              format=format, channel=channel, names=names)
+                              names=names)
 
 
 def synthetic_surface(*, hurst, size, grid, rms_height=None, rms_slope=None, long_cutoff=None, short_cutoff=None,
