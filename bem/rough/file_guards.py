@@ -47,8 +47,9 @@ def check_points(path, shape, shown=None):
     try:
         check_node_count("file", path, n)
     except InputError:
-        _refuse(shown or path, f"it declares {' x '.join(str(int(s)) for s in shape)} = {float(n):.3g} points, more than "
-                      f"the {MAX_NODES:.3g} of the largest lattice; crop or subsample it first")
+        grid = " x ".join(str(int(s)) for s in shape)
+        _refuse(shown or path, f"it declares {grid} = {float(n):.3g} points, more than the {MAX_NODES:.3g} of the "
+                               "largest lattice; crop or subsample it first")
     return n
 
 
@@ -96,7 +97,8 @@ def _x3p(path, shown):
         if main is None:
             _refuse(shown, "it is not a readable x3p file (no main.xml in the archive)")
         if main.file_size > MAX_HEADER_BYTES:
-            _refuse(shown, f"its main.xml declares {main.file_size} bytes (limit {MAX_HEADER_BYTES}): not an x3p header")
+            _refuse(shown, f"its main.xml declares {main.file_size} bytes (limit {MAX_HEADER_BYTES}): not an x3p "
+                           "header")
         try:
             root = ElementTree.fromstring(archive.read(main))
             dims = root.find("Record3/MatrixDimension")

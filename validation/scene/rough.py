@@ -29,7 +29,8 @@ scene stops before any work with :class:`validation.extras.MissingExtraError`. `
 takes ``periodic = true`` (required with a rough gap, refused without one) and
 ``cell_nodes``, the lattice nodes along x (default: ``Lx / max(dx, dy)``, the data's ``nx``
 on square pixels, :meth:`bem.rough.RoughSurface.default_n_cols`); the cell is the surface's.
-The statistics name the file as the scene does (relative to the scene file's folder). ``[load]`` takes ``mean_pressure`` [pressure], ``force`` (the force on one cell,
+The statistics name the file as the scene does (relative to the scene file's folder).
+``[load]`` takes ``mean_pressure`` [pressure], ``force`` (the force on one cell,
 ``mean_pressure Lx Ly``) or ``approach``.
 """
 
@@ -144,7 +145,8 @@ def _surface(d, units, base_dir=None):
 
     file = ck.string("gap.file", ck.require("gap", d, "file", 'give the topography file, e.g. file = "patch.x3p"'))
     reader = ck.choice("gap.reader", d.get("reader", "surfacetopography"), _READERS)
-    own = {"surfacetopography": ("format", "channel", "physical_sizes", "fill"), "core": ("format", "spacing", "nodata")}
+    own = {"surfacetopography": ("format", "channel", "physical_sizes", "fill"),
+           "core": ("format", "spacing", "nodata")}
     for key in GAP_KEYS["surface"][2:9]:
         if key in d and key not in own[reader] and key != "length_unit":
             raise ck.SceneError(f"gap.{key} = {d[key]!r} is not allowed with gap.reader = {reader!r}: that reader "
