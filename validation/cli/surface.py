@@ -95,7 +95,7 @@ def _lines(info):
     filled = (f"{s['filled']} points filled ({s['fill']}), "
               f"{100 * s['filled'] / info['data_points']:.3g} % of the grid" if s["filled"] else "none")
     seam = "flagged: the repeated cell has a step at its edges" if s["edge_jump_large"] else "within a grid step"
-    return [f"file           {s['source']} (unit {s['unit'] or 'given'}, detrend {s['detrend'] or 'none'})",
+    return [f"file           {s['source']} (unit {s['unit'] or 'none stated, --scale'}, detrend {s['detrend'] or 'none'})",
             f"grid           {s['grid'][0]} x {s['grid'][1]} points, size {s['size'][0]:.4g} x {s['size'][1]:.4g} m, "
             f"pixel {info['pixel'][0]:.4g} x {info['pixel'][1]:.4g} m",
             f"missing        {filled}",
