@@ -115,3 +115,16 @@ def test_the_shared_reader_of_file_options_returns_metres(tmp_path):
     path = instrument_file("top-1.top", tmp_path)
     args = Namespace(file=str(path), size=None, scale=None, fill=None, detrend="none", channel=0)
     assert read(args).size == pytest.approx((6e-7, 6e-7), rel=1e-12)
+
+
+def test_layer_law_takes_a_files_nanometres_as_metres_once(tmp_path):
+    """The law of a real .top file in nm records its cell in metres (a second conversion would make it 1e-18 m)."""
+    import tomllib
+
+    path = instrument_file("top-1.top", tmp_path)
+    code, _, err = cli("layer-law", path, "--E-star", "1e11", "--n-cols", "16", "--n-pressures", "3", "--no-figures",
+                       "--out", tmp_path / "law")
+    assert code == 0, err
+    law = tomllib.loads((tmp_path / "law" / "layer_law.toml").read_text())
+    surface = law["topography"]["surface"]
+    assert surface["unit"] == "nm" and surface["size"] == pytest.approx([6e-7, 6e-7], rel=1e-12)
