@@ -27,7 +27,7 @@ SYNTHETIC = "hurst=0.8,rms_height=0.5e-6,size=1e-4,grid=64,long_cutoff=25e-6,sho
 def surface_file(tmp_path_factory):
     """A periodic self-affine cell saved as heights in um (a .npy states no unit)."""
     surface = synthetic_surface(hurst=0.8, size=1e-4, grid=64, rms_height=0.5e-6, long_cutoff=25e-6,
-                                short_cutoff=12.5e-6, seed=3)
+                                short_cutoff=12.5e-6, seed=3).surface
     path = tmp_path_factory.mktemp("surface") / "heights.npy"
     np.save(path, np.asarray(surface.heights) * 1e6)
     return path
@@ -55,8 +55,12 @@ def test_a_surface_file_becomes_a_law_folder_a_scene_loads(surface_file, tmp_pat
     folder = tmp_path / "law"
     assert json.loads((folder / MARKER).read_text())["kind"] == "layer-law"
     assert sorted(p.name for p in folder.iterdir()) == sorted([MARKER, "layer_law.toml", "closure.png",
-                                                               "contact_fraction.png", "stiffness.png"])
-    assert "8 mean pressures" in out and "layer_law.toml" in out
+                                                               "contact_fraction.png", "stiffness.png", "persson.png"])
+    import tomllib
+
+    start = tomllib.loads((folder / "layer_law.toml").read_text())["topography"]["ladder_start"]
+    assert f"{8 + start['added']} mean pressures" in out and "layer_law.toml" in out
+    assert start["interpolated_share"] <= start["max_interpolated"] == 0.01  # the default rule
     scene = {"scene": {"name": "rough"}, "bodies": {"E_star": E_STAR}, "gap": {"type": "paraboloid", "R": 0.01},
              "layer": {"law": "tabulated", "file": "layer_law.toml"}, "load": {"force": 50.0},
              "bem": {"nodes_across": 16}}
@@ -120,9 +124,12 @@ def test_n_pressures_and_the_output_folder_are_checked_before_solving(tmp_path):
 
 
 def test_the_progress_hook_sees_every_step_of_the_ladder(folder):
-    _, calls = folder
-    """The library's one progress protocol, progress(label, done, total): one call after each step."""
-    assert [c[1:] for c in calls] == [(k, 8) for k in range(1, 9)]
+    out, calls = folder
+    """The library's one progress protocol, progress(label, done, total): one call after each step, the total
+    growing by the pressures added below the ladder."""
+    added = out.law.ladder_start["added"]
+    assert added > 0 and out.law.mean_pressure.size == 8 + added
+    assert [c[1:] for c in calls] == [(k, 8) for k in range(1, 9)] + [(k, k) for k in range(9, 9 + added)]
     assert all(label.startswith("A/A0 ") and label.endswith(" iterations") for label, _, _ in calls)
 
 
@@ -157,7 +164,9 @@ def test_the_contact_fraction_figure_is_against_the_pressure_over_e_star_times_r
     x = np.asarray(data.get_xdata(), float)
     np.testing.assert_allclose(x * E_STAR * law.stats.rms_slope, law.mean_pressure, rtol=1e-12)
     np.testing.assert_allclose(data.get_ydata(), law.contact_fraction, rtol=1e-12)
-    assert x[0] == pytest.approx(3e-3, rel=1e-12) and x[-1] == pytest.approx(0.3, rel=1e-12)  # the default ladder
+    added = law.ladder_start["added"]  # the default ladder, and the pressures added below it, halving
+    assert x[added] == pytest.approx(3e-3, rel=1e-12) and x[-1] == pytest.approx(0.3, rel=1e-12)
+    np.testing.assert_allclose(x[1:added + 1] / x[:added], 2.0, rtol=1e-12)
 
 
 def test_the_stiffness_figure_draws_the_finite_stiffness_in_pa_per_m(folder):
