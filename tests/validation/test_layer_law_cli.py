@@ -3,6 +3,7 @@ three figures showing the ladder's data with units); bad input stops with exit c
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -179,3 +180,61 @@ def test_the_stiffness_figure_draws_the_finite_stiffness_in_pa_per_m(folder):
     assert finite.all() and math.isfinite(float(np.max(data.get_ydata())))
     np.testing.assert_allclose(data.get_ydata(), law.stiffness, rtol=1e-12)
     np.testing.assert_allclose(np.asarray(data.get_xdata(), float) * 1e9, law.mean_pressure, rtol=1e-12)
+
+
+SPOT = Path(__file__).resolve().parents[1] / "data" / "surfaces" / "spot_1-1000nm.ibw"
+
+
+@pytest.mark.parametrize("cell, seam_warnings", [("repeat", 1), ("mirror", 0)])
+def test_a_measured_file_warns_once_about_spikes_and_seam_and_the_law_file_says_what_was_done(tmp_path, cell,
+                                                                                            seam_warnings):
+    """SurfaceTopography's AFM scan spot_1-1000nm.ibw: spikes up to 22 rms heights above the mean."""
+    import tomllib
+
+    code, out, err = cli("layer-law", SPOT, "--E-star", E_STAR, "--n-pressures", 4, "--n-cols", 32, "--spikes",
+                         "remove", "--cell", cell, "--no-figures", "--out", tmp_path / "law")
+    assert code == 0, err
+    spikes = [line for line in err.splitlines() if "spikes beyond" in line]
+    seams = [line for line in err.splitlines() if "edge jump" in line]
+    assert len(spikes) == 1 and "1422 of 65536 points" in spikes[0] and " m of the median" in spikes[0]
+    assert len(seams) == seam_warnings and all("e-09 against a grid step" in line for line in seams)  # in m
+    topo = tomllib.loads((tmp_path / "law" / "layer_law.toml").read_text())["topography"]
+    prep = topo["preparation"]
+    assert (prep["detrend"], prep["cell"], prep["spikes_removed"], prep["spike_points"]) == ("height", cell, True,
+                                                                                            1422)
+    assert prep["spikes"]["top"] == pytest.approx(21.8, abs=0.1) and prep["edge_jump_large"] == (cell == "repeat")
+    assert topo["surface"]["grid"] == ([512, 512] if cell == "mirror" else [256, 256])
+    assert topo["ladder_start"]["interpolated_share"] <= 0.01
+    assert "cell       detrend height, " + cell in out
+
+
+@pytest.mark.parametrize("args, match", [
+    (("--synthetic", SYNTHETIC, "--max-interpolated", "2"), "--max-interpolated = '2' is not allowed"),
+    (("--synthetic", SYNTHETIC, "--cell", "mirror"), "--cell = 'mirror' is not allowed with --synthetic"),
+    (("--synthetic", SYNTHETIC, "--spike-threshold", "-3"), "--spike-threshold = -3.0 is not allowed"),
+])
+def test_bad_cell_options_exit_2_with_one_line(tmp_path, args, match):
+    code, _, err = _run(tmp_path, *args)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and match in err
+
+
+def test_the_persson_figure_draws_the_ladder_beside_the_theory_of_its_spectrum(folder):
+    out, _ = folder
+    law = out.law
+    area, gap = out.figures["persson.png"].axes
+    assert (area.get_xscale(), area.get_yscale(), gap.get_xscale(), gap.get_yscale()) == ("log", "log", "log",
+                                                                                          "linear")
+    assert "A/A_0" in area.get_ylabel() and "h_\\mathrm{rms}" in gap.get_ylabel()
+    for ax, ladder, theory in ((area, law.contact_fraction, law.persson["contact_fraction"]),
+                               (gap, law.mean_gap / law.stats.rms_height,
+                                np.asarray(law.persson["mean_gap"]) / law.stats.rms_height)):
+        assert ax.get_xlabel() == "mean pressure $p$ [GPa]"
+        (persson,) = [ln for ln in ax.get_lines() if ln.get_linestyle() == "--"]
+        assert persson.get_label().startswith("Persson (2001, 2007)")
+        np.testing.assert_allclose(np.asarray(persson.get_xdata()) * 1e9, law.persson["mean_pressure"], rtol=1e-12)
+        np.testing.assert_allclose(persson.get_ydata(), theory, rtol=1e-12)
+        (points,) = [ln for ln in ax.get_lines() if ln.get_marker() == "o"]
+        np.testing.assert_allclose(np.asarray(points.get_xdata()) * 1e9, law.mean_pressure, rtol=1e-12)
+        np.testing.assert_allclose(points.get_ydata(), ladder, rtol=1e-12)
+        (added,) = [ln for ln in ax.get_lines() if ln.get_marker() == "s"]
+        assert len(added.get_xdata()) == law.ladder_start["added"]
