@@ -119,3 +119,32 @@ def test_bad_arguments_are_named(crop, periodic):
     detrended = rough.from_heights(np.array(crop.heights), SIZE, detrend="height")
     with pytest.raises(InputError, match="surface.stats.detrend = 'height' is not allowed"):
         rough.patch_cell(detrended)
+
+
+def test_a_measured_patch_on_the_half_space_touches_at_its_highest_point_and_refuses_a_spreading_contact():
+    """The non-periodic path (bem.gaps.Measured, kind = "topography"; a scene's type = "measured"): the AFM scan
+    spot_1-1000nm.ibw with its spikes, pressed lightly by a flat, carries the load on the particle at its
+    highest point; a load that spreads the contact to the border of the region is refused."""
+    from pathlib import Path
+
+    import bem
+    from bem.gaps import Measured
+
+    spot = Path(__file__).resolve().parents[1] / "data" / "surfaces" / "spot_1-1000nm.ibw"
+    cell = rough.patch_cell(rough.read_surface(spot, detrend=None))
+    z = np.asarray(cell.surface.heights)
+    dx = cell.surface.size[0] / z.shape[0]
+    x = (np.arange(z.shape[0]) - z.shape[0] / 2) * dx
+    extent = 0.4 * cell.surface.size[0]
+    gap = Measured(x, x, z, kind="topography", method="linear").region(extent)
+    E_star, area = 115e9, (2 * extent) ** 2
+    force = 1e-4 * E_star * cell.surface.stats.rms_slope * area  # mean pressure 1e-4 E* h'_rms
+    light = bem.solve(gap, E_star=E_star, step=2 * dx, extent=extent, force=force, rtol=1e-8)
+    assert light.converged and light.force == pytest.approx(force, rel=1e-8)  # sum of the nodal pressures
+    inside = np.abs(x) <= extent
+    i, j = np.unravel_index(np.argmax(np.where(inside[:, None] & inside[None, :], z, -np.inf)), z.shape)
+    k = int(np.argmax(light.p))
+    assert np.hypot(light.x[k] - x[i], light.y[k] - x[j]) <= 3 * dx  # the peak pressure on the highest point
+    assert light.contact_area < 1e-3 * area
+    with pytest.raises(bem.RegionTooSmallError, match="bem.solve_periodic"):
+        bem.solve(gap, E_star=E_star, step=2 * dx, extent=extent, force=100 * force, rtol=1e-8)
