@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 
 from bem.checks import InputError
+from bem.rough.patch import CELLS, DETREND_CHOICES, SPIKE_ACTIONS
+
 from .common import ProgressBar
 from .surface import OPTION_NAMES, add_file_args, pair, size_of
 
@@ -63,6 +65,24 @@ def add_args(p):
     p.add_argument("--rtol", type=float, default=1e-8, help="the solver's KKT tolerance (default 1e-8)")
     add_file_args(p)
     p.add_argument("--no-figures", action="store_true", help="write the law file only (no report extra needed)")
+    cell = p.add_argument_group("the periodic cell of a measured surface (bem.rough.patch_cell; recorded in the law file)")
+    cell.add_argument("--detrend", default="auto", choices=DETREND_CHOICES,
+                      help="auto (default): none for a periodic surface, height for a patch; none keeps the heights "
+                           "as they are; height: the plane of least rms height; curvature: the second-order "
+                           "polynomial (a measured form)")
+    cell.add_argument("--cell", default="repeat", choices=CELLS,
+                      help="repeat (default): the patch repeated, with a seam at its edges; mirror: the patch and "
+                           "its mirror images, a cell of 2 x 2 patches without a seam (four times the nodes)")
+    cell.add_argument("--spikes", default="keep", choices=SPIKE_ACTIONS,
+                      help="spikes are points beyond --spike-threshold robust standard deviations (1.4826 MAD) of "
+                           "the median, with their flanks; they are always reported; remove fills them by harmonic "
+                           "interpolation (default keep)")
+    cell.add_argument("--spike-threshold", type=float, metavar="K",
+                      help="robust standard deviations beyond which a point is a spike (default 10)")
+    p.add_argument("--max-interpolated", default="0.01", metavar="SHARE",
+                   help="the largest share of the closure w(p_n) left below the first pressure, where the law is a "
+                        "straight line through (0, 0): the ladder is extended downwards until it holds "
+                        "(default 0.01; none: the ladder as given)")
 
 
 def _synthetic(text):
@@ -94,10 +114,39 @@ def _summary(folder):
              f"closure    w = {w[0]:.4g} .. {w[-1]:.4g} m of the first-touch mean gap {law.first_touch_gap:.4g} m",
              f"contact    A/A0 = {law.contact_fraction[0]:.3g} .. {law.contact_fraction[-1]:.3g}",
              f"range      the law holds data up to p = {p[-1]:.4g} Pa; a solve beyond it warns",
+             f"start      {100 * law.ladder_start['interpolated_share']:.3g} % of the closure lies below p = {p[0]:.4g} "
+             f"Pa (a straight line to 0)" + (f", {law.ladder_start['added']} pressures added below the ladder"
+                                             if law.ladder_start.get("added") else ""),
              f"scene      [layer] law = \"tabulated\", file = \"{folder.law_file.name}\" (the file beside the scene)"]
+    prep = law.preparation
+    if prep:
+        spikes = prep["spikes"]
+        lines.insert(1, f"cell       detrend {prep['detrend']}, {prep['cell']}"
+                     + (", the seam is large (--cell mirror has none)" if prep["edge_jump_large"] else "")
+                     + f"; {prep['spike_points']} points in spikes beyond {spikes['threshold']:g} sigma_r"
+                     + (" filled" if prep["spikes_removed"] else (" kept" if prep["spike_points"] else "")))
     names = [folder.law_file.name, *folder.figures]
     lines.append(f"files      {folder.path}/ ({', '.join(names)})")
     return "\n".join(lines)
+
+
+def _share(text):
+    if str(text).strip().lower() == "none":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = None
+    if value is None or not 0 < value < 1:
+        raise InputError(f"--max-interpolated = {text!r} is not allowed: it must be a number between 0 and 1 "
+                         "(exclusive) or none.")
+    return value
+
+
+def _spike_threshold(value):
+    if value is not None and not value > 0:
+        raise InputError(f"--spike-threshold = {value!r} is not allowed: it must be > 0.")
+    return value
 
 
 def run(args):
@@ -113,10 +162,17 @@ def run(args):
             if value is not None:
                 raise InputError(f"{option} = {value!r} is not allowed with --synthetic: it is for a SURFACE file "
                                  "(a synthetic surface is in m).")
-        surface = synthetic_surface(**_synthetic(args.synthetic))
+        for option, value, default in (("--detrend", args.detrend, "auto"), ("--cell", args.cell, "repeat")):
+            if value != default:
+                raise InputError(f"{option} = {value!r} is not allowed with --synthetic: a synthetic surface is "
+                                 "periodic, its own cell.")
+        surface = synthetic_surface(**_synthetic(args.synthetic), spikes=args.spikes,
+                                    spike_threshold=_spike_threshold(args.spike_threshold))
     else:
         surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size_of(args), fill=args.fill,
-                                    names=dict(OPTION_NAMES, file="SURFACE"))
+                                    names=dict(OPTION_NAMES, file="SURFACE"), detrend=args.detrend, cell=args.cell,
+                                    spikes=args.spikes, spike_threshold=_spike_threshold(args.spike_threshold))
+    share = _share(args.max_interpolated)
     if args.p_range is not None:
         pressures = ladder(surface, args.E_star, pressures=pair("--p-range", args.p_range, ":"), n=args.n_pressures)
     else:
@@ -125,7 +181,8 @@ def run(args):
     bar = ProgressBar("layer law", "pressure", args.no_progress or None)
     try:
         folder = make_layer_law(surface, args.out, E_star=args.E_star, pressures=pressures, n_cols=args.n_cols,
-                                rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out")
+                                rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out",
+                                max_interpolated=share)
     except LadderNotConverged as exc:
         print(f"contactlab: error: {exc} (nothing was written)", file=sys.stderr)
         return 1
