@@ -249,7 +249,8 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, unit=N
     RoughSurface
         The detrended patch as a periodic cell [length_unit], its statistics and edge jump
         (:mod:`bem.rough.surface`; a large jump is logged as a warning), the file's unit in
-        ``stats.unit`` and the points filled in ``stats.filled``.
+        ``stats.unit``, the unit of the lengths in ``stats.length_unit`` (a name given as
+        ``length_unit``) and the points filled in ``stats.filled``.
 
     Raises
     ------
@@ -317,5 +318,5 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, unit=N
     periodic = bool(topo.is_periodic) and detrend in (None, "center")  # a plane taken off breaks a period
     said = stated if stated is not None else (unit if isinstance(unit, str) else None)
     return _surface(np.array(z, dtype=float) * factor, size, periodic=periodic, detrend=detrend,
-                    source=shown, unit=said, filled=filled,
-                    fill=fill if filled else None)
+                    source=shown, unit=said, filled=filled, fill=fill if filled else None,
+                    length_unit=length_unit if isinstance(length_unit, str) else None)

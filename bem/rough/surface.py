@@ -112,6 +112,9 @@ class SurfaceStats:
         Missing points of the file filled by interpolation (:func:`bem.rough.read_surface`).
     fill : str or None
         How they were filled (``"harmonic"``), ``None`` when none were.
+    length_unit : str or None
+        The unit of the lengths here (``"m"`` from :func:`bem.rough.read_surface` by default);
+        ``None`` where it is not known (arrays, synthetic surfaces: the caller's unit).
     """
 
     rms_height: float
@@ -128,6 +131,7 @@ class SurfaceStats:
     detrend: str | None = None
     filled: int = 0
     fill: str | None = None
+    length_unit: str | None = None
 
     @property
     def pixel(self):
@@ -198,7 +202,7 @@ def _edge_jump(z):
     return float(np.sqrt(np.mean(jumps**2))), float(np.sqrt(steps))
 
 
-def _surface(z, size, *, periodic, source, unit=None, detrend=None, filled=0, fill=None):
+def _surface(z, size, *, periodic, source, unit=None, detrend=None, filled=0, fill=None, length_unit=None):
     """A :class:`RoughSurface` of the finite grid ``z`` (owned), statistics by SurfaceTopography."""
     st = _surface_topography()
     topo = st.Topography(z, size, periodic=periodic)
@@ -212,7 +216,7 @@ def _surface(z, size, *, periodic, source, unit=None, detrend=None, filled=0, fi
                     step, excess / rms_height, rms_height, EDGE_JUMP_LIMIT)
     stats = SurfaceStats(rms_height, float(topo.rms_gradient()), float(topo.rms_curvature_from_area()),
                          (float(size[0]), float(size[1])), tuple(int(n) for n in z.shape), jump, step, bool(large),
-                         bool(periodic), source, unit, detrend, int(filled), fill)
+                         bool(periodic), source, unit, detrend, int(filled), fill, length_unit)
     z.flags.writeable = False
     return RoughSurface(z, stats.size, stats)
 

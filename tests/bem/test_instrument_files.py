@@ -39,7 +39,7 @@ def test_a_file_comes_back_in_metres_by_the_unit_it_states(tmp_path, name, unit,
     assert raw_unit == unit and raw_size == pytest.approx(size, rel=1e-7)  # the file, as its README says
     s = rough.read_surface(path, detrend=None, fill="harmonic")
     m = METRES[unit]
-    assert s.stats.unit == unit
+    assert (s.stats.unit, s.stats.length_unit) == (unit, "m")
     assert s.size == pytest.approx((size[0] * m, size[1] * m), rel=1e-7)
     measured = ~np.ma.getmaskarray(raw)
     assert np.allclose(s.heights[measured], np.ma.getdata(raw)[measured] * m, rtol=1e-12, atol=0)

@@ -41,6 +41,7 @@ def test_the_unit_a_file_states_is_converted_to_the_scenes(tmp_path):
     mm = load_scene(_scene(tmp_path, gap, units="mm, MPa, N", E_star=115.4e3, mean_pressure=2.0)).gap.surface
     assert mm.size == pytest.approx(SUR_SIZE_MM, rel=1e-7)
     assert mm.stats.rms_height == pytest.approx(si.stats.rms_height * 1e3, rel=1e-9)
+    assert (si.stats.length_unit, mm.stats.length_unit) == ("m", "mm")
     with pytest.raises(SceneError, match=r"gap.length_unit = 'um' is not allowed: .* states its lengths in mm"):
         load_scene(_scene(tmp_path, dict(gap, length_unit="um")))
 

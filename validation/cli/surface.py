@@ -42,12 +42,12 @@ OPTION_NAMES = {"file": "FILE", "unit": "--scale", "physical_sizes": "--size", "
                 "format": "--format", "channel": "--channel", "detrend": "--detrend"}
 
 
-def add_file_args(p, *, fill_default=None):
+def add_file_args(p):
     """The options of reading a surface file, shared with ``layer-law``."""
     p.add_argument("--scale", type=float, metavar="M",
                    help="metres per length unit of a file that states none (a file's own unit is always used)")
     p.add_argument("--size", metavar="LX,LY", help="size of a file that does not state it, in its length unit")
-    p.add_argument("--fill", choices=("harmonic",), default=fill_default,
+    p.add_argument("--fill", choices=("harmonic",),
                    help="fill missing points (at most 5 %% of them) by harmonic interpolation; default: refused")
 
 

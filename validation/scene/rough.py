@@ -130,8 +130,9 @@ def _read_surface(file, d, units, detrend, source):
     with ck.scene_errors("gap."):
         if isinstance(given, str) and scene is None:
             length_factor(d, units)  # the error: no scene length unit to convert to
-        surface = rough.read_surface(file, unit=given, length_unit=scene or 1.0, detrend=detrend, source=source,
-                                     names=names, unit_default=1.0, **kw)
+        named = units.length if scene is not None and units.length in LENGTH_UNITS else None
+        surface = rough.read_surface(file, unit=given, length_unit=named or scene or 1.0, detrend=detrend,
+                                     source=source, names=names, unit_default=1.0, **kw)
     if scene is None and surface.stats.unit is not None:
         raise ck.SceneError(f"gap.file = {source!r} is not allowed: it states its lengths in {surface.stats.unit} "
                             f"and the scene's units label {units.label!r} names no length unit (m, mm, um, nm) to "
