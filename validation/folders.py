@@ -41,7 +41,7 @@ log = logging.getLogger(__name__)
 #: The marker file of every folder contactlab writes: JSON ``{"kind": ..., "version": ...}``.
 MARKER = ".contactlab"
 #: The kinds of folder contactlab writes.
-KINDS = ("result", "report", "sweep", "layer-law", "study")
+KINDS = ("result", "report", "sweep", "layer-law", "study", "surface")
 #: The kinds of folder written in place (point by point) rather than replaced whole.
 IN_PLACE = ("sweep",)
 #: Longest file or folder name in bytes when the file system does not say (POSIX ``NAME_MAX``).

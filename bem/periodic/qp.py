@@ -237,7 +237,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             z -= m_one * (z.sum() / m_one.sum())
         gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
-        beta = 0.0 if k == 1 else max(0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
+        beta = 0.0 if k == 1 or gz_old == 0 else max(  # gz_old = 0: one contact node under force control
+            0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
         z_prev.fill(0.0)
         zf[idx] = z
         t_c = z + beta * np.take(tf, idx)

@@ -31,9 +31,22 @@ The ladder of mean pressures is solved in order, each solve started from the pre
 pressure field scaled by the ratio of the mean pressures. A step that does not converge stops
 the ladder with :class:`LadderNotConverged`: no table is made from it.
 
+**The start of the ladder.** Below its first pressure ``p_1`` the table is a straight line
+through ``(0, 0)``: the share ``w(p_1)/w(p_n)`` of the ladder's closure is interpolated, not
+solved. A surface whose few highest points close first (spikes, particles) can put most of its
+closure there. With ``max_interpolated = s`` the ladder is extended downwards, by the factor
+``max(p_2/p_1, 2)`` a step (at most :data:`MAX_EXTENSION` steps), until
+``w(p_1) <= s w(p_n)``; the law records the share reached, the rule and the pressures added.
+
+**Persson's theory beside it** (:mod:`bem.rough.persson`): the contact fraction and the mean
+gap of the same cell's spectrum, up to the lattice's wave number ``pi/c`` (``c`` the lattice
+step), at :data:`PERSSON_POINTS` pressures across the ladder, are recorded with the law.
+
 The table file (TOML) holds a ``[layer]`` table a scene's ``[layer]`` takes as it is
 (``law = "tabulated"``, ``p``, ``w``) and a ``[topography]`` table with the ladder's data,
-the surface statistics and the contactlab version; :func:`read_layer_law` reads it back.
+the surface statistics, what was done to the surface (``[topography.preparation]``), the
+start rule (``[topography.ladder_start]``), Persson's prediction (``[topography.persson]``) and
+the contactlab version; :func:`read_layer_law` reads it back.
 Timings: ``benchmarks/layer_from_topography.py``.
 """
 
@@ -41,19 +54,28 @@ from __future__ import annotations
 
 import importlib.metadata
 import tomllib
-from dataclasses import dataclass, fields
+import logging
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
 import tomli_w
 
-from ..checks import InputError, check_choice, check_finite_array, check_positive, check_rtol, fail
+from ..checks import InputError, check_choice, check_finite_array, check_positive, check_range, check_rtol, fail
 from ..files import write_text
 from ..layers import Tabulated
 from ..options import METHODS
 from .surface import RoughSurface, SurfaceStats
 
-__all__ = ["TopographyLaw", "LadderNotConverged", "layer_from_topography", "read_layer_law"]
+__all__ = ["TopographyLaw", "LadderNotConverged", "layer_from_topography", "read_layer_law", "MAX_EXTENSION",
+           "PERSSON_POINTS"]
+
+log = logging.getLogger(__name__)
+
+#: most pressures added below the ladder by ``max_interpolated``
+MAX_EXTENSION = 40
+#: pressures of Persson's prediction recorded with a law
+PERSSON_POINTS = 48
 
 
 class LadderNotConverged(RuntimeError):
@@ -96,6 +118,14 @@ class TopographyLaw:
         Of the surface the law comes from.
     version : str
         The contactlab version that made it.
+    preparation : dict
+        What was done to the surface (:meth:`bem.rough.PatchCell.record`), empty if not given.
+    ladder_start : dict
+        ``interpolated_share`` ``w(p_1)/w(p_n)`` [-], ``max_interpolated`` (the rule, absent
+        without one), ``added`` (pressures added below the ladder asked for).
+    persson : dict
+        Persson's prediction for the cell's spectrum (module docstring): ``mean_pressure``,
+        ``contact_fraction``, ``mean_gap`` (arrays), ``gamma``, ``rms_slope`` (of the spectrum).
     """
 
     law: Tabulated
@@ -110,6 +140,9 @@ class TopographyLaw:
     cell: dict
     stats: SurfaceStats
     version: str
+    preparation: dict = field(default_factory=dict)
+    ladder_start: dict = field(default_factory=dict)
+    persson: dict = field(default_factory=dict)
 
     def layer_table(self):
         """The scene's ``[layer]`` table: ``{"law": "tabulated", "p": [...], "w": [...]}``."""
@@ -121,9 +154,18 @@ class TopographyLaw:
                                                            "stiffness", "iterations")}
         data.update(first_touch_gap=self.first_touch_gap, E_star=self.E_star, version=self.version, **self.cell)
         data["surface"] = {k: v for k, v in self.stats.as_dict().items() if v is not None}  # TOML has no null
+        for name in ("preparation", "ladder_start", "persson"):
+            if getattr(self, name):
+                data[name] = {k: self._plain(v) if isinstance(v, np.ndarray) else v
+                              for k, v in getattr(self, name).items()}
         head = ("# contactlab layer law of a rough surface: w(p) = ubar(0+) - ubar(p), ubar the mean gap of the\n"
-                "# periodic cell under the mean pressure p; [layer] is a scene's [layer] table (docs/rough.md).\n\n")
-        return write_text(path, head + tomli_w.dumps({"layer": self.layer_table(), "topography": data}))
+                "# periodic cell under the mean pressure p; [layer] is a scene's [layer] table (docs/rough.md).\n")
+        if self.ladder_start:
+            rule = self.ladder_start.get("max_interpolated")
+            head += (f"# Below the first pressure p_1 = {self.mean_pressure[0]:.6g} the law is a straight line through\n"
+                     f"# (0, 0): {100 * self.ladder_start['interpolated_share']:.3g} % of the closure w(p_n)"
+                     + ("" if rule is None else f" (at most {100 * rule:g} %)") + ".\n")
+        return write_text(path, head + "\n" + tomli_w.dumps({"layer": self.layer_table(), "topography": data}))
 
     @staticmethod
     def _plain(a):
@@ -160,8 +202,37 @@ def _check_monotone(p, ubar, tol):
             "or space the pressures further apart.")
 
 
+def _solve(solve_periodic, h, pbar, guess, options, k):
+    """One step of the ladder (``k < 0``: the ``-k``-th pressure added below it), converged or raised."""
+    res = solve_periodic(h, mean_pressure=pbar, x0=guess, **options)
+    if not res.converged:
+        where = f"step {k} of the ladder" if k >= 0 else f"pressure {-k} added below the ladder"
+        raise LadderNotConverged(f"{where} (mean pressure {pbar!r}) did not converge: {res.message}; no layer law "
+                                 "is made from it", k, pbar, res)
+    return res
+
+
+def _share(ubar0, first, last):
+    """``w(p_1)/w(p_n)`` of two steps' results."""
+    top = ubar0 - last.mean_gap
+    return (ubar0 - first.mean_gap) / top if top > 0 else 0.0
+
+
+def _persson(surface, E_star, p, q_max):
+    """Persson's prediction for the cell's spectrum up to ``q_max`` across the ladder (module docstring)."""
+    from . import persson
+
+    full = persson.cell_spectrum(surface.heights, surface.size)
+    keep = full.q <= q_max
+    spectrum = persson.Spectrum(full.q[keep], full.weight[keep])
+    pressure = np.geomspace(p[0], p[-1], PERSSON_POINTS)
+    return dict(gamma=persson.GAMMA, rms_slope=spectrum.rms_slope, mean_pressure=pressure,
+                contact_fraction=persson.contact_fraction(pressure, E_star, spectrum),
+                mean_gap=persson.mean_gap(pressure, E_star, spectrum))
+
+
 def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton", rtol=1e-8, maxiter=None,
-                          progress=None):
+                          progress=None, max_interpolated=None, preparation=None):
     """The layer law ``w(pbar)`` of a rough surface pressed against a flat (module docstring).
 
     Parameters
@@ -182,7 +253,14 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
         The solver's iteration limit per step (its default if ``None``).
     progress : callable, optional
         Called after each step as ``progress(k, n, result)``, ``k = 1..n``, ``result`` the
-        step's :class:`bem.PeriodicContactResult`.
+        step's :class:`bem.PeriodicContactResult` (``n`` grows by the steps added below the ladder).
+    max_interpolated : float, optional
+        The largest share ``w(p_1)/w(p_n)`` of the closure left below the first pressure,
+        ``0 < s < 1``: the ladder is extended downwards until it holds (module docstring; a
+        warning is logged when :data:`MAX_EXTENSION` steps do not reach it). ``None``: the
+        ladder as given (its share is recorded all the same).
+    preparation : dict, optional
+        What was done to the surface (:meth:`bem.rough.PatchCell.record`), recorded with the law.
 
     Returns
     -------
@@ -205,21 +283,35 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
     rtol = check_rtol("rtol", rtol)
     if progress is not None and not callable(progress):
         fail("progress", progress, "callable or None")
+    if max_interpolated is not None:
+        max_interpolated = check_range("max_interpolated", max_interpolated, 0.0, 1.0, low_open=True, high_open=True)
+    if preparation is not None and not isinstance(preparation, dict):
+        fail("preparation", type(preparation).__name__, "a dict or None")
     lattice = surface.to_lattice(n_cols)
     h = lattice.gap()
     ubar0 = float(h.mean())
-    mean_gap, fraction, iterations = np.empty(p.size), np.empty(p.size), np.empty(p.size, dtype=int)
-    guess = None
+    options = dict(step=lattice.step, E_star=E_star, method=method, rtol=rtol,
+                   **({} if maxiter is None else {"maxiter": maxiter}))
+    ladder, guess = [], None  # (pressure, result)
     for k, pbar in enumerate(p):
-        res = solve_periodic(h, step=lattice.step, E_star=E_star, mean_pressure=float(pbar), method=method, rtol=rtol,
-                             x0=guess, **({} if maxiter is None else {"maxiter": maxiter}))
-        if not res.converged:
-            raise LadderNotConverged(f"step {k} of the ladder (mean pressure {pbar!r}) did not converge: "
-                                     f"{res.message}; no layer law is made from it", k, float(pbar), res)
-        mean_gap[k], fraction[k], iterations[k] = res.mean_gap, res.contact_fraction, res.iterations
-        guess = res.p.reshape(h.shape) * (p[k + 1] / pbar) if k + 1 < p.size else None
+        ladder.append((float(pbar), _solve(solve_periodic, h, float(pbar), guess, options, k)))
+        guess = ladder[-1][1].p.reshape(h.shape) * (p[k + 1] / pbar) if k + 1 < p.size else None
         if progress is not None:
-            progress(k + 1, p.size, res)
+            progress(k + 1, p.size, ladder[-1][1])
+    factor, added, lowest = max(float(p[1] / p[0]), 2.0), [], ladder[0]  # added: below the ladder, highest first
+    while (max_interpolated is not None and len(added) < MAX_EXTENSION
+           and _share(ubar0, lowest[1], ladder[-1][1]) > max_interpolated):
+        pbar = lowest[0] / factor
+        lowest = (pbar, _solve(solve_periodic, h, pbar, lowest[1].p.reshape(h.shape) / factor, options,
+                               -len(added) - 1))
+        added.append(lowest)
+        if progress is not None:
+            progress(p.size + len(added), p.size + len(added), lowest[1])
+    steps = added[::-1] + ladder
+    p = np.array([pk for pk, _ in steps])
+    mean_gap = np.array([res.mean_gap for _, res in steps], dtype=float)
+    fraction = np.array([res.contact_fraction for _, res in steps], dtype=float)
+    iterations = np.array([res.iterations for _, res in steps], dtype=int)
     _check_monotone(p, mean_gap, rtol * ubar0)
     full = fraction == 1.0  # every node touches: the mean gap is closed, whatever the rounding says
     closure = np.where(full, ubar0, np.maximum.accumulate(ubar0 - mean_gap))  # levels rises within the tolerance
@@ -229,8 +321,20 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
     np.divide(1.0, slope, out=stiffness, where=(slope > 0) & ~flat)
     cell = dict(n_cols=lattice.n_cols, n_rows=lattice.n_rows, step=lattice.step, stretch_y=lattice.stretch_y,
                 method=method, rtol=rtol)
+    start = dict(interpolated_share=float(closure[0] / closure[-1]) if closure[-1] > 0 else 0.0, added=len(added))
+    if max_interpolated is not None:
+        start["max_interpolated"] = max_interpolated
+        if start["interpolated_share"] > max_interpolated:
+            log.warning("%s: %.3g of the closure lies below the first pressure %.4g after %d pressures added below "
+                        "the ladder (max_interpolated = %g): the law is a straight line there", surface.stats.source,
+                        start["interpolated_share"], p[0], len(added), max_interpolated)
     return TopographyLaw(Tabulated(p, closure), p, closure, mean_gap, ubar0, fraction, stiffness, iterations, E_star,
-                         cell, surface.stats, _version())
+                         cell, surface.stats, _version(), dict(preparation or {}), start,
+                         _persson(surface, E_star, p, np.pi / lattice.step))
+
+
+def _arrays(table):
+    return {k: np.array(v, dtype=float) if isinstance(v, list) else v for k, v in table.items()}
 
 
 def read_layer_law(path):
@@ -264,6 +368,7 @@ def read_layer_law(path):
         return TopographyLaw(Tabulated(layer["p"], layer["w"]), arrays["mean_pressure"], arrays["closure"],
                              arrays["mean_gap"], float(topo["first_touch_gap"]), arrays["contact_fraction"],
                              arrays["stiffness"], np.array(topo["iterations"], dtype=int), float(topo["E_star"]),
-                             cell, stats, str(topo["version"]))
+                             cell, stats, str(topo["version"]), dict(topo.get("preparation", {})),
+                             dict(topo.get("ladder_start", {})), _arrays(topo.get("persson", {})))
     except (KeyError, TypeError) as exc:
         raise InputError(f"path = {str(path)!r} is not allowed: its [topography] table lacks {exc}.") from None

@@ -45,7 +45,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..checks import (InputError, check_choice, check_finite_array, check_int, check_node_count, check_positive,
+from ..checks import (InputError, check_choice, check_finite_array, check_int, check_node_count,
                       check_range, check_scale, fail)
 from .lattice_heights import to_lattice
 
@@ -105,9 +105,17 @@ class SurfaceStats:
     source : str
         The file, or how the surface was made.
     unit : str or None
-        The length unit the file states (before ``scale``), if any.
+        The length unit the file states (or the one given for a file that states none); the
+        lengths here are converted from it (:func:`bem.rough.read_surface`).
     detrend : str or None
         The ``detrend`` mode applied (:data:`DETRENDS`), ``None`` for none.
+    filled : int
+        Missing points of the file filled by interpolation (:func:`bem.rough.read_surface`).
+    fill : str or None
+        How they were filled (``"harmonic"``), ``None`` when none were.
+    length_unit : str or None
+        The unit of the lengths here (``"m"`` from :func:`bem.rough.read_surface` by default);
+        ``None`` where it is not known (arrays, synthetic surfaces: the caller's unit).
     """
 
     rms_height: float
@@ -122,6 +130,14 @@ class SurfaceStats:
     source: str
     unit: str | None = None
     detrend: str | None = None
+    filled: int = 0
+    fill: str | None = None
+    length_unit: str | None = None
+
+    @property
+    def pixel(self):
+        """The data's grid spacing ``(dx, dy) = (Lx/nx, Ly/ny)`` [length]."""
+        return self.size[0] / self.grid[0], self.size[1] / self.grid[1]
 
     def as_dict(self):
         """The fields as plain JSON values (tuples as lists)."""
@@ -158,9 +174,19 @@ class RoughSurface:
         ok = ~(np.ma.getmaskarray(q) | np.ma.getmaskarray(c)) & np.isfinite(np.ma.filled(c, np.nan))
         return np.ma.getdata(q)[ok], np.ma.getdata(c)[ok]
 
-    def to_lattice(self, n_cols):
-        """The heights on the periodic triangular lattice, :func:`bem.rough.to_lattice`."""
-        return to_lattice(self.heights, self.size, n_cols)
+    def to_lattice(self, n_cols=None):
+        """The heights on the periodic triangular lattice, :func:`bem.rough.to_lattice`
+        (``n_cols`` default: :meth:`default_n_cols`)."""
+        return to_lattice(self.heights, self.size, self.default_n_cols() if n_cols is None else n_cols)
+
+    def default_n_cols(self):
+        """Lattice nodes along x whose step is the data's coarser spacing, ``Lx / max(dx, dy)``.
+
+        On square pixels that is ``nx``; on pixels longer along y the lattice does not
+        oversample the data along y (its rows are ``sqrt(3)/2`` steps apart, the spacing of
+        a square-pixel grid's rows times 0.87), which a step of ``dx`` would by ``dy/dx``.
+        """
+        return max(MIN_POINTS, int(round(self.size[0] / max(self.stats.pixel))))
 
 
 def _pair(name, value):
@@ -178,7 +204,7 @@ def _edge_jump(z):
     return float(np.sqrt(np.mean(jumps**2))), float(np.sqrt(steps))
 
 
-def _surface(z, size, *, periodic, source, unit=None, detrend=None):
+def _surface(z, size, *, periodic, source, unit=None, detrend=None, filled=0, fill=None, length_unit=None):
     """A :class:`RoughSurface` of the finite grid ``z`` (owned), statistics by SurfaceTopography."""
     st = _surface_topography()
     topo = st.Topography(z, size, periodic=periodic)
@@ -192,7 +218,7 @@ def _surface(z, size, *, periodic, source, unit=None, detrend=None):
                     step, excess / rms_height, rms_height, EDGE_JUMP_LIMIT)
     stats = SurfaceStats(rms_height, float(topo.rms_gradient()), float(topo.rms_curvature_from_area()),
                          (float(size[0]), float(size[1])), tuple(int(n) for n in z.shape), jump, step, bool(large),
-                         bool(periodic), source, unit, detrend)
+                         bool(periodic), source, unit, detrend, int(filled), fill, length_unit)
     z.flags.writeable = False
     return RoughSurface(z, stats.size, stats)
 

@@ -257,3 +257,75 @@ def test_full_contact_closes_the_whole_mean_gap_and_turns_the_interface_rigid(tm
     assert np.isinf(law.law.inverse(1.01 * DELTA))  # rigid beyond the table
     back = rough.read_layer_law(law.save(tmp_path / "flat.toml"))
     assert np.array_equal(back.stiffness, law.stiffness)
+
+
+# -- Persson's theory beside the law -------------------------------------------------------------
+
+def test_persson_prediction_recorded_with_the_law_is_that_of_the_cells_spectrum(coarse_law, self_affine_surface):
+    """At 1 % .. 5 % contact the law's A/A0 stands about kappa/sqrt(8/pi) above Persson's (kappa = 2.47 at 4
+    nodes per cut-off wavelength, above): measured 1.50 .. 1.76 (a spectrum off by 2 or 2 pi would put it
+    outside 1.3 .. 2); the two mean gaps meet within 0.5 h_rms at the top."""
+    law, slope = coarse_law
+    theory = law.persson
+    assert theory["rms_slope"] == pytest.approx(slope, rel=1e-9)  # the whole spectrum is within the lattice's band
+    np.testing.assert_allclose(theory["mean_pressure"][[0, -1]], law.mean_pressure[[0, -1]], rtol=1e-12)
+    small = (law.contact_fraction >= 0.01) & (law.contact_fraction <= 0.05)
+    persson_area = np.exp(np.interp(np.log(law.mean_pressure[small]), np.log(theory["mean_pressure"]),
+                                    np.log(theory["contact_fraction"])))
+    ratio = law.contact_fraction[small] / persson_area
+    assert 1.3 < ratio.min() and ratio.max() < 2.0
+    gap_top = np.interp(law.mean_pressure[-1], theory["mean_pressure"], theory["mean_gap"])
+    assert abs(gap_top - law.mean_gap[-1]) < 0.5 * self_affine_surface.stats.rms_height
+
+
+# -- the start of the ladder ---------------------------------------------------------------------
+
+def _spiked():
+    """A periodic self-affine cell with one node planted 12 rms heights above its mean."""
+    base = rough.self_affine((64, 64), (1.0, 1.0), hurst=0.8, rms_height=0.05, long_cutoff=0.25, short_cutoff=1 / 8,
+                             seed=2)
+    z = np.array(base.heights)
+    z[20, 40] = z.mean() + 12 * z.std()
+    return rough.from_heights(z, base.size, periodic=True, source="spiked")
+
+
+@pytest.fixture(scope="module")
+def spiked_laws():
+    surface = _spiked()
+    p = np.geomspace(3e-3, 0.3, 6) * E_STAR * surface.stats.rms_slope
+    plain = rough.layer_from_topography(surface, E_STAR, pressures=p, n_cols=64)
+    ruled = rough.layer_from_topography(surface, E_STAR, pressures=p, n_cols=64, max_interpolated=0.01)
+    return p, plain, ruled
+
+
+def test_the_ladder_is_extended_until_at_most_the_stated_share_lies_below_its_first_pressure(spiked_laws):
+    p, plain, ruled = spiked_laws
+    assert plain.ladder_start["interpolated_share"] > 0.05  # the spike closes below the ladder asked for
+    assert plain.ladder_start == {"interpolated_share": plain.closure[0] / plain.closure[-1], "added": 0}
+    start = ruled.ladder_start
+    assert start["interpolated_share"] <= 0.01 == start["max_interpolated"]
+    assert start["interpolated_share"] == ruled.closure[0] / ruled.closure[-1]
+    added = start["added"]
+    assert added > 0 and np.array_equal(ruled.mean_pressure[added:], p)  # the ladder asked for, unchanged
+    factor = max(p[1] / p[0], 2.0)  # the ladder's own ratio, at least 2
+    np.testing.assert_allclose(ruled.mean_pressure[1:added + 1] / ruled.mean_pressure[:added], factor, rtol=1e-12)
+    share_before = ruled.closure[1] / ruled.closure[-1]  # one pressure fewer would not have been enough
+    assert share_before > 0.01
+    np.testing.assert_allclose(ruled.closure[added:], plain.closure, rtol=1e-6)
+
+
+def test_the_law_file_states_the_share_below_the_first_pressure(spiked_laws, tmp_path):
+    _, _, ruled = spiked_laws
+    path = ruled.save(tmp_path / "law.toml")
+    text = path.read_text()
+    share = 100 * ruled.ladder_start["interpolated_share"]
+    assert f"the law is a straight line through\n# (0, 0): {share:.3g} % of the closure w(p_n) (at most 1 %)" in text
+    back = rough.read_layer_law(path)
+    assert back.ladder_start == ruled.ladder_start
+    for key in ("mean_pressure", "contact_fraction", "mean_gap"):
+        np.testing.assert_array_equal(back.persson[key], ruled.persson[key])
+
+
+def test_max_interpolated_is_checked_by_name():
+    with pytest.raises(bem.InputError, match="max_interpolated = 1.0 is not allowed"):
+        rough.layer_from_topography(_sinusoid(32), E_STAR, pressures=[0.1, 0.2], n_cols=32, max_interpolated=1.0)

@@ -178,11 +178,12 @@ def test_npy_text_and_x3p_files_are_read_in_their_own_layouts(tmp_path):
 
     z, size = _periodic_map()
     np.save(tmp_path / "map.npy", z)  # SurfaceTopography's npy layout: z[ix, iy]
-    SurfaceTopography.Topography(z, size).to_matrix(str(tmp_path / "map.txt"))  # rows along y, size in header
-    SurfaceTopography.Topography(z, size).to_x3p(str(tmp_path / "map.x3p"))
-    scale = 1e-6
-    for name, kw in (("map.npy", {"physical_sizes": size}), ("map.txt", {}), ("map.x3p", {})):
-        s = rough.read_surface(tmp_path / name, detrend=None, scale=scale, **kw)
+    in_um = SurfaceTopography.Topography(z, size, unit="µm")
+    in_um.to_matrix(str(tmp_path / "map.txt"))  # rows along y, size and unit in the header
+    in_um.to_x3p(str(tmp_path / "map.x3p"))  # in metres, always
+    scale = 1e-6  # metres per um: every file comes back in metres
+    for name, kw in (("map.npy", {"physical_sizes": size, "unit": "um"}), ("map.txt", {}), ("map.x3p", {})):
+        s = rough.read_surface(tmp_path / name, detrend=None, **kw)
         assert np.allclose(s.heights, z * scale, rtol=0, atol=1e-12 * scale), name
         assert s.size == pytest.approx((size[0] * scale, size[1] * scale), rel=1e-12)
         assert s.stats.grid == z.shape and s.stats.source == str(tmp_path / name)
@@ -199,8 +200,8 @@ def test_detrending_removes_the_plane_of_least_rms_height(tmp_path):
     x = np.arange(z.shape[0])[:, None] / z.shape[0]
     y = np.arange(z.shape[1])[None, :] / z.shape[1]
     np.save(tmp_path / "tilted.npy", z + 3.0 + 0.8 * x - 0.4 * y)
-    kept = rough.read_surface(tmp_path / "tilted.npy", physical_sizes=size, detrend=None)
-    flat = rough.read_surface(tmp_path / "tilted.npy", physical_sizes=size)
+    kept = rough.read_surface(tmp_path / "tilted.npy", physical_sizes=size, unit="m", detrend=None)
+    flat = rough.read_surface(tmp_path / "tilted.npy", physical_sizes=size, unit="m")
     plane = kept.heights - flat.heights
     fit = np.linalg.lstsq(np.column_stack([np.ones(z.size), np.broadcast_to(x, z.shape).ravel(),
                                            np.broadcast_to(y, z.shape).ravel()]), kept.heights.ravel(), rcond=None)[0]
@@ -216,7 +217,7 @@ def test_edge_jump_of_a_patch_is_reported_and_warned(tmp_path, caplog):
     patch = np.cos(np.pi * x) + 0.0 * np.arange(32)[None, :]  # a half wave: opposite x-edges differ by ~2
     np.save(tmp_path / "patch.npy", patch)
     with caplog.at_level(logging.WARNING):
-        s = rough.read_surface(tmp_path / "patch.npy", physical_sizes=size, detrend="center")
+        s = rough.read_surface(tmp_path / "patch.npy", physical_sizes=size, unit="m", detrend="center")
     jumps = np.concatenate([s.heights[0, :] - s.heights[-1, :], s.heights[:, 0] - s.heights[:, -1]])
     assert s.stats.edge_jump == pytest.approx(np.sqrt(np.mean(jumps**2)), rel=1e-12)
     # neighbours differ along x only: the mean over both directions (weights ny, nx) is half that along x
@@ -241,23 +242,28 @@ def test_a_periodic_self_affine_surface_has_no_seam(hurst, caplog):
 
 @needs_extra
 @pytest.mark.parametrize("make, kwargs, blamed, rule", [
-    (lambda p: p.write_bytes(b"\x00\x01hello secret\xff" * 40), {}, "file", "cannot read"),
+    (lambda p: p.write_bytes(b"\x00\x01hello secret\xff" * 40), {}, "file", "not a readable .npy file"),
+    (lambda p: p.with_suffix(".x3p").write_bytes(b"\x00\x01hello secret\xff" * 400), {}, "file",
+     "not a readable x3p file"),
+    (lambda p: p.with_suffix(".bin").write_bytes(b"\x00\x01hello secret\xff" * 40), {}, "file", "cannot read"),
     (lambda p: np.save(p, np.ones((16, 16))), {"format": "foo"}, "format", "one of"),
-    (lambda p: np.save(p, np.where(np.eye(16) > 0, np.nan, 1.0)), {"physical_sizes": (1, 1)}, "file",
+    (lambda p: np.save(p, np.where(np.eye(16) > 0, np.nan, 1.0)), {"physical_sizes": (1, 1), "unit": "m"}, "file",
      "16 points without data"),
-    (lambda p: np.savetxt(p, np.c_[np.cumsum(np.linspace(0.5, 1.5, 40)), np.zeros(40)]), {}, "file",
-     "not on an evenly spaced grid"),
-    (lambda p: np.save(p, np.ones((6, 16))), {"physical_sizes": (1, 1)}, "file", "too small"),
-    (lambda p: np.save(p, np.ones((16, 16))), {}, "physical_sizes is missing", "give (Lx, Ly)"),
+    (lambda p: np.savetxt(p.with_suffix(".txt"), np.c_[np.cumsum(np.linspace(0.5, 1.5, 40)), np.zeros(40)]), {},
+     "file", "not on an evenly spaced grid"),
+    (lambda p: np.save(p, np.ones((6, 16))), {"physical_sizes": (1, 1), "unit": "m"}, "file", "too small"),
+    (lambda p: np.save(p, np.ones((16, 16))), {"unit": "m"}, "physical_sizes is missing", "give (Lx, Ly)"),
     (lambda p: None, {}, "file", "an existing file"),
     (lambda p: np.save(p, np.ones((16, 16))), {"physical_sizes": (1, 1), "detrend": "plane"}, "detrend", "one of"),
-    (lambda p: np.save(p, np.ones((16, 16))), {"physical_sizes": (1, 1), "scale": 0}, "scale", "> 0"),
+    (lambda p: np.save(p, np.ones((16, 16))), {"physical_sizes": (1, 1), "unit": 0}, "unit", "> 0"),
+    (lambda p: np.save(p, np.ones((16, 16))), {"physical_sizes": (1, 1)}, "unit is missing", "states no length unit"),
 ])
 def test_bad_files_stop_with_a_message_naming_the_argument(tmp_path, make, kwargs, blamed, rule, caplog, capsys):
-    path = tmp_path / "bad.npy"  # np.save would add .npy to another name; the readers look at the contents
+    path = tmp_path / "bad.npy"  # np.save would add .npy to another name
     make(path)
+    written = [p for p in tmp_path.iterdir()]
     with caplog.at_level(logging.DEBUG), pytest.raises(bem.InputError) as err:
-        rough.read_surface(path, **kwargs)
+        rough.read_surface(written[0] if written else path, **kwargs)
     message = str(err.value)
     assert message.startswith(blamed) and rule in message, message
     for said in (message, caplog.text, *capsys.readouterr()):

@@ -3,6 +3,7 @@ three figures showing the ladder's data with units); bad input stops with exit c
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,7 +28,7 @@ SYNTHETIC = "hurst=0.8,rms_height=0.5e-6,size=1e-4,grid=64,long_cutoff=25e-6,sho
 def surface_file(tmp_path_factory):
     """A periodic self-affine cell saved as heights in um (a .npy states no unit)."""
     surface = synthetic_surface(hurst=0.8, size=1e-4, grid=64, rms_height=0.5e-6, long_cutoff=25e-6,
-                                short_cutoff=12.5e-6, seed=3)
+                                short_cutoff=12.5e-6, seed=3).surface
     path = tmp_path_factory.mktemp("surface") / "heights.npy"
     np.save(path, np.asarray(surface.heights) * 1e6)
     return path
@@ -55,8 +56,12 @@ def test_a_surface_file_becomes_a_law_folder_a_scene_loads(surface_file, tmp_pat
     folder = tmp_path / "law"
     assert json.loads((folder / MARKER).read_text())["kind"] == "layer-law"
     assert sorted(p.name for p in folder.iterdir()) == sorted([MARKER, "layer_law.toml", "closure.png",
-                                                               "contact_fraction.png", "stiffness.png"])
-    assert "8 mean pressures" in out and "layer_law.toml" in out
+                                                               "contact_fraction.png", "stiffness.png", "persson.png"])
+    import tomllib
+
+    start = tomllib.loads((folder / "layer_law.toml").read_text())["topography"]["ladder_start"]
+    assert f"{8 + start['added']} mean pressures" in out and "layer_law.toml" in out
+    assert start["interpolated_share"] <= start["max_interpolated"] == 0.01  # the default rule
     scene = {"scene": {"name": "rough"}, "bodies": {"E_star": E_STAR}, "gap": {"type": "paraboloid", "R": 0.01},
              "layer": {"law": "tabulated", "file": "layer_law.toml"}, "load": {"force": 50.0},
              "bem": {"nodes_across": 16}}
@@ -173,9 +178,12 @@ def test_n_pressures_and_the_output_folder_are_checked_before_solving(tmp_path):
 
 
 def test_the_progress_hook_sees_every_step_of_the_ladder(folder):
-    _, calls = folder
-    """The library's one progress protocol, progress(label, done, total): one call after each step."""
-    assert [c[1:] for c in calls] == [(k, 8) for k in range(1, 9)]
+    out, calls = folder
+    """The library's one progress protocol, progress(label, done, total): one call after each step, the total
+    growing by the pressures added below the ladder."""
+    added = out.law.ladder_start["added"]
+    assert added > 0 and out.law.mean_pressure.size == 8 + added
+    assert [c[1:] for c in calls] == [(k, 8) for k in range(1, 9)] + [(k, k) for k in range(9, 9 + added)]
     assert all(label.startswith("A/A0 ") and label.endswith(" iterations") for label, _, _ in calls)
 
 
@@ -210,7 +218,9 @@ def test_the_contact_fraction_figure_is_against_the_pressure_over_e_star_times_r
     x = np.asarray(data.get_xdata(), float)
     np.testing.assert_allclose(x * E_STAR * law.stats.rms_slope, law.mean_pressure, rtol=1e-12)
     np.testing.assert_allclose(data.get_ydata(), law.contact_fraction, rtol=1e-12)
-    assert x[0] == pytest.approx(3e-3, rel=1e-12) and x[-1] == pytest.approx(0.3, rel=1e-12)  # the default ladder
+    added = law.ladder_start["added"]  # the default ladder, and the pressures added below it, halving
+    assert x[added] == pytest.approx(3e-3, rel=1e-12) and x[-1] == pytest.approx(0.3, rel=1e-12)
+    np.testing.assert_allclose(x[1:added + 1] / x[:added], 2.0, rtol=1e-12)
 
 
 def test_the_stiffness_figure_draws_the_finite_stiffness_in_pa_per_m(folder):
@@ -223,3 +233,61 @@ def test_the_stiffness_figure_draws_the_finite_stiffness_in_pa_per_m(folder):
     assert finite.all() and math.isfinite(float(np.max(data.get_ydata())))
     np.testing.assert_allclose(data.get_ydata(), law.stiffness, rtol=1e-12)
     np.testing.assert_allclose(np.asarray(data.get_xdata(), float) * 1e9, law.mean_pressure, rtol=1e-12)
+
+
+SPOT = Path(__file__).resolve().parents[1] / "data" / "surfaces" / "spot_1-1000nm.ibw"
+
+
+@pytest.mark.parametrize("cell, seam_warnings", [("repeat", 1), ("mirror", 0)])
+def test_a_measured_file_warns_once_about_spikes_and_seam_and_the_law_file_says_what_was_done(tmp_path, cell,
+                                                                                            seam_warnings):
+    """SurfaceTopography's AFM scan spot_1-1000nm.ibw: spikes up to 22 rms heights above the mean."""
+    import tomllib
+
+    code, out, err = cli("layer-law", SPOT, "--E-star", E_STAR, "--n-pressures", 4, "--n-cols", 32, "--spikes",
+                         "remove", "--cell", cell, "--no-figures", "--out", tmp_path / "law")
+    assert code == 0, err
+    spikes = [line for line in err.splitlines() if "spikes beyond" in line]
+    seams = [line for line in err.splitlines() if "edge jump" in line]
+    assert len(spikes) == 1 and "1422 of 65536 points" in spikes[0] and " m of the median" in spikes[0]
+    assert len(seams) == seam_warnings and all("e-09 against a grid step" in line for line in seams)  # in m
+    topo = tomllib.loads((tmp_path / "law" / "layer_law.toml").read_text())["topography"]
+    prep = topo["preparation"]
+    assert (prep["detrend"], prep["cell"], prep["spikes_removed"], prep["spike_points"]) == ("height", cell, True,
+                                                                                            1422)
+    assert prep["spikes"]["top"] == pytest.approx(21.8, abs=0.1) and prep["edge_jump_large"] == (cell == "repeat")
+    assert topo["surface"]["grid"] == ([512, 512] if cell == "mirror" else [256, 256])
+    assert topo["ladder_start"]["interpolated_share"] <= 0.01
+    assert "cell       detrend height, " + cell in out
+
+
+@pytest.mark.parametrize("args, match", [
+    (("--synthetic", SYNTHETIC, "--max-interpolated", "2"), "--max-interpolated = '2' is not allowed"),
+    (("--synthetic", SYNTHETIC, "--cell", "mirror"), "--cell = 'mirror' is not allowed with --synthetic"),
+    (("--synthetic", SYNTHETIC, "--spike-threshold", "-3"), "--spike-threshold = -3.0 is not allowed"),
+])
+def test_bad_cell_options_exit_2_with_one_line(tmp_path, args, match):
+    code, _, err = _run(tmp_path, *args)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and match in err
+
+
+def test_the_persson_figure_draws_the_ladder_beside_the_theory_of_its_spectrum(folder):
+    out, _ = folder
+    law = out.law
+    area, gap = out.figures["persson.png"].axes
+    assert (area.get_xscale(), area.get_yscale(), gap.get_xscale(), gap.get_yscale()) == ("log", "log", "log",
+                                                                                          "linear")
+    assert "A/A_0" in area.get_ylabel() and "h_\\mathrm{rms}" in gap.get_ylabel()
+    for ax, ladder, theory in ((area, law.contact_fraction, law.persson["contact_fraction"]),
+                               (gap, law.mean_gap / law.stats.rms_height,
+                                np.asarray(law.persson["mean_gap"]) / law.stats.rms_height)):
+        assert ax.get_xlabel() == "mean pressure $p$ [GPa]"
+        (persson,) = [ln for ln in ax.get_lines() if ln.get_linestyle() == "--"]
+        assert persson.get_label().startswith("Persson (2001, 2007)")
+        np.testing.assert_allclose(np.asarray(persson.get_xdata()) * 1e9, law.persson["mean_pressure"], rtol=1e-12)
+        np.testing.assert_allclose(persson.get_ydata(), theory, rtol=1e-12)
+        (points,) = [ln for ln in ax.get_lines() if ln.get_marker() == "o"]
+        np.testing.assert_allclose(np.asarray(points.get_xdata()) * 1e9, law.mean_pressure, rtol=1e-12)
+        np.testing.assert_allclose(points.get_ydata(), ladder, rtol=1e-12)
+        (added,) = [ln for ln in ax.get_lines() if ln.get_marker() == "s"]
+        assert len(added.get_xdata()) == law.ladder_start["added"]

@@ -25,7 +25,7 @@ __all__ = ["main", "build_parser"]
 #: the subcommands and their modules, in the order ``--help`` lists them; the modules (and the
 #: packages they load) are imported by :func:`build_parser`, inside :func:`main`'s signal handling
 COMMANDS = {"run": "run", "scenes": "scenes", "check": "check", "sweep": "sweep", "study": "study",
-            "report": "report", "layer-law": "layer_law"}
+            "report": "report", "layer-law": "layer_law", "surface": "surface"}
 
 DESCRIPTION = """\
 contactlab: frictionless normal contact of two elastic bodies with a nonlinear interface
@@ -68,6 +68,7 @@ examples:
   contactlab report paper --quick                    the paper's test problem, a quick preview
   contactlab layer-law patch.x3p --E-star 115e9 --out laws/patch
                                                      a rough surface's layer law file and figures
+  contactlab surface patch.x3p --out surfaces/patch  statistics, spikes, PSD and height map of a file
 
 result directory (run): result.json (p_max, force, approach, contact_area, contact_radius,
 iterations, converged, kkt_residual, wall_time_s, comparison metrics...), scene.toml (the

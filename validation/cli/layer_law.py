@@ -7,7 +7,10 @@ import sys
 from pathlib import Path
 
 from bem.checks import InputError, check_positive, check_rtol
+from bem.rough.patch import CELLS, DETREND_CHOICES, SPIKE_ACTIONS
+
 from .common import ProgressBar, option_names
+from .surface import OPTION_NAMES, add_file_args, pair, size_of
 
 PARSER = {
     "help": "the layer law w(p) of a rough surface: law file and figures",
@@ -18,7 +21,8 @@ PARSER = {
         "(the file beside the scene), and the figures closure.png (w(p), linear and log axes),\n"
         "contact_fraction.png (A/A0 against p/(E* h'_rms)) and stiffness.png (K = dp/dw).\n"
         "Units are SI: lengths in m, E* and pressures in Pa. A surface file's lengths are converted to m by\n"
-        "the unit it states, or by --scale. The ladder's last pressure must exceed the largest local\n"
+        "the unit it states (--scale and --size for a file that states neither unit nor size; --fill harmonic\n"
+        "fills missing points, at most 5 % of them). The ladder's last pressure must exceed the largest local\n"
         "pressure of the problems the law is used in: beyond it the law holds no data (a solve there warns).\n"
         "The law file needs the rough extra, the figures the report extra (or --no-figures).\n"
         "--out DIR must be new, empty or a layer-law folder contactlab wrote (marked by DIR/.contactlab)."),
@@ -39,8 +43,6 @@ SYNTHETIC = {"hurst": float, "rms_height": float, "rms_slope": float, "size": fl
              "long_cutoff": float, "short_cutoff": float, "rolloff": float, "seed": int}
 
 #: the library's arguments -> the options that set them, for the messages (:func:`.common.option_names`)
-_FILE_OPTIONS = {"file": "SURFACE", "scale": "--scale", "physical_sizes": "--size", "physical_sizes[0]": "--size LX",
-                 "physical_sizes[1]": "--size LY"}
 _LADDER_OPTIONS = {"n": "--n-pressures", "pressures": "--p-range", "pressures[0]": "--p-range LOW",
                    "pressures[1]": "--p-range HIGH", "relative": "--p-range-rel", "relative[0]": "--p-range-rel LOW",
                    "relative[1]": "--p-range-rel HIGH"}
@@ -63,24 +65,30 @@ def add_args(p):
     p.add_argument("--n-pressures", type=int, default=12, metavar="N",
                    help="mean pressures in the ladder, geometrically spaced (default 12)")
     p.add_argument("--n-cols", type=int, metavar="N",
-                   help="lattice nodes across the cell (default: the surface's grid points along x)")
+                   help="lattice nodes across the cell (default: Lx / max(dx, dy), the grid points along x of "
+                        "square pixels)")
     p.add_argument("--rtol", type=float, default=1e-8,
                    help="the solver's KKT tolerance, in (0, 1e-2] as for every solve (default 1e-8)")
-    p.add_argument("--scale", type=float, metavar="M",
-                   help="metres per length unit of SURFACE (default: from the unit the file states)")
-    p.add_argument("--size", metavar="LX,LY", help="size of a SURFACE that does not state it, in its length unit")
+    add_file_args(p)
     p.add_argument("--no-figures", action="store_true", help="write the law file only (no report extra needed)")
-
-
-def _pair(option, text, sep):
-    parts = str(text).split(sep)
-    try:
-        values = tuple(float(v) for v in parts)
-    except ValueError:
-        values = ()
-    if len(values) != 2:
-        raise InputError(f"{option} = {text!r} is not allowed: it must be two numbers separated by '{sep}'.")
-    return values
+    cell = p.add_argument_group("the periodic cell of a measured surface (bem.rough.patch_cell; recorded in the law file)")
+    cell.add_argument("--detrend", default="auto", choices=DETREND_CHOICES,
+                      help="auto (default): none for a periodic surface, height for a patch; none keeps the heights "
+                           "as they are; height: the plane of least rms height; curvature: the second-order "
+                           "polynomial (a measured form)")
+    cell.add_argument("--cell", default="repeat", choices=CELLS,
+                      help="repeat (default): the patch repeated, with a seam at its edges; mirror: the patch and "
+                           "its mirror images, a cell of 2 x 2 patches without a seam (four times the nodes)")
+    cell.add_argument("--spikes", default="keep", choices=SPIKE_ACTIONS,
+                      help="spikes are points beyond --spike-threshold robust standard deviations (1.4826 MAD) of "
+                           "the median, with their flanks; they are always reported; remove fills them by harmonic "
+                           "interpolation (default keep)")
+    cell.add_argument("--spike-threshold", type=float, metavar="K",
+                      help="robust standard deviations beyond which a point is a spike (default 10)")
+    p.add_argument("--max-interpolated", default="0.01", metavar="SHARE",
+                   help="the largest share of the closure w(p_n) left below the first pressure, where the law is a "
+                        "straight line through (0, 0): the ladder is extended downwards until it holds "
+                        "(default 0.01; none: the ladder as given)")
 
 
 def _synthetic(text):
@@ -134,10 +142,39 @@ def _summary(folder):
              f"closure    w = {w[0]:.4g} .. {w[-1]:.4g} m of the first-touch mean gap {law.first_touch_gap:.4g} m",
              f"contact    A/A0 = {law.contact_fraction[0]:.3g} .. {law.contact_fraction[-1]:.3g}",
              f"range      the law holds data up to p = {p[-1]:.4g} Pa; a solve beyond it warns",
+             f"start      {100 * law.ladder_start['interpolated_share']:.3g} % of the closure lies below p = {p[0]:.4g} "
+             f"Pa (a straight line to 0)" + (f", {law.ladder_start['added']} pressures added below the ladder"
+                                             if law.ladder_start.get("added") else ""),
              f"scene      [layer] law = \"tabulated\", file = \"{folder.law_file.name}\" (the file beside the scene)"]
+    prep = law.preparation
+    if prep:
+        spikes = prep["spikes"]
+        lines.insert(1, f"cell       detrend {prep['detrend']}, {prep['cell']}"
+                     + (", the seam is large (--cell mirror has none)" if prep["edge_jump_large"] else "")
+                     + f"; {prep['spike_points']} points in spikes beyond {spikes['threshold']:g} sigma_r"
+                     + (" filled" if prep["spikes_removed"] else (" kept" if prep["spike_points"] else "")))
     names = [folder.law_file.name, *folder.figures]
     lines.append(f"files      {folder.path}/ ({', '.join(names)})")
     return "\n".join(lines)
+
+
+def _share(text):
+    if str(text).strip().lower() == "none":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = None
+    if value is None or not 0 < value < 1:
+        raise InputError(f"--max-interpolated = {text!r} is not allowed: it must be a number between 0 and 1 "
+                         "(exclusive) or none.")
+    return value
+
+
+def _spike_threshold(value):
+    if value is not None and not value > 0:
+        raise InputError(f"--spike-threshold = {value!r} is not allowed: it must be > 0.")
+    return value
 
 
 def run(args):
@@ -151,31 +188,38 @@ def run(args):
         raise InputError("SURFACE is missing: give a surface file or --synthetic (one of them)." if args.surface is None
                          else f"SURFACE = {args.surface!r} is not allowed together with --synthetic: give one.")
     if args.synthetic is not None:
-        for option, value in (("--scale", args.scale), ("--size", args.size)):
+        for option, value in (("--scale", args.scale), ("--size", args.size), ("--fill", args.fill)):
             if value is not None:
                 raise InputError(f"{option} = {value!r} is not allowed with --synthetic: it is for a SURFACE file "
                                  "(a synthetic surface is in m).")
         with option_names({key: f"--synthetic {key}" for key in SYNTHETIC}):
             synthetic = _synthetic(args.synthetic)
             _check_size(args, synthetic=synthetic)
-            surface = synthetic_surface(**synthetic)
+            for option, value, default in (("--detrend", args.detrend, "auto"), ("--cell", args.cell, "repeat")):
+                if value != default:
+                    raise InputError(f"{option} = {value!r} is not allowed with --synthetic: a synthetic surface "
+                                     "is periodic, its own cell.")
+            surface = synthetic_surface(**synthetic, spikes=args.spikes,
+                                        spike_threshold=_spike_threshold(args.spike_threshold))
     else:
-        size = None if args.size is None else _pair("--size", args.size, ",")
-        with option_names(_FILE_OPTIONS):
-            surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size)
+        surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size_of(args), fill=args.fill,
+                                    names=dict(OPTION_NAMES, file="SURFACE"), detrend=args.detrend, cell=args.cell,
+                                    spikes=args.spikes, spike_threshold=_spike_threshold(args.spike_threshold))
         _check_size(args, surface=surface)
+    share = _share(args.max_interpolated)
     with option_names(_LADDER_OPTIONS):
         if args.p_range is not None:
-            pressures = ladder(surface, args.E_star, pressures=_pair("--p-range", args.p_range, ":"),
+            pressures = ladder(surface, args.E_star, pressures=pair("--p-range", args.p_range, ":"),
                                n=args.n_pressures)
         else:
-            pressures = ladder(surface, args.E_star, relative=_pair("--p-range-rel", args.p_range_rel, ":"),
+            pressures = ladder(surface, args.E_star, relative=pair("--p-range-rel", args.p_range_rel, ":"),
                                n=args.n_pressures)
     bar = ProgressBar("layer law", "pressure", args.no_progress or None)
     try:
         with option_names({"n_cols": "--n-cols"}):
             folder = make_layer_law(surface, args.out, E_star=args.E_star, pressures=pressures, n_cols=args.n_cols,
-                                    rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out")
+                                    rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out",
+                                    max_interpolated=share)
     except LadderNotConverged as exc:
         print(f"contactlab: error: {exc} (nothing was written)", file=sys.stderr)
         return 1

@@ -4,9 +4,10 @@ The folder (a ``"layer-law"`` folder, :mod:`validation.io`) holds
 
 - ``layer_law.toml``: the table file of :meth:`bem.rough.TopographyLaw.save`, whose ``[layer]``
   a scene names by ``[layer] law = "tabulated"``, ``file = "layer_law.toml"``;
-- ``closure.png``, ``contact_fraction.png``, ``stiffness.png``: the law ``w(p)`` on linear and
-  logarithmic axes, the contact fraction ``A/A0`` against ``p/(E* h'_rms)`` and the interfacial
-  stiffness ``K(p)`` (:mod:`validation.layer_law.figures`).
+- ``closure.png``, ``contact_fraction.png``, ``stiffness.png``, ``persson.png``: the law ``w(p)``
+  on linear and logarithmic axes, the contact fraction ``A/A0`` against ``p/(E* h'_rms)``, the
+  interfacial stiffness ``K(p)``, and ``A/A0`` and the mean gap beside Persson's theory for the
+  cell's spectrum (:mod:`validation.layer_law.figures`).
 
 Units are SI: a surface file's lengths are converted to metres by the unit the file states
 (or by ``scale``), ``E*`` and the pressures are in Pa. The ladder of mean pressures is
@@ -14,6 +15,12 @@ geometric, by default from ``3e-3`` to ``0.3`` times ``E* h'_rms`` (``h'_rms`` t
 rms slope, ``stats.rms_slope``): from a contact fraction of about 1 % to well into the
 exponential regime. Its last pressure must exceed the largest local pressure of the problems
 the law is used in: beyond it a tabulated law holds no data (:func:`bem.layers.beyond_table`).
+Below its first pressure the law is a straight line through ``(0, 0)``: the ladder is extended
+downwards until that holds at most :data:`MAX_INTERPOLATED` (1 %) of its closure.
+
+A measured surface becomes its periodic cell by :func:`bem.rough.patch_cell` (detrending,
+spikes, a repeated or mirrored cell); the law file records what was done
+(``[topography.preparation]``).
 """
 
 from __future__ import annotations
@@ -24,20 +31,21 @@ from pathlib import Path
 
 import numpy as np
 
-from bem.checks import InputError, check_int, check_positive, fail
+from bem.checks import check_int, check_positive, fail
 
 from ..io import atomic_directory, check_output_dir, output_errors, recover_output_dir
-from ..units import METRES
 
 __all__ = ["make_layer_law", "surface_from_file", "synthetic_surface", "ladder", "LayerLawFolder", "KIND",
-           "LAW_FILE", "FIGURE_NAMES", "NAMES", "DEFAULT_RANGE"]
+           "LAW_FILE", "FIGURE_NAMES", "NAMES", "DEFAULT_RANGE", "MAX_INTERPOLATED"]
 
 KIND = "layer-law"
 LAW_FILE = "layer_law.toml"
-FIGURE_NAMES = ("closure.png", "contact_fraction.png", "stiffness.png")
+FIGURE_NAMES = ("closure.png", "contact_fraction.png", "stiffness.png", "persson.png")
 NAMES = (LAW_FILE, *FIGURE_NAMES)
 #: the default ladder's first and last mean pressure, in units of ``E* h'_rms``
 DEFAULT_RANGE = (3e-3, 0.3)
+#: the largest share of the closure a law leaves below its first pressure (:func:`make_layer_law`)
+MAX_INTERPOLATED = 0.01
 
 
 @dataclass(frozen=True)
@@ -62,65 +70,75 @@ class LayerLawFolder:
     figures: dict = field(default_factory=dict)
 
 
-def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="height"):
-    """A measured surface in metres (:func:`bem.rough.read_surface`).
+def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="auto", cell="repeat", spikes="keep",
+                      spike_threshold=None, fill=None, names=None):
+    """The periodic cell of a measured surface in metres (:func:`bem.rough.read_surface`,
+    :func:`bem.rough.patch_cell`).
 
     Parameters
     ----------
     file : path-like
         An instrument or data file SurfaceTopography reads (``bem.rough.formats()``).
     scale : float, optional
-        Metres per length unit of the file. Default: from the unit the file states; a file
-        that states none (npy, plain text matrices) needs it.
+        Metres per length unit of a file that states none (npy, plain text matrices); the unit
+        a file states is always the one used (a ``scale`` that disagrees with it is refused).
     physical_sizes : (float, float), optional
         ``(Lx, Ly)`` in the file's length unit, for a file that does not state its size.
-    detrend : str or None
+    detrend, cell, spikes, spike_threshold
+        As :func:`bem.rough.patch_cell` (``spike_threshold`` ``None``: its default).
+    fill : str or None
         As :func:`bem.rough.read_surface`.
+    names : dict, optional
+        The names of the arguments in messages (:func:`bem.rough.read_surface`).
+
+    Returns
+    -------
+    bem.rough.PatchCell
+        The cell in metres and what was done to make it; the one warning about its seam is in metres.
 
     Raises
     ------
     bem.InputError
         A file that cannot be read (:func:`bem.rough.read_surface`), or no ``scale`` for a file
-        that states no known length unit.
+        that states no length unit.
     """
     from bem import rough
+    from bem.rough.patch import quiet_seam
 
-    given = scale
-    if scale is not None:
-        scale = check_positive("scale", scale)
-    surface = rough.read_surface(file, physical_sizes=physical_sizes, scale=1.0 if scale is None else scale,
-                                 detrend=detrend)
-    if given is not None:
-        return surface
-    unit = surface.stats.unit
-    if unit not in METRES:
-        raise InputError(f"scale is missing: {str(file)!r} states "
-                         + ("no length unit" if unit is None else f"the length unit {unit!r}, which is not known")
-                         + "; give the metres per length unit of the file (e.g. 1e-6 for a file in um).")
-    if METRES[unit] == 1.0:
-        return surface
-    return rough.read_surface(file, physical_sizes=physical_sizes, scale=METRES[unit], detrend=detrend)
+    names = {"unit": "scale", **(names or {})}
+    with quiet_seam():  # the seam is that of the cell made below, in metres
+        surface = rough.read_surface(file, physical_sizes=physical_sizes, unit=scale, detrend=None, fill=fill,
+                                     names=names)  # in metres already
+    return rough.patch_cell(surface, detrend=detrend, cell=cell, spikes=spikes, **_threshold(spike_threshold))
+
+
+def _threshold(spike_threshold):
+    return {} if spike_threshold is None else {"spike_threshold": spike_threshold}
 
 
 def synthetic_surface(*, hurst, size, grid, rms_height=None, rms_slope=None, long_cutoff=None, short_cutoff=None,
-                      rolloff=1.0, seed=0):
+                      rolloff=1.0, seed=0, spikes="keep", spike_threshold=None):
     """A seeded self-affine square cell (:func:`bem.rough.self_affine`): ``size`` [m] across,
-    ``grid`` points across; the other arguments as there (lengths in m)."""
+    ``grid`` points across; the other arguments as there (lengths in m). Returns its
+    :class:`bem.rough.PatchCell` (periodic: no detrending; ``spikes`` as :func:`bem.rough.patch_cell`)."""
     from bem import rough
 
     grid = check_int("grid", grid)
     size = check_positive("size", size)
-    return rough.self_affine((grid, grid), (size, size), hurst=hurst, rms_height=rms_height, rms_slope=rms_slope,
-                             long_cutoff=long_cutoff, short_cutoff=short_cutoff, rolloff=rolloff,
-                             seed=check_int("seed", seed, minimum=0))
+    surface = rough.self_affine((grid, grid), (size, size), hurst=hurst, rms_height=rms_height, rms_slope=rms_slope,
+                                long_cutoff=long_cutoff, short_cutoff=short_cutoff, rolloff=rolloff,
+                                seed=check_int("seed", seed, minimum=0))
+    return rough.patch_cell(surface, spikes=spikes, **_threshold(spike_threshold))
 
 
 def ladder(surface, E_star, *, pressures=None, relative=DEFAULT_RANGE, n=12):
     """The geometric ladder of ``n`` mean pressures [Pa].
 
     ``pressures = (low, high)`` [Pa] gives its ends; otherwise ``relative = (low, high)`` does,
-    in units of ``E* h'_rms`` (``h'_rms = surface.stats.rms_slope``).
+    in units of ``E* h'_rms`` (``h'_rms = surface.stats.rms_slope``; ``surface`` a
+    :class:`bem.rough.RoughSurface` or :class:`bem.rough.PatchCell`).
     """
+    surface, _ = _surface_and_record(surface)
     n = check_int("n", n, minimum=2)
     E_star = check_positive("E_star", E_star)
     if pressures is not None:
@@ -136,6 +154,13 @@ def ladder(surface, E_star, *, pressures=None, relative=DEFAULT_RANGE, n=12):
     return np.geomspace(low, high, n) * unit
 
 
+def _surface_and_record(surface):
+    """``(RoughSurface, what was done to it)`` of a surface or a :class:`bem.rough.PatchCell`."""
+    from bem.rough import PatchCell
+
+    return (surface.surface, surface.record()) if isinstance(surface, PatchCell) else (surface, None)
+
+
 def _check_figures(figures):
     if figures:
         from ..extras import require
@@ -144,13 +169,14 @@ def _check_figures(figures):
 
 
 def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="newton", rtol=1e-8, figures=True,
-                   progress=None, what="out_dir"):
+                   progress=None, what="out_dir", max_interpolated=MAX_INTERPOLATED):
     """Solve the layer law of ``surface`` and write its folder ``out_dir`` (module docstring).
 
     Parameters
     ----------
-    surface : bem.rough.RoughSurface
-        In metres.
+    surface : bem.rough.PatchCell or bem.rough.RoughSurface
+        In metres; a :class:`~bem.rough.PatchCell` (:func:`surface_from_file`,
+        :func:`synthetic_surface`) records what was done to the surface in the law file.
     out_dir : path-like
         The folder written: new, empty, or a layer-law folder contactlab wrote (replaced whole).
     E_star : float
@@ -168,6 +194,10 @@ def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="
         Draw the figures (needs the ``report`` extra).
     what : str
         The argument named in messages about ``out_dir`` (``"--out"``).
+    max_interpolated : float or None
+        As :func:`bem.rough.layer_from_topography` (default :data:`MAX_INTERPOLATED`: the
+        ladder is extended downwards until at most 1 % of its closure lies below its first
+        pressure).
 
     Returns
     -------
@@ -190,11 +220,12 @@ def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="
     with output_errors(out_dir.absolute(), what):
         recover_output_dir(out_dir)
         check_output_dir(out_dir, KIND, NAMES, what=what)
-    n_cols = surface.stats.grid[0] if n_cols is None else n_cols
+    surface, record = _surface_and_record(surface)
+    n_cols = surface.default_n_cols() if n_cols is None else n_cols
     step = None if progress is None else (
         lambda k, n, res: progress(f"A/A0 {res.contact_fraction:.3g}, {res.iterations} iterations", k, n))
     law = rough.layer_from_topography(surface, E_star, pressures=pressures, n_cols=n_cols, method=method, rtol=rtol,
-                                      progress=step)
+                                      progress=step, max_interpolated=max_interpolated, preparation=record)
     drawn = {}
     with atomic_directory(out_dir, KIND, NAMES, what=what) as tmp:
         law.save(tmp / LAW_FILE)

@@ -7,7 +7,12 @@
   logarithmic axes, with the small-load line ``A/A0 = 2 p/(E* h'_rms)`` of Hyun et al.
   (PRE 70, 026117, 2004) as a guide;
 - ``stiffness.png``: the interfacial stiffness ``K = dp/dw`` [Pa/m] against ``p``, logarithmic
-  axes; points in full contact (``K = inf``) are left out and named in the legend.
+  axes; points in full contact (``K = inf``) are left out and named in the legend;
+- ``persson.png``: the ladder's ``A/A0`` (logarithmic axes) and mean gap ``ubar`` (in rms
+  heights, logarithmic pressure axis) against ``p``, beside Persson's theory for the same cell's
+  spectrum (:mod:`bem.rough.persson`, recorded in ``law.persson``): where the lines part, the
+  numerical law departs from the theory (finite resolution and cell, spikes, a non-Gaussian
+  surface, or the theory's approximations). Pressures added below the ladder are marked.
 
 Matplotlib is imported inside the functions (the ``report`` extra).
 """
@@ -18,7 +23,8 @@ import numpy as np
 
 from ..report.render.style import display_unit, new_figure, save_figure
 
-__all__ = ["draw_all", "closure_figure", "contact_fraction_figure", "stiffness_figure", "HYUN_KAPPA"]
+__all__ = ["draw_all", "closure_figure", "contact_fraction_figure", "stiffness_figure", "persson_figure",
+           "HYUN_KAPPA"]
 
 #: the small-load slope of ``A/A0`` against ``p/(E* h'_rms)`` drawn as a guide (Hyun et al. 2004)
 HYUN_KAPPA = 2.0
@@ -99,8 +105,44 @@ def stiffness_figure(law, path):
         return fig
 
 
+def persson_figure(law, path):
+    """``A/A0`` and ``ubar/h_rms`` of the ladder beside Persson's theory; returns the figure after writing ``path``."""
+    theory, p = law.persson, law.mean_pressure
+    pu, pf = display_unit("Pa", float(p[-1]))
+    rms = float(law.stats.rms_height)
+    added = int(law.ladder_start.get("added", 0))
+    with new_figure((9.6, 4.2), ncols=2) as (fig, (area, gap)):
+        label = rf"Persson (2001, 2007), $\gamma$ = {theory['gamma']:g}"
+        area.loglog(theory["mean_pressure"] / pf, theory["contact_fraction"], color="0.3", linestyle="--",
+                    linewidth=1.2, label=label)
+        area.loglog(p / pf, law.contact_fraction, label=f"ladder ({p.size} solves)", **_CURVE, marker="o",
+                    markersize=5)
+        gap.semilogx(theory["mean_pressure"] / pf, np.asarray(theory["mean_gap"]) / rms, color="0.3",
+                     linestyle="--", linewidth=1.2, label=label)
+        gap.semilogx(p / pf, law.mean_gap / rms, label=f"ladder ({p.size} solves)", **_CURVE, marker="o",
+                     markersize=5)
+        gap.axhline(law.first_touch_gap / rms, color="0.6", linestyle=":", linewidth=1,
+                    label=r"first-touch mean gap $\bar u(0^+)$")
+        if added:
+            for ax, y in ((area, law.contact_fraction), (gap, law.mean_gap / rms)):
+                ax.plot(p[:added] / pf, y[:added], linestyle="none", marker="s", markersize=7, markerfacecolor="none",
+                        color="#d62728", label=f"{added} added below the ladder asked for")
+        area.set_ylabel(r"real contact fraction $A/A_0$ [-]")
+        gap.set_ylabel(rf"mean gap $\bar u / h_\mathrm{{rms}}$ [-], $h_\mathrm{{rms}}$ = {rms:.3g} m")
+        for ax in (area, gap):
+            ax.set_xlabel(f"mean pressure $p$ [{pu}]")
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(loc="best", fontsize="small")
+        fig.suptitle(f"Layer law of {_source(law)} beside Persson's theory for its spectrum "
+                     rf"($h'_\mathrm{{rms}}$ = {theory['rms_slope']:.3g}, $E^*$ = {law.E_star:.4g} Pa)",
+                     fontsize="medium")
+        save_figure(fig, path)
+        return fig
+
+
 def draw_all(law, folder):
-    """Write the three figures into ``folder``; returns ``{file name: figure}``."""
+    """Write the four figures into ``folder``; returns ``{file name: figure}``."""
     return {name: draw(law, folder / name) for name, draw in (("closure.png", closure_figure),
                                                              ("contact_fraction.png", contact_fraction_figure),
-                                                             ("stiffness.png", stiffness_figure))}
+                                                             ("stiffness.png", stiffness_figure),
+                                                             ("persson.png", persson_figure))}

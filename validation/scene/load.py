@@ -265,7 +265,7 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     layer_raw = check.FAILED if code == "refuse" and "layer" in coded else raw.get("layer")
     layer_raw = check.FAILED if layer_file is check.FAILED else layer_raw
     build = {part: code == "import" or part not in coded for part in ("gap", "layer")}
-    shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"], build=build["gap"]),
+    shape = check(lambda d, b, m: sec.gap(d, b["E_star"], units=m["units"], build=build["gap"], base_dir=base_dir),
                   section["gap"], body, meta)
     layer = check(lambda d: sec.layer(d, build=build["layer"], E_star=None if body is check.FAILED else body["E_star"]),
                   layer_raw)

@@ -19,19 +19,24 @@ A rough scene solves the periodic cell of a rough surface pressed by a rigid fla
     reader = "surfacetopography" | "core"   # bem.rough.read_surface (default) or bem.gaps.measured
     format, channel, physical_sizes         # read_surface's (physical_sizes in the file's unit)
     spacing, nodata                         # the core reader's (read_heights)
-    length_unit = "um"       # the file's length unit ("m", "mm", "um", "nm") or a factor
+    length_unit = "um"       # the file's length unit ("m", "mm", "um", "nm") or a factor, for a file
+                             # that states none; the unit a file states is always the one used
+    fill = "harmonic"        # fill missing points (at most 5 % of them; default: refused)
     detrend = "height"       # bem.rough.DETRENDS or "none"
 
 Both need SurfaceTopography (the ``rough`` extra, statistics and synthesis): without it the
 scene stops before any work with :class:`validation.extras.MissingExtraError`. ``[bem]``
 takes ``periodic = true`` (required with a rough gap, refused without one) and
-``cell_nodes``, the lattice nodes along x (default: the surface's ``nx``); the cell is the
-surface's. ``[load]`` takes ``mean_pressure`` [pressure], ``force`` (the force on one cell,
+``cell_nodes``, the lattice nodes along x (default: ``Lx / max(dx, dy)``, the data's ``nx``
+on square pixels, :meth:`bem.rough.RoughSurface.default_n_cols`); the cell is the surface's.
+The statistics name the file as the scene does (relative to the scene file's folder).
+``[load]`` takes ``mean_pressure`` [pressure], ``force`` (the force on one cell,
 ``mean_pressure Lx Ly``) or ``approach``.
 """
 
 from __future__ import annotations
 
+import os
 from functools import partial
 
 import numpy as np
@@ -42,6 +47,7 @@ from bem.rough.lattice_heights import cell_shape
 
 from ..extras import require as require_extra
 from . import checks as ck
+from .measured import LENGTH_UNITS
 from .measured import _factor as length_factor
 from .paper import is_paper_law
 from .sizing import solver_options
@@ -52,7 +58,7 @@ __all__ = ["RoughGap", "ROUGH_TYPES", "GAP_KEYS", "GAP_UNITS", "PERIODIC_KEYS", 
 GAP_KEYS = {"self_affine": ("size", "grid", "hurst", "rms_height", "rms_slope", "long_cutoff", "short_cutoff",
                             "rolloff", "seed"),
             "surface": ("file", "reader", "format", "channel", "physical_sizes", "spacing", "nodata", "length_unit",
-                        "detrend")}
+                        "fill", "detrend")}
 ROUGH_TYPES = tuple(GAP_KEYS)
 #: unit kind of the ``[gap]`` keys of a rough type that carry one (the others are dimensionless or in the file's unit)
 GAP_UNITS = dict.fromkeys(("size", "rms_height", "long_cutoff", "short_cutoff"), "length")
@@ -104,24 +110,58 @@ def _self_affine(d):
         return rough.self_affine(**kw)
 
 
-def _surface(d, units):
+def _shown(file, base_dir):
+    """The file's name as the scene gives it: relative to the scene file's folder when inside it."""
+    if base_dir is None:
+        return file
+    rel = os.path.relpath(file, base_dir)
+    return file if rel.startswith(os.pardir) else rel
+
+
+def _read_surface(file, d, units, detrend, source):
+    """A file read by SurfaceTopography in the scene's length unit (module docstring, ``length_unit``)."""
+    from bem import rough
+
+    given = d.get("length_unit")
+    if isinstance(given, str) and given in LENGTH_UNITS:
+        given = "um" if given == "µm" else given
+    elif given is not None:
+        given = length_factor(d, None)
+    scene = None if units is None else units.metres
+    kw = {k: d[k] for k in ("format", "channel", "physical_sizes", "fill") if k in d}
+    names = {"unit": "gap.length_unit", "fill": "gap.fill"}
+    with ck.scene_errors("gap."):
+        if isinstance(given, str) and scene is None:
+            length_factor(d, units)  # the error: no scene length unit to convert to
+        named = units.length if scene is not None and units.length in LENGTH_UNITS else None
+        surface = rough.read_surface(file, unit=given, length_unit=named or scene or 1.0, detrend=detrend,
+                                     source=source, names=names, unit_default=1.0, **kw)
+    if scene is None and surface.stats.unit is not None:
+        raise ck.SceneError(f"gap.file = {source!r} is not allowed: it states its lengths in {surface.stats.unit} "
+                            f"and the scene's units label {units.label!r} names no length unit (m, mm, um, nm) to "
+                            "convert them to; name one in [scene] units.")
+    return surface
+
+
+def _surface(d, units, base_dir=None):
     from bem import rough
     from bem.gaps.heights import read_heights
 
     file = ck.string("gap.file", ck.require("gap", d, "file", 'give the topography file, e.g. file = "patch.x3p"'))
     reader = ck.choice("gap.reader", d.get("reader", "surfacetopography"), _READERS)
-    own = {"surfacetopography": ("format", "channel", "physical_sizes"), "core": ("format", "spacing", "nodata")}
-    for key in GAP_KEYS["surface"][2:7]:
-        if key in d and key not in own[reader]:
+    own = {"surfacetopography": ("format", "channel", "physical_sizes", "fill"),
+           "core": ("format", "spacing", "nodata")}
+    for key in GAP_KEYS["surface"][2:9]:
+        if key in d and key not in own[reader] and key != "length_unit":
             raise ck.SceneError(f"gap.{key} = {d[key]!r} is not allowed with gap.reader = {reader!r}: that reader "
                                 f"takes {', '.join(own[reader])}.")
-    scale = length_factor(d, units)
     detrend = d.get("detrend", "height")
     detrend = None if detrend == "none" else ck.choice("gap.detrend", detrend, rough.DETRENDS)
+    source = _shown(file, base_dir)
+    if reader == "surfacetopography":
+        return _read_surface(file, d, units, detrend, source)
+    scale = length_factor(d, units)
     with ck.scene_errors("gap."):
-        if reader == "surfacetopography":
-            kw = {k: d[k] for k in ("format", "channel", "physical_sizes") if k in d}
-            return rough.read_surface(file, scale=scale, detrend=detrend, **kw)
         x, y, z = read_heights(file, **{k: d[k] for k in ("format", "spacing", "nodata") if k in d})
     holes = int(np.count_nonzero(~np.isfinite(z)))
     if holes:
@@ -129,11 +169,13 @@ def _surface(d, units):
                             "nodata); the periodic cell needs every point: fill or crop them first.")
     with ck.scene_errors("gap."):
         size = (x.size * (x[1] - x[0]) * scale, y.size * (y[1] - y[0]) * scale)
-        return rough.from_heights(z * scale, size, detrend=detrend, source=file)
+        return rough.from_heights(z * scale, size, detrend=detrend, source=source)
 
 
-def rough_gap(d, *, units=None):
+def rough_gap(d, *, units=None, base_dir=None):
     """``(spec, RoughGap)`` of a ``[gap]`` of a rough type (module docstring).
+
+    ``base_dir``: the scene file's folder, from which the statistics name the file.
 
     Raises
     ------
@@ -144,8 +186,11 @@ def rough_gap(d, *, units=None):
     """
     kind = d["type"]
     ck.unknown_keys("gap", d, ("type", *GAP_KEYS[kind]))
+    if kind == "surface" and isinstance(d.get("file"), str) and not os.path.isfile(d["file"]):
+        raise ck.SceneError(f"gap.file = {_shown(d['file'], base_dir)!r} is not allowed: there is no such file "
+                            "(a relative name starts from the scene file's folder).")
     require_extra("rough", f"gap.type = {kind!r} (a rough surface)")
-    surface = _self_affine(d) if kind == "self_affine" else _surface(d, units)
+    surface = _self_affine(d) if kind == "self_affine" else _surface(d, units, base_dir)
     return dict(d), RoughGap(kind, surface)
 
 
@@ -158,8 +203,8 @@ def _periodic(d, gap, layer_spec, layer, load):
         raise ck.SceneError(f"layer.law = {layer_spec['law']!r} given by the paper's parameters is not allowed with "
                             "bem.periodic = true: give the law's own parameters (e.g. lam).")
     out = solver_options(d, layer_spec)
-    name = "bem.cell_nodes" if "cell_nodes" in d else "bem.cell_nodes (default: the surface's nx)"
-    n_cols = ck.integer(name, d.get("cell_nodes", gap.surface.heights.shape[0]), 8, 8192)
+    name = "bem.cell_nodes" if "cell_nodes" in d else "bem.cell_nodes (default: Lx / max(dx, dy) of the surface)"
+    n_cols = ck.integer(name, d.get("cell_nodes", gap.surface.default_n_cols()), 8, 8192)
     with ck.scene_errors():  # bem's memory guard, before the cell is made
         n_rows, _ = cell_shape(gap.surface.size, n_cols)
         check_node_count(name, n_cols, n_rows * n_cols, what="the periodic cell")

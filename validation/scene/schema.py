@@ -138,7 +138,7 @@ class Unimported(gaps.Gap):
         raise ck.SceneError(f"gap.type = {self.type_name!r}: its code was not imported (contactlab check).")
 
 
-def gap(d, E_star, *, units=None, build=True):
+def gap(d, E_star, *, units=None, build=True, base_dir=None):
     """``[gap]``: ``type`` and the parameters of the :mod:`bem.gaps` shape; returns (spec, Gap).
 
     ``build = False`` checks the keys only and returns an :class:`Unimported` stand-in for a shape
@@ -157,7 +157,7 @@ def gap(d, E_star, *, units=None, build=True):
     if kind == "measured":
         return measured_gap(d, units=units)
     if kind in ROUGH_TYPES:
-        return rough_gap(d, units=units)
+        return rough_gap(d, units=units, base_dir=base_dir)
     params = _gap_parameters(GAP_TYPES[kind])
     ck.unknown_keys("gap", d, ["type", *params])
     spec = dict(d)
