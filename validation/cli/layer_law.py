@@ -18,7 +18,11 @@ PARSER = {
         "(bem.rough.layer_from_topography) and write DIR: layer_law.toml, whose [layer] a scene names by\n"
         "  [layer] law = \"tabulated\"\n  file = \"layer_law.toml\"\n"
         "(the file beside the scene), and the figures closure.png (w(p), linear and log axes),\n"
-        "contact_fraction.png (A/A0 against p/(E* h'_rms)) and stiffness.png (K = dp/dw).\n"
+        "contact_fraction.png (A/A0 against p/(E* h'_rms)), stiffness.png (K = dp/dw) and persson.png\n"
+        "(A/A0 and the mean gap beside Persson's theory for the cell's spectrum).\n"
+        "A measured surface becomes a periodic cell by --detrend, --spikes and --cell (bem.rough.patch_cell);\n"
+        "spikes and a seam are reported once, in metres, and the law file records what was done. The ladder\n"
+        "is extended downwards until at most --max-interpolated of its closure lies below its first pressure.\n"
         "Units are SI: lengths in m, E* and pressures in Pa. A surface file's lengths are converted to m by\n"
         "the unit it states, or by --scale. The ladder's last pressure must exceed the largest local\n"
         "pressure of the problems the law is used in: beyond it the law holds no data (a solve there warns).\n"
@@ -33,6 +37,7 @@ PARSER = {
         "long_cutoff=25e-6,short_cutoff=6.25e-6,seed=1 \\\n"
         "                       --E-star 115e9 --p-range-rel 1e-3:0.5 --n-pressures 20 --out laws/synthetic\n"
         "  contactlab layer-law patch.x3p --E-star 115e9 --p-range 1e6:3e9 --n-cols 512 --rtol 1e-10 --out laws/fine\n"
+        "  contactlab layer-law scan.ibw --E-star 115e9 --spikes remove --cell mirror --out laws/scan\n"
         "Timings: benchmarks/layer_from_topography.py."),
 }
 
