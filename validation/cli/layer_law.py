@@ -69,7 +69,8 @@ def add_args(p):
                    help="metres per length unit of SURFACE (default: from the unit the file states)")
     p.add_argument("--size", metavar="LX,LY", help="size of a SURFACE that does not state it, in its length unit")
     p.add_argument("--no-figures", action="store_true", help="write the law file only (no report extra needed)")
-    cell = p.add_argument_group("the periodic cell of a measured surface (bem.rough.patch_cell; recorded in the law file)")
+    cell = p.add_argument_group("the periodic cell of a measured surface (bem.rough.patch_cell; recorded in the law "
+                                "file)")
     cell.add_argument("--detrend", default="auto", choices=DETREND_CHOICES,
                       help="auto (default): none for a periodic surface, height for a patch; none keeps the heights "
                            "as they are; height: the plane of least rms height; curvature: the second-order "
@@ -129,7 +130,8 @@ def _summary(folder):
              f"closure    w = {w[0]:.4g} .. {w[-1]:.4g} m of the first-touch mean gap {law.first_touch_gap:.4g} m",
              f"contact    A/A0 = {law.contact_fraction[0]:.3g} .. {law.contact_fraction[-1]:.3g}",
              f"range      the law holds data up to p = {p[-1]:.4g} Pa; a solve beyond it warns",
-             f"start      {100 * law.ladder_start['interpolated_share']:.3g} % of the closure lies below p = {p[0]:.4g} "
+             f"start      {100 * law.ladder_start['interpolated_share']:.3g} % of the closure lies below "
+             f"p = {p[0]:.4g} "
              f"Pa (a straight line to 0)" + (f", {law.ladder_start['added']} pressures added below the ladder"
                                              if law.ladder_start.get("added") else ""),
              f"scene      [layer] law = \"tabulated\", file = \"{folder.law_file.name}\" (the file beside the scene)"]
