@@ -5,8 +5,10 @@
 package SurfaceTopography (``pip install "contactlab[rough]"``), with their statistics and the
 periodic cell of a measured patch; :mod:`bem.rough.layer_law` makes the layer law ``w(p)`` of a
 rough surface from its periodic contact under a ladder of mean pressures; :mod:`bem.rough.outliers`
-finds and removes spikes, :mod:`bem.rough.patch` makes the periodic cell of a surface as measured; :mod:`bem.rough.lattice_heights` resamples a periodic height grid onto the
-lattice cell (numpy only, no extra needed). docs/rough.md shows the whole path.
+finds and removes spikes, :mod:`bem.rough.patch` makes the periodic cell of a surface as measured,
+:mod:`bem.rough.persson` gives Persson's theory from a PSD; :mod:`bem.rough.lattice_heights`
+resamples a periodic height grid onto the lattice cell (numpy only, no extra needed). docs/rough.md
+shows the whole path.
 
 :mod:`bem.rough.file_guards` checks a file's header before it is read and
 :mod:`bem.rough.overview` gathers what a surface holds (``contactlab surface``).

@@ -162,7 +162,8 @@ class TopographyLaw:
                 "# periodic cell under the mean pressure p; [layer] is a scene's [layer] table (docs/rough.md).\n")
         if self.ladder_start:
             rule = self.ladder_start.get("max_interpolated")
-            head += (f"# Below the first pressure p_1 = {self.mean_pressure[0]:.6g} the law is a straight line through\n"
+            head += (f"# Below the first pressure p_1 = {self.mean_pressure[0]:.6g} the law is a straight line "
+                     "through\n"
                      f"# (0, 0): {100 * self.ladder_start['interpolated_share']:.3g} % of the closure w(p_n)"
                      + ("" if rule is None else f" (at most {100 * rule:g} %)") + ".\n")
         return write_text(path, head + "\n" + tomli_w.dumps({"layer": self.layer_table(), "topography": data}))

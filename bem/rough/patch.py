@@ -154,7 +154,8 @@ def patch_cell(surface, *, detrend="auto", cell="repeat", spikes="keep", spike_t
     if found.count:
         log.warning("%s: %s; %s", stats.source, found.describe(unit),
                     "they are filled by harmonic interpolation" if spikes == "remove"
-                    else "they are kept (they may decide the first touch: remove them, spikes='remove')")
+                    else "they are kept (they may decide the first touch; removing them fills them from their "
+                         "neighbours)")
         if spikes == "remove":
             z = remove_spikes(z, found, size, periodic=periodic)
     if not periodic and cell == "mirror":

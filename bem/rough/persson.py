@@ -4,7 +4,7 @@ A rough surface of isotropic PSD ``C(q)`` (normalised so that ``h_rms^2 = int d^
 2 pi int q C(q) dq``), pressed by the mean pressure ``p`` against a flat, with the effective
 modulus ``E*`` of the pair. With the second spectral moment, the mean square slope,
 
-    m2 = <|grad z|^2> = 2 pi int q^3 C(q) dq = h'_rms^2,
+    m2 = <grad z . grad z> = 2 pi int q^3 C(q) dq = h'_rms^2,
 
 Persson's diffusion of the pressure distribution (Persson 2001, J. Chem. Phys. 115, 3840,
 DOI 10.1063/1.1388626; ``G = (pi/4) (E*/p)^2 int q^3 C dq``, ``A/A0 = erf(1/(2 sqrt G))``) gives
@@ -19,8 +19,8 @@ Condens. Matter 20, 215214, DOI 10.1088/0953-8984/20/21/215214) is
 
     ubar(p) = sqrt(pi) int_{q0}^{q1} q^2 C(q) w(q) I(w(q) p/E*) dq,
     w(q)    = ( pi int_{q0}^{q} q'^3 C(q') dq' )^(-1/2),
-    I(s)    = int_s^inf [gamma + 3 (1 - gamma) erf(x)^2] exp(-x^2) dx / x
-            = gamma E1(s^2)/2 + 3 (1 - gamma) J(s),
+    I(s)    = int_s^inf [gamma + 3 (1 - gamma) erf(x)^2] exp(-x^2) dx / x,
+    I(s)    = gamma E1(s^2)/2 + 3 (1 - gamma) J(s),
 
 ``P(q, p) = erf(w p/E*)`` the contact fraction of the wavelengths up to ``q``, ``E1`` the
 exponential integral and ``J(s) = int_s^inf erf(x)^2 exp(-x^2) dx/x`` (tabulated here by

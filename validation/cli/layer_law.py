@@ -19,7 +19,11 @@ PARSER = {
         "(bem.rough.layer_from_topography) and write DIR: layer_law.toml, whose [layer] a scene names by\n"
         "  [layer] law = \"tabulated\"\n  file = \"layer_law.toml\"\n"
         "(the file beside the scene), and the figures closure.png (w(p), linear and log axes),\n"
-        "contact_fraction.png (A/A0 against p/(E* h'_rms)) and stiffness.png (K = dp/dw).\n"
+        "contact_fraction.png (A/A0 against p/(E* h'_rms)), stiffness.png (K = dp/dw) and persson.png\n"
+        "(A/A0 and the mean gap beside Persson's theory for the cell's spectrum).\n"
+        "A measured surface becomes a periodic cell by --detrend, --spikes and --cell (bem.rough.patch_cell);\n"
+        "spikes and a seam are reported once, in metres, and the law file records what was done. The ladder\n"
+        "is extended downwards until at most --max-interpolated of its closure lies below its first pressure.\n"
         "Units are SI: lengths in m, E* and pressures in Pa. A surface file's lengths are converted to m by\n"
         "the unit it states (--scale and --size for a file that states neither unit nor size; --fill harmonic\n"
         "fills missing points, at most 5 % of them). The ladder's last pressure must exceed the largest local\n"
@@ -35,6 +39,7 @@ PARSER = {
         "long_cutoff=25e-6,short_cutoff=6.25e-6,seed=1 \\\n"
         "                       --E-star 115e9 --p-range-rel 1e-3:0.5 --n-pressures 20 --out laws/synthetic\n"
         "  contactlab layer-law patch.x3p --E-star 115e9 --p-range 1e6:3e9 --n-cols 512 --rtol 1e-10 --out laws/fine\n"
+        "  contactlab layer-law scan.ibw --E-star 115e9 --spikes remove --cell mirror --out laws/scan\n"
         "Timings: benchmarks/layer_from_topography.py."),
 }
 
@@ -71,7 +76,8 @@ def add_args(p):
                    help="the solver's KKT tolerance, in (0, 1e-2] as for every solve (default 1e-8)")
     add_file_args(p)
     p.add_argument("--no-figures", action="store_true", help="write the law file only (no report extra needed)")
-    cell = p.add_argument_group("the periodic cell of a measured surface (bem.rough.patch_cell; recorded in the law file)")
+    cell = p.add_argument_group("the periodic cell of a measured surface (bem.rough.patch_cell; recorded in the law "
+                                "file)")
     cell.add_argument("--detrend", default="auto", choices=DETREND_CHOICES,
                       help="auto (default): none for a periodic surface, height for a patch; none keeps the heights "
                            "as they are; height: the plane of least rms height; curvature: the second-order "
@@ -142,7 +148,8 @@ def _summary(folder):
              f"closure    w = {w[0]:.4g} .. {w[-1]:.4g} m of the first-touch mean gap {law.first_touch_gap:.4g} m",
              f"contact    A/A0 = {law.contact_fraction[0]:.3g} .. {law.contact_fraction[-1]:.3g}",
              f"range      the law holds data up to p = {p[-1]:.4g} Pa; a solve beyond it warns",
-             f"start      {100 * law.ladder_start['interpolated_share']:.3g} % of the closure lies below p = {p[0]:.4g} "
+             f"start      {100 * law.ladder_start['interpolated_share']:.3g} % of the closure lies below "
+             f"p = {p[0]:.4g} "
              f"Pa (a straight line to 0)" + (f", {law.ladder_start['added']} pressures added below the ladder"
                                              if law.ladder_start.get("added") else ""),
              f"scene      [layer] law = \"tabulated\", file = \"{folder.law_file.name}\" (the file beside the scene)"]

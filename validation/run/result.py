@@ -14,7 +14,7 @@ import numpy as np
 
 from ..compare import RADIUS_KEYS
 from ..provenance import provenance
-from .parts import (SCHEMA, AxialProfile, BemPart, ClosedForm, Comparison, FemMesh, FemPart, FemProfile, ForceBalance,
+from .parts import (SCHEMA, BemPart, ClosedForm, Comparison, FemMesh, FemPart, FemProfile, ForceBalance,
                     PairMetrics, Scales, StressPart)
 from .record import RunResult
 
