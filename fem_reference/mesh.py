@@ -11,6 +11,12 @@ Geometry (lengths in the user's units)::
             |                  |
     z = -H  +------------------+          bottom   (lower body, "lower")
 
+A body may carry a coating of thickness ``t`` (``coating_thickness``): a line at ``z = +t``
+(upper) or ``z = -t`` (lower) splits its rectangle into the coating and the substrate, meshed
+conformingly (bonded: the two share the nodes of that line), with at least
+``N_ACROSS_COATING`` elements across ``t`` in the fine zone and elements no larger than ``t``
+along the whole coating.
+
 Both rectangles are meshed in one gmsh model that shares the interface curve,
 so the two sides of the interface get the same 1-D mesh; the nodes on it are
 then duplicated (each body gets its own copy), which makes two separate bodies
@@ -29,6 +35,7 @@ boundaries split per body (``interface_upper``, ``interface_lower``,
 from __future__ import annotations
 
 import logging
+import math
 import signal
 import threading
 import time
@@ -54,6 +61,8 @@ BOUNDARIES = {
     "outer_lower": ("outer", "lower"),
 }
 BODIES = ("upper", "lower")
+#: Elements across a coating's thickness in the fine zone (at least).
+N_ACROSS_COATING = 4
 _TRIANGLE6 = 9  # gmsh element type: 6-node second-order triangle
 _LINE3 = 8  # gmsh element type: 3-node second-order line
 
@@ -70,6 +79,8 @@ class AxiMesh:
         ``ElementTriP2``, whose mid-edge nodes are gmsh's.
     body : ndarray of int, shape (n_elements,)
         0 for elements of the upper body, 1 for the lower body.
+    coated : ndarray of bool, shape (n_elements,)
+        True for the elements of a coating.
     nodes6 : ndarray, shape (2, n_nodes6)
         gmsh's nodes (corner and mid-edge) as (r, z), interface nodes once per body.
     cells6 : ndarray of int, shape (6, n_elements)
@@ -87,6 +98,8 @@ class AxiMesh:
         Radius of the uniformly fine zone around the origin [length].
     h_coarse : float
         Far-field element size [length].
+    coating_thickness : tuple
+        Coating thickness of the upper and the lower body [length], ``None`` for none.
     mesh_time_s : float
         Wall-clock time of meshing and conversion [s].
     """
@@ -102,6 +115,8 @@ class AxiMesh:
     depth: float
     fine_radius: float
     h_coarse: float
+    coated: np.ndarray = None
+    coating_thickness: tuple = (None, None)
     mesh_time_s: float = 0.0
     physical_groups: dict = field(default_factory=dict)
 
@@ -123,34 +138,70 @@ def _options(gmsh, h_fine, h_coarse):
     gmsh.option.setNumber("General.NumThreads", 1)
 
 
-def _geometry(gmsh, R, H):
-    """Two rectangles sharing the interface curve; returns the physical-group entity tags."""
+def _geometry(gmsh, R, H, thickness=(None, None)):
+    """Two rectangles sharing the interface curve, each split at its coating's depth.
+
+    Returns the origin's point tag, each body's surfaces (coating first), the curves per
+    (group, body) and the physical groups. Without coatings the entities are created in the
+    order, and with the orientations, of the plain two-rectangle model.
+    """
     geo = gmsh.model.geo
     p0, p1 = geo.addPoint(0, 0, 0), geo.addPoint(R, 0, 0)
-    p2, p3 = geo.addPoint(R, H, 0), geo.addPoint(0, H, 0)
-    p4, p5 = geo.addPoint(R, -H, 0), geo.addPoint(0, -H, 0)
+    levels, outer_pts, axis_pts = {}, {}, {}
+    for name, sign, t in (("upper", 1.0, thickness[0]), ("lower", -1.0, thickness[1])):
+        levels[name] = [0.0] + ([t] if t else []) + [H]
+        outer_pts[name], axis_pts[name] = [p1], [p0]
+        for z in levels[name][1:]:
+            outer_pts[name].append(geo.addPoint(R, sign * z, 0))
+            axis_pts[name].append(geo.addPoint(0, sign * z, 0))
     interface = geo.addLine(p0, p1)
-    outer_u, top, axis_u = geo.addLine(p1, p2), geo.addLine(p2, p3), geo.addLine(p3, p0)
-    axis_l, bottom, outer_l = geo.addLine(p0, p5), geo.addLine(p5, p4), geo.addLine(p4, p1)
-    upper = geo.addPlaneSurface([geo.addCurveLoop([interface, outer_u, top, axis_u])])
-    lower = geo.addPlaneSurface([geo.addCurveLoop([axis_l, bottom, outer_l, -interface])])
+    lines = {}
+    for name in ("upper", "lower"):
+        O, A, n = outer_pts[name], axis_pts[name], len(levels[name]) - 1
+        if name == "upper":  # outer O_k -> O_k+1, horizontal O_k+1 -> A_k+1, axis A_k+1 -> A_k
+            made = [(geo.addLine(O[k], O[k + 1]), geo.addLine(O[k + 1], A[k + 1]), geo.addLine(A[k + 1], A[k]))
+                    for k in range(n)]
+        else:  # axis A_k -> A_k+1, horizontal A_k+1 -> O_k+1, outer O_k+1 -> O_k
+            made = [(geo.addLine(A[k], A[k + 1]), geo.addLine(A[k + 1], O[k + 1]), geo.addLine(O[k + 1], O[k]))
+                    for k in range(n)]
+            made = [(outer, horizontal, axis) for axis, horizontal, outer in made]
+        lines[name] = made
+    surfaces = {}
+    for name in ("upper", "lower"):
+        body, below = [], interface
+        for outer, horizontal, axis in lines[name]:
+            if name == "upper":  # counter-clockwise: bottom, right, top, left
+                loop = [below, outer, horizontal, axis]
+                below = -horizontal
+            else:  # counter-clockwise: left, bottom, right, top
+                loop = [axis, horizontal, outer, -below]
+                below = horizontal
+            body.append(geo.addPlaneSurface([geo.addCurveLoop(loop)]))
+        surfaces[name] = body
     geo.synchronize()
+    far = {name: lines[name][-1][1] for name in lines}
     curves = {
         ("interface", "upper"): [interface], ("interface", "lower"): [interface],
-        ("axis", "upper"): [axis_u], ("axis", "lower"): [axis_l],
-        ("top", "upper"): [top], ("bottom", "lower"): [bottom],
-        ("outer", "upper"): [outer_u], ("outer", "lower"): [outer_l],
+        ("axis", "upper"): [m[2] for m in lines["upper"]], ("axis", "lower"): [m[2] for m in lines["lower"]],
+        ("top", "upper"): [far["upper"]], ("bottom", "lower"): [far["lower"]],
+        ("outer", "upper"): [m[0] for m in lines["upper"]], ("outer", "lower"): [m[0] for m in lines["lower"]],
     }
-    groups = {"upper": (2, [upper]), "lower": (2, [lower]), "interface": (1, [interface]),
-              "axis": (1, [axis_u, axis_l]), "top": (1, [top]), "bottom": (1, [bottom]),
-              "outer": (1, [outer_u, outer_l])}
+    groups = {"upper": (2, surfaces["upper"]), "lower": (2, surfaces["lower"]), "interface": (1, [interface]),
+              "axis": (1, curves[("axis", "upper")] + curves[("axis", "lower")]),
+              "top": (1, [far["upper"]]), "bottom": (1, [far["lower"]]),
+              "outer": (1, curves[("outer", "upper")] + curves[("outer", "lower")])}
     for name, (dim, tags) in groups.items():
         gmsh.model.addPhysicalGroup(dim, tags, name=name)
-    return p0, {"upper": upper, "lower": lower}, curves, groups
+    return p0, surfaces, curves, groups
 
 
-def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth):
-    """Size ``h_fine`` within ``fine_radius`` of the origin, growing linearly (slope ``growth``)."""
+def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=()):
+    """Size ``h_fine`` within ``fine_radius`` of the origin, growing linearly (slope ``growth``).
+
+    ``coatings``: ``(z_low, z_high, t)`` per coating strip. Each caps the size at ``t`` along the
+    whole strip and at ``t / N_ACROSS_COATING`` in its part within ``fine_radius`` (both growing
+    with the same slope outside), the smallest size applying.
+    """
     fld = gmsh.model.mesh.field
     dist = fld.add("Distance")
     fld.setNumbers(dist, "PointsList", [origin])
@@ -160,25 +211,51 @@ def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth):
     fld.setNumber(thr, "SizeMax", h_coarse)
     fld.setNumber(thr, "DistMin", fine_radius)
     fld.setNumber(thr, "DistMax", fine_radius + (h_coarse - h_fine) / growth)
-    fld.setAsBackgroundMesh(thr)
+    if not coatings:
+        fld.setAsBackgroundMesh(thr)
+        return
+    fields = [thr]
+    for z_low, z_high, t in coatings:
+        boxes = [(math.inf, t)]
+        if t / N_ACROSS_COATING < h_fine:
+            boxes.append((fine_radius, t / N_ACROSS_COATING))
+        for x_max, size in boxes:
+            box = fld.add("Box")
+            fld.setNumber(box, "VIn", size)
+            fld.setNumber(box, "VOut", h_coarse)
+            fld.setNumber(box, "XMin", -1.0)
+            fld.setNumber(box, "XMax", min(x_max, 1e300))
+            fld.setNumber(box, "YMin", z_low)
+            fld.setNumber(box, "YMax", z_high)
+            fld.setNumber(box, "ZMin", -1.0)
+            fld.setNumber(box, "ZMax", 1.0)
+            fld.setNumber(box, "Thickness", max(h_coarse - size, 0.0) / growth)
+            fields.append(box)
+    smallest = fld.add("Min")
+    fld.setNumbers(smallest, "FieldsList", fields)
+    fld.setAsBackgroundMesh(smallest)
 
 
-def _extract(gmsh, surfaces, curves):
+def _extract(gmsh, surfaces, curves, thickness=(None, None)):
     """Per-body node/element arrays with the interface nodes duplicated."""
     tags, coords, _ = gmsh.model.mesh.getNodes()
     lookup = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
     lookup[tags.astype(np.int64)] = np.arange(tags.size)
     xy = coords.reshape(-1, 3)[:, :2].T
     out = {}
-    for name in BODIES:
-        types, _, node_tags = gmsh.model.mesh.getElements(2, surfaces[name])
-        if list(types) != [_TRIANGLE6]:
-            raise RuntimeError(f"gmsh produced element types {list(types)} for the {name} body, "
-                               "expected 6-node triangles")
-        cells = lookup[node_tags[0].astype(np.int64)].reshape(-1, 6)
+    for name, t in zip(BODIES, thickness):
+        blocks, coated = [], []
+        for k, tag in enumerate(surfaces[name]):
+            types, _, node_tags = gmsh.model.mesh.getElements(2, tag)
+            if list(types) != [_TRIANGLE6]:
+                raise RuntimeError(f"gmsh produced element types {list(types)} for the {name} body, "
+                                   "expected 6-node triangles")
+            blocks.append(lookup[node_tags[0].astype(np.int64)].reshape(-1, 6))
+            coated.append(np.full(blocks[-1].shape[0], bool(t) and k == 0))
+        cells = np.vstack(blocks)
         corner_ids = np.unique(cells[:, :3])
         all_ids = np.unique(cells)
-        out[name] = {"cells": cells, "corner_ids": corner_ids, "all_ids": all_ids}
+        out[name] = {"cells": cells, "corner_ids": corner_ids, "all_ids": all_ids, "coated": np.concatenate(coated)}
         edges = {}
         for (group, body), ctags in curves.items():
             if body != name:
@@ -212,7 +289,7 @@ def _to_skfem(xy, parts):
     """Assemble the two bodies into one skfem ``MeshTri`` (disconnected at the interface)."""
     from skfem import MeshTri
 
-    p_blocks, t_blocks, body, n6_blocks, c6_blocks = [], [], [], [], []
+    p_blocks, t_blocks, body, n6_blocks, c6_blocks, coated = [], [], [], [], [], []
     v_off = n6_off = 0
     vmaps = {}
     for k, name in enumerate(BODIES):
@@ -226,6 +303,7 @@ def _to_skfem(xy, parts):
         t_blocks.append(vmap[part["cells"][:, :3]].T)
         c6_blocks.append(nmap[part["cells"]].T)
         body.append(np.full(part["cells"].shape[0], k, dtype=np.int8))
+        coated.append(part["coated"])
         vmaps[name] = vmap
         v_off += part["corner_ids"].size
         n6_off += part["all_ids"].size
@@ -241,7 +319,7 @@ def _to_skfem(xy, parts):
     mesh = mesh.with_boundaries(boundaries).with_subdomains(
         {name: np.nonzero(body == k)[0].astype(np.int32) for k, name in enumerate(BODIES)}
     )
-    return mesh, body, np.hstack(n6_blocks), np.hstack(c6_blocks)
+    return mesh, body, np.hstack(n6_blocks), np.hstack(c6_blocks), np.concatenate(coated)
 
 
 def _start_gmsh(gmsh):
@@ -267,7 +345,17 @@ def _start_gmsh(gmsh):
             signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
 
-def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None):
+def _thicknesses(coating_thickness):
+    """The two coating thicknesses, checked: ``None`` or finite and ``> 0``."""
+    if not isinstance(coating_thickness, (tuple, list)) or len(coating_thickness) != 2:
+        raise InputError(f"coating_thickness = {coating_thickness!r} is not allowed: it must be a pair "
+                         "(upper, lower) of thicknesses or None.")
+    return tuple(None if t is None else check_positive(f"coating_thickness[{k}]", t)
+                 for k, t in enumerate(coating_thickness))
+
+
+def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None,
+               coating_thickness=(None, None)):
     """Mesh the two bodies with gmsh and convert the mesh to scikit-fem.
 
     Parameters
@@ -277,13 +365,17 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
     n_contact_elements : int
         Elements across ``a_est`` in the contact zone: ``h_fine = a_est / n_contact_elements``.
     domain_factor : float
-        Domain width and depth of each body in units of ``a_est``: ``R = H = domain_factor a_est``.
+        Domain width and depth of each body in units of the larger of ``a_est`` and the thickest
+        coating: ``R = H = domain_factor max(a_est, t)``.
     fine_radius : float
         Radius of the uniformly fine zone in units of ``a_est``.
     growth : float
         Slope ``dh/d(distance)`` of the linear size grading outside the fine zone [-].
     h_coarse : float, optional
         Far-field size [length]; default ``R / 8``.
+    coating_thickness : tuple of (float or None), optional
+        Coating thickness of the upper and the lower body [length] (``None``: no coating): the
+        body's elements within it form its coating (``AxiMesh.coated``).
 
     Returns
     -------
@@ -298,7 +390,8 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
     if domain_factor < 4.0 * fine_radius:
         raise InputError(f"domain_factor = {domain_factor!r} is not allowed: it must be >= 4 * fine_radius = "
                          f"{4 * fine_radius!r}.")
-    R = H = domain_factor * a_est
+    thickness = _thicknesses(coating_thickness)
+    R = H = domain_factor * max([a_est] + [t for t in thickness if t])
     h_fine = a_est / int(n_contact_elements)
     h_coarse = R / 8.0 if h_coarse is None else check_positive("h_coarse", h_coarse)
     h_coarse = max(h_coarse, h_fine)
@@ -307,19 +400,20 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
 
     _start_gmsh(gmsh)
     try:
-        _options(gmsh, h_fine, h_coarse)
+        _options(gmsh, min([h_fine] + [t / N_ACROSS_COATING for t in thickness if t]), h_coarse)
         gmsh.model.add("contactlab_axisymmetric")
-        origin, surfaces, curves, groups = _geometry(gmsh, R, H)
-        _size_field(gmsh, origin, h_fine, h_coarse, fine_radius * a_est, growth)
+        origin, surfaces, curves, groups = _geometry(gmsh, R, H, thickness)
+        strips = [(0.0, t, t) if k == 0 else (-t, 0.0, t) for k, t in enumerate(thickness) if t]
+        _size_field(gmsh, origin, h_fine, h_coarse, fine_radius * a_est, growth, strips)
         gmsh.model.mesh.generate(2)
         gmsh.model.mesh.setOrder(2)
-        xy, parts = _extract(gmsh, surfaces, curves)
+        xy, parts = _extract(gmsh, surfaces, curves, thickness)
     finally:
         gmsh.finalize()
-    mesh, body, nodes6, cells6 = _to_skfem(xy, parts)
+    mesh, body, nodes6, cells6, coated = _to_skfem(xy, parts)
     elapsed = time.perf_counter() - t0
     log.info("mesh: %d triangles, h_fine = %.3g, R = H = %.3g (%.2f s)", body.size, h_fine, R, elapsed)
     return AxiMesh(mesh=mesh, body=body, nodes6=nodes6, cells6=cells6, a_est=a_est, h_fine=h_fine,
                    n_contact_elements=int(n_contact_elements), radius=R, depth=H, fine_radius=fine_radius * a_est,
-                   h_coarse=h_coarse, mesh_time_s=elapsed,
+                   h_coarse=h_coarse, coated=coated, coating_thickness=thickness, mesh_time_s=elapsed,
                    physical_groups={k: v[0] for k, v in groups.items()})

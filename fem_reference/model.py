@@ -86,7 +86,11 @@ class AxiModel:
     E1, nu1 : float
         Young's modulus [pressure] and Poisson's ratio of the UPPER body (``z >= 0``).
     E2, nu2 : float
-        The same for the LOWER body (``z <= 0``).
+        The same for the LOWER body (``z <= 0``); with a coating, ``E`` and ``nu`` are the
+        substrate's.
+    coating1, coating2 : bem.coating.Coating, optional
+        The coating of the upper and the lower body, bonded to it; its thickness must be the
+        mesh's (``amesh.coating_thickness``).
 
     Attributes
     ----------
@@ -110,10 +114,11 @@ class AxiModel:
         ``assembly`` and ``factorize`` wall-clock times [s].
     """
 
-    def __init__(self, amesh, *, E1, nu1, E2, nu2):
+    def __init__(self, amesh, *, E1, nu1, E2, nu2, coating1=None, coating2=None):
         from skfem import Basis, ElementTriP2, ElementVector, asm
 
         check_materials(E1, nu1, E2, nu2)
+        self.coatings = check_coatings(coating1, coating2, amesh.coating_thickness)
         E, nu = np.array([E1, E2], dtype=float), np.array([nu1, nu2], dtype=float)
         self.amesh, self.E, self.nu = amesh, E, nu
         mesh = amesh.mesh
@@ -121,7 +126,12 @@ class AxiModel:
         self.basis = Basis(mesh, ElementVector(ElementTriP2()), intorder=_INTORDER)
         self.scalar_basis = Basis(mesh, ElementTriP2(), intorder=_INTORDER)
         self._check_numbering()
-        lam, mu = lame(E[amesh.body], nu[amesh.body])
+        E_el, nu_el = E[amesh.body], nu[amesh.body]
+        for index, coating in enumerate(self.coatings):
+            if coating is not None:
+                inside = amesh.coated & (amesh.body == index)
+                E_el[inside], nu_el[inside] = coating.E, coating.nu
+        lam, mu = lame(E_el, nu_el)
         zero = self.basis.zero_w()
         self.lam_w, self.mu_w = zero + lam[:, None], zero + mu[:, None]
         self.K = asm(_stiffness_form(), self.basis, lam=self.lam_w, mu=self.mu_w).tocsr()
@@ -246,7 +256,9 @@ class AxiModel:
         Loads the interface with ``q(r) = (1 - r^2/b^2)^2`` (``r < b``), whose half-space
         relative displacement at the centre is ``u(0) = (2/E*) integral_0^b q dr =
         16 b / (15 E*)`` for the force ``P = pi b^2 / 3``, i.e. ``c_hs = 16 / (5 pi b E*)``.
-        Returns ``dc = c_hs - c_fem`` where ``c_fem = (C f)_0 / sum(f)`` is the same
+        With coatings ``c_hs`` is ``(48 / (pi b)) integral_0^inf (s1 + s2)(x / b) J3(x) / x^3 dx``
+        (:func:`bem.coating.mode_compliance`; the same value for homogeneous bodies, where
+        ``integral J3(x) / x^3 dx = 1/15``). Returns ``dc = c_hs - c_fem`` where ``c_fem = (C f)_0 / sum(f)`` is the same
         quantity of the truncated, far-supported FEM bodies (``dc > 0``: they are stiffer),
         with the nodal loads ``f = weights * q`` (row-sum weights: the consistent load of the
         quadratic interpolant of ``q``). Measured: ``dc`` changes by < 1 % between
@@ -256,8 +268,52 @@ class AxiModel:
         f = self.weights * q
         u = self.lu.solve(self._load(f))[:, 0]
         c_fem = (u[self._fup[0]] - u[self._flo[0]]) / f.sum()
-        c_hs = 16.0 / (5.0 * math.pi * b * E_star)
+        if any(c is not None for c in self.coatings):
+            c_hs = _coated_centre_compliance(self, b)
+        else:
+            c_hs = 16.0 / (5.0 * math.pi * b * E_star)
         return c_hs - c_fem
+
+
+def _coated_centre_compliance(model, b):
+    """``u(0) / P`` of two half-spaces, coated or not, under ``q = (1 - r^2/b^2)^2`` [length/force].
+
+    The coatings' own half-spaces (``s_inf``, the symbol's high-frequency limit) integrate in closed
+    form (``integral J3(x) / x^3 dx = 1/15``); the rest decays as ``exp(-2 x t / b)`` and is
+    integrated by 16-point Gauss-Legendre panels of width at most 1 up to ``x t / b = 30``.
+    """
+    from scipy.special import jv
+
+    from bem.coating import mode_compliance
+
+    bodies = list(zip(model.E, model.nu, model.coatings))
+    s_inf = sum((1 - c.nu**2) / c.E if c is not None else (1 - nu**2) / E for E, nu, c in bodies)
+    x_max = 30.0 * b / min(c.thickness for _, _, c in bodies if c is not None)
+    nodes, weights = np.polynomial.legendre.leggauss(16)
+    edges = np.linspace(0.0, x_max, int(math.ceil(x_max)) + 1)
+    half = 0.5 * np.diff(edges)[:, None]
+    x = 0.5 * (edges[:-1] + edges[1:])[:, None] + half * nodes
+    s = sum(mode_compliance(x / b, E, nu, c) for E, nu, c in bodies)
+    rest = float(np.sum((s - s_inf) * jv(3, x) / x**3 * weights * half))
+    return 48.0 / (math.pi * b) * (s_inf / 15.0 + rest)
+
+
+def check_coatings(coating1, coating2, thickness):
+    """The two coatings, checked against the mesh's coating thicknesses; raise ``InputError``."""
+    from bem.coating import Coating
+
+    out = []
+    for k, (name, coating) in enumerate((("coating1", coating1), ("coating2", coating2))):
+        if coating is not None and not isinstance(coating, Coating):
+            raise InputError(f"{name} = {coating!r} is not allowed: it must be a bem.coating.Coating or None.")
+        mesh_t = thickness[k]
+        if (coating is None) != (mesh_t is None) or (coating is not None and coating.thickness != mesh_t):
+            raise InputError(f"{name} = {coating!r} is not allowed: its thickness must be the mesh's coating "
+                             f"thickness {mesh_t!r}.")
+        if coating is not None and coating.nu > 0.499:
+            raise InputError(f"{name}.nu = {coating.nu!r} is not allowed: it must be <= 0.499 (displacement FEM locks).")
+        out.append(coating)
+    return tuple(out)
 
 
 def check_materials(E1, nu1, E2, nu2):

@@ -36,7 +36,7 @@ from bem.reference import estimate_contact_radius
 
 from .interface import InterfaceLaw
 from .mesh import AxiMesh, build_mesh
-from .model import AxiModel, check_materials
+from .model import AxiModel, check_coatings, check_materials
 from .newton import solve_interface
 from .result import FemResult, axis_pressure, edge_radius
 
@@ -66,8 +66,8 @@ def _one_mesh(amesh, gap, materials, E_star, layer, penalty, force, approach, tr
               maxiter):
     """Assemble, condense and solve on one mesh; returns (model, solution, extras)."""
     t0 = time.perf_counter()
-    E1, nu1, E2, nu2 = materials
-    model = AxiModel(amesh, E1=E1, nu1=nu1, E2=E2, nu2=nu2)
+    E1, nu1, E2, nu2, coating1, coating2 = materials
+    model = AxiModel(amesh, E1=E1, nu1=nu1, E2=E2, nu2=nu2, coating1=coating1, coating2=coating2)
     t1 = time.perf_counter()
     C = model.interface_compliance()
     dc = model.reference_correction(E_star, amesh.a_est) if truncation_correction else 0.0
@@ -85,7 +85,7 @@ def _one_mesh(amesh, gap, materials, E_star, layer, penalty, force, approach, tr
     return model, sol, h, law, dc, timings
 
 
-def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est=None,
+def solve(gap, *, E1, nu1, E2, nu2, coating1=None, coating2=None, force=None, approach=None, layer=None, a_est=None,
           n_contact_elements=24, domain_factor=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5,
           truncation_correction=True, remesh=True, rtol=1e-9, maxiter=60):
     """Axisymmetric FEM reference solution of the layered contact of two elastic bodies.
@@ -99,7 +99,12 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     gap : callable
         Initial gap ``h(x, y)`` [length], axisymmetric; evaluated as ``h(r, 0)``.
     E1, nu1, E2, nu2 : float
-        Young's moduli [pressure] and Poisson's ratios (``-1 < nu <= 0.499``).
+        Young's moduli [pressure] and Poisson's ratios (``-1 < nu <= 0.499``); of the
+        substrate where the body is coated.
+    coating1, coating2 : bem.coating.Coating, optional
+        A coating bonded to body 1 or 2 (``nu <= 0.499``), meshed as its own material with
+        at least ``fem_reference.mesh.N_ACROSS_COATING`` elements across its thickness in the
+        contact zone. ``E_star`` (penalty scale, radius estimate) stays the substrates'.
     force, approach : float
         Exactly one: total force ``P`` [force] (force control: ``delta`` is an extra
         unknown of Newton's method) or half-space approach ``delta`` [length].
@@ -142,6 +147,8 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     t_start = time.perf_counter()
     check_callable("gap", gap)
     check_materials(E1, nu1, E2, nu2)
+    thickness = tuple(None if c is None else getattr(c, "thickness", c) for c in (coating1, coating2))
+    check_coatings(coating1, coating2, thickness)
     force, approach = check_load(force, approach)
     layer = check_layer("layer", layer)
     penalty = check_positive("penalty", penalty)
@@ -151,6 +158,8 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     remesh = check_bool("remesh", remesh)
     if mesh is not None and not isinstance(mesh, AxiMesh):
         fail("mesh", mesh, "a fem_reference.mesh.AxiMesh (from fem_reference.build_mesh) or None")
+    if mesh is not None:
+        check_coatings(coating1, coating2, mesh.coating_thickness)
     E_star = effective_modulus(E1, nu1, E2, nu2)
     if mesh is None and a_est is None:
         a_est = estimate_contact_radius(gap, E_star=E_star, force=force, approach=approach, layer=layer)
@@ -160,12 +169,12 @@ def solve(gap, *, E1, nu1, E2, nu2, force=None, approach=None, layer=None, a_est
     for attempt in range(2):
         if mesh is None or remeshed:
             amesh = build_mesh(a_est, n_contact_elements=n_contact_elements, domain_factor=domain_factor,
-                               fine_radius=fine_radius, growth=growth)
+                               fine_radius=fine_radius, growth=growth, coating_thickness=thickness)
         else:
             amesh = mesh
         mesh_time += amesh.mesh_time_s if (mesh is None or remeshed) else 0.0
         model, sol, h, law, dc, timings = _one_mesh(
-            amesh, gap, (E1, nu1, E2, nu2), E_star, layer, penalty, force, approach,
+            amesh, gap, (E1, nu1, E2, nu2, coating1, coating2), E_star, layer, penalty, force, approach,
             truncation_correction, rtol, maxiter)
         p = sol.p.copy()
         p[0] = axis_pressure(model.r, p)

@@ -1,0 +1,180 @@
+"""A coating bonded to an elastic half-space: its surface compliance per Fourier mode.
+
+A body of the contact may carry a coating: an elastic layer of thickness ``t`` (Young's modulus
+``E_c``, Poisson's ratio ``nu_c``) bonded to the body's own material (the substrate, ``E_s``,
+``nu_s``), loaded on its free surface by a normal pressure without shear. Under a pressure mode
+``p(x) = P cos(q . x)`` the surface sinks by ``u(x) = S(q) P cos(q . x)`` with ::
+
+    S(q) = 2 s(q) / q,    s(q) = (1 - nu_c**2) / E_c * phi(q t)                       (1)
+
+the homogeneous half-space's ``2 (1 - nu**2) / (E q)`` with the coating's constants, times the
+coating factor ::
+
+    phi(x) = (1 + 4 kappa x e^(-2x) - lambda kappa e^(-4x))
+             / (1 - (lambda + kappa + 4 kappa x^2) e^(-2x) + lambda kappa e^(-4x))       (2)
+
+    lambda = 1 - 4 (1 - nu_c) / (1 + k (3 - 4 nu_s)),
+    kappa  = (k - 1) / (k + 3 - 4 nu_c),          k = mu_c / mu_s
+
+(``mu = E / (2 (1 + nu))`` the shear moduli; M. O'Sullivan and R. King, J. Tribol. 110 (1988)
+235-240, doi:10.1115/1.3261575, in the notation of docs/method.md section 7, which derives it).
+``phi`` tends to 1 for ``q t -> inf`` (the coating's half-space), to ``E*_c / E*_s`` for
+``q t -> 0`` (the substrate's; ``E* = E / (1 - nu**2)``), and is 1 for equal materials. A rigid
+substrate (``E_s = inf``) gives ``k = 0``, the layer on a rigid base.
+
+``s(q)`` plays the part of ``(1 - nu**2) / E`` in Johnson's ``1 / E* = (1 - nu1**2)/E1 +
+(1 - nu2**2)/E2``: two bodies, coated or not, have the combined symbol ``2 (s1(q) + s2(q)) / q``.
+
+Each factor of (2) is evaluated without overflow for every ``q t >= 0`` (only ``e^(-2x)`` is
+formed, and ``x`` above 350 gives ``phi = 1`` to round-off) and without cancellation of the
+``x -> 0`` limit (``1 - lambda kappa``, ``1 - lambda``, ``1 - kappa`` in closed form, ``1 - e^(-2x)``
+by ``expm1``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .checks import check_positive, check_range, check_scale
+from .materials import NU_MAX, NU_MIN
+
+__all__ = ["Coating", "coating_factor", "mode_compliance", "oedometric_compliance"]
+
+#: Beyond this ``q t`` every exponential of (2) is below 1e-300: ``phi = 1`` to round-off.
+_X_CLIP = 350.0
+
+
+@dataclass(frozen=True)
+class Coating:
+    """An elastic coating bonded to a body (the body's own ``E``, ``nu`` are the substrate's).
+
+    Parameters
+    ----------
+    thickness : float
+        Coating thickness ``t`` [length], finite and ``> 0``.
+    E : float
+        Young's modulus of the coating [pressure], finite and ``> 0``.
+    nu : float
+        Poisson's ratio of the coating [-], in ``(-1, 0.5]``.
+    """
+
+    thickness: float
+    E: float
+    nu: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "thickness", check_positive("thickness", self.thickness))
+        object.__setattr__(self, "E", check_scale("E", self.E))
+        object.__setattr__(self, "nu", check_range("nu", self.nu, NU_MIN, NU_MAX, low_open=True))
+
+
+def _substrate(E_substrate, nu_substrate):
+    nu_s = check_range("nu_substrate", nu_substrate, NU_MIN, NU_MAX, low_open=True)
+    if isinstance(E_substrate, (int, float)) and not isinstance(E_substrate, bool) and E_substrate == math.inf:
+        return math.inf, nu_s
+    return check_scale("E_substrate", E_substrate), nu_s
+
+
+def coating_factor(x, coating, E_substrate, nu_substrate):
+    """The coating factor ``phi(q t)`` of equation (2) of :mod:`bem.coating` [-].
+
+    Parameters
+    ----------
+    x : array_like
+        ``q t``, the wavenumber [1/length] times the coating thickness [length]; ``>= 0``.
+    coating : Coating
+        The coating (its ``thickness`` is not used: ``x`` carries it).
+    E_substrate : float
+        Young's modulus of the substrate [pressure]; ``math.inf`` for a rigid substrate.
+    nu_substrate : float
+        Poisson's ratio of the substrate [-], in ``(-1, 0.5]``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``phi`` at each ``x`` (a new array; ``x`` is not modified), between ``E*_c / E*_s`` at
+        ``x = 0`` and 1 as ``x -> inf``.
+    """
+    E_s, nu_s = _substrate(E_substrate, nu_substrate)
+    shape = np.shape(x)
+    x = np.minimum(np.asarray(x, dtype=float).ravel(), _X_CLIP)
+    if x.size and not np.all(x >= 0):
+        raise ValueError("x = q t must be >= 0 (and not NaN)")
+    nu_c = coating.nu
+    mu_c = coating.E / (2.0 * (1.0 + nu_c))
+    k = 0.0 if E_s == math.inf else mu_c / (E_s / (2.0 * (1.0 + nu_s)))
+    a_s, f = 3.0 - 4.0 * nu_s, 3.0 - 4.0 * nu_c
+    one_m_lam = 4.0 * (1.0 - nu_c) / (1.0 + k * a_s)           # 1 - lambda
+    one_m_kap = 4.0 * (1.0 - nu_c) / (k + f)                   # 1 - kappa
+    one_m_lk = k * (1.0 + a_s) * (1.0 + f) / ((1.0 + k * a_s) * (k + f))  # 1 - lambda kappa
+    lam, kap = 1.0 - one_m_lam, 1.0 - one_m_kap
+    lk = lam * kap
+    e = np.exp(-2.0 * x)
+    one_m_e = -np.expm1(-2.0 * x)
+    one_m_e2 = -np.expm1(-4.0 * x)
+    num = one_m_lk + lk * one_m_e2 + 4.0 * kap * x * e
+    den = one_m_lam * one_m_kap + (lam + kap) * one_m_e - lk * one_m_e2 - 4.0 * kap * x * x * e
+    # Below x = 1 the numerator times e^(2x) is (1 - lambda kappa) e^(2x) + 2 lambda kappa
+    # (sinh 2x - 2x) + 4 x kappa (1 + lambda): on a stiff substrate its terms cancel to order x
+    # (to x^3 for an incompressible coating), which this form keeps to round-off.
+    small = x < 1.0
+    if np.any(small):
+        xs = x[small]
+        grow = np.exp(2.0 * xs)
+        num_small = one_m_lk * grow + 2.0 * lk * _sinh_minus(2.0 * xs) + 4.0 * xs * kap * (2.0 - one_m_lam)
+        num[small] = num_small / grow
+    return (num / den).reshape(shape)
+
+
+def _sinh_minus(y):
+    """``sinh(y) - y`` for ``0 <= y < 2`` to round-off (its Taylor series below 1)."""
+    out = np.sinh(y) - y
+    low = y < 1.0
+    yl = y[low]
+    term, total = yl ** 3 / 6.0, np.zeros_like(yl)
+    for n in range(1, 11):  # y^(2n+1) / (2n+1)!, the last term below 1e-22
+        total += term
+        term = term * yl * yl / ((2 * n + 2) * (2 * n + 3))
+    out[low] = total
+    return out
+
+
+def mode_compliance(q, E, nu, coating=None):
+    """A body's compliance ``s(q)`` per Fourier mode, equation (1) of :mod:`bem.coating` [1/pressure].
+
+    Parameters
+    ----------
+    q : array_like
+        Wavenumbers ``|q|`` [1/length], ``>= 0``.
+    E, nu : float
+        The body's Young's modulus [pressure] (``math.inf``: rigid) and Poisson's ratio [-]; with a
+        coating, the substrate's.
+    coating : Coating, optional
+        The coating bonded to the body; ``None`` for a homogeneous body.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``s(q)``: ``(1 - nu**2) / E`` at every ``q`` without a coating; the surface sinks by
+        ``2 s(q) / q`` per unit pressure amplitude of the mode ``q``.
+    """
+    q = np.asarray(q, dtype=float)
+    if coating is None:
+        E_s, nu_s = _substrate(E, nu)
+        return np.full(q.shape, 0.0 if E_s == math.inf else (1.0 - nu_s * nu_s) / E_s)
+    base = (1.0 - coating.nu ** 2) / coating.E
+    return base * coating_factor(q * coating.thickness, coating, E, nu)
+
+
+def oedometric_compliance(coating):
+    """The coating's oedometric (laterally confined) compliance ``t (1 + nu)(1 - 2 nu) / ((1 - nu) E)`` [length/pressure].
+
+    The limit of ``2 s(q) / q`` on a rigid substrate as ``q t -> 0``: the compliance ``lam`` of
+    the linear Winkler layer ``w = lam p`` that a thin coating on a stiff substrate stands for
+    (0 for an incompressible coating, ``nu = 0.5``).
+    """
+    nu = coating.nu
+    return coating.thickness * (1.0 + nu) * (1.0 - 2.0 * nu) / ((1.0 - nu) * coating.E)
