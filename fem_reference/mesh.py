@@ -36,14 +36,14 @@ from __future__ import annotations
 
 import logging
 import math
-import signal
-import threading
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from bem.checks import InputError, check_int, check_positive
+
+from .gmsh_session import start_gmsh
 
 __all__ = ["AxiMesh", "build_mesh", "BOUNDARIES"]
 
@@ -322,29 +322,6 @@ def _to_skfem(xy, parts):
     return mesh, body, np.hstack(n6_blocks), np.hstack(c6_blocks), np.concatenate(coated)
 
 
-def _start_gmsh(gmsh):
-    """``gmsh.initialize``, keeping the process's ``SIGINT`` and ``SIGTERM`` handlers.
-
-    The gmsh library installs handlers of its own when it starts (its ``SIGTERM`` handler ends the
-    process at once, with no clean-up); the Python handlers are put back, the two signals blocked
-    meanwhile so that one arriving then reaches them (main thread; another cannot set handlers).
-    """
-    if threading.current_thread() is not threading.main_thread():
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
-        return
-    signums = {signal.SIGINT, signal.SIGTERM}
-    handlers = {signum: signal.getsignal(signum) for signum in signums}
-    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, signums) if hasattr(signal, "pthread_sigmask") else None
-    try:
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
-    finally:
-        for signum, handler in handlers.items():
-            if handler is not None:  # None: a handler not installed from Python, left as it is
-                signal.signal(signum, handler)
-        if blocked is not None:
-            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
-
-
 def _thicknesses(coating_thickness):
     """The two coating thicknesses, checked: ``None`` or finite and ``> 0``."""
     if not isinstance(coating_thickness, (tuple, list)) or len(coating_thickness) != 2:
@@ -398,7 +375,7 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
 
     import gmsh
 
-    _start_gmsh(gmsh)
+    start_gmsh(gmsh)
     try:
         _options(gmsh, min([h_fine] + [t / N_ACROSS_COATING for t in thickness if t]), h_coarse)
         gmsh.model.add("contactlab_axisymmetric")

@@ -177,7 +177,9 @@ def test_circle_check_sees_function_level_imports(tmp_path):
 KNOWN_PRIVATE_IMPORTS = {("bem.gaps.measured", "_positive_pair"), ("bem.gaps.measured", "_refuse"),
                          ("bem.gaps.measured", "_axis"), ("bem.reference.layer_limit", "_ClosedForm"),
                          ("bem.rough.instrument_files", "_pair"), ("bem.rough.instrument_files", "_surface"),
-                         ("bem.rough.instrument_files", "_surface_topography")}
+                         ("bem.rough.instrument_files", "_surface_topography"), ("bem.rough.patch", "_surface"),
+                         ("bem.rough.patch", "_surface_topography"), ("bem.rough.outliers", "_surface_topography"),
+                         ("bem.rough.outliers", "_pair")}
 
 
 def private_imports(modules, package):

@@ -35,7 +35,7 @@ from bem.files import umask, write_text
 from .folders import (KINDS, MARKER, NAME_MAX, OutputError, check_output_dir, leftover_prefixes, marked_files,
                       marker_kind, recover_output_dir, remove_marked, write_marker)
 
-__all__ = ["atomic_write_json", "json_text", "atomic_directory", "to_jsonable", "OutputError", "MARKER", "KINDS",
+__all__ = ["atomic_write_json", "json_text", "atomic_directory", "to_jsonable", "OutputError",
            "write_marker", "marker_kind", "marked_files", "check_output_dir", "recover_output_dir", "output_errors"]
 
 log = logging.getLogger(__name__)

@@ -130,8 +130,9 @@ def _check_size(args, synthetic=None, surface=None):
         check_node_count("--synthetic grid", nx, nx * nx, what="the surface grid")
         default = "--synthetic grid"
     else:
-        nx, size = surface.stats.grid[0], surface.size
-        default = "--n-cols (default: the surface's points along x)"
+        rough = getattr(surface, "surface", surface)  # the RoughSurface of a bem.rough.PatchCell
+        nx, size = rough.default_n_cols(), rough.size
+        default = "--n-cols (default: Lx / max(dx, dy) of the surface)"
     name = default if args.n_cols is None else "--n-cols"
     n_cols = check_int(name, nx if args.n_cols is None else args.n_cols, minimum=2)
     n_rows, n_cols = cell_shape(size, n_cols)

@@ -76,8 +76,13 @@ def add_args(p):
 
 
 def size_of(args):
-    """``--size LX,LY`` as a pair, or ``None``."""
-    return None if args.size is None else pair("--size", args.size, ",")
+    """``--size LX,LY`` as a pair of physical scales (:func:`bem.checks.check_scale`), or ``None``."""
+    from bem.checks import check_scale
+
+    if args.size is None:
+        return None
+    lx, ly = pair("--size", args.size, ",")
+    return check_scale("--size LX", lx), check_scale("--size LY", ly)
 
 
 def read(args):
