@@ -22,6 +22,17 @@ def instrument_file(name, folder):
     return target
 
 
+def unpacked(name):
+    """The path of the instrument file ``name``, decompressed once per test run into a temporary folder."""
+    import tempfile
+
+    target = Path(tempfile.gettempdir()) / "contactlab-test-data" / name
+    if not target.is_file():
+        target.parent.mkdir(parents=True, exist_ok=True)
+        instrument_file(name, target.parent)
+    return target
+
+
 def write_x3p(path, grid=(16, 12), size=(1e-5, 2.5e-5), seed=0):
     """A random height map [m] written as an .x3p (float64 data) by SurfaceTopography; returns the heights."""
     import SurfaceTopography as st

@@ -8,6 +8,8 @@ import pytest
 
 from bem import InputError, rough
 
+from ..instrument_data import unpacked
+
 pytest.importorskip("SurfaceTopography")
 
 SIZE = (1.0, 0.5)
@@ -125,12 +127,10 @@ def test_a_measured_patch_on_the_half_space_touches_at_its_highest_point_and_ref
     """The non-periodic path (bem.gaps.Measured, kind = "topography"; a scene's type = "measured"): the AFM scan
     spot_1-1000nm.ibw with its spikes, pressed lightly by a flat, carries the load on the particle at its
     highest point; a load that spreads the contact to the border of the region is refused."""
-    from pathlib import Path
-
     import bem
     from bem.gaps import Measured
 
-    spot = Path(__file__).resolve().parents[1] / "data" / "surfaces" / "spot_1-1000nm.ibw"
+    spot = unpacked("spot_1-1000nm.ibw")
     cell = rough.patch_cell(rough.read_surface(spot, detrend=None))
     z = np.asarray(cell.surface.heights)
     dx = cell.surface.size[0] / z.shape[0]

@@ -1,7 +1,6 @@
 """Spikes of a height map (bem.rough.find_spikes, remove_spikes): planted spikes on a seeded surface,
 normal heights without any, the particles of a real AFM scan, and the harmonic fill."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,7 +8,9 @@ import pytest
 from bem import InputError
 from bem.rough import SPIKE_THRESHOLD, find_spikes, remove_spikes
 
-SPOT = Path(__file__).resolve().parents[1] / "data" / "surfaces" / "spot_1-1000nm.ibw"
+from ..instrument_data import unpacked
+
+SPOT = unpacked("spot_1-1000nm.ibw")
 
 
 def _field(seed=3, n=128):

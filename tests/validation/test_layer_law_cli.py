@@ -3,7 +3,6 @@ three figures showing the ladder's data with units); bad input stops with exit c
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,6 +14,8 @@ from validation.run import execute_scene
 from validation.scene import load_scene
 
 from .conftest import cli
+
+from ..instrument_data import unpacked
 
 pytest.importorskip("SurfaceTopography")
 pytest.importorskip("matplotlib")
@@ -235,7 +236,7 @@ def test_the_stiffness_figure_draws_the_finite_stiffness_in_pa_per_m(folder):
     np.testing.assert_allclose(np.asarray(data.get_xdata(), float) * 1e9, law.mean_pressure, rtol=1e-12)
 
 
-SPOT = Path(__file__).resolve().parents[1] / "data" / "surfaces" / "spot_1-1000nm.ibw"
+SPOT = unpacked("spot_1-1000nm.ibw")
 
 
 @pytest.mark.parametrize("cell, seam_warnings", [("repeat", 1), ("mirror", 0)])
