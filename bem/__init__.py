@@ -11,6 +11,7 @@ surface under the computed pressure (:func:`subsurface_stress`).
 
 from . import checks, gaps, layers
 from .errors import InputError, RegionTooSmallError
+from .coating import Bodies, Coating
 from .lattice import Lattice
 from .materials import effective_modulus
 from .operator import InfluenceOperator, diagonal_coefficient
@@ -22,7 +23,7 @@ from .solve import solve
 from .stress import SubsurfaceStress, subsurface_stress
 from .template import template
 
-__all__ = ["solve", "solve_periodic", "HalfSpaceRegion", "PeriodicCell", "PeriodicOperator", "PeriodicContactResult",
+__all__ = ["solve", "solve_periodic", "Bodies", "Coating", "HalfSpaceRegion", "PeriodicCell", "PeriodicOperator", "PeriodicContactResult",
            "subsurface_stress", "SubsurfaceStress", "template", "Lattice", "InfluenceOperator",
            "ContactResult", "STATUSES", "METHODS", "OPTIONS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
            "effective_modulus", "gaps", "layers"]

@@ -39,9 +39,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .checks import check_positive, check_range, check_scale
+from .errors import InputError
 from .materials import NU_MAX, NU_MIN
 
-__all__ = ["Coating", "coating_factor", "mode_compliance", "oedometric_compliance"]
+__all__ = ["Bodies", "Coating", "coating_factor", "mode_compliance", "oedometric_compliance"]
 
 #: Beyond this ``q t`` every exponential of (2) is below 1e-300: ``phi = 1`` to round-off.
 _X_CLIP = 350.0
@@ -178,3 +179,62 @@ def oedometric_compliance(coating):
     """
     nu = coating.nu
     return coating.thickness * (1.0 + nu) * (1.0 - 2.0 * nu) / ((1.0 - nu) * coating.E)
+
+
+@dataclass(frozen=True)
+class Bodies:
+    """The two bodies of a contact whose compliance is not one ``E*``: a coating on either or both.
+
+    Parameters
+    ----------
+    E1, nu1, E2, nu2 : float
+        Young's moduli [pressure] (``math.inf``: rigid) and Poisson's ratios [-] of the bodies; of
+        the substrates where a body is coated.
+    coating1, coating2 : Coating, optional
+        The coating of each body; ``None`` for a homogeneous body.
+
+    Notes
+    -----
+    The combined compliance of mode ``q`` is ``2 (s1(q) + s2(q)) / q`` [length/pressure per
+    wavenumber] (:func:`mode_compliance`); :attr:`E_star` is that of the substrates, the limit
+    ``q -> 0`` (long waves see through the coatings).
+    """
+
+    E1: float
+    nu1: float
+    E2: float
+    nu2: float
+    coating1: Coating | None = None
+    coating2: Coating | None = None
+
+    def __post_init__(self):
+        for i, (E, nu) in enumerate(((self.E1, self.nu1), (self.E2, self.nu2)), start=1):
+            _substrate_named(f"E{i}", E, f"nu{i}", nu)
+            coating = getattr(self, f"coating{i}")
+            if coating is not None and not isinstance(coating, Coating):
+                raise InputError(f"coating{i} = {coating!r} is not allowed: it must be a bem.Coating or None.")
+        if self.E1 == math.inf and self.E2 == math.inf:
+            raise InputError("E1 = E2 = inf is not allowed: at least one body must be elastic.")
+
+    @property
+    def is_coated(self):
+        """Whether either body carries a coating."""
+        return self.coating1 is not None or self.coating2 is not None
+
+    @property
+    def E_star(self):
+        """The effective modulus of the substrates ``1 / (s1(0) + s2(0))`` [pressure]."""
+        return 1.0 / float(mode_compliance(0.0, self.E1, self.nu1) + mode_compliance(0.0, self.E2, self.nu2))
+
+    def compliance(self, q):
+        """``s1(q) + s2(q)`` [1/pressure] at the wavenumbers ``q`` [1/length]; the surface closure of mode
+        ``q`` is ``2 (s1 + s2) / q`` per unit pressure amplitude."""
+        return (mode_compliance(q, self.E1, self.nu1, self.coating1)
+                + mode_compliance(q, self.E2, self.nu2, self.coating2))
+
+
+def _substrate_named(E_name, E, nu_name, nu):
+    """``_substrate`` with the messages naming the body's keywords."""
+    check_range(nu_name, nu, NU_MIN, NU_MAX, low_open=True)
+    if not (isinstance(E, (int, float)) and not isinstance(E, bool) and E == math.inf):
+        check_scale(E_name, E)
