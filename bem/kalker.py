@@ -19,7 +19,7 @@ import numpy as np
 from .backend import operator_backend
 from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, carry_force, entering_pressure, initial_pressure, is_per_node,
                        iterate_residual, run_constrained_cg)
-from .plastic import fill_force, leaving_pressure, plastic_approach
+from .plastic import fill_force, leaving_pressure, note_fully_plastic, plastic_approach
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
@@ -333,10 +333,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     kkt = run_constrained_cg(CGStep(measure_bounded if bounded else measure, confirms, observe, advance, lambda: p),
                              record, maxiter, callback)
-    if bracket is not None and record.converged and not bool(xp.any(contact)):
-        record.message += (f"; fully plastic: every contact node at the hardness, the approach is any value in "
-                           f"[{bracket[0]:.6g}, {bracket[1]:.6g}], the lower end returned")
-        record.history["approach_bracket"] = list(bracket)
+    note_fully_plastic(record, bracket, bounded and not bool(xp.any(contact)))
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return record.solution(p, delta, kkt, elastic, "Kalker QP")
 

@@ -33,7 +33,7 @@ from .cg_rules import QPSolution
 from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
-from .plastic import clip, fill_force
+from .plastic import clip, fill_force, fully_plastic_note
 
 __all__ = ["solve_newton"]
 
@@ -319,6 +319,10 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         p, u = _release(op, layer, h, p, u, sub.p, delta, force=force, hardness=hardness)
         if callback is not None:
             callback(k + 1, p)
+    if converged and hardness is not None and force is not None and (
+            bracket := _plastic_bracket(bk, mask, p, gap + delta, hardness)) is not None:
+        hist["approach_bracket"] = list(bracket)
+        message += fully_plastic_note(bracket)
     if not converged:
         log.debug("Newton: %s", message)
     out = QPSolution(p=p, approach=delta, iterations=len(hist["step"]), converged=converged, message=message,
@@ -327,6 +331,17 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         out = _force_by_approach(op, h, layer, force, out, rtol=rtol, maxiter=maxiter, precondition=precondition,
                                  inner_maxiter=inner_maxiter, hardness=hardness)
     return out
+
+
+def _plastic_bracket(bk, mask, p, v, hardness):
+    """The interval of the approach (:func:`bem.plastic.plastic_approach`) where every contact node is plastic,
+    else None; ``v = C p + w(p) + h``."""
+    xp = bk.xp
+    plastic = mask & (p >= hardness)
+    if bool(xp.any(mask & (p > 0) & ~plastic)) or not bool(xp.any(plastic)):
+        return None
+    open_ = mask & (p <= 0)
+    return float(xp.max(v[plastic])), float(xp.min(v[open_])) if bool(xp.any(open_)) else math.inf
 
 
 class _ApproachFailed(Exception):

@@ -116,6 +116,34 @@ def test_a_flat_punch_that_yields_everywhere_carries_the_hardness_on_its_area():
     assert res.kkt_residual <= 1e-12
 
 
+@pytest.mark.parametrize("layer", [None, bem.layers.Power(0.1, 0.5)], ids=["qp", "newton_power"])
+@pytest.mark.parametrize("share", [1.0, 0.999])
+def test_a_flat_punch_at_and_just_below_the_fully_plastic_load(layer, share):
+    """At the load H N a every node of the flat yields (the approach's interval reported); just below it all but
+    a few do, and the conditions hold. A step that clips many nodes at 0 and others at H carries more than
+    the force at H alone: every node is scaled down then (bem.plastic.fill_force)."""
+    H = 0.2
+
+    def gap(x, y):
+        return np.where(np.hypot(x, y) <= 0.3, 0.0, 1.0)
+
+    region = bem.HalfSpaceRegion(0.05, (0.6, 0.6))
+    lat = region.lattice()
+    n = int((lat.mask & (gap(lat.x, lat.y) == 0.0)).sum())
+    force = share * H * lat.node_area * n
+    res = bem.solve(gap, E_star=1.0, force=force, domain=region, hardness=H, layer=layer)
+    assert res.status == "converged", res.message
+    assert res.kkt_residual <= 1e-10 and res.force == pytest.approx(force, rel=1e-14)
+    if share == 1.0:
+        assert "fully plastic" in res.message and len(res.history["approach_bracket"]) == 2
+        assert res.plastic_area == pytest.approx(force / H, rel=1e-14)
+    else:
+        assert "fully plastic" not in res.message and 0 < n * lat.node_area - res.plastic_area
+        assert res.contact_area == pytest.approx(n * lat.node_area, rel=1e-14)  # the flat, no more
+    u, h = _sphere_dense(res, gap)
+    assert _bounded_kkt(res, u, h, force=force) <= 1e-10
+
+
 def test_a_plateau_on_a_cell_that_yields_everywhere():
     cell = bem.PeriodicCell(1.0 / 32, 32, 32)
     h = np.where(np.hypot(cell.x - 0.5, cell.y - 0.5 * cell.size[1]) <= 0.2, 0.0, 0.05)
