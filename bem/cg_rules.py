@@ -3,7 +3,9 @@
 The start (:func:`initial_pressure`), the KKT residual of an iterate (:func:`iterate_residual`),
 the stopping rule (:func:`stopping_rule`), the pressure of the nodes that enter the contact
 (:func:`entering_pressure`), the exact product every :data:`RECOMPUTE_EVERY` updates, and the
-record of the iteration and its outcome (:class:`Record`, :class:`QPSolution`). The steps are
+record of the iteration and its outcome (:class:`Record`, :class:`QPSolution`); with a hardness
+(:mod:`bem.plastic`) the sets of an iterate (:func:`bounded_sets`) and the projected step with its
+entering and leaving nodes (:func:`bounded_move`). The steps are
 :func:`bem.kalker.solve_qp` (the general loop, any array namespace) and
 :func:`bem.periodic.qp.solve_periodic_qp` (a periodic cell in the Fourier basis); each
 operator picks its own (``op.qp``).
