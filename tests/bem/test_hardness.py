@@ -331,3 +331,26 @@ def test_the_bound_runs_on_a_strict_array_namespace(monkeypatch, layer, domain):
     assert ref.status == res.status == "converged" and ref.plastic_area > 0
     assert np.abs(res.p - ref.p).max() <= 1e-10 * ref.p_max
     assert res.plastic_area == ref.plastic_area
+
+
+@pytest.mark.parametrize("domain", ["region", "cell"])
+def test_every_level_of_nested_iteration_carries_the_bound(monkeypatch, domain):
+    import sys
+
+    driver = sys.modules["bem.solve"]
+    run, levels = driver._run, []
+
+    def spy(solver, op, h, *args):
+        sol = run(solver, op, h, *args)
+        levels.append((op.lattice.n_nodes, float(sol.p.max())))
+        return sol
+
+    monkeypatch.setattr(driver, "_run", spy)
+    if domain == "region":
+        res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.02, extent=1.3, hardness=0.3)
+    else:
+        cell = bem.PeriodicCell(1.0 / 128, 128, 128)
+        res = bem.solve_periodic(_rough(cell), step=cell.step, E_star=1.0, mean_pressure=0.02, hardness=0.05)
+    assert res.status == "converged" and len(levels) >= 2
+    assert levels[0][0] < levels[-1][0]  # coarse to fine
+    assert all(p_max == res.hardness for _, p_max in levels)  # each level has plastic nodes, none above H
