@@ -250,6 +250,17 @@ def test_newton_with_a_nonlinear_layer_meets_the_bounded_kkt_conditions(control)
     assert _bounded_kkt(res, u, h, force=kw.get("force")) <= 1e-10
 
 
+def test_newton_settles_a_node_that_its_model_puts_at_the_hardness():
+    """A node just below H whose model puts it at H: damped steps never reached it (33 Newton steps at a
+    constant residual 9e-3 on this problem); moved there (bem.newton_moves.settle_plastic), 7."""
+    layer = bem.layers.Power(0.1, 0.5)
+    soft = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.5, layer=layer)
+    res = bem.solve(Paraboloid(1.0), E_star=1.0, step=0.05, extent="auto", layer=layer, hardness=0.3,
+                    approach=soft.approach)
+    assert res.status == "converged" and res.plastic_area > 0
+    assert res.iterations <= 10
+
+
 def test_newton_on_a_rough_cell_with_a_layer():
     h = _rough(CELL)
     layer = bem.layers.Power(0.002, 0.5)
