@@ -172,15 +172,18 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
     gz_old, m_one, m_full = 1.0, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
-    prev_contact = p > 0
-    n_prev = int(np.count_nonzero(prev_contact))
+    was_on = p > 0  # the contact of the previous iterate, updated at its nodes only
+    was_onf = was_on.reshape(-1)
+    prev_idx = np.flatnonzero(was_onf)
+    n_prev = int(prev_idx.size)
     fixed_scale = scale
-    contact = idx = g_c = p_c0 = g_min = None
+    idx = g_c = p_c0 = g_min = None
+    stepped = np.empty(0, dtype=np.intp)  # the nodes where r32, t and z_prev hold values (zero elsewhere)
+    r32_full = True  # r32 holds values off those nodes (the product of M and the starting contact)
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
-        nonlocal contact, idx, g_c, p_c0, delta, g_min, single
-        contact = p > 0
-        idx = np.flatnonzero(contact)
+        nonlocal idx, g_c, p_c0, delta, g_min, single
+        idx = np.flatnonzero(pf)  # p >= 0: the contact p > 0
         np.add(u, h, out=g)  # the gap is g - delta: delta is subtracted on the contact only
         g_c, p_c0 = np.take(gf, idx), np.take(pf, idx)
         if force is not None:
@@ -205,16 +208,22 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return False
 
     def observe():
-        nonlocal prev_contact, n_prev
-        kept = int(np.count_nonzero(prev_contact.reshape(-1)[idx]))  # nodes in both contacts
+        nonlocal prev_idx, n_prev
+        kept = int(np.count_nonzero(was_onf[idx]))  # nodes in both contacts
         changes = (idx.size - kept) + (n_prev - kept)
-        prev_contact, n_prev = contact, idx.size
+        was_onf[prev_idx] = False
+        was_onf[idx] = True
+        prev_idx, n_prev = idx, idx.size
         return float(p_c0.max(initial=0.0)), int(idx.size), changes, idx.size == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, gz_old, r_hat, u, stale
+        nonlocal m_full, m_one, gz_old, r_hat, u, stale, stepped, r32_full
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        r32.fill(0.0)
+        if r32_full:
+            r32.fill(0.0)
+            r32_full = False
+        else:  # zero where the last step wrote
+            r32f[stepped] = 0.0
         if soft is None:
             r32f[idx] = g_c
         else:
@@ -227,7 +236,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
             if m_full is None:
-                np.multiply(contact, stiff, out=r32, casting="unsafe")
+                np.multiply(pf.reshape(p.shape) > 0, stiff, out=r32, casting="unsafe")
+                r32_full = True
                 x = op.spectrum(r32)  # M (contact & stiff), and the Jacobi estimate at the soft nodes
                 m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1).astype(float)
                 m_full[softf] = jacf[softf]
@@ -239,7 +249,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
         beta = 0.0 if k == 1 or gz_old == 0 else max(  # gz_old = 0: one contact node under force control
             0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
-        z_prev.fill(0.0)
+        zf[stepped] = 0.0
         zf[idx] = z
         t_c = z + beta * np.take(tf, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
@@ -247,8 +257,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         gt = float(np.einsum("i,i->", g_c, t_c))
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
-        t.fill(0.0)
+        tf[stepped] = 0.0
         tf[idx] = t_c
+        stepped = idx
         gz_old = gz
         T = op.spectrum(t)
         op.n_matvec += 1
