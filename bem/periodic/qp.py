@@ -16,7 +16,7 @@ rough surface, whose contact set changes at most iterations until it settles, th
 restarts at every change and degrades to preconditioned steepest descent
 (``tests/bem/test_periodic_qp.py``: 88 iterations against 57 on a 256 x 256 self-affine cell).
 Nodes that enter the contact (``p = 0``, ``g < 0``) take the step of the preconditioned iteration
-with half the Jacobi estimate of the preconditioner at that node, ``p = -f min(tau, 1) g / (C_nn + lam)``
+with a share of the Jacobi estimate of the preconditioner at that node, ``p = -f min(tau, 1) g / (C_nn + lam)``
 (``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`, chosen by the iteration counts stated there):
 ``tau`` is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give an entering node
 ``tau C_nn`` of its Jacobi pressure, a fraction that falls with the step (on a 672 x 776 rough cell,
