@@ -43,7 +43,8 @@ from .lattice_heights import cell_shape
 from .outliers import SPIKE_THRESHOLD, Spikes, find_spikes, remove_spikes
 from .surface import DETRENDS, MIN_POINTS, RoughSurface, _surface, _surface_topography
 
-__all__ = ["PatchCell", "patch_cell", "cell_grid", "check_cell_size", "quiet_seam", "DETREND_CHOICES", "CELLS", "SPIKE_ACTIONS"]
+__all__ = ["PatchCell", "patch_cell", "cell_grid", "check_cell_size", "quiet_seam", "DETREND_CHOICES", "CELLS",
+           "SPIKE_ACTIONS"]
 
 log = logging.getLogger(__name__)
 

@@ -131,8 +131,8 @@ def test_a_periodic_file_is_refused_a_plane_taken_off(tmp_path):
     z = np.random.default_rng(3).normal(size=(32, 32)) * 1e-7
     (tmp_path / "data").mkdir()
     st.Topography(z, (1e-5, 1e-5), periodic=True).to_netcdf(str(tmp_path / "data" / "periodic.nc"))
-    with pytest.raises(SceneError, match=r"^gap.detrend = 'height' is not allowed: it must be 'none', 'center' or 'auto' "
-                                         r"for a periodic surface"):
+    with pytest.raises(SceneError, match=r"^gap.detrend = 'height' is not allowed: it must be 'none', 'center' or "
+                                         r"'auto' for a periodic surface"):
         load_scene(_scene(tmp_path, {"file": "periodic.nc", "detrend": "height"}))
     kept = load_scene(_scene(tmp_path, {"file": "periodic.nc"})).gap
     assert kept.cell.detrend == "none" and kept.cell.cell == "periodic"
