@@ -40,7 +40,8 @@ NAMES = ("surface.json", "heights.png", "psd.png")
 #: the names of read_surface's arguments as this command's options
 OPTION_NAMES = {"file": "FILE", "unit": "--scale", "physical_sizes": "--size", "fill": "--fill",
                 "format": "--format", "channel": "--channel", "detrend": "--detrend",
-                "physical_sizes_rule": "--size LX,LY", "unit_rule": "--scale M, metres per length unit of the file (e.g. --scale 1e-6 for micrometres)"}
+                "physical_sizes_rule": "--size LX,LY",
+                "unit_rule": "--scale M, metres per length unit of the file (e.g. --scale 1e-6 for micrometres)"}
 
 
 def add_file_args(p):
