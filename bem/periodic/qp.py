@@ -45,6 +45,9 @@ those of ``C`` alone, ``u = C p + D p`` and the curvature adds ``sum D t^2``; th
 is that of :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique
 projection under force control (by ``M 1`` of the starting contact).
 
+With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H``
+and the step is that of every constrained-CG step (:func:`bem.cg_rules.bounded_move`).
+
 A step costs four transforms of the cell in single precision while the contact set does not
 change (two for the preconditioner, one forward for the search direction, one inverse for its
 product), five where it changes, two of them in double precision once the residual is below
