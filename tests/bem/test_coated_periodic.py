@@ -28,7 +28,7 @@ def test_a_coating_of_the_substrate_gives_the_homogeneous_operator(coating2):
     same = bem.Coating(0.7, ES, NUS)
     op = _op(cell, same, E2=3.0, nu2=0.2, coating2=bem.Coating(0.3, 3.0, 0.2) if coating2 else None)
     hom = PeriodicOperator(cell, bem.effective_modulus(ES, NUS, 3.0, 0.2))
-    assert np.abs(op.kernel - hom.kernel).max() <= 1e-15 * np.abs(hom.kernel).max()  # measured 0 .. 3e-17
+    assert np.abs(op.kernel - hom.kernel).max() <= 1e-15 * np.abs(hom.kernel).max()  # measured 0
     assert op.diagonal == pytest.approx(hom.diagonal, rel=1e-15)
 
 
@@ -67,7 +67,7 @@ def test_a_thin_coating_tends_to_the_substrate_at_first_order():
     diff = [np.abs(_op(cell, bem.Coating(t, 1.0, 0.3)).kernel - sub.kernel).max() / sub.diagonal
             for t in (0.1, 0.05, 0.025)]
     orders = [math.log2(diff[k] / diff[k + 1]) for k in range(2)]
-    assert all(0.85 < o < 1.1 for o in orders), orders  # measured 0.95, 0.96
+    assert all(0.85 < o < 1.1 for o in orders), orders  # measured 0.90 .. 0.98
 
 
 def test_a_cosine_pressure_mode_gives_the_closed_form_displacement_as_the_lattice_refines():
@@ -86,8 +86,8 @@ def test_a_cosine_pressure_mode_gives_the_closed_form_displacement_as_the_lattic
         u = op.matvec(p)
         errors.append(np.abs(u - closed * p).max() / closed)
     orders = [math.log2(errors[k] / errors[k + 1]) for k in range(2)]
-    assert min(orders) > 1.9, (errors, orders)  # measured 2.00, 2.00: the pyramid basis is second order
-    assert errors[-1] < 2e-3
+    assert min(orders) > 1.85, (errors, orders)  # measured 1.92, 1.96: the pyramid basis is second order
+    assert errors[-1] < 1e-3  # measured 5.9e-4
 
 
 @pytest.mark.parametrize("shape", [(6, 5), (8, 12)])
@@ -95,11 +95,11 @@ def test_coated_operator_is_a_symmetric_positive_semidefinite_matrix_with_zero_m
     cell = PeriodicCell(0.3, shape[1], shape[0])
     op = _op(cell, bem.Coating(0.2, 50.0, 0.2), E2=1.0, nu2=0.4, coating2=bem.Coating(0.5, 0.1, 0.45))
     dense = op.dense()
-    assert np.abs(dense - dense.T).max() <= 1e-13 * np.abs(dense).max()
+    assert np.abs(dense - dense.T).max() <= 1e-13 * np.abs(dense).max()  # measured 9.7e-15
     p = np.random.default_rng(3).random(cell.shape)
     u = op.matvec(p)
     scale = (np.abs(dense) @ p.ravel()).max()  # the round-off of a product is relative to sum |C| p
-    assert np.abs(u.ravel() - dense @ p.ravel()).max() <= 1e-14 * scale  # measured 1.3e-15
+    assert np.abs(u.ravel() - dense @ p.ravel()).max() <= 1e-14 * scale  # measured 3.5e-15
     assert abs(u.mean()) <= 1e-15 * scale
     eig = np.linalg.eigvalsh(dense)
     assert abs(eig[0]) <= 1e-14 * eig[-1] and eig[1] > 1e-3 * eig[-1]  # one zero mode: the constant
@@ -120,8 +120,8 @@ def test_full_contact_of_a_wavy_coated_surface_gives_the_closed_form_pressure():
         p = res.grid()
         errors.append(np.abs(p - (pbar + amplitude * np.cos(q * cell.x))).max() / amplitude)
     orders = [math.log2(errors[k] / errors[k + 1]) for k in range(2)]
-    assert min(orders) > 1.9, (errors, orders)  # measured 2.0
-    assert errors[-1] < 2e-3
+    assert min(orders) > 1.85, (errors, orders)  # measured 1.94, 1.97 (KKT 2e-13 .. 5e-12)
+    assert errors[-1] < 1e-3  # measured 5.9e-4
 
 
 @pytest.mark.parametrize("method", ["newton", "kalker"])
