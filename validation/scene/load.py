@@ -40,6 +40,7 @@ from ..units import Units
 from . import checks as ck
 from . import schema as sec
 from .checks import SceneError, closest
+from .coatings import coated_sections
 from .measured import measured_region
 from .paper import ALIASES
 from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
@@ -279,7 +280,7 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     report = check(sec.report, raw.get("report"))
     stress = check(lambda b, bo: sec.stress_options(raw.get("stress"), b["materials"], bo["step"]), body, bem)
     stress = check(lambda st, bo: sec.stress_depth_bound(st, bo["extent"]), stress, bem)
-    check(lambda b: _coated(b, raw), body)
+    check(lambda b: coated_sections(b["coatings"], raw), body)
     if check.errors:
         raise SceneError.of(check.errors)
     return Scene(
@@ -290,18 +291,6 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
         base_dir=None if base_dir is None else str(base_dir), allow_code=code == "import",
         allow_outside_files=outside_files, unimported=unimported,
     )
-
-
-def _coated(body, raw):
-    """A coated scene has no ``[stress]`` and no ``[analytic]``: both are those of homogeneous bodies."""
-    if body["coatings"] is None:
-        return
-    coated = next(k for k, v in body["coatings"].items() if v is not None)
-    for section, what in (("stress", "the subsurface stresses of homogeneous half-spaces"),
-                          ("analytic", "closed forms of homogeneous bodies")):
-        if section in raw:
-            raise SceneError(f"{section} = {{...}} is not allowed with bodies.{coated}: [{section}] gives {what}; "
-                             f"remove [{section}] or the coating.")
 
 
 def _check_sweep_points(scene, **kw):

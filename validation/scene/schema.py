@@ -21,6 +21,7 @@ from bem.stress import Z_MAX_STEPS
 from ..units import DEFAULT_LABEL as DEFAULT_UNITS
 from ..units import parse_units
 from . import checks as ck
+from .coatings import COATING_KEYS, coating
 from .layer_file import is_layer_file, read_layer_file
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
@@ -36,9 +37,6 @@ __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analy
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 BODY_KEYS = ("E1", "nu1", "E2", "nu2")
-#: the coating of each body, a table ``{thickness, E, nu}`` (:class:`bem.Coating`)
-COATING_KEYS = ("coating1", "coating2")
-COATING_FIELDS = ("thickness", "E", "nu")
 #: the ``[fem]`` options and their checks, in the order they are checked
 _FEM_OPTIONS = {"n_contact_elements": partial(ck.integer, minimum=4, maximum=400),
                 **dict.fromkeys(("domain_factor", "fine_radius", "growth", "penalty"), ck.positive), "rtol": ck.rtol,
@@ -133,21 +131,8 @@ def bodies(d):
         ck.require("bodies", d, key, "give E1, nu1, E2, nu2 [Pa, -] (or E_star alone)")
     with ck.scene_errors("bodies."):
         E_star = effective_modulus(*(d[k] for k in BODY_KEYS))
-    coatings = {k: _coating(f"bodies.{k}", d[k]) if k in d else None for k in COATING_KEYS} if coated else None
+    coatings = {k: coating(f"bodies.{k}", d[k]) if k in d else None for k in COATING_KEYS} if coated else None
     return {"E_star": E_star, "materials": {k: float(d[k]) for k in BODY_KEYS}, "coatings": coatings}
-
-
-def _coating(path, d):
-    """A coating table ``{thickness [length], E [pressure], nu [-]}``, checked as :class:`bem.Coating` does."""
-    from bem import Coating
-
-    ck.table(path, d)
-    ck.unknown_keys(path, d, COATING_FIELDS)
-    for key in COATING_FIELDS:
-        ck.require(path, d, key, "give thickness [m], E [Pa] and nu [-] of the coating")
-    with ck.scene_errors(f"{path}."):
-        Coating(d["thickness"], d["E"], d["nu"])
-    return {key: float(d[key]) for key in COATING_FIELDS}
 
 
 class Unimported(gaps.Gap):
