@@ -8,6 +8,7 @@ import pytest
 
 import bem
 from validation.run import run_scene
+from validation.report.documents.sweep import report_sweep_dir
 from validation.run.runner import domain_of
 from validation.run.sweep import run_sweep, sweep_points
 from validation.scene import SceneError, parse_scene
@@ -57,6 +58,8 @@ def test_a_sweep_over_coating_thickness_and_modulus(tmp_path):
     assert p_max[1] > p_max[0]  # a stiffer coating carries the asperities on fewer, harder spots
     point = json.loads((tmp_path / "sweep" / summary["points"][1]["file"]).read_text())
     assert point["result"]["bem"]["coating1"] == {**COATING, "E": 1e11}
+    built = report_sweep_dir(tmp_path / "sweep", tmp_path / "report")
+    assert r"bodies.coating1.E \[MPa\]" in built.markdown.read_text()  # the swept modulus in the report's pressure unit
 
 
 @pytest.mark.parametrize("change, message", [
