@@ -22,7 +22,8 @@ the cell's longest wave) gives the coating's operator, and every term is formed 
 
 Cost
     The sum has about ``0.069 N g^2`` terms for ``N`` nodes and the cut ``g`` [1/step], with
-    ``g`` close to ``20 c / t`` for the thinnest coating: it grows like ``(c / t)^2``.
+    ``g`` close to ``20 c / t`` for the thinnest coating: it grows like ``(c / t)^2``, and is the
+    same for every level of nested iteration (``N c^2`` is the cell's area).
     :data:`MAX_TERMS` bounds it; a thinner coating is refused with the step that would resolve it
     (benchmarks/coated_symbol.py measures the build).
 """
@@ -104,7 +105,7 @@ def coated_template(n_rows, n_cols, step, bodies):
     return _cached(int(n_rows), int(n_cols), float(step), bodies)
 
 
-@lru_cache(maxsize=4)
+@lru_cache(maxsize=8)  # the levels of nested iteration of one or two cells
 def _cached(n_rows, n_cols, step, bodies):
     E_star = bodies.E_star
     s_inf = sum(_s_inf(*b) for b in _bodies(bodies))
