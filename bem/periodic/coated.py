@@ -39,7 +39,7 @@ from ..coating import mode_compliance
 from ..errors import InputError
 from .kernel import alias_sum, periodic_template
 
-__all__ = ["coated_template", "alias_cut", "MAX_TERMS"]
+__all__ = ["coated_template", "alias_cut", "thin_limit", "MAX_TERMS"]
 
 #: The largest number of alias terms one coated periodic template sums (memory and time bound).
 MAX_TERMS = 400_000_000
@@ -67,6 +67,42 @@ def _excess(k, bodies, step):
 
 def _bodies(bodies):
     return ((bodies.E1, bodies.nu1, bodies.coating1), (bodies.E2, bodies.nu2, bodies.coating2))
+
+
+def thin_limit(bodies):
+    """The compliance ``lim_{q -> 0} 2 (s(q) - s(0)) / q`` of the coatings [length/pressure].
+
+    A coating much thinner than the step is, on the lattice, the substrate plus this linear layer
+    ``w = lam p`` (docs/method.md, "Coated bodies on the periodic cell"): ``2 t s_c phi'(0)`` per
+    coating, with ``phi'(0) = (N'(0) D(0) - N(0) D'(0)) / D(0)^2`` of the numerator ``N`` and the
+    denominator ``D`` of :func:`bem.coating.coating_factor`. On a rigid substrate it is the
+    oedometric compliance (:func:`bem.coating.oedometric_compliance`).
+    """
+    total = 0.0
+    for E, nu, coating in _bodies(bodies):
+        if coating is None:
+            continue
+        nu_c = coating.nu
+        mu_c = coating.E / (2.0 * (1.0 + nu_c))
+        k = 0.0 if E == math.inf else mu_c / (E / (2.0 * (1.0 + nu)))
+        a_s, f = 3.0 - 4.0 * nu, 3.0 - 4.0 * nu_c
+        one_m_lam = 4.0 * (1.0 - nu_c) / (1.0 + k * a_s)
+        one_m_kap = 4.0 * (1.0 - nu_c) / (k + f)
+        one_m_lk = k * (1.0 + a_s) * (1.0 + f) / ((1.0 + k * a_s) * (k + f))
+        lam, kap = 1.0 - one_m_lam, 1.0 - one_m_kap
+        d0 = one_m_lam * one_m_kap
+        dphi = (4.0 * kap * (1.0 + lam) * d0 - one_m_lk * (2.0 * (lam + kap) - 4.0 * lam * kap)) / (d0 * d0)
+        total += 2.0 * coating.thickness * (1.0 - nu_c ** 2) / coating.E * dphi
+    return total
+
+
+def _thin_hint(lam):
+    where = "docs/method.md, coated bodies on the periodic cell"
+    if lam > 0:
+        return (f"A coating much thinner than the step is, on this lattice, the substrate with the linear layer "
+                f"w = lam p, lam = {lam:.6g} (bem.layers.Linear; {where}).")
+    return (f"A coating much thinner than the step stiffens the substrate's surface by the compliance {lam:.6g} on "
+            f"the diagonal, which no layer law stands for ({where}).")
 
 
 def alias_cut(bodies, step):
@@ -117,8 +153,7 @@ def _cached(n_rows, n_cols, step, bodies):
         raise InputError(
             f"thickness = {t!r} is not allowed with step = {step!r} on this cell of {n_rows * n_cols} nodes: the "
             f"periodic coated symbol would sum about {terms:.2g} alias terms (at most {MAX_TERMS:.0e}, which a step "
-            f"of {fine:.3g} or a cell of fewer nodes keeps); a coating much thinner than the step is resolved by a "
-            "finer lattice.")
+            f"of {fine:.3g} or a cell of fewer nodes keeps). {_thin_hint(thin_limit(bodies))}")
 
     def radial(k):
         return 2 * math.pi / k * E_star * _excess(k, bodies, step)

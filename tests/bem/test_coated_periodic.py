@@ -8,7 +8,7 @@ import pytest
 import bem
 from bem.coating import mode_compliance, oedometric_compliance
 from bem.periodic import PeriodicCell, PeriodicOperator
-from bem.periodic.coated import MAX_TERMS
+from bem.periodic.coated import MAX_TERMS, thin_limit
 
 ES, NUS = 2.0, 0.3  # the substrate of body 1
 
@@ -59,6 +59,36 @@ def test_a_thin_coating_on_a_rigid_substrate_tends_to_the_oedometric_layer(Ec, n
     orders = [math.log2(errors[k] / errors[k + 1]) for k in range(2)]
     assert min(orders) > 1.2, (errors, orders)  # measured 1.3 .. 2.2
     assert errors[-1] < 0.05  # measured 1.3e-3, 5.2e-5, 4.5e-2 (nearly incompressible: the slowest)
+
+
+@pytest.mark.parametrize("Ec, nuc, Es, nus", [(1.0, 0.3, 2.0, 0.3), (20.0, 0.45, 2.0, 0.2), (0.05, 0.49, 2.0, 0.3),
+                                             (3.0, 0.0, math.inf, 0.3), (3.0, 0.5, math.inf, 0.3)])
+def test_thin_limit_is_the_long_wave_slope_of_the_compliance(Ec, nuc, Es, nus):
+    """lim 2 (s(q) - s(0)) / q: against a Richardson extrapolation of mode_compliance, and on a rigid
+    substrate the oedometric compliance."""
+    coating = bem.Coating(0.01, Ec, nuc)
+    lam = thin_limit(bem.Bodies(Es, nus, 1.0, 0.3, coating))
+    q = np.array([1e-2, 5e-3, 2.5e-3])
+    slope = 2 * (mode_compliance(q, Es, nus, coating) - mode_compliance(0.0, Es, nus, coating)) / q
+    assert lam == pytest.approx((8 * slope[2] - 6 * slope[1] + slope[0]) / 3, rel=1e-8, abs=1e-15)  # measured 2e-11
+    if Es == math.inf:
+        assert lam == pytest.approx(oedometric_compliance(coating), rel=1e-14, abs=1e-18)
+
+
+def test_a_thin_coating_on_an_elastic_substrate_tends_to_the_substrate_with_its_thin_limit_layer():
+    cell = PeriodicCell(1.0, 8, 8)
+    sub = _homogeneous(cell, ES, NUS)
+    errors = []
+    for t in (0.1, 0.05, 0.025):
+        bodies = bem.Bodies(ES, NUS, math.inf, 0.0, bem.Coating(t, 1.0, 0.3))
+        rest = PeriodicOperator(cell, bodies.E_star, bodies=bodies).kernel - sub.kernel
+        rest[0, 0] -= thin_limit(bodies)
+        errors.append(np.abs(rest).max() / sub.diagonal)
+    orders = [math.log2(errors[k] / errors[k + 1]) for k in range(2)]
+    # measured 1.48, 1.51 (1.48 on to t = 0.0125); other coatings converge more slowly at these t:
+    # E_c = 0.2: 1.49, 1.39, 1.28; E_c = 0.5, nu_c = 0.35: 0.94, 1.17, 1.21 (t = 0.1 .. 0.0125)
+    assert min(orders) > 1.3, (errors, orders)
+    assert errors[-1] < 3e-3  # measured 1.5e-3
 
 
 def test_a_thin_coating_tends_to_the_substrate_at_first_order():
@@ -178,4 +208,7 @@ def test_periodic_operator_refuses_bodies_of_another_modulus_and_too_thin_coatin
     thin = bem.Bodies(ES, NUS, math.inf, 0.0, coating1=bem.Coating(1e-4, 1.0, 0.3))
     with pytest.raises(bem.InputError, match=r"^thickness = 0.0001 is not allowed with step = 1.0") as err:
         PeriodicOperator(cell, thin.E_star, bodies=thin)
-    assert f"{MAX_TERMS:.0e}" in str(err.value)
+    assert f"{MAX_TERMS:.0e}" in str(err.value) and f"lam = {thin_limit(thin):.6g} (bem.layers.Linear" in str(err.value)
+    stiff = bem.Bodies(ES, NUS, math.inf, 0.0, coating1=bem.Coating(1e-4, 100.0, 0.3))
+    with pytest.raises(bem.InputError, match=r"stiffens the substrate's surface by the compliance -"):
+        PeriodicOperator(cell, stiff.E_star, bodies=stiff)
