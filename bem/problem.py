@@ -61,7 +61,8 @@ def bodies_of(E1, nu1, E2, nu2, coating1, coating2):
     A coating needs its substrate: ``E1, nu1, E2, nu2`` given (not ``E_star``)."""
     for name, coating in (("coating1", coating1), ("coating2", coating2)):
         if coating is not None and not isinstance(coating, Coating):
-            raise InputError(f"{name} = {coating!r} is not allowed: it must be a bem.Coating(thickness, E, nu) or None.")
+            raise InputError(f"{name} = {coating!r} is not allowed: it must be a bem.Coating(thickness, E, nu) "
+                             "or None.")
     if coating1 is None and coating2 is None:
         return None
     if any(v is None for v in (E1, nu1, E2, nu2)):
@@ -82,8 +83,8 @@ def _load(domain, force, approach, mean_pressure):
     return check_scale("mean_pressure", mean_pressure) * area, None
 
 
-def check_problem(domain, *, E_star, E1, nu1, E2, nu2, coating1=None, coating2=None, force, approach, mean_pressure, layer, method, rtol, maxiter,
-                  nested, precondition, callback, device, options):
+def check_problem(domain, *, E_star, E1, nu1, E2, nu2, coating1=None, coating2=None, force, approach, mean_pressure,
+                  layer, method, rtol, maxiter, nested, precondition, callback, device, options):
     """The checked :class:`Problem` (the keywords of :func:`bem.solve`); :class:`bem.InputError` naming the first
     bad argument."""
     E_star = modulus(E_star, E1, nu1, E2, nu2)
@@ -107,9 +108,9 @@ def check_problem(domain, *, E_star, E1, nu1, E2, nu2, coating1=None, coating2=N
     options = check_options(method, solver, options)
     if nested is None:
         nested = solver in ("kalker", "newton")
-    return Problem(E_star=E_star, bodies=bodies, force=force, approach=approach, layer=layer, method=method, solver=solver,
-                   rtol=rtol, maxiter=maxiter, nested=nested, precondition=precondition, callback=callback,
-                   backend=backend, options=options)
+    return Problem(E_star=E_star, bodies=bodies, force=force, approach=approach, layer=layer, method=method,
+                   solver=solver, rtol=rtol, maxiter=maxiter, nested=nested, precondition=precondition,
+                   callback=callback, backend=backend, options=options)
 
 
 def initial_guess(x0, lattice):

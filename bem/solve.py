@@ -30,9 +30,9 @@ __all__ = ["solve"]
 log = logging.getLogger(__name__)
 
 
-def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, coating1=None, coating2=None, force=None, approach=None,
-          mean_pressure=None, domain=None, step=None, extent=None, layer=None, method="newton", rtol=1e-10,
-          maxiter=None, x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
+def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, coating1=None, coating2=None, force=None,
+          approach=None, mean_pressure=None, domain=None, step=None, extent=None, layer=None, method="newton",
+          rtol=1e-10, maxiter=None, x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
     """Frictionless normal contact of two elastic half-spaces with an interface layer, over a domain.
 
     Minimises the generalised Kalker functional (eq. 11, 15)

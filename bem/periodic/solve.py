@@ -35,7 +35,9 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
     mean_pressure, approach : float
         Exactly one: the mean pressure ``pbar`` [pressure] or the approach ``delta`` [length]
         (:func:`bem.solve`).
-    E_star, E1, nu1, E2, nu2, coating1, coating2, layer, method, rtol, maxiter, x0, nested, precondition, callback, device, **options
+    E_star, E1, nu1, E2, nu2, coating1, coating2, layer, method, rtol, maxiter, x0, nested
+        As for :func:`bem.solve`.
+    precondition, callback, device, **options
         As for :func:`bem.solve`.
 
     Returns
