@@ -75,7 +75,8 @@ for label in ("first", "warm"):
 def _solve_rows(n):
     from pathlib import Path
 
-    print(f"solve {n} x {n}: {'body':>10} {'solve':>6} {'wall s':>8} {'cpu s':>8} {'iter':>5} {'KKT':>9} {'contact':>8}")
+    print(f"solve {n} x {n}: {'body':>10} {'solve':>6} {'wall s':>8} {'cpu s':>8} {'iter':>5} {'KKT':>9} "
+          f"{'contact':>8}")
     for t in (0.0, 4.0):
         out = subprocess.run([sys.executable, "-c", _SOLVE, str(n), str(t), str(Path(__file__).parent)],
                              capture_output=True, text=True, check=True)

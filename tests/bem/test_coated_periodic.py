@@ -201,7 +201,7 @@ def test_a_coating_needs_the_substrate_and_a_coating_object():
     h = np.zeros(cell.shape)
     with pytest.raises(bem.InputError, match=r"^coating1 is not allowed without E1, nu1, E2, nu2"):
         bem.solve(h, domain=cell, E_star=1.0, coating1=bem.Coating(0.1, 1.0, 0.3), mean_pressure=1.0)
-    with pytest.raises(bem.InputError, match=r"^coating2 = \{'thickness': 1\} is not allowed: it must be a bem.Coating"):
+    with pytest.raises(bem.InputError, match=r"^coating2 = \{'thickness': 1\} is not allowed: it must be a bem"):
         bem.solve(h, domain=cell, E1=1.0, nu1=0.3, E2=1.0, nu2=0.3, coating2={"thickness": 1}, mean_pressure=1.0)
 
 

@@ -40,7 +40,8 @@ def test_a_coated_scene_runs_the_coated_operator_and_records_the_coating(tmp_pat
     assert result["converged"] and result["kkt_residual"] <= 1e-10
     # the same problem through bem.solve directly: the run solved the coated contact
     domain = domain_of(scene, [])
-    kw = dict(domain=domain.bem_domain, E1=210e9, nu1=0.3, E2=210e9, nu2=0.3, mean_pressure=raw["load"]["mean_pressure"])
+    kw = dict(domain=domain.bem_domain, E1=210e9, nu1=0.3, E2=210e9, nu2=0.3,
+              mean_pressure=raw["load"]["mean_pressure"])
     direct = bem.solve(domain.gap, coating1=bem.Coating(**COATING), **kw)
     assert result["p_max"] == pytest.approx(direct.p_max, rel=1e-9)
     plain = bem.solve(domain.gap, **kw)
