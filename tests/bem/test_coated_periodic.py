@@ -219,3 +219,19 @@ def test_periodic_operator_refuses_bodies_of_another_modulus_and_too_thin_coatin
     stiff = bem.Bodies(ES, NUS, math.inf, 0.0, coating1=bem.Coating(1e-4, 100.0, 0.3))
     with pytest.raises(bem.InputError, match=r"stiffens the substrate's surface by the compliance -"):
         PeriodicOperator(cell, stiff.E_star, bodies=stiff)
+
+
+def test_both_domains_take_the_bodies():
+    """The half-space region's operator gets the same bodies (its coated kernel: bem.InfluenceOperator(bodies=))."""
+    import inspect
+
+    if "bodies" not in inspect.signature(bem.InfluenceOperator).parameters:
+        pytest.skip("the coated half-space kernel (bem.InfluenceOperator(bodies=)) is not in this build")
+    gap = bem.gaps.Paraboloid(R=10.0)
+    kw = dict(step=0.02, extent=1.0, E1=ES, nu1=NUS, E2=math.inf, nu2=0.0, force=0.05)
+    plain = bem.solve(gap, **kw)
+    same = bem.solve(gap, coating1=bem.Coating(0.2, ES, NUS), **kw)
+    soft = bem.solve(gap, coating1=bem.Coating(0.2, 0.3, 0.4), **kw)
+    assert same.bodies is not None and soft.converged and soft.kkt_residual <= 1e-10
+    assert abs(same.p_max / plain.p_max - 1) <= 1e-12  # measured 1.1e-14
+    assert soft.p_max < 0.9 * plain.p_max  # measured 0.86: the soft coating spreads the contact
