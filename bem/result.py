@@ -70,6 +70,9 @@ class ContactResult:
         The candidate lattice; :meth:`grid` maps nodal arrays back onto it.
     E_star : float
         Effective modulus [pressure].
+    bodies : bem.Bodies or None
+        The coated bodies (their moduli, Poisson ratios and coatings); ``None`` when neither body
+        is coated (``E_star`` says all).
     domain : bem.HalfSpaceRegion or bem.PeriodicCell
         The domain solved on (a growing region: the one the contact fitted in).
     notes : list of str
@@ -100,6 +103,7 @@ class ContactResult:
     status: str = ""
     rtol: float = math.nan
     domain: object = None
+    bodies: object = None
     notes: list = field(default_factory=list)
 
     def __post_init__(self):
@@ -147,4 +151,13 @@ class ContactResult:
             "n_nodes": int(self.p.size),
             "n_contact": int(np.count_nonzero(self.p > 0)),
             "step": float(self.step),
+            **self._coatings(),
         }
+
+    def _coatings(self):
+        """``coating1``, ``coating2`` (each ``{"thickness", "E", "nu"}`` or None) when a body is coated."""
+        if self.bodies is None:
+            return {}
+        return {f"coating{i}": None if c is None else {"thickness": float(c.thickness), "E": float(c.E),
+                                                        "nu": float(c.nu)}
+                for i, c in ((1, self.bodies.coating1), (2, self.bodies.coating2))}
