@@ -127,13 +127,13 @@ def _fourier_part(n_rows, n_cols, alpha):
     """``W_F`` at every node of the cell, brick array ``(n_rows, n_cols)``."""
     from scipy.special import erfc
 
-    def radial(k):
-        return 2 * math.pi / k * erfc(k / (2 * alpha))
+    def weight(k):  # twice 2 pi / k erfc(k / (2 alpha)) (sqrt3 / 2)
+        return (2 * _SQRT3 * math.pi) / k * erfc(k / (2 * alpha))
 
-    return alias_sum(n_rows, n_cols, radial, 2 * alpha * _ERFC_ZERO)
+    return alias_sum(n_rows, n_cols, None, 2 * alpha * _ERFC_ZERO, weight=weight, block=256)
 
 
-def alias_sum(n_rows, n_cols, radial, g_cut):
+def alias_sum(n_rows, n_cols, radial, g_cut, *, weight=None, block=None):
     """``(1/A) sum_{0 < |G| <= g_cut} f(|G|) hat(G) exp(i G.x)`` at every node of the cell (lattice units).
 
     Parameters
@@ -144,6 +144,10 @@ def alias_sum(n_rows, n_cols, radial, g_cut):
         ``f(k)`` on a 1-D array of wavenumbers ``k > 0`` [1/lattice step], real, vectorised.
     g_cut : float
         Largest ``|G|`` summed [1/lattice step].
+    weight : callable, optional
+        ``sqrt3 f(k)`` in place of ``radial`` (the Ewald part's own rounding).
+    block : int, optional
+        Rows of ``G`` per block of the sum (default: about 2^20 terms a block).
 
     Returns
     -------
@@ -167,7 +171,7 @@ def alias_sum(n_rows, n_cols, radial, g_cut):
     # the terms of G and -G are complex conjugates (the summand is even in G, the parity phase
     # conjugates), and only the real part of the sum is kept: half the plane (n > 0, or n = 0 and
     # m > 0), counted twice
-    block = max(1, 2 ** 20 // m.size)  # rows per block: the temporaries stay small
+    block = max(1, 2 ** 20 // m.size) if block is None else block  # rows per block: small temporaries
     for n0 in range(0, n_max + 1, block):
         n = np.arange(n0, min(n0 + block, n_max + 1))[:, None]
         gy = 2 * math.pi * n / ly
@@ -177,7 +181,7 @@ def alias_sum(n_rows, n_cols, radial, g_cut):
         kk = k[keep]
         s2 = (gx[cols] / 2 + gy[rows, 0] * (_SQRT3 / 2)) / 2  # pyramid_transform by its three factors
         hat = sinc_x[cols] * _sin_over(s2) * _sin_over(s2 - gx[cols] / 2)
-        f = _SQRT3 * radial(kk) * hat  # twice f(k) (sqrt3 / 2) hat
+        f = (_SQRT3 * radial(kk) if weight is None else weight(kk)) * hat  # twice f(k) (sqrt3 / 2) hat
         # node of parity s = 1: phase exp(i pi (m / n_cols + 2 n / n_rows)) relative to parity 0
         phase = phase_x[cols] * np.exp(2j * math.pi * n[:, 0] / n_rows)[rows]
         index = np.mod(n[rows, 0], half) * n_cols + np.mod(m[cols], n_cols)
