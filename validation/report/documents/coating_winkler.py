@@ -55,16 +55,20 @@ def coating_winkler_sections(data, work=None):
         items.append(Table(("rings", "p_max [Pa]", "radius [m]", "approach [m]"),
                            tuple((lv["rings"], lv["p_max"], lv["radius"], lv["approach"]) for lv in ref["levels"]),
                            caption="The ring truth under refinement, case (a_H/t, E_c/E_s, nu_c) = "
-                                   f"{tuple(ref['case'])}."))
+                                   f"{tuple(ref['case'])}: relative changes between levels, p_max "
+                                   + ", ".join(f"{c:.1e}" for c in ref["change"]["p_max"]) + "; radius "
+                                   + ", ".join(f"{c:.1e}" for c in ref["change"]["radius"]) + "; approach "
+                                   + ", ".join(f"{c:.1e}" for c in ref["change"]["approach"]) + "."))
     if data.get("fem_check"):
-        items.append(Table(("a_H/t", "E_c/E_s", "nu_c", "FEM elements across a", "p_max", "radius", "approach",
-                            "RMS p", "time [s]"),
-                           tuple((r["a_over_t"], r["modulus_ratio"], r["nu_c"], r["elements"],
+        items.append(Table(("a_H/t", "E_c/E_s", "nu_c", "FEM elements across a", "converged", "p_max", "radius",
+                            "approach", "RMS p", "time [s]"),
+                           tuple((r["a_over_t"], r["modulus_ratio"], r["nu_c"], r["elements"], r["converged"],
                                   f"{r['vs_rings_p_max']:+.2e}", f"{r['vs_rings_radius']:+.2e}",
                                   f"{r['vs_rings_approach']:+.2e}", f"{r['vs_rings_rms']:.2e}",
                                   f"{r['wall_time_s']:.1f}") for r in data["fem_check"]),
                            caption="The FEM reference with the coating meshed against the ring truth "
-                                   "(relative differences)."))
+                                   "(relative differences; a FEM run that reports no convergence is listed "
+                                   "with its last iterate)."))
     heads, rows = errors_table(data)
     items.append(Table(heads, tuple(rows), caption="Every case: the coated solution and the layers' errors."))
     return [Section("Coatings: when a linear Winkler layer stands for a coating", "validation", text, tuple(items))]

@@ -17,6 +17,9 @@ from ..render.style import new_figure, save_figure
 
 __all__ = ["BANDS", "plot_coating_map"]
 
+#: the truths' names in the title
+_TRUTHS = {"rings": "axisymmetric rings, coated half-space", "fem": "FEM reference, coating meshed"}
+
 #: the error bands: (upper bound, colour, label)
 BANDS = ((0.01, "#1a9850", "< 1 %"), (0.05, "#a6d96a", "1 - 5 %"), (0.2, "#fee08b", "5 - 20 %"),
          (np.inf, "#f46d43", "> 20 %"))
@@ -27,6 +30,11 @@ def _edges(values):
     v = np.log10(np.asarray(values, dtype=float))
     mid = 0.5 * (v[1:] + v[:-1])
     return 10.0 ** np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+
+
+def _percent(v):
+    """A cell's label: the error in per cent, 2 significant digits below 10 %, whole above, ``>999`` beyond."""
+    return f"{100 * v:.2g}" if v < 0.1 else (f"{100 * v:.0f}" if v < 10 else ">999")
 
 
 def _grid(rows, nu, key, xs, ys):
@@ -61,8 +69,7 @@ def plot_coating_map(data, out, *, name="coating_winkler_map.png"):
                 ax.pcolormesh(xe, ye, grid, cmap=cmap, norm=norm, shading="flat", edgecolors="white", linewidth=0.5)
                 for (k, m), v in np.ndenumerate(grid):
                     if np.isfinite(v):
-                        ax.text(xs[m], ys[k], f"{100 * v:.2g}" if v < 10 else ">999", ha="center", va="center",
-                                fontsize=6.5, color="black")
+                        ax.text(xs[m], ys[k], _percent(v), ha="center", va="center", fontsize=6.5, color="black")
                 ax.axhline(1.0, color="0.3", lw=0.8, ls=":")
                 ax.set_xscale("log")
                 ax.set_yscale("log")
@@ -77,5 +84,5 @@ def plot_coating_map(data, out, *, name="coating_winkler_map.png"):
                    title="worst relative error of p_max, contact radius, approach, RMS of p(r) (numbers: per cent)",
                    fontsize="small", title_fontsize="small")
         fig.suptitle("Sphere on a coated flat: a linear Winkler layer w = lam p on the bare substrate "
-                     f"against the coated solution ({data.get('truth', 'rings')})", fontsize="medium")
+                     f"against the coated solution (truth: {_TRUTHS.get(data.get('truth'), data.get('truth'))})", fontsize="medium")
         return save_figure(fig, path)
