@@ -1,4 +1,5 @@
-"""Section of the coating study (``coating_winkler.json``, :mod:`validation.studies.coating_winkler`) in the studies report."""
+"""Section of the coating study (``coating_winkler.json``, :mod:`validation.studies.coating_winkler`) in the
+studies report."""
 
 from __future__ import annotations
 

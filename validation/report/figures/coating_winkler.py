@@ -83,6 +83,7 @@ def plot_coating_map(data, out, *, name="coating_winkler_map.png"):
         fig.legend(handles=handles, loc="outside lower center", ncols=len(BANDS),
                    title="worst relative error of p_max, contact radius, approach, RMS of p(r) (numbers: per cent)",
                    fontsize="small", title_fontsize="small")
+        truth = _TRUTHS.get(data.get("truth"), data.get("truth"))
         fig.suptitle("Sphere on a coated flat: a linear Winkler layer w = lam p on the bare substrate "
-                     f"against the coated solution (truth: {_TRUTHS.get(data.get('truth'), data.get('truth'))})", fontsize="medium")
+                     f"against the coated solution (truth: {truth})", fontsize="medium")
         return save_figure(fig, path)
