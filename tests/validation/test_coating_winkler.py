@@ -160,3 +160,41 @@ def test_rule_is_the_smallest_thickness_ratio_from_which_every_larger_one_stays_
             for x, w in ((1, 0.3), (2, 0.04), (5, 0.06), (10, 0.02), (20, 0.01))]
     rows += [dict(nu_c=0.3, modulus_ratio=10, a_over_t=x, oed_worst=0.5) for x in (1, 20)]
     assert rule(rows) == {"0.3": {"0.1": 10, "10": None}}
+
+
+def test_the_studies_report_shows_the_map_and_the_rule(quick, tmp_path):
+    from validation.report.documents.studies import report_studies_dir
+
+    out, _, _ = quick
+    report_studies_dir(out, tmp_path / "report")
+    md = (tmp_path / "report" / "report.md").read_text()
+    assert "Coatings: when a linear Winkler layer stands for a coating" in md
+    assert "figures/coating_winkler_map.png" in md
+    assert (tmp_path / "report" / "figures" / "coating_winkler_map.png").is_file()
+    assert "The oedometric layer within 5 %" in md
+
+
+def test_the_truth_is_an_argument_and_the_fem_gives_the_rings_answer():
+    from validation.studies.coating_winkler import fem_truth
+
+    case = (1.0, 0.1, 0.35)
+    calls = []
+
+    def fem(c, s):
+        calls.append(c)
+        return fem_truth(c, s, n_contact_elements=8)
+
+    by_fem, by_rings = run_case(case, S, fem), run_case(case, S)
+    assert calls == [case]
+    # the two truths differ by 2e-3 (peak) and 3e-3 (radius) at 8 elements: so do the layers' errors
+    # (measured 2.2e-3, 3.7e-3, 9e-4; lam_best 1 %)
+    for k in ("p_max", "radius", "approach"):
+        assert by_fem[f"oed_{k}"] == pytest.approx(by_rings[f"oed_{k}"], abs=5e-3)
+    assert by_fem["lam_best"] == pytest.approx(by_rings["lam_best"], rel=0.05)
+
+
+def test_the_study_refuses_a_scene():
+    from .conftest import cli
+
+    code, _, err = cli("study", "coating-winkler", "hertz")
+    assert code == 2 and "scene = 'hertz' is not allowed" in err and "Traceback" not in err
