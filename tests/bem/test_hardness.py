@@ -229,11 +229,11 @@ def test_a_hardness_above_the_peak_pressure_gives_the_elastic_answer():
     elastic = bem.solve_periodic(h, step=CELL.step, E_star=1.0, mean_pressure=0.02)
     capped = bem.solve_periodic(h, step=CELL.step, E_star=1.0, mean_pressure=0.02, hardness=1.01 * elastic.p_max)
     assert capped.plastic_area == 0.0 and capped.status == "converged"
-    assert np.abs(capped.p - elastic.p).max() <= 1e-9 * elastic.p_max
+    assert np.abs(capped.p - elastic.p).max() <= 1e-11 * elastic.p_max  # measured 1.4e-12 (the same iterations)
     assert capped.contact_area == elastic.contact_area
     sphere = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.3)
     big = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.3, hardness=1e6)
-    assert np.abs(big.p - sphere.p).max() <= 1e-9 * sphere.p_max and big.plastic_area == 0.0
+    assert np.abs(big.p - sphere.p).max() <= 1e-11 * sphere.p_max and big.plastic_area == 0.0  # measured: equal
 
 
 @pytest.mark.parametrize("control", ["force", "approach"])
