@@ -214,6 +214,11 @@ class _Kernel:
         return out
 
 
+@lru_cache(maxsize=8)
+def _kernel(bodies, step):
+    return _Kernel(bodies, step)
+
+
 def point_kernel(r, bodies, *, step=1.0):
     """Surface closure under a unit point load, ``K(r) = (1/pi) int_0^inf s(q) J0(q r) dq`` [1/length].
 
@@ -232,8 +237,10 @@ def point_kernel(r, bodies, *, step=1.0):
         ``K`` times the force gives the closure [length per force = 1/(pressure length)]; the
         homogeneous body gives ``(s1 + s2) / (pi r)``.
     """
+    if not isinstance(bodies, Bodies):
+        raise InputError(f"bodies = {bodies!r} is not allowed: it must be a bem.Bodies.")
     r = np.asarray(r, dtype=float)
-    kernel = _Kernel(bodies, check_positive("step", step))
+    kernel = _kernel(bodies, check_positive("step", step))
     rl = r.ravel() / step
     return ((kernel.S_c / rl + kernel(rl)) / (math.pi * step)).reshape(r.shape)
 
@@ -330,7 +337,7 @@ def _element(kernel, x, y, grade):
 
 @lru_cache(maxsize=4)
 def _table(step, n_rows, n_cols, bodies):
-    kernel = _Kernel(bodies, step)
+    kernel = _kernel(bodies, step)
     n = np.arange(n_rows)[:, None]
     t = np.arange(n_cols + 1)[None, :]
     x, y = (2 * t + n % 2) / 2.0 + 0.0 * n, n * (_SQRT3 / 2) + 0.0 * t

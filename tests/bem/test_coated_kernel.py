@@ -171,3 +171,59 @@ def test_coated_sphere_contact_converges_and_meets_its_limits():
     _, sol = _hertz(mid, mid.E_star)
     assert sol.converged and sol.kkt_residual <= 1e-10
     assert ref.approach < sol.approach < soft_ref[1].approach  # between the substrate and the coating
+
+
+def test_operator_with_coated_bodies_applies_its_table():
+    bodies = Bodies(10.0, 0.25, math.inf, 0.3, Coating(0.8, 1.0, 0.3))
+    lat = Lattice.from_extent(1.0, 6.0)
+    op = InfluenceOperator(lat, bodies.E_star, bodies=bodies)
+    assert op.diagonal == coated_table(1.0, lat.shape, bodies)[0, 0]
+    p = np.where(lat.mask, np.random.default_rng(3).random(lat.shape), 0.0)
+    dense = op.dense()
+    assert np.max(np.abs(op.matvec(p)[lat.mask] - dense @ p[lat.mask])) <= 1e-13 * np.max(np.abs(dense @ p[lat.mask]))
+    x, y = lat.x[lat.mask], lat.y[lat.mask]  # one entry against the Fourier integral
+    i, j = 0, int(np.argmin(np.hypot(x - x[0] - 2.0, y - y[0])))
+    ref = fourier_entry(bodies, 0.8, x[j] - x[i], y[j] - y[i], 1 - 0.3 ** 2) + (1 - 0.3 ** 2) / math.pi * float(
+        template(x[j] - x[i], y[j] - y[i]))
+    assert abs(dense[i, j] - ref) <= 1e-10 * op.diagonal
+    assert InfluenceOperator(lat, bodies.E_star, bodies=Bodies(10.0, 0.25, math.inf, 0.3)).diagonal == pytest.approx(
+        InfluenceOperator(lat, bodies.E_star).diagonal, rel=1e-15)
+
+
+def test_point_kernel_matches_a_hankel_integral_near_and_far():
+    """``(1/pi) int (s(q) - s_c) J0(q r) dq`` by quad between the zeros of ``J0`` (the table's ``G``)."""
+    from scipy.integrate import quad
+    from scipy.special import j0, jn_zeros
+
+    t = 0.7
+    bodies = Bodies(10.0, 0.25, math.inf, 0.3, Coating(t, 1.0, 0.3))
+    s_c = 1 - 0.3 ** 2
+    for r in (0.07, 0.7, 7.0, 70.0, 700.0):
+        q_max = 25.0 / t
+        zeros = jn_zeros(0, int(q_max * r / math.pi) + 2) / r
+        edges = np.concatenate([[0.0], zeros[zeros < q_max], [q_max]]) if r > 1 else np.linspace(0, q_max, 200)
+        ref = sum(quad(lambda q: (float(bodies.compliance(q)) - s_c) * j0(q * r), a, b, epsabs=1e-16, epsrel=1e-12, limit=200)[0]
+                  for a, b in zip(edges[:-1], edges[1:])) / math.pi
+        got = float(point_kernel(np.array([r]), bodies)[0]) - s_c / (math.pi * r)
+        assert abs(got - ref) <= 1e-10 * s_c / t, (r, got, ref)
+
+
+def test_far_coefficients_match_a_fine_element_rule():
+    """Offsets beyond 8 steps (box-spline rules): the element integral of ``G`` by 16 x 16 Gauss points
+    on each of the six triangles, ``G = pi K - s_c / r`` from :func:`point_kernel`."""
+    bodies = Bodies(10.0, 0.25, math.inf, 0.3, Coating(0.7, 1.0, 0.3))
+    s_c = 1 - 0.3 ** 2
+    table = coated_table(1.0, (300, 300), bodies)
+    g, w = np.polynomial.legendre.leggauss(16)
+    g, w = (g + 1) / 2, w / 2
+    s, u = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+    ws = np.outer(w, w).ravel() * s * (1 - s) * SQ3 / 2
+    hexv = [np.array([math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)]) for k in range(7)]
+    pts = np.concatenate([s[:, None] * ((1 - u)[:, None] * hexv[k] + u[:, None] * hexv[k + 1]) for k in range(6)])
+    wts = np.tile(ws, 6)
+    for n, col in ((10, 3), (12, 20), (50, 30), (290, 150)):
+        x, y = (2 * col + n % 2) / 2, n * SQ3 / 2
+        r = np.hypot(x - pts[:, 0], y - pts[:, 1])
+        G = math.pi * point_kernel(r, bodies) - s_c / r
+        ref = s_c / math.pi * float(template(x, y)) + wts @ G / math.pi
+        assert abs(table[n, col] - ref) <= 1e-11 * table[0, 0], (n, col)
