@@ -227,3 +227,17 @@ def test_far_coefficients_match_a_fine_element_rule():
         G = math.pi * point_kernel(r, bodies) - s_c / r
         ref = s_c / math.pi * float(template(x, y)) + wts @ G / math.pi
         assert abs(table[n, col] - ref) <= 1e-11 * table[0, 0], (n, col)
+
+
+def test_bad_input_is_refused():
+    from bem.errors import InputError
+
+    bodies = Bodies(10.0, 0.25, math.inf, 0.3, Coating(0.7, 1.0, 0.3))
+    with pytest.raises(InputError, match="bodies"):
+        coated_table(1.0, (4, 4), (10.0, 0.25))
+    with pytest.raises(InputError, match="shape"):
+        coated_table(1.0, (0, 4), bodies)
+    with pytest.raises(InputError, match="step"):
+        coated_table(-1.0, (4, 4), bodies)
+    with pytest.raises(InputError, match="bodies"):
+        point_kernel([1.0], "steel")
