@@ -62,7 +62,7 @@ def run(side, *, thickness, rtol, repeat):
     rows = {}
     for name in ops:
         sol = runs[name][-1][1]
-        rows[name] = dict(construct=construct if name == "coated" else float("nan"), times=[t for t, _ in runs[name]],
+        rows[name] = dict(construct=f"{construct:.2f}" if name == "coated" else "-", times=[t for t, _ in runs[name]],
                           iterations=sol.iterations, kkt=sol.kkt_residual, p_max=float(np.max(sol.p)),
                           approach=sol.approach)
     return lat, step, build, rows
@@ -84,7 +84,7 @@ def main(argv=None):
     print("|---|---|---|---|---|---|---|")
     for name, r in rows.items():
         runs = ", ".join(f"{t:.2f}" for t in r["times"])
-        print(f"| {name} | {r['construct']:.2f} | {statistics.median(r['times']):.2f} ({runs}) | {r['iterations']} | "
+        print(f"| {name} | {r['construct']} | {statistics.median(r['times']):.2f} ({runs}) | {r['iterations']} | "
               f"{r['kkt']:.1e} | {r['p_max']:.4g} | {r['approach']:.4g} |")
     ratio = statistics.median(rows["coated"]["times"]) / statistics.median(rows["uncoated"]["times"])
     print(f"coated / uncoated solve time: {ratio:.2f}; load average at end {os.getloadavg()[0]:.1f}")
