@@ -94,7 +94,7 @@ def kernel_disc(bodies, a, r, grade):
     return inner.sum() * 2 * np.pi / n_theta
 
 
-@pytest.mark.parametrize("E_s, t", [(10.0, 1.0), (10.0, 0.2), (0.1, 2.0), (math.inf, 0.5)])
+@pytest.mark.parametrize("E_s, t", [(10.0, 1.0), (10.0, 0.05), (0.1, 2.0), (math.inf, 0.5)])
 def test_disc_displacement_matches_a_hankel_integral(E_s, t):
     E2 = 100.0 if E_s == math.inf else math.inf  # a rigid substrate needs an elastic counter-body
     bodies = Bodies(E_s, 0.3, E2, 0.3, Coating(t, 1.0, 0.3))
