@@ -117,6 +117,7 @@ class _Remainder:
         grid = np.arange(0.0, 80.0, 0.05)
         big = np.abs(self._r(grid)) > 1e-15 * s_max  # above the rounding of phi - 1
         self._x_max = grid[np.flatnonzero(big)[-1]] + 1.0 if big.any() else 1.0
+        self._nodes = {}
         for _ in range(6):
             self._build(rho, radius)
             err = self.series_error() / s_max
@@ -126,23 +127,19 @@ class _Remainder:
         raise ArithmeticError(f"the remainder kernel's large-r series misses its integral by {err:.1e} s")
 
     def _build(self, rho, radius):
-        """The quadrature in ``x = q t`` and the Chebyshev panels on ``[0, rho]``."""
-        self.rho_sw = rho
+        """The Chebyshev panels on ``[0, rho]``, each filled by a quadrature in ``x = q t`` fine enough
+        for its largest ``rho``."""
+        self.rho_sw, self._radius = rho, radius
         even = np.arange(2, _ORDER + 1, 2)
         self._keep = int(np.argmin(np.abs(self._series) * rho ** -(even + 1.0))) + 1
-        h = min(radius / 2, 4 * math.pi / (1.5 * rho), 0.5)  # two periods of J0 at 1.5 rho a panel
-        edges = np.linspace(0.0, self._x_max, int(math.ceil(self._x_max / h)) + 1)
-        g, wg = _legendre(_GAUSS_X)
-        half = np.diff(edges)[:, None] / 2
-        self._x = ((edges[:-1, None] + half) + half * g).ravel()
-        self._wr = (half * wg).ravel() * self._r(self._x)
         bounds = [0.0]
         while bounds[-1] < rho:
             bounds.append(min(rho, bounds[-1] + max(1.0, bounds[-1] / 4)))
         self._bounds = np.array(bounds)
         nodes = np.cos(np.pi * (np.arange(_CHEB) + 0.5) / _CHEB)  # Chebyshev points of the first kind
         lo, hi = self._bounds[:-1, None], self._bounds[1:, None]
-        values = self.direct((lo + hi) / 2 + (hi - lo) / 2 * nodes)
+        points = (lo + hi) / 2 + (hi - lo) / 2 * nodes
+        values = np.stack([self.direct(row) for row in points])
         T = np.cos(np.outer(np.arccos(nodes), np.arange(_CHEB)))  # T_k at the nodes
         self._cheb = values @ T * (2.0 / _CHEB)
         self._cheb[:, 0] /= 2
@@ -156,16 +153,29 @@ class _Remainder:
         """``R`` at ``x = q t`` [1/pressure]."""
         return self.s_c * (coating_factor(x, self._coating, *self._substrate) - 1.0) - self.delta * np.exp(-B_RAISE * x)
 
+    def _quadrature(self, rho_max):
+        """Composite Gauss-Legendre nodes ``x`` and weights times ``R`` on ``[0, x_max]``, two periods
+        of ``J0(x rho_max)`` a panel (cached per panel length)."""
+        h = min(self._radius / 2, 4 * math.pi / max(rho_max, 1e-300), 0.5)
+        n = int(math.ceil(self._x_max / h))
+        if n not in self._nodes:
+            edges = np.linspace(0.0, self._x_max, n + 1)
+            g, wg = _legendre(_GAUSS_X)
+            half = np.diff(edges)[:, None] / 2
+            x = ((edges[:-1, None] + half) + half * g).ravel()
+            self._nodes[n] = x, (half * wg).ravel() * self._r(x)
+        return self._nodes[n]
+
     def direct(self, rho):
-        """``kt`` at ``rho`` by the quadrature in ``x`` (any shape)."""
+        """``kt`` at ``rho`` by the quadrature in ``x`` (a 1-D array)."""
         from scipy.special import j0
 
-        rho = np.asarray(rho, dtype=float)
-        flat, out = rho.ravel(), np.empty(rho.size)
-        rows = max(1, _CHUNK // self._x.size)
-        for i in range(0, flat.size, rows):
-            out[i:i + rows] = j0(np.outer(flat[i:i + rows], self._x)) @ self._wr
-        return out.reshape(rho.shape)
+        x, wr = self._quadrature(float(np.max(rho)))
+        out = np.empty(rho.size)
+        rows = max(1, _CHUNK // x.size)
+        for i in range(0, rho.size, rows):
+            out[i:i + rows] = j0(np.outer(rho[i:i + rows], x)) @ wr
+        return out
 
     def _asymptotic(self, rho):
         u = 1.0 / (rho * rho)
