@@ -73,8 +73,9 @@ def hankel_disc(bodies, a, r, s_ref, q_max):
     def f(q):
         return 2 * (float(bodies.compliance(q)) - s_ref) * a * j1(q * a) * j0(q * r) / q
 
-    edges = np.linspace(1e-300, q_max, 400)
-    rest = sum(quad(f, lo, hi, epsabs=1e-15, epsrel=1e-13, limit=200)[0] for lo, hi in zip(edges[:-1], edges[1:]))
+    edges = np.linspace(1e-300, q_max, max(400, int(q_max * (a + r))))  # a few oscillations a piece
+    rest = sum(quad(f, lo, hi, epsabs=1e-14 * s_ref * a / edges.size, epsrel=1e-12, limit=200)[0]
+               for lo, hi in zip(edges[:-1], edges[1:]))
     return 4 * s_ref * a / math.pi * ellipe((r / a) ** 2) + rest
 
 
