@@ -242,3 +242,14 @@ def test_bad_input_is_refused():
         coated_table(-1.0, (4, 4), bodies)
     with pytest.raises(InputError, match="bodies"):
         point_kernel([1.0], "steel")
+
+
+@pytest.mark.parametrize("E_s", [10.0, 0.1, 0.01, math.inf])
+def test_factor_taylor_sums_to_the_factor_inside_its_radius(E_s):
+    from bem.coating import coating_factor, factor_taylor
+
+    coating = Coating(1.0, 1.0, 0.3)
+    coeffs, radius = factor_taylor(coating, E_s, 0.3, order=40)
+    x = np.array([0.0, 0.1, 0.3, 0.5]) * radius
+    phi = coating_factor(x, coating, E_s, 0.3)
+    assert np.max(np.abs(np.polyval(coeffs[::-1], x) - phi)) <= 1e-12 * np.max(np.abs(phi))
