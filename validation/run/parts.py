@@ -93,6 +93,9 @@ class BemPart(_Part):
     contact, ``None`` for a periodic cell; ``cell``, ``size``, ``mean_pressure``,
     ``contact_fraction`` and ``mean_gap`` those of a periodic cell, ``None`` otherwise.
     ``history``: per-iteration scalar lists (``residual``, ``p_max``, ``n_contact``, ...).
+    ``hardness``: the cap of the pressure (``bodies.hardness``), ``None`` for an elastic solve;
+    ``plastic_area``: the area of the nodes at the hardness (0 when elastic); ``plastic_fraction``
+    its share of a periodic cell (``None`` otherwise).
     """
 
     method: str
@@ -121,6 +124,9 @@ class BemPart(_Part):
     mean_pressure: float | None = None
     contact_fraction: float | None = None
     mean_gap: float | None = None
+    hardness: float | None = None
+    plastic_area: float | None = None
+    plastic_fraction: float | None = None
 
 
 @dataclass
