@@ -19,9 +19,10 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .backend import operator_backend
+from .plastic import clip, fill_force
 
-__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule", "entering_pressure",
-           "is_per_node", "RECOMPUTE_EVERY"]
+__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "carry_force", "iterate_residual",
+           "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY"]
 
 log = logging.getLogger(__name__)
 
@@ -61,29 +62,54 @@ def _quantile(bk, values, q):
     return a + (b - a) * t if t < 0.5 else b - (b - a) * (1 - t)
 
 
-def initial_pressure(op, h, lam, force, approach, x0):
+def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
     """The starting pressure of the constrained CG (brick array): ``x0`` clipped at 0, or under force
     control a uniform pressure on the quarter of the nodes with the smallest gap, or under approach
-    control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``."""
+    control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``.
+
+    With a ``hardness`` ``H`` the start is clipped at ``H``, and under force control the uniform
+    pressure covers enough nodes to stay below ``0.8 H`` and is scaled by
+    :func:`bem.plastic.fill_force`."""
     lat = op.lattice
     bk, mask = operator_backend(op)
     xp = bk.xp
     if x0 is not None:
-        p = xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
+        p = xp.where(mask, clip(xp, bk.asarray(x0), hardness), 0.0)
     elif force is not None:
         # rigid-punch-like start: pressure where the gap is smallest
         hm = xp.where(mask, h, xp.inf)
-        level = _quantile(bk, hm[mask], 0.25)
+        share = 0.25
+        if hardness is not None:  # enough nodes to carry the force below 0.8 H
+            share = min(1.0, max(share, 1.25 * force / (lat.node_area * hardness * int(xp.count_nonzero(mask)))))
+        level = _quantile(bk, hm[mask], share)
         p = xp.astype(mask & (hm <= level), bk.float64)
     else:
         p = xp.where(mask, xp.maximum(approach - h, 0.0), 0.0) / (op.diagonal + float(xp.max(lam) if is_per_node(lam) else lam))
+        if hardness is not None:
+            p = xp.minimum(p, hardness)
     if force is not None:
         total = float(xp.sum(p))
         if total <= 0:
             p = xp.astype(mask, bk.float64)
             total = float(xp.sum(p))
-        p *= force / lat.node_area / total
+        if hardness is None:
+            p *= force / lat.node_area / total
+        else:
+            p = carry_force(xp, p, force / lat.node_area, hardness, mask)
     return p
+
+
+def carry_force(xp, p, target, hardness, mask):
+    """``p`` (``>= 0``) scaled to carry ``sum p = target``, capped at ``H`` and filled up by
+    :func:`bem.plastic.fill_force`; where its support cannot carry ``target``, the uniform ``target / n``
+    on the ``n`` nodes of ``mask`` (capped at ``H``: the caller checks that they can)."""
+    for start in (p, xp.astype(mask, p.dtype)):
+        total = float(xp.sum(start))
+        if total > 0:
+            filled = fill_force(xp, xp.minimum(start * (target / total), hardness), target, hardness)
+            if filled is not None:
+                return filled[0]
+    return xp.minimum(xp.astype(mask, p.dtype) * (target / float(xp.sum(xp.astype(mask, p.dtype)))), hardness)
 
 
 def entering_pressure(xp, g, tau, jacobi, per_node, preconditioned=False):
@@ -105,15 +131,17 @@ def is_per_node(lam):
     return getattr(lam, "ndim", 0) > 0
 
 
-def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None):
+def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None, plastic_gap=None):
     """The KKT residual of an iterate (:func:`bem.kkt.kkt_residual` from its parts; non-finite: ``inf``).
 
     ``max(max_contact |g|, (-min g)_+) / scale`` (every contact node has ``-g <= max_contact |g|``), with
     ``contact_gap = max_contact |g|``, ``gap_min = min g``, ``scale`` the displacement scale and
     ``gap_max()`` the largest ``|g|``, the scale where ``scale`` is not positive (or 1); under force
-    control the larger of that and ``force_error = |a sum p - P| / P``.
+    control the larger of that and ``force_error = |a sum p - P| / P``. With a hardness
+    (:mod:`bem.plastic`) the contact is the elastic one (``0 < p < H``), ``gap_min`` the smallest gap
+    off the plastic nodes and ``plastic_gap = max_plastic g`` (a plastic node may overlap, ``g <= 0``).
     """
-    parts = [contact_gap, -gap_min, 0.0]
+    parts = [contact_gap, -gap_min, 0.0] if plastic_gap is None else [contact_gap, -gap_min, plastic_gap, 0.0]
     kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) / (scale if scale > 0 else gap_max() or 1.0)
     if force_error is not None:
         kkt = float(np.max([kkt, force_error]))

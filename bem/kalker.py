@@ -17,8 +17,9 @@ import math
 import numpy as np
 
 from .backend import operator_backend
-from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, entering_pressure, initial_pressure, is_per_node, iterate_residual,
-                       run_constrained_cg)
+from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, carry_force, entering_pressure, initial_pressure, is_per_node,
+                       iterate_residual, run_constrained_cg)
+from .plastic import fill_force, leaving_pressure, plastic_approach
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
@@ -33,8 +34,8 @@ def _median(bk, values):
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True):
-    """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
+             maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True, hardness=None):
+    """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` (``0 <= p <= H`` with a hardness).
 
     Parameters
     ----------
@@ -73,6 +74,12 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         that re-checks the solution itself (Newton's inner solves) passes False and gets
         the solution of the incrementally updated products, which differ from the exact
         ones by round-off only.
+    hardness : float, optional
+        The bound ``H`` of the pressure [pressure] (:mod:`bem.plastic`): the nodes at ``p = H`` are
+        plastic, held at ``H`` and left out of the search direction like the open nodes; the step
+        is projected onto ``[0, H]``, a plastic node whose gap opens leaves at the pressure an
+        entering node would take, and under force control the approach is the mean gap of the
+        elastic contact. ``None``: no bound.
 
     Returns
     -------
@@ -100,10 +107,13 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
     if u0 is None or x0 is None:
-        p = xp.where(mask, initial_pressure(op, h, lam, force, approach, x0), 0.0)
+        p = xp.where(mask, initial_pressure(op, h, lam, force, approach, x0, hardness), 0.0)
         if target is not None:
             p = p if float(xp.sum(p)) > 0 else xp.astype(mask, bk.float64)
-            p *= target / float(xp.sum(p))
+            if hardness is None:
+                p *= target / float(xp.sum(p))
+            else:
+                p = carry_force(xp, p, target, hardness, mask)
         u0 = None
     else:  # the caller's iterate and its product, as they are
         p = xp.where(mask, x0, 0.0)
@@ -141,6 +151,33 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: several times faster
     # than x.flat[idx]).
     contact = idx = n_idx = g = g_c = p_c0 = changes = None
+    bounded = hardness is not None
+    plastic = pl = touching = bracket = None
+    prev_plastic = p >= hardness if bounded else None
+
+    def measure_bounded(k):  # measure() with the bound: the CG lives on the elastic contact 0 < p < H
+        nonlocal contact, idx, n_idx, g, delta, g_c, p_c0, plastic, pl, touching, bracket
+        touching = p > 0
+        plastic = p >= hardness
+        contact = touching & ~plastic
+        idx, pl = bk.select(contact), bk.select(plastic)
+        n_idx = bk.count(idx)
+        g = u + h
+        bk.put(g, off, 0.0)
+        if force is not None and n_idx:
+            delta = float(xp.mean(bk.take(g, idx)))
+        elif force is not None and bk.count(pl):
+            shut = xp.where(touching | ~mask, xp.inf, g)
+            delta, bracket = plastic_approach(float(xp.min(shut)), float(xp.max(bk.take(g, pl))))
+        g -= delta
+        bk.put(g, off, 0.0)
+        scale = max(float(xp.max(u)), -float(xp.min(u))) if fixed_scale is None else fixed_scale
+        g_c = bk.take(g, idx)
+        p_c0 = bk.take(p, idx)
+        return iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(xp.where(plastic, xp.inf, g))), scale,
+                                lambda: float(xp.max(xp.abs(g))),
+                                None if force is None else abs(a * float(xp.sum(p)) - force) / force,
+                                plastic_gap=bk.max0(bk.take(g, pl)))
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
         nonlocal contact, idx, n_idx, g, delta, g_c, p_c0
@@ -169,13 +206,20 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         return False
 
     def observe():
-        nonlocal changes, prev_contact
+        nonlocal changes, prev_contact, prev_plastic
+        if bounded:  # changes of the contact and of the plastic set
+            changes = int(xp.count_nonzero(touching != prev_contact)) + int(xp.count_nonzero(plastic != prev_plastic))
+            prev_contact, prev_plastic = touching, plastic
+            n_touch = n_idx + bk.count(pl)
+            return bk.max0(p), n_touch, changes, n_touch == 0 and float(xp.min(g)) >= 0
         changes = int(xp.count_nonzero(contact != prev_contact))
         prev_contact = contact
         return bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0
 
     def advance(k):  # one step of the constrained CG; (message, status) where it cannot be taken
         nonlocal m_one, gz_old, t, restart, u, stale, p
+        if bounded and not n_idx:  # every contact node plastic: only entering and leaving nodes move
+            return bounded_step(0.0, xp.zeros_like(g_c), None)
         if preconditioner is None:
             z = bk.copy(g_c)
             if force is not None:
@@ -209,6 +253,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
         else:
             tau = gz / tt
+        if bounded:
+            return bounded_step(tau, t_c, r)
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
         p_c = xp.where(clipped, 0.0, p_c)
@@ -242,7 +288,55 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         p = p_new
         return None
 
-    kkt = run_constrained_cg(CGStep(measure, confirms, observe, advance, lambda: p), record, maxiter, callback)
+    def bounded_step(tau, t_c, r):  # the step projected onto [0, H], entering and leaving nodes, the force carried
+        nonlocal restart, u, stale, p
+        p_c = xp.minimum(xp.maximum(p_c0 - tau * t_c, 0.0), hardness)
+        moved = bool(xp.any((p_c == 0) | (p_c == hardness)))  # a node reached a bound
+        p_new = spread(idx, p_c)
+        bk.put(p_new, pl, hardness)
+        low = bk.select(g < 0)
+        overlap = bk.subset(low, bk.take(p_new, low) == 0)  # open nodes that close: they enter
+        lam_o = bk.take(lam, overlap) if per_node else lam
+        bk.put(p_new, overlap, xp.minimum(entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o),
+                                                            per_node), hardness))
+        leave = bk.subset(pl, bk.take(g, pl) > 0)  # plastic nodes whose gap opens: they leave
+        lam_l = bk.take(lam, leave) if per_node else lam
+        bk.put(p_new, leave, leaving_pressure(xp, hardness, entering_pressure(
+            xp, -bk.take(g, leave), tau, 1.0 / (op.diagonal + lam_l), per_node)))
+        restart = bool(bk.count(overlap) or bk.count(leave))
+        s, capped = 1.0, False
+        if target is not None:
+            filled = fill_force(xp, p_new, target, hardness)
+            if filled is None:  # the nodes below H cannot carry the force: the step up to the first bound
+                if r is None:
+                    return "no elastic contact node can carry the force", "stalled"
+                with bk.errstate(divide="ignore", invalid="ignore"):
+                    reach = xp.where(t_c > 0, p_c0 / t_c, xp.where(t_c < 0, (p_c0 - hardness) / t_c, xp.inf))
+                tau = min(tau, float(xp.min(reach)))
+                p_new = spread(idx, xp.minimum(xp.maximum(p_c0 - tau * t_c, 0.0), hardness))
+                bk.put(p_new, pl, hardness)
+                restart, moved = False, True
+                filled = fill_force(xp, p_new, target, hardness)
+                if filled is None:
+                    return "no elastic contact node can carry the force", "stalled"
+            p_new, s, capped = filled
+        if moved or capped or restart or r is None or stale >= RECOMPUTE_EVERY:
+            u, stale = apply(p_new), 0
+        else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
+            r *= tau
+            u -= r
+            if s != 1.0:
+                u *= s
+            stale += 1
+        p = p_new
+        return None
+
+    kkt = run_constrained_cg(CGStep(measure_bounded if bounded else measure, confirms, observe, advance, lambda: p),
+                             record, maxiter, callback)
+    if bracket is not None and record.converged and not bool(xp.any(contact)):
+        record.message += (f"; fully plastic: every contact node at the hardness, the approach is any value in "
+                           f"[{bracket[0]:.6g}, {bracket[1]:.6g}], the lower end returned")
+        record.history["approach_bracket"] = list(bracket)
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return record.solution(p, delta, kkt, elastic, "Kalker QP")
 

@@ -33,6 +33,7 @@ from .cg_rules import QPSolution
 from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
+from .plastic import clip, fill_force
 
 __all__ = ["solve_newton"]
 
@@ -100,12 +101,19 @@ def _count_inner(hist, sub):
         hist["inner_worst"] = max(hist["inner_worst"], float(sub.kkt_residual))
 
 
-def _scaled(p, force, node_area):
-    """``p`` rescaled to carry ``force`` (force control); ``p`` itself otherwise."""
-    return p if force is None else p * (force / node_area / float(backend_of(p).xp.sum(p)))
+def _scaled(p, force, node_area, hardness=None):
+    """``p`` rescaled to carry ``force`` (force control); ``p`` itself otherwise. With a hardness the nodes below
+    it are scaled (:func:`bem.plastic.fill_force`; ``p`` itself where they cannot carry the force)."""
+    if force is None:
+        return p
+    xp = backend_of(p).xp
+    if hardness is None:
+        return p * (force / node_area / float(xp.sum(p)))
+    filled = fill_force(xp, p, force / node_area, hardness)
+    return p if filled is None else filled[0]
 
 
-def _release(op, layer, h, p, u, q, delta, *, force):
+def _release(op, layer, h, p, u, q, delta, *, force, hardness=None):
     """Set to 0 the nodes the model solution ``q`` releases, if that lowers ``Phi``.
 
     Where ``w`` is concave (power ``s < 1``) a node that leaves the contact is only
@@ -126,7 +134,9 @@ def _release(op, layer, h, p, u, q, delta, *, force):
     if not bk.count(out):
         return p, u
     if force is not None:
-        contact = bk.select(p > 0)
+        contact = bk.select((p > 0) if hardness is None else (p > 0) & (p < hardness))
+        if not bk.count(contact):  # every contact node plastic: no multiplier to measure the gain by
+            return p, u
         pc = bk.take(p, contact)
         delta = float(xp.mean(bk.take(u, contact) + bk.asarray(layer.w(pc)) + bk.take(h, contact)))
     pn = bk.take(p, out)
@@ -138,7 +148,7 @@ def _release(op, layer, h, p, u, q, delta, *, force):
     trial = bk.put(bk.copy(p), out, 0.0)
     if force is not None and float(xp.sum(trial)) <= 0:
         return p, u
-    trial = _scaled(trial, force, op.lattice.node_area)
+    trial = _scaled(trial, force, op.lattice.node_area, hardness)
     dp = trial - p
     c_dp = op.matvec(dp)
     if _energy_change(bk, layer, p, dp, u, c_dp, h, delta, mask) < 0:
@@ -147,7 +157,7 @@ def _release(op, layer, h, p, u, q, delta, *, force):
 
 
 def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, maxiter=100,
-                 precondition=True, callback=None, record=False, inner_maxiter=300):
+                 precondition=True, callback=None, record=False, inner_maxiter=300, hardness=None):
     """Newton's method with exact line search for the layered contact problem.
 
     Parameters
@@ -176,6 +186,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     inner_maxiter : int
         Iteration limit of each inner QP; an unfinished inner solve still gives
         a feasible trial point, and the line search decides how far to go.
+    hardness : float, optional
+        The bound ``p <= H`` [pressure] (:mod:`bem.plastic`): the inner QPs are bounded, so the
+        step ``d = q - p`` stays in the box ``0 <= p <= H`` for ``t in (0, 1]``.
 
     Returns
     -------
@@ -202,23 +215,26 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         # smooth-body solution, then one secant (variable compliance) step: a start
         # that is fair for stiff and for layer-dominated problems alike
         start = solve_qp(op, h, force=force, approach=approach, rtol=1e-3,
-                         preconditioner=op.preconditioner() if precondition else None)
+                         preconditioner=op.preconditioner() if precondition else None, hardness=hardness)
         contact = start.p > 0
         lam = float(layer.secant(float(xp.mean(start.p[contact])))) if bool(xp.any(contact)) else 0.0
         if math.isfinite(lam) and lam > 0:
             start = solve_qp(op, h, force=force, approach=approach, lam=lam, rtol=1e-3,
-                             preconditioner=op.preconditioner(lam=lam) if precondition else None)
+                             preconditioner=op.preconditioner(lam=lam) if precondition else None, hardness=hardness)
         p = start.p
     else:
-        p = xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
-        if force is not None:
+        p = xp.where(mask, clip(xp, bk.asarray(x0), hardness), 0.0)
+        if force is not None and hardness is None:
             p *= force / op.lattice.node_area / float(xp.sum(p))
+        elif force is not None:
+            p = _scaled(p, force, op.lattice.node_area, hardness)
     u = op.matvec(p)
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "step": [], "inner_iterations": [],
             "inner_missed": 0, "inner_worst": 0.0}
     if record:
         hist["p"] = []
     converged, message, status, exact = False, "", "maxiter", True
+    bound = {} if hardness is None else {"hardness": hardness}  # the elastic inner solves take no bound
     prev = p > 0
     full = bool(xp.all(mask))  # every node a candidate (a periodic cell): no masking
 
@@ -227,10 +243,12 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
 
     for k in range(maxiter + 1):
         wp = masked(bk.asarray(layer.w(p)))  # the closure w(p)
-        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp)
+        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp,
+                                         hardness=hardness)
         if kkt <= rtol and not exact:  # confirm on an exact product before stopping
             u, exact = op.matvec(p), True
-            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp)
+            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp,
+                                         hardness=hardness)
         contact = p > 0
         hist["residual"].append(kkt)
         hist["p_max"].append(float(xp.max(p)))
@@ -258,7 +276,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         # its own residual: no product to start or to confirm the inner solve (fewer products on
         # the root-layer problem of benchmarks/side_by_side.py)
         sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p, rtol=inner,
-                        maxiter=inner_maxiter, u0=u, confirm=False)
+                        maxiter=inner_maxiter, u0=u, confirm=False, **bound)
         _count_inner(hist, sub)
         d = sub.p - p
         cd = sub.displacement - u
@@ -268,7 +286,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             D = majorant(op, layer, p, sub.p, D, mask)
             b = h + wp - D * p
             sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p,
-                            rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False)
+                            rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False,
+                            **bound)
             _count_inner(hist, sub)
             d = sub.p - p
             cd = sub.displacement - u
@@ -280,9 +299,10 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             # still violate their gap. The step is then chosen by the KKT residual instead:
             # t = 1, 1/2, 1/4, 1/8, the first that lowers it.
             for t_try in (1.0, 0.5, 0.25, 0.125):
-                trial = _scaled(xp.maximum(p + t_try * d, 0.0), force, op.lattice.node_area)
+                trial = _scaled(clip(xp, p + t_try * d, hardness), force, op.lattice.node_area, hardness)
                 u_trial = op.matvec(trial)
-                if layered_state(op, h, layer, trial, u_trial, force=force, approach=approach)[2] < kkt:
+                if layered_state(op, h, layer, trial, u_trial, force=force, approach=approach,
+                                 hardness=hardness)[2] < kkt:
                     judged = t_try
                     break
         hist["step"].append(t if judged is None else judged)
@@ -294,9 +314,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             status = "stalled"
             break
         else:
-            p = _scaled(xp.maximum(p + t * d, 0.0), force, op.lattice.node_area)
+            p = _scaled(clip(xp, p + t * d, hardness), force, op.lattice.node_area, hardness)
             u, exact = u + t * cd, False
-        p, u = _release(op, layer, h, p, u, sub.p, delta, force=force)
+        p, u = _release(op, layer, h, p, u, sub.p, delta, force=force, hardness=hardness)
         if callback is not None:
             callback(k + 1, p)
     if not converged:
@@ -305,7 +325,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
                      status=status, kkt_residual=float(kkt), displacement=u, history=hist)
     if force is not None and not converged and math.isfinite(delta) and delta > 0:
         out = _force_by_approach(op, h, layer, force, out, rtol=rtol, maxiter=maxiter, precondition=precondition,
-                                 inner_maxiter=inner_maxiter)
+                                 inner_maxiter=inner_maxiter, hardness=hardness)
     return out
 
 
@@ -352,7 +372,7 @@ def _force_by_approach(op, h, layer, force, failed, *, rtol, **kw):
         return failed
     sol = solved[root]
     u = op.matvec(sol.p)
-    _, delta_f, kkt = layered_state(op, h, layer, sol.p, u, force=force)
+    _, delta_f, kkt = layered_state(op, h, layer, sol.p, u, force=force, hardness=kw.get("hardness"))
     steps = sum(s.iterations for s in solved.values())
     hist = dict(failed.history, outer_approaches=sorted(solved))
     converged = kkt <= rtol

@@ -38,6 +38,7 @@ class Problem:
     callback: object
     backend: object
     options: dict
+    hardness: float | None = None
 
 
 def modulus(E_star, E1, nu1, E2, nu2):
@@ -64,7 +65,7 @@ def _load(domain, force, approach, mean_pressure):
 
 
 def check_problem(domain, *, E_star, E1, nu1, E2, nu2, force, approach, mean_pressure, layer, method, rtol, maxiter,
-                  nested, precondition, callback, device, options):
+                  nested, precondition, callback, device, options, hardness=None):
     """The checked :class:`Problem` (the keywords of :func:`bem.solve`); :class:`bem.InputError` naming the first
     bad argument."""
     E_star = modulus(E_star, E1, nu1, E2, nu2)
@@ -85,11 +86,28 @@ def check_problem(domain, *, E_star, E1, nu1, E2, nu2, force, approach, mean_pre
             "and linear layers only; use method='newton' (or a paper method) for a nonlinear layer.")
     solver = solver_for(method, layer)
     options = check_options(method, solver, options)
+    if hardness is not None:
+        hardness = _hardness(domain, hardness, force, mean_pressure, solver)
     if nested is None:
         nested = solver in ("kalker", "newton")
     return Problem(E_star=E_star, force=force, approach=approach, layer=layer, method=method, solver=solver,
                    rtol=rtol, maxiter=maxiter, nested=nested, precondition=precondition, callback=callback,
-                   backend=backend, options=options)
+                   backend=backend, options=options, hardness=hardness)
+
+
+def _hardness(domain, hardness, force, mean_pressure, solver):
+    """The checked hardness ``H`` [pressure]: finite and > 0, a cell's mean pressure at most ``H`` (every node
+    at ``H`` carries ``H Lx Ly``), and a solver that bounds the pressure (Kalker's QP, Newton)."""
+    hardness = check_scale("hardness", hardness)
+    if solver not in ("kalker", "newton"):
+        raise InputError(f"hardness = {hardness!r} is not allowed with method = {solver!r}: the paper's fixed-point "
+                         "methods do not bound the pressure; use method='newton'.")
+    area = getattr(domain, "area", None)
+    if area is not None and force is not None and force > hardness * area:
+        name, value = ("mean_pressure", mean_pressure) if mean_pressure is not None else ("force", force)
+        fail(name, value, f"at most hardness = {hardness!r} times the cell area {area:.6g} (every node at the "
+             "hardness)" if name == "force" else f"<= hardness = {hardness!r} (every node at the hardness)")
+    return hardness
 
 
 def initial_guess(x0, lattice):

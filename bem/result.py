@@ -74,6 +74,11 @@ class ContactResult:
         The domain solved on (a growing region: the one the contact fitted in).
     notes : list of str
         What the solve did besides iterating, for people (a region enlarged).
+    hardness : float or None
+        Hardness ``H`` of the surface [pressure], the bound ``p <= H`` (:mod:`bem.plastic`); ``None``:
+        elastic.
+    plastic_area : float
+        Number of plastic nodes (``p = H``) times the node area [length^2]; 0 without a hardness.
     """
 
     x: np.ndarray
@@ -101,6 +106,8 @@ class ContactResult:
     rtol: float = math.nan
     domain: object = None
     notes: list = field(default_factory=list)
+    hardness: float | None = None
+    plastic_area: float = 0.0
 
     def __post_init__(self):
         if self.status not in STATUSES or self.converged != (self.status == "converged"):
@@ -147,4 +154,6 @@ class ContactResult:
             "n_nodes": int(self.p.size),
             "n_contact": int(np.count_nonzero(self.p > 0)),
             "step": float(self.step),
+            "hardness": None if self.hardness is None else float(self.hardness),
+            "plastic_area": float(self.plastic_area),
         }

@@ -199,7 +199,7 @@ class PeriodicOperator:
         (:func:`bem.periodic.qp.solve_periodic_qp`, whose preconditioner for a ``lam`` per node
         starts from the contact of ``x0``), else :func:`bem.kalker.constrained_cg`; a
         :class:`bem.cg_rules.QPSolution`."""
-        if precondition and self.backend.is_numpy:
+        if precondition and self.backend.is_numpy and kw.get("hardness") is None:
             from .qp import solve_periodic_qp
 
             return solve_periodic_qp(self, h, lam=lam, **kw)

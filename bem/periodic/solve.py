@@ -13,7 +13,7 @@ __all__ = ["solve_periodic", "PeriodicContactResult"]
 
 
 def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None, E2=None, nu2=None,
-                   mean_pressure=None, approach=None, layer=None, method="newton", rtol=1e-10, maxiter=None,
+                   mean_pressure=None, approach=None, layer=None, hardness=None, method="newton", rtol=1e-10, maxiter=None,
                    x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
     """Frictionless normal contact of a periodic cell: an alias of :func:`bem.solve` with ``domain=cell``.
 
@@ -34,7 +34,7 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
     mean_pressure, approach : float
         Exactly one: the mean pressure ``pbar`` [pressure] or the approach ``delta`` [length]
         (:func:`bem.solve`).
-    E_star, E1, nu1, E2, nu2, layer, method, rtol, maxiter, x0, nested, precondition, callback, device, **options
+    E_star, E1, nu1, E2, nu2, layer, hardness, method, rtol, maxiter, x0, nested, precondition, callback, device, **options
         As for :func:`bem.solve`.
 
     Returns
@@ -61,5 +61,5 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
     from ..solve import solve
 
     return solve(gap, domain=cell, E_star=E_star, E1=E1, nu1=nu1, E2=E2, nu2=nu2, mean_pressure=mean_pressure,
-                 approach=approach, layer=layer, method=method, rtol=rtol, maxiter=maxiter, x0=x0, nested=nested,
+                 approach=approach, layer=layer, hardness=hardness, method=method, rtol=rtol, maxiter=maxiter, x0=x0, nested=nested,
                  precondition=precondition, callback=callback, device=device, **options)

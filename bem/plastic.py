@@ -1,0 +1,82 @@
+"""The hardness bound of Kalker's QP: an elastic-perfectly-plastic surface, ``0 <= p <= H``.
+
+With a hardness ``H`` [pressure] the nodal pressure is bounded at every node. The bounded QP
+``min 1/2 p.(C + lam) p + p.(h - delta)`` over ``0 <= p <= H`` (and ``a sum p = P`` under force
+control) has the KKT conditions, with ``g = C p + w(p) + h - delta`` the deformed gap,
+
+* ``g >= 0`` where ``p = 0`` (open),
+* ``g = 0`` where ``0 < p < H`` (elastic contact),
+* ``g <= 0`` where ``p = H`` (plastic: the surface yields, and the overlap ``-g`` is the plastic
+  deformation).
+
+The nodes at ``p = H`` are the plastic set; the constrained conjugate gradients move the elastic
+contact nodes only and project their step onto ``[0, H]`` (:mod:`bem.cg_rules`). Under force
+control the approach is the multiplier of the elastic contact, the mean of ``C p + w(p) + h``
+over it; where every contact node is plastic (a fully plastic contact, ``A = P / H``) it is
+undetermined in the interval of :func:`plastic_approach`, and its lower end is returned.
+The rules here are shared by every step of the constrained CG, Newton's method and the KKT
+residual (:mod:`bem.kkt`).
+"""
+
+from __future__ import annotations
+
+__all__ = ["plastic_approach", "fill_force", "clip", "leaving_pressure"]
+
+#: Rounds of :func:`fill_force` (each caps at least one more node at ``H``).
+_FILL_ROUNDS = 64
+
+
+def clip(xp, p, hardness):
+    """``p`` clipped at 0 and, with a hardness, at ``H`` (``hardness`` None: at 0 only)."""
+    p = xp.maximum(p, 0.0)
+    return p if hardness is None else xp.minimum(p, hardness)
+
+
+def plastic_approach(lowest_open, highest_plastic):
+    """The approach of a contact without elastic nodes, and the interval that allows it.
+
+    With every contact node plastic the conditions ``g <= 0`` there and ``g >= 0`` at the open
+    nodes hold for every approach ``delta`` in ``[lo, hi]``, ``lo = max_plastic (C p + w + h)``,
+    ``hi = min_open (C p + w + h)``; the pressure does not depend on it. Returns
+    ``(delta, (lo, hi))`` with ``delta = lo`` (the smallest approach that closes every plastic
+    node), or the midpoint where ``lo > hi`` (an iterate that is not yet a solution: the midpoint
+    makes the largest violation smallest). ``hi`` is ``inf`` where no node is open.
+    """
+    lo, hi = float(highest_plastic), float(lowest_open)
+    return (lo if lo <= hi else 0.5 * (lo + hi)), (lo, hi)
+
+
+def fill_force(xp, p, target, hardness):
+    """``p`` (values in ``[0, H]``) with the nodes below ``H`` scaled to carry ``sum p = target``.
+
+    One factor ``s >= 0`` scales every node below ``H``; nodes that it would lift above ``H`` are
+    capped there and the factor of the others found again (a water filling, at most one round
+    per capped node). Returns ``(p, s, capped)``: the scaled pressure, the factor of the nodes
+    that stayed below ``H`` and whether a node was capped; ``None`` where the nodes below ``H``
+    cannot carry the rest of ``target`` (they carry nothing while it is positive, or all of them
+    reach ``H``).
+    """
+    fixed = p >= hardness
+    capped = False
+    for _ in range(_FILL_ROUNDS):
+        need = target - hardness * float(xp.count_nonzero(fixed))
+        rest = float(xp.sum(xp.where(fixed, 0.0, p)))
+        if not rest > 0:
+            if abs(need) <= 1e-13 * target:
+                return p, 1.0, capped
+            return None
+        s = max(need / rest, 0.0)
+        q = p * s
+        over = ~fixed & (q > hardness)
+        if not bool(xp.any(over)):
+            return xp.where(fixed, p, q), s, capped
+        capped = True
+        fixed = fixed | over
+        p = xp.where(over, hardness, p)
+    return xp.where(fixed, p, xp.minimum(p * s, hardness)), s, capped
+
+
+def leaving_pressure(xp, hardness, lowered):
+    """Pressure of a plastic node whose gap opens (``p = H``, ``g > 0``): ``H`` lowered by the pressure
+    an entering node would take at ``-g`` (:func:`bem.cg_rules.entering_pressure`), not below 0."""
+    return xp.maximum(hardness - lowered, 0.0)
