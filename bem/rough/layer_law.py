@@ -232,6 +232,15 @@ def _hardness(hardness, p):
     return hardness
 
 
+def _guess(res, ratio, hardness, shape):
+    """The start of the next step: the pressure of ``res`` scaled by the ratio of the mean pressures; with a
+    hardness, none (the solver's own start) where the nodes it loads cannot carry it below ``0.8 H``."""
+    guess = res.p.reshape(shape) * ratio
+    if hardness is not None and np.count_nonzero(guess) * 0.8 * hardness < guess.sum():
+        return None
+    return guess
+
+
 def _solve(solve_periodic, h, pbar, guess, options, k):
     """One step of the ladder (``k < 0``: the ``-k``-th pressure added below it), converged or raised."""
     res = solve_periodic(h, mean_pressure=pbar, x0=guess, **options)
@@ -330,7 +339,7 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
     ladder, guess = [], None  # (pressure, result)
     for k, pbar in enumerate(p):
         ladder.append((float(pbar), _solve(solve_periodic, h, float(pbar), guess, options, k)))
-        guess = ladder[-1][1].p.reshape(h.shape) * (p[k + 1] / pbar) if k + 1 < p.size else None
+        guess = _guess(ladder[-1][1], p[k + 1] / pbar, hardness, h.shape) if k + 1 < p.size else None
         if progress is not None:
             progress(k + 1, p.size, ladder[-1][1])
     factor, added, lowest = max(float(p[1] / p[0]), 2.0), [], ladder[0]  # added: below the ladder, highest first
