@@ -36,7 +36,8 @@ pressure is at most ``H`` (every node flowing), so the ladder must lie below ``H
 records ``H`` and the share of the cell that flows at each pressure (``plastic_fraction``).
 
 The ladder of mean pressures is solved in order, each solve started from the previous
-pressure field scaled by the ratio of the mean pressures. A step that does not converge stops
+pressure field scaled by the ratio of the mean pressures (with a hardness, from the solver's own
+start where the nodes that field loads cannot carry the next pressure below ``0.8 H``). A step that does not converge stops
 the ladder with :class:`LadderNotConverged`: no table is made from it.
 
 **The start of the ladder.** Below its first pressure ``p_1`` the table is a straight line
