@@ -277,3 +277,29 @@ def test_result_parts_carry_the_hardness():
     assert out["plastic_fraction"] == res.plastic_fraction
     elastic = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.1, extent=1.3).summary()
     assert elastic["hardness"] is None and elastic["plastic_area"] == 0.0
+
+
+@pytest.mark.parametrize("layer", [None, bem.layers.Root(0.05)], ids=["qp", "newton_root"])
+@pytest.mark.parametrize("domain", ["region", "cell"])
+def test_the_bound_runs_on_a_strict_array_namespace(monkeypatch, layer, domain):
+    """The bounded step on any array API namespace (``array_api_strict``, no conversion to NumPy allowed)
+    gives the NumPy answer."""
+    xs = pytest.importorskip("array_api_strict")
+    from array_api_strict._array_object import Array
+
+    def refuse(self, *args, **kwargs):
+        raise AssertionError("an array_api_strict array was converted to NumPy")
+
+    monkeypatch.setattr(Array, "__array__", refuse)
+    if domain == "region":
+        kw = dict(gap=Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.5, hardness=0.3, layer=layer)
+        solve = bem.solve
+    else:
+        cell = bem.PeriodicCell(1.0 / 32, 32, 32)
+        kw = dict(gap=_rough(cell), step=cell.step, E_star=1.0, mean_pressure=0.01, hardness=0.04, layer=layer)
+        solve = bem.solve_periodic
+    ref = solve(rtol=1e-12, **kw)
+    res = solve(rtol=1e-12, device=xs, **kw)
+    assert ref.status == res.status == "converged" and ref.plastic_area > 0
+    assert np.abs(res.p - ref.p).max() <= 1e-10 * ref.p_max
+    assert res.plastic_area == ref.plastic_area
