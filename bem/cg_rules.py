@@ -3,7 +3,9 @@
 The start (:func:`initial_pressure`), the KKT residual of an iterate (:func:`iterate_residual`),
 the stopping rule (:func:`stopping_rule`), the pressure of the nodes that enter the contact
 (:func:`entering_pressure`), the exact product every :data:`RECOMPUTE_EVERY` updates, and the
-record of the iteration and its outcome (:class:`Record`, :class:`QPSolution`). The steps are
+record of the iteration and its outcome (:class:`Record`, :class:`QPSolution`); with a hardness
+(:mod:`bem.plastic`) the sets of an iterate (:func:`bounded_sets`) and the projected step with its
+entering and leaving nodes (:func:`bounded_move`). The steps are
 :func:`bem.kalker.solve_qp` (the general loop, any array namespace) and
 :func:`bem.periodic.qp.solve_periodic_qp` (a periodic cell in the Fourier basis); each
 operator picks its own (``op.qp``).
@@ -19,10 +21,11 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .backend import operator_backend
-from .plastic import clip, fill_force
+from .plastic import clip, fill_force, leaving_pressure, plastic_approach
 
 __all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "carry_force", "iterate_residual",
-           "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY"]
+           "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "BoundedSets", "bounded_sets",
+           "bounded_move"]
 
 log = logging.getLogger(__name__)
 
@@ -124,6 +127,89 @@ def entering_pressure(xp, g, tau, jacobi, per_node, preconditioned=False):
     if preconditioned:
         return -g * jacobi * (min(tau, 1.0) if tau > 0 else 1.0)
     return -g * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi)
+
+
+class BoundedSets(NamedTuple):
+    """The sets of an iterate of the bounded QP (:func:`bounded_sets`)."""
+
+    on: object  # p > 0 (brick)
+    plastic: object  # p >= H (brick)
+    idx: object  # the elastic contact 0 < p < H (a node selection): the nodes of the search direction
+    pl: object  # the plastic nodes (a node selection)
+    delta: float  # the approach (under force control the multiplier of the elastic contact)
+    bracket: tuple | None  # the interval of the approach of a fully plastic contact (bem.plastic.plastic_approach)
+    gap_min: float  # the smallest deformed gap off the plastic nodes
+    plastic_gap: float  # the largest deformed gap of the plastic nodes (-inf without)
+
+
+def bounded_sets(bk, p, v, hardness, delta, force, mask=None):
+    """The sets, the approach and the gap extremes of an iterate of the bounded QP (:mod:`bem.plastic`).
+
+    ``v = (C + lam) p + h`` (brick), the deformed gap ``v - delta``; ``delta`` the approach under approach
+    control; ``mask`` the candidate nodes (``None``: every node).
+    """
+    xp = bk.xp
+    on, plastic = p > 0, p >= hardness
+    idx, pl = bk.select(on & ~plastic), bk.select(plastic)
+    v_pl = float(xp.max(bk.take(v, pl))) if bk.count(pl) else -math.inf
+    bracket = None
+    if force is not None and bk.count(idx):
+        delta = float(xp.mean(bk.take(v, idx)))
+    elif force is not None and bk.count(pl):
+        delta, bracket = plastic_approach(float(xp.min(xp.where(on if mask is None else on | ~mask, xp.inf, v))), v_pl)
+    elif force is not None:
+        delta = math.nan
+    away = plastic if mask is None else plastic | ~mask
+    return BoundedSets(on, plastic, idx, pl, delta, bracket, float(xp.min(xp.where(away, xp.inf, v))) - delta,
+                       v_pl - delta)
+
+
+def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardness, preconditioned=False):
+    """One step of the bounded constrained CG, on ``p`` (brick) in place; ``(changed, entered, s, failure)``.
+
+    The elastic nodes ``sets.idx`` move from ``p_c0`` along ``-tau t_c``, projected onto ``[0, H]``; the
+    open nodes whose gap ``v - delta`` is negative enter (:func:`entering_pressure`, at most ``H``), the
+    plastic nodes whose gap is positive leave (:func:`bem.plastic.leaving_pressure`); under force control
+    (``target = P / a``) :func:`bem.plastic.fill_force` carries the force, and where it cannot the step
+    goes up to the first bound instead. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
+    ``changed``: a node reached a bound, entered, left or was capped (``C p`` is then to be recomputed);
+    ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes; ``failure``: ``(message, status)`` where no step can be taken.
+    """
+    xp, idx, pl, delta = bk.xp, sets.idx, sets.pl, sets.delta
+
+    def jac(sel):
+        return bk.take(jacobi, sel) if per_node else jacobi
+
+    p_c = xp.minimum(xp.maximum(p_c0 - tau * t_c, 0.0), hardness)
+    hit = bool(xp.any((p_c == 0) | (p_c == hardness)))
+    bk.put(p, idx, p_c)
+    low = bk.select(v < delta)
+    overlap = bk.subset(low, bk.take(p, low) == 0)  # open nodes that close: they enter
+    leave = bk.subset(pl, bk.take(v, pl) > delta)  # plastic nodes whose gap opens: they leave
+    bk.put(p, overlap, xp.minimum(entering_pressure(xp, bk.take(v, overlap) - delta, tau, jac(overlap), per_node,
+                                                    preconditioned), hardness))
+    bk.put(p, leave, leaving_pressure(xp, hardness, entering_pressure(xp, delta - bk.take(v, leave), tau, jac(leave),
+                                                                      per_node, preconditioned)))
+    moved = bool(bk.count(overlap) or bk.count(leave))
+    if target is None:
+        return hit or moved, moved, 1.0, None
+    filled = fill_force(xp, p, target, hardness)
+    if filled is None and bk.count(idx):  # the nodes below H cannot carry the force: the step up to the first bound
+        bk.put(p, overlap, 0.0)
+        bk.put(p, leave, hardness)
+        reach = xp.where(t_c > 0, p_c0 / xp.where(t_c > 0, t_c, 1.0),
+                         xp.where(t_c < 0, (p_c0 - hardness) / xp.where(t_c < 0, t_c, 1.0), xp.inf))
+        bk.put(p, idx, xp.minimum(xp.maximum(p_c0 - min(tau, float(xp.min(reach))) * t_c, 0.0), hardness))
+        hit, moved = True, False
+        filled = fill_force(xp, p, target, hardness)
+    if filled is None:
+        bk.put(p, idx, p_c0)
+        bk.put(p, overlap, 0.0)
+        bk.put(p, leave, hardness)
+        return True, False, 1.0, ("no elastic contact node can carry the force", "stalled")
+    new, s, capped = filled
+    p[...] = new
+    return hit or moved or capped, moved, s, None
 
 
 def is_per_node(lam):

@@ -17,9 +17,9 @@ import math
 import numpy as np
 
 from .backend import operator_backend
-from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, carry_force, entering_pressure, initial_pressure, is_per_node,
-                       iterate_residual, run_constrained_cg)
-from .plastic import fill_force, leaving_pressure, plastic_approach
+from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, carry_force, entering_pressure,
+                       initial_pressure, is_per_node, iterate_residual, run_constrained_cg)
+from .plastic import note_fully_plastic
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
@@ -152,32 +152,25 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     # than x.flat[idx]).
     contact = idx = n_idx = g = g_c = p_c0 = changes = None
     bounded = hardness is not None
-    plastic = pl = touching = bracket = None
+    sets = None
     prev_plastic = p >= hardness if bounded else None
+    jacobi = 1.0 / (op.diagonal + lam) if bounded else None
 
     def measure_bounded(k):  # measure() with the bound: the CG lives on the elastic contact 0 < p < H
-        nonlocal contact, idx, n_idx, g, delta, g_c, p_c0, plastic, pl, touching, bracket
-        touching = p > 0
-        plastic = p >= hardness
-        contact = touching & ~plastic
-        idx, pl = bk.select(contact), bk.select(plastic)
+        nonlocal contact, idx, n_idx, g, delta, g_c, p_c0, sets
+        v = u + h
+        bk.put(v, off, 0.0)
+        sets = bounded_sets(bk, p, v, hardness, delta, force, mask)
+        contact, idx, delta = sets.on & ~sets.plastic, sets.idx, sets.delta
         n_idx = bk.count(idx)
-        g = u + h
-        bk.put(g, off, 0.0)
-        if force is not None and n_idx:
-            delta = float(xp.mean(bk.take(g, idx)))
-        elif force is not None and bk.count(pl):
-            shut = xp.where(touching | ~mask, xp.inf, g)
-            delta, bracket = plastic_approach(float(xp.min(shut)), float(xp.max(bk.take(g, pl))))
-        g -= delta
+        g = v - delta
         bk.put(g, off, 0.0)
         scale = max(float(xp.max(u)), -float(xp.min(u))) if fixed_scale is None else fixed_scale
         g_c = bk.take(g, idx)
         p_c0 = bk.take(p, idx)
-        return iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(xp.where(plastic, xp.inf, g))), scale,
-                                lambda: float(xp.max(xp.abs(g))),
+        return iterate_residual(bk.max0(xp.abs(g_c)), sets.gap_min, scale, lambda: float(xp.max(xp.abs(g))),
                                 None if force is None else abs(a * float(xp.sum(p)) - force) / force,
-                                plastic_gap=bk.max0(bk.take(g, pl)))
+                                plastic_gap=sets.plastic_gap)
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
         nonlocal contact, idx, n_idx, g, delta, g_c, p_c0
@@ -208,9 +201,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     def observe():
         nonlocal changes, prev_contact, prev_plastic
         if bounded:  # changes of the contact and of the plastic set
-            changes = int(xp.count_nonzero(touching != prev_contact)) + int(xp.count_nonzero(plastic != prev_plastic))
-            prev_contact, prev_plastic = touching, plastic
-            n_touch = n_idx + bk.count(pl)
+            changes = int(xp.count_nonzero(sets.on != prev_contact)) + int(xp.count_nonzero(sets.plastic != prev_plastic))
+            prev_contact, prev_plastic = sets.on, sets.plastic
+            n_touch = n_idx + bk.count(sets.pl)
             return bk.max0(p), n_touch, changes, n_touch == 0 and float(xp.min(g)) >= 0
         changes = int(xp.count_nonzero(contact != prev_contact))
         prev_contact = contact
@@ -288,55 +281,26 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         p = p_new
         return None
 
-    def bounded_step(tau, t_c, r):  # the step projected onto [0, H], entering and leaving nodes, the force carried
-        nonlocal restart, u, stale, p
-        p_c = xp.minimum(xp.maximum(p_c0 - tau * t_c, 0.0), hardness)
-        moved = bool(xp.any((p_c == 0) | (p_c == hardness)))  # a node reached a bound
-        p_new = spread(idx, p_c)
-        bk.put(p_new, pl, hardness)
-        low = bk.select(g < 0)
-        overlap = bk.subset(low, bk.take(p_new, low) == 0)  # open nodes that close: they enter
-        lam_o = bk.take(lam, overlap) if per_node else lam
-        bk.put(p_new, overlap, xp.minimum(entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o),
-                                                            per_node), hardness))
-        leave = bk.subset(pl, bk.take(g, pl) > 0)  # plastic nodes whose gap opens: they leave
-        lam_l = bk.take(lam, leave) if per_node else lam
-        bk.put(p_new, leave, leaving_pressure(xp, hardness, entering_pressure(
-            xp, -bk.take(g, leave), tau, 1.0 / (op.diagonal + lam_l), per_node)))
-        restart = bool(bk.count(overlap) or bk.count(leave))
-        s, capped = 1.0, False
-        if target is not None:
-            filled = fill_force(xp, p_new, target, hardness)
-            if filled is None:  # the nodes below H cannot carry the force: the step up to the first bound
-                if r is None:
-                    return "no elastic contact node can carry the force", "stalled"
-                with bk.errstate(divide="ignore", invalid="ignore"):
-                    reach = xp.where(t_c > 0, p_c0 / t_c, xp.where(t_c < 0, (p_c0 - hardness) / t_c, xp.inf))
-                tau = min(tau, float(xp.min(reach)))
-                p_new = spread(idx, xp.minimum(xp.maximum(p_c0 - tau * t_c, 0.0), hardness))
-                bk.put(p_new, pl, hardness)
-                restart, moved = False, True
-                filled = fill_force(xp, p_new, target, hardness)
-                if filled is None:
-                    return "no elastic contact node can carry the force", "stalled"
-            p_new, s, capped = filled
-        if moved or capped or restart or r is None or stale >= RECOMPUTE_EVERY:
-            u, stale = apply(p_new), 0
+    def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
+        nonlocal restart, u, stale
+        changed, restart, s, failure = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
+                                                    hardness)
+        if failure is not None:
+            return failure
+        if changed or r is None or stale >= RECOMPUTE_EVERY:
+            u, stale = apply(p), 0
         else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
             r *= tau
             u -= r
             if s != 1.0:
                 u *= s
             stale += 1
-        p = p_new
         return None
 
-    kkt = run_constrained_cg(CGStep(measure_bounded if bounded else measure, confirms, observe, advance, lambda: p),
+    report = (lambda: bk.copy(p)) if bounded else (lambda: p)  # the bounded step updates p in place
+    kkt = run_constrained_cg(CGStep(measure_bounded if bounded else measure, confirms, observe, advance, report),
                              record, maxiter, callback)
-    if bracket is not None and record.converged and not bool(xp.any(contact)):
-        record.message += (f"; fully plastic: every contact node at the hardness, the approach is any value in "
-                           f"[{bracket[0]:.6g}, {bracket[1]:.6g}], the lower end returned")
-        record.history["approach_bracket"] = list(bracket)
+    note_fully_plastic(record, sets.bracket if bounded else None, bounded and not n_idx)
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return record.solution(p, delta, kkt, elastic, "Kalker QP")
 

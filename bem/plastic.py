@@ -20,7 +20,8 @@ residual (:mod:`bem.kkt`).
 
 from __future__ import annotations
 
-__all__ = ["plastic_approach", "fill_force", "clip", "leaving_pressure"]
+__all__ = ["plastic_approach", "fill_force", "clip", "leaving_pressure", "note_fully_plastic",
+           "fully_plastic_note"]
 
 #: Rounds of :func:`fill_force` (each caps at least one more node at ``H``).
 _FILL_ROUNDS = 64
@@ -51,15 +52,19 @@ def fill_force(xp, p, target, hardness):
 
     One factor ``s >= 0`` scales every node below ``H``; nodes that it would lift above ``H`` are
     capped there and the factor of the others found again (a water filling, at most one round
-    per capped node). Returns ``(p, s, capped)``: the scaled pressure, the factor of the nodes
-    that stayed below ``H`` and whether a node was capped; ``None`` where the nodes below ``H``
-    cannot carry the rest of ``target`` (they carry nothing while it is positive, or all of them
-    reach ``H``).
+    per capped node). Where the nodes at ``H`` alone carry more than ``target`` (a step that
+    clipped many nodes at 0 and others at ``H``), every node is scaled down by one factor instead,
+    and the plastic ones leave ``H``. Returns ``(p, s, capped)``: the scaled pressure, the factor
+    of the nodes that stayed below ``H`` and whether a node was capped or left ``H``; ``None``
+    where the nodes below ``H`` cannot carry the rest of ``target`` (they carry nothing while it is
+    positive, or all of them reach ``H``).
     """
     fixed = p >= hardness
     capped = False
     for _ in range(_FILL_ROUNDS):
         need = target - hardness * float(xp.count_nonzero(fixed))
+        if need < -1e-13 * target:  # too many nodes at H: all of them scaled down
+            return p * (target / float(xp.sum(p))), 1.0, True
         rest = float(xp.sum(xp.where(fixed, 0.0, p)))
         if not rest > 0:
             if abs(need) <= 1e-13 * target:
@@ -74,6 +79,20 @@ def fill_force(xp, p, target, hardness):
         fixed = fixed | over
         p = xp.where(over, hardness, p)
     return xp.where(fixed, p, xp.minimum(p * s, hardness)), s, capped
+
+
+def note_fully_plastic(record, bracket, fully_plastic):
+    """Say in a converged constrained CG's ``record`` (:class:`bem.cg_rules.Record`) that its contact is fully
+    plastic and the approach ``bracket[0]`` one of the interval ``bracket`` (:func:`plastic_approach`)."""
+    if fully_plastic and bracket is not None and record.converged:
+        record.message += fully_plastic_note(bracket)
+        record.history["approach_bracket"] = list(bracket)
+
+
+def fully_plastic_note(bracket):
+    """The words a converged solve adds to its message where every contact node is plastic."""
+    return (f"; fully plastic: every contact node at the hardness, the approach is any value in "
+            f"[{bracket[0]:.6g}, {bracket[1]:.6g}], the lower end returned")
 
 
 def leaving_pressure(xp, hardness, lowered):

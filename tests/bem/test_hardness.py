@@ -116,6 +116,34 @@ def test_a_flat_punch_that_yields_everywhere_carries_the_hardness_on_its_area():
     assert res.kkt_residual <= 1e-12
 
 
+@pytest.mark.parametrize("layer", [None, bem.layers.Power(0.1, 0.5)], ids=["qp", "newton_power"])
+@pytest.mark.parametrize("share", [1.0, 0.999])
+def test_a_flat_punch_at_and_just_below_the_fully_plastic_load(layer, share):
+    """At the load H N a every node of the flat yields (the approach's interval reported); just below it all but
+    a few do, and the conditions hold. A step that clips many nodes at 0 and others at H carries more than
+    the force at H alone: every node is scaled down then (bem.plastic.fill_force)."""
+    H = 0.2
+
+    def gap(x, y):
+        return np.where(np.hypot(x, y) <= 0.3, 0.0, 1.0)
+
+    region = bem.HalfSpaceRegion(0.05, (0.6, 0.6))
+    lat = region.lattice()
+    n = int((lat.mask & (gap(lat.x, lat.y) == 0.0)).sum())
+    force = share * H * lat.node_area * n
+    res = bem.solve(gap, E_star=1.0, force=force, domain=region, hardness=H, layer=layer)
+    assert res.status == "converged", res.message
+    assert res.kkt_residual <= 1e-10 and res.force == pytest.approx(force, rel=1e-14)
+    if share == 1.0:
+        assert "fully plastic" in res.message and len(res.history["approach_bracket"]) == 2
+        assert res.plastic_area == pytest.approx(force / H, rel=1e-14)
+    else:
+        assert "fully plastic" not in res.message and 0 < n * lat.node_area - res.plastic_area
+        assert res.contact_area == pytest.approx(n * lat.node_area, rel=1e-14)  # the flat, no more
+    u, h = _sphere_dense(res, gap)
+    assert _bounded_kkt(res, u, h, force=force) <= 1e-10
+
+
 def test_a_plateau_on_a_cell_that_yields_everywhere():
     cell = bem.PeriodicCell(1.0 / 32, 32, 32)
     h = np.where(np.hypot(cell.x - 0.5, cell.y - 0.5 * cell.size[1]) <= 0.2, 0.0, 0.05)
@@ -222,6 +250,17 @@ def test_newton_with_a_nonlinear_layer_meets_the_bounded_kkt_conditions(control)
     assert _bounded_kkt(res, u, h, force=kw.get("force")) <= 1e-10
 
 
+def test_newton_settles_a_node_that_its_model_puts_at_the_hardness():
+    """A node just below H whose model puts it at H: damped steps never reached it (33 Newton steps at a
+    constant residual 9e-3 on this problem); moved there (bem.newton_moves.settle_plastic), 7."""
+    layer = bem.layers.Power(0.1, 0.5)
+    soft = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.5, layer=layer)
+    res = bem.solve(Paraboloid(1.0), E_star=1.0, step=0.05, extent="auto", layer=layer, hardness=0.3,
+                    approach=soft.approach)
+    assert res.status == "converged" and res.plastic_area > 0
+    assert res.iterations <= 10
+
+
 def test_newton_on_a_rough_cell_with_a_layer():
     h = _rough(CELL)
     layer = bem.layers.Power(0.002, 0.5)
@@ -303,3 +342,26 @@ def test_the_bound_runs_on_a_strict_array_namespace(monkeypatch, layer, domain):
     assert ref.status == res.status == "converged" and ref.plastic_area > 0
     assert np.abs(res.p - ref.p).max() <= 1e-10 * ref.p_max
     assert res.plastic_area == ref.plastic_area
+
+
+@pytest.mark.parametrize("domain", ["region", "cell"])
+def test_every_level_of_nested_iteration_carries_the_bound(monkeypatch, domain):
+    import sys
+
+    driver = sys.modules["bem.solve"]
+    run, levels = driver._run, []
+
+    def spy(solver, op, h, *args):
+        sol = run(solver, op, h, *args)
+        levels.append((op.lattice.n_nodes, float(sol.p.max())))
+        return sol
+
+    monkeypatch.setattr(driver, "_run", spy)
+    if domain == "region":
+        res = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.02, extent=1.3, hardness=0.3)
+    else:
+        cell = bem.PeriodicCell(1.0 / 128, 128, 128)
+        res = bem.solve_periodic(_rough(cell), step=cell.step, E_star=1.0, mean_pressure=0.02, hardness=0.05)
+    assert res.status == "converged" and len(levels) >= 2
+    assert levels[0][0] < levels[-1][0]  # coarse to fine
+    assert all(p_max == res.hardness for _, p_max in levels)  # each level has plastic nodes, none above H
