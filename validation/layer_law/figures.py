@@ -43,7 +43,7 @@ def _source(law):
 
 def _hardness(law):
     """``", H = ... Pa (plastic asperities)"`` for a law with a hardness, ``""`` for an elastic one."""
-    return "" if law.hardness is None else f", $H$ = {law.hardness:.4g} Pa (plastic asperities)"
+    return "" if law.hardness is None else f", hardness $H$ = {law.hardness:.4g} Pa (plastic asperities)"
 
 
 def closure_figure(law, path):
@@ -94,7 +94,7 @@ def contact_fraction_figure(law, path):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(loc="lower right", fontsize="small")
         ax.set_title(rf"Contact fraction, $h'_\mathrm{{rms}}$ = {slope:.4g}, $E^*$ = {law.E_star:.4g} Pa"
-                     + ("" if law.hardness is None else f", $H$ = {law.hardness:.4g} Pa"), fontsize="medium")
+                     + ("" if law.hardness is None else f", hardness $H$ = {law.hardness:.4g} Pa"), fontsize="medium")
         save_figure(fig, path)
         return fig
 
