@@ -123,7 +123,7 @@ def test_a_measured_surface_scene_takes_the_hardness(tmp_path):
     raw = _rough()
     raw["gap"] = {"type": "surface", "file": "z.npy", "reader": "core", "spacing": 1 / 32}
     raw["bem"]["cell_nodes"] = 32
-    raw["bodies"] = {"E_star": 1.0, "hardness": 0.1}  # numbers of order one (the solver's bound in SI: report)
+    raw["bodies"] = {"E_star": 1.0, "hardness": 0.1}  # numbers of order one
     raw["load"] = {"mean_pressure": 0.01}
     (tmp_path / "s.toml").write_text(tomli_w.dumps(raw))
     code, out, err = cli("run", tmp_path / "s.toml", "--out", tmp_path / "out")
