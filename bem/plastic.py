@@ -59,25 +59,28 @@ def fill_force(xp, p, target, hardness):
     where the nodes below ``H`` cannot carry the rest of ``target`` (they carry nothing while it is
     positive, or all of them reach ``H``).
     """
-    fixed = p >= hardness
-    capped = False
+    fixed = p >= hardness  # the nodes at H (the values are at most H)
+    n_fixed, total, capped = int(xp.count_nonzero(fixed)), float(xp.sum(p)), False
     for _ in range(_FILL_ROUNDS):
-        need = target - hardness * float(xp.count_nonzero(fixed))
+        need = target - hardness * n_fixed
         if need < -1e-13 * target:  # too many nodes at H: all of them scaled down
-            return p * (target / float(xp.sum(p))), 1.0, True
-        rest = float(xp.sum(xp.where(fixed, 0.0, p)))
-        if not rest > 0:
-            if abs(need) <= 1e-13 * target:
-                return p, 1.0, capped
-            return None
+            return p * (target / total), 1.0, True
+        rest = total - hardness * n_fixed
+        if not rest > 1e-10 * total:  # little or nothing below H: its sum without cancellation
+            rest = float(xp.sum(xp.where(fixed, 0.0, p)))
+            if not rest > 0:
+                return (p, 1.0, capped) if abs(need) <= 1e-13 * target else None
         s = max(need / rest, 0.0)
-        q = p * s
-        over = ~fixed & (q > hardness)
-        if not bool(xp.any(over)):
-            return xp.where(fixed, p, q), s, capped
-        capped = True
-        fixed = fixed | over
-        p = xp.where(over, hardness, p)
+        if s <= 1.0:  # no node rises to H
+            return xp.where(fixed, p, p * s), s, capped
+        q = xp.minimum(p * s, hardness)
+        top = q >= hardness
+        n_top = int(xp.count_nonzero(top))
+        if n_top == n_fixed:
+            return q, s, capped
+        capped, fixed, n_fixed = True, top, n_top
+        p = xp.where(top, hardness, p)
+        total = float(xp.sum(p))
     return xp.where(fixed, p, xp.minimum(p * s, hardness)), s, capped
 
 

@@ -12,20 +12,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from .backend import get_backend
+from .coating import Bodies, Coating
 from .checks import (check_bool, check_callable, check_choice, check_finite_array, check_int, check_layer, check_load,
                      check_rtol, check_scale, fail)
 from .errors import InputError
 from .materials import effective_modulus
 from .options import METHODS, check_options, solver_for
 
-__all__ = ["Problem", "check_problem", "initial_guess", "modulus"]
+__all__ = ["Problem", "bodies_of", "check_problem", "initial_guess", "modulus"]
 
 
 @dataclass(frozen=True)
 class Problem:
-    """The checked arguments of :func:`bem.solve` (``solver``: the one that runs, :func:`bem.options.solver_for`)."""
+    """The checked arguments of :func:`bem.solve` (``solver``: the one that runs, :func:`bem.options.solver_for`;
+    ``bodies``: the coated bodies, a :class:`bem.Bodies`, or ``None`` when neither is coated)."""
 
     E_star: float
+    bodies: object
     force: float | None
     approach: float | None
     layer: object
@@ -53,6 +56,23 @@ def modulus(E_star, E1, nu1, E2, nu2):
     return effective_modulus(E1, nu1, E2, nu2)
 
 
+def bodies_of(E1, nu1, E2, nu2, coating1, coating2):
+    """The coated bodies (:class:`bem.Bodies`) of the arguments of :func:`bem.solve`, ``None`` without a coating.
+
+    A coating needs its substrate: ``E1, nu1, E2, nu2`` given (not ``E_star``)."""
+    for name, coating in (("coating1", coating1), ("coating2", coating2)):
+        if coating is not None and not isinstance(coating, Coating):
+            raise InputError(f"{name} = {coating!r} is not allowed: it must be a bem.Coating(thickness, E, nu) "
+                             "or None.")
+    if coating1 is None and coating2 is None:
+        return None
+    if any(v is None for v in (E1, nu1, E2, nu2)):
+        name = "coating1" if coating1 is not None else "coating2"
+        raise InputError(f"{name} is not allowed without E1, nu1, E2, nu2: a coating's substrate is its body's "
+                         "material, so give the bodies' moduli and Poisson ratios instead of E_star.")
+    return Bodies(E1, nu1, E2, nu2, coating1, coating2)
+
+
 def _load(domain, force, approach, mean_pressure):
     if mean_pressure is None:
         return check_load(force, approach)
@@ -64,11 +84,12 @@ def _load(domain, force, approach, mean_pressure):
     return check_scale("mean_pressure", mean_pressure) * area, None
 
 
-def check_problem(domain, *, E_star, E1, nu1, E2, nu2, force, approach, mean_pressure, layer, method, rtol, maxiter,
-                  nested, precondition, callback, device, options, hardness=None):
+def check_problem(domain, *, E_star, E1, nu1, E2, nu2, coating1=None, coating2=None, force, approach, mean_pressure,
+                  layer, method, rtol, maxiter, nested, precondition, callback, device, options, hardness=None):
     """The checked :class:`Problem` (the keywords of :func:`bem.solve`); :class:`bem.InputError` naming the first
     bad argument."""
     E_star = modulus(E_star, E1, nu1, E2, nu2)
+    bodies = bodies_of(E1, nu1, E2, nu2, coating1, coating2)
     force, approach = _load(domain, force, approach, mean_pressure)
     check_choice("method", method, METHODS)
     rtol = check_rtol("rtol", rtol)
@@ -90,9 +111,9 @@ def check_problem(domain, *, E_star, E1, nu1, E2, nu2, force, approach, mean_pre
         hardness = _hardness(domain, hardness, force, mean_pressure, solver)
     if nested is None:
         nested = solver in ("kalker", "newton")
-    return Problem(E_star=E_star, force=force, approach=approach, layer=layer, method=method, solver=solver,
-                   rtol=rtol, maxiter=maxiter, nested=nested, precondition=precondition, callback=callback,
-                   backend=backend, options=options, hardness=hardness)
+    return Problem(E_star=E_star, bodies=bodies, force=force, approach=approach, layer=layer, method=method,
+                   solver=solver, rtol=rtol, maxiter=maxiter, nested=nested, precondition=precondition,
+                   callback=callback, backend=backend, options=options, hardness=hardness)
 
 
 def _hardness(domain, hardness, force, mean_pressure, solver):

@@ -70,6 +70,9 @@ class ContactResult:
         The candidate lattice; :meth:`grid` maps nodal arrays back onto it.
     E_star : float
         Effective modulus [pressure].
+    bodies : bem.Bodies or None
+        The coated bodies (their moduli, Poisson ratios and coatings); ``None`` when neither body
+        is coated (``E_star`` says all).
     domain : bem.HalfSpaceRegion or bem.PeriodicCell
         The domain solved on (a growing region: the one the contact fitted in).
     notes : list of str
@@ -105,6 +108,7 @@ class ContactResult:
     status: str = ""
     rtol: float = math.nan
     domain: object = None
+    bodies: object = None
     notes: list = field(default_factory=list)
     hardness: float | None = None
     plastic_area: float = 0.0
@@ -156,4 +160,13 @@ class ContactResult:
             "step": float(self.step),
             "hardness": None if self.hardness is None else float(self.hardness),
             "plastic_area": float(self.plastic_area),
+            **self._coatings(),
         }
+
+    def _coatings(self):
+        """``coating1``, ``coating2`` (each ``{"thickness", "E", "nu"}`` or None) when a body is coated."""
+        if self.bodies is None:
+            return {}
+        return {f"coating{i}": None if c is None else {"thickness": float(c.thickness), "E": float(c.E),
+                                                        "nu": float(c.nu)}
+                for i, c in ((1, self.bodies.coating1), (2, self.bodies.coating2))}

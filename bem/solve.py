@@ -30,9 +30,10 @@ __all__ = ["solve"]
 log = logging.getLogger(__name__)
 
 
-def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None, approach=None,
-          mean_pressure=None, domain=None, step=None, extent=None, layer=None, hardness=None, method="newton", rtol=1e-10,
-          maxiter=None, x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
+def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, coating1=None, coating2=None, force=None,
+          approach=None, mean_pressure=None, domain=None, step=None, extent=None, layer=None, hardness=None,
+          method="newton", rtol=1e-10, maxiter=None, x0=None, nested=None, precondition=True, callback=None,
+          device="cpu", **options):
     """Frictionless normal contact of two elastic half-spaces with an interface layer, over a domain.
 
     Minimises the generalised Kalker functional (eq. 11, 15)
@@ -52,6 +53,13 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         ``x = (q + (r mod 2)/2) c``, ``y = r c sqrt3/2``).
     E_star : float, optional
         Effective modulus [pressure]; or give ``E1, nu1, E2, nu2`` instead.
+    E1, nu1, E2, nu2 : float, optional
+        Young's moduli [pressure] (``math.inf``: rigid) and Poisson's ratios [-] of the two
+        bodies (of the substrates where a body is coated), instead of ``E_star``.
+    coating1, coating2 : bem.Coating, optional
+        A coating bonded to body 1 or 2 (:mod:`bem.coating`); needs ``E1, nu1, E2, nu2``. The
+        operator then carries the bodies' compliance per Fourier mode ``2 (s1 + s2) / q``;
+        ``result.E_star`` is the substrates' and ``result.bodies`` the :class:`bem.Bodies`.
     force, approach, mean_pressure : float
         Exactly one: total force ``P`` [force] (force control, eq. 9; on a cell the force on one
         cell), the approach ``delta`` [length] (approach control), or, on a cell, the mean
@@ -165,7 +173,8 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     t_start = time.perf_counter()
     domain = _domain(domain, step, extent)
     domain.check_gap(gap)
-    problem = check_problem(domain, E_star=E_star, E1=E1, nu1=nu1, E2=E2, nu2=nu2, force=force, approach=approach,
+    problem = check_problem(domain, E_star=E_star, E1=E1, nu1=nu1, E2=E2, nu2=nu2, coating1=coating1,
+                            coating2=coating2, force=force, approach=approach,
                             mean_pressure=mean_pressure, layer=layer, method=method, rtol=rtol, maxiter=maxiter,
                             nested=nested, precondition=precondition, callback=callback, device=device,
                             options=options, hardness=hardness)
@@ -227,7 +236,9 @@ def _solve_on(region, gap, problem, x0, t_start):
     coarse_rtol = region.coarse_rtol(problem.solver)
 
     def make_op(lat):
-        return region.operator(lat, problem.E_star, problem.backend)
+        if problem.bodies is None:
+            return region.operator(lat, problem.E_star, problem.backend)
+        return region.operator(lat, problem.E_star, problem.backend, bodies=problem.bodies)
 
     def run(op, h_lat, kw):
         return _run(problem.solver, op, h_lat, problem.layer, problem.precondition, kw, problem.options)
@@ -314,5 +325,5 @@ def _result(region, lattice, op, h, sol, closure, problem, t_start, n_matvec=0):
         message=sol.message, status=sol.status, rtol=float(problem.rtol), iterations=int(sol.iterations),
         kkt_residual=float(kkt), method=problem.solver, wall_time_s=time.perf_counter() - t_start, lattice=lattice,
         E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=n_matvec + op.n_matvec,
-        domain=region, hardness=problem.hardness,
+        domain=region, bodies=problem.bodies, hardness=problem.hardness,
         plastic_area=0.0 if problem.hardness is None else float(a * np.count_nonzero(p[mask] >= problem.hardness)))
