@@ -3,8 +3,7 @@
 A scene file has the sections (units: those of ``[scene] units``, SI by default)::
 
     [scene]    name, title, description, units           (name required)
-    [bodies]   E1, nu1, E2, nu2 [Pa, -]  -- or E_star [Pa] alone; coating1, coating2 = {thickness [m], E [Pa], nu};
-               hardness [Pa] (plastic surface)
+    [bodies]   E1, nu1, E2, nu2 [Pa, -] or E_star [Pa] alone; coating1, coating2 = {thickness [m], E [Pa], nu}; hardness
     [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...), or
                type = "measured" with a file (validation.scene.measured)
     [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn with cnn_step,
@@ -72,8 +71,7 @@ class Scene:
     ``layer_spec`` the validated ``[layer]`` and ``layer`` the law built from it once (``None``
     without a layer, or for a law of the paper's parameters, which the runner resolves);
     ``bem`` the solver options with the resolved lattice (:func:`validation.scene.sizing.bem_options`).
-    ``hardness``: ``bodies.hardness`` [pressure], the cap of the contact pressure of every solve of the
-    run (:func:`bem.solve`), ``None``: elastic.
+    ``hardness``: ``bodies.hardness`` [pressure] that caps the pressure of the run's solve, ``None``: elastic.
     ``base_dir``, ``allow_code`` and ``allow_outside_files``: the folder its file names start
     from and what it may reach (:attr:`trust`); ``unimported``: ``(key, "module:function")``
     of code named but not imported (:func:`check_scene`; such a scene does not run);
