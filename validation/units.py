@@ -12,12 +12,17 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-__all__ = ["Units", "parse_units", "DEFAULT_LABEL", "METRES"]
+__all__ = ["Units", "parse_units", "DEFAULT_LABEL", "METRES", "PASCALS", "pressure_in_pa"]
 
 DEFAULT_LABEL = "SI (m, Pa, N)"
 #: metres per length unit that a label or a measured file may name
 METRES = {"nm": 1e-9, "um": 1e-6, "µm": 1e-6, "mm": 1e-3, "cm": 1e-2, "m": 1.0, "km": 1e3, "in": 0.0254,
           "ft": 0.3048}
+#: pascals per pressure unit that a label or a command-line value may name
+PASCALS = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9, "bar": 1e5, "psi": 6894.757293168361,
+           "ksi": 6894757.293168361}
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?:nan|inf))\s*([A-Za-z]*)\s*$",
+                       re.IGNORECASE)
 _KINDS = {  # unit kind -> regular expression of a unit token of that kind
     "pressure": re.compile(r"^(?:[kMG]?Pa|psi|ksi|bar)$"),
     "force": re.compile(r"^(?:[mkM]?N|lbf|kgf)$"),
@@ -92,3 +97,26 @@ def parse_units(label):
     if not found and re.match(r"^\s*SI\b", label):
         found = {"length": "m", "pressure": "Pa", "force": "N"}
     return Units(label, **found)
+
+
+def pressure_in_pa(name, text):
+    """A pressure written as a number with an optional unit of :data:`PASCALS` (``"2.5GPa"``,
+    ``"300 MPa"``, ``"1e9"``: Pa), in Pa: finite and ``> 0``.
+
+    Raises
+    ------
+    bem.InputError
+        Not a number, an unknown unit, or not finite and ``> 0``; the message names ``name``.
+    """
+    import math
+
+    from bem.checks import InputError
+
+    match = _QUANTITY.match(str(text))
+    if match is None or (match.group(2) and match.group(2) not in PASCALS):
+        raise InputError(f"{name} = {text!r} is not allowed: it must be a number with an optional pressure unit ("
+                         + ", ".join(PASCALS) + "; none: Pa), e.g. 2.5GPa.")
+    value = float(match.group(1)) * PASCALS[match.group(2) or "Pa"]
+    if not (math.isfinite(value) and value > 0):
+        raise InputError(f"{name} = {text!r} is not allowed: it must be finite and > 0 (a pressure).")
+    return value

@@ -4,7 +4,8 @@
 :mod:`bem.rough.surface` synthesises seeded self-affine surfaces, both through the optional
 package SurfaceTopography (``pip install "contactlab[rough]"``), with their statistics and the
 periodic cell of a measured patch; :mod:`bem.rough.layer_law` makes the layer law ``w(p)`` of a
-rough surface from its periodic contact under a ladder of mean pressures; :mod:`bem.rough.outliers`
+rough surface from its periodic contact under a ladder of mean pressures (:mod:`bem.rough.law_file` reads its
+table file back); :mod:`bem.rough.outliers`
 finds and removes spikes, :mod:`bem.rough.patch` makes the periodic cell of a surface as measured,
 :mod:`bem.rough.persson` gives Persson's theory from a PSD; :mod:`bem.rough.lattice_heights`
 resamples a periodic height grid onto the lattice cell (numpy only, no extra needed). docs/rough.md
@@ -20,7 +21,8 @@ from .instrument_files import FILLS, MAX_MISSING
 from .overview import summary
 from .outliers import SPIKE_THRESHOLD, Spikes, find_spikes, remove_spikes
 from .patch import CELLS, DETREND_CHOICES, PatchCell, patch_cell
-from .layer_law import LadderNotConverged, TopographyLaw, layer_from_topography, read_layer_law
+from .layer_law import LadderNotConverged, TopographyLaw, layer_from_topography
+from .law_file import read_layer_law
 from .surface import (DETRENDS, EDGE_JUMP_LIMIT, MIN_POINTS, RoughSurface, SurfaceStats, combined, from_heights,
                       self_affine)
 

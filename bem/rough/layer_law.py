@@ -27,8 +27,17 @@ a mean gap of zero in full contact) are levelled, ``w_k = max_(j <= k) (ubar(0+)
 Two rough surfaces in contact are their sum (:func:`bem.rough.combined`) with the effective
 modulus ``E*`` of the pair.
 
+**Plastic asperities.** With a ``hardness`` ``H`` every solve of the ladder caps the pressure
+at ``H`` (:func:`bem.solve`, elastic-perfectly-plastic): a node at ``H`` flows and its
+overlap is the plastic flattening of the asperity. The approach, hence the closure, then
+includes the flattening, ``ubar = mean(h) - delta`` is the mean gap of the flattened surface
+(smaller than the elastic one at the same pressure), and ``A/A0`` grows. A cell's mean
+pressure is at most ``H`` (every node flowing), so the ladder must lie below ``H``. The law
+records ``H`` and the share of the cell that flows at each pressure (``plastic_fraction``).
+
 The ladder of mean pressures is solved in order, each solve started from the previous
-pressure field scaled by the ratio of the mean pressures. A step that does not converge stops
+pressure field scaled by the ratio of the mean pressures (with a hardness, from the solver's own
+start where the nodes that field loads cannot carry the next pressure below ``0.8 H``). A step that does not converge stops
 the ladder with :class:`LadderNotConverged`: no table is made from it.
 
 **The start of the ladder.** Below its first pressure ``p_1`` the table is a straight line
@@ -46,17 +55,15 @@ The table file (TOML) holds a ``[layer]`` table a scene's ``[layer]`` takes as i
 (``law = "tabulated"``, ``p``, ``w``) and a ``[topography]`` table with the ladder's data,
 the surface statistics, what was done to the surface (``[topography.preparation]``), the
 start rule (``[topography.ladder_start]``), Persson's prediction (``[topography.persson]``) and
-the contactlab version; :func:`read_layer_law` reads it back.
+the contactlab version; :func:`bem.rough.read_layer_law` reads it back.
 Timings: ``benchmarks/layer_from_topography.py``.
 """
 
 from __future__ import annotations
 
 import importlib.metadata
-import tomllib
 import logging
-from dataclasses import dataclass, field, fields
-from pathlib import Path
+from dataclasses import dataclass, field
 
 import numpy as np
 import tomli_w
@@ -67,8 +74,7 @@ from ..layers import Tabulated
 from ..options import METHODS
 from .surface import RoughSurface, SurfaceStats
 
-__all__ = ["TopographyLaw", "LadderNotConverged", "layer_from_topography", "read_layer_law", "MAX_EXTENSION",
-           "PERSSON_POINTS"]
+__all__ = ["TopographyLaw", "LadderNotConverged", "layer_from_topography", "MAX_EXTENSION", "PERSSON_POINTS"]
 
 log = logging.getLogger(__name__)
 
@@ -125,7 +131,13 @@ class TopographyLaw:
         without one), ``added`` (pressures added below the ladder asked for).
     persson : dict
         Persson's prediction for the cell's spectrum (module docstring): ``mean_pressure``,
-        ``contact_fraction``, ``mean_gap`` (arrays), ``gamma``, ``rms_slope`` (of the spectrum).
+        ``contact_fraction``, ``mean_gap`` (arrays), ``gamma``, ``rms_slope`` (of the spectrum);
+        elastic (it knows no hardness).
+    hardness : float or None
+        The hardness ``H`` of the solves [pressure] (module docstring); ``None``: elastic.
+    plastic_fraction : ndarray or None
+        The share of the cell at the pressure ``H`` at each step [-] (``plastic_area / A0``);
+        ``None`` for an elastic law.
     """
 
     law: Tabulated
@@ -143,6 +155,8 @@ class TopographyLaw:
     preparation: dict = field(default_factory=dict)
     ladder_start: dict = field(default_factory=dict)
     persson: dict = field(default_factory=dict)
+    hardness: float | None = None
+    plastic_fraction: np.ndarray | None = None
 
     def layer_table(self):
         """The scene's ``[layer]`` table: ``{"law": "tabulated", "p": [...], "w": [...]}``."""
@@ -153,6 +167,8 @@ class TopographyLaw:
         data = {k: self._plain(getattr(self, k)) for k in ("mean_pressure", "closure", "mean_gap", "contact_fraction",
                                                            "stiffness", "iterations")}
         data.update(first_touch_gap=self.first_touch_gap, E_star=self.E_star, version=self.version, **self.cell)
+        if self.hardness is not None:  # TOML has no null: an elastic law has neither key
+            data.update(hardness=self.hardness, plastic_fraction=self._plain(self.plastic_fraction))
         data["surface"] = {k: v for k, v in self.stats.as_dict().items() if v is not None}  # TOML has no null
         for name in ("preparation", "ladder_start", "persson"):
             if getattr(self, name):
@@ -166,6 +182,9 @@ class TopographyLaw:
                      "through\n"
                      f"# (0, 0): {100 * self.ladder_start['interpolated_share']:.3g} % of the closure w(p_n)"
                      + ("" if rule is None else f" (at most {100 * rule:g} %)") + ".\n")
+        if self.hardness is not None:
+            head += (f"# Plastic asperities: the pressure is capped at the hardness H = {self.hardness:.6g}; "
+                     f"at p_n {100 * self.plastic_fraction[-1]:.3g} %\n# of the cell flows.\n")
         return write_text(path, head + "\n" + tomli_w.dumps({"layer": self.layer_table(), "topography": data}))
 
     @staticmethod
@@ -203,6 +222,26 @@ def _check_monotone(p, ubar, tol):
             "or space the pressures further apart.")
 
 
+def _hardness(hardness, p):
+    """The checked hardness (``None``: elastic); the ladder must lie below it (module docstring)."""
+    if hardness is None:
+        return None
+    hardness = check_positive("hardness", hardness)
+    if p[-1] >= hardness:
+        fail(f"pressures[{p.size - 1}]", float(p[-1]), f"< hardness = {hardness!r}: a cell's mean pressure is at "
+                                                       "most the hardness, reached when every node flows")
+    return hardness
+
+
+def _guess(res, ratio, hardness, shape):
+    """The start of the next step: the pressure of ``res`` scaled by the ratio of the mean pressures; with a
+    hardness, none (the solver's own start) where the nodes it loads cannot carry it below ``0.8 H``."""
+    guess = res.p.reshape(shape) * ratio
+    if hardness is not None and np.count_nonzero(guess) * 0.8 * hardness < guess.sum():
+        return None
+    return guess
+
+
 def _solve(solve_periodic, h, pbar, guess, options, k):
     """One step of the ladder (``k < 0``: the ``-k``-th pressure added below it), converged or raised."""
     res = solve_periodic(h, mean_pressure=pbar, x0=guess, **options)
@@ -233,7 +272,7 @@ def _persson(surface, E_star, p, q_max):
 
 
 def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton", rtol=1e-8, maxiter=None,
-                          progress=None, max_interpolated=None, preparation=None):
+                          progress=None, max_interpolated=None, preparation=None, hardness=None):
     """The layer law ``w(pbar)`` of a rough surface pressed against a flat (module docstring).
 
     Parameters
@@ -262,6 +301,9 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
         ladder as given (its share is recorded all the same).
     preparation : dict, optional
         What was done to the surface (:meth:`bem.rough.PatchCell.record`), recorded with the law.
+    hardness : float, optional
+        The hardness ``H`` [pressure], ``> 0`` and above the ladder: every solve caps the pressure
+        at ``H`` (plastic asperities, module docstring). ``None``: elastic.
 
     Returns
     -------
@@ -288,15 +330,17 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
         max_interpolated = check_range("max_interpolated", max_interpolated, 0.0, 1.0, low_open=True, high_open=True)
     if preparation is not None and not isinstance(preparation, dict):
         fail("preparation", type(preparation).__name__, "a dict or None")
+    hardness = _hardness(hardness, p)
     lattice = surface.to_lattice(n_cols)
     h = lattice.gap()
     ubar0 = float(h.mean())
     options = dict(step=lattice.step, E_star=E_star, method=method, rtol=rtol,
-                   **({} if maxiter is None else {"maxiter": maxiter}))
+                   **({} if maxiter is None else {"maxiter": maxiter}),
+                   **({} if hardness is None else {"hardness": hardness}))
     ladder, guess = [], None  # (pressure, result)
     for k, pbar in enumerate(p):
         ladder.append((float(pbar), _solve(solve_periodic, h, float(pbar), guess, options, k)))
-        guess = ladder[-1][1].p.reshape(h.shape) * (p[k + 1] / pbar) if k + 1 < p.size else None
+        guess = _guess(ladder[-1][1], p[k + 1] / pbar, hardness, h.shape) if k + 1 < p.size else None
         if progress is not None:
             progress(k + 1, p.size, ladder[-1][1])
     factor, added, lowest = max(float(p[1] / p[0]), 2.0), [], ladder[0]  # added: below the ladder, highest first
@@ -313,8 +357,11 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
     mean_gap = np.array([res.mean_gap for _, res in steps], dtype=float)
     fraction = np.array([res.contact_fraction for _, res in steps], dtype=float)
     iterations = np.array([res.iterations for _, res in steps], dtype=int)
+    plastic = None if hardness is None else np.array([res.plastic_fraction for _, res in steps], dtype=float)
     _check_monotone(p, mean_gap, rtol * ubar0)
-    full = fraction == 1.0  # every node touches: the mean gap is closed, whatever the rounding says
+    full = fraction == 1.0  # every node touches: the elastic mean gap is closed, whatever the rounding says
+    if plastic is not None:
+        full &= plastic == 0  # a flattened surface closes beyond its mean plane
     closure = np.where(full, ubar0, np.maximum.accumulate(ubar0 - mean_gap))  # levels rises within the tolerance
     flat = full & np.r_[full[0], full[:-1]] & np.r_[full[1:], full[-1]]  # full contact on either side: rigid
     slope = np.gradient(closure, p)
@@ -331,45 +378,4 @@ def layer_from_topography(surface, E_star, *, pressures, n_cols, method="newton"
                         start["interpolated_share"], p[0], len(added), max_interpolated)
     return TopographyLaw(Tabulated(p, closure), p, closure, mean_gap, ubar0, fraction, stiffness, iterations, E_star,
                          cell, surface.stats, _version(), dict(preparation or {}), start,
-                         _persson(surface, E_star, p, np.pi / lattice.step))
-
-
-def _arrays(table):
-    return {k: np.array(v, dtype=float) if isinstance(v, list) else v for k, v in table.items()}
-
-
-def read_layer_law(path):
-    """Read a table file written by :meth:`TopographyLaw.save`.
-
-    Returns
-    -------
-    TopographyLaw
-
-    Raises
-    ------
-    bem.InputError
-        The file cannot be read, is not TOML, or lacks the ``[layer]`` or ``[topography]`` table.
-    """
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
-        raise InputError(f"path = {str(path)!r} is not allowed: it must be a readable TOML table file "
-                         f"({'nested too deep' if isinstance(exc, RecursionError) else type(exc).__name__}).") from None
-    layer, topo = data.get("layer"), data.get("topography")
-    if not isinstance(layer, dict) or layer.get("law") != "tabulated" or not isinstance(topo, dict):
-        fail("path", str(path), "a layer law file with [layer] law = 'tabulated' and a [topography] table")
-    try:
-        stats = dict(topo["surface"])
-        stats.update(size=tuple(stats["size"]), grid=tuple(stats["grid"]))
-        stats = SurfaceStats(**{f.name: stats[f.name] for f in fields(SurfaceStats) if f.name in stats})
-        arrays = {k: np.array(topo[k], dtype=float) for k in ("mean_pressure", "closure", "mean_gap",
-                                                               "contact_fraction", "stiffness")}
-        cell = {k: topo[k] for k in ("n_cols", "n_rows", "step", "stretch_y", "method", "rtol")}
-        return TopographyLaw(Tabulated(layer["p"], layer["w"]), arrays["mean_pressure"], arrays["closure"],
-                             arrays["mean_gap"], float(topo["first_touch_gap"]), arrays["contact_fraction"],
-                             arrays["stiffness"], np.array(topo["iterations"], dtype=int), float(topo["E_star"]),
-                             cell, stats, str(topo["version"]), dict(topo.get("preparation", {})),
-                             dict(topo.get("ladder_start", {})), _arrays(topo.get("persson", {})))
-    except (KeyError, TypeError) as exc:
-        raise InputError(f"path = {str(path)!r} is not allowed: its [topography] table lacks {exc}.") from None
+                         _persson(surface, E_star, p, np.pi / lattice.step), hardness, plastic)

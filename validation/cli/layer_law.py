@@ -28,6 +28,8 @@ PARSER = {
         "the unit it states (--scale and --size for a file that states neither unit nor size; --fill harmonic\n"
         "fills missing points, at most 5 % of them). The ladder's last pressure must exceed the largest local\n"
         "pressure of the problems the law is used in: beyond it the law holds no data (a solve there warns).\n"
+        "--hardness H caps the pressure at H in every solve (elastic-perfectly-plastic asperities): the law\n"
+        "file records H and the share of the cell that flows, the figures name it; the ladder must lie below H.\n"
         "The law file needs the rough extra, the figures the report extra (or --no-figures).\n"
         "--out DIR must be new, empty or a layer-law folder contactlab wrote (marked by DIR/.contactlab)."),
     "epilog": (
@@ -40,6 +42,7 @@ PARSER = {
         "                       --E-star 115e9 --p-range-rel 1e-3:0.5 --n-pressures 20 --out laws/synthetic\n"
         "  contactlab layer-law patch.x3p --E-star 115e9 --p-range 1e6:3e9 --n-cols 512 --rtol 1e-10 --out laws/fine\n"
         "  contactlab layer-law scan.ibw --E-star 115e9 --spikes remove --cell mirror --out laws/scan\n"
+        "  contactlab layer-law patch.x3p --E-star 115e9 --hardness 2.5GPa --p-range 1e6:1e9 --out laws/plastic\n"
         "Timings: benchmarks/layer_from_topography.py."),
 }
 
@@ -67,6 +70,10 @@ def add_args(p):
     rng.add_argument("--p-range", metavar="LOW:HIGH", help="first and last mean pressure of the ladder [Pa]")
     rng.add_argument("--p-range-rel", metavar="LOW:HIGH", default="3e-3:0.3",
                      help="the same in units of E* h'_rms, h'_rms the surface's rms slope (default 3e-3:0.3)")
+    p.add_argument("--hardness", metavar="VALUE[UNIT]",
+                   help="hardness H of the asperities, a pressure with an optional unit (Pa, kPa, MPa, GPa, bar, "
+                        "psi, ksi; none: Pa), e.g. 2.5GPa: every solve caps the pressure at H (plastic "
+                        "asperities); above the ladder's last pressure (default: elastic)")
     p.add_argument("--n-pressures", type=int, default=12, metavar="N",
                    help="mean pressures in the ladder, geometrically spaced (default 12)")
     p.add_argument("--n-cols", type=int, metavar="N",
@@ -144,6 +151,9 @@ def _summary(folder):
              f"closure    w = {w[0]:.4g} .. {w[-1]:.4g} m of the first-touch mean gap {law.first_touch_gap:.4g} m",
              f"contact    A/A0 = {law.contact_fraction[0]:.3g} .. {law.contact_fraction[-1]:.3g}",
              f"range      the law holds data up to p = {p[-1]:.4g} Pa; a solve beyond it warns",
+             *([] if law.hardness is None else
+               [f"plastic    hardness H = {law.hardness:.4g} Pa: {100 * law.plastic_fraction[-1]:.3g} % of the cell "
+                f"flows at p = {p[-1]:.4g} Pa"]),
              f"start      {100 * law.ladder_start['interpolated_share']:.3g} % of the closure lies below "
              f"p = {p[0]:.4g} "
              f"Pa (a straight line to 0)" + (f", {law.ladder_start['added']} pressures added below the ladder"
@@ -184,9 +194,11 @@ def run(args):
     from bem.rough import LadderNotConverged
 
     from ..layer_law import ladder, make_layer_law, surface_from_file, synthetic_surface
+    from ..units import pressure_in_pa
 
     check_positive("--E-star", args.E_star)  # the options the library checks again, checked before any work
     check_rtol("--rtol", args.rtol)
+    hardness = None if args.hardness is None else pressure_in_pa("--hardness", args.hardness)
     if (args.surface is None) == (args.synthetic is None):
         raise InputError("SURFACE is missing: give a surface file or --synthetic (one of them)." if args.surface is None
                          else f"SURFACE = {args.surface!r} is not allowed together with --synthetic: give one.")
@@ -217,12 +229,16 @@ def run(args):
         else:
             pressures = ladder(surface, args.E_star, relative=pair("--p-range-rel", args.p_range_rel, ":"),
                                n=args.n_pressures)
+    if hardness is not None and pressures[-1] >= hardness:
+        raise InputError(f"--hardness = {args.hardness!r} ({hardness:.6g} Pa) is not allowed: it must exceed the "
+                         f"ladder's last mean pressure {pressures[-1]:.6g} Pa (a cell's mean pressure is at most the "
+                         "hardness); give a lower --p-range or --p-range-rel.")
     bar = ProgressBar("layer law", "pressure", args.no_progress or None)
     try:
         with option_names({"n_cols": "--n-cols"}):
             folder = make_layer_law(surface, args.out, E_star=args.E_star, pressures=pressures, n_cols=args.n_cols,
                                     rtol=args.rtol, figures=not args.no_figures, progress=bar, what="--out",
-                                    max_interpolated=share)
+                                    max_interpolated=share, hardness=hardness)
     except LadderNotConverged as exc:
         print(f"contactlab: error: {exc} (nothing was written)", file=sys.stderr)
         return 1

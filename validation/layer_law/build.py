@@ -18,6 +18,10 @@ the law is used in: beyond it a tabulated law holds no data (:func:`bem.layers.b
 Below its first pressure the law is a straight line through ``(0, 0)``: the ladder is extended
 downwards until that holds at most :data:`MAX_INTERPOLATED` (1 %) of its closure.
 
+With a hardness ``H`` [Pa] the asperities flow at ``H`` (:mod:`bem.rough.layer_law`): the law file
+records ``H`` and the share of the cell that flows, the figures name ``H``, and the ladder must
+lie below ``H`` (a default ladder reaching it is refused by name: give a lower range).
+
 A measured surface becomes its periodic cell by :func:`bem.rough.patch_cell` (detrending,
 spikes, a repeated or mirrored cell); the law file records what was done
 (``[topography.preparation]``).
@@ -176,7 +180,7 @@ def _check_figures(figures):
 
 
 def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="newton", rtol=1e-8, figures=True,
-                   progress=None, what="out_dir", max_interpolated=MAX_INTERPOLATED):
+                   progress=None, what="out_dir", max_interpolated=MAX_INTERPOLATED, hardness=None):
     """Solve the layer law of ``surface`` and write its folder ``out_dir`` (module docstring).
 
     Parameters
@@ -205,6 +209,9 @@ def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="
         As :func:`bem.rough.layer_from_topography` (default :data:`MAX_INTERPOLATED`: the
         ladder is extended downwards until at most 1 % of its closure lies below its first
         pressure).
+    hardness : float, optional
+        The hardness ``H`` [Pa] of plastic asperities, above the ladder (as
+        :func:`bem.rough.layer_from_topography`); ``None``: elastic.
 
     Returns
     -------
@@ -232,7 +239,8 @@ def make_layer_law(surface, out_dir, *, E_star, pressures, n_cols=None, method="
     step = None if progress is None else (
         lambda k, n, res: progress(f"A/A0 {res.contact_fraction:.3g}, {res.iterations} iterations", k, n))
     law = rough.layer_from_topography(surface, E_star, pressures=pressures, n_cols=n_cols, method=method, rtol=rtol,
-                                      progress=step, max_interpolated=max_interpolated, preparation=record)
+                                      progress=step, max_interpolated=max_interpolated, preparation=record,
+                                      hardness=hardness)
     drawn = {}
     with atomic_directory(out_dir, KIND, NAMES, what=what) as tmp:
         law.save(tmp / LAW_FILE)

@@ -14,6 +14,10 @@
   numerical law departs from the theory (finite resolution and cell, spikes, a non-Gaussian
   surface, or the theory's approximations). Pressures added below the ladder are marked.
 
+A law of plastic asperities (``law.hardness``, :mod:`bem.rough.layer_law`) names its hardness
+``H`` in every title; ``contact_fraction.png`` draws the share of the cell at ``H`` beside
+``A/A0``, and ``persson.png`` notes that the theory is elastic.
+
 Matplotlib is imported inside the functions (the ``report`` extra).
 """
 
@@ -37,6 +41,11 @@ def _source(law):
     return source if len(source) <= 60 else "..." + source[-57:]
 
 
+def _hardness(law):
+    """``", H = ... Pa (plastic asperities)"`` for a law with a hardness, ``""`` for an elastic one."""
+    return "" if law.hardness is None else f", hardness $H$ = {law.hardness:.4g} Pa (plastic asperities)"
+
+
 def closure_figure(law, path):
     """``w(p)`` on linear and logarithmic axes; returns the figure after writing ``path``."""
     p, w = law.mean_pressure, law.closure
@@ -49,7 +58,7 @@ def closure_figure(law, path):
         lin.axhline(law.first_touch_gap / wf, color="0.4", linestyle="--", linewidth=1,
                     label=r"first-touch mean gap $\bar u(0^+)$ (full closure)")
         lin.set_xlim(0.0, 1.02 * p[-1] / pf)
-        lin.set_ylim(0.0, 1.08 * law.first_touch_gap / wf)
+        lin.set_ylim(0.0, 1.08 * max(law.first_touch_gap, w[-1]) / wf)  # a flattened surface closes beyond it
         lin.legend(loc="lower right", fontsize="small")
         geo = np.geomspace(p[0], p[-1], 400)
         log.loglog(geo / pf, law.law.w(geo) / wf, **_CURVE)
@@ -61,7 +70,7 @@ def closure_figure(law, path):
         lin.set_title("linear axes")
         log.set_title("logarithmic axes")
         fig.suptitle(r"Layer law $w(p) = \bar u(0^+) - \bar u(p)$ of " + _source(law)
-                     + f", $E^*$ = {law.E_star:.4g} Pa")
+                     + f", $E^*$ = {law.E_star:.4g} Pa" + _hardness(law))
         save_figure(fig, path)
         return fig
 
@@ -76,12 +85,16 @@ def contact_fraction_figure(law, path):
         ax.loglog(guide, HYUN_KAPPA * guide, color="0.5", linestyle="--", linewidth=1,
                   label=rf"$A/A_0 = {HYUN_KAPPA:g}\, p/(E^* h'_\mathrm{{rms}})$ (Hyun et al. 2004)")
         ax.loglog(x, a, label=f"ladder ({x.size} solves)", **_CURVE, marker="o", markersize=5)
+        if law.hardness is not None and np.any(law.plastic_fraction > 0):
+            flows = law.plastic_fraction > 0
+            ax.loglog(x[flows], law.plastic_fraction[flows], color="#d62728", marker="s", markersize=4,
+                      linewidth=1, label=f"share at the hardness $H$ = {law.hardness:.4g} Pa (flowing)")
         ax.set_xlabel(r"$p\,/\,(E^*\,h'_\mathrm{rms})$ [-]")
         ax.set_ylabel(r"real contact fraction $A/A_0$ [-]")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(loc="lower right", fontsize="small")
-        ax.set_title(rf"Contact fraction, $h'_\mathrm{{rms}}$ = {slope:.4g}, $E^*$ = {law.E_star:.4g} Pa",
-                     fontsize="medium")
+        ax.set_title(rf"Contact fraction, $h'_\mathrm{{rms}}$ = {slope:.4g}, $E^*$ = {law.E_star:.4g} Pa"
+                     + ("" if law.hardness is None else f", hardness $H$ = {law.hardness:.4g} Pa"), fontsize="medium")
         save_figure(fig, path)
         return fig
 
@@ -100,7 +113,8 @@ def stiffness_figure(law, path):
         ax.set_ylabel(r"interfacial stiffness $K = \mathrm{d}p/\mathrm{d}w$ [Pa/m]")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(loc="lower right", fontsize="small")
-        ax.set_title(r"Interfacial stiffness $K = -\mathrm{d}p/\mathrm{d}\bar u$", fontsize="medium")
+        ax.set_title(r"Interfacial stiffness $K = -\mathrm{d}p/\mathrm{d}\bar u$" + _hardness(law),
+                     fontsize="medium")
         save_figure(fig, path)
         return fig
 
@@ -112,7 +126,8 @@ def persson_figure(law, path):
     rms = float(law.stats.rms_height)
     added = int(law.ladder_start.get("added", 0))
     with new_figure((9.6, 4.2), ncols=2) as (fig, (area, gap)):
-        label = rf"Persson (2001, 2007), $\gamma$ = {theory['gamma']:g}"
+        label = rf"Persson (2001, 2007), $\gamma$ = {theory['gamma']:g}" + ("" if law.hardness is None else
+                                                                             ", elastic (no hardness)")
         area.loglog(theory["mean_pressure"] / pf, theory["contact_fraction"], color="0.3", linestyle="--",
                     linewidth=1.2, label=label)
         area.loglog(p / pf, law.contact_fraction, label=f"ladder ({p.size} solves)", **_CURVE, marker="o",
@@ -134,7 +149,8 @@ def persson_figure(law, path):
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(loc="best", fontsize="small")
         fig.suptitle(f"Layer law of {_source(law)} beside Persson's theory for its spectrum "
-                     rf"($h'_\mathrm{{rms}}$ = {theory['rms_slope']:.3g}, $E^*$ = {law.E_star:.4g} Pa)",
+                     rf"($h'_\mathrm{{rms}}$ = {theory['rms_slope']:.3g}, $E^*$ = {law.E_star:.4g} Pa"
+                     + _hardness(law) + ")",
                      fontsize="medium")
         save_figure(fig, path)
         return fig

@@ -95,6 +95,9 @@ class BemPart(_Part):
     ``coating1``, ``coating2``: the coating of each body (``thickness``, ``E``, ``nu``), ``None`` for an
     uncoated body.
     ``history``: per-iteration scalar lists (``residual``, ``p_max``, ``n_contact``, ...).
+    ``hardness``: the cap of the pressure (``bodies.hardness``), ``None`` for an elastic solve;
+    ``plastic_area``: the area of the nodes at the hardness (0 when elastic); ``plastic_fraction``
+    its share of a periodic cell (``None`` otherwise).
     """
 
     method: str
@@ -123,6 +126,9 @@ class BemPart(_Part):
     mean_pressure: float | None = None
     contact_fraction: float | None = None
     mean_gap: float | None = None
+    hardness: float | None = None
+    plastic_area: float | None = None
+    plastic_fraction: float | None = None
     coating1: dict | None = None
     coating2: dict | None = None
 

@@ -105,14 +105,17 @@ def domain_of(scene, messages):
 class _BemSolves:
     """:func:`bem.solve` of the scene's problem on its domain for a given layer: the run's solve and the
     calibration's. A region grown by one solve is where the next one starts (the calibration's region
-    carries over to the run's solve); ``messages`` gets the notes of each solve (how it grew)."""
+    carries over to the run's solve); ``messages`` gets the notes of each solve (how it grew). The run's
+    solve caps the pressure at ``bodies.hardness`` when the scene gives one; the calibration of a law of
+    the paper's parameters solves the elastic problem its parameters are defined on."""
 
     def __init__(self, scene, domain, messages):
         opts = scene.bem
         self.domain, self.messages = domain, messages
         self.bem_domain = domain.bem_domain
         problem = dict(bodies_keywords(scene), **domain.load)
-        self.kw = dict(problem, **solver_keywords(opts))
+        plastic = {} if scene.hardness is None else {"hardness": scene.hardness}
+        self.kw = dict(problem, **plastic, **solver_keywords(opts))
         self.calibration_kw = dict(problem, method="newton", **{k: opts[k] for k in CALIBRATION_KEYS if k in opts})
         self.calibration_solves = 0
 

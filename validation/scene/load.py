@@ -3,7 +3,7 @@
 A scene file has the sections (units: those of ``[scene] units``, SI by default)::
 
     [scene]    name, title, description, units           (name required)
-    [bodies]   E1, nu1, E2, nu2 [Pa, -]  -- or E_star [Pa] alone; coating1, coating2 = {thickness [m], E [Pa], nu}
+    [bodies]   E1, nu1, E2, nu2 [Pa, -] or E_star [Pa] alone; coating1, coating2 = {thickness [m], E [Pa], nu}; hardness
     [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...), or
                type = "measured" with a file (validation.scene.measured)
     [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn with cnn_step,
@@ -71,6 +71,7 @@ class Scene:
     ``layer_spec`` the validated ``[layer]`` and ``layer`` the law built from it once (``None``
     without a layer, or for a law of the paper's parameters, which the runner resolves);
     ``bem`` the solver options with the resolved lattice (:func:`validation.scene.sizing.bem_options`).
+    ``hardness``: ``bodies.hardness`` [pressure] that caps the pressure of the run's solve, ``None``: elastic.
     ``base_dir``, ``allow_code`` and ``allow_outside_files``: the folder its file names start
     from and what it may reach (:attr:`trust`); ``unimported``: ``(key, "module:function")``
     of code named but not imported (:func:`check_scene`; such a scene does not run);
@@ -103,6 +104,7 @@ class Scene:
     allow_outside_files: bool = False
     unimported: tuple = field(default=())
     skipped: tuple = field(default=())
+    hardness: float | None = None
 
     @property
     def trust(self):
@@ -281,6 +283,7 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     stress = check(lambda b, bo: sec.stress_options(raw.get("stress"), b["materials"], bo["step"]), body, bem)
     stress = check(lambda st, bo: sec.stress_depth_bound(st, bo["extent"]), stress, bem)
     check(lambda b: coated_sections(b["coatings"], raw), body)
+    hardness = check(sec.hardness_bound, body, load, bem, fem, analytic)
     if check.errors:
         raise SceneError.of(check.errors)
     return Scene(
@@ -289,7 +292,7 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
         gap_spec=shape[0], layer_spec=layer[0], layer=layer[1], load=load, bem=bem, fem=fem, analytic=analytic,
         sweep=sweep, report=report, overrides=tuple(overrides), stress=stress, coatings=body["coatings"],
         base_dir=None if base_dir is None else str(base_dir), allow_code=code == "import",
-        allow_outside_files=outside_files, unimported=unimported,
+        allow_outside_files=outside_files, unimported=unimported, hardness=hardness,
     )
 
 

@@ -31,8 +31,8 @@ from .rough import PERIODIC_KEYS, ROUGH_TYPES, rough_gap
 from .sizing import KEYS as BEM_KEYS
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic", "report", "sweep_spec",
-           "stress_options", "stress_depth_bound", "scene_keys", "KEYS", "report_sections", "REPORT_SECTIONS",
-           "ANALYTIC_KINDS", "DEFAULT_UNITS", "BODY_KEYS", "COATING_KEYS", "Unimported"]
+           "stress_options", "stress_depth_bound", "hardness_bound", "scene_keys", "KEYS", "report_sections",
+           "REPORT_SECTIONS", "ANALYTIC_KINDS", "DEFAULT_UNITS", "BODY_KEYS", "COATING_KEYS", "Unimported"]
 
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
@@ -42,7 +42,7 @@ _FEM_OPTIONS = {"n_contact_elements": partial(ck.integer, minimum=4, maximum=400
                 **dict.fromkeys(("domain_factor", "fine_radius", "growth", "penalty"), ck.positive), "rtol": ck.rtol,
                 "maxiter": partial(ck.integer, minimum=1), "remesh": ck.boolean, "truncation_correction": ck.boolean}
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
-KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS, *COATING_KEYS),
+KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS, *COATING_KEYS, "hardness"),
         "load": ("force", "approach", "mean_pressure"), "bem": (*BEM_KEYS, *PERIODIC_KEYS),
         "fem": tuple(_FEM_OPTIONS), "analytic": ("kind",),
         "sweep": ("parameter", "values"), "report": ("sections", "format"),
@@ -115,8 +115,11 @@ def scene_meta(d):
 def bodies(d):
     """``[bodies]``: ``E_star`` alone, or ``E1, nu1, E2, nu2`` (``E = inf``: rigid body) and optionally
     ``coating1``, ``coating2`` (``{thickness, E, nu}``, on the body of that number; ``coatings`` in the
-    result: ``{"coating1": {...} or None, "coating2": ...}``, or ``None`` without a coating)."""
+    result: ``{"coating1": {...} or None, "coating2": ...}``, or ``None`` without a coating); and
+    ``hardness`` [pressure], the cap of the contact pressure (elastic-perfectly-plastic surface,
+    :func:`bem.solve`), ``None`` when absent (elastic)."""
     _section("bodies", d)
+    hardness = None if "hardness" not in d else ck.scale("bodies.hardness", d["hardness"])
     coated = [k for k in COATING_KEYS if k in d]
     if coated and "E_star" in d:
         raise ck.SceneError(f"bodies.{coated[0]} is not allowed with bodies.E_star: a coating's substrate is its "
@@ -126,13 +129,38 @@ def bodies(d):
             given = ", ".join(f"bodies.{k}" for k in BODY_KEYS if k in d)
             raise ck.SceneError(f"bodies.E_star = {d['E_star']!r} is not allowed together with {given}: "
                                 "give E_star alone or all of E1, nu1, E2, nu2.")
-        return {"E_star": ck.scale("bodies.E_star", d["E_star"]), "materials": None, "coatings": None}
+        return {"E_star": ck.scale("bodies.E_star", d["E_star"]), "materials": None, "coatings": None,
+                "hardness": hardness}
     for key in BODY_KEYS:
         ck.require("bodies", d, key, "give E1, nu1, E2, nu2 [Pa, -] (or E_star alone)")
     with ck.scene_errors("bodies."):
         E_star = effective_modulus(*(d[k] for k in BODY_KEYS))
     coatings = {k: coating(f"bodies.{k}", d[k]) if k in d else None for k in COATING_KEYS} if coated else None
-    return {"E_star": E_star, "materials": {k: float(d[k]) for k in BODY_KEYS}, "coatings": coatings}
+    return {"E_star": E_star, "materials": {k: float(d[k]) for k in BODY_KEYS}, "coatings": coatings,
+            "hardness": hardness}
+
+
+def hardness_bound(body, load, bem, fem, analytic):
+    """``bodies.hardness`` with the rest of the scene: the references that are elastic (``[fem]``,
+    ``[analytic]``) are refused with it, and a periodic cell's mean pressure (``load.mean_pressure``, or
+    ``load.force`` over the cell) must lie below it (a cell's mean pressure is at most the hardness,
+    reached when every node flows)."""
+    hardness = body["hardness"]
+    if hardness is None:
+        return hardness
+    for name, part, what in (("fem", fem, "the FEM reference"), ("analytic", analytic, "the closed form")):
+        if part is not None:
+            raise ck.SceneError(f"bodies.hardness = {hardness!r} is not allowed with [{name}]: {what} is elastic; "
+                                f"remove [{name}] or the hardness.")
+    if bem.get("periodic"):
+        lx, ly = bem["size"]
+        key, mean = (("mean_pressure", load["mean_pressure"]) if load.get("mean_pressure") is not None
+                     else ("force", None if load["force"] is None else load["force"] / (lx * ly)))
+        if mean is not None and mean >= hardness:
+            raise ck.SceneError(f"bodies.hardness = {hardness!r} is not allowed with load.{key} = {load[key]!r}: the "
+                                f"cell's mean pressure {mean:.6g} must be below the hardness (it is at most the "
+                                "hardness, reached when every node flows).")
+    return hardness
 
 
 class Unimported(gaps.Gap):

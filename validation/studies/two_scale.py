@@ -7,6 +7,12 @@ model is :func:`bem.solve` with the gap :class:`~validation.studies.two_scale_mo
 with the law :func:`bem.rough.layer_from_topography` of the same cell; Greenwood and Tripp's
 model (:func:`~validation.studies.two_scale_models.greenwood_tripp_law`) stands beside it.
 
+With ``settings["hardness"] = H`` [pressure] the asperities are plastic: every solve caps the
+pressure at ``H`` (:func:`bem.solve`): the resolved sphere, the law's ladder
+(:func:`bem.rough.layer_from_topography`, tabulated up to ``HARDNESS_SHARE H`` at most) and the
+smooth sphere with either law (its nominal pressure is at most ``H`` as well). ``None`` (the
+default): elastic.
+
 Cases: the ratio of the Hertz radius to the roll-off wavelength ``a_H/lambda_L`` (5, 10, 20) at
 the lighter load ``P1``; a sphere with ``sigma R/a_H^2 = ALPHA`` (Greenwood and Tripp's
 roughness parameter); loads ``P1`` and ``LOAD_RATIO P1``. Every model runs under force control.
@@ -41,7 +47,7 @@ from .two_scale_models import (TiledRoughness, greenwood_tripp_law, nominal_radi
                                windowed)
 
 __all__ = ["SETTINGS", "QUICK", "make_surface", "run_case", "run_two_scale", "refinement", "summary_lines",
-           "OUTPUT_NAMES", "main", "STEM"]
+           "OUTPUT_NAMES", "main", "STEM", "HARDNESS_SHARE"]
 
 #: the study's file is ``STEM + ".json"``, named after this module (:data:`validation.studies.STUDY_FILES`)
 STEM = __name__.rpartition(".")[2]
@@ -52,9 +58,17 @@ OUTPUT_NAMES = ("two_scale.json", "two_scale.md", "two_scale_map.png", "two_scal
 #: the full study (SI units)
 SETTINGS = dict(E_star=115e9, hurst=0.8, roll_off=20e-6, cutoff_ratio=4, cell_roll_offs=4, rms_height=0.1e-6,
                 seed=1, alpha=0.1, load_ratio=2.0, ratios=(5, 10, 20), nodes_per_roll_off=16, extent_factor=2.0,
-                layer_nodes_across=80, rtol=1e-8, refine=(8, 16, 32), refine_ratio=5)
+                layer_nodes_across=80, rtol=1e-8, refine=(8, 16, 32), refine_ratio=5, hardness=None)
 #: the small run ``rough_sphere_two_scale`` (``contactlab study two-scale --quick``)
 QUICK = dict(SETTINGS, ratios=(3,), nodes_per_roll_off=8, layer_nodes_across=40, refine=(4, 8, 16), refine_ratio=3)
+#: the law of plastic asperities is tabulated up to this share of the hardness at most (a cell's mean
+#: pressure is below the hardness)
+HARDNESS_SHARE = 0.9
+
+
+def _plastic(s):
+    """The keywords of :func:`bem.solve` for the hardness of settings ``s`` (none when elastic)."""
+    return {} if s.get("hardness") is None else {"hardness": s["hardness"]}
 
 
 def make_surface(s):
@@ -116,16 +130,21 @@ def resolved_solve(s, surface, R, force, nodes_per_roll_off, extent):
 
     cell = surface.to_lattice(nodes_per_roll_off * s["cell_roll_offs"])
     gap = TiledRoughness(cell, R)
-    return bem.solve(gap, E_star=s["E_star"], force=force, step=cell.step, extent=extent, rtol=s["rtol"]), gap
+    return bem.solve(gap, E_star=s["E_star"], force=force, step=cell.step, extent=extent, rtol=s["rtol"],
+                     **_plastic(s)), gap
 
 
 def layer_laws(s, surface, p_max):
-    """``(topography law, Greenwood-Tripp law)`` of the cell, tabulated up to ``p_max`` [pressure]."""
+    """``(topography law, Greenwood-Tripp law)`` of the cell, tabulated up to ``p_max`` [pressure] (at most
+    :data:`HARDNESS_SHARE` times the hardness)."""
     from bem import rough
 
     n_cols = s["nodes_per_roll_off"] * s["cell_roll_offs"]
+    if s.get("hardness") is not None:
+        p_max = min(p_max, HARDNESS_SHARE * s["hardness"])
     pressures = np.geomspace(1e-4, 1.0, 16) * p_max
-    topo = rough.layer_from_topography(surface, s["E_star"], pressures=pressures, n_cols=n_cols, rtol=s["rtol"])
+    topo = rough.layer_from_topography(surface, s["E_star"], pressures=pressures, n_cols=n_cols, rtol=s["rtol"],
+                                       **_plastic(s))
     moments = spectral_moments(surface.heights, surface.size)
     return topo, greenwood_tripp_law(moments, s["E_star"], topo.first_touch_gap, p_max)
 
@@ -151,7 +170,7 @@ def run_case(s, surface, laws, ratio, load_factor):
     models, results = {}, {}
     for name, law in zip(("layer", "gt"), laws):
         out = results[name] = bem.solve(bem.gaps.Paraboloid(R), E_star=s["E_star"], force=force, step=step, extent=extent,
-                        layer=law, rtol=s["rtol"])
+                        layer=law, rtol=s["rtol"], **_plastic(s))
         models[name] = _summary(out, width, extent)
         row[f"{name}_converged"] = models[name]["converged"]
         row.update({f"{name}_{k}_err": v for k, v in _errors(models[name], resolved).items()})
