@@ -50,11 +50,12 @@ RTOL_MAX = 1e-2
 #: this range float64 overflows or underflows before an answer is reached.
 SCALE_RANGE = (1e-60, 1e60)
 #: Peak memory of a solve per node [bytes], by what holds the nodes (the ``what`` of
-#: :func:`check_node_count`): the largest peak resident set of ``bem.solve`` per node measured on
-#: that domain (``python benchmarks/memory.py``: Hertz and the rough periodic cell, smooth and
-#: with a root layer, 256^2 to 2048^2 nodes) plus the gap (8 bytes a node), times 1.25.
-#: A surface grid becomes the gap of a periodic cell of as many nodes.
-BYTES_PER_NODE = {"the candidate region": 550, "the periodic cell": 420, "the surface grid": 420}
+#: :func:`check_node_count`): the largest peak of the resident set of ``bem.solve`` per node
+#: measured on that domain at 1M-4M nodes (``python benchmarks/memory.py``: spheres on a region,
+#: smooth, rough and with a root layer; the rough periodic cell, smooth and with a root layer)
+#: plus the gap (8 bytes a node), times 1.25. A surface grid becomes the gap of a periodic cell
+#: of as many nodes.
+BYTES_PER_NODE = {"the candidate region": 530, "the periodic cell": 400, "the surface grid": 400}
 
 
 def machine_memory():

@@ -6,11 +6,12 @@ the problem solved, and the peak resident set read (``VmHWM``). Reported per nod
 own peak, ``(VmHWM - VmRSS before) / N``, and the whole process's, ``VmHWM / N``.
 
 The guard's bytes per node of a domain (``bem.checks.BYTES_PER_NODE``) is the largest solve peak
-per node measured on that domain plus the gap itself (8 bytes a node), times ``--margin``; the
-constant printed at the end is that rule applied to the run's measurements.
+per node measured on that domain at ``--min-nodes`` nodes or more (where the solve's fixed
+allocations no longer count) plus the gap itself (8 bytes a node), times ``--margin``, rounded
+up to 10 bytes; the constants printed at the end are that rule applied to the run's rows.
 
 Run: ``python benchmarks/memory.py [--problems periodic periodic-root hertz hertz-wide rough-sphere]
-[--sizes 256 1024 2048] [--margin 1.25] [--out results/memory]``
+[--sizes 256 1024 2048] [--margin 1.25] [--min-nodes 1e6] [--out results/memory]``
 """
 
 from __future__ import annotations
@@ -31,8 +32,7 @@ import cases  # noqa: E402
 
 #: the domain of each problem (the guard's key)
 DOMAIN = {"periodic": "periodic cell", "periodic-root": "periodic cell", "hertz": "half-space region",
-          "hertz-wide": "half-space region",
-          "rough-sphere": "half-space region"}
+          "hertz-root": "half-space region", "hertz-wide": "half-space region", "rough-sphere": "half-space region"}
 GAP_BYTES = 8
 
 
@@ -45,8 +45,8 @@ def measure(problem, n):
     load = cases.loadavg()
     t, c = time.perf_counter(), time.process_time()
     res = solve()
-    gap_s = getattr(gap, "seconds", 0.0)
-    wall, cpu = time.perf_counter() - t - gap_s, time.process_time() - c - gap_s
+    gap_s, gap_cpu = getattr(gap, "seconds", 0.0), getattr(gap, "cpu_seconds", 0.0)
+    wall, cpu = time.perf_counter() - t - gap_s, time.process_time() - c - gap_cpu
     peak = cases.peak_rss()
     out = dict(cases.summary(res), problem=problem, n=n, wall_s=wall, cpu_s=cpu, gap_s=gap_s,
                rss_before_mb=before / 1e6, peak_mb=peak / 1e6, peak_reset=reset, load_before=load,
@@ -66,11 +66,12 @@ def fresh(problem, n, timeout=None):
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def bytes_per_node(rows, margin):
+def bytes_per_node(rows, margin, min_nodes):
     """The guard's bytes per node of each domain from ``rows`` (module docstring)."""
     out = {}
     for domain in dict.fromkeys(DOMAIN.values()):
-        peaks = [r["solve_bytes_per_node"] for r in rows if DOMAIN[r["problem"]] == domain and "error" not in r]
+        peaks = [r["solve_bytes_per_node"] for r in rows
+                 if DOMAIN[r["problem"]] == domain and "error" not in r and r["nodes"] >= min_nodes]
         if peaks:
             out[domain] = dict(measured=max(peaks), guard=int(10 * math.ceil(margin * (max(peaks) + GAP_BYTES) / 10)))
     return out
@@ -81,6 +82,7 @@ def main(argv=None):
     parser.add_argument("--problems", nargs="+", default=list(cases.PROBLEMS), choices=cases.PROBLEMS)
     parser.add_argument("--sizes", nargs="+", type=int, default=[256, 1024, 2048])
     parser.add_argument("--margin", type=float, default=1.25)
+    parser.add_argument("--min-nodes", type=float, default=1e6, help="smallest problem the rule reads")
     parser.add_argument("--out", help="folder for memory.json")
     parser.add_argument("--one", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -102,7 +104,7 @@ def main(argv=None):
             print(f"| {problem} | {n}^2 | {r['nodes']:,} | {r['iterations']} | {r['wall_s']:.2f} | "
                   f"{r['rss_before_mb']:.0f} | {r['peak_mb']:.0f} | {r['solve_bytes_per_node']:.0f} | "
                   f"{r['bytes_per_node']:.0f} | {r['load_before'][0]:.1f} / {r['load_after'][0]:.1f} |", flush=True)
-    derived = bytes_per_node(rows, args.margin)
+    derived = bytes_per_node(rows, args.margin, args.min_nodes)
     print(f"# bytes per node for the guard (largest solve peak + {GAP_BYTES} B of gap, x {args.margin}): "
           + json.dumps(derived))
     if args.out:

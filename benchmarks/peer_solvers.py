@@ -10,8 +10,9 @@ that is not installed raises :class:`ImportError`, which ``peers.py`` reports as
   ``tol=1e-10`` on its certified Frank-Wolfe error; ``aspher`` in its default precision,
   ``aspher-mixed`` with ``precision="float_then_double"``. Its cell and its region are squares:
   on the periodic problem it solves the same recipe on the unit square (``cases.periodic_grid_gap``).
-- tamaas: ``PolonskyKeerRel`` at tolerance 1e-10 on the cell (Westergaard), and with the
-  non-periodic operator (``ModelFactory.registerNonPeriodic``) on the half-space problems.
+- tamaas: ``PolonskyKeerRey`` (pressure control) at tolerance 1e-10 on the cell (Westergaard),
+  and with the non-periodic operator (``ModelFactory.registerNonPeriodic``) on the half-space
+  problems; its iterations and error are read from its log.
 - ContactMechanics: ``constrained_conjugate_gradients`` (Polonsky-Keer) under force control on
   ``PeriodicFFTElasticHalfSpace`` / ``FreeFFTElasticHalfSpace``, penetration tolerance 1e-10 of
   the gap's range, force tolerance 1e-10 of the mean force per node, ``thermotol=1e-10``.
@@ -19,6 +20,9 @@ that is not installed raises :class:`ImportError`, which ``peers.py`` reports as
 
 from __future__ import annotations
 
+import os
+import sys
+import tempfile
 import time
 
 import numpy as np
@@ -64,13 +68,29 @@ def run_aspher(problem, n, *, mixed=False):
     res = aspher.solve_nested(**kw)
     wall, cpu = _since(t)
     stages = list(res.stage_stats)
-    finest = [s for s in stages if s["q"] == stages[-1]["q"]] if stages else []
+    finest = [s for s in stages if not str(s["name"]).startswith("coarse")]  # finest (and its polish)
     return dict(nodes=n * n, wall_s=wall, cpu_s=cpu, iterations=int(res.iterations),
                 finest_iterations=int(sum(s["iterations"] for s in finest)) if finest else None,
                 converged=bool(res.converged), status=str(res.status), residual=float(res.fw_error),
                 contact_fraction=float(res.contact_area),
                 note=f"backend {backend}, precision {'float_then_double' if mixed else 'default'}"
                      + (", the recipe on the unit square" if periodic else ""))
+
+
+def _captured(fn):
+    """``(fn(), text)``: what ``fn`` wrote on the process's stderr (tamaas logs there)."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile(mode="w+") as tmp:
+        os.dup2(tmp.fileno(), 2)
+        try:
+            out = fn()
+        finally:
+            sys.stderr.flush()
+            os.dup2(saved, 2)
+            os.close(saved)
+        tmp.seek(0)
+        return out, tmp.read()
 
 
 def run_tamaas(problem, n):
@@ -81,20 +101,22 @@ def run_tamaas(problem, n):
     model.E, model.nu = 1.0, 0.0  # E* = E / (1 - nu^2) = 1
     surface = np.ascontiguousarray(gap.max() - gap)  # the rigid surface's heights
     t = _clock()
-    if periodic:
-        solver = tm.PolonskyKeerRel(model, surface, cases.RTOL)
-    else:
+    if not periodic:
         tm.ModelFactory.registerNonPeriodic(model, "dual")
-        solver = tm.PolonskyKeerRey(model, surface, cases.RTOL, tm.PolonskyKeerRey.pressure,
-                                    tm.PolonskyKeerRey.pressure)
+    solver = tm.PolonskyKeerRey(model, surface, cases.RTOL, tm.PolonskyKeerRey.pressure,
+                                tm.PolonskyKeerRey.pressure)
+    if not periodic:
         solver.setIntegralOperator("dual")
     solver.setMaxIterations(100000)
-    solver.solve(pbar)
+    _, log = _captured(lambda: solver.solve(pbar))
     wall, cpu = _since(t)
+    last = [line.split() for line in log.splitlines() if line.split() and line.split()[0].isdigit()][-1]
     p = np.asarray(model.traction)
-    return dict(nodes=n * n, wall_s=wall, cpu_s=cpu, iterations=None, converged=None, status="returned",
-                contact_fraction=float(np.mean(p > 0)),
-                note="Westergaard (periodic)" if periodic else "non-periodic operator (registerNonPeriodic)")
+    return dict(nodes=n * n, wall_s=wall, cpu_s=cpu, iterations=int(last[0]), residual=float(last[-1]),
+                converged=float(last[-1]) <= cases.RTOL, status="converged" if float(last[-1]) <= cases.RTOL
+                else "not converged", contact_fraction=float(np.mean(p > 0)),
+                note="PolonskyKeerRey, Westergaard (periodic)" if periodic
+                else "PolonskyKeerRey, non-periodic operator (registerNonPeriodic)")
 
 
 def run_contactmechanics(problem, n):
@@ -113,7 +135,7 @@ def run_contactmechanics(problem, n):
                                           forcetol=cases.RTOL * force / (n * n), thermotol=cases.RTOL,
                                           maxiter=100000)
     wall, cpu = _since(t)
-    p = -np.asarray(res.jac)
+    p = np.asarray(res.jac)  # the force on each node
     return dict(nodes=n * n, wall_s=wall, cpu_s=cpu, iterations=int(res.nit), converged=bool(res.success),
                 status=str(res.message), contact_fraction=float(np.mean(p > 0)),
                 note="PeriodicFFTElasticHalfSpace" if periodic else "FreeFFTElasticHalfSpace")

@@ -163,7 +163,7 @@ def _write(path, text):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", required=True, help="results folder")
+    parser.add_argument("--out", help="results folder (required)")
     parser.add_argument("--problems", nargs="+", default=list(PROBLEMS), choices=list(PROBLEMS))
     parser.add_argument("--size", nargs="+", default=[], metavar="PROBLEM=N", help="grid side per problem")
     parser.add_argument("--solvers", nargs="+", default=SOLVER_NAMES, choices=SOLVER_NAMES)
@@ -174,6 +174,8 @@ def main(argv=None):
     if args.one:
         print(json.dumps(one(args.one[0], int(args.one[1]), args.one[2])))
         return
+    if not args.out:
+        parser.error("--out is required")
     sizes = dict(PROBLEMS, **{k: int(v) for k, v in (s.split("=") for s in args.size)})
     skipped = {s: f"`import {MODULES[s]}` failed: `pip install {'contactlab[peers]' if s != 'contactlab' else '-e .'}`"
                for s in args.solvers if importlib.util.find_spec(MODULES[s]) is None}
