@@ -51,11 +51,12 @@ RTOL_MAX = 1e-2
 SCALE_RANGE = (1e-60, 1e60)
 #: Peak memory of a solve per node [bytes], by what holds the nodes (the ``what`` of
 #: :func:`check_node_count`): the largest peak of the resident set of ``bem.solve`` per node
-#: measured on that domain at 1M-4M nodes (``python benchmarks/memory.py``: spheres on a region,
-#: smooth, rough and with a root layer; the rough periodic cell, smooth and with a root layer)
-#: plus the gap (8 bytes a node), times 1.25. A surface grid becomes the gap of a periodic cell
-#: of as many nodes.
-BYTES_PER_NODE = {"the candidate region": 530, "the periodic cell": 400, "the surface grid": 400}
+#: measured on that domain at 1M-4M nodes (``python benchmarks/memory.py``: spheres on a region
+#: with contacts of 4 % and 28 % of it and with a root layer; the rough periodic cell, smooth and
+#: with a root layer; the peak per node falls or stays level as the nodes grow) plus the gap
+#: (8 bytes a node), times 1.1. A gap callable's own temporaries come on top. A surface grid
+#: becomes the gap of a periodic cell of as many nodes.
+BYTES_PER_NODE = {"the candidate region": 360, "the periodic cell": 350, "the surface grid": 350}
 
 
 def machine_memory():

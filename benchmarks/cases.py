@@ -11,7 +11,7 @@ Problems (``E* = 1``, KKT residual ``1e-10``):
   sphere of ``hertz`` with the root layer ``w = 0.04 sqrt(p)`` of :mod:`side_by_side`.
 - ``rough-sphere``: the same sphere and region carrying a rough surface, the Fourier series of
   :mod:`periodic_rough` with the unit square as its period (rms slope 0.1), under the force of a
-  smooth Hertz radius 0.3 (the nominal contact covers 28 % of the region). :class:`Roughness`
+  smooth Hertz radius 0.3 (contact 27 % of the region). :class:`Roughness`
   evaluates the series exactly at any nodes that lie on rows (a lattice or a grid), so every
   solver solves the same surface at its own nodes.
 

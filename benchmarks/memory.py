@@ -8,10 +8,12 @@ own peak, ``(VmHWM - VmRSS before) / N``, and the whole process's, ``VmHWM / N``
 The guard's bytes per node of a domain (``bem.checks.BYTES_PER_NODE``) is the largest solve peak
 per node measured on that domain at ``--min-nodes`` nodes or more (where the solve's fixed
 allocations no longer count) plus the gap itself (8 bytes a node), times ``--margin``, rounded
-up to 10 bytes; the constants printed at the end are that rule applied to the run's rows.
+up to 10 bytes; the constants printed at the end are that rule applied to the run's rows. The
+rough sphere does not enter the rule: its gap is a Python callable (:class:`cases.RoughSphere`)
+whose own temporaries are counted in its peak, as a user's callable would add its own.
 
 Run: ``python benchmarks/memory.py [--problems periodic periodic-root hertz hertz-wide rough-sphere]
-[--sizes 256 1024 2048] [--margin 1.25] [--min-nodes 1e6] [--out results/memory]``
+[--sizes 256 1024 2048] [--margin 1.1] [--min-nodes 1e6] [--out results/memory]``
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ import cases  # noqa: E402
 
 #: the domain of each problem (the guard's key)
 DOMAIN = {"periodic": "periodic cell", "periodic-root": "periodic cell", "hertz": "half-space region",
-          "hertz-root": "half-space region", "hertz-wide": "half-space region", "rough-sphere": "half-space region"}
+          "hertz-root": "half-space region", "hertz-wide": "half-space region", "rough-sphere": None}
 GAP_BYTES = 8
 
 
@@ -69,7 +71,7 @@ def fresh(problem, n, timeout=None):
 def bytes_per_node(rows, margin, min_nodes):
     """The guard's bytes per node of each domain from ``rows`` (module docstring)."""
     out = {}
-    for domain in dict.fromkeys(DOMAIN.values()):
+    for domain in dict.fromkeys(d for d in DOMAIN.values() if d):
         peaks = [r["solve_bytes_per_node"] for r in rows
                  if DOMAIN[r["problem"]] == domain and "error" not in r and r["nodes"] >= min_nodes]
         if peaks:
@@ -81,7 +83,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--problems", nargs="+", default=list(cases.PROBLEMS), choices=cases.PROBLEMS)
     parser.add_argument("--sizes", nargs="+", type=int, default=[256, 1024, 2048])
-    parser.add_argument("--margin", type=float, default=1.25)
+    parser.add_argument("--margin", type=float, default=1.1)
     parser.add_argument("--min-nodes", type=float, default=1e6, help="smallest problem the rule reads")
     parser.add_argument("--out", help="folder for memory.json")
     parser.add_argument("--one", nargs=2, help=argparse.SUPPRESS)

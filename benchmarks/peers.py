@@ -18,6 +18,9 @@ are interleaved (round ``k`` runs every solver once, the order rotated by ``k``)
 records the wall time, the CPU time of the process (all threads), the peak resident set
 (``VmHWM``), the 1-, 5-, 15-minute load averages before and after it, and the solver's own
 iterations, status and contact fraction. A run longer than ``--timeout`` is stopped and recorded.
+``--threads k`` runs every solver on ``k`` threads (``CONTACTLAB_THREADS``, ``OMP_NUM_THREADS``,
+the BLAS's); by default each uses its own default (contactlab and the OpenMP of ASPHER and
+tamaas: every core).
 
 Writes ``peers.json`` (machine, every run, the table), ``peers.md`` (the table: best and median
 wall time per solver) and ``peers.png`` (best wall time per problem and solver, log scale) under
@@ -48,6 +51,8 @@ SOLVER_NAMES = ["contactlab", "aspher", "aspher-mixed", "tamaas", "contactmechan
 MODULES = {"contactlab": "bem", "aspher": "aspher", "aspher-mixed": "aspher", "tamaas": "tamaas",
            "contactmechanics": "ContactMechanics"}
 LABELS = {"periodic": "periodic self-affine cell", "rough-sphere": "rough sphere", "hertz": "Hertz"}
+#: what ``--threads`` sets for every solve: contactlab's FFT threads, OpenMP (ASPHER, tamaas), BLAS
+THREAD_VARIABLES = ("CONTACTLAB_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def one(problem, n, solver):
@@ -59,12 +64,15 @@ def one(problem, n, solver):
     return out
 
 
-def _run(problem, n, solver, timeout):
+def _run(problem, n, solver, timeout, threads=None):
+    env = dict(os.environ)
+    if threads:
+        env.update({k: str(threads) for k in THREAD_VARIABLES})
     load = cases.loadavg()
     t = time.perf_counter()
     try:
         done = subprocess.run([sys.executable, __file__, "--one", problem, str(n), solver], capture_output=True,
-                              text=True, timeout=timeout)
+                              text=True, timeout=timeout, env=env)
         if done.returncode == 0:
             row = json.loads(done.stdout.strip().splitlines()[-1])
         else:
@@ -106,7 +114,8 @@ def _fmt(v, spec):
 
 def markdown(table, info, skipped):
     lines = [f"Machine: {info['cpu']}, {info['cores']} cores ({info['affinity']} in the affinity mask), "
-             f"{info['memory_gb']} GB, Python {info['python']}, numpy {info['numpy']}; load average "
+             f"{info['memory_gb']} GB, Python {info['python']}, numpy {info['numpy']}; threads: {info['threads']}; "
+             f"load average "
              f"(1, 5, 15 min) at start {info['load_start']}, at end {info['load_end']}.", ""]
     lines += [f"- {s}: skipped ({why})" for s, why in skipped.items()]
     lines += ["", "| problem | N | solver | best / median wall [s] | CPU [s] | iterations (finest) | status | "
@@ -118,7 +127,8 @@ def markdown(table, info, skipped):
                          f"{min(r['loads']):.1f}-{max(r['loads']):.1f} | |")
             continue
         its = _fmt(r["iterations"], "d") + (f" ({r['finest_iterations']})" if r.get("finest_iterations") else "")
-        lines.append(f"| {LABELS[r['problem']]} | {r['n']}^2 | {r['solver']} | {r['best_s']:.2f} / {r['median_s']:.2f} | "
+        lines.append(f"| {LABELS[r['problem']]} | {r['n']}^2 | {r['solver']} | "
+                     f"{r['best_s']:.2f} / {r['median_s']:.2f} | "
                      f"{r['cpu_s']:.2f} | {its} | {r['status']} | {_fmt(r['contact_fraction'], '.3f')} | "
                      f"{r['peak_rss_mb']:.0f} | {min(r['loads']):.1f}-{max(r['loads']):.1f} | {r['note']} |")
     return "\n".join(lines) + "\n"
@@ -169,6 +179,7 @@ def main(argv=None):
     parser.add_argument("--solvers", nargs="+", default=SOLVER_NAMES, choices=SOLVER_NAMES)
     parser.add_argument("--repeat", type=int, default=3, help="interleaved rounds")
     parser.add_argument("--timeout", type=float, default=1800, help="seconds per solve")
+    parser.add_argument("--threads", type=int, help="threads of every solver (default: each its own)")
     parser.add_argument("--one", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.one:
@@ -182,7 +193,7 @@ def main(argv=None):
     for s, why in skipped.items():
         print(f"# {s}: skipped ({why})", flush=True)
     solvers = [s for s in args.solvers if s not in skipped]
-    info = dict(cases.machine(), load_start=cases.loadavg())
+    info = dict(cases.machine(), load_start=cases.loadavg(), threads=args.threads or "each solver's default")
     print(f"# {info}", flush=True)
     os.makedirs(args.out, exist_ok=True)
     runs = []
@@ -190,7 +201,7 @@ def main(argv=None):
         for problem in args.problems:
             order = solvers[k % len(solvers):] + solvers[:k % len(solvers)]
             for solver in order:
-                runs.append(_run(problem, sizes[problem], solver, args.timeout))
+                runs.append(_run(problem, sizes[problem], solver, args.timeout, args.threads))
                 print(json.dumps(runs[-1]), flush=True)
     info["load_end"] = cases.loadavg()
     table = summarise(runs)

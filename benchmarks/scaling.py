@@ -66,7 +66,8 @@ def markdown(data):
         for n in sorted(set(sizes) | {k[1] for k in done if k[0] == problem}):
             r = done.get((problem, n))
             if r is None:
-                lines.append(f"| {LABELS[problem]} | {n}^2 | about {n * n / 1e6:.3g}M | not yet measured | | | | | | | |")
+                lines.append(f"| {LABELS[problem]} | {n}^2 | about {n * n / 1e6:.3g}M | not yet measured "
+                             "| | | | | | | |")
             elif "error" in r:
                 lines.append(f"| {LABELS[problem]} | {n}^2 | - | failed: {r['error']} | | | | | | | |")
             else:
@@ -110,8 +111,8 @@ def plot(data, path):
         ax.grid(True, which="both", alpha=0.3)
     ax_t.set_ylabel("time of the solve [s]")
     ax_m.set_ylabel("peak resident set of the process [GB]")
-    ax_t.legend(fontsize=7)
-    ax_m.legend(fontsize=7)
+    ax_t.legend(fontsize=7, loc="upper left")
+    ax_m.legend(fontsize=7, loc="upper left")
     fig.suptitle("bem.solve, KKT 1e-10, one fresh process per case", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -33,7 +33,8 @@ def _refused(call):
 def _states(message, n_nodes, what):
     """The message gives the nodes, the limit, the memory of ``n_nodes`` nodes and the machine's."""
     per_node = checks.BYTES_PER_NODE[what]
-    assert f"would hold {n_nodes:.3g} nodes (limit {checks.machine_memory() // per_node:.3g} on this machine)" in message
+    limit = checks.machine_memory() // per_node
+    assert f"would hold {n_nodes:.3g} nodes (limit {limit:.3g} on this machine)" in message
     assert f"about {n_nodes * per_node / 1e9:.3g} GB of memory at {per_node} bytes a node" in message
     assert f"the machine has {checks.machine_memory() / 1e9:.3g} GB" in message
 

@@ -37,7 +37,8 @@ def _refused(*argv):
 def _states(err, n_nodes, what):
     """The line gives the nodes, the limit, the memory they need and the memory of the machine."""
     assert f"would hold {n_nodes:.3g} nodes (limit {max_nodes(what):.3g} on this machine)" in err
-    assert f"about {n_nodes * BYTES_PER_NODE[what] / 1e9:.3g} GB of memory at {BYTES_PER_NODE[what]} bytes a node" in err
+    per_node = BYTES_PER_NODE[what]
+    assert f"about {n_nodes * per_node / 1e9:.3g} GB of memory at {per_node} bytes a node" in err
     assert f"the machine has {checks.machine_memory() / 1e9:.3g} GB" in err  # conftest pins it
 
 
