@@ -23,7 +23,7 @@ the BLAS's); by default each uses its own default (contactlab and the OpenMP of 
 tamaas: every core).
 
 Writes ``peers.json`` (machine, every run, the table), ``peers.md`` (the table: best and median
-wall time per solver) and ``peers.png`` (best wall time per problem and solver, log scale) under
+wall time per solver) and ``peers.png`` (best wall time and median CPU time per problem and solver, log scale) under
 ``--out``.
 
 Run: ``python benchmarks/peers.py --out results/peers [--problems periodic rough-sphere hertz]
@@ -51,6 +51,10 @@ SOLVER_NAMES = ["contactlab", "aspher", "aspher-mixed", "tamaas", "contactmechan
 MODULES = {"contactlab": "bem", "aspher": "aspher", "aspher-mixed": "aspher", "tamaas": "tamaas",
            "contactmechanics": "ContactMechanics"}
 LABELS = {"periodic": "periodic self-affine cell", "rough-sphere": "rough sphere", "hertz": "Hertz"}
+#: how to install a missing peer, for the skip message
+INSTALL = dict.fromkeys(("aspher", "aspher-mixed", "tamaas", "contactmechanics"),
+                        'pip install "contactlab[peers]" (ASPHER builds from its source: a C++17 compiler, CMake, '
+                        "Eigen; Debian: apt-get install libeigen3-dev)")
 #: what ``--threads`` sets for every solve: contactlab's FFT threads, OpenMP (ASPHER, tamaas), BLAS
 THREAD_VARIABLES = ("CONTACTLAB_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
@@ -142,24 +146,28 @@ def plot(table, path):
 
     problems = list(dict.fromkeys(r["problem"] for r in table))
     solvers = [s for s in SOLVER_NAMES if any(r["solver"] == s for r in table)]
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), sharey=True)
     width = 0.8 / max(len(solvers), 1)
-    for j, s in enumerate(solvers):
-        xs, ys = [], []
-        for i, p in enumerate(problems):
-            r = next((r for r in table if r["problem"] == p and r["solver"] == s and "best_s" in r), None)
-            if r:
-                xs.append(i + (j - (len(solvers) - 1) / 2) * width)
-                ys.append(r["best_s"])
-        bars = ax.bar(xs, ys, width, label=s)
-        ax.bar_label(bars, labels=[f"{y:.2g}" for y in ys], fontsize=7)
-    ax.set_yscale("log")
-    ax.set_xticks(range(len(problems)),
-                  [f"{LABELS[p]}\n{next(r['n'] for r in table if r['problem'] == p)}^2" for p in problems])
-    ax.set_ylabel("best wall time [s] (log scale)")
-    ax.set_title("Each solver to its own residual 1e-10, one fresh process per solve")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
+    for ax, key, title in ((axes[0], "best_s", "best wall time"), (axes[1], "cpu_s", "median CPU time (all threads)")):
+        for j, s in enumerate(solvers):
+            xs, ys = [], []
+            for i, p in enumerate(problems):
+                r = next((r for r in table if r["problem"] == p and r["solver"] == s and "best_s" in r), None)
+                if r:
+                    xs.append(i + (j - (len(solvers) - 1) / 2) * width)
+                    ys.append(r[key])
+            bars = ax.bar(xs, ys, width, label=s, color=f"C{j}")
+            ax.bar_label(bars, labels=[f"{y:.2g}" for y in ys], fontsize=6, rotation=90, padding=2)
+        ax.set_yscale("log")
+        ax.set_xticks(range(len(problems)),
+                      [f"{LABELS[p]}\n{next(r['n'] for r in table if r['problem'] == p)}^2" for p in problems],
+                      fontsize=8)
+        ax.set_title(title, fontsize=10)
+        ax.margins(y=0.25)
+    axes[0].set_ylabel("seconds (log scale)")
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=len(solvers), fontsize=8)
+    fig.suptitle("Each solver to its own residual 1e-10, one fresh process per solve", fontsize=10)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
@@ -188,7 +196,7 @@ def main(argv=None):
     if not args.out:
         parser.error("--out is required")
     sizes = dict(PROBLEMS, **{k: int(v) for k, v in (s.split("=") for s in args.size)})
-    skipped = {s: f"`import {MODULES[s]}` failed: `pip install {'contactlab[peers]' if s != 'contactlab' else '-e .'}`"
+    skipped = {s: f"`{MODULES[s]}` is not installed: {INSTALL.get(s, 'pip install -e .')}"
                for s in args.solvers if importlib.util.find_spec(MODULES[s]) is None}
     for s, why in skipped.items():
         print(f"# {s}: skipped ({why})", flush=True)
