@@ -3,7 +3,9 @@
 The start (:func:`initial_pressure`), the KKT residual of an iterate (:func:`iterate_residual`),
 the stopping rule (:func:`stopping_rule`), the pressure of the nodes that enter the contact
 (:func:`entering_pressure`), the exact product every :data:`RECOMPUTE_EVERY` updates, and the
-record of the iteration and its outcome (:class:`Record`, :class:`QPSolution`). The steps are
+record of the iteration and its outcome (:class:`Record`, :class:`QPSolution`); with a hardness
+(:mod:`bem.plastic`) the sets of an iterate (:func:`bounded_sets`) and the projected step with its
+entering and leaving nodes (:func:`bounded_move`). The steps are
 :func:`bem.kalker.solve_qp` (the general loop, any array namespace) and
 :func:`bem.periodic.qp.solve_periodic_qp` (a periodic cell in the Fourier basis); each
 operator picks its own (``op.qp``).
@@ -19,14 +21,25 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .backend import operator_backend
+from .plastic import clip, fill_force, leaving_pressure, plastic_approach
 
-__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule", "entering_pressure",
-           "is_per_node", "RECOMPUTE_EVERY"]
+__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "carry_force", "iterate_residual",
+           "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BoundedSets",
+           "bounded_sets", "bounded_move"]
 
 log = logging.getLogger(__name__)
 
 #: An exactly recomputed ``C p`` every so many incremental updates of the constrained CG.
 RECOMPUTE_EVERY = 20
+
+#: The share of its Jacobi estimate ``-g / (C_nn + lam)`` a node takes when it enters the contact in a
+#: preconditioned step (:func:`entering_pressure`). Measured finest-level iterations of the periodic step
+#: at the shares 0.35 / 0.5 / 0.7 / 1: 57 / 57 / 64 / 72 (256^2 self-affine cell, force control),
+#: 51 / 50 / 52 / 61 and 52 / 49 / 52 / 54 (the 672 x 776 cell of tests/bem/test_periodic_robustness.py
+#: at 0.03 and 0.04 E*), 44 / 43 / 46 / 45 (benchmarks/periodic_rough.py's cell at 512^2). A compliance
+#: per node (Newton's model QP) takes the whole estimate: the root layer of that benchmark at 1024^2
+#: needs 85 products of C in all with it, 90 with half.
+ENTERING_FRACTION = 0.5
 
 
 @dataclass
@@ -61,29 +74,54 @@ def _quantile(bk, values, q):
     return a + (b - a) * t if t < 0.5 else b - (b - a) * (1 - t)
 
 
-def initial_pressure(op, h, lam, force, approach, x0):
+def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
     """The starting pressure of the constrained CG (brick array): ``x0`` clipped at 0, or under force
     control a uniform pressure on the quarter of the nodes with the smallest gap, or under approach
-    control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``."""
+    control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``.
+
+    With a ``hardness`` ``H`` the start is clipped at ``H``, and under force control the uniform
+    pressure covers enough nodes to stay below ``0.8 H`` and is scaled by
+    :func:`bem.plastic.fill_force`."""
     lat = op.lattice
     bk, mask = operator_backend(op)
     xp = bk.xp
     if x0 is not None:
-        p = xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
+        p = xp.where(mask, clip(xp, bk.asarray(x0), hardness), 0.0)
     elif force is not None:
         # rigid-punch-like start: pressure where the gap is smallest
         hm = xp.where(mask, h, xp.inf)
-        level = _quantile(bk, hm[mask], 0.25)
+        share = 0.25
+        if hardness is not None:  # enough nodes to carry the force below 0.8 H
+            share = min(1.0, max(share, 1.25 * force / (lat.node_area * hardness * int(xp.count_nonzero(mask)))))
+        level = _quantile(bk, hm[mask], share)
         p = xp.astype(mask & (hm <= level), bk.float64)
     else:
         p = xp.where(mask, xp.maximum(approach - h, 0.0), 0.0) / (op.diagonal + float(xp.max(lam) if is_per_node(lam) else lam))
+        if hardness is not None:
+            p = xp.minimum(p, hardness)
     if force is not None:
         total = float(xp.sum(p))
         if total <= 0:
             p = xp.astype(mask, bk.float64)
             total = float(xp.sum(p))
-        p *= force / lat.node_area / total
+        if hardness is None:
+            p *= force / lat.node_area / total
+        else:
+            p = carry_force(xp, p, force / lat.node_area, hardness, mask)
     return p
+
+
+def carry_force(xp, p, target, hardness, mask):
+    """``p`` (``>= 0``) scaled to carry ``sum p = target``, capped at ``H`` and filled up by
+    :func:`bem.plastic.fill_force`; where its support cannot carry ``target``, the uniform ``target / n``
+    on the ``n`` nodes of ``mask`` (capped at ``H``: the caller checks that they can)."""
+    for start in (p, xp.astype(mask, p.dtype)):
+        total = float(xp.sum(start))
+        if total > 0:
+            filled = fill_force(xp, xp.minimum(start * (target / total), hardness), target, hardness)
+            if filled is not None:
+                return filled[0]
+    return xp.minimum(xp.astype(mask, p.dtype) * (target / float(xp.sum(xp.astype(mask, p.dtype)))), hardness)
 
 
 def entering_pressure(xp, g, tau, jacobi, per_node, preconditioned=False):
@@ -93,11 +131,96 @@ def entering_pressure(xp, g, tau, jacobi, per_node, preconditioned=False):
     A step along the gap itself (``preconditioned`` False) gives Polonsky-Keer's ``-tau g``, capped by the
     Jacobi estimate ``-g / (C_nn + lam)`` so that a node with a large layer compliance cannot overshoot.
     A step along the preconditioned gap ``M g`` has a dimensionless ``tau``: the entering node takes
-    that step with the Jacobi estimate of ``M`` there, ``-min(tau, 1) g / (C_nn + lam)``.
+    that step with :data:`ENTERING_FRACTION` of the Jacobi estimate of ``M`` there,
+    ``-f min(tau, 1) g / (C_nn + lam)`` (nodes enter in clusters, and each closes part of its neighbours'
+    gaps); with a compliance per node (Newton's model) the whole estimate, ``f = 1``.
     """
     if preconditioned:
-        return -g * jacobi * (min(tau, 1.0) if tau > 0 else 1.0)
+        return -g * jacobi * ((1.0 if per_node else ENTERING_FRACTION) * (min(tau, 1.0) if tau > 0 else 1.0))
     return -g * ((xp.minimum(tau, jacobi) if per_node else min(tau, jacobi)) if tau > 0 else jacobi)
+
+
+class BoundedSets(NamedTuple):
+    """The sets of an iterate of the bounded QP (:func:`bounded_sets`)."""
+
+    on: object  # p > 0 (brick)
+    plastic: object  # p >= H (brick)
+    idx: object  # the elastic contact 0 < p < H (a node selection): the nodes of the search direction
+    pl: object  # the plastic nodes (a node selection)
+    delta: float  # the approach (under force control the multiplier of the elastic contact)
+    bracket: tuple | None  # the interval of the approach of a fully plastic contact (bem.plastic.plastic_approach)
+    gap_min: float  # the smallest deformed gap off the plastic nodes
+    plastic_gap: float  # the largest deformed gap of the plastic nodes (-inf without)
+
+
+def bounded_sets(bk, p, v, hardness, delta, force, mask=None):
+    """The sets, the approach and the gap extremes of an iterate of the bounded QP (:mod:`bem.plastic`).
+
+    ``v = (C + lam) p + h`` (brick), the deformed gap ``v - delta``; ``delta`` the approach under approach
+    control; ``mask`` the candidate nodes (``None``: every node).
+    """
+    xp = bk.xp
+    on, plastic = p > 0, p >= hardness
+    idx, pl = bk.select(on & ~plastic), bk.select(plastic)
+    v_pl = float(xp.max(bk.take(v, pl))) if bk.count(pl) else -math.inf
+    bracket = None
+    if force is not None and bk.count(idx):
+        delta = float(xp.mean(bk.take(v, idx)))
+    elif force is not None and bk.count(pl):
+        delta, bracket = plastic_approach(float(xp.min(xp.where(on if mask is None else on | ~mask, xp.inf, v))), v_pl)
+    elif force is not None:
+        delta = math.nan
+    away = plastic if mask is None else plastic | ~mask
+    return BoundedSets(on, plastic, idx, pl, delta, bracket, float(xp.min(xp.where(away, xp.inf, v))) - delta,
+                       v_pl - delta)
+
+
+def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardness, preconditioned=False):
+    """One step of the bounded constrained CG, on ``p`` (brick) in place; ``(changed, entered, s, failure)``.
+
+    The elastic nodes ``sets.idx`` move from ``p_c0`` along ``-tau t_c``, projected onto ``[0, H]``; the
+    open nodes whose gap ``v - delta`` is negative enter (:func:`entering_pressure`, at most ``H``), the
+    plastic nodes whose gap is positive leave (:func:`bem.plastic.leaving_pressure`); under force control
+    (``target = P / a``) :func:`bem.plastic.fill_force` carries the force, and where it cannot the step
+    goes up to the first bound instead. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
+    ``changed``: a node reached a bound, entered, left or was capped (``C p`` is then to be recomputed);
+    ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes; ``failure``: ``(message, status)`` where no step can be taken.
+    """
+    xp, idx, pl, delta = bk.xp, sets.idx, sets.pl, sets.delta
+
+    def jac(sel):
+        return bk.take(jacobi, sel) if per_node else jacobi
+
+    p_c = xp.minimum(xp.maximum(p_c0 - tau * t_c, 0.0), hardness)
+    hit = bool(xp.any((p_c == 0) | (p_c == hardness)))
+    bk.put(p, idx, p_c)
+    low = bk.select(v < delta)
+    overlap = bk.subset(low, bk.take(p, low) == 0)  # open nodes that close: they enter
+    leave = bk.subset(pl, bk.take(v, pl) > delta)  # plastic nodes whose gap opens: they leave
+    bk.put(p, overlap, xp.minimum(entering_pressure(xp, bk.take(v, overlap) - delta, tau, jac(overlap), per_node,
+                                                    preconditioned), hardness))
+    bk.put(p, leave, leaving_pressure(xp, hardness, entering_pressure(xp, delta - bk.take(v, leave), tau, jac(leave),
+                                                                      per_node, preconditioned)))
+    moved = bool(bk.count(overlap) or bk.count(leave))
+    if target is None:
+        return hit or moved, moved, 1.0, None
+    filled = fill_force(xp, p, target, hardness)
+    if filled is None and bk.count(idx):  # the nodes below H cannot carry the force: the step up to the first bound
+        bk.put(p, overlap, 0.0)
+        bk.put(p, leave, hardness)
+        reach = xp.where(t_c > 0, p_c0 / xp.where(t_c > 0, t_c, 1.0),
+                         xp.where(t_c < 0, (p_c0 - hardness) / xp.where(t_c < 0, t_c, 1.0), xp.inf))
+        bk.put(p, idx, xp.minimum(xp.maximum(p_c0 - min(tau, float(xp.min(reach))) * t_c, 0.0), hardness))
+        hit, moved = True, False
+        filled = fill_force(xp, p, target, hardness)
+    if filled is None:
+        bk.put(p, idx, p_c0)
+        bk.put(p, overlap, 0.0)
+        bk.put(p, leave, hardness)
+        return True, False, 1.0, ("no elastic contact node can carry the force", "stalled")
+    new, s, capped = filled
+    p[...] = new
+    return hit or moved or capped, moved, s, None
 
 
 def is_per_node(lam):
@@ -105,15 +228,17 @@ def is_per_node(lam):
     return getattr(lam, "ndim", 0) > 0
 
 
-def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None):
+def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None, plastic_gap=None):
     """The KKT residual of an iterate (:func:`bem.kkt.kkt_residual` from its parts; non-finite: ``inf``).
 
     ``max(max_contact |g|, (-min g)_+) / scale`` (every contact node has ``-g <= max_contact |g|``), with
     ``contact_gap = max_contact |g|``, ``gap_min = min g``, ``scale`` the displacement scale and
     ``gap_max()`` the largest ``|g|``, the scale where ``scale`` is not positive (or 1); under force
-    control the larger of that and ``force_error = |a sum p - P| / P``.
+    control the larger of that and ``force_error = |a sum p - P| / P``. With a hardness
+    (:mod:`bem.plastic`) the contact is the elastic one (``0 < p < H``), ``gap_min`` the smallest gap
+    off the plastic nodes and ``plastic_gap = max_plastic g`` (a plastic node may overlap, ``g <= 0``).
     """
-    parts = [contact_gap, -gap_min, 0.0]
+    parts = [contact_gap, -gap_min, 0.0] if plastic_gap is None else [contact_gap, -gap_min, plastic_gap, 0.0]
     kkt = (math.nan if any(math.isnan(v) for v in parts) else max(parts)) / (scale if scale > 0 else gap_max() or 1.0)
     if force_error is not None:
         kkt = float(np.max([kkt, force_error]))

@@ -38,6 +38,7 @@ __all__ = [
     "SCALE_RANGE",
     "BYTES_PER_NODE",
     "machine_memory",
+    "bytes_per_node",
     "max_nodes",
 ]
 
@@ -55,8 +56,9 @@ SCALE_RANGE = (1e-60, 1e60)
 #: with contacts of 4 % and 28 % of it and with a root layer; the rough periodic cell, smooth and
 #: with a root layer; the peak per node falls or stays level as the nodes grow) plus the gap
 #: (8 bytes a node), times 1.1. A gap callable's own temporaries come on top. A surface grid
-#: becomes the gap of a periodic cell of as many nodes.
-BYTES_PER_NODE = {"the candidate region": 360, "the periodic cell": 350, "the surface grid": 350}
+#: becomes the gap of a periodic cell of as many nodes. Keys: how the ``what`` of
+#: :func:`check_node_count` ends (``"the mirrored periodic cell"`` is a periodic cell).
+BYTES_PER_NODE = {"candidate region": 360, "periodic cell": 350, "surface grid": 350}
 
 
 def machine_memory():
@@ -74,10 +76,18 @@ def machine_memory():
     return memory
 
 
+def bytes_per_node(what="the candidate region"):
+    """:data:`BYTES_PER_NODE` of ``what``, the key it ends with (``"the periodic cell"``: 350)."""
+    for key, value in BYTES_PER_NODE.items():
+        if what.endswith(key):
+            return value
+    raise ValueError(f"what = {what!r}: it must end with one of {list(BYTES_PER_NODE)}")
+
+
 def max_nodes(what="the candidate region"):
     """Largest number of nodes that ``what`` may hold on this machine: :func:`machine_memory` over
-    :data:`BYTES_PER_NODE` of ``what`` (the rule of :func:`check_node_count`)."""
-    return machine_memory() // BYTES_PER_NODE[what]
+    :func:`bytes_per_node` of ``what`` (the rule of :func:`check_node_count`)."""
+    return machine_memory() // bytes_per_node(what)
 
 
 def fail(name, value, rule):
@@ -160,10 +170,11 @@ def check_node_count(name, value, n_nodes, *, what="the candidate region"):
     n_nodes : int
         The nodes that ``value`` gives, counted without building them.
     what : str
-        What holds the nodes, a key of :data:`BYTES_PER_NODE`: ``"the candidate region"``,
-        ``"the periodic cell"`` or ``"the surface grid"`` (also named in the message).
+        What holds the nodes, ending with a key of :data:`BYTES_PER_NODE` (``"the candidate
+        region"``, ``"the periodic cell"``, ``"the mirrored surface grid"``, ...; also named in
+        the message).
     """
-    per_node = BYTES_PER_NODE[what]
+    per_node = bytes_per_node(what)
     memory = machine_memory()
     limit = memory // per_node
     if n_nodes > limit:

@@ -42,7 +42,7 @@ from .checks import check_positive, check_range, check_scale
 from .errors import InputError
 from .materials import NU_MAX, NU_MIN
 
-__all__ = ["Bodies", "Coating", "coating_factor", "mode_compliance", "oedometric_compliance"]
+__all__ = ["Bodies", "Coating", "coating_factor", "factor_taylor", "mode_compliance", "oedometric_compliance"]
 
 #: Beyond this ``q t`` every exponential of (2) is below 1e-300: ``phi = 1`` to round-off.
 _X_CLIP = 350.0
@@ -99,18 +99,11 @@ def coating_factor(x, coating, E_substrate, nu_substrate):
         ``phi`` at each ``x`` (a new array; ``x`` is not modified), between ``E*_c / E*_s`` at
         ``x = 0`` and 1 as ``x -> inf``.
     """
-    E_s, nu_s = _substrate(E_substrate, nu_substrate)
     shape = np.shape(x)
     x = np.minimum(np.asarray(x, dtype=float).ravel(), _X_CLIP)
     if x.size and not np.all(x >= 0):
         raise ValueError("x = q t must be >= 0 (and not NaN)")
-    nu_c = coating.nu
-    mu_c = coating.E / (2.0 * (1.0 + nu_c))
-    k = 0.0 if E_s == math.inf else mu_c / (E_s / (2.0 * (1.0 + nu_s)))
-    a_s, f = 3.0 - 4.0 * nu_s, 3.0 - 4.0 * nu_c
-    one_m_lam = 4.0 * (1.0 - nu_c) / (1.0 + k * a_s)           # 1 - lambda
-    one_m_kap = 4.0 * (1.0 - nu_c) / (k + f)                   # 1 - kappa
-    one_m_lk = k * (1.0 + a_s) * (1.0 + f) / ((1.0 + k * a_s) * (k + f))  # 1 - lambda kappa
+    one_m_lam, one_m_kap, one_m_lk = _one_minus(coating, E_substrate, nu_substrate)
     lam, kap = 1.0 - one_m_lam, 1.0 - one_m_kap
     lk = lam * kap
     e = np.exp(-2.0 * x)
@@ -128,6 +121,66 @@ def coating_factor(x, coating, E_substrate, nu_substrate):
         num_small = one_m_lk * grow + 2.0 * lk * _sinh_minus(2.0 * xs) + 4.0 * xs * kap * (2.0 - one_m_lam)
         num[small] = num_small / grow
     return (num / den).reshape(shape)
+
+
+def _one_minus(coating, E_substrate, nu_substrate):
+    """``1 - lambda``, ``1 - kappa`` and ``1 - lambda kappa`` of equation (2), each in closed form."""
+    E_s, nu_s = _substrate(E_substrate, nu_substrate)
+    nu_c = coating.nu
+    mu_c = coating.E / (2.0 * (1.0 + nu_c))
+    k = 0.0 if E_s == math.inf else mu_c / (E_s / (2.0 * (1.0 + nu_s)))
+    a_s, f = 3.0 - 4.0 * nu_s, 3.0 - 4.0 * nu_c
+    one_m_lam = 4.0 * (1.0 - nu_c) / (1.0 + k * a_s)
+    one_m_kap = 4.0 * (1.0 - nu_c) / (k + f)
+    one_m_lk = k * (1.0 + a_s) * (1.0 + f) / ((1.0 + k * a_s) * (k + f))
+    return one_m_lam, one_m_kap, one_m_lk
+
+
+def factor_taylor(coating, E_substrate, nu_substrate, *, order):
+    """Taylor coefficients ``phi_m`` of ``phi(x) = sum_m phi_m x^m`` at ``x = 0``, ``m <= order`` [-].
+
+    By the Cauchy integral (the trapezoidal rule on ``8 (order + 1)`` points, equation (2) at complex
+    ``x``) on a circle of radius ``0.6 r0``: ``r0`` is the largest radius of the ladder ``2 * 0.8**j``
+    whose circle encloses no zero of the denominator of (2) (a pole of ``phi``), counted by the
+    winding number of the denominator on 2048 points.
+
+    Parameters
+    ----------
+    coating, E_substrate, nu_substrate
+        As for :func:`coating_factor`.
+    order : int
+        Highest power kept, ``>= 0``.
+
+    Returns
+    -------
+    coefficients : numpy.ndarray
+        ``phi_0 .. phi_order`` (real); coefficient ``m`` carries a rounding error of about
+        ``1e-16 max|phi| / radius**m``.
+    radius : float
+        The radius of the circle used [-], below the radius of convergence of the series.
+    """
+    one_m_lam, one_m_kap, _ = _one_minus(coating, E_substrate, nu_substrate)
+    lam, kap = 1.0 - one_m_lam, 1.0 - one_m_kap
+
+    def parts(x):
+        e = np.exp(-2.0 * x)
+        return 1.0 + 4.0 * kap * x * e - lam * kap * e * e, 1.0 - (lam + kap + 4.0 * kap * x * x) * e + lam * kap * e * e
+
+    ring = np.exp(2j * np.pi * np.arange(2048) / 2048)
+    radius = 2.0
+    for _ in range(80):  # down to 2 * 0.8**80 = 3e-8
+        den = parts(radius * ring)[1]
+        winding = np.sum(np.angle(np.roll(den, -1) / den)) / (2.0 * np.pi)
+        if abs(winding) < 0.5:
+            break
+        radius *= 0.8
+    else:
+        raise ArithmeticError("phi has a pole within 3e-8 of x = 0: no Taylor series")
+    radius *= 0.6
+    n = 8 * (int(order) + 1)
+    num, den = parts(radius * np.exp(2j * np.pi * np.arange(n) / n))
+    coeffs = np.fft.fft(num / den)[: int(order) + 1].real / n
+    return coeffs / radius ** np.arange(int(order) + 1), radius
 
 
 def _sinh_minus(y):

@@ -1,8 +1,9 @@
 """The paper's two iterative methods for a nonlinear layer (section 5).
 
 Both reduce the structurally and physically nonlinear problem (eq. 14) to a
-sequence of Kalker QPs (eq. 11, 13), each solved by
-:func:`bem.kalker.solve_qp`:
+sequence of Kalker QPs (eq. 11, 13), each solved by the operator's own
+constrained-CG step (``op.qp``: :func:`bem.kalker.solve_qp` on a half-space region,
+:func:`bem.periodic.qp.solve_periodic_qp` on a periodic cell):
 
 * augmented gap method (eq. 17-20): the layer closure of the previous iterate
   is added to the gap, ``h_bar = h + w(p_k)``, and the smooth-body QP is solved
@@ -38,7 +39,6 @@ import numpy as np
 
 from .backend import backend_of, operator_backend
 from .cg_rules import QPSolution
-from .kalker import compliance_preconditioner, solve_qp
 from .kkt import layered_state
 from .layers.device import device_layer
 
@@ -158,7 +158,6 @@ def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rto
     layer = device_layer(layer, bk)
     h = xp.where(mask, bk.asarray(h), 0.0)
     track = _Tracker(op, h, layer, force, approach, record)
-    precond = op.preconditioner() if precondition else None
     p = xp.zeros(op.lattice.shape, dtype=bk.float64) if x0 is None else xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
     u = op.matvec(p)
     dh_old = xp.where(mask, layer.w(p), 0.0)
@@ -166,8 +165,8 @@ def solve_augmented_gap(op, h, *, layer, force=None, approach=None, x0=None, rto
     reason = f"no convergence in maxiter = {maxiter} iterations"
     for k in range(1, maxiter + 1):
         dh = xp.where(mask, layer.w(p), 0.0)
-        sub = solve_qp(op, h + dh, force=force, approach=approach, x0=p if bool(xp.any(p != 0)) else None,
-                       rtol=rtol / 10, preconditioner=precond)
+        sub = op.qp(h + dh, force=force, approach=approach, x0=p if bool(xp.any(p != 0)) else None,
+                    rtol=rtol / 10, precondition=precondition)
         track.count_inner(sub)
         omega = relaxation if k > 1 else 1.0
         p_new = (1 - omega) * p + omega * sub.p
@@ -252,9 +251,8 @@ def solve_variable_compliance(op, h, *, layer, force=None, approach=None, x0=Non
                 lam = xp.where(contact, layer.secant(p), layer.secant(xp.zeros_like(p)))
             lam = xp.where(xp.isfinite(lam), lam, float(layer.secant(p_ref)))
             lam = xp.where(mask, lam, 0.0)
-        precond = compliance_preconditioner(op, lam, contact) if precondition else None
-        sub = solve_qp(op, h, force=force, approach=approach, lam=lam, x0=p, rtol=rtol / 10,
-                       preconditioner=precond)
+        sub = op.qp(h, force=force, approach=approach, lam=lam, x0=p, rtol=rtol / 10, precondition=precondition,
+                    contact=contact)
         track.count_inner(sub)
         p_new = sub.p
         if not bool(xp.all(xp.isfinite(p_new))):

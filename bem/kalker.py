@@ -17,8 +17,9 @@ import math
 import numpy as np
 
 from .backend import operator_backend
-from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, entering_pressure, initial_pressure, is_per_node, iterate_residual,
-                       run_constrained_cg)
+from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, carry_force, entering_pressure,
+                       initial_pressure, is_per_node, iterate_residual, run_constrained_cg)
+from .plastic import note_fully_plastic
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
@@ -33,8 +34,8 @@ def _median(bk, values):
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True):
-    """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``.
+             maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True, hardness=None):
+    """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` (``0 <= p <= H`` with a hardness).
 
     Parameters
     ----------
@@ -73,6 +74,12 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         that re-checks the solution itself (Newton's inner solves) passes False and gets
         the solution of the incrementally updated products, which differ from the exact
         ones by round-off only.
+    hardness : float, optional
+        The bound ``H`` of the pressure [pressure] (:mod:`bem.plastic`): the nodes at ``p = H`` are
+        plastic, held at ``H`` and left out of the search direction like the open nodes; the step
+        is projected onto ``[0, H]``, a plastic node whose gap opens leaves at the pressure an
+        entering node would take, and under force control the approach is the mean gap of the
+        elastic contact. ``None``: no bound.
 
     Returns
     -------
@@ -100,10 +107,13 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
     if u0 is None or x0 is None:
-        p = xp.where(mask, initial_pressure(op, h, lam, force, approach, x0), 0.0)
+        p = xp.where(mask, initial_pressure(op, h, lam, force, approach, x0, hardness), 0.0)
         if target is not None:
             p = p if float(xp.sum(p)) > 0 else xp.astype(mask, bk.float64)
-            p *= target / float(xp.sum(p))
+            if hardness is None:
+                p *= target / float(xp.sum(p))
+            else:
+                p = carry_force(xp, p, target, hardness, mask)
         u0 = None
     else:  # the caller's iterate and its product, as they are
         p = xp.where(mask, x0, 0.0)
@@ -141,6 +151,26 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: several times faster
     # than x.flat[idx]).
     contact = idx = n_idx = g = g_c = p_c0 = changes = None
+    bounded = hardness is not None
+    sets = None
+    prev_plastic = p >= hardness if bounded else None
+    jacobi = 1.0 / (op.diagonal + lam) if bounded else None
+
+    def measure_bounded(k):  # measure() with the bound: the CG lives on the elastic contact 0 < p < H
+        nonlocal contact, idx, n_idx, g, delta, g_c, p_c0, sets
+        v = u + h
+        bk.put(v, off, 0.0)
+        sets = bounded_sets(bk, p, v, hardness, delta, force, mask)
+        contact, idx, delta = sets.on & ~sets.plastic, sets.idx, sets.delta
+        n_idx = bk.count(idx)
+        g = v - delta
+        bk.put(g, off, 0.0)
+        scale = max(float(xp.max(u)), -float(xp.min(u))) if fixed_scale is None else fixed_scale
+        g_c = bk.take(g, idx)
+        p_c0 = bk.take(p, idx)
+        return iterate_residual(bk.max0(xp.abs(g_c)), sets.gap_min, scale, lambda: float(xp.max(xp.abs(g))),
+                                None if force is None else abs(a * float(xp.sum(p)) - force) / force,
+                                plastic_gap=sets.plastic_gap)
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
         nonlocal contact, idx, n_idx, g, delta, g_c, p_c0
@@ -169,13 +199,20 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         return False
 
     def observe():
-        nonlocal changes, prev_contact
+        nonlocal changes, prev_contact, prev_plastic
+        if bounded:  # changes of the contact and of the plastic set
+            changes = int(xp.count_nonzero(sets.on != prev_contact)) + int(xp.count_nonzero(sets.plastic != prev_plastic))
+            prev_contact, prev_plastic = sets.on, sets.plastic
+            n_touch = n_idx + bk.count(sets.pl)
+            return bk.max0(p), n_touch, changes, n_touch == 0 and float(xp.min(g)) >= 0
         changes = int(xp.count_nonzero(contact != prev_contact))
         prev_contact = contact
         return bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0
 
     def advance(k):  # one step of the constrained CG; (message, status) where it cannot be taken
         nonlocal m_one, gz_old, t, restart, u, stale, p
+        if bounded and not n_idx:  # every contact node plastic: only entering and leaving nodes move
+            return bounded_step(0.0, xp.zeros_like(g_c), None)
         if preconditioner is None:
             z = bk.copy(g_c)
             if force is not None:
@@ -209,6 +246,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
         else:
             tau = gz / tt
+        if bounded:
+            return bounded_step(tau, t_c, r)
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
         p_c = xp.where(clipped, 0.0, p_c)
@@ -242,7 +281,26 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         p = p_new
         return None
 
-    kkt = run_constrained_cg(CGStep(measure, confirms, observe, advance, lambda: p), record, maxiter, callback)
+    def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
+        nonlocal restart, u, stale
+        changed, restart, s, failure = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
+                                                    hardness)
+        if failure is not None:
+            return failure
+        if changed or r is None or stale >= RECOMPUTE_EVERY:
+            u, stale = apply(p), 0
+        else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
+            r *= tau
+            u -= r
+            if s != 1.0:
+                u *= s
+            stale += 1
+        return None
+
+    report = (lambda: bk.copy(p)) if bounded else (lambda: p)  # the bounded step updates p in place
+    kkt = run_constrained_cg(CGStep(measure_bounded if bounded else measure, confirms, observe, advance, report),
+                             record, maxiter, callback)
+    note_fully_plastic(record, sets.bracket if bounded else None, bounded and not n_idx)
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return record.solution(p, delta, kkt, elastic, "Kalker QP")
 

@@ -8,18 +8,24 @@ At a minimiser of the functional of eq. 15 over ``p >= 0`` the deformed gap
 * ``g_n >= 0`` where ``p_n = 0`` (dual feasibility),
 * ``sqrt(3)/2 c^2 sum p_n = P`` under force control (eq. 9).
 
+With a hardness ``H`` (:mod:`bem.plastic`) also ``p_n <= H``, and at the plastic nodes
+(``p_n = H``) ``g_n <= 0`` instead of ``g_n = 0``.
+
 :func:`kkt_residual` measures each violation relative to its natural scale and
 returns the largest; every solver reports it for its final state.
 """
 
 from __future__ import annotations
 
+import math
+
 from .backend import backend_of, operator_backend
+from .plastic import plastic_approach
 
 __all__ = ["kkt_residual", "layered_state"]
 
 
-def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
+def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None, hardness=None):
     """Largest relative violation of the optimality conditions.
 
     Parameters
@@ -36,6 +42,9 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
         ``|a sum p - P| / P`` (``a`` = ``node_area``) is included.
     node_area : float, optional
         Quadrature weight ``sqrt(3)/2 c^2`` [length^2]; needed with ``force``.
+    hardness : float, optional
+        The bound ``H`` [pressure] of ``p`` (:mod:`bem.plastic`): the contact nodes with ``p >= H``
+        are plastic, measured by ``max_{p>=H} g_+ / s`` and ``max (p - H)_+ / H``.
 
     Returns
     -------
@@ -55,17 +64,27 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None):
         s = bk.max0(xp.abs(gap)) or 1.0
     p_max = bk.max0(p)
     contact = p > 0
-    parts = [
-        max(0.0, -bk.min0(p)) / p_max if p_max > 0 else 0.0,
-        bk.max0(xp.abs(gap[contact])) / s,
-        max(0.0, -bk.min0(gap[~contact])) / s,
-    ]
+    if hardness is None:
+        parts = [
+            max(0.0, -bk.min0(p)) / p_max if p_max > 0 else 0.0,
+            bk.max0(xp.abs(gap[contact])) / s,
+            max(0.0, -bk.min0(gap[~contact])) / s,
+        ]
+    else:
+        plastic = p >= hardness
+        parts = [
+            max(0.0, -bk.min0(p)) / p_max if p_max > 0 else 0.0,
+            max(0.0, p_max - hardness) / hardness,
+            bk.max0(xp.abs(gap[contact & ~plastic])) / s,
+            max(0.0, -bk.min0(gap[~contact])) / s,
+            max(0.0, bk.max0(gap[plastic])) / s,
+        ]
     if force is not None:
         parts.append(abs(node_area * float(xp.sum(p)) - force) / force)
     return max(parts)
 
 
-def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, closure=None):
+def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, closure=None, hardness=None):
     """Deformed gap, approach and KKT residual of a pressure with a layer.
 
     Parameters
@@ -84,6 +103,9 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, c
         Nodes of the problem (default: the lattice's candidate nodes).
     closure : ndarray, optional
         ``w(p)`` (0 off ``mask``) where the caller has it [length].
+    hardness : float, optional
+        The bound ``H`` of ``p`` [pressure]: under force control ``delta`` is the mean over the
+        elastic contact (``0 < p < H``), or :func:`bem.plastic.plastic_approach` without one.
 
     Returns
     -------
@@ -101,6 +123,8 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, c
     if closure is None:
         closure = xp.zeros_like(p) if layer is None else xp.where(mask, layer.w(p), 0.0)
     total = u + closure
+    if hardness is not None:
+        return _bounded_state(bk, lat, h, p, total, force, approach, mask, hardness)
     if bool(xp.all(mask)):  # every node of the lattice (a periodic cell): the same numbers without the masking
         contact = p > 0
         gap = total + h
@@ -117,4 +141,26 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, c
     gap = xp.where(mask, total + h - delta, 0.0)
     kkt = kkt_residual(p[mask], gap[mask], displacement_scale=float(xp.max(xp.abs(total[mask]))),
                        force=force, node_area=lat.node_area)
+    return gap, delta, kkt
+
+
+def _bounded_state(bk, lat, h, p, total, force, approach, mask, hardness):
+    """:func:`layered_state` with the hardness bound ``H``."""
+    xp = bk.xp
+    v = xp.where(mask, total + h, 0.0)
+    contact = mask & (p > 0)
+    plastic = mask & (p >= hardness)
+    if force is None:
+        delta = float(approach)
+    elif bool(xp.any(contact & ~plastic)):
+        delta = float(xp.mean(v[contact & ~plastic]))
+    elif bool(xp.any(plastic)):
+        open_ = mask & ~contact
+        lowest = float(xp.min(v[open_])) if bool(xp.any(open_)) else math.inf
+        delta = plastic_approach(lowest, float(xp.max(v[plastic])))[0]
+    else:
+        delta = 0.0
+    gap = xp.where(mask, v - delta, 0.0)
+    kkt = kkt_residual(p[mask], gap[mask], displacement_scale=float(xp.max(xp.abs(total[mask]))), force=force,
+                       node_area=lat.node_area, hardness=hardness)
     return gap, delta, kkt

@@ -33,6 +33,8 @@ from .cg_rules import QPSolution
 from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
+from .newton_moves import release, scaled, settle_plastic
+from .plastic import clip, fully_plastic_note
 
 __all__ = ["solve_newton"]
 
@@ -68,25 +70,6 @@ def _line_search(bk, layer, p, d, u, cd, h, delta, mask):
     return brent_root(slope, 0.0, 1.0, s0, s1, xtol=1e-14, rtol=4 * np.finfo(float).eps)
 
 
-def _energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
-    """``(Phi(p + dp) - Phi(p)) / a`` of eq. 15, free of cancellation.
-
-    ``u = C p``, ``c_dp = C dp``. The layer term uses the Taylor expansion where the move
-    is tiny against the pressure, so that changes far below the round-off of ``Phi``
-    itself are still measured with their sign.
-    """
-    xp = bk.xp
-    # the nodes that move or carry pressure: every other node adds exactly 0
-    sel = bk.select(mask & ((delta_p != 0) | (p > 0)))
-    dp, pp = bk.take(delta_p, sel), bk.take(p, sel)
-    lin = bk.dot(dp, bk.take(u, sel) + bk.take(h, sel) - delta) + 0.5 * bk.dot(dp, bk.take(c_dp, sel))
-    small = xp.abs(dp) < 1e-4 * pp
-    with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        taylor = layer.w(pp) * dp + 0.5 * bk.asarray(layer.dw(pp)) * dp * dp
-        direct = layer.energy(xp.maximum(pp + dp, 0.0)) - layer.energy(pp)
-    return lin + float(xp.sum(xp.where(small, taylor, direct)))
-
-
 def _model_qp(op, b, D, contact, precondition, **kw):
     """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one):
     the operator's own constrained-CG step (``op.qp``, :meth:`bem.operator.InfluenceOperator.qp`)."""
@@ -100,54 +83,8 @@ def _count_inner(hist, sub):
         hist["inner_worst"] = max(hist["inner_worst"], float(sub.kkt_residual))
 
 
-def _scaled(p, force, node_area):
-    """``p`` rescaled to carry ``force`` (force control); ``p`` itself otherwise."""
-    return p if force is None else p * (force / node_area / float(backend_of(p).xp.sum(p)))
-
-
-def _release(op, layer, h, p, u, q, delta, *, force):
-    """Set to 0 the nodes the model solution ``q`` releases, if that lowers ``Phi``.
-
-    Where ``w`` is concave (power ``s < 1``) a node that leaves the contact is only
-    approached geometrically by damped steps (``p -> (1 - t) p``), where ``w'`` grows
-    without bound: it never reaches 0, and its gap stays violated. The projected move
-    to 0 is tried once per step and kept when the functional decreases; it costs one
-    product with ``C``. Only nodes whose release alone lowers ``Phi``,
-    ``p_n (u_n + h_n - delta) + W(p_n) - C_nn p_n^2 / 2 > 0`` (``delta`` the multiplier of
-    the current contact under force control), are moved: on the root-layer problem of
-    ``benchmarks/side_by_side.py`` releasing every node the model releases raises ``Phi``,
-    releasing those that pass this test lowers it and saves a Newton step (the others are
-    released by the model of a later step).
-    Returns ``(p, u)``.
-    """
-    bk, mask = operator_backend(op)
-    xp = bk.xp
-    out = bk.select(mask & (q == 0) & (p > 0))
-    if not bk.count(out):
-        return p, u
-    if force is not None:
-        contact = bk.select(p > 0)
-        pc = bk.take(p, contact)
-        delta = float(xp.mean(bk.take(u, contact) + bk.asarray(layer.w(pc)) + bk.take(h, contact)))
-    pn = bk.take(p, out)
-    with bk.errstate(over="ignore", invalid="ignore"):
-        gain = pn * (bk.take(u, out) + bk.take(h, out) - delta) + layer.energy(pn) - 0.5 * op.diagonal * pn * pn
-    out = bk.subset(out, gain > 0)
-    if not bk.count(out):
-        return p, u
-    trial = bk.put(bk.copy(p), out, 0.0)
-    if force is not None and float(xp.sum(trial)) <= 0:
-        return p, u
-    trial = _scaled(trial, force, op.lattice.node_area)
-    dp = trial - p
-    c_dp = op.matvec(dp)
-    if _energy_change(bk, layer, p, dp, u, c_dp, h, delta, mask) < 0:
-        return trial, u + c_dp
-    return p, u
-
-
 def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, maxiter=100,
-                 precondition=True, callback=None, record=False, inner_maxiter=300):
+                 precondition=True, callback=None, record=False, inner_maxiter=300, hardness=None):
     """Newton's method with exact line search for the layered contact problem.
 
     Parameters
@@ -176,6 +113,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     inner_maxiter : int
         Iteration limit of each inner QP; an unfinished inner solve still gives
         a feasible trial point, and the line search decides how far to go.
+    hardness : float, optional
+        The bound ``p <= H`` [pressure] (:mod:`bem.plastic`): the inner QPs are bounded, so the
+        step ``d = q - p`` stays in the box ``0 <= p <= H`` for ``t in (0, 1]``.
 
     Returns
     -------
@@ -187,7 +127,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     recomputed ``C p``. Where the line search finds no measurable decrease of ``Phi`` (its
     change is below round-off near the solution) the full step is taken if it lowers ``r``;
     otherwise the iteration stops, not converged. After each step, nodes that the model
-    solution releases (``q_n = 0``) are set to 0 when that lowers ``Phi``. The inner
+    solution releases (``q_n = 0``) are set to 0 when that lowers ``Phi`` (and with a hardness, those it
+    puts at ``H`` are set to ``H``; :mod:`bem.newton_moves`). The inner
     QP of step ``k`` is solved to ``min(1e-2, eta_k r_k)``, never below ``rtol / 3``
     (``r_k`` the current KKT residual): an inexact Newton method with the forcing term
     ``eta_k = min(0.3, r_k / r_(k-1))``, which follows the convergence of the outer
@@ -202,23 +143,26 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         # smooth-body solution, then one secant (variable compliance) step: a start
         # that is fair for stiff and for layer-dominated problems alike
         start = solve_qp(op, h, force=force, approach=approach, rtol=1e-3,
-                         preconditioner=op.preconditioner() if precondition else None)
+                         preconditioner=op.preconditioner() if precondition else None, hardness=hardness)
         contact = start.p > 0
         lam = float(layer.secant(float(xp.mean(start.p[contact])))) if bool(xp.any(contact)) else 0.0
         if math.isfinite(lam) and lam > 0:
             start = solve_qp(op, h, force=force, approach=approach, lam=lam, rtol=1e-3,
-                             preconditioner=op.preconditioner(lam=lam) if precondition else None)
+                             preconditioner=op.preconditioner(lam=lam) if precondition else None, hardness=hardness)
         p = start.p
     else:
-        p = xp.where(mask, xp.maximum(bk.asarray(x0), 0.0), 0.0)
-        if force is not None:
+        p = xp.where(mask, clip(xp, bk.asarray(x0), hardness), 0.0)
+        if force is not None and hardness is None:
             p *= force / op.lattice.node_area / float(xp.sum(p))
+        elif force is not None:
+            p = scaled(p, force, op.lattice.node_area, hardness)
     u = op.matvec(p)
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "step": [], "inner_iterations": [],
             "inner_missed": 0, "inner_worst": 0.0}
     if record:
         hist["p"] = []
     converged, message, status, exact = False, "", "maxiter", True
+    bound = {} if hardness is None else {"hardness": hardness}  # the elastic inner solves take no bound
     prev = p > 0
     full = bool(xp.all(mask))  # every node a candidate (a periodic cell): no masking
 
@@ -227,10 +171,12 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
 
     for k in range(maxiter + 1):
         wp = masked(bk.asarray(layer.w(p)))  # the closure w(p)
-        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp)
+        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp,
+                                         hardness=hardness)
         if kkt <= rtol and not exact:  # confirm on an exact product before stopping
             u, exact = op.matvec(p), True
-            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp)
+            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp,
+                                         hardness=hardness)
         contact = p > 0
         hist["residual"].append(kkt)
         hist["p_max"].append(float(xp.max(p)))
@@ -258,7 +204,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         # its own residual: no product to start or to confirm the inner solve (fewer products on
         # the root-layer problem of benchmarks/side_by_side.py)
         sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p, rtol=inner,
-                        maxiter=inner_maxiter, u0=u, confirm=False)
+                        maxiter=inner_maxiter, u0=u, confirm=False, **bound)
         _count_inner(hist, sub)
         d = sub.p - p
         cd = sub.displacement - u
@@ -268,7 +214,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             D = majorant(op, layer, p, sub.p, D, mask)
             b = h + wp - D * p
             sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p,
-                            rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False)
+                            rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False,
+                            **bound)
             _count_inner(hist, sub)
             d = sub.p - p
             cd = sub.displacement - u
@@ -280,9 +227,10 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             # still violate their gap. The step is then chosen by the KKT residual instead:
             # t = 1, 1/2, 1/4, 1/8, the first that lowers it.
             for t_try in (1.0, 0.5, 0.25, 0.125):
-                trial = _scaled(xp.maximum(p + t_try * d, 0.0), force, op.lattice.node_area)
+                trial = scaled(clip(xp, p + t_try * d, hardness), force, op.lattice.node_area, hardness)
                 u_trial = op.matvec(trial)
-                if layered_state(op, h, layer, trial, u_trial, force=force, approach=approach)[2] < kkt:
+                if layered_state(op, h, layer, trial, u_trial, force=force, approach=approach,
+                                 hardness=hardness)[2] < kkt:
                     judged = t_try
                     break
         hist["step"].append(t if judged is None else judged)
@@ -294,19 +242,36 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             status = "stalled"
             break
         else:
-            p = _scaled(xp.maximum(p + t * d, 0.0), force, op.lattice.node_area)
+            p = scaled(clip(xp, p + t * d, hardness), force, op.lattice.node_area, hardness)
             u, exact = u + t * cd, False
-        p, u = _release(op, layer, h, p, u, sub.p, delta, force=force)
+        p, u = release(op, layer, h, p, u, sub.p, delta, force=force, hardness=hardness)
+        if hardness is not None:
+            p, u = settle_plastic(op, layer, h, p, u, sub.p, delta, force=force, hardness=hardness)
         if callback is not None:
             callback(k + 1, p)
+    if converged and hardness is not None and force is not None and (
+            bracket := _plastic_bracket(bk, mask, p, gap + delta, hardness)) is not None:
+        hist["approach_bracket"] = list(bracket)
+        message += fully_plastic_note(bracket)
     if not converged:
         log.debug("Newton: %s", message)
     out = QPSolution(p=p, approach=delta, iterations=len(hist["step"]), converged=converged, message=message,
                      status=status, kkt_residual=float(kkt), displacement=u, history=hist)
     if force is not None and not converged and math.isfinite(delta) and delta > 0:
         out = _force_by_approach(op, h, layer, force, out, rtol=rtol, maxiter=maxiter, precondition=precondition,
-                                 inner_maxiter=inner_maxiter)
+                                 inner_maxiter=inner_maxiter, hardness=hardness)
     return out
+
+
+def _plastic_bracket(bk, mask, p, v, hardness):
+    """The interval of the approach (:func:`bem.plastic.plastic_approach`) where every contact node is plastic,
+    else None; ``v = C p + w(p) + h``."""
+    xp = bk.xp
+    plastic = mask & (p >= hardness)
+    if bool(xp.any(mask & (p > 0) & ~plastic)) or not bool(xp.any(plastic)):
+        return None
+    open_ = mask & (p <= 0)
+    return float(xp.max(v[plastic])), float(xp.min(v[open_])) if bool(xp.any(open_)) else math.inf
 
 
 class _ApproachFailed(Exception):
@@ -352,7 +317,7 @@ def _force_by_approach(op, h, layer, force, failed, *, rtol, **kw):
         return failed
     sol = solved[root]
     u = op.matvec(sol.p)
-    _, delta_f, kkt = layered_state(op, h, layer, sol.p, u, force=force)
+    _, delta_f, kkt = layered_state(op, h, layer, sol.p, u, force=force, hardness=kw.get("hardness"))
     steps = sum(s.iterations for s in solved.values())
     hist = dict(failed.history, outer_approaches=sorted(solved))
     converged = kkt <= rtol

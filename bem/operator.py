@@ -93,6 +93,11 @@ class InfluenceOperator:
         Effective modulus ``E*`` [pressure], ``1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2``.
     device : {"cpu", "cuda"} or module, optional
         Where the products run (:func:`bem.backend.get_backend`).
+    bodies : bem.Bodies, optional
+        Coated bodies: the influence coefficients are those of their compliance per mode
+        (:func:`bem.coated_kernel.coated_table`, cached per step, shape and bodies); ``E_star``
+        is then the substrates' (``bodies.E_star``), the scale of tolerances and bounds. ``None``
+        or uncoated bodies: the half-space of ``E_star``.
 
     Notes
     -----
@@ -103,7 +108,7 @@ class InfluenceOperator:
     the host and copied to the device once per window (a few windows are cached).
     """
 
-    def __init__(self, lattice, E_star, device="cpu"):
+    def __init__(self, lattice, E_star, device="cpu", bodies=None):
         self.lattice = lattice
         self.backend = get_backend(device)
         self.mask = self.backend.asarray(lattice.mask, dtype=self.backend.xp.bool)  # candidate nodes, on the device
@@ -117,10 +122,17 @@ class InfluenceOperator:
         # w_t at every offset (m/2, n sqrt3/2), m = n mod 2 (lattice units), times c / (pi E*)
         n = np.arange(n_rows)[:, None]
         t = np.arange(n_cols + 1)[None, :]
-        self._table = template((2 * t + n % 2) / 2.0, n * (math.sqrt(3.0) / 2))
-        self._table *= lattice.step / (math.pi * self.E_star)
+        self.bodies = bodies if bodies is not None and bodies.is_coated else None
+        if self.bodies is not None:  # coated bodies: the coefficients of bem.coated_kernel (cached)
+            from .coated_kernel import coated_table
+
+            self._table = coated_table(lattice.step, (n_rows, n_cols), self.bodies)
+            self.diagonal = float(self._table[0, 0])
+        else:
+            self._table = template((2 * t + n % 2) / 2.0, n * (math.sqrt(3.0) / 2))
+            self._table *= lattice.step / (math.pi * self.E_star)
+            self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
         self._spectra = OrderedDict()
-        self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
 
     # -- geometry of the 2 x 2 block convolution -------------------------------------------------
 
@@ -348,12 +360,17 @@ class InfluenceOperator:
         """The dense matrix ``C`` over the flattened candidate nodes (small problems only).
 
         Built directly from :func:`bem.template.template` at every node pair,
-        independently of the FFT path, so the two can be checked against each other.
+        independently of the FFT path, so the two can be checked against each other (coated
+        bodies: the entries of the coefficient table at each node pair's offset).
         """
         mask = self.lattice.mask
         x = self.lattice.x[mask] / self.lattice.step
         y = self.lattice.y[mask] / self.lattice.step
         if x.size > 20000:
             raise MemoryError(f"dense C for {x.size} nodes would need {8 * x.size**2 / 1e9:.1f} GB")
+        if self.bodies is not None:  # coated: the table entry of each offset
+            n = np.rint(np.abs(y[:, None] - y[None, :]) / (math.sqrt(3.0) / 2)).astype(int)
+            m = np.rint(2 * np.abs(x[:, None] - x[None, :])).astype(int)
+            return self._table[n, (m - n % 2) // 2]
         scale = self.lattice.step / (math.pi * self.E_star)
         return scale * template(x[:, None] - x[None, :], y[:, None] - y[None, :])

@@ -12,20 +12,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from .backend import get_backend
+from .coating import Bodies, Coating
 from .checks import (check_bool, check_callable, check_choice, check_finite_array, check_int, check_layer, check_load,
                      check_rtol, check_scale, fail)
 from .errors import InputError
 from .materials import effective_modulus
 from .options import METHODS, check_options, solver_for
 
-__all__ = ["Problem", "check_problem", "initial_guess", "modulus"]
+__all__ = ["Problem", "bodies_of", "check_problem", "initial_guess", "modulus"]
 
 
 @dataclass(frozen=True)
 class Problem:
-    """The checked arguments of :func:`bem.solve` (``solver``: the one that runs, :func:`bem.options.solver_for`)."""
+    """The checked arguments of :func:`bem.solve` (``solver``: the one that runs, :func:`bem.options.solver_for`;
+    ``bodies``: the coated bodies, a :class:`bem.Bodies`, or ``None`` when neither is coated)."""
 
     E_star: float
+    bodies: object
     force: float | None
     approach: float | None
     layer: object
@@ -38,6 +41,7 @@ class Problem:
     callback: object
     backend: object
     options: dict
+    hardness: float | None = None
 
 
 def modulus(E_star, E1, nu1, E2, nu2):
@@ -52,6 +56,23 @@ def modulus(E_star, E1, nu1, E2, nu2):
     return effective_modulus(E1, nu1, E2, nu2)
 
 
+def bodies_of(E1, nu1, E2, nu2, coating1, coating2):
+    """The coated bodies (:class:`bem.Bodies`) of the arguments of :func:`bem.solve`, ``None`` without a coating.
+
+    A coating needs its substrate: ``E1, nu1, E2, nu2`` given (not ``E_star``)."""
+    for name, coating in (("coating1", coating1), ("coating2", coating2)):
+        if coating is not None and not isinstance(coating, Coating):
+            raise InputError(f"{name} = {coating!r} is not allowed: it must be a bem.Coating(thickness, E, nu) "
+                             "or None.")
+    if coating1 is None and coating2 is None:
+        return None
+    if any(v is None for v in (E1, nu1, E2, nu2)):
+        name = "coating1" if coating1 is not None else "coating2"
+        raise InputError(f"{name} is not allowed without E1, nu1, E2, nu2: a coating's substrate is its body's "
+                         "material, so give the bodies' moduli and Poisson ratios instead of E_star.")
+    return Bodies(E1, nu1, E2, nu2, coating1, coating2)
+
+
 def _load(domain, force, approach, mean_pressure):
     if mean_pressure is None:
         return check_load(force, approach)
@@ -63,11 +84,12 @@ def _load(domain, force, approach, mean_pressure):
     return check_scale("mean_pressure", mean_pressure) * area, None
 
 
-def check_problem(domain, *, E_star, E1, nu1, E2, nu2, force, approach, mean_pressure, layer, method, rtol, maxiter,
-                  nested, precondition, callback, device, options):
+def check_problem(domain, *, E_star, E1, nu1, E2, nu2, coating1=None, coating2=None, force, approach, mean_pressure,
+                  layer, method, rtol, maxiter, nested, precondition, callback, device, options, hardness=None):
     """The checked :class:`Problem` (the keywords of :func:`bem.solve`); :class:`bem.InputError` naming the first
     bad argument."""
     E_star = modulus(E_star, E1, nu1, E2, nu2)
+    bodies = bodies_of(E1, nu1, E2, nu2, coating1, coating2)
     force, approach = _load(domain, force, approach, mean_pressure)
     check_choice("method", method, METHODS)
     rtol = check_rtol("rtol", rtol)
@@ -85,11 +107,28 @@ def check_problem(domain, *, E_star, E1, nu1, E2, nu2, force, approach, mean_pre
             "and linear layers only; use method='newton' (or a paper method) for a nonlinear layer.")
     solver = solver_for(method, layer)
     options = check_options(method, solver, options)
+    if hardness is not None:
+        hardness = _hardness(domain, hardness, force, mean_pressure, solver)
     if nested is None:
         nested = solver in ("kalker", "newton")
-    return Problem(E_star=E_star, force=force, approach=approach, layer=layer, method=method, solver=solver,
-                   rtol=rtol, maxiter=maxiter, nested=nested, precondition=precondition, callback=callback,
-                   backend=backend, options=options)
+    return Problem(E_star=E_star, bodies=bodies, force=force, approach=approach, layer=layer, method=method,
+                   solver=solver, rtol=rtol, maxiter=maxiter, nested=nested, precondition=precondition,
+                   callback=callback, backend=backend, options=options, hardness=hardness)
+
+
+def _hardness(domain, hardness, force, mean_pressure, solver):
+    """The checked hardness ``H`` [pressure]: finite and > 0, a cell's mean pressure at most ``H`` (every node
+    at ``H`` carries ``H Lx Ly``), and a solver that bounds the pressure (Kalker's QP, Newton)."""
+    hardness = check_scale("hardness", hardness)
+    if solver not in ("kalker", "newton"):
+        raise InputError(f"hardness = {hardness!r} is not allowed with method = {solver!r}: the paper's fixed-point "
+                         "methods do not bound the pressure; use method='newton'.")
+    area = getattr(domain, "area", None)
+    if area is not None and force is not None and force > hardness * area:
+        name, value = ("mean_pressure", mean_pressure) if mean_pressure is not None else ("force", force)
+        fail(name, value, f"at most hardness = {hardness!r} times the cell area {area:.6g} (every node at the "
+             "hardness)" if name == "force" else f"<= hardness = {hardness!r} (every node at the hardness)")
+    return hardness
 
 
 def initial_guess(x0, lattice):

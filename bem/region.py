@@ -138,9 +138,11 @@ class HalfSpaceRegion:
         """KKT residual to which the coarser lattices of nested iteration are solved."""
         return _COARSE_RTOL
 
-    def operator(self, lattice, E_star, backend):
-        """The influence operator ``C`` of the half-space on ``lattice``."""
-        return InfluenceOperator(lattice, E_star, device=backend)
+    def operator(self, lattice, E_star, backend, *, bodies=None):
+        """The influence operator ``C`` of the half-space on ``lattice`` (of coated ``bodies`` where given)."""
+        if bodies is None:
+            return InfluenceOperator(lattice, E_star, device=backend)
+        return InfluenceOperator(lattice, E_star, device=backend, bodies=bodies)
 
     def solve_level(self, run, make_op, lattice, h, kw, delta, solver):
         """One level of nested iteration (``delta``: the approach it knows, or None): on the candidate

@@ -70,10 +70,18 @@ class ContactResult:
         The candidate lattice; :meth:`grid` maps nodal arrays back onto it.
     E_star : float
         Effective modulus [pressure].
+    bodies : bem.Bodies or None
+        The coated bodies (their moduli, Poisson ratios and coatings); ``None`` when neither body
+        is coated (``E_star`` says all).
     domain : bem.HalfSpaceRegion or bem.PeriodicCell
         The domain solved on (a growing region: the one the contact fitted in).
     notes : list of str
         What the solve did besides iterating, for people (a region enlarged).
+    hardness : float or None
+        Hardness ``H`` of the surface [pressure], the bound ``p <= H`` (:mod:`bem.plastic`); ``None``:
+        elastic.
+    plastic_area : float
+        Number of plastic nodes (``p = H``) times the node area [length^2]; 0 without a hardness.
     """
 
     x: np.ndarray
@@ -100,7 +108,10 @@ class ContactResult:
     status: str = ""
     rtol: float = math.nan
     domain: object = None
+    bodies: object = None
     notes: list = field(default_factory=list)
+    hardness: float | None = None
+    plastic_area: float = 0.0
 
     def __post_init__(self):
         if self.status not in STATUSES or self.converged != (self.status == "converged"):
@@ -147,4 +158,15 @@ class ContactResult:
             "n_nodes": int(self.p.size),
             "n_contact": int(np.count_nonzero(self.p > 0)),
             "step": float(self.step),
+            "hardness": None if self.hardness is None else float(self.hardness),
+            "plastic_area": float(self.plastic_area),
+            **self._coatings(),
         }
+
+    def _coatings(self):
+        """``coating1``, ``coating2`` (each ``{"thickness", "E", "nu"}`` or None) when a body is coated."""
+        if self.bodies is None:
+            return {}
+        return {f"coating{i}": None if c is None else {"thickness": float(c.thickness), "E": float(c.E),
+                                                        "nu": float(c.nu)}
+                for i, c in ((1, self.bodies.coating1), (2, self.bodies.coating2))}

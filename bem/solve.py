@@ -30,9 +30,10 @@ __all__ = ["solve"]
 log = logging.getLogger(__name__)
 
 
-def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None, approach=None,
-          mean_pressure=None, domain=None, step=None, extent=None, layer=None, method="newton", rtol=1e-10,
-          maxiter=None, x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
+def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, coating1=None, coating2=None, force=None,
+          approach=None, mean_pressure=None, domain=None, step=None, extent=None, layer=None, hardness=None,
+          method="newton", rtol=1e-10, maxiter=None, x0=None, nested=None, precondition=True, callback=None,
+          device="cpu", **options):
     """Frictionless normal contact of two elastic half-spaces with an interface layer, over a domain.
 
     Minimises the generalised Kalker functional (eq. 11, 15)
@@ -52,6 +53,13 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         ``x = (q + (r mod 2)/2) c``, ``y = r c sqrt3/2``).
     E_star : float, optional
         Effective modulus [pressure]; or give ``E1, nu1, E2, nu2`` instead.
+    E1, nu1, E2, nu2 : float, optional
+        Young's moduli [pressure] (``math.inf``: rigid) and Poisson's ratios [-] of the two
+        bodies (of the substrates where a body is coated), instead of ``E_star``.
+    coating1, coating2 : bem.Coating, optional
+        A coating bonded to body 1 or 2 (:mod:`bem.coating`); needs ``E1, nu1, E2, nu2``. The
+        operator then carries the bodies' compliance per Fourier mode ``2 (s1 + s2) / q``;
+        ``result.E_star`` is the substrates' and ``result.bodies`` the :class:`bem.Bodies`.
     force, approach, mean_pressure : float
         Exactly one: total force ``P`` [force] (force control, eq. 9; on a cell the force on one
         cell), the approach ``delta`` [length] (approach control), or, on a cell, the mean
@@ -68,6 +76,14 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
         :meth:`bem.gaps.Measured.region`) refuses a region beyond its data.
     layer : bem.layers.Layer, optional
         Interface layer law ``w(p)``; ``None`` for smooth bodies.
+    hardness : float, optional
+        Hardness ``H`` [pressure] of an elastic-perfectly-plastic surface: the pressure is bounded,
+        ``0 <= p <= H`` at every node, and a node at ``H`` yields (its gap may close beyond
+        contact, the plastic deformation; :mod:`bem.plastic`). ``None``: elastic. Taken by Kalker's
+        QP and ``"newton"`` (the paper's fixed-point methods refuse it). On a cell the mean
+        pressure is at most ``H``; under force control a contact whose every node yields leaves
+        the approach undetermined in an interval, whose lower end is returned
+        (``history["approach_bracket"]``).
     method : {"newton", "augmented_gap", "variable_compliance", "kalker"}
         ``"newton"`` (default): direct minimisation of eq. 15
         (:func:`bem.newton.solve_newton`); ``"augmented_gap"`` (eq. 17-20) and
@@ -157,10 +173,11 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, force=None,
     t_start = time.perf_counter()
     domain = _domain(domain, step, extent)
     domain.check_gap(gap)
-    problem = check_problem(domain, E_star=E_star, E1=E1, nu1=nu1, E2=E2, nu2=nu2, force=force, approach=approach,
+    problem = check_problem(domain, E_star=E_star, E1=E1, nu1=nu1, E2=E2, nu2=nu2, coating1=coating1,
+                            coating2=coating2, force=force, approach=approach,
                             mean_pressure=mean_pressure, layer=layer, method=method, rtol=rtol, maxiter=maxiter,
                             nested=nested, precondition=precondition, callback=callback, device=device,
-                            options=options)
+                            options=options, hardness=hardness)
     region = domain.resolved(gap, E_star=problem.E_star, force=problem.force, approach=problem.approach, layer=layer)
     if x0 is not None and getattr(region, "grow", False):
         raise InputError(f"x0 is not allowed with {region!r}: its lattice changes as the region grows "
@@ -219,7 +236,9 @@ def _solve_on(region, gap, problem, x0, t_start):
     coarse_rtol = region.coarse_rtol(problem.solver)
 
     def make_op(lat):
-        return region.operator(lat, problem.E_star, problem.backend)
+        if problem.bodies is None:
+            return region.operator(lat, problem.E_star, problem.backend)
+        return region.operator(lat, problem.E_star, problem.backend, bodies=problem.bodies)
 
     def run(op, h_lat, kw):
         return _run(problem.solver, op, h_lat, problem.layer, problem.precondition, kw, problem.options)
@@ -231,6 +250,9 @@ def _solve_on(region, gap, problem, x0, t_start):
                   rtol=rtol if finest else max(rtol, coarse_rtol), callback=problem.callback if finest else None)
         if problem.maxiter is not None:
             kw["maxiter"] = problem.maxiter
+        if problem.hardness is not None:
+            _check_capacity(region, lat, problem)
+            kw["hardness"] = problem.hardness
         sol, ops = region.solve_level(run, make_op, lat, h_lat, kw, delta if nested else None, problem.solver)
         delta = sol.approach
         if not finest:
@@ -241,6 +263,18 @@ def _solve_on(region, gap, problem, x0, t_start):
     closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
     return _result(region, lattice, op, h, sol, closure, problem, t_start,
                    n_matvec=sum(o.n_matvec for o in ops if o is not op))
+
+
+def _check_capacity(region, lattice, problem):
+    """Raise :class:`bem.RegionTooSmallError` where the candidate nodes of ``lattice`` at the hardness cannot
+    carry the force (a growing region then grows)."""
+    if problem.force is None:
+        return
+    capacity = problem.hardness * lattice.node_area * int(np.count_nonzero(lattice.mask))
+    if problem.force > capacity:
+        raise RegionTooSmallError(
+            f"force = {problem.force!r} is not allowed on {region!r}: its candidate nodes at hardness = "
+            f"{problem.hardness!r} carry at most {capacity:.6g}. Make extent larger or reduce the load.")
 
 
 def _inner_summary(history):
@@ -280,7 +314,7 @@ def _result(region, lattice, op, h, sol, closure, problem, t_start, n_matvec=0):
     g = u + closure + h - sol.approach
     a = lattice.node_area
     kkt = kkt_residual(p[mask], g[mask], displacement_scale=float(np.abs(u + closure).max()),
-                       force=problem.force, node_area=a)
+                       force=problem.force, node_area=a, hardness=problem.hardness)
     if not np.all(np.isfinite(p)):
         raise FloatingPointError(f"{problem.solver}: the solver produced non-finite pressures ({sol.message})")
     return region.result_class(
@@ -291,4 +325,5 @@ def _result(region, lattice, op, h, sol, closure, problem, t_start, n_matvec=0):
         message=sol.message, status=sol.status, rtol=float(problem.rtol), iterations=int(sol.iterations),
         kkt_residual=float(kkt), method=problem.solver, wall_time_s=time.perf_counter() - t_start, lattice=lattice,
         E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=n_matvec + op.n_matvec,
-        domain=region)
+        domain=region, bodies=problem.bodies, hardness=problem.hardness,
+        plastic_area=0.0 if problem.hardness is None else float(a * np.count_nonzero(p[mask] >= problem.hardness)))

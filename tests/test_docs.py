@@ -105,8 +105,8 @@ def test_scenes_doc_defaults_are_the_code_defaults():
     assert _default(doc["scene"][""]["units"]) == ss.DEFAULT_UNITS
     scenes = " ".join((DOCS / "scenes.md").read_text().split())
     assert "`bem.checks.max_nodes`" in scenes
-    assert (f"{BYTES_PER_NODE['the candidate region']} bytes a node on a half-space region, "
-            f"{BYTES_PER_NODE['the periodic cell']} on a periodic cell or a surface grid") in scenes
+    assert (f"{BYTES_PER_NODE['candidate region']} bytes a node on a half-space region, "
+            f"{BYTES_PER_NODE['periodic cell']} on a periodic cell or a surface grid") in scenes
     assert checked > 10
     sections = doc["report"][""]["sections"][4]
     assert all(f"`{name}`" in sections for name in ss.report_sections())
@@ -133,11 +133,14 @@ def real_results(tmp_path_factory):
             ("paper_bilinear", ["bem.nodes_across=16", "fem.n_contact_elements=8"]),  # paper layer: alpha_a, alpha_c
             ("paper_root", ["bem.nodes_across=16", "layer.alpha_b=0.9"]),    # alpha_b target and result
             ("elliptic", ["bem.nodes_across=16"]),                          # hertz_elliptic, not axisymmetric
-            ("rough_flat", ["gap.grid=32", "bem.cell_nodes=32"])]           # a periodic cell
+            ("rough_flat", ["gap.grid=32", "bem.cell_nodes=32"]),           # a periodic cell
+            ("rough_flat", ["gap.grid=32", "bem.cell_nodes=32", "bodies.E1=210e9", "bodies.nu1=0.3",  # coated
+                            "bodies.E2=210e9", "bodies.nu2=0.3", "bodies.coating1.thickness=1e-5",
+                            "bodies.coating1.E=2e10", "bodies.coating1.nu=0.3"])]
     out = []
-    for name, overrides in runs:
-        run_scene(name, tmp / name, overrides=overrides)
-        out.append(json.loads((tmp / name / "result.json").read_text()))
+    for i, (name, overrides) in enumerate(runs):
+        run_scene(name, tmp / f"{i}_{name}", overrides=overrides)
+        out.append(json.loads((tmp / f"{i}_{name}" / "result.json").read_text()))
     return out
 
 

@@ -1,6 +1,7 @@
 """The scripts of docs/examples run, and say what they claim (examples as tests)."""
 
 import math
+import re
 import runpy
 from pathlib import Path
 
@@ -16,7 +17,7 @@ def run_example(name):
 
 
 def test_every_example_is_tested():
-    tested = {"hertz", "paper_problem", "user_gap", "measured_layer", "sweep", "paper_report"}
+    tested = {"hertz", "paper_problem", "user_gap", "measured_layer", "sweep", "paper_report", "rough_walkthrough"}
     assert {p.stem for p in EXAMPLES.glob("*.py")} == tested  # paper_report: tests/validation/test_report_paper.py
 
 
@@ -67,3 +68,59 @@ def test_sweep_example_scales_as_hertz(tmp_path):
         assert row["p_max"] == pytest.approx(expected, rel=1e-3)
     assert (tmp_path / "sweep" / "summary.csv").is_file()
     assert len(list((tmp_path / "sweep" / "points").glob("point-*.json"))) == 4
+
+
+def _walkthrough_blocks():
+    """``[(language, text)]`` of the code blocks of docs/rough.md's walk-through."""
+    text = (EXAMPLES.parent / "rough.md").read_text()
+    section = text[text.index("\n## A walk-through"):]
+    return re.findall(r"```(\w+)\n(.*?)```", section, re.S)
+
+
+@pytest.mark.slow
+def test_rough_walkthrough_runs_the_commands_of_its_page(tmp_path):
+    """The commands and the scene of docs/rough.md's walk-through are the script's, they run, the output
+    the page quotes is theirs, and the macro contact behaves as a softening layer must."""
+    pytest.importorskip("SurfaceTopography")
+    pytest.importorskip("matplotlib")
+    from bem.reference import hertz_sphere
+    from bem.rough import read_layer_law
+
+    script = runpy.run_path(str(EXAMPLES / "rough_walkthrough.py"), run_name="example")
+    blocks = _walkthrough_blocks()
+    commands = [line for lang, block in blocks if lang == "bash" for line in block.splitlines()
+                if line.startswith("contactlab ")]
+    assert commands == script["COMMANDS"]
+    assert [block for lang, block in blocks if lang == "toml"] == [script["SCENE"]]
+
+    out = script["main"](tmp_path / "work", tmp_path / "figures")
+    printed = "\n".join(out["printed"].values())
+    for lang, block in blocks:
+        if lang == "text":
+            for line in block.splitlines():
+                assert line in printed, f"docs/rough.md quotes {line!r}, which the commands do not print"
+    for path in out["figures"]:
+        assert 10_000 < path.stat().st_size < 400_000, path
+
+    removed, kept = (read_layer_law(tmp_path / "work" / f / "layer_law.toml") for f in ("law", "law_spikes"))
+    assert removed.preparation["spikes_removed"] and not kept.preparation["spikes_removed"]
+    assert removed.stats.rms_height < 0.5 * kept.stats.rms_height  # the spikes carry most of the rms height
+    p = np.geomspace(1e5, 9e8, 30)
+    assert (kept.law.w(p) > removed.law.w(p)).all()  # the particles add closure at every pressure
+
+    R, E_star, P = 1.0, 115.4e9, 1.0
+    a = (3 * P * R / (4 * E_star)) ** (1 / 3)  # Hertz's smooth ball, written out here
+    assert hertz_sphere(R, E_star, force=P).contact_radius == pytest.approx(a, rel=1e-12)
+    p0 = 3 * P / (2 * math.pi * a**2)
+    ball, spikes = out["results"]["ball"], out["results"]["ball_spikes"]
+    for res in (ball, spikes):
+        assert res["converged"] and res["force"] == pytest.approx(P, rel=1e-9)
+    # a compliant layer spreads the load: lower peak, wider contact, larger approach; more so the softer law
+    assert spikes["p_max"] < ball["p_max"] < p0
+    assert a < ball["contact_radius"] < spikes["contact_radius"]
+    assert a**2 / R < ball["approach"] < spikes["approach"]
+    # the closure at the centre is the law's at the local pressure, inside its data
+    profile = ball["profile"]
+    centre = int(np.argmin(np.abs(np.array(profile["x"]))))
+    assert profile["closure"][centre] == pytest.approx(float(removed.law.w(profile["p"][centre])), rel=1e-9)
+    assert ball["p_max"] < removed.mean_pressure[-1]

@@ -127,9 +127,9 @@ class PeriodicCell:
         """KKT residual to which the coarser cells of nested iteration are solved."""
         return _COARSE_RTOL.get(solver, _COARSE_RTOL_DEFAULT)
 
-    def operator(self, cell, E_star, backend):
-        """The periodic influence operator on ``cell``."""
-        return PeriodicOperator(cell, E_star, device=backend)
+    def operator(self, cell, E_star, backend, *, bodies=None):
+        """The periodic influence operator on ``cell`` (of coated ``bodies`` where given)."""
+        return PeriodicOperator(cell, E_star, device=backend, bodies=bodies)
 
     def solve_level(self, run, make_op, cell, h, kw, delta, solver):
         """One level of nested iteration, on the whole cell; the solution and the operator used."""

@@ -26,9 +26,25 @@ from .. import fft
 from ..backend import get_backend
 from ..checks import check_positive
 from ..operator import diagonal_coefficient
+from .coated import coated_template
 from .kernel import periodic_template
 
 __all__ = ["PeriodicOperator"]
+
+
+def _checked_bodies(bodies, E_star):
+    """``bodies`` when coated (checked against ``E_star``), ``None`` for homogeneous bodies."""
+    if bodies is None:
+        return None
+    from ..coating import Bodies
+    from ..errors import InputError
+
+    if not isinstance(bodies, Bodies):
+        raise InputError(f"bodies = {bodies!r} is not allowed: it must be a bem.Bodies or None.")
+    if abs(bodies.E_star - E_star) > 1e-12 * E_star:
+        raise InputError(f"E_star = {E_star!r} is not allowed with bodies: it must be bodies.E_star = "
+                         f"{bodies.E_star!r}, the substrates' effective modulus.")
+    return bodies if bodies.is_coated else None
 
 
 class PeriodicOperator:
@@ -43,6 +59,11 @@ class PeriodicOperator:
     device : {"cpu", "cuda"} or module, optional
         Where the products run (:func:`bem.backend.get_backend`); brick arrays in and out are
         in its namespace. The kernel spectra are computed on the host once and copied over.
+    bodies : bem.Bodies, optional
+        Coated bodies: the operator carries their compliance per mode ``2 s(k) / k``
+        (:func:`bem.periodic.coated.coated_template`); ``E_star`` must then be
+        ``bodies.E_star``, the substrates'. ``None`` (or bodies without a coating): the
+        homogeneous operator of ``E_star``.
 
     Attributes
     ----------
@@ -50,17 +71,25 @@ class PeriodicOperator:
         The local self-compliance ``C_nn = c / (pi E*) w_t(0, 0)`` of the half-space (the
         scale of layer compliances and of the solvers' Jacobi estimates), as for
         :class:`bem.operator.InfluenceOperator`; the periodic coefficient ``C[n, n]`` differs
-        from it by the images and the zero mean.
+        from it by the images and the zero mean. With coatings it is scaled by the ratio of the
+        periodic coefficients ``C[n, n]`` with and without them (the coating's ``C_nn`` for a
+        thick coating, the substrate's for a thin one).
     """
 
-    def __init__(self, lattice, E_star, device="cpu"):
+    def __init__(self, lattice, E_star, device="cpu", *, bodies=None):
         self.lattice = lattice
         self.backend = bk = get_backend(device)
         self.mask = bk.asarray(lattice.mask, dtype=bk.xp.bool)
         self.E_star = check_positive("E_star", E_star)
+        self.bodies = _checked_bodies(bodies, self.E_star)
         self.n_matvec = 0
         self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
-        w = periodic_template(lattice.n_rows, lattice.n_cols) * (lattice.step / (math.pi * self.E_star))
+        w = periodic_template(lattice.n_rows, lattice.n_cols)
+        if self.bodies is not None:
+            coated = coated_template(lattice.n_rows, lattice.n_cols, lattice.step, self.bodies)
+            self.diagonal *= coated[0, 0] / w[0, 0]
+            w = coated
+        w = w * (lattice.step / (math.pi * self.E_star))
         self.kernel = w  # C between node (0, 0) and node (q, r), brick array
         even, odd = w[0::2], w[1::2]
         self._spectrum_shape = (even.shape[0], even.shape[1] // 2 + 1)

@@ -46,7 +46,7 @@ from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["periodic_template", "pyramid_transform"]
+__all__ = ["alias_sum", "periodic_template", "pyramid_transform"]
 
 _SQRT3 = math.sqrt(3.0)
 # Ewald split [1/lattice step]. The Fourier sum of a cell has about 10 alpha^2 terms per node and
@@ -125,14 +125,43 @@ def _sin_over(x):
 
 def _fourier_part(n_rows, n_cols, alpha):
     """``W_F`` at every node of the cell, brick array ``(n_rows, n_cols)``."""
-    import scipy.fft as sfft
     from scipy.special import erfc
+
+    def weight(k):  # twice 2 pi / k erfc(k / (2 alpha)) (sqrt3 / 2)
+        return (2 * _SQRT3 * math.pi) / k * erfc(k / (2 * alpha))
+
+    return alias_sum(n_rows, n_cols, None, 2 * alpha * _ERFC_ZERO, weight=weight, block=256)
+
+
+def alias_sum(n_rows, n_cols, radial, g_cut, *, weight=None, block=None):
+    """``(1/A) sum_{0 < |G| <= g_cut} f(|G|) hat(G) exp(i G.x)`` at every node of the cell (lattice units).
+
+    Parameters
+    ----------
+    n_rows, n_cols : int
+        Rows (even) and columns of the cell.
+    radial : callable
+        ``f(k)`` on a 1-D array of wavenumbers ``k > 0`` [1/lattice step], real, vectorised.
+    g_cut : float
+        Largest ``|G|`` summed [1/lattice step].
+    weight : callable, optional
+        ``sqrt3 f(k)`` in place of ``radial`` (the Ewald part's own rounding).
+    block : int, optional
+        Rows of ``G`` per block of the sum (default: about 2^20 terms a block).
+
+    Returns
+    -------
+    ndarray, shape ``(n_rows, n_cols)``
+        The sum at the offset of node ``(q, r)`` from node ``(0, 0)``, brick storage: ``G`` over the
+        reciprocal lattice of the periods, each term binned onto the cell's discrete Fourier modes
+        and brought to the nodes by two inverse FFTs, one per row parity.
+    """
+    import scipy.fft as sfft
 
     from .. import fft
 
     half = n_rows // 2
     lx, ly = float(n_cols), n_rows * _SQRT3 / 2
-    g_cut = 2 * alpha * _ERFC_ZERO
     m_max, n_max = int(g_cut * lx / (2 * math.pi)) + 1, int(g_cut * ly / (2 * math.pi)) + 1
     m = np.arange(-m_max, m_max + 1)
     gx = 2 * math.pi * m / lx
@@ -142,8 +171,9 @@ def _fourier_part(n_rows, n_cols, alpha):
     # the terms of G and -G are complex conjugates (the summand is even in G, the parity phase
     # conjugates), and only the real part of the sum is kept: half the plane (n > 0, or n = 0 and
     # m > 0), counted twice
-    for n0 in range(0, n_max + 1, 256):  # blocks of rows keep the temporaries small
-        n = np.arange(n0, min(n0 + 256, n_max + 1))[:, None]
+    block = max(1, 2 ** 20 // m.size) if block is None else block  # rows per block: small temporaries
+    for n0 in range(0, n_max + 1, block):
+        n = np.arange(n0, min(n0 + block, n_max + 1))[:, None]
         gy = 2 * math.pi * n / ly
         k = np.sqrt(gx * gx + gy * gy)
         keep = (k <= g_cut) & ((n > 0) | (m > 0))
@@ -151,7 +181,7 @@ def _fourier_part(n_rows, n_cols, alpha):
         kk = k[keep]
         s2 = (gx[cols] / 2 + gy[rows, 0] * (_SQRT3 / 2)) / 2  # pyramid_transform by its three factors
         hat = sinc_x[cols] * _sin_over(s2) * _sin_over(s2 - gx[cols] / 2)
-        f = (2 * _SQRT3 * math.pi) / kk * erfc(kk / (2 * alpha)) * hat  # twice 2 pi / k erfc (sqrt3 / 2) hat
+        f = (_SQRT3 * radial(kk) if weight is None else weight(kk)) * hat  # twice f(k) (sqrt3 / 2) hat
         # node of parity s = 1: phase exp(i pi (m / n_cols + 2 n / n_rows)) relative to parity 0
         phase = phase_x[cols] * np.exp(2j * math.pi * n[:, 0] / n_rows)[rows]
         index = np.mod(n[rows, 0], half) * n_cols + np.mod(m[cols], n_cols)

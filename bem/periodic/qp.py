@@ -14,9 +14,10 @@ minimum along ``t``, ``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the cont
 change, the conjugate-gradient step); where ``g.t <= 0`` the step falls back to ``t = z``. On a
 rough surface, whose contact set changes at most iterations until it settles, the general loop
 restarts at every change and degrades to preconditioned steepest descent
-(``tests/bem/test_periodic_qp.py``: 88 iterations against 62 on a 256 x 256 self-affine cell).
+(``tests/bem/test_periodic_qp.py``: 88 iterations against 57 on a 256 x 256 self-affine cell).
 Nodes that enter the contact (``p = 0``, ``g < 0``) take the step of the preconditioned iteration
-with the Jacobi estimate of the preconditioner at that node, ``p = -min(tau, 1) g / (C_nn + lam)``:
+with a share of the Jacobi estimate of the preconditioner at that node, ``p = -f min(tau, 1) g / (C_nn + lam)``
+(``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`, chosen by the iteration counts stated there):
 ``tau`` is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give an entering node
 ``tau C_nn`` of its Jacobi pressure, a fraction that falls with the step (on a 672 x 776 rough cell,
 1e-4 of the mean contact pressure: a cycle of nodes entering with almost no pressure and leaving,
@@ -44,6 +45,9 @@ those of ``C`` alone, ``u = C p + D p`` and the curvature adds ``sum D t^2``; th
 is that of :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique
 projection under force control (by ``M 1`` of the starting contact).
 
+With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H``
+and the step is that of every constrained-CG step (:func:`bem.cg_rules.bounded_move`).
+
 A step costs four transforms of the cell in single precision while the contact set does not
 change (two for the preconditioner, one forward for the search direction, one inverse for its
 product), five where it changes, two of them in double precision once the residual is below
@@ -57,8 +61,10 @@ import math
 
 import numpy as np
 
-from ..cg_rules import (RECOMPUTE_EVERY, CGStep, Record, entering_pressure, initial_pressure, iterate_residual,
-                        run_constrained_cg)
+from ..backend import operator_backend
+from ..cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, carry_force, entering_pressure,
+                        initial_pressure, iterate_residual, run_constrained_cg)
+from ..plastic import note_fully_plastic
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -67,7 +73,7 @@ SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_AB
 
 
 def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
-                      callback=None, scale=None, u0=None, confirm=True, threshold=4.0):
+                      callback=None, scale=None, u0=None, confirm=True, threshold=4.0, hardness=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell (NumPy).
 
     Parameters
@@ -99,6 +105,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     threshold : float
         With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner,
         as in :func:`bem.kalker.compliance_preconditioner`.
+    hardness : float, optional
+        The bound ``p <= H`` [pressure] (:mod:`bem.plastic`): the search direction lives on the elastic
+        contact ``0 < p < H`` and the step is :func:`bem.cg_rules.bounded_move`.
 
     Returns
     -------
@@ -116,10 +125,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
     if u0 is None or x0 is None:
-        p = initial_pressure(op, h, D if per_node else lam, force, approach, x0)
+        p = initial_pressure(op, h, D if per_node else lam, force, approach, x0, hardness)
         if target is not None:
             p = p if float(p.sum()) > 0 else np.ones(lat.shape)
-            p *= target / float(p.sum())
+            if hardness is None:
+                p *= target / float(p.sum())
+            else:
+                p = carry_force(np, p, target, hardness, np.ones(lat.shape, dtype=bool))
         u0 = None
     else:  # the caller's iterate and its product, as they are
         p = np.array(x0, dtype=float)
@@ -172,15 +184,35 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
     gz_old, m_one, m_full = 1.0, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
-    prev_contact = p > 0
-    n_prev = int(np.count_nonzero(prev_contact))
+    was_on = p > 0  # the contact of the previous iterate, updated at its nodes only
+    was_onf = was_on.reshape(-1)
+    prev_idx = np.flatnonzero(was_onf)
+    n_prev = int(prev_idx.size)
     fixed_scale = scale
-    contact = idx = g_c = p_c0 = g_min = None
+    idx = g_c = p_c0 = g_min = None
+    stepped = np.empty(0, dtype=np.intp)  # the nodes where r32, t and z_prev hold values (zero elsewhere)
+    r32_full = True  # r32 holds values off those nodes (the product of M and the starting contact)
+
+    bounded, sets = hardness is not None, None
+    was_plastic, bk = (p >= hardness, operator_backend(op)[0]) if hardness is not None else (None, None)
+
+    def measure_bounded(k):  # measure() with the bound: the CG lives on the elastic contact 0 < p < H
+        nonlocal idx, g_c, p_c0, delta, g_min, single, sets
+        np.add(u, h, out=g)  # the gap is g - delta
+        sets = bounded_sets(bk, p, g, hardness, delta, force)
+        idx, delta, g_min = sets.idx, sets.delta, sets.gap_min
+        g_c, p_c0 = np.take(gf, idx) - delta, np.take(pf, idx)
+        scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
+        kkt = iterate_residual(float(np.abs(g_c).max(initial=0.0)), g_min, scale, lambda: float(np.abs(g - delta).max()),
+                               None if force is None else abs(a * float(pf.sum()) - force) / force,
+                               plastic_gap=sets.plastic_gap)
+        if k == 1:
+            single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
+        return kkt
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
-        nonlocal contact, idx, g_c, p_c0, delta, g_min, single
-        contact = p > 0
-        idx = np.flatnonzero(contact)
+        nonlocal idx, g_c, p_c0, delta, g_min, single
+        idx = np.flatnonzero(pf)  # p >= 0: the contact p > 0
         np.add(u, h, out=g)  # the gap is g - delta: delta is subtracted on the contact only
         g_c, p_c0 = np.take(gf, idx), np.take(pf, idx)
         if force is not None:
@@ -204,17 +236,32 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             return True
         return False
 
+    def observe_bounded():  # changes of the contact and of the plastic set
+        nonlocal was_on, was_plastic
+        changes = int(np.count_nonzero(sets.on != was_on)) + int(np.count_nonzero(sets.plastic != was_plastic))
+        was_on, was_plastic = sets.on, sets.plastic
+        n_touch = idx.size + sets.pl.size
+        return float(pf.max(initial=0.0)), n_touch, changes, n_touch == 0 and g_min >= 0
+
     def observe():
-        nonlocal prev_contact, n_prev
-        kept = int(np.count_nonzero(prev_contact.reshape(-1)[idx]))  # nodes in both contacts
+        nonlocal prev_idx, n_prev
+        kept = int(np.count_nonzero(was_onf[idx]))  # nodes in both contacts
         changes = (idx.size - kept) + (n_prev - kept)
-        prev_contact, n_prev = contact, idx.size
+        was_onf[prev_idx] = False
+        was_onf[idx] = True
+        prev_idx, n_prev = idx, idx.size
         return float(p_c0.max(initial=0.0)), int(idx.size), changes, idx.size == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, gz_old, r_hat, u, stale
+        nonlocal m_full, m_one, gz_old, r_hat, u, stale, stepped, r32_full
+        if bounded and not idx.size:  # every contact node plastic: only entering and leaving nodes move
+            return bounded_step(0.0, np.zeros(0), None, None)
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        r32.fill(0.0)
+        if r32_full:
+            r32.fill(0.0)
+            r32_full = False
+        else:  # zero where the last step wrote
+            r32f[stepped] = 0.0
         if soft is None:
             r32f[idx] = g_c
         else:
@@ -227,7 +274,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
             if m_full is None:
-                np.multiply(contact, stiff, out=r32, casting="unsafe")
+                np.multiply(pf.reshape(p.shape) > 0, stiff, out=r32, casting="unsafe")
+                r32_full = True
                 x = op.spectrum(r32)  # M (contact & stiff), and the Jacobi estimate at the soft nodes
                 m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1).astype(float)
                 m_full[softf] = jacf[softf]
@@ -239,7 +287,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
         beta = 0.0 if k == 1 or gz_old == 0 else max(  # gz_old = 0: one contact node under force control
             0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
-        z_prev.fill(0.0)
+        zf[stepped] = 0.0
         zf[idx] = z
         t_c = z + beta * np.take(tf, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
@@ -247,8 +295,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         gt = float(np.einsum("i,i->", g_c, t_c))
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
-        t.fill(0.0)
+        tf[stepped] = 0.0
         tf[idx] = t_c
+        stepped = idx
         gz_old = gz
         T = op.spectrum(t)
         op.n_matvec += 1
@@ -263,12 +312,14 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
         else:
             tau = gt / tt  # the minimum along t (gt = gz when the contact has not changed)
+        if bounded:
+            return bounded_step(tau, t_c, R, D_c if per_node else None)
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
         p_c[clipped] = 0.0
         pf[idx] = p_c  # p is 0 off idx
         # re-entering nodes (p = 0, g < 0): the step tau of the preconditioned direction with the Jacobi
-        # estimate of M there, -min(tau, 1) g / (C_nn + lam) (module docstring: entering nodes)
+        # estimate of M there, -f min(tau, 1) g / (C_nn + lam) (module docstring: entering nodes)
         low = np.flatnonzero(g < delta)
         overlap = low[pf[low] == 0]
         p_o = None
@@ -308,7 +359,31 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             stale += 1
         return None
 
-    kkt = run_constrained_cg(CGStep(measure, confirms, observe, advance, p.copy), record, maxiter, callback)
+    def bounded_step(tau, t_c, R, D_c):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
+        nonlocal u, stale
+        changed, _, s, failure = bounded_move(bk, p, sets, p_c0, t_c, tau, g, jacobi, per_node, target, hardness,
+                                              preconditioned=True)
+        if failure is not None:
+            return failure
+        if changed or R is None or stale >= RECOMPUTE_EVERY:
+            u, stale = op.brick(product(p), overwrite=True), 0
+            if per_node:
+                u += D * p
+        else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
+            cr = op.brick(R, overwrite=True)
+            cr *= np.float32(tau)
+            u -= cr
+            if per_node:
+                u.reshape(-1)[idx] -= tau * (D_c * t_c)
+            if s != 1.0:
+                u *= s
+            stale += 1
+        return None
+
+    step = CGStep(measure_bounded, confirms, observe_bounded, advance, p.copy) if bounded else CGStep(
+        measure, confirms, observe, advance, p.copy)
+    kkt = run_constrained_cg(step, record, maxiter, callback)
+    note_fully_plastic(record, sets.bracket if bounded else None, bounded and not idx.size)
     # C p: the layer's closure is not a displacement
     elastic = u - (D if per_node else lam) * p if per_node or lam else u.astype(float, copy=False)
     return record.solution(p, delta, kkt, elastic, "Kalker QP (periodic)")

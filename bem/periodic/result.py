@@ -30,6 +30,13 @@ class PeriodicContactResult(ContactResult):
         return float(np.count_nonzero(self.p > 0)) / self.p.size
 
     @property
+    def plastic_fraction(self):
+        """Fraction of the nodes at the hardness (``p = H``): the relative plastic area; 0 without a hardness."""
+        if self.hardness is None:
+            return 0.0
+        return float(np.count_nonzero(self.p >= self.hardness)) / self.p.size
+
+    @property
     def mean_gap(self):
         """Mean deformed gap over the cell, ``mean(h + w(p)) - delta`` [length] (the mean-plane separation)."""
         return float(np.mean(self.gap))
@@ -38,5 +45,5 @@ class PeriodicContactResult(ContactResult):
         out = super().summary()
         del out["contact_radius"]
         out.update(mean_pressure=float(self.mean_pressure), contact_fraction=self.contact_fraction,
-                   mean_gap=self.mean_gap, cell=[int(self.lattice.n_cols), int(self.lattice.n_rows)])
+                   mean_gap=self.mean_gap, plastic_fraction=self.plastic_fraction, cell=[int(self.lattice.n_cols), int(self.lattice.n_rows)])
         return out

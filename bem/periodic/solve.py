@@ -12,9 +12,10 @@ from .result import PeriodicContactResult
 __all__ = ["solve_periodic", "PeriodicContactResult"]
 
 
-def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None, E2=None, nu2=None,
-                   mean_pressure=None, approach=None, layer=None, method="newton", rtol=1e-10, maxiter=None,
-                   x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
+def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None, E2=None, nu2=None, coating1=None,
+                   coating2=None,
+                   mean_pressure=None, approach=None, layer=None, hardness=None, method="newton", rtol=1e-10,
+                   maxiter=None, x0=None, nested=None, precondition=True, callback=None, device="cpu", **options):
     """Frictionless normal contact of a periodic cell: an alias of :func:`bem.solve` with ``domain=cell``.
 
     ``solve_periodic(gap, cell=cell, ...)`` is ``bem.solve(gap, domain=cell, ...)``, and
@@ -34,7 +35,9 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
     mean_pressure, approach : float
         Exactly one: the mean pressure ``pbar`` [pressure] or the approach ``delta`` [length]
         (:func:`bem.solve`).
-    E_star, E1, nu1, E2, nu2, layer, method, rtol, maxiter, x0, nested, precondition, callback, device, **options
+    E_star, E1, nu1, E2, nu2, coating1, coating2, layer, hardness, method, rtol, maxiter, x0, nested
+        As for :func:`bem.solve`.
+    precondition, callback, device, **options
         As for :func:`bem.solve`.
 
     Returns
@@ -60,6 +63,7 @@ def solve_periodic(gap, *, step=None, cell=None, E_star=None, E1=None, nu1=None,
         cell = PeriodicCell(step, shape[1], shape[0])
     from ..solve import solve
 
-    return solve(gap, domain=cell, E_star=E_star, E1=E1, nu1=nu1, E2=E2, nu2=nu2, mean_pressure=mean_pressure,
-                 approach=approach, layer=layer, method=method, rtol=rtol, maxiter=maxiter, x0=x0, nested=nested,
+    return solve(gap, domain=cell, E_star=E_star, E1=E1, nu1=nu1, E2=E2, nu2=nu2, coating1=coating1,
+                 coating2=coating2, mean_pressure=mean_pressure,
+                 approach=approach, layer=layer, hardness=hardness, method=method, rtol=rtol, maxiter=maxiter, x0=x0, nested=nested,
                  precondition=precondition, callback=callback, device=device, **options)

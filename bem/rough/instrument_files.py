@@ -143,10 +143,10 @@ def _check_grid(path, shape, refuse):
 def _sizes(path, stated, given, name):
     """The ``physical_sizes`` keyword of the reader: the file's own, or the one given."""
     if stated is None and given is None:
-        raise InputError(f"{name('physical_sizes')} is missing: file = {path!r} does not state its size; give "
-                         "(Lx, Ly) in the file's length unit.")
+        raise InputError(f"{name('physical_sizes')} is missing: {name('file')} = {path!r} does not state its size; "
+                         f"give {names_rule(name, 'physical_sizes', '(Lx, Ly)')} in the file's length unit.")
     if stated is not None and given is not None:
-        fail(name("physical_sizes"), given, f"left out: file = {path!r} states its size "
+        fail(name("physical_sizes"), given, f"left out: {name('file')} = {path!r} states its size "
                                             f"{tuple(float(s) for s in stated)}")
     return {} if given is None else {"physical_sizes": given}
 
@@ -167,6 +167,13 @@ def _length(unit):
     return length_units.get(mangle_length_unit_utf8(unit)) if isinstance(unit, str) else None
 
 
+def names_rule(name, key, rule):
+    """The rule of the argument ``key`` as the caller's user knows it: ``name(key + "_rule")`` where the caller
+    gives one (:func:`read_surface`, ``names``), else ``rule``."""
+    given = name(f"{key}_rule")
+    return rule if given == f"{key}_rule" else given
+
+
 def _factor(path, stated, unit, length_unit, name):
     """Returned lengths per file length (module docstring, Units)."""
     if isinstance(length_unit, str):
@@ -178,16 +185,18 @@ def _factor(path, stated, unit, length_unit, name):
     if stated is not None:
         metres = _length(stated)
         if metres is None:
-            raise InputError(f"file = {path!r} is not allowed: it states the length unit {stated!r}, which is not "
-                             "a known length unit; convert the file")
+            raise InputError(f"{name('file')} = {path!r} is not allowed: it states the length unit {stated!r}, which "
+                             "is not a known length unit; convert the file")
         factor = metres / out
         given = _length(unit) / out if isinstance(unit, str) else unit
         if unit is not None and not np.isclose(given, factor, rtol=1e-9, atol=0):
-            fail(name("unit"), unit, f"left out: file = {path!r} states its lengths in {stated}, the unit used")
+            fail(name("unit"), unit,
+                 f"left out: {name('file')} = {path!r} states its lengths in {stated}, the unit used")
         return factor
     if unit is None:
-        raise InputError(f"{name('unit')} is missing: file = {path!r} states no length unit; give its unit "
-                         "(m, mm, um, nm) or the returned lengths per file length.")
+        raise InputError(f"{name('unit')} is missing: {name('file')} = {path!r} states no length unit; give "
+                         + names_rule(name, "unit", "its unit (m, mm, um, nm) or the returned lengths per file length")
+                         + ".")
     return _length(unit) / out if isinstance(unit, str) else unit
 
 
@@ -239,7 +248,9 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, unit=N
         What the statistics and warnings call the file (default: ``file`` as given).
     names : dict, optional
         The names the caller's user knows the arguments by, for messages (e.g.
-        ``{"unit": "--scale", "physical_sizes": "--size"}``).
+        ``{"unit": "--scale", "physical_sizes": "--size"}``); ``"unit_rule"``: what a missing
+        ``unit`` should be, in the caller's terms (e.g. ``"metres per unit of the file"``),
+        ``"physical_sizes_rule"`` the same for ``physical_sizes`` (e.g. ``"--size LX,LY"``).
     unit_default : str or float, optional
         ``unit`` of a file that states none when ``unit`` is not given (a scene's own length
         unit); default: such a file needs ``unit``.

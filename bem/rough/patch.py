@@ -26,7 +26,8 @@ and makes the cell the periodic solver repeats, in this order:
    then touch later or not at all, and so changes the contact the law is made from.
 
 The one warning about the seam is that of the cell solved (:mod:`bem.rough.surface`, in its
-length unit): a mirrored cell has none.
+length unit): a mirrored cell has none. :func:`check_cell_size` counts the nodes of the cell
+(a mirrored one included) from the surface before :func:`patch_cell` makes it.
 """
 
 from __future__ import annotations
@@ -37,11 +38,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_choice, check_positive, fail
+from ..checks import check_choice, check_int, check_node_count, check_positive, fail
+from .lattice_heights import cell_shape
 from .outliers import SPIKE_THRESHOLD, Spikes, find_spikes, remove_spikes
-from .surface import DETRENDS, RoughSurface, _surface, _surface_topography
+from .surface import DETRENDS, MIN_POINTS, RoughSurface, _surface, _surface_topography
 
-__all__ = ["PatchCell", "patch_cell", "quiet_seam", "DETREND_CHOICES", "CELLS", "SPIKE_ACTIONS"]
+__all__ = ["PatchCell", "patch_cell", "cell_grid", "check_cell_size", "quiet_seam", "DETREND_CHOICES", "CELLS",
+           "SPIKE_ACTIONS"]
 
 log = logging.getLogger(__name__)
 
@@ -97,6 +100,57 @@ def quiet_seam():
         logger.setLevel(before)
 
 
+def cell_grid(surface, *, cell="repeat", name="cell"):
+    """``((nx, ny), (Lx, Ly), mirrored)``: the height grid and size of the cell :func:`patch_cell`
+    makes of ``surface`` with ``cell`` (named ``name`` in messages), counted without making it."""
+    if not isinstance(surface, RoughSurface):
+        fail("surface", type(surface).__name__, "a bem.rough.RoughSurface")
+    check_choice(name, cell, CELLS)
+    k = 2 if cell == "mirror" and not surface.stats.periodic else 1
+    nx, ny = surface.heights.shape
+    return (k * nx, k * ny), (k * surface.size[0], k * surface.size[1]), k == 2
+
+
+def check_cell_size(surface, *, cell="repeat", n_cols=None, names=None):
+    """Refuse a cell :func:`patch_cell` would make too large, counted from ``surface`` before it is made.
+
+    The memory guard :func:`bem.checks.check_node_count` on the heights of a mirrored cell
+    (``2 nx x 2 ny`` points) and on the lattice cell of ``n_cols`` nodes along x over the
+    cell's size (``(2 Lx, 2 Ly)`` when mirrored).
+
+    Parameters
+    ----------
+    surface : RoughSurface
+        The surface :func:`patch_cell` is given.
+    cell : str
+        As :func:`patch_cell`.
+    n_cols : int, optional
+        Lattice nodes along x of the cell, ``>= 2``; default: the cell's ``Lx / max(dx, dy)``
+        (:meth:`RoughSurface.default_n_cols` of the cell made).
+    names : dict, optional
+        The names the caller's user knows ``cell`` and ``n_cols`` by, for messages (e.g.
+        ``{"cell": "--cell", "n_cols": "--n-cols"}``); a default ``n_cols`` is named with its rule.
+
+    Returns
+    -------
+    int
+        ``n_cols`` (its default when not given).
+    """
+    names = dict(names or {})
+    (nx, ny), size, mirrored = cell_grid(surface, cell=cell, name=names.get("cell", "cell"))
+    what = "the mirrored periodic cell" if mirrored else "the periodic cell"
+    if mirrored:
+        check_node_count(names.get("cell", "cell"), cell, nx * ny, what="the mirrored surface grid")
+    k = 2 if mirrored else 1
+    name = names.get("n_cols", "n_cols")
+    if n_cols is None:
+        name = f"{name} (default: Lx / max(dx, dy) of the {'mirrored ' if k == 2 else ''}cell)"
+        n_cols = max(MIN_POINTS, int(round(size[0] / max(surface.stats.pixel))))
+    n_rows, n_cols = cell_shape(size, check_int(name, n_cols, minimum=2))
+    check_node_count(name, n_cols, n_rows * n_cols, what=what)
+    return n_cols
+
+
 def _mirrored(z):
     top = np.concatenate([z, z[::-1, :]], axis=0)
     return np.concatenate([top, top[:, ::-1]], axis=1)
@@ -128,11 +182,17 @@ def patch_cell(surface, *, detrend="auto", cell="repeat", spikes="keep", spike_t
     Returns
     -------
     PatchCell
+
+    Raises
+    ------
+    bem.InputError
+        A bad argument, or a mirrored cell of more than :func:`bem.checks.max_nodes` points
+        (counted before it is made; :func:`check_cell_size` counts its lattice too).
     """
-    if not isinstance(surface, RoughSurface):
-        fail("surface", type(surface).__name__, "a bem.rough.RoughSurface")
     check_choice("detrend", detrend, DETREND_CHOICES)
-    check_choice("cell", cell, CELLS)
+    (nx, ny), _, mirrored = cell_grid(surface, cell=cell)
+    if mirrored:
+        check_node_count("cell", cell, nx * ny, what="the mirrored surface grid")
     check_choice("spikes", spikes, SPIKE_ACTIONS)
     scale = check_positive("scale", scale)
     spike_threshold = check_positive("spike_threshold", spike_threshold)
@@ -161,5 +221,6 @@ def patch_cell(surface, *, detrend="auto", cell="repeat", spikes="keep", spike_t
     if not periodic and cell == "mirror":
         z, size = _mirrored(z), (2 * size[0], 2 * size[1])
     out = _surface(z, size, periodic=periodic or cell == "mirror", source=stats.source, unit=stats.unit,
-                   detrend=None if detrend == "none" else detrend)
+                   detrend=None if detrend == "none" else detrend, filled=stats.filled, fill=stats.fill,
+                   length_unit=stats.length_unit if scale == 1.0 else None)
     return PatchCell(out, detrend, "periodic" if periodic else cell, found, spikes == "remove" and found.count > 0)

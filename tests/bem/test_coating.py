@@ -17,7 +17,14 @@ def _lame(E, nu):
 
 
 def _surface_sink(t, Ec, nuc, Es, nus, depth=40.0):
-    """Surface displacement W(0) of the mode q = 1 under sigma_zz(0) = -1, sigma_xz(0) = 0.
+    """Surface displacement W(0) of the mode q = 1 under sigma_zz(0) = -1, sigma_xz(0) = 0."""
+    return float(navier_solution(t, Ec, nuc, Es, nus, depth)(0.0)[2])
+
+
+def navier_solution(t, Ec, nuc, Es, nus, depth=40.0):
+    """The mode q = 1 under sigma_zz(0) = -1, sigma_xz(0) = 0, solved as a boundary-value problem:
+    ``sol(s)`` gives ``(U, U', W, W')`` of the coating at ``z = s t`` (rows 0-3) and of the substrate at
+    ``z = t + s depth`` (rows 4-7; ``'`` is ``d/dz``), ``0 <= s <= 1``.
 
     Plane strain along q: u_x = U(z) sin x, u_z = W(z) cos x, z into the body; Navier's equations
     mu (U'' - U) - (lam + mu)(U + W') = 0 and (lam + 2 mu) W'' = mu W - (lam + mu) U' in the
@@ -50,7 +57,7 @@ def _surface_sink(t, Ec, nuc, Es, nus, depth=40.0):
     s = np.linspace(0.0, 1.0, 401)
     sol = solve_bvp(rhs, bc, s, np.zeros((8, s.size)), tol=1e-10, max_nodes=200_000)
     assert sol.status == 0, sol.message
-    return float(sol.sol(0.0)[2])
+    return sol.sol
 
 
 @pytest.mark.parametrize("t, Ec, nuc, Es, nus", [

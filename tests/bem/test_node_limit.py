@@ -32,7 +32,7 @@ def _refused(call):
 
 def _states(message, n_nodes, what):
     """The message gives the nodes, the limit, the memory of ``n_nodes`` nodes and the machine's."""
-    per_node = checks.BYTES_PER_NODE[what]
+    per_node = checks.bytes_per_node(what)
     limit = checks.machine_memory() // per_node
     assert f"would hold {n_nodes:.3g} nodes (limit {limit:.3g} on this machine)" in message
     assert f"about {n_nodes * per_node / 1e9:.3g} GB of memory at {per_node} bytes a node" in message
@@ -41,13 +41,14 @@ def _states(message, n_nodes, what):
 
 def _memory(monkeypatch, nodes, what):
     """Let the machine have the memory of exactly ``nodes`` nodes of ``what``."""
-    monkeypatch.setattr(checks, "machine_memory", lambda: nodes * checks.BYTES_PER_NODE[what])
+    monkeypatch.setattr(checks, "machine_memory", lambda: nodes * checks.bytes_per_node(what))
 
 
 def test_the_limit_is_the_memory_of_the_machine_over_the_bytes_per_node(monkeypatch):
-    assert checks.machine_memory() == 16_000_000 * checks.BYTES_PER_NODE["the candidate region"]  # conftest
-    for what, per_node in checks.BYTES_PER_NODE.items():
-        assert checks.max_nodes(what) == checks.machine_memory() // per_node
+    assert checks.machine_memory() == 16_000_000 * checks.BYTES_PER_NODE["candidate region"]  # conftest
+    for key, per_node in checks.BYTES_PER_NODE.items():
+        assert checks.max_nodes(f"the {key}") == checks.machine_memory() // per_node
+    assert checks.bytes_per_node("the mirrored periodic cell") == checks.BYTES_PER_NODE["periodic cell"]
     _memory(monkeypatch, 2_000_000, "the candidate region")  # twice the memory, twice the nodes
     assert checks.max_nodes() == 2_000_000
     assert checks.check_node_count("step", 0.1, 2_000_000) == 2_000_000

@@ -118,7 +118,7 @@ def _self_affine(cell, seed=2026, hurst=0.8, rolloff=4, cutoff=128):
 def test_periodic_qp_keeps_its_conjugate_directions_when_the_contact_changes():
     """On a rough cell whose contact set changes over most of the iterations, the QP reaches the
     answer of the general loop (which restarts the conjugate gradients at every change) in fewer
-    iterations (72 against 88 from the default start)."""
+    iterations (57 against 88 from the default start)."""
     cell = PeriodicCell(1.0 / 256, 256, 256)
     h = _self_affine(cell)
     op = PeriodicOperator(cell, E_STAR)
@@ -128,7 +128,7 @@ def test_periodic_qp_keeps_its_conjugate_directions_when_the_contact_changes():
     assert ref.converged and fast.converged
     assert sum(ref.history["changes"]) > 50 * ref.iterations  # the contact set moves a lot
     assert np.abs(fast.p - ref.p).max() <= 1e-8 * ref.p.max()
-    assert fast.iterations <= 0.85 * ref.iterations
+    assert fast.iterations <= 0.75 * ref.iterations
 
 
 @pytest.mark.parametrize("control", ["force", "approach"])

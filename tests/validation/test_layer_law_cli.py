@@ -3,6 +3,7 @@ three figures showing the ladder's data with units); bad input stops with exit c
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -120,7 +121,24 @@ def test_bad_input_exits_2_with_one_line(tmp_path, args, match):
 
 def test_a_file_without_a_length_unit_needs_scale(surface_file, tmp_path):
     code, _, err = _run(tmp_path, surface_file, "--size", f"{SIZE_UM},{SIZE_UM}")
-    assert code == 2 and err.startswith("contactlab: error: --scale is missing") and "states no length unit" in err
+    assert code == 2 and err.startswith(f"contactlab: error: --scale is missing: SURFACE = '{surface_file}' states "
+                                        "no length unit; give --scale M, metres per length unit of the file")
+    code, _, err = _run(tmp_path, surface_file, "--scale", "1e-6")
+    assert code == 2 and err.startswith(f"contactlab: error: --size is missing: SURFACE = '{surface_file}' does not "
+                                        "state its size; give --size LX,LY in the file's length unit"), err
+    assert "file =" not in err and "physical_sizes" not in err
+
+
+def test_the_readme_line_runs_as_written(surface_file, tmp_path, monkeypatch):
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    line = next(x for x in readme.splitlines() if x.startswith("contactlab layer-law surface.npy"))
+    argv = line.split("#")[0].split()[1:]
+    monkeypatch.chdir(tmp_path)
+    np.save(tmp_path / "surface.npy", np.load(surface_file)[:16, :16])  # a small surface.npy, heights in um
+    code, out, err = cli(*argv)
+    assert code == 0, err
+    law = (tmp_path / argv[argv.index("--out") + 1] / "layer_law.toml")
+    assert law.is_file() and "lattice nodes" in out
 
 
 @pytest.mark.parametrize("args, match", [

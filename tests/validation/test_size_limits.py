@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from bem import checks
-from bem.checks import BYTES_PER_NODE, max_nodes
+from bem.checks import bytes_per_node, max_nodes
 
 from .conftest import cli
 
@@ -37,7 +37,7 @@ def _refused(*argv):
 def _states(err, n_nodes, what):
     """The line gives the nodes, the limit, the memory they need and the memory of the machine."""
     assert f"would hold {n_nodes:.3g} nodes (limit {max_nodes(what):.3g} on this machine)" in err
-    per_node = BYTES_PER_NODE[what]
+    per_node = bytes_per_node(what)
     assert f"about {n_nodes * per_node / 1e9:.3g} GB of memory at {per_node} bytes a node" in err
     assert f"the machine has {checks.machine_memory() / 1e9:.3g} GB" in err  # conftest pins it
 

@@ -79,9 +79,9 @@ def test_missing_points_without_fill_name_the_option(sur):
 def test_a_file_without_unit_or_size_names_the_options(tmp_path):
     np.save(tmp_path / "z.npy", np.zeros((16, 16)))
     code, _, err = cli("surface", tmp_path / "z.npy", "--scale", "1e-6")
-    assert code == 2 and err.startswith("contactlab: error: --size is missing: file = ")
+    assert code == 2 and err.startswith("contactlab: error: --size is missing: FILE = ") and "give --size LX,LY" in err
     code, _, err = cli("surface", tmp_path / "z.npy", "--size", "10,10")
-    assert code == 2 and err.startswith("contactlab: error: --scale is missing: file = ")
+    assert code == 2 and err.startswith("contactlab: error: --scale is missing: FILE = ") and "give --scale M" in err
     code, out, _ = cli("surface", tmp_path / "z.npy", "--size", "10,10", "--scale", "1e-6")
     assert code == 0 and "size 1e-05 x 1e-05 m" in out
     code, _, err = cli("layer-law", tmp_path / "z.npy", "--scale", "1e-6", "--E-star", "1e9", "--out", tmp_path / "x")

@@ -75,7 +75,7 @@ def test_a_run_records_the_points_filled_and_the_file_relative_to_the_scene(tmp_
         "data/sur-2.sur", "mm", 117, "harmonic")
     assert surface["size"] == pytest.approx([SUR_SIZE_MM[0] * 1e-3, SUR_SIZE_MM[1] * 1e-3], rel=1e-7)
     assert str(tmp_path) not in text and str(tmp_path) not in err  # warnings name data/sur-2.sur too
-    assert "data/sur-2.sur" in err  # the edge-jump warning of this patch
+    assert "data/sur-2.sur" in err  # the spike warning of this patch (the seam is a note of the run)
 
 
 def test_check_refuses_an_x3p_that_would_inflate_beyond_its_header(tmp_path, monkeypatch):

@@ -116,24 +116,19 @@ def _synthetic(text):
     return out
 
 
-def _check_size(args, synthetic=None, surface=None):
-    """bem's memory guard (:func:`bem.checks.check_node_count`) on ``--synthetic grid`` and the lattice cell
-    (``--n-cols``), named as the command line names them: before the surface is made (``synthetic``, the
-    parsed ``--synthetic``) or, for a surface file, before the cell is made."""
+def _check_size(args, synthetic):
+    """bem's memory guard (:func:`bem.checks.check_node_count`) on ``--synthetic grid`` and its lattice cell
+    (``--n-cols``), named as the command line names them, before the surface is made (``synthetic``, the
+    parsed ``--synthetic``). A surface file's cell is counted by :func:`validation.layer_law.surface_from_file`
+    after the file is read and before the cell (a mirrored one too) is made."""
     from bem.checks import check_int, check_node_count, check_positive
     from bem.rough import MIN_POINTS
     from bem.rough.lattice_heights import cell_shape
 
-    if synthetic is not None:
-        nx = check_int("--synthetic grid", synthetic["grid"], minimum=MIN_POINTS)
-        size = (check_positive("--synthetic size", synthetic["size"]),) * 2
-        check_node_count("--synthetic grid", nx, nx * nx, what="the surface grid")
-        default = "--synthetic grid"
-    else:
-        rough = getattr(surface, "surface", surface)  # the RoughSurface of a bem.rough.PatchCell
-        nx, size = rough.default_n_cols(), rough.size
-        default = "--n-cols (default: Lx / max(dx, dy) of the surface)"
-    name = default if args.n_cols is None else "--n-cols"
+    nx = check_int("--synthetic grid", synthetic["grid"], minimum=MIN_POINTS)
+    size = (check_positive("--synthetic size", synthetic["size"]),) * 2
+    check_node_count("--synthetic grid", nx, nx * nx, what="the surface grid")
+    name = "--synthetic grid" if args.n_cols is None else "--n-cols"
     n_cols = check_int(name, nx if args.n_cols is None else args.n_cols, minimum=2)
     n_rows, n_cols = cell_shape(size, n_cols)
     check_node_count(name, n_cols, n_rows * n_cols, what="the periodic cell")
@@ -202,7 +197,7 @@ def run(args):
                                  "(a synthetic surface is in m).")
         with option_names({key: f"--synthetic {key}" for key in SYNTHETIC}):
             synthetic = _synthetic(args.synthetic)
-            _check_size(args, synthetic=synthetic)
+            _check_size(args, synthetic)
             for option, value, default in (("--detrend", args.detrend, "auto"), ("--cell", args.cell, "repeat")):
                 if value != default:
                     raise InputError(f"{option} = {value!r} is not allowed with --synthetic: a synthetic surface "
@@ -211,9 +206,9 @@ def run(args):
                                         spike_threshold=_spike_threshold(args.spike_threshold))
     else:
         surface = surface_from_file(Path(args.surface), scale=args.scale, physical_sizes=size_of(args), fill=args.fill,
-                                    names=dict(OPTION_NAMES, file="SURFACE"), detrend=args.detrend, cell=args.cell,
-                                    spikes=args.spikes, spike_threshold=_spike_threshold(args.spike_threshold))
-        _check_size(args, surface=surface)
+                                    names=dict(OPTION_NAMES, file="SURFACE", cell="--cell", n_cols="--n-cols"),
+                                    detrend=args.detrend, cell=args.cell, spikes=args.spikes,
+                                    spike_threshold=_spike_threshold(args.spike_threshold), n_cols=args.n_cols)
     share = _share(args.max_interpolated)
     with option_names(_LADDER_OPTIONS):
         if args.p_range is not None:

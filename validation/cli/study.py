@@ -16,6 +16,7 @@ PARSER = {"help": "studies: " + ", ".join(STUDIES),
           "epilog": "examples:\n  contactlab study error-time hertz --out reports/studies\n"
                     "  contactlab study stability --quick\n"
                     "  contactlab study two-scale --quick    (rough_sphere_two_scale, the small two-scale check)\n"
+                    "  contactlab study coating-winkler --quick    (the small map: coating against Winkler layer)\n"
                     "  contactlab report reports/studies      (work-precision plot and tables)"}
 
 

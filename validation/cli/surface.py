@@ -39,7 +39,9 @@ CLIP = (0.5, 99.5)
 NAMES = ("surface.json", "heights.png", "psd.png")
 #: the names of read_surface's arguments as this command's options
 OPTION_NAMES = {"file": "FILE", "unit": "--scale", "physical_sizes": "--size", "fill": "--fill",
-                "format": "--format", "channel": "--channel", "detrend": "--detrend"}
+                "format": "--format", "channel": "--channel", "detrend": "--detrend",
+                "physical_sizes_rule": "--size LX,LY",
+                "unit_rule": "--scale M, metres per length unit of the file (e.g. --scale 1e-6 for micrometres)"}
 
 
 def add_file_args(p):

@@ -71,7 +71,7 @@ class LayerLawFolder:
 
 
 def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="auto", cell="repeat", spikes="keep",
-                      spike_threshold=None, fill=None, names=None):
+                      spike_threshold=None, fill=None, n_cols=None, names=None):
     """The periodic cell of a measured surface in metres (:func:`bem.rough.read_surface`,
     :func:`bem.rough.patch_cell`).
 
@@ -88,8 +88,14 @@ def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="auto", 
         As :func:`bem.rough.patch_cell` (``spike_threshold`` ``None``: its default).
     fill : str or None
         As :func:`bem.rough.read_surface`.
+    n_cols : int, optional
+        The lattice nodes along x the cell will be solved on (default: the cell's own,
+        ``Lx / max(dx, dy)``): the cell is refused before it is made when it would hold more
+        than :func:`bem.checks.max_nodes` nodes (:func:`bem.rough.patch.check_cell_size`; a
+        mirrored cell counts ``2 x 2`` patches).
     names : dict, optional
-        The names of the arguments in messages (:func:`bem.rough.read_surface`).
+        The names of the arguments in messages (:func:`bem.rough.read_surface`; ``cell`` and
+        ``n_cols`` too).
 
     Returns
     -------
@@ -99,16 +105,17 @@ def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="auto", 
     Raises
     ------
     bem.InputError
-        A file that cannot be read (:func:`bem.rough.read_surface`), or no ``scale`` for a file
-        that states no length unit.
+        A file that cannot be read (:func:`bem.rough.read_surface`), no ``scale`` for a file
+        that states no length unit, or a cell too large.
     """
     from bem import rough
-    from bem.rough.patch import quiet_seam
+    from bem.rough.patch import check_cell_size, quiet_seam
 
     names = {"unit": "scale", **(names or {})}
     with quiet_seam():  # the seam is that of the cell made below, in metres
         surface = rough.read_surface(file, physical_sizes=physical_sizes, unit=scale, detrend=None, fill=fill,
                                      names=names)  # in metres already
+    check_cell_size(surface, cell=cell, n_cols=n_cols, names=names)
     return rough.patch_cell(surface, detrend=detrend, cell=cell, spikes=spikes, **_threshold(spike_threshold))
 
 

@@ -19,7 +19,7 @@ __all__ = ["SCHEMA", "ResultFileError", "BemPart", "FemMesh", "FemPart", "FemPro
            "PeriodicPart", "AxialProfile"]
 
 #: The schema string of ``result.json``; a file with another one is refused.
-SCHEMA = "contactlab.result/2"
+SCHEMA = "contactlab.result/3"
 
 
 class ResultFileError(InputError):
@@ -92,6 +92,8 @@ class BemPart(_Part):
     ``extent`` and ``nodes_across_contact`` (``2 sqrt(A / pi) / step``) are those of an isolated
     contact, ``None`` for a periodic cell; ``cell``, ``size``, ``mean_pressure``,
     ``contact_fraction`` and ``mean_gap`` those of a periodic cell, ``None`` otherwise.
+    ``coating1``, ``coating2``: the coating of each body (``thickness``, ``E``, ``nu``), ``None`` for an
+    uncoated body.
     ``history``: per-iteration scalar lists (``residual``, ``p_max``, ``n_contact``, ...).
     """
 
@@ -121,6 +123,8 @@ class BemPart(_Part):
     mean_pressure: float | None = None
     contact_fraction: float | None = None
     mean_gap: float | None = None
+    coating1: dict | None = None
+    coating2: dict | None = None
 
 
 @dataclass

@@ -139,7 +139,10 @@ class Cell:
         cell, lattice, stats = res.lattice, self.lattice, self.scene.gap.surface.stats
         labels, n = contact_spots(res.p.reshape(cell.shape) > 0)
         self.spots = labels
-        surface = dict(stats.as_dict(), stretch_y=lattice.stretch_y, stretch_large=bool(lattice.stretch_large))
+        made = self.scene.gap.cell
+        surface = dict(stats.as_dict(), stretch_y=lattice.stretch_y, stretch_large=bool(lattice.stretch_large),
+                       cell=made.cell, spike_points=made.spikes.count, spikes_removed=made.spikes_removed,
+                       spikes=made.spikes.as_dict())
         periodic = PeriodicPart(mean_pressure=res.mean_pressure, contact_fraction=res.contact_fraction,
                                 mean_gap=res.mean_gap, n_spots=n,
                                 spots=SpotSummary(**_spot_summary(labels, n, cell.node_area)), surface=surface)
@@ -152,13 +155,15 @@ class Cell:
 
 
 def _surface_notes(scene):
-    """What the run says about the surface's cell: a large edge jump, a lattice that stretches it."""
+    """What the run says about the surface's cell: a large edge jump (the one statement of the seam of a scene's
+    cell, the library's warning kept quiet), a lattice that stretches it."""
     lattice, stats = scene.gap.lattice, scene.gap.surface.stats
+    unit = f" {scene.units.length}" if scene.units.length else ""
     notes = []
     if stats.edge_jump_large:
-        notes.append(f"the surface's cell has a large edge jump ({stats.edge_jump:.4g} against a grid step of "
-                     f"{stats.grid_step:.4g}, rms height {stats.rms_height:.4g}): its repetition has a step at "
-                     "the cell's edges")
+        notes.append(f"the surface's cell has a large edge jump ({stats.edge_jump:.4g}{unit} against a grid step of "
+                     f"{stats.grid_step:.4g}{unit}, rms height {stats.rms_height:.4g}{unit}): its repetition has a "
+                     "step at the cell's edges (gap.cell = \"mirror\" makes a cell without one)")
     if lattice.stretch_large:
         notes.append(f"the lattice stretches the surface along y by {lattice.stretch_y:.4f}: choose bem.cell_nodes "
                      "for which the cell's rows fit (docs/rough.md)")

@@ -78,6 +78,20 @@ def planned_stages(scene, *, write=False):
     return [stage for stage, on in wanted.items() if on]
 
 
+def coating_keywords(scene):
+    """``coating1``, ``coating2`` (:class:`bem.Coating` or None) of a coated scene; ``{}`` without a coating."""
+    if scene.coatings is None:
+        return {}
+    return {k: None if c is None else bem.Coating(c["thickness"], c["E"], c["nu"]) for k, c in scene.coatings.items()}
+
+
+def bodies_keywords(scene):
+    """The bodies' keywords of :func:`bem.solve`: ``E_star``, or ``E1, nu1, E2, nu2`` and the coatings."""
+    if scene.coatings is None:
+        return {"E_star": scene.E_star}
+    return {**scene.materials, **coating_keywords(scene)}
+
+
 def domain_of(scene, messages):
     """The domain of ``scene``: its periodic cell (:class:`validation.run.periodic.Cell`) or its region of
     the half-space (:class:`validation.run.region.Region`); ``messages``: the run's messages."""
@@ -97,7 +111,7 @@ class _BemSolves:
         opts = scene.bem
         self.domain, self.messages = domain, messages
         self.bem_domain = domain.bem_domain
-        problem = dict(E_star=scene.E_star, **domain.load)
+        problem = dict(bodies_keywords(scene), **domain.load)
         self.kw = dict(problem, **solver_keywords(opts))
         self.calibration_kw = dict(problem, method="newton", **{k: opts[k] for k in CALIBRATION_KEYS if k in opts})
         self.calibration_solves = 0
@@ -203,7 +217,8 @@ def execute_scene(scene, *, progress=None, overrides=None):
         import fem_reference
 
         stages("fem")
-        fem = fem_reference.solve(scene.gap, **scene.materials, **scene.load, layer=layer, **scene.fem)
+        fem = fem_reference.solve(scene.gap, **scene.materials, **coating_keywords(scene), **scene.load, layer=layer,
+                                  **scene.fem)
         times["fem"] = fem.wall_time_s
         if not fem.converged:
             messages.append(f"FEM did not converge: {fem.message}")

@@ -3,7 +3,7 @@
 A scene file has the sections (units: those of ``[scene] units``, SI by default)::
 
     [scene]    name, title, description, units           (name required)
-    [bodies]   E1, nu1, E2, nu2 [Pa, -]  -- or E_star [Pa] alone
+    [bodies]   E1, nu1, E2, nu2 [Pa, -]  -- or E_star [Pa] alone; coating1, coating2 = {thickness [m], E [Pa], nu}
     [gap]      type + parameters of a bem.gaps shape      (paraboloid: R [m], ...), or
                type = "measured" with a file (validation.scene.measured)
     [layer]    law + parameters of a bem.layers law, or the paper's lam_over_cnn with cnn_step,
@@ -40,6 +40,7 @@ from ..units import Units
 from . import checks as ck
 from . import schema as sec
 from .checks import SceneError, closest
+from .coatings import coated_sections
 from .measured import measured_region
 from .paper import ALIASES
 from .paper import EXCLUSIVE as LAYER_EXCLUSIVE
@@ -96,6 +97,7 @@ class Scene:
     report: dict | None = None
     overrides: tuple = field(default=())
     stress: dict | None = None
+    coatings: dict | None = None
     base_dir: str | None = None
     allow_code: bool = False
     allow_outside_files: bool = False
@@ -278,13 +280,14 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     report = check(sec.report, raw.get("report"))
     stress = check(lambda b, bo: sec.stress_options(raw.get("stress"), b["materials"], bo["step"]), body, bem)
     stress = check(lambda st, bo: sec.stress_depth_bound(st, bo["extent"]), stress, bem)
+    check(lambda b: coated_sections(b["coatings"], raw), body)
     if check.errors:
         raise SceneError.of(check.errors)
     return Scene(
         name=meta["name"], title=meta["title"], description=meta["description"], units=meta["units"],
         source=source, raw=raw, E_star=body["E_star"], materials=body["materials"], gap=shape[1],
         gap_spec=shape[0], layer_spec=layer[0], layer=layer[1], load=load, bem=bem, fem=fem, analytic=analytic,
-        sweep=sweep, report=report, overrides=tuple(overrides), stress=stress,
+        sweep=sweep, report=report, overrides=tuple(overrides), stress=stress, coatings=body["coatings"],
         base_dir=None if base_dir is None else str(base_dir), allow_code=code == "import",
         allow_outside_files=outside_files, unimported=unimported,
     )

@@ -22,7 +22,16 @@ A rough scene solves the periodic cell of a rough surface pressed by a rigid fla
     length_unit = "um"       # the file's length unit ("m", "mm", "um", "nm") or a factor, for a file
                              # that states none; the unit a file states is always the one used
     fill = "harmonic"        # fill missing points (at most 5 % of them; default: refused)
-    detrend = "height"       # bem.rough.DETRENDS or "none"
+    detrend = "auto"         # bem.rough.DETREND_CHOICES: none for a periodic file, height for a patch
+    cell = "repeat"          # or "mirror": the patch and its mirror images, 2 x 2 patches, no seam
+    spikes = "keep"          # or "remove": fill the spikes (bem.rough.find_spikes) from their neighbours
+    spike_threshold = 10     # robust standard deviations beyond which a point is a spike
+
+The cell of a measured surface is made by :func:`bem.rough.patch_cell` (as ``contactlab
+layer-law`` makes it): the file is read as measured, detrended, its spikes found (and removed),
+the patch repeated or mirrored; ``result.json`` records what was done. The seam is stated
+once, by the run (a note of its result), in the scene's length unit (a mirrored cell has none); a mirrored
+grid of more than :func:`bem.checks.max_nodes` points is refused before it is made.
 
 Both need SurfaceTopography (the ``rough`` extra, statistics and synthesis): without it the
 scene stops before any work with :class:`validation.extras.MissingExtraError`. ``[bem]``
@@ -44,6 +53,7 @@ import numpy as np
 from bem import InputError
 from bem.checks import check_node_count
 from bem.rough.lattice_heights import cell_shape
+from bem.rough.patch import quiet_seam
 
 from ..extras import require as require_extra
 from . import checks as ck
@@ -58,7 +68,7 @@ __all__ = ["RoughGap", "ROUGH_TYPES", "GAP_KEYS", "GAP_UNITS", "PERIODIC_KEYS", 
 GAP_KEYS = {"self_affine": ("size", "grid", "hurst", "rms_height", "rms_slope", "long_cutoff", "short_cutoff",
                             "rolloff", "seed"),
             "surface": ("file", "reader", "format", "channel", "physical_sizes", "spacing", "nodata", "length_unit",
-                        "fill", "detrend")}
+                        "fill", "detrend", "cell", "spikes", "spike_threshold")}
 ROUGH_TYPES = tuple(GAP_KEYS)
 #: unit kind of the ``[gap]`` keys of a rough type that carry one (the others are dimensionless or in the file's unit)
 GAP_UNITS = dict.fromkeys(("size", "rms_height", "long_cutoff", "short_cutoff"), "length")
@@ -71,14 +81,15 @@ _READERS = ("surfacetopography", "core")
 class RoughGap:
     """The gap of a rough scene: a :class:`bem.rough.RoughSurface` against a rigid flat.
 
+    ``cell`` is the :class:`bem.rough.PatchCell` the surface was made by (what was done to it);
     ``lattice`` (:class:`bem.rough.LatticeHeights`) is set by :func:`bem_section`, the initial
     gap of the cell is ``lattice.gap()``.
     """
 
     is_axisymmetric = False
 
-    def __init__(self, type_name, surface):
-        self.type_name, self.surface, self.lattice = type_name, surface, None
+    def __init__(self, type_name, cell):
+        self.type_name, self.cell, self.surface, self.lattice = type_name, cell, cell.surface, None
 
     def nodal_gap(self):
         """The initial gap at the cell's nodes [length], flattened in the order of the result arrays."""
@@ -118,7 +129,7 @@ def _shown(file, base_dir):
     return file if rel.startswith(os.pardir) else rel
 
 
-def _read_surface(file, d, units, detrend, source):
+def _read_surface(file, d, units, source):
     """A file read by SurfaceTopography in the scene's length unit (module docstring, ``length_unit``)."""
     from bem import rough
 
@@ -134,8 +145,9 @@ def _read_surface(file, d, units, detrend, source):
         if isinstance(given, str) and scene is None:
             length_factor(d, units)  # the error: no scene length unit to convert to
         named = units.length if scene is not None and units.length in LENGTH_UNITS else None
-        surface = rough.read_surface(file, unit=given, length_unit=named or scene or 1.0, detrend=detrend,
-                                     source=source, names=names, unit_default=1.0, **kw)
+        with quiet_seam():  # the seam is that of the cell patch_cell makes
+            surface = rough.read_surface(file, unit=given, length_unit=named or scene or 1.0, detrend=None,
+                                         source=source, names=names, unit_default=1.0, **kw)
     if scene is None and surface.stats.unit is not None:
         raise ck.SceneError(f"gap.file = {source!r} is not allowed: it states its lengths in {surface.stats.unit} "
                             f"and the scene's units label {units.label!r} names no length unit (m, mm, um, nm) to "
@@ -155,11 +167,9 @@ def _surface(d, units, base_dir=None):
         if key in d and key not in own[reader] and key != "length_unit":
             raise ck.SceneError(f"gap.{key} = {d[key]!r} is not allowed with gap.reader = {reader!r}: that reader "
                                 f"takes {', '.join(own[reader])}.")
-    detrend = d.get("detrend", "height")
-    detrend = None if detrend == "none" else ck.choice("gap.detrend", detrend, rough.DETRENDS)
     source = _shown(file, base_dir)
     if reader == "surfacetopography":
-        return _read_surface(file, d, units, detrend, source)
+        return _read_surface(file, d, units, source)
     scale = length_factor(d, units)
     with ck.scene_errors("gap."):
         x, y, z = read_heights(file, **{k: d[k] for k in ("format", "spacing", "nodata") if k in d})
@@ -169,7 +179,7 @@ def _surface(d, units, base_dir=None):
                             "nodata); the periodic cell needs every point: fill or crop them first.")
     with ck.scene_errors("gap."):
         size = (x.size * (x[1] - x[0]) * scale, y.size * (y[1] - y[0]) * scale)
-        return rough.from_heights(z * scale, size, detrend=detrend, source=source)
+        return rough.from_heights(z * scale, size, source=source)
 
 
 def rough_gap(d, *, units=None, base_dir=None):
@@ -189,9 +199,37 @@ def rough_gap(d, *, units=None, base_dir=None):
     if kind == "surface" and isinstance(d.get("file"), str) and not os.path.isfile(d["file"]):
         raise ck.SceneError(f"gap.file = {_shown(d['file'], base_dir)!r} is not allowed: there is no such file "
                             "(a relative name starts from the scene file's folder).")
+    options = _cell_options(d) if kind == "surface" else {}
     require_extra("rough", f"gap.type = {kind!r} (a rough surface)")
     surface = _self_affine(d) if kind == "self_affine" else _surface(d, units, base_dir)
-    return dict(d), RoughGap(kind, surface)
+    return dict(d), RoughGap(kind, _cell(surface, options, units))
+
+
+def _cell_options(d):
+    """The keys of :func:`bem.rough.patch_cell` of a ``type = "surface"`` gap, checked before the file is read."""
+    from bem.rough.outliers import SPIKE_THRESHOLD
+    from bem.rough.patch import CELLS, DETREND_CHOICES, SPIKE_ACTIONS
+
+    return {"detrend": ck.choice("gap.detrend", d.get("detrend", "auto"), DETREND_CHOICES),
+            "cell": ck.choice("gap.cell", d.get("cell", "repeat"), CELLS),
+            "spikes": ck.choice("gap.spikes", d.get("spikes", "keep"), SPIKE_ACTIONS),
+            "spike_threshold": ck.positive("gap.spike_threshold", d.get("spike_threshold", SPIKE_THRESHOLD))}
+
+
+def _cell(surface, options, units):
+    """The :class:`bem.rough.PatchCell` of the surface (a synthetic one: itself, its spikes found); a mirrored
+    grid counted before it is made (:func:`bem.checks.check_node_count`)."""
+    from bem import rough
+    from bem.rough.patch import cell_grid
+
+    cell = options.get("cell", "repeat")
+    (nx, ny), _, mirrored = cell_grid(surface, cell=cell, name="gap.cell")
+    with ck.scene_errors("gap."):
+        if mirrored:
+            check_node_count("gap.cell", cell, nx * ny, what="the mirrored surface grid")
+        unit = getattr(units, "length", None) if getattr(units, "metres", None) is not None else None
+        with quiet_seam():  # the run states the seam of the cell solved, once (validation.run.periodic)
+            return rough.patch_cell(surface, unit=unit or "length units", **options)
 
 
 def _periodic(d, gap, layer_spec, layer, load):

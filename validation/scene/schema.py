@@ -21,6 +21,7 @@ from bem.stress import Z_MAX_STEPS
 from ..units import DEFAULT_LABEL as DEFAULT_UNITS
 from ..units import parse_units
 from . import checks as ck
+from .coatings import COATING_KEYS, coating
 from .layer_file import is_layer_file, read_layer_file
 from .measured import KEYS as MEASURED_KEYS
 from .measured import measured_gap
@@ -31,7 +32,7 @@ from .sizing import KEYS as BEM_KEYS
 
 __all__ = ["scene_meta", "bodies", "gap", "load", "layer", "fem_options", "analytic", "report", "sweep_spec",
            "stress_options", "stress_depth_bound", "scene_keys", "KEYS", "report_sections", "REPORT_SECTIONS",
-           "ANALYTIC_KINDS", "DEFAULT_UNITS", "BODY_KEYS", "Unimported"]
+           "ANALYTIC_KINDS", "DEFAULT_UNITS", "BODY_KEYS", "COATING_KEYS", "Unimported"]
 
 ANALYTIC_KINDS = ("hertz", "hertz_elliptic", "rigid_layer")
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
@@ -41,7 +42,7 @@ _FEM_OPTIONS = {"n_contact_elements": partial(ck.integer, minimum=4, maximum=400
                 **dict.fromkeys(("domain_factor", "fine_radius", "growth", "penalty"), ck.positive), "rtol": ck.rtol,
                 "maxiter": partial(ck.integer, minimum=1), "remesh": ck.boolean, "truncation_correction": ck.boolean}
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
-KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS),
+KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS, *COATING_KEYS),
         "load": ("force", "approach", "mean_pressure"), "bem": (*BEM_KEYS, *PERIODIC_KEYS),
         "fem": tuple(_FEM_OPTIONS), "analytic": ("kind",),
         "sweep": ("parameter", "values"), "report": ("sections", "format"),
@@ -112,19 +113,26 @@ def scene_meta(d):
 
 
 def bodies(d):
-    """``[bodies]``: ``E_star`` alone, or ``E1, nu1, E2, nu2`` (``E = inf``: rigid body)."""
+    """``[bodies]``: ``E_star`` alone, or ``E1, nu1, E2, nu2`` (``E = inf``: rigid body) and optionally
+    ``coating1``, ``coating2`` (``{thickness, E, nu}``, on the body of that number; ``coatings`` in the
+    result: ``{"coating1": {...} or None, "coating2": ...}``, or ``None`` without a coating)."""
     _section("bodies", d)
+    coated = [k for k in COATING_KEYS if k in d]
+    if coated and "E_star" in d:
+        raise ck.SceneError(f"bodies.{coated[0]} is not allowed with bodies.E_star: a coating's substrate is its "
+                            "body's material; give bodies.E1, nu1, E2, nu2 instead of E_star.")
     if "E_star" in d:
         if any(k in d for k in BODY_KEYS):
             given = ", ".join(f"bodies.{k}" for k in BODY_KEYS if k in d)
             raise ck.SceneError(f"bodies.E_star = {d['E_star']!r} is not allowed together with {given}: "
                                 "give E_star alone or all of E1, nu1, E2, nu2.")
-        return {"E_star": ck.scale("bodies.E_star", d["E_star"]), "materials": None}
+        return {"E_star": ck.scale("bodies.E_star", d["E_star"]), "materials": None, "coatings": None}
     for key in BODY_KEYS:
         ck.require("bodies", d, key, "give E1, nu1, E2, nu2 [Pa, -] (or E_star alone)")
     with ck.scene_errors("bodies."):
         E_star = effective_modulus(*(d[k] for k in BODY_KEYS))
-    return {"E_star": E_star, "materials": {k: float(d[k]) for k in BODY_KEYS}}
+    coatings = {k: coating(f"bodies.{k}", d[k]) if k in d else None for k in COATING_KEYS} if coated else None
+    return {"E_star": E_star, "materials": {k: float(d[k]) for k in BODY_KEYS}, "coatings": coatings}
 
 
 class Unimported(gaps.Gap):

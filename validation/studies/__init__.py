@@ -9,10 +9,13 @@
   every converged answer checked against the KKT conditions with the dense influence matrix;
 - :mod:`~validation.studies.two_scale`: a fully resolved rough sphere against the smooth sphere
   with the layer law of its roughness and Greenwood-Tripp;
+- :mod:`~validation.studies.coating_winkler`: a sphere on a coated flat against the bare substrate
+  with a linear Winkler layer (the oedometric one and the best one), over thickness, moduli and
+  Poisson's ratio (the axisymmetric ring solutions of :mod:`~validation.studies.coating_rings`);
 - :mod:`~validation.studies.paper_problem`: the paper's test problem (section 6) on one lattice,
   its cases, sweeps and methods, which the paper report draws (``contactlab report paper``).
 
-The first four are the studies of :data:`STUDIES` (``contactlab study NAME``); each has
+The first five are the studies of :data:`STUDIES` (``contactlab study NAME``); each has
 ``main(out=..., scene=..., quick=..., progress=...)``, which writes the study's JSON file
 (``STEM + ".json"``, :data:`STUDY_FILES`) and returns a :class:`StudyRun`, which the report renders
 (:mod:`validation.report.documents.studies`).
@@ -43,7 +46,8 @@ __all__ = ["StudyRun", "attempt", "timed", "classify", "finite", "save", "write_
 #: the studies of ``contactlab study NAME``, in the order their reports show them: name -> the module
 #: that runs it (its ``main``); the study's file is named after the module (its ``STEM + ".json"``)
 STUDIES = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
-           "robustness": "validation.studies.robustness", "two-scale": "validation.studies.two_scale"}
+           "robustness": "validation.studies.robustness", "two-scale": "validation.studies.two_scale",
+           "coating-winkler": "validation.studies.coating_winkler"}
 #: the file each study of :data:`STUDIES` writes, in the same order
 STUDY_FILES = tuple(f"{module.rpartition('.')[2]}.json" for module in STUDIES.values())
 

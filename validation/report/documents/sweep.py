@@ -36,7 +36,7 @@ _KEY_KINDS = {"force": "force", "approach": "length", "R": "length", "Rx": "leng
               "length": "length", "a": "length", "edge_radius": "length", "crown_radius": "length",
               "step": "length", "extent": "length", "E1": "pressure", "E2": "pressure", "E_star": "pressure",
               "p_cr": "pressure", "p_star": "pressure", "lam": "compliance", "lam1": "compliance",
-              "lam2": "compliance"}
+              "lam2": "compliance", "thickness": "length", "E": "pressure"}
 
 
 class Sweep(NamedTuple):

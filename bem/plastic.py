@@ -1,0 +1,104 @@
+"""The hardness bound of Kalker's QP: an elastic-perfectly-plastic surface, ``0 <= p <= H``.
+
+With a hardness ``H`` [pressure] the nodal pressure is bounded at every node. The bounded QP
+``min 1/2 p.(C + lam) p + p.(h - delta)`` over ``0 <= p <= H`` (and ``a sum p = P`` under force
+control) has the KKT conditions, with ``g = C p + w(p) + h - delta`` the deformed gap,
+
+* ``g >= 0`` where ``p = 0`` (open),
+* ``g = 0`` where ``0 < p < H`` (elastic contact),
+* ``g <= 0`` where ``p = H`` (plastic: the surface yields, and the overlap ``-g`` is the plastic
+  deformation).
+
+The nodes at ``p = H`` are the plastic set; the constrained conjugate gradients move the elastic
+contact nodes only and project their step onto ``[0, H]`` (:mod:`bem.cg_rules`). Under force
+control the approach is the multiplier of the elastic contact, the mean of ``C p + w(p) + h``
+over it; where every contact node is plastic (a fully plastic contact, ``A = P / H``) it is
+undetermined in the interval of :func:`plastic_approach`, and its lower end is returned.
+The rules here are shared by every step of the constrained CG, Newton's method and the KKT
+residual (:mod:`bem.kkt`).
+"""
+
+from __future__ import annotations
+
+__all__ = ["plastic_approach", "fill_force", "clip", "leaving_pressure", "note_fully_plastic",
+           "fully_plastic_note"]
+
+#: Rounds of :func:`fill_force` (each caps at least one more node at ``H``).
+_FILL_ROUNDS = 64
+
+
+def clip(xp, p, hardness):
+    """``p`` clipped at 0 and, with a hardness, at ``H`` (``hardness`` None: at 0 only)."""
+    p = xp.maximum(p, 0.0)
+    return p if hardness is None else xp.minimum(p, hardness)
+
+
+def plastic_approach(lowest_open, highest_plastic):
+    """The approach of a contact without elastic nodes, and the interval that allows it.
+
+    With every contact node plastic the conditions ``g <= 0`` there and ``g >= 0`` at the open
+    nodes hold for every approach ``delta`` in ``[lo, hi]``, ``lo = max_plastic (C p + w + h)``,
+    ``hi = min_open (C p + w + h)``; the pressure does not depend on it. Returns
+    ``(delta, (lo, hi))`` with ``delta = lo`` (the smallest approach that closes every plastic
+    node), or the midpoint where ``lo > hi`` (an iterate that is not yet a solution: the midpoint
+    makes the largest violation smallest). ``hi`` is ``inf`` where no node is open.
+    """
+    lo, hi = float(highest_plastic), float(lowest_open)
+    return (lo if lo <= hi else 0.5 * (lo + hi)), (lo, hi)
+
+
+def fill_force(xp, p, target, hardness):
+    """``p`` (values in ``[0, H]``) with the nodes below ``H`` scaled to carry ``sum p = target``.
+
+    One factor ``s >= 0`` scales every node below ``H``; nodes that it would lift above ``H`` are
+    capped there and the factor of the others found again (a water filling, at most one round
+    per capped node). Where the nodes at ``H`` alone carry more than ``target`` (a step that
+    clipped many nodes at 0 and others at ``H``), every node is scaled down by one factor instead,
+    and the plastic ones leave ``H``. Returns ``(p, s, capped)``: the scaled pressure, the factor
+    of the nodes that stayed below ``H`` and whether a node was capped or left ``H``; ``None``
+    where the nodes below ``H`` cannot carry the rest of ``target`` (they carry nothing while it is
+    positive, or all of them reach ``H``).
+    """
+    fixed = p >= hardness  # the nodes at H (the values are at most H)
+    n_fixed, total, capped = int(xp.count_nonzero(fixed)), float(xp.sum(p)), False
+    for _ in range(_FILL_ROUNDS):
+        need = target - hardness * n_fixed
+        if need < -1e-13 * target:  # too many nodes at H: all of them scaled down
+            return p * (target / total), 1.0, True
+        rest = total - hardness * n_fixed
+        if not rest > 1e-10 * total:  # little or nothing below H: its sum without cancellation
+            rest = float(xp.sum(xp.where(fixed, 0.0, p)))
+            if not rest > 0:
+                return (p, 1.0, capped) if abs(need) <= 1e-13 * target else None
+        s = max(need / rest, 0.0)
+        if s <= 1.0:  # no node rises to H
+            return xp.where(fixed, p, p * s), s, capped
+        q = xp.minimum(p * s, hardness)
+        top = q >= hardness
+        n_top = int(xp.count_nonzero(top))
+        if n_top == n_fixed:
+            return q, s, capped
+        capped, fixed, n_fixed = True, top, n_top
+        p = xp.where(top, hardness, p)
+        total = float(xp.sum(p))
+    return xp.where(fixed, p, xp.minimum(p * s, hardness)), s, capped
+
+
+def note_fully_plastic(record, bracket, fully_plastic):
+    """Say in a converged constrained CG's ``record`` (:class:`bem.cg_rules.Record`) that its contact is fully
+    plastic and the approach ``bracket[0]`` one of the interval ``bracket`` (:func:`plastic_approach`)."""
+    if fully_plastic and bracket is not None and record.converged:
+        record.message += fully_plastic_note(bracket)
+        record.history["approach_bracket"] = list(bracket)
+
+
+def fully_plastic_note(bracket):
+    """The words a converged solve adds to its message where every contact node is plastic."""
+    return (f"; fully plastic: every contact node at the hardness, the approach is any value in "
+            f"[{bracket[0]:.6g}, {bracket[1]:.6g}], the lower end returned")
+
+
+def leaving_pressure(xp, hardness, lowered):
+    """Pressure of a plastic node whose gap opens (``p = H``, ``g > 0``): ``H`` lowered by the pressure
+    an entering node would take at ``-g`` (:func:`bem.cg_rules.entering_pressure`), not below 0."""
+    return xp.maximum(hardness - lowered, 0.0)
