@@ -36,8 +36,10 @@ __all__ = [
     "check_gap_values",
     "RTOL_MAX",
     "SCALE_RANGE",
-    "MAX_NODES",
     "BYTES_PER_NODE",
+    "machine_memory",
+    "bytes_per_node",
+    "max_nodes",
 ]
 
 #: Loosest tolerance on the KKT residual (:func:`bem.kkt.kkt_residual`) that :func:`bem.solve`
@@ -48,13 +50,44 @@ RTOL_MAX = 1e-2
 #: the problem multiplies and divides them (``P R / E*``, ``C = c / (pi E*)``, ...), and beyond
 #: this range float64 overflows or underflows before an answer is reached.
 SCALE_RANGE = (1e-60, 1e60)
-#: Largest lattice, in nodes (a memory guard): a solve holds about :data:`BYTES_PER_NODE` per
-#: node at its peak (``python benchmarks/bem_hertz.py`` reports the peak RSS), so the limit is
-#: about 6.4 GB. The one limit of :func:`bem.solve` (the candidate region) and
-#: :func:`bem.solve_periodic` (the cell), checked by :func:`check_node_count`.
-MAX_NODES = 16_000_000
-#: Peak memory of a solve per lattice node [bytes] (:data:`MAX_NODES`).
-BYTES_PER_NODE = 400
+#: Peak memory of a solve per node [bytes], by what holds the nodes (the ``what`` of
+#: :func:`check_node_count`): the largest peak of the resident set of ``bem.solve`` per node
+#: measured on that domain at 1M-4M nodes (``python benchmarks/memory.py``: spheres on a region
+#: with contacts of 4 % and 28 % of it and with a root layer; the rough periodic cell, smooth and
+#: with a root layer; the peak per node falls or stays level as the nodes grow) plus the gap
+#: (8 bytes a node), times 1.1. A gap callable's own temporaries come on top. A surface grid
+#: becomes the gap of a periodic cell of as many nodes. Keys: how the ``what`` of
+#: :func:`check_node_count` ends (``"the mirrored periodic cell"`` is a periodic cell).
+BYTES_PER_NODE = {"candidate region": 360, "periodic cell": 350, "surface grid": 350}
+
+
+def machine_memory():
+    """Memory this process may use [bytes]: the machine's physical memory, or the control group's
+    limit where one is set and smaller (``/sys/fs/cgroup``)."""
+    memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    for path in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
+        try:
+            with open(path) as f:
+                text = f.read().strip()
+        except OSError:
+            continue
+        if text.isdigit():
+            memory = min(memory, int(text))
+    return memory
+
+
+def bytes_per_node(what="the candidate region"):
+    """:data:`BYTES_PER_NODE` of ``what``, the key it ends with (``"the periodic cell"``: 350)."""
+    for key, value in BYTES_PER_NODE.items():
+        if what.endswith(key):
+            return value
+    raise ValueError(f"what = {what!r}: it must end with one of {list(BYTES_PER_NODE)}")
+
+
+def max_nodes(what="the candidate region"):
+    """Largest number of nodes that ``what`` may hold on this machine: :func:`machine_memory` over
+    :func:`bytes_per_node` of ``what`` (the rule of :func:`check_node_count`)."""
+    return machine_memory() // bytes_per_node(what)
 
 
 def fail(name, value, rule):
@@ -122,8 +155,12 @@ def check_file_name(name, value):
 
 
 def check_node_count(name, value, n_nodes, *, what="the candidate region"):
-    """Return ``n_nodes``; raise unless it is at most :data:`MAX_NODES`: the memory guard of
-    :func:`bem.solve` and :func:`bem.solve_periodic`, checked before anything is built.
+    """Return ``n_nodes``; raise unless it is at most :func:`max_nodes` of ``what``: the memory guard
+    of :func:`bem.solve` and :func:`bem.solve_periodic`, checked before anything is built.
+
+    The rule: ``n_nodes`` times the peak memory a solve needs per node (:data:`BYTES_PER_NODE`)
+    must fit in the memory of the machine (:func:`machine_memory`); the refusal states the nodes,
+    the memory they would need and the memory the machine has.
 
     Parameters
     ----------
@@ -133,14 +170,18 @@ def check_node_count(name, value, n_nodes, *, what="the candidate region"):
     n_nodes : int
         The nodes that ``value`` gives, counted without building them.
     what : str
-        What holds the nodes, for the message (``"the periodic cell"``).
+        What holds the nodes, ending with a key of :data:`BYTES_PER_NODE` (``"the candidate
+        region"``, ``"the periodic cell"``, ``"the mirrored surface grid"``, ...; also named in
+        the message).
     """
-    if n_nodes > MAX_NODES:
-        need, limit = (n * BYTES_PER_NODE / 1e9 for n in (float(n_nodes), MAX_NODES))
+    per_node = bytes_per_node(what)
+    memory = machine_memory()
+    limit = memory // per_node
+    if n_nodes > limit:
         raise InputError(f"{name} = {value!r} is not allowed: {what} would hold {float(n_nodes):.3g} nodes "
-                         f"(limit {MAX_NODES:.3g}, about {BYTES_PER_NODE / 1e3:g} kB each), which need about "
-                         f"{need:.3g} GB of memory ({limit:.2g} GB at the limit); make the lattice coarser or "
-                         f"{what} smaller.")
+                         f"(limit {float(limit):.3g} on this machine), which need about "
+                         f"{float(n_nodes) * per_node / 1e9:.3g} GB of memory at {per_node} bytes a node; the "
+                         f"machine has {memory / 1e9:.3g} GB. Make the lattice coarser or {what} smaller.")
     return n_nodes
 
 

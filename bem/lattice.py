@@ -81,7 +81,7 @@ class Lattice:
         extent : float or (float, float)
             Half-width of the candidate region [length]: one number for a square,
             ``(ex, ey)`` for a rectangle. At least two steps each way, and at most
-            :data:`bem.checks.MAX_NODES` nodes in all.
+            :func:`bem.checks.max_nodes` nodes in all.
         """
         step = check_scale("step", step)
         ex, ey = extent_pair("extent", extent)

@@ -65,7 +65,7 @@ class HalfSpaceRegion:
         Half-widths ``(ex, ey)`` of the region ``|x| <= ex``, ``|y| <= ey`` [length] (one number
         for a square), or ``"auto"``: :data:`EXTENT_FACTOR` times the gap's expected contact
         semi-axes, within :func:`region_limit`. The region holds at most
-        :data:`bem.checks.MAX_NODES` nodes (checked before anything is built).
+        :func:`bem.checks.max_nodes` nodes (checked before anything is built).
     grow : bool, optional
         Enlarge the region when the contact reaches its border (module docstring). Default:
         True for ``extent="auto"``, False otherwise (the contact at the border is then a

@@ -71,7 +71,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, coating1=No
     step, extent : float
         Shorthand for ``domain=HalfSpaceRegion(step, extent)`` (lattice step ``c`` [length],
         half-widths of the region [length] or ``"auto"``, which grows), not with ``domain``. The region holds at most
-        :data:`bem.checks.MAX_NODES` nodes (a memory guard, checked before anything is built).
+        :func:`bem.checks.max_nodes` nodes (a memory guard, checked before anything is built).
         A gap with a ``check_region(extent)`` method (a measured surface's table,
         :meth:`bem.gaps.Measured.region`) refuses a region beyond its data.
     layer : bem.layers.Layer, optional

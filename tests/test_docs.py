@@ -26,7 +26,7 @@ from validation.scene import schema as ss
 from validation.run import run_scene
 from validation.scene import SECTIONS
 from validation.scene import sizing
-from bem.checks import MAX_NODES
+from bem.checks import BYTES_PER_NODE
 from validation.run.sweep import SUMMARY_COLUMNS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -103,7 +103,10 @@ def test_scenes_doc_defaults_are_the_code_defaults():
     assert _default(doc["bem"][""]["nodes_across"]) == sizing.DEFAULT_NODES_ACROSS
     assert _default(doc["bem"][""]["extent_factor"]) == sizing.DEFAULT_EXTENT_FACTOR
     assert _default(doc["scene"][""]["units"]) == ss.DEFAULT_UNITS
-    assert f"{MAX_NODES / 1e6:g} million nodes" in (DOCS / "scenes.md").read_text()
+    scenes = " ".join((DOCS / "scenes.md").read_text().split())
+    assert "`bem.checks.max_nodes`" in scenes
+    assert (f"{BYTES_PER_NODE['candidate region']} bytes a node on a half-space region, "
+            f"{BYTES_PER_NODE['periodic cell']} on a periodic cell or a surface grid") in scenes
     assert checked > 10
     sections = doc["report"][""]["sections"][4]
     assert all(f"`{name}`" in sections for name in ss.report_sections())

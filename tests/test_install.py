@@ -77,6 +77,7 @@ def test_extras_layout():
     assert _extra("3d") == {"pyvista"}
     assert _extra("rough") == {"surfacetopography"}
     assert _extra("docs") == {"sphinx", "numpydoc", "myst-parser"}
+    assert _extra("peers") == {"aspher", "tamaas", "contactmechanics"}
     assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask") | _extra("rough")
     assert _extra("test") == _extra("all") | _extra("3d") | _extra("docs") | {
         "pytest", "html5lib", "pyyaml", "array-api-strict", "array-api-compat"}

@@ -56,7 +56,7 @@ class PeriodicCell:
     n_cols : int
         Nodes per row, >= 4.
     n_rows : int
-        Rows, even, >= 2; ``n_cols n_rows`` at most :data:`bem.checks.MAX_NODES` (the memory guard
+        Rows, even, >= 2; ``n_cols n_rows`` at most :func:`bem.checks.max_nodes` (the memory guard
         of :func:`bem.solve`, as for a half-space region).
     """
 

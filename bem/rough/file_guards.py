@@ -6,8 +6,8 @@ what the format declares (numpy's ``.npy`` header; an ``.x3p`` archive's directo
 ``main.xml``) and refuses:
 
 - a file larger than :data:`MAX_BYTES_PER_POINT` bytes per point of the largest grid
-  (:data:`bem.checks.MAX_NODES`), before any reader sees it;
-- a grid of more than :data:`bem.checks.MAX_NODES` points (:func:`check_points`, also called
+  (:func:`bem.checks.max_nodes` of a surface grid), before any reader sees it;
+- a grid of more than :func:`bem.checks.max_nodes` points (:func:`check_points`, also called
   on the grid every other format declares);
 - an ``.x3p`` that is not a zip archive or has no readable ``main.xml``, whose ``main.xml``
   is larger than :data:`MAX_HEADER_BYTES`, or whose data member does not hold exactly
@@ -25,7 +25,7 @@ import zipfile
 
 import numpy as np
 
-from ..checks import MAX_NODES, InputError, check_node_count
+from ..checks import InputError, check_node_count, max_nodes
 
 __all__ = ["guard_file", "check_points", "read_npy", "MAX_BYTES_PER_POINT", "MAX_HEADER_BYTES"]
 
@@ -41,15 +41,16 @@ def _refuse(path, rule):
 
 
 def check_points(path, shape, shown=None):
-    """Refuse a grid ``shape`` of more than :data:`bem.checks.MAX_NODES` points (a memory guard);
+    """Refuse a grid ``shape`` of more than :func:`bem.checks.max_nodes` points (a memory guard);
     ``shown``: the file's name in messages (default ``path``)."""
     n = int(np.prod([int(s) for s in shape]))
     try:
-        check_node_count("file", path, n)
+        check_node_count("file", path, n, what="the surface grid")
     except InputError:
         grid = " x ".join(str(int(s)) for s in shape)
-        _refuse(shown or path, f"it declares {grid} = {float(n):.3g} points, more than the {MAX_NODES:.3g} of the "
-                               "largest lattice; crop or subsample it first")
+        _refuse(shown or path, f"it declares {grid} = {float(n):.3g} points, more than the "
+                               f"{float(max_nodes('the surface grid')):.3g} of the largest grid this machine's memory "
+                               "holds; crop or subsample it first")
     return n
 
 
@@ -127,9 +128,10 @@ def guard_file(path, format=None, shown=None):
     """
     shown = shown or path
     size = os.path.getsize(path)
-    if size > MAX_BYTES_PER_POINT * MAX_NODES:
-        _refuse(shown, f"it is {size / 2**30:.3g} GiB, more than a file of the largest lattice ({MAX_NODES:.3g} "
-                      f"points) needs; crop or subsample it first")
+    largest = max_nodes("the surface grid")
+    if size > MAX_BYTES_PER_POINT * largest:
+        _refuse(shown, f"it is {size / 2**30:.3g} GiB, more than a file of the largest grid this machine's memory "
+                      f"holds ({float(largest):.3g} points) needs; crop or subsample it first")
     kind = format or os.path.splitext(path)[1].lower().lstrip(".")
     if kind == "x3p":
         _x3p(path, shown)

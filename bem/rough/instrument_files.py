@@ -20,7 +20,7 @@ the measured points around it as boundary values), and refused in any case when 
 the surface. :attr:`SurfaceStats.filled` counts the points filled.
 
 **Guards.** The header is checked before the data is read (:mod:`bem.rough.file_guards`):
-more points than :data:`bem.checks.MAX_NODES`, an ``.x3p`` whose data does not match its
+more points than :func:`bem.checks.max_nodes`, an ``.x3p`` whose data does not match its
 header or that would inflate beyond it, and a file that is not of the format its extension
 names (random bytes called ``.x3p``) stop with a message naming the file.
 
@@ -268,7 +268,7 @@ def read_surface(file, *, format=None, physical_sizes=None, channel=None, unit=N
     bem.InputError
         No such file, a format SurfaceTopography cannot read, a file that is not of the format
         its extension names, a header its data does not match, more points than
-        :data:`bem.checks.MAX_NODES`, a line scan, points not on an evenly spaced grid,
+        :func:`bem.checks.max_nodes`, a line scan, points not on an evenly spaced grid,
         missing points (without ``fill``, or more than :data:`MAX_MISSING`), fewer than 8 x 8
         points, a missing or conflicting unit or ``physical_sizes``, a bad argument; the
         message starts with its name and quotes nothing from the file. SurfaceTopography

@@ -151,7 +151,7 @@ def to_lattice(heights, size, n_cols):
         The period ``(Lx_d, Ly_d)`` [length], each ``> 0``.
     n_cols : int
         Nodes of the cell along x, ``>= 2``; the step is ``c = Lx_d/n_cols``. The cell holds at
-        most :data:`bem.checks.MAX_NODES` nodes (checked before it is built).
+        most :func:`bem.checks.max_nodes` nodes (checked before it is built).
 
     Returns
     -------

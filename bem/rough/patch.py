@@ -186,7 +186,7 @@ def patch_cell(surface, *, detrend="auto", cell="repeat", spikes="keep", spike_t
     Raises
     ------
     bem.InputError
-        A bad argument, or a mirrored cell of more than :data:`bem.checks.MAX_NODES` points
+        A bad argument, or a mirrored cell of more than :func:`bem.checks.max_nodes` points
         (counted before it is made; :func:`check_cell_size` counts its lattice too).
     """
     check_choice("detrend", detrend, DETREND_CHOICES)

@@ -271,7 +271,7 @@ def self_affine(grid, size, *, hurst, rms_height=None, rms_slope=None, long_cuto
     Parameters
     ----------
     grid : (int, int)
-        ``(nx, ny)`` points, each ``>= 8``, ``nx ny`` at most :data:`bem.checks.MAX_NODES`.
+        ``(nx, ny)`` points, each ``>= 8``, ``nx ny`` at most :func:`bem.checks.max_nodes`.
     size : (float, float)
         The period ``(Lx, Ly)`` [length]; each length here is a physical scale, in
         :data:`bem.checks.SCALE_RANGE`.

@@ -112,5 +112,5 @@ def test_the_checks_table_has_a_row_for_every_argument_of_solve():
 @pytest.mark.parametrize("build", [lambda: bem.HalfSpaceRegion(1e-4, 1.0), lambda: bem.PeriodicCell(1.0, 5000, 5000)],
                          ids=["region", "cell"])
 def test_both_domains_refuse_more_nodes_than_the_limit_before_building_them(build):
-    with pytest.raises(bem.InputError, match=re.escape(f"nodes (limit {bem.checks.MAX_NODES:.3g},")):
+    with pytest.raises(bem.InputError, match=r"nodes \(limit [0-9.e+]+ on this machine\)"):
         build()

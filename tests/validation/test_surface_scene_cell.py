@@ -167,7 +167,8 @@ def _no_mirror(monkeypatch):
 
 
 def test_a_mirrored_cell_too_large_is_refused_from_its_size_before_it_is_made(tmp_path, monkeypatch):
-    monkeypatch.setattr(bem.checks, "MAX_NODES", 100_000)  # the patch, 65536 points, fits; 2 x 2 patches do not
+    # the patch, 65536 points, fits; 2 x 2 patches do not
+    monkeypatch.setattr(bem.checks, "machine_memory", lambda: 100_000 * bem.checks.bytes_per_node("surface grid"))
     _no_mirror(monkeypatch)
     assert load_scene(_scene(tmp_path, {"file": SPOT})).gap.surface.heights.size == 65536
     with pytest.raises(SceneError) as err:
@@ -182,7 +183,7 @@ def test_a_mirrored_cell_too_large_is_refused_from_its_size_before_it_is_made(tm
 
 def test_the_lattice_of_a_mirrored_cell_is_counted_before_it_is_made(tmp_path, monkeypatch):
     # the grid, 512 x 512 = 262144 points, fits; its default lattice, 512 x 592 nodes, does not
-    monkeypatch.setattr(bem.checks, "MAX_NODES", 300_000)
+    monkeypatch.setattr(bem.checks, "machine_memory", lambda: 300_000 * bem.checks.bytes_per_node("periodic cell"))
     _no_mirror(monkeypatch)
     code, _, err = cli("layer-law", unpacked(SPOT), "--E-star", 115e9, "--cell", "mirror", "--out", tmp_path / "law")
     assert code == 2 and err.startswith(
@@ -191,5 +192,5 @@ def test_the_lattice_of_a_mirrored_cell_is_counted_before_it_is_made(tmp_path, m
     with pytest.raises(SceneError, match=r"^bem.cell_nodes \(default: Lx / max\(dx, dy\) of the surface\) = 512 is "
                                          r"not allowed: the periodic cell would hold 3.03e\+05 nodes"):
         monkeypatch.undo()  # the scene's lattice is counted from the cell made (its grid fits)
-        monkeypatch.setattr(bem.checks, "MAX_NODES", 300_000)
+        monkeypatch.setattr(bem.checks, "machine_memory", lambda: 300_000 * bem.checks.bytes_per_node("periodic cell"))
         load_scene(_scene(tmp_path, {"file": SPOT, "cell": "mirror"}, cell_nodes=None))

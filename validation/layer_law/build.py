@@ -95,7 +95,7 @@ def surface_from_file(file, *, scale=None, physical_sizes=None, detrend="auto", 
     n_cols : int, optional
         The lattice nodes along x the cell will be solved on (default: the cell's own,
         ``Lx / max(dx, dy)``): the cell is refused before it is made when it would hold more
-        than :data:`bem.checks.MAX_NODES` nodes (:func:`bem.rough.patch.check_cell_size`; a
+        than :func:`bem.checks.max_nodes` nodes (:func:`bem.rough.patch.check_cell_size`; a
         mirrored cell counts ``2 x 2`` patches).
     names : dict, optional
         The names of the arguments in messages (:func:`bem.rough.read_surface`; ``cell`` and

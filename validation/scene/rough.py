@@ -31,7 +31,7 @@ The cell of a measured surface is made by :func:`bem.rough.patch_cell` (as ``con
 layer-law`` makes it): the file is read as measured, detrended, its spikes found (and removed),
 the patch repeated or mirrored; ``result.json`` records what was done. The seam is stated
 once, by the run (a note of its result), in the scene's length unit (a mirrored cell has none); a mirrored
-grid of more than :data:`bem.checks.MAX_NODES` points is refused before it is made.
+grid of more than :func:`bem.checks.max_nodes` points is refused before it is made.
 
 Both need SurfaceTopography (the ``rough`` extra, statistics and synthesis): without it the
 scene stops before any work with :class:`validation.extras.MissingExtraError`. ``[bem]``
