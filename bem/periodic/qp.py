@@ -184,14 +184,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
     gz_old, m_one, m_full = 1.0, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
-    was_on = p > 0  # the contact of the previous iterate, updated at its nodes only
-    was_onf = was_on.reshape(-1)
-    prev_idx = np.flatnonzero(was_onf)
-    n_prev = int(prev_idx.size)
+    was_on = p > 0  # the contact of the previous iterate
+    n_prev = int(np.count_nonzero(was_on))
     fixed_scale = scale
-    idx = g_c = p_c0 = g_min = None
-    stepped = np.empty(0, dtype=np.intp)  # the nodes where r32, t and z_prev hold values (zero elsewhere)
-    r32_full = True  # r32 holds values off those nodes (the product of M and the starting contact)
+    contact = idx = g_c = p_c0 = g_min = None
 
     bounded, sets = hardness is not None, None
     was_plastic, bk = (p >= hardness, operator_backend(op)[0]) if hardness is not None else (None, None)
@@ -211,8 +207,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return kkt
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
-        nonlocal idx, g_c, p_c0, delta, g_min, single
-        idx = np.flatnonzero(pf)  # p >= 0: the contact p > 0
+        nonlocal contact, idx, g_c, p_c0, delta, g_min, single
+        contact = p > 0
+        idx = np.flatnonzero(contact)  # a boolean array: several times faster than flatnonzero(p)
         np.add(u, h, out=g)  # the gap is g - delta: delta is subtracted on the contact only
         g_c, p_c0 = np.take(gf, idx), np.take(pf, idx)
         if force is not None:
@@ -244,24 +241,18 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return float(pf.max(initial=0.0)), n_touch, changes, n_touch == 0 and g_min >= 0
 
     def observe():
-        nonlocal prev_idx, n_prev
-        kept = int(np.count_nonzero(was_onf[idx]))  # nodes in both contacts
+        nonlocal was_on, n_prev
+        kept = int(np.count_nonzero(was_on.reshape(-1)[idx]))  # nodes in both contacts
         changes = (idx.size - kept) + (n_prev - kept)
-        was_onf[prev_idx] = False
-        was_onf[idx] = True
-        prev_idx, n_prev = idx, idx.size
+        was_on, n_prev = contact, idx.size
         return float(p_c0.max(initial=0.0)), int(idx.size), changes, idx.size == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, gz_old, r_hat, u, stale, stepped, r32_full
+        nonlocal m_full, m_one, gz_old, r_hat, u, stale
         if bounded and not idx.size:  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, np.zeros(0), None, None)
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        if r32_full:
-            r32.fill(0.0)
-            r32_full = False
-        else:  # zero where the last step wrote
-            r32f[stepped] = 0.0
+        r32.fill(0.0)  # a fill: faster than zeroing the nodes of the last step
         if soft is None:
             r32f[idx] = g_c
         else:
@@ -275,7 +266,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
             if m_full is None:
                 np.multiply(pf.reshape(p.shape) > 0, stiff, out=r32, casting="unsafe")
-                r32_full = True
                 x = op.spectrum(r32)  # M (contact & stiff), and the Jacobi estimate at the soft nodes
                 m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1).astype(float)
                 m_full[softf] = jacf[softf]
@@ -287,7 +277,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
         beta = 0.0 if k == 1 or gz_old == 0 else max(  # gz_old = 0: one contact node under force control
             0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
-        zf[stepped] = 0.0
+        z_prev.fill(0.0)
         zf[idx] = z
         t_c = z + beta * np.take(tf, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
@@ -295,9 +285,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         gt = float(np.einsum("i,i->", g_c, t_c))
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
-        tf[stepped] = 0.0
+        t.fill(0.0)
         tf[idx] = t_c
-        stepped = idx
         gz_old = gz
         T = op.spectrum(t)
         op.n_matvec += 1
