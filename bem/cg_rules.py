@@ -24,13 +24,18 @@ from .backend import operator_backend
 from .plastic import clip, fill_force, leaving_pressure, plastic_approach
 
 __all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "carry_force", "iterate_residual",
-           "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BoundedSets",
-           "bounded_sets", "bounded_move"]
+           "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS",
+           "BoundedSets", "bounded_sets", "bounded_move"]
 
 log = logging.getLogger(__name__)
 
 #: An exactly recomputed ``C p`` every so many incremental updates of the constrained CG.
 RECOMPUTE_EVERY = 20
+
+#: Halvings of the step of the bounded constrained CG (:func:`bounded_move`) where the projected step leaves the
+#: nodes below ``H`` unable to carry the force, before the step up to the first bound: a step that sends hundreds of
+#: nodes to both bounds at once is shortened instead of reduced to one node per iteration.
+BACKTRACK_HALVINGS = 8
 
 #: The share of its Jacobi estimate ``-g / (C_nn + lam)`` a node takes when it enters the contact in a
 #: preconditioned step (:func:`entering_pressure`). Measured finest-level iterations of the periodic step
@@ -114,14 +119,21 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
 def carry_force(xp, p, target, hardness, mask):
     """``p`` (``>= 0``) scaled to carry ``sum p = target``, capped at ``H`` and filled up by
     :func:`bem.plastic.fill_force`; where its support cannot carry ``target``, the uniform ``target / n``
-    on the ``n`` nodes of ``mask`` (capped at ``H``: the caller checks that they can)."""
+    on the ``n`` nodes of ``mask`` (capped at ``H``: the caller checks that they can). Values within round-off
+    (a relative ``1e-12``) of ``H`` are set to ``H``: a start that the force fills to the bound is plastic there."""
     for start in (p, xp.astype(mask, p.dtype)):
         total = float(xp.sum(start))
         if total > 0:
             filled = fill_force(xp, xp.minimum(start * (target / total), hardness), target, hardness)
             if filled is not None:
-                return filled[0]
-    return xp.minimum(xp.astype(mask, p.dtype) * (target / float(xp.sum(xp.astype(mask, p.dtype)))), hardness)
+                return _snap(xp, filled[0], hardness)
+    return _snap(xp, xp.minimum(xp.astype(mask, p.dtype) * (target / float(xp.sum(xp.astype(mask, p.dtype)))),
+                                hardness), hardness)
+
+
+def _snap(xp, p, hardness):
+    """``p`` with the values within a relative ``1e-12`` of ``H`` set to ``H``."""
+    return xp.where(p >= hardness * (1.0 - 1e-12), hardness, p)
 
 
 def entering_pressure(xp, g, tau, jacobi, per_node, preconditioned=False):
@@ -176,15 +188,18 @@ def bounded_sets(bk, p, v, hardness, delta, force, mask=None):
 
 
 def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardness, preconditioned=False):
-    """One step of the bounded constrained CG, on ``p`` (brick) in place; ``(changed, entered, s, failure)``.
+    """One step of the bounded constrained CG, on ``p`` (brick) in place; ``(changed, entered, s, failure, restart)``.
 
     The elastic nodes ``sets.idx`` move from ``p_c0`` along ``-tau t_c``, projected onto ``[0, H]``; the
     open nodes whose gap ``v - delta`` is negative enter (:func:`entering_pressure`, at most ``H``), the
     plastic nodes whose gap is positive leave (:func:`bem.plastic.leaving_pressure`); under force control
     (``target = P / a``) :func:`bem.plastic.fill_force` carries the force, and where it cannot the step
-    goes up to the first bound instead. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
+    is halved up to :data:`BACKTRACK_HALVINGS` times and, where none of those can either, goes up to the
+    first bound. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
     ``changed``: a node reached a bound, entered, left or was capped (``C p`` is then to be recomputed);
-    ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes; ``failure``: ``(message, status)`` where no step can be taken.
+    ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes; ``failure``: ``(message, status)`` where no step can be taken; ``restart``:
+    the step was shortened so that the force is carried, or a node entered or left with plastic nodes present
+    (the step that keeps its directions on entering nodes restarts them there).
     """
     xp, idx, pl, delta = bk.xp, sets.idx, sets.pl, sets.delta
 
@@ -203,8 +218,16 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
                                                                       per_node, preconditioned)))
     moved = bool(bk.count(overlap) or bk.count(leave))
     if target is None:
-        return hit or moved, moved, 1.0, None
+        return hit or moved, moved, 1.0, None, False
     filled = fill_force(xp, p, target, hardness)
+    shorter, short = tau, filled is None
+    for _ in range(BACKTRACK_HALVINGS if filled is None and bk.count(idx) else 0):  # a shorter projected step
+        shorter *= 0.5
+        bk.put(p, idx, xp.minimum(xp.maximum(p_c0 - shorter * t_c, 0.0), hardness))
+        filled = fill_force(xp, p, target, hardness)
+        if filled is not None:
+            hit = True
+            break
     if filled is None and bk.count(idx):  # the nodes below H cannot carry the force: the step up to the first bound
         bk.put(p, overlap, 0.0)
         bk.put(p, leave, hardness)
@@ -217,10 +240,10 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
         bk.put(p, idx, p_c0)
         bk.put(p, overlap, 0.0)
         bk.put(p, leave, hardness)
-        return True, False, 1.0, ("no elastic contact node can carry the force", "stalled")
+        return True, False, 1.0, ("no elastic contact node can carry the force", "stalled"), True
     new, s, capped = filled
     p[...] = new
-    return hit or moved or capped, moved, s, None
+    return hit or moved or capped, moved or short, s, None, short or (moved and bool(bk.count(pl) or capped))
 
 
 def is_per_node(lam):

@@ -283,8 +283,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
         nonlocal restart, u, stale
-        changed, restart, s, failure = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
-                                                    hardness)
+        changed, restart, s, failure, _ = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
+                                                    hardness, preconditioned=preconditioner is not None)
         if failure is not None:
             return failure
         if changed or r is None or stale >= RECOMPUTE_EVERY:
