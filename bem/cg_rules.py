@@ -23,9 +23,9 @@ import numpy as np
 from .backend import operator_backend
 from .plastic import clip, fill_force, leaving_pressure, plastic_approach
 
-__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "carry_force", "iterate_residual",
-           "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS",
-           "BoundedSets", "bounded_sets", "bounded_move"]
+__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "carry_force", "plastic_start",
+           "iterate_residual", "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION",
+           "BACKTRACK_HALVINGS", "BoundedSets", "bounded_sets", "bounded_move"]
 
 log = logging.getLogger(__name__)
 
@@ -112,16 +112,38 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
         if hardness is None:
             p *= force / lat.node_area / total
         else:
-            p = carry_force(xp, p, force / lat.node_area, hardness, mask)
+            p = carry_force(xp, p, force / lat.node_area, hardness, mask, h)
     return p
 
 
-def carry_force(xp, p, target, hardness, mask):
+def plastic_start(xp, h, target, hardness, mask):
+    """``H`` on the nodes of ``mask`` in the order of their gap ``h``, smallest first, until they carry
+    ``target = P / a`` (the rest of it shared by the nodes at the next gap value): the rigid-plastic
+    pressure (brick array); ``None`` where the nodes of ``mask`` cannot carry ``target`` below ``H``."""
+    hm = xp.where(mask, h, xp.inf)
+    values = xp.sort(xp.reshape(hm, (-1,)))
+    k = int(target // hardness)
+    if k >= int(xp.count_nonzero(mask)):
+        return None
+    level = float(values[k])
+    full = hm < level
+    tie = hm == level
+    rest = target - hardness * int(xp.count_nonzero(full))
+    share = xp.astype(tie, h.dtype) * (rest / int(xp.count_nonzero(tie)))
+    return xp.minimum(xp.where(full, hardness, share), hardness)
+
+
+def carry_force(xp, p, target, hardness, mask, h=None):
     """``p`` (``>= 0``) scaled to carry ``sum p = target``, capped at ``H`` and filled up by
-    :func:`bem.plastic.fill_force`; where its support cannot carry ``target``, the uniform ``target / n``
-    on the ``n`` nodes of ``mask`` (capped at ``H``: the caller checks that they can). Values within round-off
-    (a relative ``1e-12``) of ``H`` are set to ``H``: a start that the force fills to the bound is plastic there."""
-    for start in (p, xp.astype(mask, p.dtype)):
+    :func:`bem.plastic.fill_force`; where its support cannot carry ``target``, ``p`` joined (the larger value
+    at each node) by the rigid-plastic pressure of the gap ``h`` (:func:`plastic_start`) and scaled down to
+    ``target``, or without ``h`` the uniform ``target / n`` on the ``n`` nodes of ``mask`` (capped at ``H``:
+    the caller checks that they can). Values within round-off (a relative ``1e-12``) of ``H`` are set to
+    ``H``: a start that the force fills to the bound is plastic there."""
+    starts = [p]
+    if h is not None and (rigid := plastic_start(xp, h, target, hardness, mask)) is not None:
+        starts.append(xp.maximum(xp.minimum(p * (target / max(float(xp.sum(p)), 1e-300)), hardness), rigid))
+    for start in (*starts, xp.astype(mask, p.dtype)):
         total = float(xp.sum(start))
         if total > 0:
             filled = fill_force(xp, xp.minimum(start * (target / total), hardness), target, hardness)
