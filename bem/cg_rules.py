@@ -209,17 +209,20 @@ def bounded_sets(bk, p, v, hardness, delta, force, mask=None):
                        v_pl - delta)
 
 
-def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardness, preconditioned=False):
+def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardness, preconditioned=False,
+                 halvings=0):
     """One step of the bounded constrained CG, on ``p`` (brick) in place; ``(changed, entered, s, failure, restart)``.
 
     The elastic nodes ``sets.idx`` move from ``p_c0`` along ``-tau t_c``, projected onto ``[0, H]``; the
     open nodes whose gap ``v - delta`` is negative enter (:func:`entering_pressure`, at most ``H``), the
     plastic nodes whose gap is positive leave (:func:`bem.plastic.leaving_pressure`); under force control
     (``target = P / a``) :func:`bem.plastic.fill_force` carries the force, and where it cannot the step
-    is halved up to :data:`BACKTRACK_HALVINGS` times and, where none of those can either, goes up to the
+    is halved up to ``halvings`` times (the periodic step: :data:`BACKTRACK_HALVINGS`; the general step, whose
+    Fletcher-Reeves directions do better without, none) and, where none of those can either, goes up to the
     first bound. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
     ``changed``: a node reached a bound, entered, left or was capped (``C p`` is then to be recomputed);
-    ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes; ``failure``: ``(message, status)`` where no step can be taken; ``restart``:
+    ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes;
+    ``failure``: ``(message, status)`` where no step can be taken; ``restart``:
     the step was shortened so that the force is carried, or a node entered or left with plastic nodes present
     (the step that keeps its directions on entering nodes restarts them there).
     """
@@ -243,7 +246,7 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
         return hit or moved, moved, 1.0, None, False
     filled = fill_force(xp, p, target, hardness)
     shorter, short = tau, filled is None
-    for _ in range(BACKTRACK_HALVINGS if filled is None and bk.count(idx) else 0):  # a shorter projected step
+    for _ in range(halvings if filled is None and bk.count(idx) else 0):  # a shorter projected step
         shorter *= 0.5
         bk.put(p, idx, xp.minimum(xp.maximum(p_c0 - shorter * t_c, 0.0), hardness))
         filled = fill_force(xp, p, target, hardness)
@@ -265,7 +268,7 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
         return True, False, 1.0, ("no elastic contact node can carry the force", "stalled"), True
     new, s, capped = filled
     p[...] = new
-    return hit or moved or capped, moved or short, s, None, short or (moved and bool(bk.count(pl) or capped))
+    return hit or moved or capped, moved, s, None, short or (moved and bool(bk.count(pl) or capped))
 
 
 def is_per_node(lam):

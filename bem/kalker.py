@@ -227,7 +227,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                     m_one = bk.take(preconditioner(xp.astype(contact, bk.float64)), idx)
                 z -= m_one * (xp.sum(z) / xp.sum(m_one))
         gz = float(xp.sum(g_c * z))
-        beta = 0.0 if restart else gz / gz_old
+        beta = 0.0 if restart or gz_old == 0 else gz / gz_old  # gz_old = 0: one contact node under force control
         t_c = z + beta * bk.take(t, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (xp.sum(t_c) / xp.sum(m_one)) if oblique and m_one is not None else xp.mean(t_c)

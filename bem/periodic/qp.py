@@ -66,8 +66,8 @@ import math
 import numpy as np
 
 from ..backend import operator_backend
-from ..cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, carry_force, entering_pressure,
-                        initial_pressure, iterate_residual, run_constrained_cg)
+from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, carry_force,
+                        entering_pressure, initial_pressure, iterate_residual, run_constrained_cg)
 from ..plastic import note_fully_plastic
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
@@ -367,7 +367,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def bounded_step(tau, t_c, R, D_c):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
         nonlocal u, stale, restart
         changed, _, s, failure, restart = bounded_move(bk, p, sets, p_c0, t_c, tau, g, jacobi, per_node, target,
-                                                       hardness, preconditioned=True)
+                                                       hardness, preconditioned=True, halvings=BACKTRACK_HALVINGS)
         if failure is not None:
             return failure
         if changed or R is None or stale >= RECOMPUTE_EVERY:
