@@ -21,16 +21,19 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .backend import operator_backend
-from .plastic import clip, fill_force, leaving_pressure, plastic_approach
+from .plastic import carry_force, clip, fill_force, leaving_pressure, plastic_approach, plastic_start
 
-__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "carry_force", "plastic_start",
-           "iterate_residual", "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION",
-           "BACKTRACK_HALVINGS", "BoundedSets", "bounded_sets", "bounded_move"]
+__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule",
+           "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS", "RIGID_SHARE", "BoundedSets", "bounded_sets", "bounded_move"]
 
 log = logging.getLogger(__name__)
 
 #: An exactly recomputed ``C p`` every so many incremental updates of the constrained CG.
 RECOMPUTE_EVERY = 20
+
+#: The share of its nodes that may lie deeper, by their deformed gap, than the lowest open node for the rigid-plastic
+#: pressure to be the start of a bounded solve under force control (:func:`initial_pressure`).
+RIGID_SHARE = 0.1
 
 #: Halvings of the step of the bounded constrained CG (:func:`bounded_move`) where the projected step leaves the
 #: nodes below ``H`` unable to carry the force, before the step up to the first bound: a step that sends hundreds of
@@ -86,7 +89,9 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
 
     With a ``hardness`` ``H`` the start is clipped at ``H``, and under force control the uniform
     pressure covers enough nodes to stay below ``0.8 H`` and is scaled by
-    :func:`bem.plastic.fill_force`."""
+    :func:`bem.plastic.fill_force`; where the rigid-plastic pressure (:func:`bem.plastic.plastic_start`) nearly keeps
+    its order under its own displacement (:data:`RIGID_SHARE`) it is the start instead, and an ``x0`` whose
+    nodes cannot carry the force below ``H`` is joined by it (:func:`bem.plastic.carry_force`)."""
     lat = op.lattice
     bk, mask = operator_backend(op)
     xp = bk.xp
@@ -100,6 +105,8 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
             share = min(1.0, max(share, 1.25 * force / (lat.node_area * hardness * int(xp.count_nonzero(mask)))))
         level = _quantile(bk, hm[mask], share)
         p = xp.astype(mask & (hm <= level), bk.float64)
+        if hardness is not None and (rigid := _rigid_plastic(op, bk, h, force / lat.node_area, hardness, mask)) is not None:
+            return rigid
     else:
         p = xp.where(mask, xp.maximum(approach - h, 0.0), 0.0) / (op.diagonal + float(xp.max(lam) if is_per_node(lam) else lam))
         if hardness is not None:
@@ -116,46 +123,19 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
     return p
 
 
-def plastic_start(xp, h, target, hardness, mask):
-    """``H`` on the nodes of ``mask`` in the order of their gap ``h``, smallest first, until they carry
-    ``target = P / a`` (the rest of it shared by the nodes at the next gap value): the rigid-plastic
-    pressure (brick array); ``None`` where the nodes of ``mask`` cannot carry ``target`` below ``H``."""
-    hm = xp.where(mask, h, xp.inf)
-    values = xp.sort(xp.reshape(hm, (-1,)))
-    k = int(target // hardness)
-    if k >= int(xp.count_nonzero(mask)):
+def _rigid_plastic(op, bk, h, target, hardness, mask):
+    """The rigid-plastic pressure of the gap (:func:`bem.plastic.plastic_start`) where it nearly keeps its order under its own
+    elastic displacement ``u``: fewer than :data:`RIGID_SHARE` of its nodes have a deformed gap ``h + u`` above the
+    smallest one of the open nodes (a surface far softer in yield than in elasticity); else ``None``."""
+    xp = bk.xp
+    rigid = plastic_start(xp, h, target, hardness, mask)
+    if rigid is None:
         return None
-    level = float(values[k])
-    full = hm < level
-    tie = hm == level
-    rest = target - hardness * int(xp.count_nonzero(full))
-    share = xp.astype(tie, h.dtype) * (rest / int(xp.count_nonzero(tie)))
-    return xp.minimum(xp.where(full, hardness, share), hardness)
-
-
-def carry_force(xp, p, target, hardness, mask, h=None):
-    """``p`` (``>= 0``) scaled to carry ``sum p = target``, capped at ``H`` and filled up by
-    :func:`bem.plastic.fill_force`; where its support cannot carry ``target``, ``p`` joined (the larger value
-    at each node) by the rigid-plastic pressure of the gap ``h`` (:func:`plastic_start`) and scaled down to
-    ``target``, or without ``h`` the uniform ``target / n`` on the ``n`` nodes of ``mask`` (capped at ``H``:
-    the caller checks that they can). Values within round-off (a relative ``1e-12``) of ``H`` are set to
-    ``H``: a start that the force fills to the bound is plastic there."""
-    starts = [p]
-    if h is not None and (rigid := plastic_start(xp, h, target, hardness, mask)) is not None:
-        starts.append(xp.maximum(xp.minimum(p * (target / max(float(xp.sum(p)), 1e-300)), hardness), rigid))
-    for start in (*starts, xp.astype(mask, p.dtype)):
-        total = float(xp.sum(start))
-        if total > 0:
-            filled = fill_force(xp, xp.minimum(start * (target / total), hardness), target, hardness)
-            if filled is not None:
-                return _snap(xp, filled[0], hardness)
-    return _snap(xp, xp.minimum(xp.astype(mask, p.dtype) * (target / float(xp.sum(xp.astype(mask, p.dtype)))),
-                                hardness), hardness)
-
-
-def _snap(xp, p, hardness):
-    """``p`` with the values within a relative ``1e-12`` of ``H`` set to ``H``."""
-    return xp.where(p >= hardness * (1.0 - 1e-12), hardness, p)
+    v = op.matvec(rigid) + h
+    on = rigid > 0
+    lowest_open = float(xp.min(xp.where(on | ~mask, xp.inf, v)))
+    n_out = int(xp.count_nonzero(on & (v > lowest_open)))
+    return rigid if n_out < RIGID_SHARE * int(xp.count_nonzero(on)) else None
 
 
 def entering_pressure(xp, g, tau, jacobi, per_node, preconditioned=False):
@@ -210,13 +190,16 @@ def bounded_sets(bk, p, v, hardness, delta, force, mask=None):
 
 
 def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardness, preconditioned=False,
-                 halvings=0):
+                 halvings=0, mask=None):
     """One step of the bounded constrained CG, on ``p`` (brick) in place; ``(changed, entered, s, failure, restart)``.
 
     The elastic nodes ``sets.idx`` move from ``p_c0`` along ``-tau t_c``, projected onto ``[0, H]``; the
     open nodes whose gap ``v - delta`` is negative enter (:func:`entering_pressure`, at most ``H``), the
     plastic nodes whose gap is positive leave (:func:`bem.plastic.leaving_pressure`); under force control
-    (``target = P / a``) :func:`bem.plastic.fill_force` carries the force, and where it cannot the step
+    (``target = P / a``) :func:`bem.plastic.fill_force` carries the force. Where the step has no elastic direction
+    (``tau = 0`` or no elastic node) and the force cannot be carried, or the nodes at ``H`` carry too much, the
+    pressure is the rigid-plastic one of the deformed gap ``v`` (:func:`bem.plastic.plastic_start` on ``mask``, ``None``:
+    every node): a contact that is (nearly) fully plastic. Elsewhere, where the force cannot be carried, the step
     is halved up to ``halvings`` times (the periodic step: :data:`BACKTRACK_HALVINGS`; the general step, whose
     Fletcher-Reeves directions do better without, none) and, where none of those can either, goes up to the
     first bound. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
@@ -253,6 +236,12 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
         if filled is not None:
             hit = True
             break
+    over = hardness * int(xp.count_nonzero(p >= hardness)) > target * (1.0 + 1e-13)  # the nodes at H carry too much
+    if (filled is None or over) and (tau == 0 or not bk.count(idx)):  # no elastic step: the smallest deformed gaps
+        rigid = plastic_start(xp, v, target, hardness, (v == v) if mask is None else mask)
+        if rigid is not None:
+            p[...] = rigid
+            return True, True, 1.0, None, True
     if filled is None and bk.count(idx):  # the nodes below H cannot carry the force: the step up to the first bound
         bk.put(p, overlap, 0.0)
         bk.put(p, leave, hardness)

@@ -17,9 +17,9 @@ import math
 import numpy as np
 
 from .backend import operator_backend
-from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, carry_force, entering_pressure,
+from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, entering_pressure,
                        initial_pressure, is_per_node, iterate_residual, run_constrained_cg)
-from .plastic import note_fully_plastic
+from .plastic import carry_force, note_fully_plastic
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
@@ -284,7 +284,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
         nonlocal restart, u, stale
         changed, restart, s, failure, _ = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
-                                                    hardness, preconditioned=preconditioner is not None)
+                                                    hardness, preconditioned=preconditioner is not None, mask=mask)
         if failure is not None:
             return failure
         if changed or r is None or stale >= RECOMPUTE_EVERY:

@@ -29,12 +29,12 @@ import numpy as np
 from .brent import brent_root
 from .backend import backend_of, operator_backend
 from .layers.device import device_layer
-from .cg_rules import QPSolution, carry_force
+from .cg_rules import QPSolution
 from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 from .newton_moves import release, scaled, settle_plastic
-from .plastic import clip, fully_plastic_note
+from .plastic import carry_force, clip, fully_plastic_note
 
 __all__ = ["solve_newton"]
 

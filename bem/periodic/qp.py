@@ -66,9 +66,9 @@ import math
 import numpy as np
 
 from ..backend import operator_backend
-from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, carry_force,
+from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
                         entering_pressure, initial_pressure, iterate_residual, run_constrained_cg)
-from ..plastic import note_fully_plastic
+from ..plastic import carry_force, note_fully_plastic
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 

@@ -34,7 +34,7 @@ def test_a_warm_start_that_cannot_carry_the_load_below_the_hardness(layered, pba
 
 
 def test_the_rigid_plastic_start_fills_the_nodes_of_smallest_gap_at_the_hardness():
-    from bem.cg_rules import plastic_start
+    from bem.plastic import plastic_start
 
     h = np.array([[0.3, 0.1, 0.2], [0.0, 0.5, 0.4]])
     mask = np.ones(h.shape, dtype=bool)
