@@ -21,16 +21,24 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .backend import operator_backend
-from .plastic import clip, fill_force, leaving_pressure, plastic_approach
+from .plastic import carry_force, clip, fill_force, leaving_pressure, plastic_approach, plastic_start
 
-__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "carry_force", "iterate_residual",
-           "stopping_rule", "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BoundedSets",
-           "bounded_sets", "bounded_move"]
+__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule",
+           "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS", "RIGID_SHARE", "BoundedSets", "bounded_sets", "bounded_move"]
 
 log = logging.getLogger(__name__)
 
 #: An exactly recomputed ``C p`` every so many incremental updates of the constrained CG.
 RECOMPUTE_EVERY = 20
+
+#: The share of its nodes that may lie deeper, by their deformed gap, than the lowest open node for the rigid-plastic
+#: pressure to be the start of a bounded solve under force control (:func:`initial_pressure`).
+RIGID_SHARE = 0.1
+
+#: Halvings of the step of the bounded constrained CG (:func:`bounded_move`) where the projected step leaves the
+#: nodes below ``H`` unable to carry the force, before the step up to the first bound: a step that sends hundreds of
+#: nodes to both bounds at once is shortened instead of reduced to one node per iteration.
+BACKTRACK_HALVINGS = 8
 
 #: The share of its Jacobi estimate ``-g / (C_nn + lam)`` a node takes when it enters the contact in a
 #: preconditioned step (:func:`entering_pressure`). Measured finest-level iterations of the periodic step
@@ -81,7 +89,9 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
 
     With a ``hardness`` ``H`` the start is clipped at ``H``, and under force control the uniform
     pressure covers enough nodes to stay below ``0.8 H`` and is scaled by
-    :func:`bem.plastic.fill_force`."""
+    :func:`bem.plastic.fill_force`; where the rigid-plastic pressure (:func:`bem.plastic.plastic_start`) nearly keeps
+    its order under its own displacement (:data:`RIGID_SHARE`) it is the start instead, and an ``x0`` whose
+    nodes cannot carry the force below ``H`` is joined by it (:func:`bem.plastic.carry_force`)."""
     lat = op.lattice
     bk, mask = operator_backend(op)
     xp = bk.xp
@@ -95,6 +105,8 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
             share = min(1.0, max(share, 1.25 * force / (lat.node_area * hardness * int(xp.count_nonzero(mask)))))
         level = _quantile(bk, hm[mask], share)
         p = xp.astype(mask & (hm <= level), bk.float64)
+        if hardness is not None and (rigid := _rigid_plastic(op, bk, h, force / lat.node_area, hardness, mask)) is not None:
+            return rigid
     else:
         p = xp.where(mask, xp.maximum(approach - h, 0.0), 0.0) / (op.diagonal + float(xp.max(lam) if is_per_node(lam) else lam))
         if hardness is not None:
@@ -107,21 +119,23 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
         if hardness is None:
             p *= force / lat.node_area / total
         else:
-            p = carry_force(xp, p, force / lat.node_area, hardness, mask)
+            p = carry_force(xp, p, force / lat.node_area, hardness, mask, h)
     return p
 
 
-def carry_force(xp, p, target, hardness, mask):
-    """``p`` (``>= 0``) scaled to carry ``sum p = target``, capped at ``H`` and filled up by
-    :func:`bem.plastic.fill_force`; where its support cannot carry ``target``, the uniform ``target / n``
-    on the ``n`` nodes of ``mask`` (capped at ``H``: the caller checks that they can)."""
-    for start in (p, xp.astype(mask, p.dtype)):
-        total = float(xp.sum(start))
-        if total > 0:
-            filled = fill_force(xp, xp.minimum(start * (target / total), hardness), target, hardness)
-            if filled is not None:
-                return filled[0]
-    return xp.minimum(xp.astype(mask, p.dtype) * (target / float(xp.sum(xp.astype(mask, p.dtype)))), hardness)
+def _rigid_plastic(op, bk, h, target, hardness, mask):
+    """The rigid-plastic pressure of the gap (:func:`bem.plastic.plastic_start`) where it nearly keeps its order under its own
+    elastic displacement ``u``: fewer than :data:`RIGID_SHARE` of its nodes have a deformed gap ``h + u`` above the
+    smallest one of the open nodes (a surface far softer in yield than in elasticity); else ``None``."""
+    xp = bk.xp
+    rigid = plastic_start(xp, h, target, hardness, mask)
+    if rigid is None:
+        return None
+    v = op.matvec(rigid) + h
+    on = rigid > 0
+    lowest_open = float(xp.min(xp.where(on | ~mask, xp.inf, v)))
+    n_out = int(xp.count_nonzero(on & (v > lowest_open)))
+    return rigid if n_out < RIGID_SHARE * int(xp.count_nonzero(on)) else None
 
 
 def entering_pressure(xp, g, tau, jacobi, per_node, preconditioned=False):
@@ -175,16 +189,25 @@ def bounded_sets(bk, p, v, hardness, delta, force, mask=None):
                        v_pl - delta)
 
 
-def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardness, preconditioned=False):
-    """One step of the bounded constrained CG, on ``p`` (brick) in place; ``(changed, entered, s, failure)``.
+def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardness, preconditioned=False,
+                 halvings=0, mask=None):
+    """One step of the bounded constrained CG, on ``p`` (brick) in place; ``(changed, entered, s, failure, restart)``.
 
     The elastic nodes ``sets.idx`` move from ``p_c0`` along ``-tau t_c``, projected onto ``[0, H]``; the
     open nodes whose gap ``v - delta`` is negative enter (:func:`entering_pressure`, at most ``H``), the
     plastic nodes whose gap is positive leave (:func:`bem.plastic.leaving_pressure`); under force control
-    (``target = P / a``) :func:`bem.plastic.fill_force` carries the force, and where it cannot the step
-    goes up to the first bound instead. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
+    (``target = P / a``) :func:`bem.plastic.fill_force` carries the force. Where the step has no elastic direction
+    (``tau = 0`` or no elastic node) and the force cannot be carried, or the nodes at ``H`` carry too much, the
+    pressure is the rigid-plastic one of the deformed gap ``v`` (:func:`bem.plastic.plastic_start` on ``mask``, ``None``:
+    every node): a contact that is (nearly) fully plastic. Elsewhere, where the force cannot be carried, the step
+    is halved up to ``halvings`` times (the periodic step: :data:`BACKTRACK_HALVINGS`; the general step, whose
+    Fletcher-Reeves directions do better without, none) and, where none of those can either, goes up to the
+    first bound. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
     ``changed``: a node reached a bound, entered, left or was capped (``C p`` is then to be recomputed);
-    ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes; ``failure``: ``(message, status)`` where no step can be taken.
+    ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes;
+    ``failure``: ``(message, status)`` where no step can be taken; ``restart``:
+    the step was shortened so that the force is carried, or a node entered or left with plastic nodes present
+    (the step that keeps its directions on entering nodes restarts them there).
     """
     xp, idx, pl, delta = bk.xp, sets.idx, sets.pl, sets.delta
 
@@ -203,8 +226,22 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
                                                                       per_node, preconditioned)))
     moved = bool(bk.count(overlap) or bk.count(leave))
     if target is None:
-        return hit or moved, moved, 1.0, None
+        return hit or moved, moved, 1.0, None, False
     filled = fill_force(xp, p, target, hardness)
+    shorter, short = tau, filled is None
+    for _ in range(halvings if filled is None and bk.count(idx) else 0):  # a shorter projected step
+        shorter *= 0.5
+        bk.put(p, idx, xp.minimum(xp.maximum(p_c0 - shorter * t_c, 0.0), hardness))
+        filled = fill_force(xp, p, target, hardness)
+        if filled is not None:
+            hit = True
+            break
+    over = hardness * int(xp.count_nonzero(p >= hardness)) > target * (1.0 + 1e-13)  # the nodes at H carry too much
+    if (filled is None or over) and (tau == 0 or not bk.count(idx)):  # no elastic step: the smallest deformed gaps
+        rigid = plastic_start(xp, v, target, hardness, (v == v) if mask is None else mask)
+        if rigid is not None:
+            p[...] = rigid
+            return True, True, 1.0, None, True
     if filled is None and bk.count(idx):  # the nodes below H cannot carry the force: the step up to the first bound
         bk.put(p, overlap, 0.0)
         bk.put(p, leave, hardness)
@@ -217,10 +254,10 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
         bk.put(p, idx, p_c0)
         bk.put(p, overlap, 0.0)
         bk.put(p, leave, hardness)
-        return True, False, 1.0, ("no elastic contact node can carry the force", "stalled")
+        return True, False, 1.0, ("no elastic contact node can carry the force", "stalled"), True
     new, s, capped = filled
     p[...] = new
-    return hit or moved or capped, moved, s, None
+    return hit or moved or capped, moved, s, None, short or (moved and bool(bk.count(pl) or capped))
 
 
 def is_per_node(lam):

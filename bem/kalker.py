@@ -17,9 +17,9 @@ import math
 import numpy as np
 
 from .backend import operator_backend
-from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, carry_force, entering_pressure,
+from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, entering_pressure,
                        initial_pressure, is_per_node, iterate_residual, run_constrained_cg)
-from .plastic import note_fully_plastic
+from .plastic import carry_force, note_fully_plastic
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
@@ -227,7 +227,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                     m_one = bk.take(preconditioner(xp.astype(contact, bk.float64)), idx)
                 z -= m_one * (xp.sum(z) / xp.sum(m_one))
         gz = float(xp.sum(g_c * z))
-        beta = 0.0 if restart else gz / gz_old
+        beta = 0.0 if restart or gz_old == 0 else gz / gz_old  # gz_old = 0: one contact node under force control
         t_c = z + beta * bk.take(t, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (xp.sum(t_c) / xp.sum(m_one)) if oblique and m_one is not None else xp.mean(t_c)
@@ -283,8 +283,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
         nonlocal restart, u, stale
-        changed, restart, s, failure = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
-                                                    hardness)
+        changed, restart, s, failure, _ = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
+                                                    hardness, preconditioned=preconditioner is not None, mask=mask)
         if failure is not None:
             return failure
         if changed or r is None or stale >= RECOMPUTE_EVERY:

@@ -34,7 +34,7 @@ from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 from .newton_moves import release, scaled, settle_plastic
-from .plastic import clip, fully_plastic_note
+from .plastic import carry_force, clip, fully_plastic_note
 
 __all__ = ["solve_newton"]
 
@@ -154,8 +154,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         p = xp.where(mask, clip(xp, bk.asarray(x0), hardness), 0.0)
         if force is not None and hardness is None:
             p *= force / op.lattice.node_area / float(xp.sum(p))
-        elif force is not None:
-            p = scaled(p, force, op.lattice.node_area, hardness)
+        elif force is not None:  # its nodes below H carry the force, or the nodes of smallest gap help them
+            p = carry_force(xp, p, force / op.lattice.node_area, hardness, mask, h)
     u = op.matvec(p)
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "step": [], "inner_iterations": [],
             "inner_missed": 0, "inner_worst": 0.0}

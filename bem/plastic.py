@@ -20,8 +20,8 @@ residual (:mod:`bem.kkt`).
 
 from __future__ import annotations
 
-__all__ = ["plastic_approach", "fill_force", "clip", "leaving_pressure", "note_fully_plastic",
-           "fully_plastic_note"]
+__all__ = ["plastic_approach", "fill_force", "plastic_start", "carry_force", "clip", "leaving_pressure",
+           "note_fully_plastic", "fully_plastic_note"]
 
 #: Rounds of :func:`fill_force` (each caps at least one more node at ``H``).
 _FILL_ROUNDS = 64
@@ -102,3 +102,45 @@ def leaving_pressure(xp, hardness, lowered):
     """Pressure of a plastic node whose gap opens (``p = H``, ``g > 0``): ``H`` lowered by the pressure
     an entering node would take at ``-g`` (:func:`bem.cg_rules.entering_pressure`), not below 0."""
     return xp.maximum(hardness - lowered, 0.0)
+
+
+def plastic_start(xp, h, target, hardness, mask):
+    """``H`` on the nodes of ``mask`` in the order of their gap ``h``, smallest first, until they carry
+    ``target = P / a`` (the rest of it shared by the nodes at the next gap value): the rigid-plastic
+    pressure (brick array); ``None`` where the nodes of ``mask`` cannot carry ``target`` below ``H``."""
+    hm = xp.where(mask, h, xp.inf)
+    values = xp.sort(xp.reshape(hm, (-1,)))
+    k = int(target // hardness)
+    if k >= int(xp.count_nonzero(mask)):
+        return None
+    level = float(values[k])
+    full = hm < level
+    tie = hm == level
+    rest = target - hardness * int(xp.count_nonzero(full))
+    share = xp.astype(tie, h.dtype) * (rest / int(xp.count_nonzero(tie)))
+    return xp.minimum(xp.where(full, hardness, share), hardness)
+
+
+def carry_force(xp, p, target, hardness, mask, h=None):
+    """``p`` (``>= 0``) scaled to carry ``sum p = target``, capped at ``H`` and filled up by
+    :func:`bem.plastic.fill_force`; where its support cannot carry ``target``, ``p`` joined (the larger value
+    at each node) by the rigid-plastic pressure of the gap ``h`` (:func:`plastic_start`) and scaled down to
+    ``target``, or without ``h`` the uniform ``target / n`` on the ``n`` nodes of ``mask`` (capped at ``H``:
+    the caller checks that they can). Values within round-off (a relative ``1e-12``) of ``H`` are set to
+    ``H``: a start that the force fills to the bound is plastic there."""
+    starts = [p]
+    if h is not None and (rigid := plastic_start(xp, h, target, hardness, mask)) is not None:
+        starts.append(xp.maximum(xp.minimum(p * (target / max(float(xp.sum(p)), 1e-300)), hardness), rigid))
+    for start in (*starts, xp.astype(mask, p.dtype)):
+        total = float(xp.sum(start))
+        if total > 0:
+            filled = fill_force(xp, xp.minimum(start * (target / total), hardness), target, hardness)
+            if filled is not None:
+                return _snap(xp, filled[0], hardness)
+    return _snap(xp, xp.minimum(xp.astype(mask, p.dtype) * (target / float(xp.sum(xp.astype(mask, p.dtype)))),
+                                hardness), hardness)
+
+
+def _snap(xp, p, hardness):
+    """``p`` with the values within a relative ``1e-12`` of ``H`` set to ``H``."""
+    return xp.where(p >= hardness * (1.0 - 1e-12), hardness, p)

@@ -233,7 +233,11 @@ def test_a_hardness_above_the_peak_pressure_gives_the_elastic_answer():
     assert capped.contact_area == elastic.contact_area
     sphere = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.3)
     big = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.3, hardness=1e6)
-    assert np.abs(big.p - sphere.p).max() <= 1e-11 * sphere.p_max and big.plastic_area == 0.0  # measured: equal
+    # on the half-space the bounded step gives entering nodes the pressure of a preconditioned step (free of units),
+    # the elastic one Polonsky-Keer's -min(tau, 1 / C_nn) g: two iterations, each at its KKT tolerance 1e-10
+    assert big.status == sphere.status == "converged" and big.plastic_area == 0.0
+    assert big.contact_area == sphere.contact_area
+    assert np.abs(big.p - sphere.p).max() <= 1e-8 * sphere.p_max  # measured 2.1e-9
 
 
 @pytest.mark.parametrize("control", ["force", "approach"])

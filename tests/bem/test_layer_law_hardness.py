@@ -83,10 +83,6 @@ def test_a_hardness_far_above_the_peaks_gives_the_elastic_law(surface, ladder, l
     np.testing.assert_array_equal(stiff.contact_fraction, elastic.contact_fraction)
 
 
-@pytest.mark.xfail(strict=True, raises=(rough.LadderNotConverged, ZeroDivisionError),
-                   reason="bem.solve with a hardness far below E* h'_rms fails at the first pressures: 'no elastic "
-                          "contact node can carry the force', or a ZeroDivisionError in the conjugate gradients' "
-                          "beta (bem/kalker.py), with every contact node plastic")
 def test_soft_asperities_follow_the_bearing_area_curve(surface):
     """Rigid-plastic limit: with a hardness far below ``E* h'_rms`` the elastic displacements are
     negligible (of order ``H L / E*``), every node in contact flows, ``A/A0 = p/H``, and the approach is
