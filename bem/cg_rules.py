@@ -206,8 +206,8 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
     ``changed``: a node reached a bound, entered, left or was capped (``C p`` is then to be recomputed);
     ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes;
     ``failure``: ``(message, status)`` where no step can be taken; ``restart``:
-    the step was shortened so that the force is carried, or a node entered or left with plastic nodes present
-    (the step that keeps its directions on entering nodes restarts them there).
+    the step was shortened, or nodes capped at ``H``, so that the force is carried (the step that keeps its
+    directions on entering nodes restarts them there).
     """
     xp, idx, pl, delta = bk.xp, sets.idx, sets.pl, sets.delta
 
@@ -257,7 +257,7 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
         return True, False, 1.0, ("no elastic contact node can carry the force", "stalled"), True
     new, s, capped = filled
     p[...] = new
-    return hit or moved or capped, moved, s, None, short or (moved and bool(bk.count(pl) or capped))
+    return hit or moved or capped, moved, s, None, short or capped
 
 
 def is_per_node(lam):
