@@ -42,7 +42,7 @@ from .checks import check_positive, check_range, check_scale
 from .errors import InputError
 from .materials import NU_MAX, NU_MIN
 
-__all__ = ["Bodies", "Coating", "coating_factor", "factor_taylor", "mode_compliance", "oedometric_compliance"]
+__all__ = ["Bodies", "Coating", "coating_factor", "factor_constants", "factor_taylor", "mode_compliance", "oedometric_compliance"]
 
 #: Beyond this ``q t`` every exponential of (2) is below 1e-300: ``phi = 1`` to round-off.
 _X_CLIP = 350.0
@@ -103,7 +103,7 @@ def coating_factor(x, coating, E_substrate, nu_substrate):
     x = np.minimum(np.asarray(x, dtype=float).ravel(), _X_CLIP)
     if x.size and not np.all(x >= 0):
         raise ValueError("x = q t must be >= 0 (and not NaN)")
-    one_m_lam, one_m_kap, one_m_lk = _one_minus(coating, E_substrate, nu_substrate)
+    one_m_lam, one_m_kap, one_m_lk = factor_constants(coating, E_substrate, nu_substrate)
     lam, kap = 1.0 - one_m_lam, 1.0 - one_m_kap
     lk = lam * kap
     e = np.exp(-2.0 * x)
@@ -123,8 +123,9 @@ def coating_factor(x, coating, E_substrate, nu_substrate):
     return (num / den).reshape(shape)
 
 
-def _one_minus(coating, E_substrate, nu_substrate):
-    """``1 - lambda``, ``1 - kappa`` and ``1 - lambda kappa`` of equation (2), each in closed form."""
+def factor_constants(coating, E_substrate, nu_substrate):
+    """``(1 - lambda, 1 - kappa, 1 - lambda kappa)`` of equation (2) [-], each in closed form (no cancellation
+    on a stiff substrate); the substrate's ``E_substrate`` [pressure] may be ``math.inf`` (rigid)."""
     E_s, nu_s = _substrate(E_substrate, nu_substrate)
     nu_c = coating.nu
     mu_c = coating.E / (2.0 * (1.0 + nu_c))
@@ -159,7 +160,7 @@ def factor_taylor(coating, E_substrate, nu_substrate, *, order):
     radius : float
         The radius of the circle used [-], below the radius of convergence of the series.
     """
-    one_m_lam, one_m_kap, _ = _one_minus(coating, E_substrate, nu_substrate)
+    one_m_lam, one_m_kap, _ = factor_constants(coating, E_substrate, nu_substrate)
     lam, kap = 1.0 - one_m_lam, 1.0 - one_m_kap
 
     def parts(x):

@@ -35,7 +35,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..coating import mode_compliance
+from ..coating import factor_constants, mode_compliance
 from ..errors import InputError
 from .kernel import alias_sum, periodic_template
 
@@ -83,12 +83,7 @@ def thin_limit(bodies):
         if coating is None:
             continue
         nu_c = coating.nu
-        mu_c = coating.E / (2.0 * (1.0 + nu_c))
-        k = 0.0 if E == math.inf else mu_c / (E / (2.0 * (1.0 + nu)))
-        a_s, f = 3.0 - 4.0 * nu, 3.0 - 4.0 * nu_c
-        one_m_lam = 4.0 * (1.0 - nu_c) / (1.0 + k * a_s)
-        one_m_kap = 4.0 * (1.0 - nu_c) / (k + f)
-        one_m_lk = k * (1.0 + a_s) * (1.0 + f) / ((1.0 + k * a_s) * (k + f))
+        one_m_lam, one_m_kap, one_m_lk = factor_constants(coating, E, nu)
         lam, kap = 1.0 - one_m_lam, 1.0 - one_m_kap
         d0 = one_m_lam * one_m_kap
         dphi = (4.0 * kap * (1.0 + lam) * d0 - one_m_lk * (2.0 * (lam + kap) - 4.0 * lam * kap)) / (d0 * d0)
