@@ -72,11 +72,12 @@ class Coating:
         object.__setattr__(self, "nu", check_range("nu", self.nu, NU_MIN, NU_MAX, low_open=True))
 
 
-def _substrate(E_substrate, nu_substrate):
-    nu_s = check_range("nu_substrate", nu_substrate, NU_MIN, NU_MAX, low_open=True)
+def _substrate(E_substrate, nu_substrate, names=("E_substrate", "nu_substrate")):
+    """``(E, nu)`` of a substrate checked (``E = math.inf``: rigid), the messages naming ``names``."""
+    nu_s = check_range(names[1], nu_substrate, NU_MIN, NU_MAX, low_open=True)
     if isinstance(E_substrate, (int, float)) and not isinstance(E_substrate, bool) and E_substrate == math.inf:
         return math.inf, nu_s
-    return check_scale("E_substrate", E_substrate), nu_s
+    return check_scale(names[0], E_substrate), nu_s
 
 
 def coating_factor(x, coating, E_substrate, nu_substrate):
@@ -263,7 +264,7 @@ class Bodies:
 
     def __post_init__(self):
         for i, (E, nu) in enumerate(((self.E1, self.nu1), (self.E2, self.nu2)), start=1):
-            _substrate_named(f"E{i}", E, f"nu{i}", nu)
+            _substrate(E, nu, (f"E{i}", f"nu{i}"))
             coating = getattr(self, f"coating{i}")
             if coating is not None and not isinstance(coating, Coating):
                 raise InputError(f"coating{i} = {coating!r} is not allowed: it must be a bem.Coating or None.")
@@ -286,9 +287,3 @@ class Bodies:
         return (mode_compliance(q, self.E1, self.nu1, self.coating1)
                 + mode_compliance(q, self.E2, self.nu2, self.coating2))
 
-
-def _substrate_named(E_name, E, nu_name, nu):
-    """``_substrate`` with the messages naming the body's keywords."""
-    check_range(nu_name, nu, NU_MIN, NU_MAX, low_open=True)
-    if not (isinstance(E, (int, float)) and not isinstance(E, bool) and E == math.inf):
-        check_scale(E_name, E)

@@ -43,7 +43,8 @@ FIELDS = ("U", "W", "Szz", "Ssz", "Sss", "Snn")
 
 
 def _lame(E, nu):
-    return E * nu / ((1 + nu) * (1 - 2 * nu)) if nu < 0.5 else math.inf, E / (2 * (1 + nu))
+    """Lame's ``lam, mu`` [pressure] (``nu < 0.5``: :func:`_check` refuses an incompressible material)."""
+    return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
 
 
 def _basis(q, z, s, k, z0):
@@ -60,8 +61,6 @@ def _basis(q, z, s, k, z0):
 def _stresses(q, parts, lam, mu):
     """``Szz, Ssz, Sss, Snn`` of ``(U, U', W, W')`` in a material of Lame constants ``lam``, ``mu``."""
     U, dU, W, dW = parts
-    if math.isinf(lam):  # incompressible: lam (q U + W') -> the pressure; not reached (nu <= 0.5 - eps in use)
-        raise ValueError("an incompressible material has no Lame constant lam: use nu < 0.5")
     div = q * U + dW
     return np.stack([lam * div + 2 * mu * dW, mu * (dU - q * W), lam * div + 2 * mu * q * U, lam * div])
 
@@ -115,7 +114,7 @@ def mode_fields(q, z, coating, E_substrate, nu_substrate, *, side="coating"):
     lam_c, mu_c = _lame(coating.E, coating.nu)
     k_c = 3 - 4 * coating.nu
     rigid = math.isinf(E_s)
-    lam_s, mu_s = (math.inf, math.inf) if rigid else _lame(E_s, nu_s)
+    lam_s, mu_s = (None, None) if rigid else _lame(E_s, nu_s)
     k_s = 3 - 4 * nu_s
     thick = q * t >= 1.0  # the growing pair written from the interface
     z0_grow = np.where(thick, t, 0.0)

@@ -155,3 +155,25 @@ def test_inputs_are_not_modified():
 def test_bad_coating_is_refused_naming_the_argument(kwargs, name):
     with pytest.raises(InputError, match=rf"^{name} = "):
         Coating(**kwargs)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(E1=-1.0), "E1"), (dict(nu2=0.9), "nu2"), (dict(coating1="thin"), "coating1"),
+    (dict(E1=math.inf, E2=math.inf), "E1 = E2 = inf")])
+def test_bodies_refuse_bad_input_naming_the_keyword(kwargs, name):
+    from bem.coating import Bodies
+
+    args = dict(E1=1.0, nu1=0.3, E2=1.0, nu2=0.3) | kwargs
+    with pytest.raises(InputError, match=name):
+        Bodies(**args)
+
+
+def test_bodies_combine_the_compliances_and_see_the_substrates_at_long_waves():
+    from bem.coating import Bodies
+
+    c = Coating(0.1, 0.5, 0.25)
+    b = Bodies(E1=2.0, nu1=0.3, E2=math.inf, nu2=0.3, coating1=c)
+    q = np.array([1e-9, 1.0, 1e4])
+    np.testing.assert_allclose(b.compliance(q), mode_compliance(q, 2.0, 0.3, c), rtol=1e-15)
+    assert b.E_star == pytest.approx(2.0 / (1 - 0.09), rel=1e-15)
+    assert b.compliance(q)[0] == pytest.approx(1 / b.E_star, rel=1e-7)
