@@ -273,7 +273,7 @@ class PeriodicOperator:
         xp = self.backend.xp
         a = xp.real(self._s00) + lam
         b = self.backend.copy(self._s01)
-        shift = 0.5 * self.diagonal  # the constant mode (1, 1) / sqrt 2 of frequency 0 gets eigenvalue C_nn + lam
+        shift = 0.5 * float(self.diagonal)  # the constant mode (1, 1) / sqrt 2 of frequency 0 gets eigenvalue C_nn + lam
         a[0, 0] += shift
         b[0, 0] += shift
         det = a * a - (xp.real(b) ** 2 + xp.imag(b) ** 2)

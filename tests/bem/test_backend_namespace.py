@@ -102,6 +102,33 @@ def test_strict_namespace_periodic_solve_equals_the_numpy_solve(strict, layer, m
     assert set(seen) == {"array_api_strict"}
 
 
+COATING = dict(E1=1.0, nu1=0.3, E2=1.0, nu2=0.3)
+
+
+@pytest.mark.parametrize("case", ["hardness", "coating"])
+def test_hardness_and_coatings_run_on_the_strict_namespace(strict, case):
+    """The hardness cap (bounded step) and a coated body (coated influence coefficients, coated
+    cell kernel) on the strict namespace: the NumPy answer, on the half-space and on the cell."""
+    extra = (dict(E_star=1.0, hardness=0.5) if case == "hardness"
+             else dict(COATING, coating1=bem.Coating(0.2, 3.0, 0.3)))
+    kw = {k: v for k, v in KW.items() if k != "E_star"} | extra
+    ref = bem.solve(Paraboloid(1.0), **kw)
+    seen, callback = _iterates(strict)
+    _same(ref, bem.solve(Paraboloid(1.0), device=strict, callback=callback, **kw))
+    assert set(seen) == {"array_api_strict"}
+    if case == "hardness":
+        assert 0 < ref.plastic_area
+    cell = PeriodicCell(1.0 / 32, 32, 32)
+    kw = dict(step=cell.step, mean_pressure=2.0, rtol=1e-13) | (dict(E_star=1.0, hardness=4.0) if case == "hardness"
+                                                                else extra)
+    ref = solve_periodic(_rough(cell), **kw)
+    seen, callback = _iterates(strict)
+    _same(ref, solve_periodic(_rough(cell), device=strict, callback=callback, **kw))
+    assert set(seen) == {"array_api_strict"}
+    if case == "hardness":
+        assert 0 < ref.plastic_fraction < ref.contact_fraction
+
+
 def test_an_unknown_device_is_refused():
     with pytest.raises(bem.InputError, match="device = 'tpu' is not allowed: .*'cpu', 'cuda' or an array API"):
         bem.solve(Paraboloid(1.0), device="tpu", **KW)
