@@ -65,3 +65,22 @@ def test_an_incompressible_coating_is_no_winkler_layer_and_its_pressure_stays_fi
 def test_nearly_incompressible_coatings_converge_with_finite_pressure(nu_c):
     coated, _ = _pair(5, nu_c)
     assert np.all(np.isfinite(coated.p)) and coated.p.max() > 0
+
+
+def test_coatings_a_thousandth_of_a_step_and_a_thousand_regions_thick_give_their_limits():
+    """On the half-space region: ``t = c / 1000`` is the substrate with the thin-limit layer
+    (:func:`bem.periodic.coated.thin_limit`, the long-wave slope of the compliance), ``t = 1000``
+    times the region the coating's own half-space, each to 1e-6 of the peak pressure."""
+    from bem.periodic.coated import thin_limit
+
+    step, extent = 0.05, 1.2
+    kw = dict(force=1.0, step=step, extent=extent, E1=1.0, nu1=0.3, E2=1.0, nu2=0.3, rtol=1e-12)
+    thin = bem.solve(Paraboloid(1.0), coating2=bem.Coating(step / 1000, 0.3, 0.35), **kw)
+    limit = bem.solve(Paraboloid(1.0), layer=layers.Linear(thin_limit(thin.bodies)), **kw)
+    bare = bem.solve(Paraboloid(1.0), **kw)
+    assert np.abs(thin.p - limit.p).max() <= 1e-6 * limit.p.max()  # measured 1.6e-7
+    assert np.abs(thin.p - bare.p).max() >= 1e-4 * bare.p.max()  # the coating is seen (2.8e-4)
+    thick = bem.solve(Paraboloid(1.0), coating2=bem.Coating(1000 * 2 * extent, 3.0, 0.35), **kw)
+    own = bem.solve(Paraboloid(1.0), **dict(kw, E2=3.0, nu2=0.35))
+    assert np.all(np.isfinite(thick.p))
+    assert np.abs(thick.p - own.p).max() <= 1e-6 * own.p.max()  # measured 2.6e-11
