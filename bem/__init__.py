@@ -21,7 +21,7 @@ from .periodic import PeriodicCell, PeriodicContactResult, PeriodicOperator, sol
 from .region import HalfSpaceRegion
 from .solve import solve
 from .stress import SubsurfaceStress, subsurface_stress
-from .coated_stress import CoatedStress, coated_stress
+from .coated_subsurface import CoatedStress, coated_stress
 from .template import template
 
 __all__ = ["solve", "solve_periodic", "Bodies", "Coating", "HalfSpaceRegion", "PeriodicCell", "PeriodicOperator", "PeriodicContactResult",

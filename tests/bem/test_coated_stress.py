@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import bem
-from bem.coated_stress import coating_of_substrate
+from bem.coated_subsurface import coating_of_substrate
 from bem.coating_fields import axisymmetric_stress, mode_fields
 from bem.gaps import Paraboloid
 from bem.mode_sum import rotated_modes
