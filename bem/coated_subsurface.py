@@ -151,8 +151,9 @@ class CoatedStress:
     wall_time_s: float
     meta: dict = field(default_factory=dict)
 
-    def interface_traction(self, side="substrate"):
-        """``sigma_zz``, ``sigma_xz``, ``sigma_yz`` and the shear ``hypot(xz, yz)`` at the interface [pressure], shape (M,) each."""
+    def interface_traction(self, side="coating"):
+        """``zz``, ``xz``, ``yz`` (``sigma_zz``, ``sigma_xz``, ``sigma_yz``) and ``shear`` (``hypot(xz, yz)``) at the
+        interface [pressure], shape (M,) each, from the ``side`` ``"coating"`` or ``"substrate"`` (equal to round-off)."""
         s = {"coating": self.interface_coating, "substrate": self.interface_substrate}[side]
         return {"zz": s[:, 2], "xz": s[:, 4], "yz": s[:, 3], "shear": np.hypot(s[:, 4], s[:, 3])}
 

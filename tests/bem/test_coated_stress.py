@@ -218,3 +218,15 @@ def test_uncoated_and_rigid_substrates_are_refused_by_name():
     assert st.interface_substrate is None and np.isfinite(st.sigma).all()
     with pytest.raises(bem.InputError, match=r"z\[1\] = 0.5 is not allowed: body 1's substrate is rigid"):
         bem.coated_stress(rigid, [0.1, 0.5])
+
+
+def test_the_coated_body_is_found_on_either_side():
+    kw = dict(force=0.1, step=0.1, extent=1.4)
+    one = bem.solve(Paraboloid(10.0), E1=ES, nu1=NUS, E2=math.inf, nu2=0.0, coating1=COAT, **kw)
+    two = bem.solve(Paraboloid(10.0), E1=math.inf, nu1=0.0, E2=ES, nu2=NUS, coating2=COAT, **kw)
+    a, b = bem.coated_stress(one, [0.1, 0.5]), bem.coated_stress(two, [0.1, 0.5])
+    assert (a.body, b.body) == (1, 2)
+    assert np.abs(a.sigma - b.sigma).max() <= 1e-12 * one.p_max
+    both = bem.solve(Paraboloid(10.0), E1=ES, nu1=NUS, E2=ES, nu2=NUS, coating1=COAT, coating2=COAT, **kw)
+    with pytest.raises(bem.InputError, match="body = None is not allowed: both bodies are coated"):
+        bem.coated_stress(both, [0.1])
