@@ -21,9 +21,10 @@ from .periodic import PeriodicCell, PeriodicContactResult, PeriodicOperator, sol
 from .region import HalfSpaceRegion
 from .solve import solve
 from .stress import SubsurfaceStress, subsurface_stress
+from .coated_subsurface import CoatedStress, coated_stress
 from .template import template
 
 __all__ = ["solve", "solve_periodic", "Bodies", "Coating", "HalfSpaceRegion", "PeriodicCell", "PeriodicOperator", "PeriodicContactResult",
-           "subsurface_stress", "SubsurfaceStress", "template", "Lattice", "InfluenceOperator",
+           "subsurface_stress", "SubsurfaceStress", "coated_stress", "CoatedStress", "template", "Lattice", "InfluenceOperator",
            "ContactResult", "STATUSES", "METHODS", "OPTIONS", "RegionTooSmallError", "InputError", "checks", "diagonal_coefficient",
            "effective_modulus", "gaps", "layers"]

@@ -302,7 +302,7 @@ def subsurface_stress(result, z, *, nu, x=None, y=None, device="cpu"):
     nu : float
         Poisson's ratio of the body, in ``(-1, 0.5]``. For dissimilar bodies call once per body:
         frictionless, each body carries the same pressure and its stresses depend only on its
-        own ``nu`` (not on ``E``).
+        own ``nu`` (not on ``E``). A coated body's stresses: :func:`bem.coated_stress`.
     x, y : array_like, shape (M,), optional
         Horizontal points [length] inside the candidate region; default: every candidate node
         (``result.x``, ``result.y``). Values between nodes are interpolated linearly.
