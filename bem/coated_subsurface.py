@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -310,15 +310,16 @@ def coated_stress(result, z, *, body=None, x=None, y=None, pad=4.0):
     out = np.zeros((depths.size, x.size, 6))
     if not periodic:
         kw = {} if on_nodes else {"x": x, "y": y}
+        homogeneous = replace(result, bodies=None)  # the pressure on homogeneous half-spaces of each nu
         zc = depths[[s == "coating" for s in sides]]
         zs = depths[[s == "substrate" for s in sides]]
         if zc.size:
-            bc = subsurface_stress(result, np.concatenate([zc, zc + t]), nu=coating.nu, **kw).sigma
-            bs = subsurface_stress(result, zc + t, nu=nu_s, **kw).sigma
+            bc = subsurface_stress(homogeneous, np.concatenate([zc, zc + t]), nu=coating.nu, **kw).sigma
+            bs = subsurface_stress(homogeneous, zc + t, nu=nu_s, **kw).sigma
             out[[s == "coating" for s in sides]] = (bc[:zc.size] - bc[zc.size:]
                                                      + coating_of_substrate(bs, *mats))
         if zs.size:
-            out[[s == "substrate" for s in sides]] = subsurface_stress(result, zs, nu=nu_s, **kw).sigma
+            out[[s == "substrate" for s in sides]] = subsurface_stress(homogeneous, zs, nu=nu_s, **kw).sigma
     g_cuts = []
     for k, (depth, side) in enumerate(zip(depths, sides)):
         if periodic:

@@ -142,7 +142,8 @@ def test_equal_materials_give_the_homogeneous_stress():
                     force=0.1, step=0.1, extent=1.4)
     z = np.array([0.0, 0.1, 0.3, 0.6])
     st = bem.coated_stress(res, z)
-    hom = bem.subsurface_stress(res, np.concatenate([z, [0.3]]), nu=NUS)
+    plain = dataclasses.replace(res, bodies=None)  # the same pressure, read as a homogeneous body's
+    hom = bem.subsurface_stress(plain, np.concatenate([z, [0.3]]), nu=NUS)
     assert np.abs(st.sigma - hom.sigma[:4]).max() <= 1e-12 * res.p_max
     assert np.abs(st.interface_coating - hom.sigma[4]).max() <= 1e-12 * res.p_max
     assert np.abs(st.interface_substrate - hom.sigma[4]).max() <= 1e-12 * res.p_max
@@ -230,3 +231,17 @@ def test_the_coated_body_is_found_on_either_side():
     both = bem.solve(Paraboloid(10.0), E1=ES, nu1=NUS, E2=ES, nu2=NUS, coating1=COAT, coating2=COAT, **kw)
     with pytest.raises(bem.InputError, match="body = None is not allowed: both bodies are coated"):
         bem.coated_stress(both, [0.1])
+
+
+def test_the_homogeneous_stress_refuses_a_coated_body_and_takes_the_uncoated_one():
+    res = bem.solve(Paraboloid(10.0), E1=ES, nu1=NUS, E2=2.0, nu2=0.3, coating1=COAT, force=0.1, step=0.15,
+                    extent=3.0)
+    with pytest.raises(bem.InputError, match=r"^body = None is not allowed for this result: body 1 is coated"):
+        bem.subsurface_stress(res, 0.1, nu=NUS)
+    with pytest.raises(bem.InputError, match=r"^body = 1 is not allowed: that body is coated"):
+        bem.subsurface_stress(res, 0.1, nu=NUS, body=1)
+    with pytest.raises(bem.InputError, match=r"^body = 3 is not allowed"):
+        bem.subsurface_stress(res, 0.1, nu=0.3, body=3)
+    lower = bem.subsurface_stress(res, [0.1, 0.3], nu=0.3, body=2)
+    plain = bem.subsurface_stress(dataclasses.replace(res, bodies=None), [0.1, 0.3], nu=0.3)
+    assert np.array_equal(lower.sigma, plain.sigma)
