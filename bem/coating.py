@@ -42,7 +42,8 @@ from .checks import check_positive, check_range, check_scale
 from .errors import InputError
 from .materials import NU_MAX, NU_MIN
 
-__all__ = ["Bodies", "Coating", "coating_factor", "factor_constants", "factor_taylor", "mode_compliance", "oedometric_compliance"]
+__all__ = ["Bodies", "Coating", "check_uncoated_body", "coating_factor", "factor_constants", "factor_taylor", "mode_compliance",
+           "oedometric_compliance"]
 
 #: Beyond this ``q t`` every exponential of (2) is below 1e-300: ``phi = 1`` to round-off.
 _X_CLIP = 350.0
@@ -287,3 +288,19 @@ class Bodies:
         return (mode_compliance(q, self.E1, self.nu1, self.coating1)
                 + mode_compliance(q, self.E2, self.nu2, self.coating2))
 
+
+def check_uncoated_body(result, body):
+    """Refuse ``body`` of ``result`` for a homogeneous body's stresses (:func:`bem.subsurface_stress`): a
+    coated body, or no body named where one of the two is coated; ``body`` must be 1, 2 or None."""
+    bodies = getattr(result, "bodies", None)
+    coated = [] if bodies is None else [i for i in (1, 2) if getattr(bodies, f"coating{i}") is not None]
+    if body is not None and body not in (1, 2):
+        raise InputError(f"body = {body!r} is not allowed: it must be 1, 2 or None.")
+    if not coated:
+        return
+    if body is None:
+        raise InputError(f"body = None is not allowed for this result: body {coated[0]} is coated, so the body must be "
+                         "named (its stresses, in the coating and the substrate: bem.coated_stress).")
+    if body in coated:
+        raise InputError(f"body = {body!r} is not allowed: that body is coated, and its stresses are those of "
+                         "bem.coated_stress (in the coating and the substrate), not of a homogeneous half-space.")

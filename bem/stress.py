@@ -41,6 +41,7 @@ import numpy as np
 
 from . import boussinesq as bq
 from .checks import InputError, check_finite_array, check_range
+from .coating import check_uncoated_body
 from .kernel_convolution import SymmetricKernelConvolution
 from .result import ContactResult
 
@@ -289,22 +290,6 @@ def _convolve_depths(lattice, grid, loaded, depths, nu, x, y, on_nodes, store, v
             list(pool.map(one, range(len(depths))))
 
 
-def _check_uncoated(result, body):
-    """Refuse a coated body, and an unnamed body of a result with a coated one."""
-    bodies = getattr(result, "bodies", None)
-    coated = [] if bodies is None else [i for i in (1, 2) if getattr(bodies, f"coating{i}") is not None]
-    if body is not None and body not in (1, 2):
-        raise InputError(f"body = {body!r} is not allowed: it must be 1, 2 or None.")
-    if not coated:
-        return
-    if body is None:
-        raise InputError(f"body = None is not allowed for this result: body {coated[0]} is coated, so the body must be "
-                         "named (its stresses, in the coating and the substrate: bem.coated_stress).")
-    if body in coated:
-        raise InputError(f"body = {body!r} is not allowed: that body is coated, and its stresses are those of "
-                         "bem.coated_stress (in the coating and the substrate), not of a homogeneous half-space.")
-
-
 def subsurface_stress(result, z, *, nu, x=None, y=None, body=None, device="cpu"):
     """Stress tensor at depths ``z`` below the surface of a body under the computed contact pressure.
 
@@ -323,8 +308,7 @@ def subsurface_stress(result, z, *, nu, x=None, y=None, body=None, device="cpu")
         Horizontal points [length] inside the candidate region; default: every candidate node
         (``result.x``, ``result.y``). Values between nodes are interpolated linearly.
     body : {1, 2}, optional
-        The body, where ``result`` has a coated one (``result.bodies``): it must be named and
-        be the uncoated body; a coated body's stresses are :func:`bem.coated_stress`'s.
+        The (uncoated) body, named where ``result`` has a coated one (:func:`bem.coated_stress`).
     device : {"cpu", "cuda"} or module
         Where the convolutions run (:mod:`bem.backend`). The kernel samples and their
         cosine/sine transforms (not in the array API standard) are computed on the host and
@@ -367,7 +351,7 @@ def subsurface_stress(result, z, *, nu, x=None, y=None, body=None, device="cpu")
         raise InputError("result = PeriodicContactResult is not allowed: it must be a bounded contact of bem.solve; "
                          "the stresses below a periodic cell need the images of every other cell, which this "
                          "sum over one candidate region does not hold.")
-    _check_uncoated(result, body)
+    check_uncoated_body(result, body)
     nu = check_range("nu", nu, -1.0, 0.5, low_open=True)
     z = check_finite_array("z", z)
     if z.ndim > 1:
