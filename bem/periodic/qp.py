@@ -154,16 +154,15 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
     M = op.symbol(lam_pc, inverse=True, single=True)
     A32 = op.symbol(lam, single=True)
-    spectral = (lat.n_rows // 2, 2, lat.n_cols // 2 + 1)  # the layout of PeriodicOperator.spectrum
-    work, work32, r_hat = np.empty(spectral, dtype=complex), np.empty(spectral, dtype=np.complex64), None
+    r_hat = None  # the spectrum of (C + lam) t, kept from step to step
 
     def product(v):
         op.n_matvec += 1
         if single:
             x = op.spectrum(v.astype(np.float32))
-            return op.mix(x, A32, out=x, work=work32)
+            return op.mix(x, A32, out=x)
         x = op.spectrum(v)
-        return op.mix(x, A, out=x, work=work)
+        return op.mix(x, A, out=x)
 
     def precondition(r32, idx, r_c):  # M r at the nodes idx: r_c = r there, r32 = r (float32) at the stiff nodes
         x = op.spectrum(r32)
@@ -233,6 +232,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         nonlocal single, u, stale
         if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
             single = False  # confirm on an exact product, or go on in double precision
+            u = None  # the product replaces it: not both at once
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:
                 u += D * p
@@ -296,7 +296,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         gz_old = gz
         T = op.spectrum(t)
         op.n_matvec += 1
-        R = r_hat = op.mix(T, A32, out=r_hat, work=work32)  # (C + lam) t, single precision
+        R = r_hat = op.mix(T, A32, out=r_hat)  # (C + lam) t, single precision
         tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
         if per_node:
             D_c = Df[idx]
@@ -336,6 +336,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 p_o *= s
             pf[overlap] = p_o
         if bool(clipped.any()) or entered or stale >= RECOMPUTE_EVERY:
+            u = None
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:  # u += D p, on the nodes where p > 0
                 uf = u.reshape(-1)
@@ -361,6 +362,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if failure is not None:
             return failure
         if changed or R is None or stale >= RECOMPUTE_EVERY:
+            u = None
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:
                 u += D * p
