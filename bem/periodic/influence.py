@@ -18,6 +18,7 @@ and :mod:`bem.fixed_point` run on it unchanged.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 import scipy.fft as sfft
@@ -48,6 +49,28 @@ def _checked_bodies(bodies, E_star):
         raise InputError(f"E_star = {E_star!r} is not allowed with bodies: it must be bodies.E_star = "
                          f"{bodies.E_star!r}, the substrates' effective modulus.")
     return bodies if bodies.is_coated else None
+
+
+def _spectra(w):
+    """Spectra of ``K_00 = K_11``, ``K_10`` and ``K_01`` of the kernel ``w`` (brick array), stacked.
+
+    Real kernels; the ``1/N`` of the inverse FFT is applied there."""
+    even, odd = w[0::2], w[1::2]
+    return sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
+
+
+def _packed(spectra):
+    """The packed symbol of :meth:`PeriodicOperator.mix` from :func:`_spectra` (the spectra themselves are not kept)."""
+    return PeriodicOperator._pack(spectra[0].real, spectra[2], spectra[1])
+
+
+@lru_cache(maxsize=8)  # the levels of nested iteration of one or two cells
+def _homogeneous_symbol(n_rows, n_cols, scale):
+    """The packed symbol of the homogeneous operator of a cell, ``scale = c / (pi E*)``, read-only."""
+    d, b = _packed(_spectra(periodic_template(n_rows, n_cols, cache=False) * scale))
+    d.setflags(write=False)
+    b.setflags(write=False)
+    return d, b
 
 
 class PeriodicOperator:
@@ -87,29 +110,26 @@ class PeriodicOperator:
         self.bodies = _checked_bodies(bodies, self.E_star)
         self.n_matvec = 0
         self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
+        self._spectrum_shape = (lattice.n_rows // 2, lattice.n_cols // 2 + 1)
+        self._symbol32 = self._symbol = self._s00 = None
+        scale = lattice.step / (math.pi * self.E_star)
+        if self.bodies is None and bk.is_numpy:  # the packed symbol only, shared by the operators of a cell
+            self._symbol = _homogeneous_symbol(lattice.n_rows, lattice.n_cols, scale)
+            return
         w = self._template()
         if self.bodies is not None:
             self.diagonal *= w[0, 0] / periodic_template(lattice.n_rows, lattice.n_cols)[0, 0]
-        w = w * (lattice.step / (math.pi * self.E_star))
-        even, odd = w[0::2], w[1::2]
-        self._spectrum_shape = (even.shape[0], even.shape[1] // 2 + 1)
-        spectra = sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
-        del w, even, odd
-        # spectra of K_00 = K_11, K_10 and K_01 (real kernels: the 1/N of the inverse FFT is applied there).
-        # On NumPy only the packed symbol of mix() is kept (the spectra it is made of are not): its real
-        # diagonal block once, the off-diagonal blocks as they are
-        self._symbol32 = None
+        spectra = _spectra(w * scale)
         if bk.is_numpy:
-            self._symbol, self._s00 = self._pack(spectra[0].real, spectra[2], spectra[1]), None
+            self._symbol = _packed(spectra)
         else:
             self._s00, self._s10, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra)
-            self._symbol = None
 
     def _template(self):
         """The dimensionless template of the cell: periodic, or of the coated bodies."""
         lat = self.lattice
         if self.bodies is None:
-            return periodic_template(lat.n_rows, lat.n_cols)
+            return periodic_template(lat.n_rows, lat.n_cols, cache=False)
         return coated_template(lat.n_rows, lat.n_cols, lat.step, self.bodies)
 
     @property

@@ -180,9 +180,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     if per_node:
         u += D * p
         softf, jacf, Df = (None if soft is None else soft.reshape(-1)), jacobi.reshape(-1), D.reshape(-1)
-    t = np.zeros(lat.shape, dtype=np.float32)  # the search direction, transformed in single precision
+    # the search direction, transformed in single precision, and in the same array the gap on the contact
+    # that the preconditioner transforms (the direction at the contact nodes is taken out first)
+    t = r32 = np.zeros(lat.shape, dtype=np.float32)
     g = np.empty(lat.shape)
-    r32 = np.empty(lat.shape, dtype=np.float32)
     r32f = r32.reshape(-1)
     z_prev = np.zeros(lat.shape)
     gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
@@ -257,6 +258,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         nonlocal m_full, m_one, gz_old, r_hat, u, stale
         if bounded and not idx.size:  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, np.zeros(0), None, None)
+        t_old = np.take(tf, idx)  # the last direction on the contact (r32 is t)
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         r32.fill(0.0)  # a fill: faster than zeroing the nodes of the last step
         if soft is None:
@@ -285,7 +287,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
         z_prev.fill(0.0)
         zf[idx] = z
-        t_c = z + beta * np.take(tf, idx)
+        t_c = z + beta * t_old
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (t_c.sum() / m_one.sum()) if m_one is not None else t_c.mean()
         gt = float(np.einsum("i,i->", g_c, t_c))
