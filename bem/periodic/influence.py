@@ -30,10 +30,7 @@ from ..operator import diagonal_coefficient
 from .coated import coated_template
 from .kernel import periodic_template
 
-__all__ = ["PeriodicOperator", "MIX_BLOCK"]
-
-#: entries of a spectrum per block of :meth:`PeriodicOperator.mix` (its buffer: one block, not a spectrum)
-MIX_BLOCK = 1 << 15
+__all__ = ["PeriodicOperator"]
 
 
 def _checked_bodies(bodies, E_star):
@@ -178,13 +175,13 @@ class PeriodicOperator:
         ``symbol = (D, B)`` in the same layout: ``D[:, a] = S_aa`` (real; ``D`` of shape
         ``(n_rows/2, 1, n_cols/2 + 1)`` where the two blocks are equal, as :meth:`symbol` gives
         it) and ``B[:, a] = S_a(1-a)``, so that ``out = D X + B X'`` with ``X'`` the spectrum with
-        its parities swapped: three passes over blocks of :data:`MIX_BLOCK` entries (the product
+        its parities swapped: three passes over blocks of :data:`bem.fft.BLOCK` entries (the product
         ``B X'`` in a buffer of one block), on :func:`bem.fft.in_parts` threads. ``out``
         (default: a new array) may be ``spectrum`` itself.
         """
         d, b = symbol
         out = np.empty_like(spectrum) if out is None else out
-        rows = max(1, MIX_BLOCK // (spectrum.size // max(spectrum.shape[0], 1) or 1))
+        rows = max(1, fft.BLOCK // (spectrum.size // max(spectrum.shape[0], 1) or 1))
 
         def part(s):  # rows s of every array: the parity swap stays inside a row
             work = np.empty((min(rows, s.stop - s.start),) + spectrum.shape[1:], dtype=spectrum.dtype)
