@@ -77,10 +77,11 @@ def _block_product(S, V):
     same numbers), elsewhere of a whole spectrum each."""
     if not isinstance(S, tuple):  # the kernel spectra of a window, one array S[a, b, ...]
         S = ((S[0, 0, ...], S[0, 1, ...]), (S[1, 0, ...], S[1, 1, ...]))
+    conj = S[1][0] is None  # a Hermitian symbol: S_10 = conj(S_01), not stored
     if not isinstance(V, np.ndarray):
         t = S[0][1] * V[1, ...]
         V[1, ...] *= S[1][1]
-        V[1, ...] += S[1][0] * V[0, ...]
+        V[1, ...] += (V[0, ...] * S[0][1].conj() if conj else S[1][0] * V[0, ...])
         V[0, ...] *= S[0][0]
         V[0, ...] += t
         return V
@@ -94,7 +95,11 @@ def _block_product(S, V):
         v0, v1 = V[0, r], V[1, r]
         np.multiply(S[0][1][r], v1, out=t[:n])
         v1 *= S[1][1][r]
-        np.multiply(S[1][0][r], v0, out=w[:n])
+        if conj:
+            np.conjugate(S[0][1][r], out=w[:n])
+            w[:n] *= v0
+        else:
+            np.multiply(S[1][0][r], v0, out=w[:n])
         v1 += w[:n]
         v0 *= S[0][0][r]
         v0 += t[:n]
@@ -201,7 +206,10 @@ class InfluenceOperator:
         lq = fft.fast_length(nq + bq - 1, real=True)
         f = np.r_[0:nq, -(bq - 1) : 0]  # circular column positions
         dq = f + oq - iq  # column offset output - input
-        kernels = np.zeros((2, 2, lk, lq))
+        # on NumPy one block at a time into the spectra (the same numbers as the batch: each line is
+        # transformed alone), so that the padded kernels are never all held at once
+        numpy = self.backend.is_numpy
+        out = np.empty((2, 2, lk, lq // 2 + 1), dtype=complex) if numpy else np.zeros((2, 2, lk, lq))
         for a in (0, 1):
             for b in (0, 1):
                 (oa, na), (ib, nb) = o_rows[a], i_rows[b]
@@ -209,11 +217,19 @@ class InfluenceOperator:
                 dr = self._start[a] - self._start[b] + 2 * (e + oa - ib)  # brick row offset
                 t = (np.abs(2 * dq + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
                 block = self._table.take(np.abs(dr), axis=0).take(t, axis=1)  # rows e, columns f
+                kernel = np.zeros((lk, lq)) if numpy else out[a, b]
                 for rows, src_r in ((slice(0, na), slice(0, na)), (slice(lk - nb + 1, lk), slice(na, None))):
                     for cols, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq + 1, lq), slice(nq, None))):
-                        kernels[a, b, rows, cols] = block[src_r, src_c]
-        kernels /= lk * lq
-        return (lk, lq), self.backend.forward(self.backend.asarray(kernels), (lk, lq))
+                        kernel[rows, cols] = block[src_r, src_c]
+                del block
+                if numpy:
+                    kernel /= lk * lq
+                    out[a, b] = fft.forward(kernel, (lk, lq))
+                    del kernel
+        if numpy:
+            return (lk, lq), out
+        out /= lk * lq
+        return (lk, lq), self.backend.forward(self.backend.asarray(out), (lk, lq))
 
     def _cached(self, key, build):
         if key in self._spectra:
@@ -254,10 +270,10 @@ class InfluenceOperator:
             k0, nb = i_rows[b]
             data[b, :nb, :] = v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq]
         V = _block_product(spectra, bk.forward(data, shape))
-        res = bk.inverse(V, shape, (max(r[1] for r in o_rows), nq))
-        for a, s in enumerate(self._start):
+        del data
+        for a, s in enumerate(self._start):  # one parity at a time: half the inverse's output held at once
             k0, na = o_rows[a]
-            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = res[a, :na, :]
+            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = bk.inverse(V[a], shape, (na, nq))
         if self._masked_last:
             out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 
@@ -332,9 +348,10 @@ class InfluenceOperator:
             if full:
                 box = self._full()
             if box not in symbols:
-                shape, K = self._cached(("M", box), lambda: self._kernel_spectra(box, box))
                 symbols.clear()  # one box at a time: the contact moves rarely
+                shape, K = self._kernel_spectra(box, box)  # not cached: only its inverse is kept
                 symbols[box] = shape, self._inverse_symbol(K, shape, lam, floor)
+                del K
             shape, spectra = symbols[box]
             self._convolve(spectra, shape, r, box, box, out)
             return out
@@ -358,8 +375,9 @@ class InfluenceOperator:
         diff = inv_hi - inv_lo
         pb = B * half * diff
         scale = 1.0 / (shape[0] * shape[1]) ** 2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
+        # S_10 = conj(S_01): not stored (None), _block_product conjugates S_01
         return ((inv_lo + xp.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale), \
-            (xp.conj(pb) * scale, (inv_lo + xp.where(safe, (D - m + d) * half, 0.5) * diff) * scale)
+            (None, (inv_lo + xp.where(safe, (D - m + d) * half, 0.5) * diff) * scale)
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""

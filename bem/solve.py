@@ -267,7 +267,28 @@ def _solve_on(region, gap, problem, x0, t_start):
     sol.displacement = None
     layer = problem.layer
     closure = None if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
-    return _result(region, lattice, op, h, sol, closure, problem, t_start, n_matvec=n_matvec)
+    u = to_host(op.matvec(sol.p))
+    n_matvec += op.n_matvec
+    op = None  # its kernel spectra go before the result is made
+    g, scale = _deformed_gap(u, closure, h, sol.approach)
+    # the full arrays are handed over in a dict, so that the result can let each go once it has its nodes
+    fields = dict(u=u, g=g, closure=closure)
+    u = g = closure = h = h_lat = None
+    return _result(region, lattice, fields, scale, sol, problem, t_start, n_matvec)
+
+
+def _deformed_gap(u, closure, h, approach):
+    """``(g, s)``: the gap ``u + closure + h - approach`` and the scale ``max |u + closure|`` of the KKT residual
+    (``closure`` None: no layer), without temporaries beyond ``g``."""
+    if closure is None:  # (u + 0) + h - delta, in place
+        g = u + h
+        scale = max(float(u.max()), -float(u.min()))  # max |u|
+    else:
+        g = u + closure
+        scale = max(float(g.max()), -float(g.min()))
+        g += h
+    g -= approach
+    return g, scale
 
 
 def _check_capacity(region, lattice, problem):
@@ -312,10 +333,11 @@ def _dispatch(solver, op, h, layer, precondition, kw, options):
     return run(op, h, layer=layer, precondition=precondition, **kw, **options)
 
 
-def _result(region, lattice, op, h, sol, closure, problem, t_start, n_matvec=0):
-    """The result on the candidate nodes; ``closure`` None: no layer (zeros). Where every node is a
-    candidate (a periodic cell) its arrays are flat views of the lattice's, not copies: x and y
-    (the lattice's, read-only), p, the displacement and the gap."""
+def _result(region, lattice, fields, scale, sol, problem, t_start, n_matvec):
+    """The result on the candidate nodes from the full arrays ``fields`` (``u``, ``g`` and ``closure``, None
+    without a layer: zeros), each let go once its nodes are taken. Where every node is a candidate (a
+    periodic cell) its arrays are flat views, not copies: x and y (the lattice's, read-only), p, the
+    displacement and the gap; elsewhere the lattice's coordinates are made one at a time and released."""
     mask = lattice.mask
     whole = bool(mask.all())
 
@@ -328,29 +350,29 @@ def _result(region, lattice, op, h, sol, closure, problem, t_start, n_matvec=0):
             flat.flags.writeable = False
         return flat
 
+    def coordinate(name):
+        values = nodes(getattr(lattice, name), False)
+        if not whole and hasattr(lattice, "release_coordinates"):
+            lattice.release_coordinates()
+        return values
+
     p = sol.p
-    u = to_host(op.matvec(p))
-    if closure is None:  # (u + 0) + h - delta, in place
-        g = u + h
-        scale = max(float(u.max()), -float(u.min()))  # max |u|, without a temporary
-    else:
-        g = u + closure
-        scale = max(float(g.max()), -float(g.min()))
-        g += h
-    g -= sol.approach
     a = lattice.node_area
-    p_n, g_n = nodes(p), nodes(g)
+    p_n, g_n = nodes(p), nodes(fields.pop("g"))
     kkt = kkt_residual(p_n, g_n, displacement_scale=scale, force=problem.force, node_area=a, hardness=problem.hardness)
     if not np.all(np.isfinite(p)):
         raise FloatingPointError(f"{problem.solver}: the solver produced non-finite pressures ({sol.message})")
     n_nodes = p_n.size
+    u_n = nodes(fields.pop("u"))
+    closure = fields.pop("closure")
+    closure = np.zeros(n_nodes) if closure is None else nodes(closure)
+    x, y = coordinate("x"), coordinate("y")
     return region.result_class(
-        x=nodes(lattice.x, False), y=nodes(lattice.y, False), p=p_n, displacement=nodes(u),
-        closure=np.zeros(n_nodes) if closure is None else nodes(closure), gap=g_n,
+        x=x, y=y, p=p_n, displacement=u_n, closure=closure, gap=g_n,
         approach=float(sol.approach), force=float(a * p.sum()), p_max=float(p.max()),
         contact_area=float(a * np.count_nonzero(p_n > 0)), converged=bool(sol.converged),
         message=sol.message, status=sol.status, rtol=float(problem.rtol), iterations=int(sol.iterations),
         kkt_residual=float(kkt), method=problem.solver, wall_time_s=time.perf_counter() - t_start, lattice=lattice,
-        E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=n_matvec + op.n_matvec,
+        E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=n_matvec,
         domain=region, bodies=problem.bodies, hardness=problem.hardness,
         plastic_area=0.0 if problem.hardness is None else float(a * np.count_nonzero(p[mask] >= problem.hardness)))
