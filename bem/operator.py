@@ -349,17 +349,19 @@ class InfluenceOperator:
                 box = self._full()
             if box not in symbols:
                 symbols.clear()  # one box at a time: the contact moves rarely
-                shape, K = self._kernel_spectra(box, box)  # not cached: only its inverse is kept
-                symbols[box] = shape, self._inverse_symbol(K, shape, lam, floor)
-                del K
+                symbols[box] = self._inverse_symbol(box, lam, floor)  # its spectra are not kept
             shape, spectra = symbols[box]
             self._convolve(spectra, shape, r, box, box, out)
             return out
 
         return apply
 
-    def _inverse_symbol(self, K, shape, lam, floor):
-        """Spectra of ``(K + lam)^-1`` for a symmetric 2 x 2 block symbol (eigenvalues floored)."""
+    def _inverse_symbol(self, box, lam, floor):
+        """``(shape, S)``: the spectra ``S`` of ``(K + lam)^-1`` for the symmetric 2 x 2 block symbol ``K`` of
+        ``box`` (:meth:`_kernel_spectra`, eigenvalues floored), on its padded ``shape``."""
+        if self.backend.is_numpy:
+            return self._inverse_symbol_numpy(box, lam, floor)
+        shape, K = self._kernel_spectra(box, box)
         xp = self.backend.xp
         lam_hat = lam / (shape[0] * shape[1])  # spectra carry the 1/(Lk Lq) of the inverse FFT
         A, D, B = xp.real(K[0, 0, ...]) + lam_hat, xp.real(K[1, 1, ...]) + lam_hat, K[0, 1, ...]
@@ -376,8 +378,60 @@ class InfluenceOperator:
         pb = B * half * diff
         scale = 1.0 / (shape[0] * shape[1]) ** 2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
         # S_10 = conj(S_01): not stored (None), _block_product conjugates S_01
-        return ((inv_lo + xp.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale), \
-            (None, (inv_lo + xp.where(safe, (D - m + d) * half, 0.5) * diff) * scale)
+        return shape, (((inv_lo + xp.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale),
+                       (None, (inv_lo + xp.where(safe, (D - m + d) * half, 0.5) * diff) * scale))
+
+    def _inverse_symbol_numpy(self, box, lam, floor):
+        """:meth:`_inverse_symbol` on NumPy: the same operations, in place where they can be (fewer temporaries
+        of the box's size), and ``K`` let go once ``S_01`` is made."""
+        shape, K = self._kernel_spectra(box, box)
+        size = shape[0] * shape[1]
+        lam_hat = lam / size  # spectra carry the 1/(Lk Lq) of the inverse FFT
+        A, D = K[0, 0].real + lam_hat, K[1, 1].real + lam_hat
+        m = A + D
+        m /= 2
+        d = A - D
+        d /= 2
+        np.square(d, out=d)
+        b2 = np.abs(K[0, 1])
+        np.square(b2, out=b2)
+        d += b2
+        del b2
+        np.sqrt(d, out=d)
+        low = (floor * self.diagonal + lam) / size
+        inv_hi = m + d
+        np.maximum(inv_hi, low, out=inv_hi)
+        np.divide(1.0, inv_hi, out=inv_hi)
+        inv_lo = m - d
+        np.maximum(inv_lo, low, out=inv_lo)
+        np.divide(1.0, inv_lo, out=inv_lo)
+        # H^-1 = P+/l+ + P-/l-,  P+ = (H - (m - d) I) / (2 d),  P- = I - P+
+        with np.errstate(divide="ignore", invalid="ignore"):
+            safe = d > 1e-14 * np.abs(m)
+            half = np.where(safe, d, 1.0)
+            np.divide(0.5, half, out=half)
+        unsafe = ~safe
+        del safe
+        half[unsafe] = 0.0
+        diff = inv_hi
+        diff -= inv_lo  # inv_hi - inv_lo
+        scale = 1.0 / size**2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
+        pb = K[0, 1] * half
+        del K
+        pb *= diff
+        pb *= scale
+        blocks = []
+        for X in (D, A):  # (inv_lo + where(safe, (X - m + d) half, 0.5) diff) scale, in place on X
+            X -= m
+            X += d
+            X *= half
+            X[unsafe] = 0.5
+            X *= diff
+            X += inv_lo
+            X *= scale
+            blocks.append(X)
+        # S_10 = conj(S_01): not stored (None), _block_product conjugates S_01
+        return shape, ((blocks[1], pb), (None, blocks[0]))
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""
