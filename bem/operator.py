@@ -81,7 +81,7 @@ def _block_product(S, V):
     if not isinstance(V, np.ndarray):
         t = S[0][1] * V[1, ...]
         V[1, ...] *= S[1][1]
-        V[1, ...] += (V[0, ...] * S[0][1].conj() if conj else S[1][0] * V[0, ...])
+        V[1, ...] += (V.__array_namespace__().conj(S[0][1]) if conj else S[1][0]) * V[0, ...]
         V[0, ...] *= S[0][0]
         V[0, ...] += t
         return V
@@ -273,7 +273,7 @@ class InfluenceOperator:
         del data
         for a, s in enumerate(self._start):  # one parity at a time: half the inverse's output held at once
             k0, na = o_rows[a]
-            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = bk.inverse(V[a], shape, (na, nq))
+            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = bk.inverse(V[a, ...], shape, (na, nq))
         if self._masked_last:
             out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 

@@ -185,8 +185,16 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     t = r32 = np.zeros(lat.shape, dtype=np.float32)
     g = np.empty(lat.shape)
     r32f = r32.reshape(-1)
-    z_prev = np.zeros(lat.shape)
-    gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
+    # the last preconditioned gap, on its contact only: its nodes (sorted) and values
+    z_nodes, z_values = np.zeros(0, dtype=np.intp), np.zeros(0)
+    gf, tf = g.reshape(-1), t.reshape(-1)
+
+    def z_prev_at(nodes):  # the last z at the (sorted) nodes, 0 where they were off its contact
+        if not z_nodes.size:
+            return np.zeros(nodes.size)
+        pos = np.searchsorted(z_nodes, nodes)
+        np.minimum(pos, z_nodes.size - 1, out=pos)
+        return np.where(z_nodes[pos] == nodes, z_values[pos], 0.0)
     gz_old, m_one, m_full = 1.0, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     was_on = p > 0  # the contact of the previous iterate
@@ -255,7 +263,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return float(p_c0.max(initial=0.0)), int(idx.size), changes, idx.size == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, gz_old, r_hat, u, stale
+        nonlocal m_full, m_one, gz_old, r_hat, u, stale, z_nodes, z_values
         if bounded and not idx.size:  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, np.zeros(0), None, None)
         t_old = np.take(tf, idx)  # the last direction on the contact (r32 is t)
@@ -275,18 +283,18 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             if m_full is None:
                 np.multiply(pf.reshape(p.shape) > 0, stiff, out=r32, casting="unsafe")
                 x = op.spectrum(r32)  # M (contact & stiff), and the Jacobi estimate at the soft nodes
-                m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1).astype(float)
-                m_full[softf] = jacf[softf]
-            m_one = m_full[idx]
+                m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1)  # single precision, kept so
+            m_one = m_full[idx].astype(float)
+            on_soft = softf[idx]
+            m_one[on_soft] = jacf[idx[on_soft]]  # the Jacobi estimate at the soft nodes
             if not m_one.sum() > 0:  # a contact far from the starting one: the mean instead
                 m_one = np.ones(idx.size)
             z -= m_one * (z.sum() / m_one.sum())
         gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
         beta = 0.0 if k == 1 or gz_old == 0 or restart else max(  # gz_old = 0: one contact node under force control
-            0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
-        z_prev.fill(0.0)
-        zf[idx] = z
+            0.0, (gz - float(np.einsum("i,i->", g_c, z_prev_at(idx)))) / gz_old)
+        z_nodes, z_values = idx, z.copy()
         t_c = z + beta * t_old
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (t_c.sum() / m_one.sum()) if m_one is not None else t_c.mean()
