@@ -33,6 +33,7 @@ import numpy as np
 
 from . import fft
 from .backend import get_backend
+from .block_symbol import block_product, inverse_symbol
 from .checks import check_positive
 from .template import template
 
@@ -68,42 +69,6 @@ def _rows(s, k0, n, n_rows):
     """Slice of the brick rows ``s + 2 k``, ``k0 <= k < k0 + n``, of an array of ``n_rows`` rows."""
     stop = s + 2 * (k0 + n) - 1
     return slice(s + 2 * k0, stop if stop < n_rows else None, 2)
-
-
-def _block_product(S, V):
-    """``V_a <- sum_b S_ab V_b`` in place on a pair of spectra (``V`` of shape ``(2, rows, cols)``).
-
-    Two temporaries: on NumPy of the rows of :data:`bem.fft.BLOCK` entries each (the rows one after the other, the
-    same numbers), elsewhere of a whole spectrum each."""
-    if not isinstance(S, tuple):  # the kernel spectra of a window, one array S[a, b, ...]
-        S = ((S[0, 0, ...], S[0, 1, ...]), (S[1, 0, ...], S[1, 1, ...]))
-    conj = S[1][0] is None  # a Hermitian symbol: S_10 = conj(S_01), not stored
-    if not isinstance(V, np.ndarray):
-        t = S[0][1] * V[1, ...]
-        V[1, ...] *= S[1][1]
-        V[1, ...] += (V.__array_namespace__().conj(S[0][1]) if conj else S[1][0]) * V[0, ...]
-        V[0, ...] *= S[0][0]
-        V[0, ...] += t
-        return V
-    rows = V.shape[1]
-    step = max(1, fft.BLOCK // max(1, V.shape[2]))
-    t = np.empty((min(step, rows),) + V.shape[2:], dtype=np.result_type(S[0][1], V))
-    w = np.empty_like(t)
-    for lo in range(0, rows, step):
-        r = slice(lo, min(lo + step, rows))
-        n = r.stop - lo
-        v0, v1 = V[0, r], V[1, r]
-        np.multiply(S[0][1][r], v1, out=t[:n])
-        v1 *= S[1][1][r]
-        if conj:
-            np.conjugate(S[0][1][r], out=w[:n])
-            w[:n] *= v0
-        else:
-            np.multiply(S[1][0][r], v0, out=w[:n])
-        v1 += w[:n]
-        v0 *= S[0][0][r]
-        v0 += t[:n]
-    return V
 
 
 class InfluenceOperator:
@@ -269,7 +234,7 @@ class InfluenceOperator:
         for b, s in enumerate(self._start):  # the rows of parity b: brick rows s, s + 2, ...
             k0, nb = i_rows[b]
             data[b, :nb, :] = v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq]
-        V = _block_product(spectra, bk.forward(data, shape))
+        V = block_product(spectra, bk.forward(data, shape))
         del data
         for a, s in enumerate(self._start):  # one parity at a time: half the inverse's output held at once
             k0, na = o_rows[a]
@@ -357,81 +322,8 @@ class InfluenceOperator:
         return apply
 
     def _inverse_symbol(self, box, lam, floor):
-        """``(shape, S)``: the spectra ``S`` of ``(K + lam)^-1`` for the symmetric 2 x 2 block symbol ``K`` of
-        ``box`` (:meth:`_kernel_spectra`, eigenvalues floored), on its padded ``shape``."""
-        if self.backend.is_numpy:
-            return self._inverse_symbol_numpy(box, lam, floor)
-        shape, K = self._kernel_spectra(box, box)
-        xp = self.backend.xp
-        lam_hat = lam / (shape[0] * shape[1])  # spectra carry the 1/(Lk Lq) of the inverse FFT
-        A, D, B = xp.real(K[0, 0, ...]) + lam_hat, xp.real(K[1, 1, ...]) + lam_hat, K[0, 1, ...]
-        m = (A + D) / 2
-        d = xp.sqrt(((A - D) / 2) ** 2 + xp.abs(B) ** 2)
-        low = (floor * self.diagonal + lam) / (shape[0] * shape[1])
-        inv_hi = 1.0 / xp.maximum(m + d, low)
-        inv_lo = 1.0 / xp.maximum(m - d, low)
-        # H^-1 = P+/l+ + P-/l-,  P+ = (H - (m - d) I) / (2 d),  P- = I - P+
-        with self.backend.errstate(divide="ignore", invalid="ignore"):
-            safe = d > 1e-14 * xp.abs(m)
-            half = xp.where(safe, 0.5 / xp.where(safe, d, 1.0), 0.0)
-        diff = inv_hi - inv_lo
-        pb = B * half * diff
-        scale = 1.0 / (shape[0] * shape[1]) ** 2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
-        # S_10 = conj(S_01): not stored (None), _block_product conjugates S_01
-        return shape, (((inv_lo + xp.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale),
-                       (None, (inv_lo + xp.where(safe, (D - m + d) * half, 0.5) * diff) * scale))
-
-    def _inverse_symbol_numpy(self, box, lam, floor):
-        """:meth:`_inverse_symbol` on NumPy: the same operations, in place where they can be (fewer temporaries
-        of the box's size), and ``K`` let go once ``S_01`` is made."""
-        shape, K = self._kernel_spectra(box, box)
-        size = shape[0] * shape[1]
-        lam_hat = lam / size  # spectra carry the 1/(Lk Lq) of the inverse FFT
-        A, D = K[0, 0].real + lam_hat, K[1, 1].real + lam_hat
-        m = A + D
-        m /= 2
-        d = A - D
-        d /= 2
-        np.square(d, out=d)
-        b2 = np.abs(K[0, 1])
-        np.square(b2, out=b2)
-        d += b2
-        del b2
-        np.sqrt(d, out=d)
-        low = (floor * self.diagonal + lam) / size
-        inv_hi = m + d
-        np.maximum(inv_hi, low, out=inv_hi)
-        np.divide(1.0, inv_hi, out=inv_hi)
-        inv_lo = m - d
-        np.maximum(inv_lo, low, out=inv_lo)
-        np.divide(1.0, inv_lo, out=inv_lo)
-        # H^-1 = P+/l+ + P-/l-,  P+ = (H - (m - d) I) / (2 d),  P- = I - P+
-        with np.errstate(divide="ignore", invalid="ignore"):
-            safe = d > 1e-14 * np.abs(m)
-            half = np.where(safe, d, 1.0)
-            np.divide(0.5, half, out=half)
-        unsafe = ~safe
-        del safe
-        half[unsafe] = 0.0
-        diff = inv_hi
-        diff -= inv_lo  # inv_hi - inv_lo
-        scale = 1.0 / size**2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
-        pb = K[0, 1] * half
-        del K
-        pb *= diff
-        pb *= scale
-        blocks = []
-        for X in (D, A):  # (inv_lo + where(safe, (X - m + d) half, 0.5) diff) scale, in place on X
-            X -= m
-            X += d
-            X *= half
-            X[unsafe] = 0.5
-            X *= diff
-            X += inv_lo
-            X *= scale
-            blocks.append(X)
-        # S_10 = conj(S_01): not stored (None), _block_product conjugates S_01
-        return shape, ((blocks[1], pb), (None, blocks[0]))
+        """``(shape, S)``: the spectra of ``(K + lam)^-1`` for the symbol ``K`` of ``box`` (:func:`bem.block_symbol.inverse_symbol`)."""
+        return inverse_symbol(self.backend, lambda: self._kernel_spectra(box, box), lam, floor, self.diagonal)
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""

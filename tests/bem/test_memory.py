@@ -18,7 +18,7 @@ import pytest
 
 import bem
 from bem import fft
-from bem.operator import _block_product
+from bem.block_symbol import block_product
 from bem.periodic import PeriodicCell, PeriodicOperator
 
 
@@ -87,10 +87,10 @@ def test_the_block_products_equal_the_whole_array_formulas_bit_for_bit(monkeypat
     V = rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
     # the operands in the order of the whole-array formula: V_a *= S_aa, then += S_ab V_b
     want = np.stack([V[0] * S[0][0] + S[0][1] * V[1], V[1] * S[1][1] + S[1][0] * V[0]])
-    assert np.array_equal(_block_product(((S[0][0], S[0][1]), (S[1][0], S[1][1])), V.copy()), want)
+    assert np.array_equal(block_product(((S[0][0], S[0][1]), (S[1][0], S[1][1])), V.copy()), want)
     # a Hermitian symbol without its conjugate block: S_10 = conj(S_01)
     want = np.stack([V[0] * S[0][0] + S[0][1] * V[1], V[1] * S[1][1] + np.conj(S[0][1]) * V[0]])
-    assert np.array_equal(_block_product(((S[0][0], S[0][1]), (None, S[1][1])), V.copy()), want)
+    assert np.array_equal(block_product(((S[0][0], S[0][1]), (None, S[1][1])), V.copy()), want)
 
 
 def test_the_preconditioner_symbol_in_place_is_the_closed_expression():
