@@ -19,6 +19,12 @@ from . import fft
 __all__ = ["block_product", "inverse_symbol"]
 
 
+def _conj(x):
+    """``conj(x)`` in the array's own namespace (a strict array API namespace has no ``x.conj()``)."""
+    space = getattr(x, "__array_namespace__", None)
+    return space().conj(x) if space is not None else x.conj()
+
+
 def block_product(S, V):
     """``V_a <- sum_b S_ab V_b`` in place on a pair of spectra (``V`` of shape ``(2, rows, cols)``).
 
@@ -30,7 +36,7 @@ def block_product(S, V):
     if not isinstance(V, np.ndarray):
         t = S[0][1] * V[1, ...]
         V[1, ...] *= S[1][1]
-        V[1, ...] += (V.__array_namespace__().conj(S[0][1]) if conj else S[1][0]) * V[0, ...]
+        V[1, ...] += (_conj(S[0][1]) if conj else S[1][0]) * V[0, ...]
         V[0, ...] *= S[0][0]
         V[0, ...] += t
         return V
