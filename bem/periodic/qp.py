@@ -148,7 +148,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         stiff = D <= threshold * op.diagonal
         sel = stiff & (p > 0)
         lam_pc = float(np.median(D[sel])) if bool(sel.any()) else 0.0
-        jacobi = 1.0 / (op.diagonal + D)
+        # the Jacobi estimate 1 / (C_nn + D) at the nodes that need it (whole only for the bounded step)
+        jacobi = 1.0 / (op.diagonal + D) if hardness is not None else None
         soft = None if bool(stiff.all()) else ~stiff
     else:
         lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
@@ -169,7 +170,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         z = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1)[idx].astype(float)
         if soft is not None:
             out = softf[idx]
-            z[out] = jacf[idx[out]] * r_c[out]
+            z[out] = jacobi_at(idx[out]) * r_c[out]
         return z
 
     single = False  # the first product in double precision: it sets the scale of the KKT residual
@@ -179,7 +180,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         u, stale = np.array(u0, dtype=float), 1
     if per_node:
         u += D * p
-        softf, jacf, Df = (None if soft is None else soft.reshape(-1)), jacobi.reshape(-1), D.reshape(-1)
+        softf, Df = (None if soft is None else soft.reshape(-1)), D.reshape(-1)
+
+        def jacobi_at(nodes):  # 1 / (C_nn + D) at the nodes (flat indices): the numbers of the whole array
+            return 1.0 / (op.diagonal + Df[nodes])
     # the search direction, transformed in single precision, and in the same array the gap on the contact
     # that the preconditioner transforms (the direction at the contact nodes is taken out first)
     t = r32 = np.zeros(lat.shape, dtype=np.float32)
@@ -286,7 +290,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1)  # single precision, kept so
             m_one = m_full[idx].astype(float)
             on_soft = softf[idx]
-            m_one[on_soft] = jacf[idx[on_soft]]  # the Jacobi estimate at the soft nodes
+            m_one[on_soft] = jacobi_at(idx[on_soft])  # the Jacobi estimate at the soft nodes
             if not m_one.sum() > 0:  # a contact far from the starting one: the mean instead
                 m_one = np.ones(idx.size)
             z -= m_one * (z.sum() / m_one.sum())
@@ -329,7 +333,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         overlap = low[pf[low] == 0]
         p_o = None
         if overlap.size:
-            cap = jacf[overlap] if per_node else jacobi
+            cap = jacobi_at(overlap) if per_node else jacobi
             p_o = entering_pressure(np, gf[overlap] - delta, tau, cap, per_node, preconditioned=True)
         entered = bool(overlap.size)
         s = 1.0
