@@ -37,10 +37,13 @@ from concurrent.futures import ThreadPoolExecutor
 
 import scipy.fft as _sfft
 
-__all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "in_parts"]
+__all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "in_parts", "BLOCK"]
 
 _ENV = "CONTACTLAB_THREADS"
 _override = None
+#: entries per block of the element-wise products of spectra that run in place (their buffers hold one
+#: block, not a spectrum)
+BLOCK = 1 << 15
 _PARTS_MIN = 1 << 17  # entries below which in_parts runs in the calling thread
 _pool, _pool_size = None, 0
 

@@ -102,7 +102,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     a = lat.node_area
     per_node = is_per_node(lam)
     lam = xp.where(mask, lam, 0.0) if per_node else float(lam)
-    h = xp.where(mask, bk.asarray(h), 0.0)
+    h = _masked_gap(bk, mask, h)
     if maxiter is None:
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
@@ -177,6 +177,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         contact = p > 0
         idx = bk.select(contact)
         n_idx = bk.count(idx)
+        g = None  # the last gap goes before the new one is made
         g = u + h
         if force is not None:
             delta = float(xp.mean(bk.take(g, idx)))
@@ -194,6 +195,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     def confirms(kkt):  # an incrementally updated C p at the tolerance: recompute it and measure again
         nonlocal u, stale
         if kkt <= rtol and stale and confirm:
+            u = None  # not held through its own recomputation
             u, stale = apply(p), 0
             return True
         return False
@@ -270,15 +272,16 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 bk.put(p_new, idx, bk.take(p_new, idx) * s)
                 entering = bk.subset(overlap, ~bk.take(contact, overlap))  # a clipped contact node may re-enter
                 bk.put(p_new, entering, bk.take(p_new, entering) * s)
+        p = p_new  # the last iterate goes before the product
         if bool(xp.any(clipped)) or restart or stale >= RECOMPUTE_EVERY:
-            u, stale = apply(p_new), 0
+            u = r = None
+            u, stale = apply(p), 0
         else:
             r *= tau
             u -= r
             if s != 1.0:
                 u *= s
             stale += 1
-        p = p_new
         return None
 
     def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
@@ -288,6 +291,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         if failure is not None:
             return failure
         if changed or r is None or stale >= RECOMPUTE_EVERY:
+            u = r = None
             u, stale = apply(p), 0
         else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
             r *= tau
@@ -303,6 +307,16 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not n_idx)
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return record.solution(p, delta, kkt, elastic, "Kalker QP")
+
+
+def _masked_gap(bk, mask, h):
+    """``h`` with 0 off the candidate nodes: ``h`` itself where it is 0 there already (a region's nodal gap), so
+    that the solve holds no copy of it."""
+    h = bk.asarray(h)
+    off = h[~mask]
+    if off.size and not (bool(bk.xp.all(off == 0)) and not bool(bk.xp.any(bk.xp.signbit(off)))):
+        return bk.xp.where(mask, h, 0.0)
+    return h if h.dtype == bk.float64 else bk.xp.where(mask, h, 0.0)
 
 
 def constrained_cg(op, h, *, lam=0.0, precondition=True, contact=None, **kw):

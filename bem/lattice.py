@@ -126,6 +126,11 @@ class Lattice:
         row = self.step * SQRT3 / 2 * self.j
         return np.broadcast_to(row[:, None], self.shape).copy()
 
+    def release_coordinates(self):
+        """Drop the cached :attr:`x` and :attr:`y` (16 bytes a node); they are made again when asked for."""
+        for name in ("x", "y"):
+            self.__dict__.pop(name, None)
+
     @cached_property
     def mask(self):
         """Candidate nodes (inside the symmetric rectangle), shape :attr:`shape`."""

@@ -138,7 +138,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     bk, mask = operator_backend(op)
     xp = bk.xp
     layer = device_layer(layer, bk)
-    h = xp.where(mask, bk.asarray(h), 0.0)
+    h = bk.asarray(h)
+    if not bool(xp.all(mask)):  # a periodic cell's gap is used as it is (never written)
+        h = xp.where(mask, h, 0.0)
     if x0 is None:
         # smooth-body solution, then one secant (variable compliance) step: a start
         # that is fair for stiff and for layer-dominated problems alike
@@ -196,6 +198,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             break
         p_ref = float(xp.mean(p[contact])) if bool(xp.any(contact)) else 1.0
         D = masked(tangent(bk, layer, p, gap, p_ref))
+        gap = None  # recomputed at the next step; not held through the model's solve
         b = h + wp - D * p
         # forcing term: _FORCING, or the last step's reduction of the residual where that is smaller
         eta = min(_FORCING, kkt / hist["residual"][-2]) if len(hist["residual"]) > 1 else _FORCING
@@ -249,6 +252,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             p, u = settle_plastic(op, layer, h, p, u, sub.p, delta, force=force, hardness=hardness)
         if callback is not None:
             callback(k + 1, p)
+        sub = d = cd = b = D = trial = u_trial = None  # not held through the next step's model solve
     if converged and hardness is not None and force is not None and (
             bracket := _plastic_bracket(bk, mask, p, gap + delta, hardness)) is not None:
         hist["approach_bracket"] = list(bracket)

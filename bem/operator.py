@@ -33,6 +33,7 @@ import numpy as np
 
 from . import fft
 from .backend import get_backend
+from .block_symbol import block_product, inverse_symbol
 from .checks import check_positive
 from .template import template
 
@@ -68,18 +69,6 @@ def _rows(s, k0, n, n_rows):
     """Slice of the brick rows ``s + 2 k``, ``k0 <= k < k0 + n``, of an array of ``n_rows`` rows."""
     stop = s + 2 * (k0 + n) - 1
     return slice(s + 2 * k0, stop if stop < n_rows else None, 2)
-
-
-def _block_product(S, V):
-    """``V_a <- sum_b S_ab V_b`` in place on a pair of spectra (``V`` of shape ``(2, ...)``), two temporaries."""
-    if not isinstance(S, tuple):  # the kernel spectra of a window, one array S[a, b, ...]
-        S = ((S[0, 0, ...], S[0, 1, ...]), (S[1, 0, ...], S[1, 1, ...]))
-    t = S[0][1] * V[1, ...]
-    V[1, ...] *= S[1][1]
-    V[1, ...] += S[1][0] * V[0, ...]
-    V[0, ...] *= S[0][0]
-    V[0, ...] += t
-    return V
 
 
 class InfluenceOperator:
@@ -182,7 +171,10 @@ class InfluenceOperator:
         lq = fft.fast_length(nq + bq - 1, real=True)
         f = np.r_[0:nq, -(bq - 1) : 0]  # circular column positions
         dq = f + oq - iq  # column offset output - input
-        kernels = np.zeros((2, 2, lk, lq))
+        # on NumPy one block at a time into the spectra (the same numbers as the batch: each line is
+        # transformed alone), so that the padded kernels are never all held at once
+        numpy = self.backend.is_numpy
+        out = np.empty((2, 2, lk, lq // 2 + 1), dtype=complex) if numpy else np.zeros((2, 2, lk, lq))
         for a in (0, 1):
             for b in (0, 1):
                 (oa, na), (ib, nb) = o_rows[a], i_rows[b]
@@ -190,11 +182,19 @@ class InfluenceOperator:
                 dr = self._start[a] - self._start[b] + 2 * (e + oa - ib)  # brick row offset
                 t = (np.abs(2 * dq + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
                 block = self._table.take(np.abs(dr), axis=0).take(t, axis=1)  # rows e, columns f
+                kernel = np.zeros((lk, lq)) if numpy else out[a, b]
                 for rows, src_r in ((slice(0, na), slice(0, na)), (slice(lk - nb + 1, lk), slice(na, None))):
                     for cols, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq + 1, lq), slice(nq, None))):
-                        kernels[a, b, rows, cols] = block[src_r, src_c]
-        kernels /= lk * lq
-        return (lk, lq), self.backend.forward(self.backend.asarray(kernels), (lk, lq))
+                        kernel[rows, cols] = block[src_r, src_c]
+                del block
+                if numpy:
+                    kernel /= lk * lq
+                    out[a, b] = fft.forward(kernel, (lk, lq))
+                    del kernel
+        if numpy:
+            return (lk, lq), out
+        out /= lk * lq
+        return (lk, lq), self.backend.forward(self.backend.asarray(out), (lk, lq))
 
     def _cached(self, key, build):
         if key in self._spectra:
@@ -234,11 +234,11 @@ class InfluenceOperator:
         for b, s in enumerate(self._start):  # the rows of parity b: brick rows s, s + 2, ...
             k0, nb = i_rows[b]
             data[b, :nb, :] = v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq]
-        V = _block_product(spectra, bk.forward(data, shape))
-        res = bk.inverse(V, shape, (max(r[1] for r in o_rows), nq))
-        for a, s in enumerate(self._start):
+        V = block_product(spectra, bk.forward(data, shape))
+        del data
+        for a, s in enumerate(self._start):  # one parity at a time: half the inverse's output held at once
             k0, na = o_rows[a]
-            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = res[a, :na, :]
+            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = bk.inverse(V[a, ...], shape, (na, nq))
         if self._masked_last:
             out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 
@@ -313,34 +313,17 @@ class InfluenceOperator:
             if full:
                 box = self._full()
             if box not in symbols:
-                shape, K = self._cached(("M", box), lambda: self._kernel_spectra(box, box))
                 symbols.clear()  # one box at a time: the contact moves rarely
-                symbols[box] = shape, self._inverse_symbol(K, shape, lam, floor)
+                symbols[box] = self._inverse_symbol(box, lam, floor)  # its spectra are not kept
             shape, spectra = symbols[box]
             self._convolve(spectra, shape, r, box, box, out)
             return out
 
         return apply
 
-    def _inverse_symbol(self, K, shape, lam, floor):
-        """Spectra of ``(K + lam)^-1`` for a symmetric 2 x 2 block symbol (eigenvalues floored)."""
-        xp = self.backend.xp
-        lam_hat = lam / (shape[0] * shape[1])  # spectra carry the 1/(Lk Lq) of the inverse FFT
-        A, D, B = xp.real(K[0, 0, ...]) + lam_hat, xp.real(K[1, 1, ...]) + lam_hat, K[0, 1, ...]
-        m = (A + D) / 2
-        d = xp.sqrt(((A - D) / 2) ** 2 + xp.abs(B) ** 2)
-        low = (floor * self.diagonal + lam) / (shape[0] * shape[1])
-        inv_hi = 1.0 / xp.maximum(m + d, low)
-        inv_lo = 1.0 / xp.maximum(m - d, low)
-        # H^-1 = P+/l+ + P-/l-,  P+ = (H - (m - d) I) / (2 d),  P- = I - P+
-        with self.backend.errstate(divide="ignore", invalid="ignore"):
-            safe = d > 1e-14 * xp.abs(m)
-            half = xp.where(safe, 0.5 / xp.where(safe, d, 1.0), 0.0)
-        diff = inv_hi - inv_lo
-        pb = B * half * diff
-        scale = 1.0 / (shape[0] * shape[1]) ** 2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
-        return ((inv_lo + xp.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale), \
-            (xp.conj(pb) * scale, (inv_lo + xp.where(safe, (D - m + d) * half, 0.5) * diff) * scale)
+    def _inverse_symbol(self, box, lam, floor):
+        """``(shape, S)``: the spectra of ``(K + lam)^-1`` for the symbol ``K`` of ``box`` (:func:`bem.block_symbol.inverse_symbol`)."""
+        return inverse_symbol(self.backend, lambda: self._kernel_spectra(box, box), lam, floor, self.diagonal)
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""

@@ -119,6 +119,8 @@ class HalfSpaceRegion:
         x, y = lattice.x, lattice.y
         h = check_gap_values(gap(x, y), {"x": x, "y": y}, mask=lattice.mask,
                              region="over the candidate region (make extent smaller or fix the gap)")
+        del x, y
+        lattice.release_coordinates()  # not held through the solve (the result makes them again)
         return np.where(lattice.mask, h, 0.0)
 
     def check_approach(self, approach, h, layer):

@@ -244,8 +244,9 @@ def _solve_on(region, gap, problem, x0, t_start):
         return _run(problem.solver, op, h_lat, problem.layer, problem.precondition, kw, problem.options)
 
     rtol, delta = problem.rtol, problem.approach  # the approach, or under force control its coarser estimate
-    for level, (lat, h_lat) in enumerate(levels):
-        finest = level == len(levels) - 1
+    while levels:  # each level leaves the list as it is solved: a coarser level's arrays go before the next
+        lat, h_lat = levels.pop(0)
+        finest = not levels
         kw = dict(force=problem.force, approach=problem.approach, x0=guess,
                   rtol=rtol if finest else max(rtol, coarse_rtol), callback=problem.callback if finest else None)
         if problem.maxiter is not None:
@@ -255,14 +256,39 @@ def _solve_on(region, gap, problem, x0, t_start):
             kw["hardness"] = problem.hardness
         sol, ops = region.solve_level(run, make_op, lat, h_lat, kw, delta if nested else None, problem.solver)
         delta = sol.approach
-        if not finest:
-            guess = region.refine(lat, sol.p, levels[level + 1][0])
+        if not finest:  # the coarse solution and operators are released before the finer level is solved
+            guess = region.refine(lat, sol.p, levels[0][0])
+            sol = ops = h_lat = None
     region.check_solution(lattice, sol.p)
     op = ops[-1] if ops[-1].lattice is lattice else make_op(lattice)
+    n_matvec = sum(o.n_matvec for o in ops if o is not op)
+    # the result recomputes C p: the solver's copy, the start and the level's operators go first
+    guess = kw = ops = levels = None
+    sol.displacement = None
     layer = problem.layer
-    closure = np.zeros(lattice.shape) if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
-    return _result(region, lattice, op, h, sol, closure, problem, t_start,
-                   n_matvec=sum(o.n_matvec for o in ops if o is not op))
+    closure = None if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
+    u = to_host(op.matvec(sol.p))
+    n_matvec += op.n_matvec
+    op = None  # its kernel spectra go before the result is made
+    g, scale = _deformed_gap(u, closure, h, sol.approach)
+    # the full arrays are handed over in a dict, so that the result can let each go once it has its nodes
+    fields = dict(u=u, g=g, closure=closure)
+    u = g = closure = h = h_lat = None
+    return _result(region, lattice, fields, scale, sol, problem, t_start, n_matvec)
+
+
+def _deformed_gap(u, closure, h, approach):
+    """``(g, s)``: the gap ``u + closure + h - approach`` and the scale ``max |u + closure|`` of the KKT residual
+    (``closure`` None: no layer), without temporaries beyond ``g``."""
+    if closure is None:  # (u + 0) + h - delta, in place
+        g = u + h
+        scale = max(float(u.max()), -float(u.min()))  # max |u|
+    else:
+        g = u + closure
+        scale = max(float(g.max()), -float(g.min()))
+        g += h
+    g -= approach
+    return g, scale
 
 
 def _check_capacity(region, lattice, problem):
@@ -307,23 +333,46 @@ def _dispatch(solver, op, h, layer, precondition, kw, options):
     return run(op, h, layer=layer, precondition=precondition, **kw, **options)
 
 
-def _result(region, lattice, op, h, sol, closure, problem, t_start, n_matvec=0):
+def _result(region, lattice, fields, scale, sol, problem, t_start, n_matvec):
+    """The result on the candidate nodes from the full arrays ``fields`` (``u``, ``g`` and ``closure``, None
+    without a layer: zeros), each let go once its nodes are taken. Where every node is a candidate (a
+    periodic cell) its arrays are flat views, not copies: x and y (the lattice's, read-only), p, the
+    displacement and the gap; elsewhere the lattice's coordinates are made one at a time and released."""
     mask = lattice.mask
+    whole = bool(mask.all())
+
+    def nodes(values, writeable=True):
+        if not whole:
+            return values[mask]
+        flat = values.reshape(-1)
+        if not writeable:
+            flat = flat.view()
+            flat.flags.writeable = False
+        return flat
+
+    def coordinate(name):
+        values = nodes(getattr(lattice, name), False)
+        if not whole and hasattr(lattice, "release_coordinates"):
+            lattice.release_coordinates()
+        return values
+
     p = sol.p
-    u = to_host(op.matvec(p))
-    g = u + closure + h - sol.approach
     a = lattice.node_area
-    kkt = kkt_residual(p[mask], g[mask], displacement_scale=float(np.abs(u + closure).max()),
-                       force=problem.force, node_area=a, hardness=problem.hardness)
+    p_n, g_n = nodes(p), nodes(fields.pop("g"))
+    kkt = kkt_residual(p_n, g_n, displacement_scale=scale, force=problem.force, node_area=a, hardness=problem.hardness)
     if not np.all(np.isfinite(p)):
         raise FloatingPointError(f"{problem.solver}: the solver produced non-finite pressures ({sol.message})")
+    n_nodes = p_n.size
+    u_n = nodes(fields.pop("u"))
+    closure = fields.pop("closure")
+    closure = np.zeros(n_nodes) if closure is None else nodes(closure)
+    x, y = coordinate("x"), coordinate("y")
     return region.result_class(
-        x=lattice.x[mask], y=lattice.y[mask], p=p[mask], displacement=u[mask],
-        closure=closure[mask], gap=g[mask],
+        x=x, y=y, p=p_n, displacement=u_n, closure=closure, gap=g_n,
         approach=float(sol.approach), force=float(a * p.sum()), p_max=float(p.max()),
-        contact_area=float(a * np.count_nonzero(p[mask] > 0)), converged=bool(sol.converged),
+        contact_area=float(a * np.count_nonzero(p_n > 0)), converged=bool(sol.converged),
         message=sol.message, status=sol.status, rtol=float(problem.rtol), iterations=int(sol.iterations),
         kkt_residual=float(kkt), method=problem.solver, wall_time_s=time.perf_counter() - t_start, lattice=lattice,
-        E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=n_matvec + op.n_matvec,
+        E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=n_matvec,
         domain=region, bodies=problem.bodies, hardness=problem.hardness,
         plastic_area=0.0 if problem.hardness is None else float(a * np.count_nonzero(p[mask] >= problem.hardness)))

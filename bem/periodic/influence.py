@@ -18,6 +18,7 @@ and :mod:`bem.fixed_point` run on it unchanged.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 import scipy.fft as sfft
@@ -45,6 +46,28 @@ def _checked_bodies(bodies, E_star):
         raise InputError(f"E_star = {E_star!r} is not allowed with bodies: it must be bodies.E_star = "
                          f"{bodies.E_star!r}, the substrates' effective modulus.")
     return bodies if bodies.is_coated else None
+
+
+def _spectra(w):
+    """Spectra of ``K_00 = K_11``, ``K_10`` and ``K_01`` of the kernel ``w`` (brick array), stacked.
+
+    Real kernels; the ``1/N`` of the inverse FFT is applied there."""
+    even, odd = w[0::2], w[1::2]
+    return sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
+
+
+def _packed(spectra):
+    """The packed symbol of :meth:`PeriodicOperator.mix` from :func:`_spectra` (the spectra themselves are not kept)."""
+    return PeriodicOperator._pack(spectra[0].real, spectra[2], spectra[1])
+
+
+@lru_cache(maxsize=8)  # the levels of nested iteration of one or two cells
+def _homogeneous_symbol(n_rows, n_cols, scale):
+    """The packed symbol of the homogeneous operator of a cell, ``scale = c / (pi E*)``, read-only."""
+    d, b = _packed(_spectra(periodic_template(n_rows, n_cols, cache=False) * scale))
+    d.setflags(write=False)
+    b.setflags(write=False)
+    return d, b
 
 
 class PeriodicOperator:
@@ -84,19 +107,32 @@ class PeriodicOperator:
         self.bodies = _checked_bodies(bodies, self.E_star)
         self.n_matvec = 0
         self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
-        w = periodic_template(lattice.n_rows, lattice.n_cols)
+        self._spectrum_shape = (lattice.n_rows // 2, lattice.n_cols // 2 + 1)
+        self._symbol32 = self._symbol = self._s00 = None
+        scale = lattice.step / (math.pi * self.E_star)
+        if self.bodies is None and bk.is_numpy:  # the packed symbol only, shared by the operators of a cell
+            self._symbol = _homogeneous_symbol(lattice.n_rows, lattice.n_cols, scale)
+            return
+        w = self._template()
         if self.bodies is not None:
-            coated = coated_template(lattice.n_rows, lattice.n_cols, lattice.step, self.bodies)
-            self.diagonal *= coated[0, 0] / w[0, 0]
-            w = coated
-        w = w * (lattice.step / (math.pi * self.E_star))
-        self.kernel = w  # C between node (0, 0) and node (q, r), brick array
-        even, odd = w[0::2], w[1::2]
-        self._spectrum_shape = (even.shape[0], even.shape[1] // 2 + 1)
-        spectra = sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
-        # spectra of K_00 = K_11, K_10 and K_01 (real kernels: the 1/N of the inverse FFT is applied there)
-        self._s00, self._s10, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra)
-        self._symbol = self._symbol32 = None
+            self.diagonal *= w[0, 0] / periodic_template(lattice.n_rows, lattice.n_cols)[0, 0]
+        spectra = _spectra(w * scale)
+        if bk.is_numpy:
+            self._symbol = _packed(spectra)
+        else:
+            self._s00, self._s10, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra)
+
+    def _template(self):
+        """The dimensionless template of the cell: periodic, or of the coated bodies."""
+        lat = self.lattice
+        if self.bodies is None:
+            return periodic_template(lat.n_rows, lat.n_cols, cache=False)
+        return coated_template(lat.n_rows, lat.n_cols, lat.step, self.bodies)
+
+    @property
+    def kernel(self):
+        """``C`` between node ``(0, 0)`` and node ``(q, r)`` [length/pressure], brick array (made at each call)."""
+        return self._template() * (self.lattice.step / (math.pi * self.E_star))
 
     def _forward(self, v):
         """Spectra of the even and odd rows of a brick array: ``(2, n_rows/2, n_cols/2 + 1)``.
@@ -133,23 +169,28 @@ class PeriodicOperator:
         return sfft.irfft(cols, n=n_cols, axis=2, overwrite_x=True, workers=workers).reshape(n_rows, n_cols)
 
     @staticmethod
-    def mix(spectrum, symbol, out=None, work=None):
+    def mix(spectrum, symbol, out=None):
         """``out_a = sum_b S_ab X_b`` on a spectrum ``X`` of :meth:`spectrum`'s layout.
 
-        ``symbol = (D, B)`` in the same layout: ``D[:, a] = S_aa`` (real) and ``B[:, a] = S_a(1-a)``
-        (:meth:`symbol`), so that ``out = D X + B X'`` with ``X'`` the
-        spectrum with its parities swapped: three passes over contiguous arrays, on
-        :func:`bem.fft.in_parts` threads. ``out`` (default: a new array) may be ``spectrum``
-        itself; ``work``, an array like ``spectrum``, is a buffer.
+        ``symbol = (D, B)`` in the same layout: ``D[:, a] = S_aa`` (real; ``D`` of shape
+        ``(n_rows/2, 1, n_cols/2 + 1)`` where the two blocks are equal, as :meth:`symbol` gives
+        it) and ``B[:, a] = S_a(1-a)``, so that ``out = D X + B X'`` with ``X'`` the spectrum with
+        its parities swapped: three passes over blocks of :data:`bem.fft.BLOCK` entries (the product
+        ``B X'`` in a buffer of one block), on :func:`bem.fft.in_parts` threads. ``out``
+        (default: a new array) may be ``spectrum`` itself.
         """
         d, b = symbol
         out = np.empty_like(spectrum) if out is None else out
-        work = np.empty_like(spectrum) if work is None else work
+        rows = max(1, fft.BLOCK // (spectrum.size // max(spectrum.shape[0], 1) or 1))
 
         def part(s):  # rows s of every array: the parity swap stays inside a row
-            np.multiply(b[s], spectrum[s, ::-1, :], out=work[s])
-            np.multiply(d[s], spectrum[s], out=out[s])
-            np.add(out[s], work[s], out=out[s])
+            work = np.empty((min(rows, s.stop - s.start),) + spectrum.shape[1:], dtype=spectrum.dtype)
+            for lo in range(s.start, s.stop, rows):
+                r = slice(lo, min(lo + rows, s.stop))
+                w = work[:r.stop - lo]
+                np.multiply(b[r], spectrum[r, ::-1, :], out=w)
+                np.multiply(d[r], spectrum[r], out=out[r])
+                np.add(out[r], w, out=out[r])
 
         fft.in_parts(part, spectrum.shape[0], spectrum.size)
         return out
@@ -172,14 +213,14 @@ class PeriodicOperator:
     def symbol(self, lam=0.0, inverse=False, single=False):
         """The 2 x 2 block symbol of ``C + lam I``, or of :meth:`preconditioner` (``inverse``), for :meth:`mix`.
 
-        NumPy only. ``(D, B)``: the diagonal blocks are real (the kernel of a parity on itself is
-        even), ``D`` holds their real parts, ``B`` the off-diagonal blocks. ``single``: in single
-        precision (float32, complex64), rounded from the double-precision blocks.
+        NumPy only. ``(D, B)``: the diagonal blocks are real and equal (the kernel of a parity on
+        itself is even, and the same for both parities), ``D`` holds their real part once, shape
+        ``(n_rows/2, 1, n_cols/2 + 1)``, ``B`` the off-diagonal blocks, shape ``(n_rows/2, 2,
+        n_cols/2 + 1)``. ``single``: in single precision (float32, complex64), rounded from the
+        double-precision blocks.
         """
         if inverse:
-            return self._pack(*self._inverse_blocks(lam), single=single)
-        if self._symbol is None:
-            self._symbol = self._pack(self._s00, self._s01, self._s10, self._s00)
+            return self._pack(*self._inverse_blocks(lam), None, single=single)
         d, b = self._symbol
         if single and not lam:  # the symbol of C alone, rounded once per operator
             if self._symbol32 is None:
@@ -189,10 +230,16 @@ class PeriodicOperator:
         return (d.astype(np.float32), b.astype(np.complex64)) if single else (d, b)
 
     @staticmethod
-    def _pack(s00, s01, s10, s11, single=False):
-        d = np.empty((s00.shape[0], 2, s00.shape[1]), dtype=np.float32 if single else np.float64)
-        b = np.empty(d.shape, dtype=np.complex64 if single else np.complex128)
-        d[:, 0], d[:, 1], b[:, 0], b[:, 1] = s00.real, s11.real, s01, s10
+    def _pack(d00, s01, s10, single=False):
+        """``(D, B)`` of :meth:`symbol` from the real diagonal block ``d00`` and the off-diagonal ones
+        (``s10`` None: its conjugate ``conj(s01)``)."""
+        d = np.empty((d00.shape[0], 1, d00.shape[1]), dtype=np.float32 if single else np.float64)
+        b = np.empty((d00.shape[0], 2, d00.shape[1]), dtype=np.complex64 if single else np.complex128)
+        d[:, 0], b[:, 0] = d00, s01
+        if s10 is None:
+            np.conjugate(s01, out=b[:, 1], casting="same_kind")
+        else:
+            b[:, 1] = s10
         return d, b
 
     def _apply(self, v, s00, s01, s10, s11):
@@ -256,7 +303,8 @@ class PeriodicOperator:
         if self.backend.is_numpy:
             i00, i01, i10, i11 = self.symbol(lam, inverse=True), None, None, None
         else:
-            i00, i01, i10, i11 = self._inverse_blocks(lam)
+            a, b = self._inverse_blocks(lam)
+            i00, i01, i10, i11 = a, b, self.backend.xp.conj(b), a
 
         def apply(r):
             return self._apply(r, i00, i01, i10, i11)
@@ -264,22 +312,26 @@ class PeriodicOperator:
         return apply
 
     def _inverse_blocks(self, lam):
-        """The blocks ``(I00, I01, I10, I11)`` of the symbol of :meth:`preconditioner`.
+        """The blocks ``(I00, I01)`` of the symbol of :meth:`preconditioner` (``I11 = I00``, ``I10 = conj(I01)``).
 
         ``C`` is symmetric, so its symbol is Hermitian: ``S_11 = S_00`` is real and
         ``S_10 = conj(S_01)``. The determinant ``S_00^2 - |S_01|^2`` is then real, ``I00 = I11``
         is real and ``I10 = conj(I01)``.
         """
         xp = self.backend.xp
-        a = xp.real(self._s00) + lam
-        b = self.backend.copy(self._s01)
+        if self.backend.is_numpy:  # the blocks of the packed symbol: the same numbers as the spectra
+            d, s01 = self._symbol[0][:, 0], self._symbol[1][:, 0]
+            a, b = d + lam, s01.copy()
+        else:
+            a = xp.real(self._s00) + lam
+            b = self.backend.copy(self._s01)
         shift = 0.5 * float(self.diagonal)  # the constant mode (1, 1) / sqrt 2 of frequency 0 gets eigenvalue C_nn + lam
         a[0, 0] += shift
         b[0, 0] += shift
         det = a * a - (xp.real(b) ** 2 + xp.imag(b) ** 2)
         b /= -det
         a /= det
-        return a, b, xp.conj(b), a
+        return a, b
 
     def dense(self):
         """The dense matrix ``C`` over the flattened nodes (small cells only), from :attr:`kernel` by offsets."""

@@ -197,15 +197,17 @@ def alias_sum(n_rows, n_cols, radial, g_cut, *, weight=None, block=None):
     return out
 
 
-@lru_cache(maxsize=8)
-def _cached(n_rows, n_cols, alpha):
+def _template(n_rows, n_cols, alpha):
     w = _fourier_part(n_rows, n_cols, alpha) + _real_part(n_rows, n_cols, alpha)
     w -= w.mean()  # zero to round-off already (see the module docstring)
     w.setflags(write=False)
     return w
 
 
-def periodic_template(n_rows, n_cols, alpha=ALPHA):
+_cached = lru_cache(maxsize=8)(_template)
+
+
+def periodic_template(n_rows, n_cols, alpha=ALPHA, *, cache=True):
     """``W`` at every node of a cell of ``n_cols x n_rows`` nodes, lattice units.
 
     Parameters
@@ -215,6 +217,9 @@ def periodic_template(n_rows, n_cols, alpha=ALPHA):
     alpha : float
         Ewald split parameter [1/lattice step]; the result does not depend on it
         (to the accuracy stated in the module docstring).
+    cache : bool
+        Keep the result for the next call on the same cell (the last 8 cells). ``False``: computed
+        and not kept (the homogeneous :class:`bem.periodic.PeriodicOperator` keeps its symbol instead).
 
     Returns
     -------
@@ -222,4 +227,4 @@ def periodic_template(n_rows, n_cols, alpha=ALPHA):
         ``W`` at the offset of node ``(q, r)`` from node ``(0, 0)``, brick storage. The
         displacement of a pyramid of height ``p`` on a lattice of step ``c`` is ``c p W / (pi E*)``.
     """
-    return _cached(int(n_rows), int(n_cols), float(alpha))
+    return (_cached if cache else _template)(int(n_rows), int(n_cols), float(alpha))

@@ -148,29 +148,29 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         stiff = D <= threshold * op.diagonal
         sel = stiff & (p > 0)
         lam_pc = float(np.median(D[sel])) if bool(sel.any()) else 0.0
-        jacobi = 1.0 / (op.diagonal + D)
+        # the Jacobi estimate 1 / (C_nn + D) at the nodes that need it (whole only for the bounded step)
+        jacobi = 1.0 / (op.diagonal + D) if hardness is not None else None
         soft = None if bool(stiff.all()) else ~stiff
     else:
         lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
     M = op.symbol(lam_pc, inverse=True, single=True)
     A32 = op.symbol(lam, single=True)
-    spectral = (lat.n_rows // 2, 2, lat.n_cols // 2 + 1)  # the layout of PeriodicOperator.spectrum
-    work, work32, r_hat = np.empty(spectral, dtype=complex), np.empty(spectral, dtype=np.complex64), None
+    r_hat = None  # the spectrum of (C + lam) t, kept from step to step
 
     def product(v):
         op.n_matvec += 1
         if single:
             x = op.spectrum(v.astype(np.float32))
-            return op.mix(x, A32, out=x, work=work32)
+            return op.mix(x, A32, out=x)
         x = op.spectrum(v)
-        return op.mix(x, A, out=x, work=work)
+        return op.mix(x, A, out=x)
 
     def precondition(r32, idx, r_c):  # M r at the nodes idx: r_c = r there, r32 = r (float32) at the stiff nodes
         x = op.spectrum(r32)
         z = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1)[idx].astype(float)
         if soft is not None:
             out = softf[idx]
-            z[out] = jacf[idx[out]] * r_c[out]
+            z[out] = jacobi_at(idx[out]) * r_c[out]
         return z
 
     single = False  # the first product in double precision: it sets the scale of the KKT residual
@@ -180,13 +180,25 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         u, stale = np.array(u0, dtype=float), 1
     if per_node:
         u += D * p
-        softf, jacf, Df = (None if soft is None else soft.reshape(-1)), jacobi.reshape(-1), D.reshape(-1)
-    t = np.zeros(lat.shape, dtype=np.float32)  # the search direction, transformed in single precision
+        softf, Df = (None if soft is None else soft.reshape(-1)), D.reshape(-1)
+
+        def jacobi_at(nodes):  # 1 / (C_nn + D) at the nodes (flat indices): the numbers of the whole array
+            return 1.0 / (op.diagonal + Df[nodes])
+    # the search direction, transformed in single precision, and in the same array the gap on the contact
+    # that the preconditioner transforms (the direction at the contact nodes is taken out first)
+    t = r32 = np.zeros(lat.shape, dtype=np.float32)
     g = np.empty(lat.shape)
-    r32 = np.empty(lat.shape, dtype=np.float32)
     r32f = r32.reshape(-1)
-    z_prev = np.zeros(lat.shape)
-    gf, tf, zf = g.reshape(-1), t.reshape(-1), z_prev.reshape(-1)
+    # the last preconditioned gap, on its contact only: its nodes (sorted) and values
+    z_nodes, z_values = np.zeros(0, dtype=np.intp), np.zeros(0)
+    gf, tf = g.reshape(-1), t.reshape(-1)
+
+    def z_prev_at(nodes):  # the last z at the (sorted) nodes, 0 where they were off its contact
+        if not z_nodes.size:
+            return np.zeros(nodes.size)
+        pos = np.searchsorted(z_nodes, nodes)
+        np.minimum(pos, z_nodes.size - 1, out=pos)
+        return np.where(z_nodes[pos] == nodes, z_values[pos], 0.0)
     gz_old, m_one, m_full = 1.0, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     was_on = p > 0  # the contact of the previous iterate
@@ -233,6 +245,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         nonlocal single, u, stale
         if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
             single = False  # confirm on an exact product, or go on in double precision
+            u = None  # the product replaces it: not both at once
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:
                 u += D * p
@@ -254,9 +267,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return float(p_c0.max(initial=0.0)), int(idx.size), changes, idx.size == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, gz_old, r_hat, u, stale
+        nonlocal m_full, m_one, gz_old, r_hat, u, stale, z_nodes, z_values
         if bounded and not idx.size:  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, np.zeros(0), None, None)
+        t_old = np.take(tf, idx)  # the last direction on the contact (r32 is t)
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         r32.fill(0.0)  # a fill: faster than zeroing the nodes of the last step
         if soft is None:
@@ -273,19 +287,19 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             if m_full is None:
                 np.multiply(pf.reshape(p.shape) > 0, stiff, out=r32, casting="unsafe")
                 x = op.spectrum(r32)  # M (contact & stiff), and the Jacobi estimate at the soft nodes
-                m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1).astype(float)
-                m_full[softf] = jacf[softf]
-            m_one = m_full[idx]
+                m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1)  # single precision, kept so
+            m_one = m_full[idx].astype(float)
+            on_soft = softf[idx]
+            m_one[on_soft] = jacobi_at(idx[on_soft])  # the Jacobi estimate at the soft nodes
             if not m_one.sum() > 0:  # a contact far from the starting one: the mean instead
                 m_one = np.ones(idx.size)
             z -= m_one * (z.sum() / m_one.sum())
         gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
         beta = 0.0 if k == 1 or gz_old == 0 or restart else max(  # gz_old = 0: one contact node under force control
-            0.0, (gz - float(np.einsum("i,i->", g_c, np.take(zf, idx)))) / gz_old)
-        z_prev.fill(0.0)
-        zf[idx] = z
-        t_c = z + beta * np.take(tf, idx)
+            0.0, (gz - float(np.einsum("i,i->", g_c, z_prev_at(idx)))) / gz_old)
+        z_nodes, z_values = idx, z.copy()
+        t_c = z + beta * t_old
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (t_c.sum() / m_one.sum()) if m_one is not None else t_c.mean()
         gt = float(np.einsum("i,i->", g_c, t_c))
@@ -296,7 +310,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         gz_old = gz
         T = op.spectrum(t)
         op.n_matvec += 1
-        R = r_hat = op.mix(T, A32, out=r_hat, work=work32)  # (C + lam) t, single precision
+        R = r_hat = op.mix(T, A32, out=r_hat)  # (C + lam) t, single precision
         tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
         if per_node:
             D_c = Df[idx]
@@ -319,7 +333,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         overlap = low[pf[low] == 0]
         p_o = None
         if overlap.size:
-            cap = jacf[overlap] if per_node else jacobi
+            cap = jacobi_at(overlap) if per_node else jacobi
             p_o = entering_pressure(np, gf[overlap] - delta, tau, cap, per_node, preconditioned=True)
         entered = bool(overlap.size)
         s = 1.0
@@ -336,6 +350,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 p_o *= s
             pf[overlap] = p_o
         if bool(clipped.any()) or entered or stale >= RECOMPUTE_EVERY:
+            u = None
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:  # u += D p, on the nodes where p > 0
                 uf = u.reshape(-1)
@@ -361,6 +376,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if failure is not None:
             return failure
         if changed or R is None or stale >= RECOMPUTE_EVERY:
+            u = None
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:
                 u += D * p

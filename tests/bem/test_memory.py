@@ -1,0 +1,149 @@
+"""What a solve holds in memory: the invariants its peak per node rests on (``benchmarks/memory.py``
+measures the peak itself, ``docs/performance.md`` reports it).
+
+- nested iteration lets a coarser level's operator and solution go before the finer level is solved;
+- the periodic operator keeps its packed symbol and nothing of the cell's size besides;
+- the in-place products by blocks give the numbers of the whole-array formulas, bit for bit;
+- the traced peak of a solve per node (NumPy's allocations, :mod:`tracemalloc`) stays below a bound
+  on a 256 x 256 problem of each kind, a bound that solves without these invariants exceed by half or more.
+"""
+
+import gc
+import math
+import tracemalloc
+import weakref
+
+import numpy as np
+import pytest
+
+import bem
+from bem import fft
+from bem.block_symbol import block_product
+from bem.periodic import PeriodicCell, PeriodicOperator
+
+
+def _rough(cell, seed=7, modes=24):
+    """A seeded random-phase surface on the cell: a sum of its own Fourier modes (periodic), rms slope about 0.1."""
+    rng = np.random.default_rng(seed)
+    lx, ly = cell.size
+    x, y = cell.x, cell.y
+    h = np.zeros(cell.shape)
+    for m in range(1, modes + 1):
+        kx, ky = 2 * math.pi * rng.integers(-m, m + 1) / lx, 2 * math.pi * m / ly
+        h += np.cos(kx * x + ky * y + rng.uniform(0, 2 * math.pi)) / (m * math.hypot(kx, ky))
+    h *= 0.1 / math.sqrt(np.mean(np.gradient(h, cell.step, axis=1) ** 2))
+    return h.max() - h
+
+
+def test_nested_iteration_lets_each_coarser_level_go_before_the_finer_one(monkeypatch):
+    cell = PeriodicCell(1.0 / 128, 128, 128)
+    h = _rough(cell)
+    made = []
+    operator = PeriodicCell.operator
+
+    def tracked(self, lattice, *args, **kw):
+        op = operator(self, lattice, *args, **kw)
+        made.append(weakref.ref(op))
+        return op
+
+    monkeypatch.setattr(PeriodicCell, "operator", tracked)
+    alive = []
+
+    def callback(k, p):  # called on the finest level only
+        gc.collect()
+        alive.append(sum(ref() is not None for ref in made))
+
+    res = bem.solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=0.01, method="kalker", callback=callback)
+    assert res.converged and len(made) == 2  # 128^2 and 64^2 (the coarsest has 4096 nodes or more)
+    assert alive and max(alive) == 1  # the finest level's operator only
+
+
+def test_the_periodic_operator_keeps_its_packed_symbol_only():
+    cell = PeriodicCell(0.1, 64, 32)
+    op = PeriodicOperator(cell, 2.0)
+    held = sum(a.nbytes for a in vars(op).values() if isinstance(a, np.ndarray))
+    assert held <= cell.n_nodes  # the candidate mask (a byte a node), no spectra, no kernel
+    d, b = op.symbol()
+    assert d.shape == (16, 1, 33) and b.shape == (16, 2, 33)  # the real diagonal block once
+    # the kernel it no longer stores is made on request, the same numbers as the template scaled
+    w = bem.periodic.periodic_template(32, 64) * (0.1 / (math.pi * 2.0))
+    assert np.array_equal(op.kernel, w)
+
+
+def test_the_block_products_equal_the_whole_array_formulas_bit_for_bit(monkeypatch):
+    rng = np.random.default_rng(3)
+    monkeypatch.setattr(fft, "BLOCK", 96)  # several blocks, the last one short
+    cell = PeriodicCell(0.1, 22, 26)
+    op = PeriodicOperator(cell, 1.0)
+    x = op.spectrum(rng.standard_normal(cell.shape))
+    d, b = op.symbol(0.3 * op.diagonal)
+    expected = d * x + b * x[:, ::-1, :]
+    assert np.array_equal(op.mix(x, (d, b)), expected)
+    y = x.copy()
+    assert op.mix(y, (d, b), out=y) is y and np.array_equal(y, expected)
+
+    shape = (2, 37, 19)
+    S = [[rng.standard_normal(shape[1:]) + 1j * rng.standard_normal(shape[1:]) for _ in range(2)] for _ in range(2)]
+    V = rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
+    # the operands in the order of the whole-array formula: V_a *= S_aa, then += S_ab V_b
+    want = np.stack([V[0] * S[0][0] + S[0][1] * V[1], V[1] * S[1][1] + S[1][0] * V[0]])
+    assert np.array_equal(block_product(((S[0][0], S[0][1]), (S[1][0], S[1][1])), V.copy()), want)
+    # a Hermitian symbol without its conjugate block: S_10 = conj(S_01)
+    want = np.stack([V[0] * S[0][0] + S[0][1] * V[1], V[1] * S[1][1] + np.conj(S[0][1]) * V[0]])
+    assert np.array_equal(block_product(((S[0][0], S[0][1]), (None, S[1][1])), V.copy()), want)
+
+
+def test_the_preconditioner_symbol_in_place_is_the_closed_expression():
+    lattice = bem.Lattice.from_extent(0.05, (1.0, 0.8))
+    op = bem.InfluenceOperator(lattice, 1.0)
+    box = op._full()
+    lam, floor = 0.7 * op.diagonal, 0.5
+    shape, ((s00, s01), (s10, s11)) = op._inverse_symbol(box, lam, floor)
+    _, K = op._kernel_spectra(box, box)
+    size = shape[0] * shape[1]
+    A, D, B = K[0, 0].real + lam / size, K[1, 1].real + lam / size, K[0, 1]
+    m = (A + D) / 2
+    d = np.sqrt(((A - D) / 2) ** 2 + np.abs(B) ** 2)
+    low = (floor * op.diagonal + lam) / size
+    inv_hi, inv_lo = 1.0 / np.maximum(m + d, low), 1.0 / np.maximum(m - d, low)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        safe = d > 1e-14 * np.abs(m)
+        half = np.where(safe, 0.5 / np.where(safe, d, 1.0), 0.0)
+    diff = inv_hi - inv_lo
+    scale = 1.0 / size**2
+    assert s10 is None
+    assert np.array_equal(s01, B * half * diff * scale)
+    assert np.array_equal(s00, (inv_lo + np.where(safe, (A - m + d) * half, 0.5) * diff) * scale)
+    assert np.array_equal(s11, (inv_lo + np.where(safe, (D - m + d) * half, 0.5) * diff) * scale)
+
+
+def _traced_peak_per_node(solve):
+    gc.collect()
+    tracemalloc.start()
+    try:
+        base = tracemalloc.get_traced_memory()[0]
+        res = solve()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert res.converged
+    return (peak - base) / res.p.size
+
+
+# traced peaks per node of these problems (numpy 2.4): 93, 136, 87 and 193 bytes; a solve that holds its
+# coarser levels, the spectra its symbols are made of and its copies of the iterates traces 176, 275, 180 and 343
+@pytest.mark.parametrize("problem, bound", [("periodic", 105), ("periodic root layer", 155), ("sphere", 100),
+                                            ("wide sphere", 220)])
+def test_the_traced_peak_of_a_solve_per_node_stays_below_its_bound(problem, bound):
+    if problem.startswith("periodic"):
+        cell = PeriodicCell(1.0 / 256, 256, 256)
+        h = _rough(cell)
+        layer = bem.layers.Root(bem.diagonal_coefficient(cell.step, 1.0) * math.sqrt(0.05)) if "root" in problem else None
+        peak = _traced_peak_per_node(lambda: bem.solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=0.01,
+                                                                layer=layer))
+    else:
+        radius = 0.3 if problem == "wide sphere" else 0.1
+        step = math.sqrt(2 / math.sqrt(3)) / 256
+        peak = _traced_peak_per_node(lambda: bem.solve(bem.gaps.Paraboloid(1.0), E_star=1.0, force=4 * radius**3 / 3,
+                                                       step=step, extent=0.5))
+    assert peak < bound
