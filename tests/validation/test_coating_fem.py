@@ -32,3 +32,20 @@ def test_coated_bem_agrees_with_the_fem_within_the_measured_discretisation_error
     for q, tol in TOLERANCE.items():
         assert math.isclose(b_row[q], f_row[q], rel_tol=tol), (q, b_row[q] / f_row[q] - 1.0)
     assert rms_nodes(b, f) < 0.03
+
+
+@pytest.mark.slow
+def test_quick_study_writes_json_markdown_and_figure(tmp_path):
+    import json
+
+    from .conftest import cli
+
+    out = tmp_path / "study"
+    code, stdout, err = cli("study", "coating-fem", "--quick", "--out", str(out))
+    assert code == 0, err
+    assert sorted(p.name for p in out.iterdir()) == [".contactlab", "coating_fem.json", "coating_fem.md",
+                                                     "coating_fem.png"]
+    (row,) = json.loads((out / "coating_fem.json").read_text())["rows"]
+    assert row["converged"] and (row["a_over_t"], row["modulus_ratio"], row["nu_c"]) == CASE
+    assert row["worst_extrapolated"] < 5e-3  # the study's target
+    assert "The coated BEM against the FEM" in (out / "coating_fem.md").read_text()

@@ -31,6 +31,7 @@ def plot_coating_fem(data, out, *, name="coating_fem.png"):
         top.semilogy(x, [max(r["rms"], floor) for r in rows], "x", ls="none", color="0.3",
                      label="RMS of p(r), finest levels")
         top.axhline(5e-3, color="tab:red", lw=0.8, ls="--", label="0.5 %")
+        top.set_ylim(floor / 2, 1.0)
         top.set_ylabel("|BEM / FEM - 1|, extrapolated")
         top.legend(fontsize="small", ncols=5, loc="upper left")
         for method, colour in (("bem", "tab:blue"), ("fem", "tab:orange")):
