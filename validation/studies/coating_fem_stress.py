@@ -7,7 +7,7 @@ against the FEM's projected nodal stresses (:func:`fem_reference.fields.nodal_st
 - The von Mises stress at the FEM node of its largest value in the coating (depths ``0.02 t ... 0.75 t``)
   and in the substrate (``1.25 t ... t + 3 a``), ``r <= 2 a``, and the BEM's there. The FEM's nodal
   stresses are a continuous projection: at the bond, where ``sigma_rr`` and ``sigma_tt`` jump, they take
-  a mean of the two materials, hence the quarter thickness kept clear of it on both sides.
+  a mean of the two materials, hence the quarter thickness kept clear of it on both sides (``None`` where the window holds no node).
 """
 
 from __future__ import annotations
@@ -49,6 +49,9 @@ def interface_stresses(b, f, coating, s):
              "substrate": (depth >= 1.25 * t) & (depth <= t + 3.0 * a)}
     for name, nodes in zones.items():
         nodes = np.nonzero(nodes & (r <= 2.0 * a))[0]
+        if nodes.size == 0:  # a thick coating's coarse substrate mesh: no node in the window
+            out[f"vm_{name}_fem"] = out[f"vm_{name}_bem"] = out[f"vm_{name}_at"] = out[f"vm_{name}"] = None
+            continue
         k = nodes[np.argmax(fs["von_mises"][nodes])]
         st = axisymmetric_stress(p, edge, [r[k]], [depth[k]], coating, E, nu, side=name)
         out[f"vm_{name}_fem"] = float(fs["von_mises"][k])

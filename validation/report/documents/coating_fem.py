@@ -37,7 +37,7 @@ def levels_table(data):
     rows = []
     for r in data["rows"]:
         st = r.get("stresses") or {}
-        cell = (lambda k: f"{st[k]:+.2%}" if k in st else "-")  # noqa: E731
+        cell = (lambda k: f"{st[k]:+.2%}" if st.get(k) is not None else "-")  # noqa: E731
         rows.append((*_case(r), r["converged"], f"{r['rms']:.2%}", cell("szz"), cell("srz"), cell("vm_coating"),
                      cell("vm_substrate"), f"{r['wall_time_s']:.0f}"))
     return heads, rows
