@@ -64,6 +64,7 @@ examples:
   contactlab study robustness                        every layer method over 12 decades of compliance
   contactlab study two-scale --quick                 resolved rough sphere against its layer law
   contactlab study coating-winkler --quick           coated flat against a linear Winkler layer
+  contactlab study coating-fem --quick               coated BEM against the FEM, both refined
   contactlab report results/hertz --out report/      figures + HTML/Markdown report
   contactlab report results/hertz-sweep-load.force   report of a sweep directory
   contactlab report paper --quick                    the paper's test problem, a quick preview

@@ -17,6 +17,7 @@ PARSER = {"help": "studies: " + ", ".join(STUDIES),
                     "  contactlab study stability --quick\n"
                     "  contactlab study two-scale --quick    (rough_sphere_two_scale, the small two-scale check)\n"
                     "  contactlab study coating-winkler --quick    (the small map: coating against Winkler layer)\n"
+                    "  contactlab study coating-fem --quick    (one case: the coated BEM against the FEM)\n"
                     "  contactlab report reports/studies      (work-precision plot and tables)"}
 
 

@@ -12,10 +12,12 @@
 - :mod:`~validation.studies.coating_winkler`: a sphere on a coated flat against the bare substrate
   with a linear Winkler layer (the oedometric one and the best one), over thickness, moduli and
   Poisson's ratio (the axisymmetric ring solutions of :mod:`~validation.studies.coating_rings`);
+- :mod:`~validation.studies.coating_fem`: the coated BEM against the FEM reference with the coating
+  meshed, both refined, with their observed orders and extrapolated values;
 - :mod:`~validation.studies.paper_problem`: the paper's test problem (section 6) on one lattice,
   its cases, sweeps and methods, which the paper report draws (``contactlab report paper``).
 
-The first five are the studies of :data:`STUDIES` (``contactlab study NAME``); each has
+The first six are the studies of :data:`STUDIES` (``contactlab study NAME``); each has
 ``main(out=..., scene=..., quick=..., progress=...)``, which writes the study's JSON file
 (``STEM + ".json"``, :data:`STUDY_FILES`) and returns a :class:`StudyRun`, which the report renders
 (:mod:`validation.report.documents.studies`).
@@ -47,7 +49,7 @@ __all__ = ["StudyRun", "attempt", "timed", "classify", "finite", "save", "write_
 #: that runs it (its ``main``); the study's file is named after the module (its ``STEM + ".json"``)
 STUDIES = {"error-time": "validation.studies.error_time", "stability": "validation.studies.stability",
            "robustness": "validation.studies.robustness", "two-scale": "validation.studies.two_scale",
-           "coating-winkler": "validation.studies.coating_winkler"}
+           "coating-winkler": "validation.studies.coating_winkler", "coating-fem": "validation.studies.coating_fem"}
 #: the file each study of :data:`STUDIES` writes, in the same order
 STUDY_FILES = tuple(f"{module.rpartition('.')[2]}.json" for module in STUDIES.values())
 

@@ -16,6 +16,7 @@ from ...provenance import display_path
 from ...studies import STUDY_FILES
 from ..render import Figure, Progress, Section, Table, draw_and_build, table_from_rows
 from .results import read_json
+from .coating_fem import coating_fem_sections
 from .coating_winkler import coating_winkler_sections
 from .two_scale import two_scale_sections
 
@@ -119,7 +120,8 @@ def _robustness_sections(data, work=None):
 #: study file -> function(data, work) -> sections (``work``: the figures' folder, None for none), in the
 #: order of :data:`validation.studies.STUDIES`
 _SECTIONS = dict(zip(STUDY_FILES, (_error_time_sections, _stability_sections, _robustness_sections,
-                                   two_scale_sections, coating_winkler_sections)))
+                                   two_scale_sections, coating_winkler_sections,
+                                   coating_fem_sections)))
 
 
 def study_sections(directory, work):
@@ -142,14 +144,15 @@ def study_markdown(name, data):
     title = {"error_time.json": "Error against run time", "stability.json": "Stability on stiff and extreme cases",
              "robustness.json": "Robustness of the layer methods",
              "two_scale.json": "Two-scale check",
-             "coating_winkler.json": "Coatings and the Winkler layer"}[name]
+             "coating_winkler.json": "Coatings and the Winkler layer",
+             "coating_fem.json": "The coated BEM against the FEM"}[name]
     return render_markdown(_SECTIONS[name](data, None), title=title, names={})
 
 
 def write_study_outputs(run):
     """Beside the JSON file of a study's run (:class:`validation.studies.StudyRun`), its tables as
     ``<stem>.md`` and, for the two-scale check with its fields, the two figures of its first case; for
-    the coating study, its map.
+    the coating study, its map; for the coating-FEM study, its figure.
 
     Returns ``(markdown, figure files)``; the Markdown is made from the JSON as written.
     """
@@ -171,6 +174,12 @@ def write_study_outputs(run):
 
         require("report", "the coating study (its map)")
         figures = [plot_coating_map(run.data, run.path.parent)]
+    elif run.stem == "coating_fem" and run.data.get("rows"):
+        from ...extras import require
+        from ..figures.coating_fem import plot_coating_fem
+
+        require("report", "the coating-FEM study (its figure)")
+        figures = [plot_coating_fem(run.data, run.path.parent)]
     return text, figures
 
 

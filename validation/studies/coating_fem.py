@@ -1,0 +1,208 @@
+"""The coated BEM against the FEM reference with the coating meshed: a sphere on a coated flat, both
+methods refined, their convergence orders and extrapolated values compared.
+
+The problem is the one of :mod:`validation.studies.coating_winkler`: an elastic sphere (radius ``R``,
+the substrate's material ``E_s, nu_s``) pressed by the force of the Hertz radius ``a_H`` of the
+uncoated pair on a flat coated with a bonded layer of thickness ``t = a_H / (a_H/t)``, modulus
+``E_c`` and Poisson's ratio ``nu_c``. Each case ``(a_H/t, E_c/E_s, nu_c)`` is solved
+
+- by the BEM (:func:`bem.solve` with ``coating2``) on lattices of step ``a_H / n``, ``n`` in
+  ``bem_levels``;
+- by the FEM reference (:func:`fem_reference.solve` with ``coating2``, quadratic triangles, the
+  coating its own material) with ``n_contact_elements`` in ``fem_levels``.
+
+Measured per level: ``p_max``, the contact radius (the edge of the loaded zone, :func:`bem_edge`
+for the BEM; :func:`fem_reference.result.edge_radius` for the FEM) and the approach. Per method and
+quantity, from the last three levels (each step half the one before): the observed order
+``log2(|q1 - q2| / |q2 - q3|)`` and the Richardson value ``q3 + (q3 - q2) / (2^order - 1)``
+(:func:`richardson`). The BEM-vs-FEM differences of the extrapolated and of the finest values, and the
+RMS of ``p(r)`` (:func:`rms_nodes`). One case carries a root layer ``w = lam sqrt(p)`` on the coating
+(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``). Interface stresses:
+:mod:`validation.studies.coating_fem_stress`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from ..progress import each
+from . import no_scene, save
+from .coating_winkler import _coating, _listed, problem
+
+__all__ = ["SETTINGS", "QUICK", "QUANTITIES", "STEM", "OUTPUT_NAMES", "richardson", "bem_edge", "rms_nodes",
+           "bem_levels", "fem_levels", "compare_case", "run_coating_fem", "summary_lines", "main"]
+
+STEM = __name__.rpartition(".")[2]
+OUTPUT_NAMES = ("coating_fem.json", "coating_fem.md", "coating_fem.png")
+#: the compared scalars of a solution
+QUANTITIES = ("p_max", "radius", "approach")
+
+#: the full study (SI units); ``*_levels``: ``a_H / step`` of the BEM, ``n_contact_elements`` of the FEM
+SETTINGS = dict(R=0.01, E_s=200e9, nu_s=0.3, a_H=1e-4, a_over_t=(0.1, 1.0, 10.0),
+                modulus_ratios=(0.01, 0.1, 10.0, 100.0), nu_c=(0.25, 0.45), bem_levels=(10, 20, 40),
+                fem_levels=(6, 12, 24), root_case=(1.0, 0.1, 0.25), root_lam=0.1, stresses=True)
+#: the small run (``contactlab study coating-fem --quick``): one case
+QUICK = dict(SETTINGS, a_over_t=(1.0,), modulus_ratios=(10.0,), nu_c=(0.25,), root_case=None)
+
+
+def richardson(values):
+    """``(order, extrapolated)`` from the last three values of a sequence on steps halved each time.
+
+    ``order = log2(|q1 - q2| / |q2 - q3|)``; the extrapolated value ``q3 + (q3 - q2) / (2^order - 1)``
+    only where the differences keep their sign and the order lies in ``[0.5, 6]`` (else ``None``: the
+    sequence is not in its asymptotic range, or has converged to round-off, and the finest value stands).
+    """
+    q1, q2, q3 = (float(v) for v in values[-3:])
+    d1, d2 = q1 - q2, q2 - q3
+    if d2 == 0.0 or d1 == 0.0:
+        return None, None
+    order = math.log2(abs(d1 / d2))
+    if d1 * d2 < 0 or not 0.5 <= order <= 6.0:
+        return order, None
+    return order, q3 - d2 / (2.0**order - 1.0)
+
+
+def bem_edge(res, *, layer=False):
+    """The edge of the BEM's loaded zone [length], from its nodes.
+
+    Smooth bodies: ``p^2`` (which vanishes linearly at a square-root edge) over the loaded nodes; with a
+    layer: the overlap taken by the layer, ``w(p)`` inside and ``-gap`` outside (smooth across the edge).
+    A quadratic in ``r`` fitted to it within ``0.4`` area radii of the area radius gives a root; a second
+    fit within three lattice steps of that root gives the edge.
+    """
+    r = np.hypot(res.x, res.y)
+    a = edge = res.contact_radius
+    y = np.where(res.p > 0, res.layer.w(res.p), -res.gap) if layer else res.p**2
+    for half in (0.4 * a, 3.0 * res.step):  # a wide fit, then a local one around its root
+        band = np.abs(r - edge) < half
+        if not layer:
+            band &= res.p > 0
+        if band.sum() < 4:
+            break
+        c = np.polynomial.polynomial.polyfit((r[band] - edge) / half, y[band] / np.abs(y[band]).max(), 2)
+        roots = np.polynomial.polynomial.polyroots(c)
+        roots = roots[np.isreal(roots)].real
+        roots = roots[np.abs(roots) < 1.0]
+        if not roots.size:
+            break
+        edge = float(edge + half * roots[np.argmin(np.abs(roots))])
+    return float(edge)
+
+
+def rms_nodes(res, fem):
+    """RMS of the BEM nodes' pressure against the FEM's ``p(r)`` (linear between its nodes) at their radii,
+    relative: ``sqrt(sum (p_n - p_FEM(r_n))^2 / sum p_FEM(r_n)^2)`` (a uniform lattice: area weights)."""
+    pf = np.interp(np.hypot(res.x, res.y), fem.r, fem.p, right=0.0)
+    return float(math.sqrt(np.sum((res.p - pf) ** 2) / np.sum(pf**2)))
+
+
+def _gap(s):
+    from bem.gaps import Paraboloid
+
+    return Paraboloid(s["R"])
+
+
+def bem_levels(case, s, layer=None):
+    """The BEM at every ``s["bem_levels"]``: ``(rows, finest result)``."""
+    import bem
+
+    rows, res = [], None
+    for n in s["bem_levels"]:
+        t0 = time.perf_counter()
+        res = bem.solve(_gap(s), E1=s["E_s"], nu1=s["nu_s"], E2=s["E_s"], nu2=s["nu_s"], coating2=_coating(case, s),
+                        force=problem(s)[1], step=s["a_H"] / n, extent="auto", layer=layer)
+        rows.append(dict(level=n, converged=bool(res.converged), message=res.message, p_max=float(res.p_max),
+                         radius=bem_edge(res, layer=layer is not None), area_radius=float(res.contact_radius),
+                         approach=float(res.approach), iterations=int(res.iterations), nodes=int(res.p.size),
+                         wall_time_s=time.perf_counter() - t0))
+    return rows, res
+
+
+def fem_levels(case, s, layer=None):
+    """The FEM reference at every ``s["fem_levels"]``: ``(rows, finest result)``."""
+    from fem_reference import solve
+
+    rows, res = [], None
+    for n in s["fem_levels"]:
+        t0 = time.perf_counter()
+        res = solve(_gap(s), E1=s["E_s"], nu1=s["nu_s"], E2=s["E_s"], nu2=s["nu_s"], coating2=_coating(case, s),
+                    force=problem(s)[1], layer=layer, n_contact_elements=n)
+        rows.append(dict(level=n, converged=bool(res.converged), message=res.message, p_max=float(res.p_max),
+                         radius=float(res.edge_radius), approach=float(res.approach), elements=int(res.n_elements),
+                         wall_time_s=time.perf_counter() - t0))
+    return rows, res
+
+
+def _extrapolate(rows):
+    out = {}
+    for q in QUANTITIES:
+        order, value = richardson([r[q] for r in rows])
+        out[q] = dict(order=order, extrapolated=value, finest=rows[-1][q])
+    return out
+
+
+def compare_case(case, s, *, layer=None):
+    """One case: both methods' levels, orders, extrapolated values, differences and interface stresses."""
+    t0 = time.perf_counter()
+    b_rows, b = bem_levels(case, s, layer)
+    f_rows, f = fem_levels(case, s, layer)
+    bx, fx = _extrapolate(b_rows), _extrapolate(f_rows)
+    diff = {}
+    for q in QUANTITIES:
+        fe = fx[q]["extrapolated"] if fx[q]["extrapolated"] is not None else fx[q]["finest"]
+        be = bx[q]["extrapolated"] if bx[q]["extrapolated"] is not None else bx[q]["finest"]
+        diff[q] = dict(extrapolated=be / fe - 1.0, finest=bx[q]["finest"] / fx[q]["finest"] - 1.0)
+    row = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], thickness=_coating(case, s).thickness,
+               layer=None if layer is None else layer.to_dict() if hasattr(layer, "to_dict") else repr(layer),
+               converged=all(r["converged"] for r in b_rows + f_rows), bem=b_rows, fem=f_rows, bem_x=bx, fem_x=fx,
+               diff=diff, rms=rms_nodes(b, f))
+    row["worst_extrapolated"] = max(abs(d["extrapolated"]) for d in diff.values())
+    row["worst_finest"] = max(abs(d["finest"]) for d in diff.values())
+    if s.get("stresses") and f.converged:
+        from .coating_fem_stress import interface_stresses
+
+        row["stresses"] = interface_stresses(b, f, _coating(case, s), s)
+    row["wall_time_s"] = time.perf_counter() - t0
+    return row
+
+
+def _root(s):
+    from bem.layers import Root
+
+    _, _, p_H, d_H = problem(s)
+    return Root(s["root_lam"] * d_H / math.sqrt(p_H))
+
+
+def run_coating_fem(settings=None, *, quick=False, progress=None):
+    """Run the study; returns a JSON-ready dict: ``rows`` (one per case, :func:`compare_case`; the root
+    layer's case last), ``settings``, ``wall_time_s``. ``progress(label, done, total)``: one step per case."""
+    s = dict(QUICK if quick else SETTINGS, **(settings or {}))
+    cases = [(c, None) for c in ((x, e, n) for n in s["nu_c"] for e in s["modulus_ratios"] for x in s["a_over_t"])]
+    if s.get("root_case"):
+        cases.append((tuple(s["root_case"]), _root(s)))
+    t0 = time.perf_counter()
+    rows = [compare_case(c, s, layer=lay) for c, lay in
+            each(cases, progress, lambda c: "a/t = {:g}, Ec/Es = {:g}, nu_c = {:g}".format(*c[0])
+                 + (" + root layer" if c[1] is not None else ""))]
+    return {"study": STEM, "mode": "quick" if quick else "full", "settings": {k: _listed(v) for k, v in s.items()},
+            "rows": rows, "wall_time_s": time.perf_counter() - t0}
+
+
+def summary_lines(data):
+    """Per case: the BEM-vs-FEM differences of the extrapolated values; lines for a terminal."""
+    return [f"a/t = {r['a_over_t']:g}, Ec/Es = {r['modulus_ratio']:g}, nu_c = {r['nu_c']:g}"
+            + (" (root layer)" if r["layer"] else "") + ": "
+            + ", ".join(f"{q} {r['diff'][q]['extrapolated']:+.2%}" for q in QUANTITIES)
+            + f", RMS p {r['rms']:.2%}" for r in data["rows"]]
+
+
+def main(*, out=None, scene=None, quick=False, progress=None):
+    """``contactlab study coating-fem``: the whole grid, or one case when ``quick``; writes
+    ``coating_fem.json`` into the folder ``out`` (``None``: the current directory). The study takes no
+    ``scene``; the exit status is 1 when a solve did not converge."""
+    no_scene("coating-fem", scene)
+    data = run_coating_fem(quick=bool(quick), progress=progress)
+    return save(out, STEM, data, status=0 if all(r["converged"] for r in data["rows"]) else 1)
