@@ -40,6 +40,9 @@ from .template import template
 __all__ = ["InfluenceOperator", "diagonal_coefficient"]
 
 _WINDOWS_KEPT = 3  # kernel spectra cached per operator (matvec windows, preconditioner boxes)
+#: Spectrum entries of one row parity above which a product's inverse transform runs one parity at a
+#: time (half its output held at once); below, both in one call (fewer, larger transforms)
+SPLIT_INVERSE = 1 << 16
 _SNAP = 16  # support boxes snap to a grid of 1/_SNAP of the region
 # A cached matvec window containing the support is reused up to this size ratio (exact either
 # way; saves kernel spectra while a contact shrinks). Preconditioner boxes are not reused: a box
@@ -236,9 +239,12 @@ class InfluenceOperator:
             data[b, :nb, :] = v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq]
         V = block_product(spectra, bk.forward(data, shape))
         del data
-        for a, s in enumerate(self._start):  # one parity at a time: half the inverse's output held at once
+        split = V[0, ...].size > SPLIT_INVERSE  # large: one parity at a time, half the inverse's output held at once
+        both = None if split else bk.inverse(V, shape, (max(r[1] for r in o_rows), nq))
+        for a, s in enumerate(self._start):
             k0, na = o_rows[a]
-            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = bk.inverse(V[a, ...], shape, (na, nq))
+            part = bk.inverse(V[a, ...], shape, (na, nq)) if split else both[a, :na, :]
+            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = part
         if self._masked_last:
             out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 
