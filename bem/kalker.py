@@ -24,15 +24,6 @@ from .plastic import carry_force, note_fully_plastic
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
 
-def _median(bk, values):
-    """``numpy.median`` of a non-empty 1-D array, as a Python float."""
-    if bk.is_numpy:
-        return float(np.median(values))
-    v = bk.xp.sort(values)
-    n = v.shape[0]
-    return float(v[n // 2]) if n % 2 else float(bk.xp.mean(v[n // 2 - 1 : n // 2 + 1]))
-
-
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
              maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True, hardness=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` (``0 <= p <= H`` with a hardness).
@@ -344,7 +335,7 @@ def compliance_preconditioner(op, D, contact, threshold=4.0):
     xp = bk.xp
     stiff = D <= threshold * op.diagonal
     sel = stiff & contact
-    lam = _median(bk, D[sel]) if bool(xp.any(sel)) else 0.0
+    lam = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
     fft = op.preconditioner(lam=lam)
     jacobi = 1.0 / (op.diagonal + D)
     if bool(xp.all(stiff)):

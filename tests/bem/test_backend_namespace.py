@@ -184,3 +184,59 @@ def test_the_iterations_move_no_array_to_the_host(strict, monkeypatch, layer, me
     res = bem.solve(Paraboloid(1.0), layer=layer, method=method, device=strict, nested=False, **KW)
     assert res.converged and res.iterations > 3
     assert len(copies) == 3
+
+
+def _newton_model(cell, h, step=3):
+    """``(b, D, x0)`` of the model QP of Newton step ``step`` of the root layer on the cell (NumPy): a
+    compliance per node ``D``, stiff on the contact and soft (``D > 4 C_nn``) at the open nodes."""
+    import bem.newton
+
+    models = []
+    model_qp = bem.newton._model_qp
+
+    def spy(op, b, D, contact, precondition, **kw):
+        models.append((b.copy(), D.copy(), kw["x0"].copy()))
+        return model_qp(op, b, D, contact, precondition, **kw)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(bem.newton, "_model_qp", spy)
+        solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=2.0, layer=layers.Root(0.2), nested=False)
+    return models[step - 1]
+
+
+@pytest.mark.parametrize("case", ["smooth", "newton_root", "hardness", "coated"])
+def test_the_fourier_qp_takes_the_numpy_path_on_the_strict_namespace(strict, monkeypatch, case):
+    """The periodic cell's QP in the Fourier basis (bem.periodic.qp) on the strict namespace: the iteration
+    of NumPy, step by step (the KKT residual of the iterates to the rounding of other single-precision
+    transforms, the same number of iterations to rtol = 1e-10) and its answer; not the general loop."""
+    import bem.kalker
+    from bem.periodic import PeriodicOperator
+
+    cell = PeriodicCell(1.0 / 32, 32, 32)
+    h, kw = _rough(cell), dict(force=2.0 * cell.size[0] * cell.size[1], rtol=1e-10)
+    bodies = bem.Bodies(**COATING, coating1=bem.Coating(0.2, 3.0, 0.3)) if case == "coated" else None
+    E_star = bodies.E_star if bodies is not None else 1.0
+    if case == "newton_root":
+        h, D, x0 = _newton_model(cell, h)
+        kw |= dict(lam=D, x0=x0)
+        assert 0 < np.count_nonzero(D > 4 * PeriodicOperator(cell, 1.0).diagonal) < D.size  # soft and stiff nodes
+    elif case == "hardness":
+        kw |= dict(hardness=4.0)
+    ref = PeriodicOperator(cell, E_star, bodies=bodies).qp(h, **kw)
+
+    def general_loop(*args, **kwargs):
+        raise AssertionError("the general constrained CG ran")
+
+    monkeypatch.setattr(bem.kalker, "constrained_cg", general_loop)
+    on_strict = {k: xs.asarray(v) if isinstance(v, np.ndarray) else v for k, v in kw.items()}
+    res = PeriodicOperator(cell, E_star, device=strict, bodies=bodies).qp(xs.asarray(h), **on_strict)
+    assert ref.converged and res.converged and ref.iterations > 8
+    assert res.iterations == ref.iterations
+    residual = np.array(ref.history["residual"])
+    early = residual > 1e-6  # before the rounding of single-precision transforms (1e-7) has grown through the iterations
+    assert np.abs(np.array(res.history["residual"])[early] / residual[early] - 1).max() < 1e-2
+    p = bem.backend.to_host(res.p)
+    assert np.abs(p - ref.p).max() <= 1e-10 * ref.p.max()
+    assert abs(res.approach - ref.approach) <= 1e-10 * abs(ref.approach)
+    if case == "hardness":
+        assert 0 < np.count_nonzero(ref.p >= 4.0) < np.count_nonzero(ref.p > 0)
