@@ -6,7 +6,7 @@ control (``delta`` given). Solved by constrained conjugate gradients on the
 active set (Polonsky & Keer 1999, doi:10.1016/S0043-1648(99)00113-1), with an
 optional FFT preconditioner built from the inverse symbol of ``C + lam`` in
 the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005). :func:`solve_qp` is the step
-of the half-space operator (and of any operator on a device other than NumPy) in the one loop
+of the half-space operator (on every device) in the one loop
 :func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
 """
 

@@ -60,13 +60,11 @@ product), five where it changes, two of them in double precision once the residu
 compliance per node).
 
 The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any
-array API namespace with ``xp.fft``): the transforms are ``xp.fft``'s off NumPy, and every array stays on
-the device; the host receives the scalars of the step (reductions: the KKT residual's extremes, the sums of
-the force, the inner products of the step, the counts of the contact and its changes: about 16 a step, and
-the sizes of three node selections).
-The same iteration on every namespace: the rounding of other transforms changes the iterates by round-off,
-not the path (``tests/bem/test_backend_namespace.py``). On NumPy buffers are reused in place and the last
-preconditioned gap is looked up on its nodes (:mod:`bem.periodic.qp_parts`).
+array API namespace with ``xp.fft``), every array on the device; the host receives the scalars of the step
+(the KKT residual's extremes, the sums of the force, the inner products, the counts of the contact and its
+changes: about 16 a step, and the sizes of three node selections). Other transforms round differently and
+take the same iterations (``tests/bem/test_backend_namespace.py``); NumPy reuses buffers in place
+(:mod:`bem.periodic.qp_parts`).
 """
 
 from __future__ import annotations
