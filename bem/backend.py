@@ -169,6 +169,8 @@ class Backend:
 
     def take(self, x, sel):
         """Values of the brick array ``x`` at the selected nodes (1-D, C order)."""
+        if self.is_numpy:  # np.take: faster than an index array on a flat view, the same values
+            return np.take(x.reshape(-1), sel)
         if self._flat:
             return x.reshape(-1)[sel]
         return x[sel]

@@ -157,7 +157,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         stiff = D <= threshold * diag
         sel = stiff & (p > 0)
         lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
-        jacobi = 1.0 / (diag + D)  # the Jacobi estimate 1 / (C_nn + D) per node (brick array)
+        # the Jacobi estimate 1 / (C_nn + D) at the nodes that need it (whole only for the bounded step)
+        jacobi = 1.0 / (diag + D) if hardness is not None else None
         soft = None if bool(xp.all(stiff)) else ~stiff
     else:
         lam_pc, jacobi = lam, 1.0 / (diag + lam)
@@ -186,16 +187,16 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def precondition(r32, nodes, r_c):  # M r at the nodes: r_c = r there, r32 = r (float32) at the stiff nodes
         x = op.spectrum(r32)
         z = xp.astype(bk.take(op.brick(op.mix(x, M, out=x), overwrite=True), nodes), xp.float64)
-        return z if soft is None else xp.where(bk.take(soft, nodes), bk.take(jacobi, nodes) * r_c, z)
+        return z if soft is None else xp.where(bk.take(soft, nodes), jacobi_at(nodes) * r_c, z)
+
+    def jacobi_at(nodes):  # 1 / (C_nn + D) at the nodes: the numbers of the whole array
+        return 1.0 / (diag + bk.take(D, nodes))
 
     def add_at(x, nodes, values):  # x += values at the nodes, in x's precision
         bk.put(x, nodes, xp.astype(bk.take(x, nodes) + values, x.dtype, copy=False))
 
-    def add_into(x, y):  # x += y in x's precision
-        if buf32 is not None:
-            x += y
-            return x
-        return xp.astype(x + y, x.dtype, copy=False)
+    def add_into(x, y):  # x += y in x's precision (NumPy: in place)
+        return np.add(x, y, out=x) if buf32 is not None else xp.astype(x + y, x.dtype, copy=False)
 
     def exact_u():  # (C + lam) p, and D p per node
         u = op.brick(product(p), overwrite=True)
@@ -219,12 +220,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     restart = False  # with a hardness: the last step was shortened to carry the force, the direction restarts
     was_plastic = p >= hardness if bounded else None
 
-    def gap():  # u + h
+    def gap():  # u + h (NumPy: in one buffer)
         nonlocal g
-        if buf32 is None:
-            g = u + h
-        else:
-            np.add(u, h, out=g)
+        g = u + h if buf32 is None else np.add(u, h, out=g)
 
     def residual(k, contact_gap, force_error, plastic_gap=None):
         nonlocal single
@@ -296,7 +294,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 x = op.spectrum(xp.astype((p > 0) & stiff, xp.float32))  # M (contact & stiff)
                 m_full = op.brick(op.mix(x, M, out=x), overwrite=True)  # single precision, kept so
             # and the Jacobi estimate at the soft nodes
-            m_one = xp.where(bk.take(soft, idx), bk.take(jacobi, idx), xp.astype(bk.take(m_full, idx), xp.float64))
+            m_one = xp.where(bk.take(soft, idx), jacobi_at(idx), xp.astype(bk.take(m_full, idx), xp.float64))
             if not float(xp.sum(m_one)) > 0:  # a contact far from the starting one: the mean instead
                 m_one = xp.ones(bk.count(idx), dtype=xp.float64)
             z -= m_one * (float(xp.sum(z)) / float(xp.sum(m_one)))
@@ -339,7 +337,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         entered = bool(bk.count(overlap))
         p_o = None
         if entered:
-            cap = bk.take(jacobi, overlap) if per_node else jacobi
+            cap = jacobi_at(overlap) if per_node else jacobi
             p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, cap, per_node, preconditioned=True)
         s = 1.0
         if target is not None:

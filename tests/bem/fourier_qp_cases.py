@@ -7,7 +7,9 @@ import math
 import numpy as np
 import pytest
 
-import bem
+import bem.backend
+import bem.kalker
+import bem.newton
 from bem import layers
 from bem.periodic import PeriodicCell, PeriodicOperator, solve_periodic
 
@@ -30,8 +32,6 @@ def rough(cell, seed=7):
 def _newton_model(h, step=3):
     """``(b, D, x0)`` of the model QP of Newton step ``step`` of the root layer on :data:`CELL` (NumPy): a
     compliance per node ``D``, stiff on the contact and soft (``D > 4 C_nn``) at the open nodes."""
-    import bem.newton
-
     models = []
     model_qp = bem.newton._model_qp
 
@@ -50,8 +50,6 @@ def compare(case, device, to_device, monkeypatch):
     iterations: the KKT residual of each iterate above ``1e-5`` to 1 %, before the rounding of other
     single-precision transforms (1e-7) has grown through the iterations, the same count to rtol = 1e-10, and
     the answer to 1e-10; never the general loop. Returns the device's solution."""
-    import bem.kalker
-
     h, kw = rough(CELL), dict(force=2.0 * CELL.size[0] * CELL.size[1], rtol=1e-10)
     bodies = bem.Bodies(**COATING, coating1=bem.Coating(0.2, 3.0, 0.3)) if case == "coated" else None
     E_star = bodies.E_star if bodies is not None else 1.0
