@@ -62,9 +62,9 @@ compliance per node).
 The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any
 array API namespace with ``xp.fft``), every array on the device; the host receives the scalars of the step
 (the KKT residual's extremes, the sums of the force, the inner products, the counts of the contact and its
-changes: about 16 a step, and the sizes of three node selections). Other transforms round differently and
-take the same iterations (``tests/bem/test_backend_namespace.py``); NumPy reuses buffers in place
-(:mod:`bem.periodic.qp_parts`).
+changes: about 16 a step, more with a compliance per node or a hardness, and the sizes of three node
+selections). Other transforms round differently and take the same iterations
+(``tests/bem/test_backend_namespace.py``); NumPy reuses buffers in place (:mod:`bem.periodic.qp_parts`).
 """
 
 from __future__ import annotations

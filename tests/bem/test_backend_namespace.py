@@ -187,3 +187,12 @@ def test_the_fourier_qp_takes_the_numpy_path_on_the_strict_namespace(strict, mon
     """The periodic cell's QP in the Fourier basis (bem.periodic.qp) on the strict namespace: the iteration
     of NumPy, step by step, to the same count, and its answer (tests/bem/fourier_qp_cases.py)."""
     compare(case, strict, xs.asarray, monkeypatch)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_the_fourier_qp_takes_the_numpy_path_on_the_flat_index_path_of_cupy(monkeypatch, case):
+    """The same on CuPy's code path (flat-index selections, the namespace's own FFTs) run by array_api_compat.numpy."""
+    compat = pytest.importorskip("array_api_compat.numpy")
+    from bem.backend import Backend
+
+    compare(case, Backend(compat, "compat-numpy", flat_indices=True), compat.asarray, monkeypatch)
