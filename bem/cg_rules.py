@@ -7,7 +7,7 @@ record of the iteration and its outcome (:class:`Record`, :class:`QPSolution`); 
 (:mod:`bem.plastic`) the sets of an iterate (:func:`bounded_sets`) and the projected step with its
 entering and leaving nodes (:func:`bounded_move`). The steps are
 :func:`bem.kalker.solve_qp` (the general loop, any array namespace) and
-:func:`bem.periodic.qp.solve_periodic_qp` (a periodic cell in the Fourier basis); each
+:func:`bem.periodic.qp.solve_periodic_qp` (a periodic cell in the Fourier basis, any namespace); each
 operator picks its own (``op.qp``).
 """
 

@@ -6,7 +6,7 @@ control (``delta`` given). Solved by constrained conjugate gradients on the
 active set (Polonsky & Keer 1999, doi:10.1016/S0043-1648(99)00113-1), with an
 optional FFT preconditioner built from the inverse symbol of ``C + lam`` in
 the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005). :func:`solve_qp` is the step
-of the half-space operator (and of any operator on a device other than NumPy) in the one loop
+of the half-space operator (on every device) in the one loop
 :func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
 """
 
@@ -22,15 +22,6 @@ from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_se
 from .plastic import carry_force, note_fully_plastic
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
-
-
-def _median(bk, values):
-    """``numpy.median`` of a non-empty 1-D array, as a Python float."""
-    if bk.is_numpy:
-        return float(np.median(values))
-    v = bk.xp.sort(values)
-    n = v.shape[0]
-    return float(v[n // 2]) if n % 2 else float(bk.xp.mean(v[n // 2 - 1 : n // 2 + 1]))
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
@@ -344,7 +335,7 @@ def compliance_preconditioner(op, D, contact, threshold=4.0):
     xp = bk.xp
     stiff = D <= threshold * op.diagonal
     sel = stiff & contact
-    lam = _median(bk, D[sel]) if bool(xp.any(sel)) else 0.0
+    lam = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
     fft = op.preconditioner(lam=lam)
     jacobi = 1.0 / (op.diagonal + D)
     if bool(xp.all(stiff)):

@@ -24,7 +24,7 @@ import numpy as np
 import scipy.fft as sfft
 
 from .. import fft
-from ..backend import get_backend
+from ..backend import backend_of, get_backend
 from ..checks import check_positive
 from ..operator import diagonal_coefficient
 from .coated import coated_template
@@ -148,13 +148,17 @@ class PeriodicOperator:
         return out
 
     def spectrum(self, v):
-        """Spectra of the two parities of a brick array (NumPy), shape ``(n_rows/2, 2, n_cols/2 + 1)``.
+        """Spectra of the two parities of a brick array, shape ``(n_rows/2, 2, n_cols/2 + 1)``.
 
         ``[:, a, :]`` is the 2-D real FFT of the rows of parity ``a``: one ``rfft2`` over the
         axes 0 and 2 of the view ``(n_rows/2, 2, n_cols)`` of the brick array, no copy. A float32
-        array gives a complex64 spectrum.
+        array gives a complex64 spectrum. In the namespace of the operator's device (``xp.fft``
+        off NumPy).
         """
         n_rows, n_cols = self.lattice.shape
+        if not self.backend.is_numpy:
+            xp = self.backend.xp
+            return xp.fft.fft(xp.fft.rfft(xp.reshape(v, (n_rows // 2, 2, n_cols)), axis=2), axis=0)
         workers = fft.threads()
         # the two 1-D passes of rfft2, the second in place: the same numbers, 10-15 % faster
         # (benchmarks/periodic_rough.py --cases products)
@@ -164,6 +168,9 @@ class PeriodicOperator:
     def brick(self, spectrum, overwrite=False):
         """The brick array of a spectrum laid out as :meth:`spectrum` gives it (the inverse of it)."""
         n_rows, n_cols = self.lattice.shape
+        if not self.backend.is_numpy:
+            xp = self.backend.xp
+            return xp.reshape(xp.fft.irfft(xp.fft.ifft(spectrum, axis=0), n=n_cols, axis=2), (n_rows, n_cols))
         workers = fft.threads()
         cols = sfft.ifft(spectrum, axis=0, overwrite_x=overwrite, workers=workers)  # irfft2 in two passes
         return sfft.irfft(cols, n=n_cols, axis=2, overwrite_x=True, workers=workers).reshape(n_rows, n_cols)
@@ -177,9 +184,12 @@ class PeriodicOperator:
         it) and ``B[:, a] = S_a(1-a)``, so that ``out = D X + B X'`` with ``X'`` the spectrum with
         its parities swapped: three passes over blocks of :data:`bem.fft.BLOCK` entries (the product
         ``B X'`` in a buffer of one block), on :func:`bem.fft.in_parts` threads. ``out``
-        (default: a new array) may be ``spectrum`` itself.
+        (default: a new array) may be ``spectrum`` itself. Off NumPy, ``D X + B X'`` in the
+        spectrum's namespace (a new array; ``out`` is not used).
         """
         d, b = symbol
+        if not isinstance(spectrum, np.ndarray):
+            return d * spectrum + b * backend_of(spectrum).xp.flip(spectrum, axis=1)
         out = np.empty_like(spectrum) if out is None else out
         rows = max(1, fft.BLOCK // (spectrum.size // max(spectrum.shape[0], 1) or 1))
 
@@ -198,6 +208,15 @@ class PeriodicOperator:
     def inner(self, x, y):
         """``sum x y`` over the cell of two real brick arrays from their spectra (:meth:`spectrum`)."""
         n_rows, n_cols = self.lattice.shape
+        if not self.backend.is_numpy:  # in double precision on the device, as below
+            xp = self.backend.xp
+            weight = xp.full((x.shape[-1],), 2.0, dtype=xp.float64)
+            weight[0] = 1.0
+            if n_cols % 2 == 0:
+                weight[-1] = 1.0
+            w = (xp.astype(xp.real(x), xp.float64) * xp.astype(xp.real(y), xp.float64)
+                 + xp.astype(xp.imag(x), xp.float64) * xp.astype(xp.imag(y), xp.float64))
+            return float(xp.sum(w * weight)) / (n_rows // 2 * n_cols)  # one transfer to the host
 
         def dot(a, b):  # Re sum conj(a) b of two small arrays
             return float(np.sum(a.real * b.real + a.imag * b.imag, dtype=np.float64))
@@ -213,26 +232,40 @@ class PeriodicOperator:
     def symbol(self, lam=0.0, inverse=False, single=False):
         """The 2 x 2 block symbol of ``C + lam I``, or of :meth:`preconditioner` (``inverse``), for :meth:`mix`.
 
-        NumPy only. ``(D, B)``: the diagonal blocks are real and equal (the kernel of a parity on
-        itself is even, and the same for both parities), ``D`` holds their real part once, shape
+        ``(D, B)``, in the namespace of the operator's device: the diagonal blocks are real and equal
+        (the kernel of a parity on itself is even, and the same for both parities), ``D`` holds their real part once, shape
         ``(n_rows/2, 1, n_cols/2 + 1)``, ``B`` the off-diagonal blocks, shape ``(n_rows/2, 2,
         n_cols/2 + 1)``. ``single``: in single precision (float32, complex64), rounded from the
         double-precision blocks.
         """
         if inverse:
             return self._pack(*self._inverse_blocks(lam), None, single=single)
+        if self._symbol is None:  # a device: packed from its spectra once
+            self._symbol = self._pack(self.backend.xp.real(self._s00), self._s01, self._s10)
         d, b = self._symbol
         if single and not lam:  # the symbol of C alone, rounded once per operator
             if self._symbol32 is None:
-                self._symbol32 = (d.astype(np.float32), b.astype(np.complex64))
+                self._symbol32 = self._rounded(d, b)
             return self._symbol32
         d = d + lam if lam else d
-        return (d.astype(np.float32), b.astype(np.complex64)) if single else (d, b)
+        return self._rounded(d, b) if single else (d, b)
+
+    def _rounded(self, d, b):
+        """``(D, B)`` of :meth:`symbol` rounded to single precision."""
+        if self.backend.is_numpy:
+            return d.astype(np.float32), b.astype(np.complex64)
+        xp = self.backend.xp
+        return xp.astype(d, xp.float32), xp.astype(b, xp.complex64)
 
     @staticmethod
     def _pack(d00, s01, s10, single=False):
         """``(D, B)`` of :meth:`symbol` from the real diagonal block ``d00`` and the off-diagonal ones
-        (``s10`` None: its conjugate ``conj(s01)``)."""
+        (``s10`` None: its conjugate ``conj(s01)``), in their namespace."""
+        if not isinstance(d00, np.ndarray):
+            xp = backend_of(d00).xp
+            d = xp.reshape(d00, (d00.shape[0], 1, d00.shape[1]))
+            b = xp.stack([s01, xp.conj(s01) if s10 is None else s10], axis=1)
+            return (xp.astype(d, xp.float32), xp.astype(b, xp.complex64)) if single else (d, b)
         d = np.empty((d00.shape[0], 1, d00.shape[1]), dtype=np.float32 if single else np.float64)
         b = np.empty((d00.shape[0], 2, d00.shape[1]), dtype=np.complex64 if single else np.complex128)
         d[:, 0], b[:, 0] = d00, s01
@@ -271,11 +304,11 @@ class PeriodicOperator:
 
     def qp(self, h, *, lam=0.0, precondition=True, contact=None, **kw):
         """The constrained-CG step of Kalker's QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``
-        on the cell: preconditioned on NumPy, in the Fourier basis
+        on the cell: preconditioned, in the Fourier basis on every device
         (:func:`bem.periodic.qp.solve_periodic_qp`, whose preconditioner for a ``lam`` per node
         starts from the contact of ``x0``), else :func:`bem.kalker.constrained_cg`; a
         :class:`bem.cg_rules.QPSolution`."""
-        if precondition and self.backend.is_numpy:
+        if precondition:
             from .qp import solve_periodic_qp
 
             return solve_periodic_qp(self, h, lam=lam, **kw)

@@ -5,7 +5,7 @@ The step of the periodic operator (:meth:`bem.periodic.PeriodicOperator.qp`) in 
 
 The iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active
 set, Polonsky & Keer 1999, with the FFT preconditioner, the same entering rule, Jacobi cap and
-stopping rule), specialised to :class:`bem.periodic.PeriodicOperator` on NumPy, where ``C`` is
+stopping rule), specialised to :class:`bem.periodic.PeriodicOperator`, where ``C`` is
 diagonal in the Fourier basis of the cell (a 2 x 2 block per frequency, one block row per row
 parity) and every node is a candidate. It does not restart the conjugate directions when nodes
 enter the contact: the new direction is ``t = z + beta t_old`` on the current contact with the
@@ -58,6 +58,13 @@ change (two for the preconditioner, one forward for the search direction, one in
 product), five where it changes, two of them in double precision once the residual is below
 ``SINGLE_ABOVE`` (the general loop: four or six in double precision, or up to eight with a
 compliance per node).
+
+The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any
+array API namespace with ``xp.fft``), every array on the device; the host receives the scalars of the step
+(the KKT residual's extremes, the sums of the force, the inner products, the counts of the contact and its
+changes: about 16 a step, more with a compliance per node or a hardness, and the sizes of three node
+selections). Other transforms round differently and take the same iterations
+(``tests/bem/test_backend_namespace.py``); NumPy reuses buffers in place (:mod:`bem.periodic.qp_parts`).
 """
 
 from __future__ import annotations
@@ -68,8 +75,9 @@ import numpy as np
 
 from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
-                        entering_pressure, initial_pressure, iterate_residual, run_constrained_cg)
+                        entering_pressure, initial_pressure, is_per_node, iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, note_fully_plastic
+from .qp_parts import LastPreconditionedGap, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -79,13 +87,13 @@ SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_AB
 
 def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
                       callback=None, scale=None, u0=None, confirm=True, threshold=4.0, hardness=None):
-    """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell (NumPy).
+    """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell.
 
     Parameters
     ----------
     op : bem.periodic.PeriodicOperator
-        ``C`` on the cell, on the ``"cpu"`` device.
-    h : ndarray
+        ``C`` on the cell, on any device (the arrays in and out are in its namespace).
+    h : array
         Gap at the nodes, brick array [length].
     force, approach : float
         Exactly one: total force on the cell ``P`` [force] or approach ``delta`` [length].
@@ -122,200 +130,195 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     """
     lat = op.lattice
     a = lat.node_area
-    per_node = np.ndim(lam) > 0
-    D = np.asarray(lam, dtype=float) if per_node else None
+    bk = operator_backend(op)[0]
+    xp = bk.xp
+    per_node = is_per_node(lam)
+    D = bk.asarray(lam) if per_node else None
     lam = 0.0 if per_node else float(lam)
-    h = np.asarray(h, dtype=float)
+    h = bk.asarray(h)
     if maxiter is None:
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
     if u0 is None or x0 is None:
         p = initial_pressure(op, h, D if per_node else lam, force, approach, x0, hardness)
         if target is not None:
-            p = p if float(p.sum()) > 0 else np.ones(lat.shape)
+            p = p if float(xp.sum(p)) > 0 else xp.ones(lat.shape, dtype=xp.float64)
             if hardness is None:
-                p *= target / float(p.sum())
+                p *= target / float(xp.sum(p))
             else:
-                p = carry_force(np, p, target, hardness, np.ones(lat.shape, dtype=bool))
+                p = carry_force(xp, p, target, hardness, xp.ones(lat.shape, dtype=xp.bool))
         u0 = None
     else:  # the caller's iterate and its product, as they are
-        p = np.array(x0, dtype=float)
-    p = np.array(p, dtype=float)  # updated in place below
-    pf = p.reshape(-1)
-    A = op.symbol(lam)  # C + lam I
-    soft = None
+        p = x0
+    p = bk.copy(bk.asarray(p))  # updated in place below
+    A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
+    soft = stiff = None
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
-        stiff = D <= threshold * op.diagonal
+        stiff = D <= threshold * diag
         sel = stiff & (p > 0)
-        lam_pc = float(np.median(D[sel])) if bool(sel.any()) else 0.0
+        lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
         # the Jacobi estimate 1 / (C_nn + D) at the nodes that need it (whole only for the bounded step)
-        jacobi = 1.0 / (op.diagonal + D) if hardness is not None else None
-        soft = None if bool(stiff.all()) else ~stiff
+        jacobi = 1.0 / (diag + D) if hardness is not None else None
+        soft = None if bool(xp.all(stiff)) else ~stiff
     else:
-        lam_pc, jacobi = lam, 1.0 / (op.diagonal + lam)
+        lam_pc, jacobi = lam, 1.0 / (diag + lam)
     M = op.symbol(lam_pc, inverse=True, single=True)
     A32 = op.symbol(lam, single=True)
-    r_hat = None  # the spectrum of (C + lam) t, kept from step to step
+    r_hat = None  # the spectrum of (C + lam) t, kept from step to step (NumPy)
+    # a float32 brick with values at some nodes, 0 elsewhere: on NumPy one buffer, refilled, that holds the gap on the
+    # contact the preconditioner transforms and then the search direction (whose values at the contact are taken first)
+    buf32 = np.zeros(lat.shape, dtype=np.float32) if bk.is_numpy else None
+
+    def f32_at(nodes, values):
+        if buf32 is None:
+            return bk.put(xp.zeros(lat.shape, dtype=xp.float32), nodes, xp.astype(values, xp.float32))
+        buf32.fill(0.0)  # a fill: faster than zeroing the nodes of the last step
+        buf32.reshape(-1)[nodes] = values
+        return buf32
 
     def product(v):
         op.n_matvec += 1
         if single:
-            x = op.spectrum(v.astype(np.float32))
+            x = op.spectrum(xp.astype(v, xp.float32))
             return op.mix(x, A32, out=x)
         x = op.spectrum(v)
         return op.mix(x, A, out=x)
 
-    def precondition(r32, idx, r_c):  # M r at the nodes idx: r_c = r there, r32 = r (float32) at the stiff nodes
+    def precondition(r32, nodes, r_c):  # M r at the nodes: r_c = r there, r32 = r (float32) at the stiff nodes
         x = op.spectrum(r32)
-        z = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1)[idx].astype(float)
-        if soft is not None:
-            out = softf[idx]
-            z[out] = jacobi_at(idx[out]) * r_c[out]
-        return z
+        z = xp.astype(bk.take(op.brick(op.mix(x, M, out=x), overwrite=True), nodes), xp.float64)
+        return z if soft is None else xp.where(bk.take(soft, nodes), jacobi_at(nodes) * r_c, z)
+
+    def jacobi_at(nodes):  # 1 / (C_nn + D) at the nodes: the numbers of the whole array
+        return 1.0 / (diag + bk.take(D, nodes))
+
+    def add_at(x, nodes, values):  # x += values at the nodes, in x's precision
+        bk.put(x, nodes, xp.astype(bk.take(x, nodes) + values, x.dtype, copy=False))
+
+    def add_into(x, y):  # x += y in x's precision (NumPy: in place)
+        return np.add(x, y, out=x) if buf32 is not None else xp.astype(x + y, x.dtype, copy=False)
+
+    def exact_u():  # (C + lam) p, and D p per node
+        u = op.brick(product(p), overwrite=True)
+        return add_into(u, D * p) if per_node else u
 
     single = False  # the first product in double precision: it sets the scale of the KKT residual
     if u0 is None:
-        u, stale = op.brick(product(p), overwrite=True), 0
+        u, stale = exact_u(), 0
     else:  # C x0 from the caller, confirmed like an incremental update
-        u, stale = np.array(u0, dtype=float), 1
-    if per_node:
-        u += D * p
-        softf, Df = (None if soft is None else soft.reshape(-1)), D.reshape(-1)
-
-        def jacobi_at(nodes):  # 1 / (C_nn + D) at the nodes (flat indices): the numbers of the whole array
-            return 1.0 / (op.diagonal + Df[nodes])
-    # the search direction, transformed in single precision, and in the same array the gap on the contact
-    # that the preconditioner transforms (the direction at the contact nodes is taken out first)
-    t = r32 = np.zeros(lat.shape, dtype=np.float32)
-    g = np.empty(lat.shape)
-    r32f = r32.reshape(-1)
-    # the last preconditioned gap, on its contact only: its nodes (sorted) and values
-    z_nodes, z_values = np.zeros(0, dtype=np.intp), np.zeros(0)
-    gf, tf = g.reshape(-1), t.reshape(-1)
-
-    def z_prev_at(nodes):  # the last z at the (sorted) nodes, 0 where they were off its contact
-        if not z_nodes.size:
-            return np.zeros(nodes.size)
-        pos = np.searchsorted(z_nodes, nodes)
-        np.minimum(pos, z_nodes.size - 1, out=pos)
-        return np.where(z_nodes[pos] == nodes, z_values[pos], 0.0)
+        u, stale = add_into(bk.copy(bk.asarray(u0)), D * p) if per_node else bk.copy(bk.asarray(u0)), 1
+    t, g = (buf32, np.empty(lat.shape)) if bk.is_numpy else (xp.zeros(lat.shape, dtype=xp.float32), None)  # t, u + h
+    last_z = LastPreconditionedGap(bk, lat.shape)  # the last preconditioned gap, on its contact only
     gz_old, m_one, m_full = 1.0, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     was_on = p > 0  # the contact of the previous iterate
-    n_prev = int(np.count_nonzero(was_on))
+    n_prev = int(xp.count_nonzero(was_on))
     fixed_scale = scale
     contact = idx = g_c = p_c0 = g_min = None
 
     bounded, sets = hardness is not None, None
     restart = False  # with a hardness: the last step was shortened to carry the force, the direction restarts
-    was_plastic, bk = (p >= hardness, operator_backend(op)[0]) if hardness is not None else (None, None)
+    was_plastic = p >= hardness if bounded else None
 
-    def measure_bounded(k):  # measure() with the bound: the CG lives on the elastic contact 0 < p < H
-        nonlocal idx, g_c, p_c0, delta, g_min, single, sets
-        np.add(u, h, out=g)  # the gap is g - delta
-        sets = bounded_sets(bk, p, g, hardness, delta, force)
-        idx, delta, g_min = sets.idx, sets.delta, sets.gap_min
-        g_c, p_c0 = np.take(gf, idx) - delta, np.take(pf, idx)
-        scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
-        kkt = iterate_residual(float(np.abs(g_c).max(initial=0.0)), g_min, scale, lambda: float(np.abs(g - delta).max()),
-                               None if force is None else abs(a * float(pf.sum()) - force) / force,
-                               plastic_gap=sets.plastic_gap)
-        if k == 1:
-            single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
-        return kkt
+    def gap():  # u + h (NumPy: in one buffer)
+        nonlocal g
+        g = u + h if buf32 is None else np.add(u, h, out=g)
 
-    def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
-        nonlocal contact, idx, g_c, p_c0, delta, g_min, single
-        contact = p > 0
-        idx = np.flatnonzero(contact)  # a boolean array: several times faster than flatnonzero(p)
-        np.add(u, h, out=g)  # the gap is g - delta: delta is subtracted on the contact only
-        g_c, p_c0 = np.take(gf, idx), np.take(pf, idx)
-        if force is not None:
-            delta = float(np.mean(g_c)) if idx.size else math.nan
-        g_c -= delta
-        scale = max(float(u.max()), -float(u.min())) if fixed_scale is None else fixed_scale
-        g_min = float(g.min()) - delta
-        kkt = iterate_residual(float(np.abs(g_c).max(initial=0.0)), g_min, scale, lambda: float(np.abs(g - delta).max()),
-                               None if force is None else abs(a * float(p_c0.sum()) - force) / force)
+    def residual(k, contact_gap, force_error, plastic_gap=None):
+        nonlocal single
+        scale = max(float(xp.max(u)), -float(xp.min(u))) if fixed_scale is None else fixed_scale
+        kkt = iterate_residual(contact_gap, g_min, scale, lambda: float(xp.max(xp.abs(g - delta))), force_error,
+                               plastic_gap=plastic_gap)
         if k == 1:  # single precision pays for its closing product only well above SINGLE_ABOVE
             single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
         return kkt
+
+    def measure_bounded(k):  # measure() with the bound: the CG lives on the elastic contact 0 < p < H
+        nonlocal idx, g_c, p_c0, delta, g_min, sets
+        gap()  # the gap is g - delta
+        sets = bounded_sets(bk, p, g, hardness, delta, force)
+        idx, delta, g_min = sets.idx, sets.delta, sets.gap_min
+        g_c, p_c0 = bk.take(g, idx) - delta, bk.take(p, idx)
+        return residual(k, bk.max0(xp.abs(g_c)), None if force is None else abs(a * float(xp.sum(p)) - force) / force,
+                        sets.plastic_gap)
+
+    def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
+        nonlocal contact, idx, g_c, p_c0, delta, g_min
+        contact = p > 0
+        idx = bk.select(contact)  # a boolean array: several times faster than flatnonzero(p)
+        gap()  # the gap is g - delta: delta is subtracted on the contact only
+        g_c, p_c0 = bk.take(g, idx), bk.take(p, idx)
+        if force is not None:
+            delta = float(xp.mean(g_c)) if bk.count(idx) else math.nan
+        g_c -= delta
+        g_min = float(xp.min(g)) - delta
+        return residual(k, bk.max0(xp.abs(g_c)), None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
 
     def confirms(kkt):  # recompute C p exactly at the tolerance, or in double precision below SINGLE_ABOVE
         nonlocal single, u, stale
         if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
             single = False  # confirm on an exact product, or go on in double precision
             u = None  # the product replaces it: not both at once
-            u, stale = op.brick(product(p), overwrite=True), 0
-            if per_node:
-                u += D * p
+            u, stale = exact_u(), 0
             return True
         return False
 
     def observe_bounded():  # changes of the contact and of the plastic set
         nonlocal was_on, was_plastic
-        changes = int(np.count_nonzero(sets.on != was_on)) + int(np.count_nonzero(sets.plastic != was_plastic))
+        changes = int(xp.count_nonzero(sets.on != was_on)) + int(xp.count_nonzero(sets.plastic != was_plastic))
         was_on, was_plastic = sets.on, sets.plastic
-        n_touch = idx.size + sets.pl.size
-        return float(pf.max(initial=0.0)), n_touch, changes, n_touch == 0 and g_min >= 0
+        n_touch = bk.count(idx) + bk.count(sets.pl)
+        return bk.max0(p), n_touch, changes, n_touch == 0 and g_min >= 0
 
     def observe():
         nonlocal was_on, n_prev
-        kept = int(np.count_nonzero(was_on.reshape(-1)[idx]))  # nodes in both contacts
-        changes = (idx.size - kept) + (n_prev - kept)
-        was_on, n_prev = contact, idx.size
-        return float(p_c0.max(initial=0.0)), int(idx.size), changes, idx.size == 0 and g_min >= 0
+        n = bk.count(idx)
+        kept = int(xp.count_nonzero(bk.take(was_on, idx)))  # nodes in both contacts
+        changes = (n - kept) + (n_prev - kept)
+        was_on, n_prev = contact, n
+        return bk.max0(p_c0), n, changes, n == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, gz_old, r_hat, u, stale, z_nodes, z_values
-        if bounded and not idx.size:  # every contact node plastic: only entering and leaving nodes move
-            return bounded_step(0.0, np.zeros(0), None, None)
-        t_old = np.take(tf, idx)  # the last direction on the contact (r32 is t)
+        nonlocal m_full, m_one, gz_old, r_hat, u, stale, t
+        if bounded and not bk.count(idx):  # every contact node plastic: only entering and leaving nodes move
+            return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
+        t_old = bk.take(t, idx)  # the last direction on the contact (float32)
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        r32.fill(0.0)  # a fill: faster than zeroing the nodes of the last step
-        if soft is None:
-            r32f[idx] = g_c
-        else:
-            on = ~softf[idx]
-            r32f[idx[on]] = g_c[on]
-        z = precondition(r32, idx, g_c)
+        z = precondition(f32_at(idx, g_c if soft is None else xp.where(bk.take(stiff, idx), g_c, 0.0)), idx, g_c)
         if force is not None and soft is None:
-            z -= z.mean()
+            z -= xp.mean(z)
         elif force is not None:
             # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
             if m_full is None:
-                np.multiply(pf.reshape(p.shape) > 0, stiff, out=r32, casting="unsafe")
-                x = op.spectrum(r32)  # M (contact & stiff), and the Jacobi estimate at the soft nodes
-                m_full = op.brick(op.mix(x, M, out=x), overwrite=True).reshape(-1)  # single precision, kept so
-            m_one = m_full[idx].astype(float)
-            on_soft = softf[idx]
-            m_one[on_soft] = jacobi_at(idx[on_soft])  # the Jacobi estimate at the soft nodes
-            if not m_one.sum() > 0:  # a contact far from the starting one: the mean instead
-                m_one = np.ones(idx.size)
-            z -= m_one * (z.sum() / m_one.sum())
-        gz = float(np.einsum("i,i->", g_c, z))  # no threaded BLAS
+                x = op.spectrum(xp.astype((p > 0) & stiff, xp.float32))  # M (contact & stiff)
+                m_full = op.brick(op.mix(x, M, out=x), overwrite=True)  # single precision, kept so
+            # and the Jacobi estimate at the soft nodes
+            m_one = xp.where(bk.take(soft, idx), jacobi_at(idx), xp.astype(bk.take(m_full, idx), xp.float64))
+            if not float(xp.sum(m_one)) > 0:  # a contact far from the starting one: the mean instead
+                m_one = xp.ones(bk.count(idx), dtype=xp.float64)
+            z -= m_one * (float(xp.sum(z)) / float(xp.sum(m_one)))
+        gz = bk.dot(g_c, z)  # no threaded BLAS
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
         beta = 0.0 if k == 1 or gz_old == 0 or restart else max(  # gz_old = 0: one contact node under force control
-            0.0, (gz - float(np.einsum("i,i->", g_c, z_prev_at(idx)))) / gz_old)
-        z_nodes, z_values = idx, z.copy()
+            0.0, (gz - bk.dot(g_c, last_z.at(idx))) / gz_old)
+        last_z.keep(idx, z)
         t_c = z + beta * t_old
         if force is not None:  # nodes that left the contact broke the zero sum of t
-            t_c -= m_one * (t_c.sum() / m_one.sum()) if m_one is not None else t_c.mean()
-        gt = float(np.einsum("i,i->", g_c, t_c))
+            t_c -= m_one * (float(xp.sum(t_c)) / float(xp.sum(m_one))) if m_one is not None else xp.mean(t_c)
+        gt = bk.dot(g_c, t_c)
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
-        t.fill(0.0)
-        tf[idx] = t_c
+        t = f32_at(idx, t_c)
         gz_old = gz
         T = op.spectrum(t)
         op.n_matvec += 1
         R = r_hat = op.mix(T, A32, out=r_hat)  # (C + lam) t, single precision
         tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
         if per_node:
-            D_c = Df[idx]
-            tt += float(np.einsum("i,i,i->", D_c, t_c, t_c))
-        if not np.any(t_c):
+            D_c = bk.take(D, idx)
+            tt += weighted_square(bk, D_c, t_c)
+        if not bool(xp.any(t_c != 0)):
             tau = 0.0  # a single contact node under force control: only entering nodes can move
         elif tt <= 0 or not math.isfinite(tt):
             return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
@@ -325,49 +328,51 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             return bounded_step(tau, t_c, R, D_c if per_node else None)
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
-        p_c[clipped] = 0.0
-        pf[idx] = p_c  # p is 0 off idx
+        p_c = xp.where(clipped, 0.0, p_c)
+        bk.put(p, idx, p_c)  # p is 0 off idx
         # re-entering nodes (p = 0, g < 0): the step tau of the preconditioned direction with the Jacobi
         # estimate of M there, -f min(tau, 1) g / (C_nn + lam) (module docstring: entering nodes)
-        low = np.flatnonzero(g < delta)
-        overlap = low[pf[low] == 0]
+        low = bk.select(g < delta)
+        overlap = bk.subset(low, bk.take(p, low) == 0)
+        entered = bool(bk.count(overlap))
         p_o = None
-        if overlap.size:
+        if entered:
             cap = jacobi_at(overlap) if per_node else jacobi
-            p_o = entering_pressure(np, gf[overlap] - delta, tau, cap, per_node, preconditioned=True)
-        entered = bool(overlap.size)
+            p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, cap, per_node, preconditioned=True)
         s = 1.0
         if target is not None:
-            total = float(p_c.sum()) + (float(p_o.sum()) if entered else 0.0)
+            total = float(xp.sum(p_c)) + (float(xp.sum(p_o)) if entered else 0.0)
             if not total > 0:  # every node left the contact and none entered: no force to rescale
-                pf[idx] = p_c0
+                bk.put(p, idx, p_c0)
                 return "the iteration produced a non-finite value", "nonfinite"
             s = target / total
             p_c *= s
-            pf[idx] = p_c
+            bk.put(p, idx, p_c)
         if entered:
             if s != 1.0:
                 p_o *= s
-            pf[overlap] = p_o
-        if bool(clipped.any()) or entered or stale >= RECOMPUTE_EVERY:
+            bk.put(p, overlap, p_o)
+        if bool(xp.any(clipped)) or entered or stale >= RECOMPUTE_EVERY:
             u = None
             u, stale = op.brick(product(p), overwrite=True), 0
             if per_node:  # u += D p, on the nodes where p > 0
-                uf = u.reshape(-1)
-                uf[idx] += D_c * p_c
+                add_at(u, idx, D_c * p_c)
                 if entered:
-                    uf[overlap] += Df[overlap] * p_o
+                    add_at(u, overlap, bk.take(D, overlap) * p_o)
         else:  # p = s (p - tau t) on the contact: u = s (u - tau (C + lam) t), plus D t per node
-            cr = op.brick(R, overwrite=True)
-            cr *= np.float32(tau)
-            u -= cr
-            if per_node:
-                uf = u.reshape(-1)
-                uf[idx] -= tau * (D_c * t_c)
-            if s != 1.0:
-                u *= s
-            stale += 1
+            update_u(R, tau, t_c, D_c if per_node else None, s)
         return None
+
+    def update_u(R, tau, t_c, D_c, s):  # u - tau (C + lam) t (from its spectrum R) - tau D t, times s
+        nonlocal u, stale
+        cr = op.brick(R, overwrite=True)
+        cr *= np.float32(tau) if buf32 is not None else tau
+        u -= cr
+        if D_c is not None:
+            add_at(u, idx, -tau * (D_c * t_c))
+        if s != 1.0:
+            u *= s
+        stale += 1
 
     def bounded_step(tau, t_c, R, D_c):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
         nonlocal u, stale, restart
@@ -377,24 +382,16 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             return failure
         if changed or R is None or stale >= RECOMPUTE_EVERY:
             u = None
-            u, stale = op.brick(product(p), overwrite=True), 0
-            if per_node:
-                u += D * p
+            u, stale = exact_u(), 0
         else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
-            cr = op.brick(R, overwrite=True)
-            cr *= np.float32(tau)
-            u -= cr
-            if per_node:
-                u.reshape(-1)[idx] -= tau * (D_c * t_c)
-            if s != 1.0:
-                u *= s
-            stale += 1
+            update_u(R, tau, t_c, D_c, s)
         return None
 
-    step = CGStep(measure_bounded, confirms, observe_bounded, advance, p.copy) if bounded else CGStep(
-        measure, confirms, observe, advance, p.copy)
+    step = CGStep(measure_bounded, confirms, observe_bounded, advance, lambda: bk.copy(p)) if bounded else CGStep(
+        measure, confirms, observe, advance, lambda: bk.copy(p))
     kkt = run_constrained_cg(step, record, maxiter, callback)
-    note_fully_plastic(record, sets.bracket if bounded else None, bounded and not idx.size)
+    note_fully_plastic(record, sets.bracket if bounded else None, bounded and not bk.count(idx))
     # C p: the layer's closure is not a displacement
-    elastic = u - (D if per_node else lam) * p if per_node or lam else u.astype(float, copy=False)
+    elastic = u - (D if per_node else lam) * p if per_node or lam else xp.astype(u, xp.float64, copy=False)
     return record.solution(p, delta, kkt, elastic, "Kalker QP (periodic)")
+

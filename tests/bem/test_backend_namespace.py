@@ -6,7 +6,6 @@ backend would fail instead of falling back silently. The callbacks see every ite
 strict namespace.
 """
 
-import math
 
 import numpy as np
 import pytest
@@ -16,6 +15,8 @@ import bem.backend
 from bem import layers
 from bem.gaps import Paraboloid
 from bem.periodic import PeriodicCell, solve_periodic
+
+from .fourier_qp_cases import CASES, COATING, compare, rough
 
 xs = pytest.importorskip("array_api_strict")
 
@@ -76,23 +77,13 @@ def test_every_solver_and_a_host_only_law_run_on_the_strict_namespace(strict, me
     assert set(seen) == {"array_api_strict"}
 
 
-def _rough(cell, seed=7):
-    rng = np.random.default_rng(seed)
-    h = np.zeros(cell.shape)
-    for _ in range(4):
-        kx, ky = rng.integers(1, 4, size=2)
-        h += rng.uniform(0.2, 1.0) * np.cos(2 * math.pi * (kx * cell.x / cell.size[0] + ky * cell.y / cell.size[1])
-                                            + rng.uniform(0, 2 * math.pi))
-    return h - h.min()
-
-
 @pytest.mark.parametrize("layer, method", [(None, "kalker"), (layers.Root(0.2), "newton")],
                          ids=["periodic_kalker_qp", "periodic_root_newton"])
 def test_strict_namespace_periodic_solve_equals_the_numpy_solve(strict, layer, method):
     cell = PeriodicCell(1.0 / 32, 32, 32)
-    h = _rough(cell)
-    # on NumPy the QP runs in the Fourier basis (bem.periodic.qp), another iteration than the general
-    # loop of the namespace: both are solved far enough for their answers to agree to 1e-12
+    h = rough(cell)
+    # the QP in the Fourier basis (bem.periodic.qp) on both, solved far enough (KKT 1e-13) for the answers
+    # to agree to 1e-12 (the iteration counts may differ by one at the round-off of single-precision transforms)
     kw = dict(step=cell.step, E_star=1.0, mean_pressure=2.0, layer=layer, method=method, rtol=1e-13)
     ref = solve_periodic(h, **kw)
     seen, callback = _iterates(strict)
@@ -100,9 +91,6 @@ def test_strict_namespace_periodic_solve_equals_the_numpy_solve(strict, layer, m
     assert 0.05 < ref.contact_fraction < 0.95
     _same(ref, res)
     assert set(seen) == {"array_api_strict"}
-
-
-COATING = dict(E1=1.0, nu1=0.3, E2=1.0, nu2=0.3)
 
 
 @pytest.mark.parametrize("case", ["hardness", "coating"])
@@ -121,9 +109,9 @@ def test_hardness_and_coatings_run_on_the_strict_namespace(strict, case):
     cell = PeriodicCell(1.0 / 32, 32, 32)
     kw = dict(step=cell.step, mean_pressure=2.0, rtol=1e-13) | (dict(E_star=1.0, hardness=4.0) if case == "hardness"
                                                                 else extra)
-    ref = solve_periodic(_rough(cell), **kw)
+    ref = solve_periodic(rough(cell), **kw)
     seen, callback = _iterates(strict)
-    _same(ref, solve_periodic(_rough(cell), device=strict, callback=callback, **kw))
+    _same(ref, solve_periodic(rough(cell), device=strict, callback=callback, **kw))
     assert set(seen) == {"array_api_strict"}
     if case == "hardness":
         assert 0 < ref.plastic_fraction < ref.contact_fraction
@@ -166,13 +154,15 @@ def test_the_flat_index_path_of_cupy_emulated_on_numpy_equals_the_numpy_solve():
         _same(ref, bem.solve(Paraboloid(1.0), layer=layer, method=method, device=device, **KW), tol=1e-10)
     cell = PeriodicCell(1.0 / 32, 32, 32)
     kw = dict(step=cell.step, E_star=1.0, mean_pressure=2.0, layer=layers.Root(0.2), rtol=1e-13)  # as above
-    _same(solve_periodic(_rough(cell), **kw), solve_periodic(_rough(cell), device=device, **kw))
+    _same(solve_periodic(rough(cell), **kw), solve_periodic(rough(cell), device=device, **kw))
 
 
+@pytest.mark.parametrize("domain", ["region", "cell"])
 @pytest.mark.parametrize("layer, method", [(None, "kalker"), (layers.Root(0.05), "newton")])
-def test_the_iterations_move_no_array_to_the_host(strict, monkeypatch, layer, method):
+def test_the_iterations_move_no_array_to_the_host(strict, monkeypatch, layer, method, domain):
     """Device arrays reach the host only through bem.backend.to_host (DLPack): the solution, its
-    displacement and the result's product, whatever the number of iterations."""
+    displacement and the result's product, whatever the number of iterations (on the cell: of the
+    QP in the Fourier basis)."""
     copies = []
     from_dlpack = np.from_dlpack
 
@@ -181,6 +171,28 @@ def test_the_iterations_move_no_array_to_the_host(strict, monkeypatch, layer, me
         return from_dlpack(x, *args, **kwargs)
 
     monkeypatch.setattr(np, "from_dlpack", counted)
-    res = bem.solve(Paraboloid(1.0), layer=layer, method=method, device=strict, nested=False, **KW)
+    if domain == "region":
+        res = bem.solve(Paraboloid(1.0), layer=layer, method=method, device=strict, nested=False, **KW)
+    else:
+        cell = PeriodicCell(1.0 / 32, 32, 32)
+        res = solve_periodic(rough(cell), step=cell.step, E_star=1.0, mean_pressure=2.0, layer=layer, method=method,
+                             device=strict, nested=False)
     assert res.converged and res.iterations > 3
     assert len(copies) == 3
+
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_the_fourier_qp_takes_the_numpy_path_on_the_strict_namespace(strict, monkeypatch, case):
+    """The periodic cell's QP in the Fourier basis (bem.periodic.qp) on the strict namespace: the iteration
+    of NumPy, step by step, to the same count, and its answer (tests/bem/fourier_qp_cases.py)."""
+    compare(case, strict, xs.asarray, monkeypatch)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_the_fourier_qp_takes_the_numpy_path_on_the_flat_index_path_of_cupy(monkeypatch, case):
+    """The same on CuPy's code path (flat-index selections, the namespace's own FFTs) run by array_api_compat.numpy."""
+    compat = pytest.importorskip("array_api_compat.numpy")
+    from bem.backend import Backend
+
+    compare(case, Backend(compat, "compat-numpy", flat_indices=True), compat.asarray, monkeypatch)

@@ -10,6 +10,8 @@ from bem import layers
 from bem.gaps import Paraboloid
 from bem.periodic import PeriodicCell, solve_periodic
 
+from .fourier_qp_cases import CASES, compare
+
 cupy = pytest.importorskip("cupy")
 
 
@@ -57,8 +59,7 @@ def test_cuda_solve_equals_the_numpy_solve(layer, method, kw):
 def test_cuda_periodic_solve_equals_the_numpy_solve(layer):
     cell = PeriodicCell(1.0 / 64, 64, 64)
     h = 0.05 * (2 - np.cos(2 * math.pi * cell.x) - np.cos(2 * math.pi * cell.y / cell.size[1]))
-    # on NumPy the cell's QP runs in the Fourier basis, on CuPy by the general loop: both solved far
-    # enough (KKT 1e-13) for their answers to agree to 1e-10
+    # the cell's QP in the Fourier basis on both, solved far enough (KKT 1e-13) for the answers to agree to 1e-10
     kw = dict(step=cell.step, E_star=1.0, mean_pressure=0.02, layer=layer, rtol=1e-13)
     _same(solve_periodic(h, **kw), solve_periodic(h, device="cuda", **kw))
 
@@ -83,3 +84,11 @@ def test_cuda_hardness_and_coatings_equal_the_numpy_solve(case):
     kw = dict(step=cell.step, mean_pressure=0.02, rtol=1e-13) | (dict(E_star=1.0, hardness=0.05) if case == "hardness"
                                                                  else extra)
     _same(solve_periodic(h, **kw), solve_periodic(h, device="cuda", **kw))
+
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_cuda_fourier_qp_takes_the_numpy_path(monkeypatch, case):
+    """The periodic cell's QP in the Fourier basis (bem.periodic.qp) on CuPy: the iteration of NumPy, step by
+    step, to the same count, and its answer (tests/bem/fourier_qp_cases.py, as on the strict namespace)."""
+    assert isinstance(compare(case, "cuda", cupy.asarray, monkeypatch).p, cupy.ndarray)
