@@ -185,6 +185,8 @@ def test_the_command_line_runs_a_coated_scene_with_stress(tmp_path):
     assert code == 0, err
     result = RunResult.read(tmp_path / "run" / "result.json")
     assert list(result.stress.bodies) == ["body1"] and result.stress.bodies["body1"].coated.thickness == 4e-5
+    c = result.stress.bodies["body1"].coated
+    assert f"shear up to {c.interface_max_shear:.6g} Pa" in out and "coating max von Mises" in out
 
 
 def test_a_rigid_substrate_has_stresses_in_its_coating_only(tmp_path):

@@ -359,7 +359,8 @@ def stress_figures(res, work):
     curves, marks = [], []
     for i, (name, b) in enumerate(bodies.items()):
         ax, key = b.axis, ("bem", "fem")[i % 2] if i else "bem"
-        curves += [{"label": f"{name} (nu = {fmt(b.nu)}): von Mises", "z": ax["z"], "values": ax["von_mises"],
+        coat = "" if b.coated is None else ", coated"
+        curves += [{"label": f"{name} (nu = {fmt(b.nu)}{coat}): von Mises", "z": ax["z"], "values": ax["von_mises"],
                     "key": key, "ls": "-"},
                    {"label": f"{name}: max shear", "z": ax["z"], "values": ax["tresca"], "key": key, "ls": ":"}]
         marks.append((b.depth_of_max, b.max_von_mises, "black"))
