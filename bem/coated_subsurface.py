@@ -157,6 +157,33 @@ class CoatedStress:
         s = {"coating": self.interface_coating, "substrate": self.interface_substrate}[side]
         return {"zz": s[:, 2], "xz": s[:, 4], "yz": s[:, 3], "shear": np.hypot(s[:, 4], s[:, 3])}
 
+    def layers(self):
+        """The depths with the interface from both sides, sorted: ``(z, sigma, von_mises, in_coating)``.
+
+        Returns
+        -------
+        z : ndarray, shape (L,)
+            The depths ``z`` [length] with the interface depth ``t`` on the coating's side and, below a
+            substrate that is not rigid, again on the substrate's side (once each), increasing; at ``z = t``
+            the coating's side comes first.
+        sigma : ndarray, shape (L, M, 6)
+            The stress tensor at those depths [pressure].
+        von_mises : ndarray, shape (L, M)
+            ``sqrt(3 J2)`` [pressure].
+        in_coating : ndarray of bool, shape (L,)
+            Whether each row lies in the coating.
+        """
+        t = self.coating.thickness
+        rows = [(float(d), not c, self.sigma[k]) for k, (d, c) in enumerate(zip(self.z, self.in_coating))]
+        if not np.any(self.z == t):
+            rows.append((t, False, self.interface_coating))
+        if self.interface_substrate is not None:
+            rows.append((t, True, self.interface_substrate))
+        rows.sort(key=lambda row: row[:2])
+        sigma = np.stack([row[2] for row in rows])
+        return (np.array([row[0] for row in rows]), sigma, _von_mises(sigma),
+                np.array([not row[1] for row in rows]))
+
     def nearest(self, x0=0.0, y0=0.0):
         """Index of the point nearest to ``(x0, y0)`` [length]."""
         return int(np.argmin((self.x - x0) ** 2 + (self.y - y0) ** 2))

@@ -255,10 +255,13 @@ def write_stress_vtu(path, result, upper=None, lower=None):
         Target ``.vtu`` file.
     result : bem.ContactResult
         The BEM solution the stresses were computed from (its lattice and nodes).
-    upper, lower : bem.SubsurfaceStress, optional
+    upper, lower : bem.SubsurfaceStress or bem.CoatedStress, optional
         Stresses of the upper body (cell data ``body = 0``) and of the lower one (``body = 1``),
         numbered as in the FEM reference's field file ``fem_field.vtu``,
-        on the candidate nodes at increasing depths [length].
+        on the candidate nodes at increasing depths [length]. A coated body's coating and
+        substrate are two blocks of cells that meet at the interface without sharing points (each
+        holds its own side's stresses there, :meth:`bem.CoatedStress.layers`), the cell data
+        ``coating`` 1 in the coating, 0 elsewhere.
 
     Returns
     -------
@@ -268,33 +271,48 @@ def write_stress_vtu(path, result, upper=None, lower=None):
     -----
     Point data: ``stress`` (six components in VTK's order ``xx, yy, zz, xy, yz, xz``, which
     ParaView reads as a symmetric tensor), ``von_mises`` and ``max_shear`` [pressure]; single
-    precision (a picture: the numbers of record are those of :func:`bem.subsurface_stress`).
+    precision (a picture: the numbers of record are those of :func:`bem.subsurface_stress`
+    and :func:`bem.coated_stress`).
     """
     from .stress import principal_stresses
 
-    bodies = [(body, sign, st) for body, sign, st in ((0, 1.0, upper), (1, -1.0, lower)) if st is not None]
-    rows, cols, nodes = volume_grid(result.lattice, max(st.z.size for *_, st in bodies), len(bodies))
+    bodies = [(body, sign, _blocks(st)) for body, sign, st in ((0, 1.0, upper), (1, -1.0, lower)) if st is not None]
+    depths = max(sum(b[0].size for b in blocks) for *_, blocks in bodies)
+    rows, cols, nodes = volume_grid(result.lattice, depths, len(bodies))
     flat = nodes.ravel()
-    points, data, cells, body_id = [], [], [], []
+    points, data, cells, body_id, coating = [], [], [], [], []
     offset = 0
-    for body, sign, st in bodies:
-        # lower body (depth downwards): reverse the depth order so that every cell's first face is its lowest
-        order = np.arange(st.z.size) if sign > 0 else np.arange(st.z.size)[::-1]
-        z = sign * st.z[order]
-        x = np.broadcast_to(result.x[flat], (z.size, flat.size))
-        y = np.broadcast_to(result.y[flat], (z.size, flat.size))
-        points.append(np.stack([x, y, np.broadcast_to(z[:, None], x.shape)], axis=-1).reshape(-1, 3))
-        sigma = st.sigma[order][:, flat].reshape(-1, 6).copy()
-        if sign < 0:
-            sigma[:, 3:5] *= -1.0  # yz, xz in the global frame
-        principal = principal_stresses(sigma)
-        data.append((sigma[:, _VOIGT_TO_VTK], st.von_mises[order][:, flat].ravel(),
-                     0.5 * (principal[:, 0] - principal[:, 2])))
-        hexa = _hexahedra(z.size, rows.size, cols.size, offset)
-        cells.append(hexa)
-        body_id.append(np.full(len(hexa), body, dtype=np.int32))
-        offset += z.size * flat.size
+    for body, sign, blocks in bodies:
+        for depth, stress, von_mises, in_coating in blocks:
+            # lower body (depth downwards): reverse the depth order so that every cell's first face is its lowest
+            order = np.arange(depth.size) if sign > 0 else np.arange(depth.size)[::-1]
+            z = sign * depth[order]
+            x = np.broadcast_to(result.x[flat], (z.size, flat.size))
+            y = np.broadcast_to(result.y[flat], (z.size, flat.size))
+            points.append(np.stack([x, y, np.broadcast_to(z[:, None], x.shape)], axis=-1).reshape(-1, 3))
+            sigma = stress[order][:, flat].reshape(-1, 6).copy()
+            if sign < 0:
+                sigma[:, 3:5] *= -1.0  # yz, xz in the global frame
+            principal = principal_stresses(sigma)
+            data.append((sigma[:, _VOIGT_TO_VTK], von_mises[order][:, flat].ravel(),
+                         0.5 * (principal[:, 0] - principal[:, 2])))
+            hexa = _hexahedra(z.size, rows.size, cols.size, offset)
+            cells.append(hexa)
+            body_id.append(np.full(len(hexa), body, dtype=np.int32))
+            coating.append(np.full(len(hexa), in_coating, dtype=np.int32))
+            offset += z.size * flat.size
     return write_vtu(path, np.concatenate(points), [("hexahedron", np.concatenate(cells))],
                      point_data={name: np.concatenate([d[k] for d in data]).astype(np.float32)
                                  for k, name in enumerate(("stress", "von_mises", "max_shear"))},
-                     cell_data={"body": [np.concatenate(body_id)]})
+                     cell_data={"body": [np.concatenate(body_id)], "coating": [np.concatenate(coating)]})
+
+
+def _blocks(st):
+    """``(z, sigma, von_mises, in_coating)`` blocks of a body's stresses: the body (``in_coating = 0``), or a
+    coated body's coating (1) and substrate (0, none when rigid), each with its side of the interface."""
+    from .coated_subsurface import CoatedStress
+
+    if not isinstance(st, CoatedStress):
+        return [(st.z, st.sigma, st.von_mises, 0)]
+    z, sigma, von_mises, inside = st.layers()
+    return [(z[m], sigma[m], von_mises[m], flag) for m, flag in ((inside, 1), (~inside, 0)) if m.any()]

@@ -45,7 +45,7 @@ from .coating import check_uncoated_body
 from .kernel_convolution import SymmetricKernelConvolution
 from .result import ContactResult
 
-__all__ = ["subsurface_stress", "SubsurfaceStress", "VOIGT", "principal_stresses"]
+__all__ = ["subsurface_stress", "SubsurfaceStress", "VOIGT", "principal_stresses", "peak_in_depth"]
 
 log = logging.getLogger(__name__)
 
@@ -105,7 +105,7 @@ def _tresca(s, block=1 << 15):
     return out.reshape(s.shape[:-1])
 
 
-def _peak(field, z):
+def peak_in_depth(field, z):
     """Maximum of ``field`` (n_z, M): value, depth and point index, refined in depth by a parabola.
 
     The parabola goes through the sampled maximum and its neighbours in depth at the same point
@@ -381,7 +381,7 @@ def subsurface_stress(result, z, *, nu, x=None, y=None, body=None, device="cpu")
     if loaded.size:
         _convolve_depths(lattice, grid, loaded, z / c, nu, x, y, on_nodes, store, vm, backend)
     sigma = np.moveaxis(store, 1, 2)  # (n_z, M, 6), a view
-    vmax, vdepth, vn = _peak(vm, z)
+    vmax, vdepth, vn = peak_in_depth(vm, z)
     # the largest maximum shear lies where von Mises >= (sqrt(3)/2) max von Mises (since
     # vm / 2 <= tresca <= vm / sqrt(3)): principal stresses only there, then along the depth
     # of the largest one (for the refinement)
@@ -390,7 +390,7 @@ def subsurface_stress(result, z, *, nu, x=None, y=None, body=None, device="cpu")
     tres[cand] = _tresca(sigma[cand])
     n_top = np.unravel_index(int(np.argmax(tres)), tres.shape)[1]
     tres[:, n_top] = _tresca(sigma[:, n_top])
-    tmax, tdepth, tn = _peak(tres, z)
+    tmax, tdepth, tn = peak_in_depth(tres, z)
     out = SubsurfaceStress(
         x=x, y=y, z=z, sigma=sigma, von_mises=vm, nu=nu, max_von_mises=vmax, depth_of_max=vdepth,
         location_of_max=(float(x[vn]), float(y[vn]), vdepth), max_tresca=tmax, depth_of_max_tresca=tdepth,

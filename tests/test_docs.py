@@ -137,9 +137,18 @@ def real_results(tmp_path_factory):
             ("rough_flat", ["gap.grid=32", "bem.cell_nodes=32", "bodies.E1=210e9", "bodies.nu1=0.3",  # coated
                             "bodies.E2=210e9", "bodies.nu2=0.3", "bodies.coating1.thickness=1e-5",
                             "bodies.coating1.E=2e10", "bodies.coating1.nu=0.3"])]
+    from validation.scene.load import read_toml
+    from validation.scene.source import builtin_path
+
+    coated = read_toml(builtin_path("hertz"))  # a coated body's [stress]: stress.bodies.*.coated
+    for section in ("analytic", "fem", "report"):
+        coated.pop(section)
+    coated["bodies"]["coating1"] = {"thickness": 4e-5, "E": 4.5e11, "nu": 0.25}
+    runs.append((coated, ["bem.nodes_across=8", "stress.n_depths=4"]))
     out = []
-    for i, (name, overrides) in enumerate(runs):
-        run_scene(name, tmp / f"{i}_{name}", overrides=overrides)
+    for i, (scene, overrides) in enumerate(runs):
+        name = scene if isinstance(scene, str) else "coated_stress"
+        run_scene(scene, tmp / f"{i}_{name}", overrides=overrides)
         out.append(json.loads((tmp / f"{i}_{name}" / "result.json").read_text()))
     return out
 

@@ -81,18 +81,15 @@ def test_bad_coatings_are_refused_naming_the_key(change, message):
         parse_scene(raw)
 
 
-def test_a_coated_scene_refuses_the_homogeneous_stresses_and_closed_forms():
+def test_a_coated_scene_refuses_the_homogeneous_closed_forms_and_takes_stress():
     raw = read_toml(builtin_path("hertz"))
     raw.pop("fem", None)
-    stress = raw.pop("stress", {"depths": "auto"})
     raw["bodies"]["coating1"] = dict(COATING)
     raw.setdefault("analytic", {"kind": "hertz"})
     with pytest.raises(SceneError, match=r"analytic = \{\.\.\.\} is not allowed with bodies.coating1"):
         parse_scene(raw)
     raw.pop("analytic")
-    raw["stress"] = stress
-    with pytest.raises(SceneError, match=r"stress = \{\.\.\.\} is not allowed with bodies.coating1"):
-        parse_scene(raw)
+    assert parse_scene(raw).stress["bodies"] == ["body1", "body2"]  # bem.coated_stress (test_coated_stress_scene.py)
 
 
 def test_the_cli_sets_a_coating(tmp_path):

@@ -65,7 +65,7 @@ def test_the_written_result_holds_the_solvers_numbers(hertz_run):
     assert r.wall_time_s_by_part["bem"] > 0 and r.wall_time_s_by_part["layer_reference"] is None
 
 
-@pytest.mark.parametrize("schema", ["contactlab.result/2", "contactlab.result/4", None])
+@pytest.mark.parametrize("schema", ["contactlab.result/3", "contactlab.result/5", None])
 def test_a_result_of_another_schema_is_refused(hertz_run, tmp_path, schema):
     d, data = _copy(hertz_run[1], tmp_path)
     data["schema"] = schema

@@ -77,6 +77,10 @@ def _summary(result, out_dir):
         x, y, z = body.location_of_max
         lines.append(f"stress     {name}: max von Mises {_g(body.max_von_mises)} {Pa} at depth {_g(z)} {L} "
                      f"(x {_g(x, '.3g')}, y {_g(y, '.3g')}), max shear {_g(body.max_tresca)} {Pa}")
+        if (c := body.coated) is not None:
+            lines.append(f"           coating max von Mises {_g(c.max_von_mises_coating)} {Pa}, substrate "
+                         f"{_g(c.max_von_mises_substrate)} {Pa}; interface at depth {_g(c.thickness)} {L}: sigma_zz "
+                         f"down to {_g(c.interface_min_sigma_zz)} {Pa}, shear up to {_g(c.interface_max_shear)} {Pa}")
     lines += [f"note       {msg}" for msg in result.messages]
     if out_dir is not None:
         lines.append(f"files      {out_dir}/ ({', '.join(result.files.values())})")

@@ -8,7 +8,7 @@
 - :mod:`validation.run.record`: :class:`RunResult`, the typed content of ``result.json`` (its
   JSON reading and writing, the schema version), its parts in :mod:`validation.run.parts`;
   :mod:`validation.run.result` makes it;
-- :mod:`validation.run.stress`: the ``[stress]`` part of a run;
+- :mod:`validation.run.stress`: the ``[stress]`` part of a run (a coated body's: :mod:`validation.run.stress_coated`);
 - :mod:`validation.run.sweep`: one scene over a list of values of a parameter.
 """
 

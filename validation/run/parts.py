@@ -15,11 +15,11 @@ from dataclasses import dataclass
 from bem.checks import InputError
 
 __all__ = ["SCHEMA", "ResultFileError", "BemPart", "FemMesh", "FemPart", "FemProfile", "ClosedForm", "PairMetrics",
-           "ForceBalance", "Comparison", "Scales", "StressFem", "StressBody", "StressPart", "SpotSummary",
+           "ForceBalance", "Comparison", "Scales", "StressFem", "StressCoated", "StressBody", "StressPart", "SpotSummary",
            "PeriodicPart", "AxialProfile"]
 
 #: The schema string of ``result.json``; a file with another one is refused.
-SCHEMA = "contactlab.result/3"
+SCHEMA = "contactlab.result/4"
 
 
 class ResultFileError(InputError):
@@ -262,8 +262,28 @@ class StressFem(_Part):
 
 
 @dataclass
+class StressCoated(_Part):
+    """A coated body's stresses (:func:`validation.run.stress_coated.coated_block`): von Mises maxima per material,
+    the interface tractions' extremes, and the interface along the x-z section (``None``: rigid substrate)."""
+
+    thickness: float
+    max_von_mises_coating: float
+    location_of_max_coating: list
+    max_von_mises_substrate: float | None
+    location_of_max_substrate: list | None
+    interface_min_sigma_zz: float
+    location_of_interface_min_sigma_zz: list
+    interface_max_sigma_zz: float
+    location_of_interface_max_sigma_zz: list
+    interface_max_shear: float
+    location_of_interface_max_shear: list
+    interface: dict
+
+
+@dataclass
 class StressBody(_Part):
-    """One body's stresses (:meth:`bem.SubsurfaceStress.summary`), its axis profile and x-z section."""
+    """One body's stresses (:meth:`bem.SubsurfaceStress.summary`), its axis profile and x-z section; ``coated``
+    for a coated body (``None`` otherwise)."""
 
     nu: float
     max_von_mises: float
@@ -278,6 +298,7 @@ class StressBody(_Part):
     axis: dict
     section: dict
     fem: StressFem | None
+    coated: StressCoated | None
 
 
 @dataclass

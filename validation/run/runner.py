@@ -238,6 +238,7 @@ def execute_scene(scene, *, progress=None, overrides=None):
 
         stages("stress")
         stress = run_stress(scene, res, fem)
+        messages.extend(stress.notes)
         times["stress"] = stress.wall_time_s
     times["total"] = time.perf_counter() - t0
     stress_block = None
@@ -284,8 +285,9 @@ def write_outputs(outcome, out_dir, *, progress=None, what="out_dir"):
         if outcome.fem is not None:
             write_vtu(tmp / files["fem_field"], **outcome.fem.field())
         if outcome.stress is not None:
-            write_stress_vtu(tmp / files["stress_field"], res, upper=outcome.stress.bodies.get("body1"),
-                             lower=outcome.stress.bodies.get("body2"))
+            run = outcome.stress  # a coated body's field: its coating and substrate (bem.CoatedStress)
+            upper, lower = (run.coated.get(name, run.bodies.get(name)) for name in ("body1", "body2"))
+            write_stress_vtu(tmp / files["stress_field"], res, upper=upper, lower=lower)
         write_text(tmp / files["scene"], tomli_w.dumps(scene.raw))
         outcome.result.write(tmp, files["result"])
     stages.done()

@@ -3,9 +3,11 @@
 :func:`run_stress` evaluates :func:`bem.subsurface_stress` for the bodies the scene names
 (``body1``: ``E1, nu1``, the upper body; ``body2``: ``E2, nu2``, the lower one) at the scene's
 depths (``"auto"``: ``n_depths`` equal steps from the surface down to ``max_depth`` contact
-half-widths), :func:`stress_summary` turns the result into the ``stress`` block of
-``result.json`` (maxima, their depths and locations, the profile on the axis and the x-z
-section through the axis for the report), and, when the FEM reference ran, the same maxima
+half-widths), and :func:`bem.coated_stress` for a coated one (:mod:`validation.run.stress_coated`:
+its interface, from both sides, among the depths); :func:`stress_summary` turns the result into
+the ``stress`` block of ``result.json`` (maxima, their depths and locations, the profile on the
+axis and the x-z section through the axis for the report; a coated body's maxima per material
+and interface tractions), and, when the FEM reference ran, the same maxima of an uncoated body
 are taken from its recovered nodal stresses (:func:`fem_body_stresses`) and compared
 (:func:`compare_with_fem`).
 
@@ -29,6 +31,8 @@ import numpy as np
 import bem
 from bem.stress import principal_stresses
 
+from .stress_coated import coated_block, coated_body_stress, coated_layers, interface_depths
+
 __all__ = ["BODIES", "StressRun", "run_stress", "stress_summary", "fem_body_stresses", "peak_fit",
            "compare_with_fem", "contact_half_width"]
 
@@ -51,8 +55,13 @@ class StressRun:
     scale : float
         Contact half-width the ``"auto"`` depths were set from [length].
     fem : dict
-        ``name -> comparison`` (:func:`compare_with_fem`) when the FEM ran.
+        ``name -> comparison`` (:func:`compare_with_fem`) when the FEM ran (uncoated bodies).
     wall_time_s : float
+    coated : dict
+        ``name -> bem.CoatedStress`` of the coated bodies (:mod:`validation.run.stress_coated`); their
+        ``bodies`` entry holds its rows with the interface from both sides.
+    notes : list of str
+        Messages for the run (a coated body not compared with the FEM).
     """
 
     bodies: dict
@@ -60,6 +69,8 @@ class StressRun:
     scale: float
     fem: dict = field(default_factory=dict)
     wall_time_s: float = 0.0
+    coated: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
 
 
 def contact_half_width(res):
@@ -76,16 +87,25 @@ def run_stress(scene, res, fem=None):
     t0 = time.perf_counter()
     spec = scene.stress
     scale = contact_half_width(res)
+    layers = coated_layers(scene)
     if spec["depths"] == "auto":
-        depths = np.linspace(0.0, spec["max_depth"] * scale, spec["n_depths"])
+        depths = interface_depths(np.linspace(0.0, spec["max_depth"] * scale, spec["n_depths"]), layers)
     else:
         depths = np.unique(np.asarray(spec["depths"], dtype=float))
-    bodies = {name: bem.subsurface_stress(res, depths, nu=scene.materials[BODIES[name]])
-              for name in spec["bodies"]}
-    run = StressRun(bodies=bodies, depths=depths, scale=scale)
+    bodies, coated = {}, {}
+    for name in spec["bodies"]:
+        body = int(name.removeprefix("body"))
+        if name in layers:
+            bodies[name], coated[name] = coated_body_stress(res, depths, body, layers[name][1], layers[name][0])
+        else:
+            bodies[name] = bem.subsurface_stress(res, depths, nu=scene.materials[BODIES[name]], body=body)
+    run = StressRun(bodies=bodies, depths=depths, scale=scale, coated=coated)
     if fem is not None:
         fem_stresses = fem_body_stresses(fem)
-        run.fem = {name: compare_with_fem(res, st, fem_stresses[name]) for name, st in bodies.items()}
+        run.fem = {name: compare_with_fem(res, st, fem_stresses[name]) for name, st in bodies.items()
+                   if name not in coated}
+        run.notes += [f"stress: {name} is coated; its stresses are not compared with the FEM's, whose nodal "
+                      "recovery averages them across the coating/substrate interface." for name in coated]
     run.wall_time_s = time.perf_counter() - t0
     return run
 
@@ -168,6 +188,7 @@ def stress_summary(run):
                         "tresca": 0.5 * (principal[:, 0] - principal[:, 2]), "sigma_zz": st.sigma[:, n, 2],
                         "sigma_xx": st.sigma[:, n, 0]}
         body["section"] = {"x": st.x[row], "y": float(st.y[row[0]]), "z": st.z, "von_mises": st.von_mises[:, row]}
-        body["fem"] = run.fem.get(name)  # None: the FEM did not run
+        body["fem"] = run.fem.get(name)  # None: the FEM did not run, or the body is coated
+        body["coated"] = coated_block(run.coated[name], row) if name in run.coated else None
         out["bodies"][name] = body
     return out

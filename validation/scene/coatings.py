@@ -1,10 +1,11 @@
-"""Coatings in a scene: ``[bodies] coating1``, ``coating2`` (a :class:`bem.Coating` each) and what they exclude."""
+"""Coatings in a scene: ``[bodies] coating1``, ``coating2`` (a :class:`bem.Coating` each) and what they exclude
+or bound (``[analytic]``; ``[stress] depths`` below a rigid substrate)."""
 
 from __future__ import annotations
 
 from . import checks as ck
 
-__all__ = ["COATING_KEYS", "COATING_FIELDS", "coating", "coated_sections"]
+__all__ = ["COATING_KEYS", "COATING_FIELDS", "coating", "coated_sections", "coated_stress_depths"]
 
 #: the coating of each body, a table ``{thickness, E, nu}`` (:class:`bem.Coating`)
 COATING_KEYS = ("coating1", "coating2")
@@ -24,14 +25,34 @@ def coating(path, d):
     return {key: float(d[key]) for key in COATING_FIELDS}
 
 
-def coated_sections(coatings, raw):
-    """A coated scene (``coatings`` of :func:`validation.scene.schema.bodies`) has no ``[stress]`` and no
-    ``[analytic]``: both are those of homogeneous bodies."""
+def coated_sections(coatings, raw, stress=None, materials=None):
+    """A coated scene (``coatings`` of :func:`validation.scene.schema.bodies`) has no ``[analytic]``: its
+    closed forms are those of homogeneous bodies; its ``stress`` (:func:`validation.scene.schema.stress_options`)
+    is checked by :func:`coated_stress_depths` (``materials``: the bodies' ``E1, nu1, E2, nu2``) and returned."""
     if coatings is None:
-        return
+        return stress
     coated = next(k for k, v in coatings.items() if v is not None)
-    for section, what in (("stress", "the subsurface stresses of homogeneous half-spaces"),
-                          ("analytic", "closed forms of homogeneous bodies")):
-        if section in raw:
-            raise ck.SceneError(f"{section} = {{...}} is not allowed with bodies.{coated}: [{section}] gives {what}; "
-                                f"remove [{section}] or the coating.")
+    if "analytic" in raw:
+        raise ck.SceneError(f"analytic = {{...}} is not allowed with bodies.{coated}: [analytic] gives closed forms "
+                            "of homogeneous bodies; remove [analytic] or the coating.")
+    return coated_stress_depths(stress, materials, coatings)
+
+
+def coated_stress_depths(stress, materials, coatings):
+    """``[stress] depths`` (a list) of a coated body on a rigid substrate (``bodies.E1`` or ``E2 = inf``) lie
+    in its coating (at most its thickness): a rigid substrate has no stresses. Returns ``stress``."""
+    if stress is None or coatings is None or stress["depths"] == "auto":
+        return stress
+    for name in stress["bodies"]:
+        k = name.removeprefix("body")
+        c = coatings[f"coating{k}"]
+        if c is None or materials[f"E{k}"] != float("inf"):
+            continue
+        for i, depth in enumerate(stress["depths"]):
+            if depth > c["thickness"]:
+                raise ck.SceneError(
+                    f"stress.depths[{i}] = {depth!r} is not allowed with bodies.E{k} = inf and bodies.coating{k}: "
+                    f"the rigid substrate has no stresses, so {name}'s depths must be at most the coating thickness "
+                    f"bodies.coating{k}.thickness = {c['thickness']!r}; list depths within it or leave {name} out "
+                    "of stress.bodies.")
+    return stress

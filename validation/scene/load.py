@@ -282,7 +282,7 @@ def _validate(raw, source, overrides, *, base_dir=None, code="refuse", outside_f
     report = check(sec.report, raw.get("report"))
     stress = check(lambda b, bo: sec.stress_options(raw.get("stress"), b["materials"], bo["step"]), body, bem)
     stress = check(lambda st, bo: sec.stress_depth_bound(st, bo["extent"]), stress, bem)
-    check(lambda b: coated_sections(b["coatings"], raw), body)
+    stress = check(lambda b, st: coated_sections(b["coatings"], raw, st, b["materials"]), body, stress)
     hardness = check(sec.hardness_bound, body, load, bem, fem, analytic)
     if check.errors:
         raise SceneError.of(check.errors)

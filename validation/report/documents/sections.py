@@ -170,7 +170,15 @@ def stress(res, work):
                     f"max shear / {s_name}", f"its depth / {l_name}"), tuple(rows),
                    caption="Largest von Mises stress and largest maximum shear (s1 - s3)/2 of each body over all "
                            "candidate nodes and depths, refined in depth by a parabola through the largest sample and "
-                           f"its neighbours.{_scales_text(res, a, s, l_name, s_name)}")]
+                           "its neighbours" + ("; of a coated body (nu: its substrate's), in each material apart, its "
+                                               "interface from both sides" if _coated_rows(block, a, s) else "")
+                           + f".{_scales_text(res, a, s, l_name, s_name)}")]
+    if coated_rows := _coated_rows(block, a, s):
+        items.append(Table(("body", "quantity", f"value / {s_name}", f"at x, y, z / {l_name}"), tuple(coated_rows),
+                           caption="A coated body (bem.coated_stress): the largest von Mises stress in its coating and "
+                                   "in its substrate, and the extreme tractions on the coating/substrate interface "
+                                   "(depth t; sigma_zz < 0 is compression, shear = sqrt(sigma_xz^2 + sigma_yz^2)); "
+                                   "over all candidate nodes and depths, the interface from both sides."))
     fem_rows = [(name, fmt(f.max_von_mises / s), f"{100 * f.max_von_mises_rel:+.2f} %", fmt(f.max_tresca / s),
                  f"{100 * f.max_tresca_rel:+.2f} %", fmt(f.axis_depth_of_max / a),
                  fmt(f.bem_axis_depth_of_max / a), f"{100 * f.axis_depth_of_max_rel:+.2f} %",
@@ -192,6 +200,24 @@ def stress(res, work):
             "surface for a smooth contact.")
     text += f" Computed in {fmt(float(block.wall_time_s), 3)} s."
     return Section("Subsurface stresses", kind="results", text=(text,), items=tuple(items))
+
+
+def _coated_rows(block, a, s):
+    """Rows of the coated bodies' table of :func:`stress`: quantity, value, location."""
+    rows = []
+    for name, b in block.bodies.items():
+        if (c := b.coated) is None:
+            continue
+        t = c.thickness
+        where = [("largest von Mises stress in the coating", c.max_von_mises_coating, c.location_of_max_coating),
+                 ("largest von Mises stress in the substrate", c.max_von_mises_substrate, c.location_of_max_substrate),
+                 ("interface: most compressive sigma_zz", c.interface_min_sigma_zz,
+                  [*c.location_of_interface_min_sigma_zz, t]),
+                 ("interface: largest sigma_zz", c.interface_max_sigma_zz, [*c.location_of_interface_max_sigma_zz, t]),
+                 ("interface: largest shear traction", c.interface_max_shear, [*c.location_of_interface_max_shear, t])]
+        rows += [(name, what, fmt(None if v is None else v / s),
+                  "-" if at is None else ", ".join(fmt(u / a) for u in at)) for what, v, at in where]
+    return rows
 
 
 def _scales_text(res, a, s, l_name, s_name):

@@ -4,7 +4,8 @@ of a run's report.
 Drawing functions, by subject: :mod:`.profiles` (pressure along a line, solvers against a
 reference, layer laws), :mod:`.iterations` (iterates and convergence), :mod:`.sweeps`
 (families of curves, the transition line), :mod:`.surfaces` (3-D surfaces and contact maps),
-:mod:`.fields` (stress fields and depth profiles), :mod:`.precision` (work-precision);
+:mod:`.fields` (stress fields and depth profiles), :mod:`.coated` (a coated body's interface),
+:mod:`.precision` (work-precision);
 :mod:`.run` draws them from a run's results. Their conventions: ``path`` names the file to
 write, in the format of :func:`validation.report.render.style.figure_format` (a PNG at
 :data:`~validation.report.render.style.DPI`, an SVG, or a PDF beside the PNG: the one rule of
@@ -21,7 +22,7 @@ section ``section`` of :data:`validation.report.documents.sections.SECTIONS`, af
 section's tables. A new figure is one function and one line here.
 """
 
-from . import periodic, run
+from . import coated, periodic, run
 
 __all__ = ["FIGURES"]
 
@@ -32,5 +33,6 @@ FIGURES = {
     "convergence": ("convergence", run.convergence),
     "fem_von_mises": ("fem_field", run.fem_von_mises),
     "stress": ("stress", run.stress_figures),
+    "stress_interface": ("stress", coated.interface_tractions),
     "cell_maps": ("rough", periodic.cell_maps),
 }

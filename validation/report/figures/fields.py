@@ -145,14 +145,25 @@ def section_field_from_vtu(path, field="von_mises"):
     return mesh.points[:, 0], mesh.points[:, 1], np.vstack(blocks), np.asarray(mesh.point_data[field], dtype=float)
 
 
-def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, fem=None, labels=None, title=None):
+def _split_at_repeats(z, values):
+    """``(z, values)`` split where a depth repeats (a material boundary: the two sides of one depth); parts
+    with fewer than two depths are left out."""
+    z, values = np.asarray(z, dtype=float), np.asarray(values, dtype=float)
+    cuts = np.flatnonzero(np.diff(z) == 0) + 1
+    return [(zp, vp) for zp, vp in zip(np.split(z, cuts), np.split(values, cuts)) if zp.size >= 2]
+
+
+def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, fem=None, labels=None, title=None,
+                        interfaces=()):
     """Von Mises stress in the x-z section through the axis, body 1 above and body 2 below the interface.
 
     Parameters
     ----------
     panels : sequence of (sign, x, z, values)
         One per body: ``sign`` +1 (drawn at ``+z``, upper body) or -1 (at ``-z``), ``x`` (n_x,)
-        [length], ``z`` (n_z,) depths [length], ``values`` (n_z, n_x) in the unit of ``scale``.
+        [length], ``z`` (n_z,) depths [length], ``values`` (n_z, n_x) in the unit of ``scale``. A depth
+        given twice is a material boundary (a coated body's interface: the coating's side first); the
+        field is drawn on each side of it up to it.
     label : str
         Colour-bar label (mathtext).
     contact_radius : float, optional
@@ -162,6 +173,9 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
         mirrored about the axis, are drawn over the map at the same levels (dashed).
     labels : dict, optional
         ``{"x", "z"}`` axis labels.
+    interfaces : sequence of float
+        Heights ``z`` [length] (``+t`` in the upper body, ``-t`` in the lower one) of coating/substrate
+        interfaces, drawn as dashed lines.
     """
     if not panels:
         raise InputError("panels = [] is not allowed: give at least one body's section.")
@@ -175,11 +189,15 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
     height = 5.2 if len(panels) > 1 else 3.6
     width = min(9.0, max(3.8, 1.6 + (height - 0.8) * 2 * x_lim / span))
     with new_figure((width, height), title=title) as (fig, ax):
-        for sign, x, z, values in panels:
-            xx, zz = np.meshgrid(np.asarray(x) / a, sign * np.asarray(z) / a)
-            vv = np.asarray(values) / scale
-            mesh = ax.pcolormesh(xx, zz, vv, shading="gouraud", cmap="magma", vmin=0.0, vmax=vmax)
-            ax.contour(xx, zz, vv, levels=levels, colors="white", linewidths=0.6, alpha=0.7)
+        for sign, x, z_body, values_body in panels:
+            for z, values in _split_at_repeats(z_body, values_body):
+                xx, zz = np.meshgrid(np.asarray(x) / a, sign * z / a)
+                vv = values / scale
+                mesh = ax.pcolormesh(xx, zz, vv, shading="gouraud", cmap="magma", vmin=0.0, vmax=vmax)
+                ax.contour(xx, zz, vv, levels=levels, colors="white", linewidths=0.6, alpha=0.7)
+        for i, height in enumerate(interfaces):
+            ax.axhline(height / a, color="#7fff7f", lw=1.0, ls="--",
+                       label="coating/substrate interface" if i == 0 else None)
         if fem is not None:
             r, zf, tri, vf = (np.asarray(v) for v in fem)
             keep = np.all(np.abs(zf[tri]) / a <= 1.05 * z_lim, axis=1) & np.all(r[tri] / a <= 1.05 * x_lim, axis=1)
@@ -190,7 +208,7 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
         if contact_radius:
             rc = contact_radius / a
             ax.plot([-rc, rc], [0.0, 0.0], color="#00d0ff", lw=3.0, solid_capstyle="butt", label="contact")
-        if contact_radius or fem is not None:
+        if contact_radius or fem is not None or len(interfaces):
             ax.legend(loc="lower right", fontsize=8, facecolor="#333333", labelcolor="white", framealpha=0.8)
         fig.colorbar(mesh, ax=ax, pad=0.01).set_label(label)
         ax.set_xlim(-x_lim, x_lim)
@@ -205,7 +223,7 @@ def plot_stress_section(panels, path, *, a, scale, label, contact_radius=None, f
 
 
 def plot_depth_profiles(curves, path, *, a, scale, stress_label, depth_label=r"depth $z\,/\,a_H$", marks=(),
-                        title=None):
+                        title=None, interfaces=()):
     """Stresses against the depth on the axis (depth downwards).
 
     Parameters
@@ -217,6 +235,8 @@ def plot_depth_profiles(curves, path, *, a, scale, stress_label, depth_label=r"d
         Axis labels (mathtext); depths are divided by ``a``, stresses by ``scale``.
     marks : sequence of (depth, value, color)
         Points to mark (e.g. the maxima) [length], [stress].
+    interfaces : sequence of (depth, label)
+        Depths [length] of coating/substrate interfaces, drawn as dashed lines.
     """
     if not curves:
         raise InputError("curves = [] is not allowed: give at least one profile.")
@@ -228,6 +248,8 @@ def plot_depth_profiles(curves, path, *, a, scale, stress_label, depth_label=r"d
                     markersize=3.5, lw=1.5)
         for depth, value, color in marks:
             ax.plot([value / scale], [depth / a], "o", color=color, markersize=6, markerfacecolor="none")
+        for depth, text in interfaces:
+            ax.axhline(depth / a, color="#2ca02c", lw=0.9, ls="--", label=text)
         ax.invert_yaxis()
         ax.set_xlabel(stress_label)
         ax.set_ylabel(depth_label)

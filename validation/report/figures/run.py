@@ -347,17 +347,20 @@ def stress_figures(res, work):
     a, s, l_name, s_name, normalised = stress_view(res)
     length = (a, l_name, normalised)
     z_label, s_label = axis_label("z", length), axis_label(r"\sigma", (s, s_name, normalised))
-    panels = [({"body1": 1.0, "body2": -1.0}[name], b.section["x"], b.section["z"], b.section["von_mises"])
-              for name, b in bodies.items()]
+    sign = {"body1": 1.0, "body2": -1.0}
+    panels = [(sign[name], b.section["x"], b.section["z"], b.section["von_mises"]) for name, b in bodies.items()]
+    coated = [(name, b.coated.thickness) for name, b in bodies.items() if b.coated is not None]
     section = plot_stress_section(panels, work / "stress_section.png", a=a, scale=s,
                                   label="von Mises " + s_label.replace(r"\sigma", r"\sigma_{vM}"),
                                   contact_radius=res.result.contact_radius, fem=res.fem_field,
                                   labels={"x": axis_label("x", length), "z": z_label},
-                                  title="von Mises stress in the section y = 0")
+                                  title="von Mises stress in the section y = 0",
+                                  interfaces=[sign[name] * t for name, t in coated])
     curves, marks = [], []
     for i, (name, b) in enumerate(bodies.items()):
         ax, key = b.axis, ("bem", "fem")[i % 2] if i else "bem"
-        curves += [{"label": f"{name} (nu = {fmt(b.nu)}): von Mises", "z": ax["z"], "values": ax["von_mises"],
+        coat = "" if b.coated is None else ", coated"
+        curves += [{"label": f"{name} (nu = {fmt(b.nu)}{coat}): von Mises", "z": ax["z"], "values": ax["von_mises"],
                     "key": key, "ls": "-"},
                    {"label": f"{name}: max shear", "z": ax["z"], "values": ax["tresca"], "key": key, "ls": ":"}]
         marks.append((b.depth_of_max, b.max_von_mises, "black"))
@@ -371,12 +374,15 @@ def stress_figures(res, work):
                            "key": "smooth", "ls": "--"})
     profiles_ = plot_depth_profiles(curves, work / "stress_profiles.png", a=a, scale=s, stress_label=s_label,
                                     depth_label=z_label.replace("$z", "depth $z"), marks=marks,
-                                    title="stresses on the axis x = y = 0")
+                                    title="stresses on the axis x = y = 0",
+                                    interfaces=[(t, f"{name}: coating/substrate interface") for name, t in coated])
     depths = np.asarray(block.depths, dtype=float)
     text = (f"{depths.size} depths from {fmt(depths.min() / a)} to {fmt(depths.max() / a)} {l_name}"
             f" (down to {fmt(depths.max() / block.scale)} contact half-widths), every candidate node; "
             "bem.subsurface_stress: the BEM pressure (pyramids on the lattice) convolved with the stresses "
-            "under one pyramid, frictionless, each body with its own Poisson ratio.")
+            "under one pyramid, frictionless, each body with its own Poisson ratio"
+            + ("; a coated body: bem.coated_stress, in its coating and its substrate (the nu shown), the interface "
+               "(dashed) evaluated from both sides, so that the stresses jump there." if coated else "."))
     overlay = " Dashed: the FEM reference's von Mises stress at the same levels." if res.fem_field is not None else ""
     crosses = " Crosses: FEM axis nodes." if any(b.fem is not None for b in bodies.values()) else ""
     return [Figure(section, "Von Mises stress of the BEM solution in the x-z section through the axis (lattice row "
