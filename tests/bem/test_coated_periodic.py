@@ -216,6 +216,8 @@ def test_periodic_operator_refuses_bodies_of_another_modulus_and_too_thin_coatin
     with pytest.raises(bem.InputError, match=r"^thickness = 0.0001 is not allowed with step = 1.0") as err:
         PeriodicOperator(cell, thin.E_star, bodies=thin)
     assert f"{MAX_TERMS:.0e}" in str(err.value) and f"lam = {thin_limit(thin):.6g} (bem.layers.Linear" in str(err.value)
+    assert "real-space route needs a cell at least 18 long in both directions" in str(err.value)
+    assert PeriodicOperator(PeriodicCell(1.0, 18, 22), thin.E_star, bodies=thin).diagonal > 0  # that cell takes it
     stiff = bem.Bodies(ES, NUS, math.inf, 0.0, coating1=bem.Coating(1e-4, 100.0, 0.3))
     with pytest.raises(bem.InputError, match=r"stiffens the substrate's surface by the compliance -"):
         PeriodicOperator(cell, stiff.E_star, bodies=stiff)
