@@ -4,12 +4,12 @@ A coated body's part of the periodic template (:mod:`bem.periodic.coated`, latti
 ``c = 1``, ``tau = t / c``) is split at the substrate's long-wave compliance ``s0 = s(0)`` instead of
 the coating's ``s_inf``::
 
-    W_i(x) = s0 W(x) + D(x),   D(x) = (1/A) sum_{G != 0} (2 pi / |G|) (s(|G|) - s0) hat(G) exp(i G.x).
+    W_i(x) = E* s0 W(x) + D(x),   D(x) = (1/A) sum_{G != 0} (2 pi / |G|) E* (s(|G|) - s0) hat(G) exp(i G.x).
 
 By Poisson's summation ``D`` is the sum over the periods ``L`` of the region's coefficient
-difference ``d(x) = int pyr(xi) k(|x - xi|) dxi``, ``k(r) = int_0^inf (s(q) - s0) J0(q r) dq``,
+difference ``d(x) = E* int pyr(xi) k(|x - xi|) dxi``, ``k(r) = int_0^inf (s(q) - s0) J0(q r) dq``,
 less a constant (the ``G = 0`` term, removed with the template's mean). ``d`` is the coated
-region's template less the substrate's, ``pi / c`` times :func:`bem.coated_kernel.coated_table`
+region's template less the substrate's, ``E*`` times ``pi / c`` :func:`bem.coated_kernel.coated_table`
 minus ``s0 w_t`` (:func:`bem.template.template`): exact at any ``tau``, local on the scale ``t``, and
 beyond :func:`bem.coated_kernel.series_reach` it is its large-``r`` series ::
 
@@ -20,8 +20,8 @@ beyond :func:`bem.coated_kernel.series_reach` it is its large-``r`` series ::
 powers of ``q`` give ``delta`` terms, local). So ``D`` at the node offset ``x`` is ``d`` at the
 minimum image ``x0`` of ``x`` (``|x0| <= (Lx/2, Ly/2)``) plus the tail summed over the other images,
 each at least ``R = min(Lx, Ly)/2 - 1`` away through the pyramid's support. The route holds where
-``R`` is beyond the series' reach (and at least 8 steps, the element's scale against the split
-below): :func:`reach`.
+``R`` is beyond the series' reach (and at least 8 steps, so that the split below is smooth on the
+element's scale): :func:`reach`, :func:`admits`.
 
 The tail's lattice sum, term by term (``r^(-2 sigma)``, ``sigma = (m+1)/2``), by Ewald's split
 ``r^(-2 sigma) = Q(sigma, a^2 r^2) r^(-2 sigma) + T(r)``, ``Q`` the regularised upper incomplete
@@ -34,9 +34,10 @@ E_sigma(|k|^2 / (4 a^2))`` (``E_sigma`` the exponential integral of order ``sigm
         = (1/A) sum_G T^(G) hat(G) exp(i G.x) - int pyr(xi) T(|x0 - xi|) dxi.
 
 The Fourier sum stops at ``|G|^2 = 4 a^2 * 42`` (:func:`bem.periodic.kernel.alias_sum`, a few
-thousand terms); the element integral of the smooth ``T`` (scale ``1 / a >= R / 9``) is a tensor
-Gauss rule of the pyramid (:func:`bem.coated_kernel.box_rule`) with as many points a direction as
-make its error below ``1e-16`` of ``T``. The terms are kept up to the smallest at ``R``.
+thousand terms); the element integral of the smooth ``T`` (its scale ``1 / a`` is ``R / 6`` for the
+leading term) is a tensor Gauss rule of the pyramid (:func:`bem.coated_kernel.box_rule`) with as
+many points a direction as make its error below ``1e-17 s0``, ``T`` itself by Chebyshev panels. The
+terms are kept up to the smallest at ``R``, and while above ``1e-20 s0`` there.
 
 Cost: the region's coefficients at the ``(n_rows/2 + 1) (n_cols/2 + 1)`` minimum-image offsets (a
 quarter of the cell, by symmetry) and one element rule a distinct offset; independent of ``tau``
@@ -46,6 +47,7 @@ quarter of the cell, by symmetry) and one element rule a distinct offset; indepe
 from __future__ import annotations
 
 import math
+
 import numpy as np
 
 from ..coated_kernel import box_rule, coated_table, series_reach
@@ -88,8 +90,10 @@ def admits(n_rows, n_cols, step, bodies, i):
     return far >= MIN_REACH and far >= reach(bodies, i, step)
 
 
-def _tail(bodies, which, step, r_min):
-    """``(c_m, sigma_m)`` of the tail of the bodies ``which``, kept up to the smallest term at ``r_min``."""
+def _tail(bodies, which, step, r_min, s_scale):
+    """``(c_m, sigma_m)`` of the tail of the bodies ``which``, kept up to the smallest term at ``r_min`` and
+    while the terms there are above ``1e-20 s0`` (with ``Q`` and the Fourier part, a term's smooth parts
+    are up to ``z_m^sigma / Gamma(sigma + 1)`` times the term: no more of them than needed)."""
     from scipy.special import gamma
 
     m = np.arange(2, _ORDER + 1, 2)
@@ -101,22 +105,37 @@ def _tail(bodies, which, step, r_min):
         tau = coating.thickness / step
         c += (1.0 - coating.nu ** 2) / coating.E * phi[m] * tau ** m * g
     size = np.abs(c) * r_min ** -(m + 1.0)
-    keep = int(np.argmin(size)) + 1
+    size[c == 0] = np.inf
+    keep = min(int(np.argmin(size)) + 1, int(np.count_nonzero(np.cumprod(size >= 1e-20 * s_scale))) + 1)
     return c[:keep], (m[:keep] + 1) / 2.0
 
 
-def _exp_integrals(sigmas, z):
-    """``E_sigma(z)`` for the half-integer orders ``sigmas`` (increasing from 3/2), by the recurrence
-    ``sigma E_(sigma+1) = e^-z - z E_sigma`` from ``E_(1/2)(z) = sqrt(pi / z) erfc(sqrt z)``."""
+def _exp_integral(sigma, z):
+    """``E_sigma(z) = int_1^inf e^(-z u) u^(-sigma) du`` for a half-integer ``sigma >= 3/2``: below ``z = 2`` by
+    the recurrence ``s E_(s+1) = e^-z - z E_s`` from ``E_(1/2)(z) = sqrt(pi / z) erfc(sqrt z)`` (no growth
+    of rounding there), above by its continued fraction (modified Lentz, 60 levels: converged from ``z = 2``)."""
     from scipy.special import erfc
 
-    e, order, out = np.sqrt(math.pi / z) * erfc(np.sqrt(z)), 0.5, {}
-    ez = np.exp(-z)
-    while order < sigmas[-1]:
-        e = (ez - z * e) / order
+    out = np.empty_like(z)
+    low = z < 2.0
+    zl = z[low]
+    e, order = np.sqrt(math.pi / zl) * erfc(np.sqrt(zl)), 0.5
+    while order < sigma:
+        e = (np.exp(-zl) - zl * e) / order
         order += 1.0
-        out[order] = e
-    return [out[s] for s in sigmas]
+    out[low] = e
+    zh = z[~low]
+    b = zh + sigma
+    c, d = np.full_like(zh, 1e300), 1.0 / b
+    h = d
+    for i in range(1, 61):
+        an = -i * (sigma - 1.0 + i)
+        b = b + 2.0
+        d = 1.0 / (an * d + b)
+        c = b + an / c
+        h = h * c * d
+    out[~low] = h * np.exp(-zh)
+    return out
 
 
 def _smooth(sigma, a, r2):
@@ -217,7 +236,7 @@ def thin_part(n_rows, n_cols, step, bodies, which):
         table = coated_table(step, (x.shape[0], x.shape[1] - 1), one)
         quarter += table * (math.pi / step) - s0 * template(x, y)
     r_min = image_reach(n_rows, n_cols)
-    c, sigmas = _tail(bodies, which, step, r_min)
+    c, sigmas = _tail(bodies, which, step, r_min, s_scale)
     from scipy.special import gamma, gammainccinv
 
     alphas = np.array([math.sqrt(gammainccinv(s, _Q_FLOOR)) / r_min for s in sigmas])
@@ -234,7 +253,7 @@ def thin_part(n_rows, n_cols, step, bodies, which):
         out = np.zeros_like(k)
         for cm, s, a in zip(c, sigmas, alphas):
             z = k * k / (4 * a * a)
-            out += cm * math.pi / gamma(s) * a ** (2 * s - 2) * _exp_integrals([s], z)[0]
+            out += cm * math.pi / gamma(s) * a ** (2 * s - 2) * _exp_integral(s, z)
         return out
 
     w = E_star * (quarter[row, col] + alias_sum(n_rows, n_cols, radial, 2 * alphas.max() * math.sqrt(_Z_CUT)))
