@@ -24,16 +24,19 @@ Routes
     The sum has about ``0.069 N g^2`` terms for ``N`` nodes and the cut ``g`` [1/step], with
     ``g`` close to ``20 c / t`` for the thinnest coating: it grows like ``(c / t)^2``, and is the
     same for every level of nested iteration (``N c^2`` is the cell's area). A coating whose own
-    sum would exceed :data:`ALIAS_PER_NODE` terms a node (or :data:`MAX_TERMS`) takes the
+    sum would exceed :data:`ALIAS_PER_NODE` terms a node and :data:`ALIAS_FLOOR` (or :data:`MAX_TERMS`) takes the
     real-space route of :mod:`bem.periodic.coated_thin` where the cell admits it
-    (:func:`bem.periodic.coated_thin.admits`: every image but the nearest beyond the coating's
-    reach, 8 steps at least, about ``40 t`` for a soft coating, ``6600 t`` at ``E_c = 100 E_s``): its part of
+    (:func:`bem.periodic.coated_thin.admits`: the images within the coating's reach, 8 steps at
+    least, about ``40 t`` for a soft coating, ``6600 t`` at ``E_c = 100 E_s``, at most
+    :data:`bem.periodic.coated_thin.MAX_OFFSETS` coefficients of the half-space region): its part of
     the template split at the substrate's ``s(0)`` instead of ``s_inf``, the half-space region's
-    coefficients at the minimum images and the tail of the images in closed form, at a cost that
-    does not depend on ``t``. Both routes are exact where they run (tests/bem/test_coated_periodic_thin.py);
-    the switch is one of cost (:func:`routes`, per coated body). A coating that neither takes
-    (its sum above :data:`MAX_TERMS` on a cell shorter than twice its reach) is refused with the
-    step and the cell length that would take it (benchmarks/coated_symbol.py measures the build).
+    coefficients at the images within the reach and the tail of the others in closed form, at a
+    cost that does not depend on ``t`` on a cell longer than twice the reach. Both routes are
+    exact where they run (tests/bem/test_coated_periodic_thin.py); the switch is one of cost
+    (:func:`routes`, per coated body). A coating that neither takes (its sum above
+    :data:`MAX_TERMS`, its images within reach above
+    :data:`bem.periodic.coated_thin.MAX_OFFSETS` coefficients) is refused with the step that
+    would take it (benchmarks/coated_symbol.py measures the build).
 """
 
 from __future__ import annotations
@@ -45,15 +48,18 @@ import numpy as np
 
 from ..coating import factor_constants, mode_compliance
 from ..errors import InputError
-from .coated_thin import MIN_REACH, admits, image_reach, reach, thin_part
+from .coated_thin import admits, refusal, thin_part
 from .kernel import alias_sum, periodic_template
 
-__all__ = ["coated_template", "alias_cut", "routes", "thin_limit", "ALIAS_PER_NODE", "MAX_TERMS"]
+__all__ = ["coated_template", "alias_cut", "routes", "thin_limit", "ALIAS_FLOOR", "ALIAS_PER_NODE", "MAX_TERMS"]
 
 #: The largest number of alias terms one coated periodic template sums (memory and time bound).
 MAX_TERMS = 400_000_000
 #: Alias terms a node above which a coating takes the real-space route where it can (cost, not accuracy).
 ALIAS_PER_NODE = 30.0
+#: Alias terms below which a coating keeps the alias sum (the real-space route's fixed cost: the tabulation
+#: of the coating's remainder kernel, up to seconds for a stiff coating).
+ALIAS_FLOOR = 10_000_000
 _TERM_FLOOR = 1e-17  # terms below this fraction of E* s_inf are left out
 _HAT_BOUND = 2.31  # |hat(k)| <= 2.31 / |k|^2 (hat <= sqrt3/2 everywhere)
 _SQRT3 = math.sqrt(3.0)
@@ -129,8 +135,8 @@ def routes(n_rows, n_cols, step, bodies):
     """The coated bodies (1, 2) of the alias sum and of the real-space route on this cell, ``(alias, real)``.
 
     A coating goes the real-space way (:mod:`bem.periodic.coated_thin`) when its own alias sum would
-    exceed :data:`ALIAS_PER_NODE` terms a node (or :data:`MAX_TERMS`) and the cell's images are beyond
-    its reach (:func:`bem.periodic.coated_thin.admits`); the alias sum otherwise. Both are exact where
+    exceed :data:`ALIAS_PER_NODE` terms a node and :data:`ALIAS_FLOOR` terms (or :data:`MAX_TERMS`)
+    and the cell admits it (:func:`bem.periodic.coated_thin.admits`); the alias sum otherwise. Both are exact where
     they run; the switch is one of cost.
     """
     alias, real = [], []
@@ -138,7 +144,8 @@ def routes(n_rows, n_cols, step, bodies):
         if coating is None:
             continue
         terms = 0.069 * n_rows * n_cols * _cut([(E, nu, coating)], bodies, step) ** 2
-        if terms > min(ALIAS_PER_NODE * n_rows * n_cols, MAX_TERMS) and admits(n_rows, n_cols, step, bodies, i):
+        if terms > min(max(ALIAS_PER_NODE * n_rows * n_cols, ALIAS_FLOOR), MAX_TERMS) and admits(
+                n_rows, n_cols, step, bodies, i):
             real.append(i)
         else:
             alias.append(i)
@@ -176,15 +183,15 @@ def _cached(n_rows, n_cols, step, bodies):
     E_star = bodies.E_star
     alias, real = routes(n_rows, n_cols, step, bodies)
     parts = [b for i, b in enumerate(_bodies(bodies), start=1) if i in alias]
-    s_base = sum(float(mode_compliance(0.0, E, nu)) if i in real else _s_inf(E, nu, c)
-                 for i, (E, nu, c) in enumerate(_bodies(bodies), start=1))
-    w = E_star * s_base * periodic_template(n_rows, n_cols)
     if parts:
         g_cut = _cut(parts, bodies, step)
         terms = 0.069 * n_rows * n_cols * g_cut * g_cut  # (sqrt3/2) N g^2 / (4 pi): the G in the disc
         if terms > MAX_TERMS:
             _refuse(n_rows, n_cols, step, bodies, parts, terms)
-
+    s_base = sum(float(mode_compliance(0.0, E, nu)) if i in real else _s_inf(E, nu, c)
+                 for i, (E, nu, c) in enumerate(_bodies(bodies), start=1))
+    w = E_star * s_base * periodic_template(n_rows, n_cols)
+    if parts:
         def radial(k):
             return 2 * math.pi / k * E_star * _excess(k, parts, step)
 
@@ -200,10 +207,8 @@ def _refuse(n_rows, n_cols, step, bodies, parts, terms):
     t = min(c.thickness for _, _, c in parts)
     i = 1 if bodies.coating1 is not None and bodies.coating1.thickness == t else 2
     fine = step * math.sqrt(MAX_TERMS / terms)
-    far = image_reach(n_rows, n_cols)  # the coating's reach is tabulated (by routes) only on a cell this long
-    need = 2 * ((reach(bodies, i, step) if far >= MIN_REACH else MIN_REACH) + 1) * step
     raise InputError(
         f"thickness = {t!r} is not allowed with step = {step!r} on this cell of {n_rows * n_cols} nodes: the "
         f"periodic coated symbol would sum about {terms:.2g} alias terms (at most {MAX_TERMS:.0e}, which a step "
-        f"of {fine:.3g} or a cell of fewer nodes keeps), and its real-space route needs a cell at least "
-        f"{need:.3g} long in both directions. {_thin_hint(thin_limit(bodies))}")
+        f"of {fine:.3g} or a cell of fewer nodes keeps), and {refusal(n_rows, n_cols, step, bodies, i)}. "
+        f"{_thin_hint(thin_limit(bodies))}")

@@ -17,11 +17,12 @@ beyond :func:`bem.coated_kernel.series_reach` it is its large-``r`` series ::
     g_m = 2^m Gamma((m+1)/2) / Gamma((1-m)/2)   (g_2 = -1: the tail -s_c phi_2 tau^2 / r^3),
 
 ``phi_m`` the Taylor coefficients of the coating factor (:func:`bem.coating.factor_taylor`; the odd
-powers of ``q`` give ``delta`` terms, local). So ``D`` at the node offset ``x`` is ``d`` at the
-minimum image ``x0`` of ``x`` (``|x0| <= (Lx/2, Ly/2)``) plus the tail summed over the other images,
-each at least ``R = min(Lx, Ly)/2 - 1`` away through the pyramid's support. The route holds where
-``R`` is beyond the series' reach (and at least 8 steps, so that the split below is smooth on the
-element's scale): :func:`reach`, :func:`admits`.
+powers of ``q`` give ``delta`` terms, local). So ``D`` at the node offset ``x`` is ``d`` summed over the
+images ``x0 + (i Lx, j Ly)``, ``|i| <= I``, ``|j| <= J``, of its minimum image ``x0`` (``|x0| <= (Lx/2,
+Ly/2)``), plus the tail summed over the other images, each at least ``R = min((I + 1/2) Lx, (J + 1/2)
+Ly) - 1`` away through the pyramid's support (:func:`image_reach`). ``(I, J)`` are the fewest that
+put ``R`` beyond the series' reach and 8 steps (so that the split below is smooth on the element's
+scale): :func:`reach`, :func:`images_for`; ``(0, 0)`` on a cell longer than twice the reach.
 
 The tail's lattice sum, term by term (``r^(-2 sigma)``, ``sigma = (m+1)/2``), by Ewald's split
 ``r^(-2 sigma) = Q(sigma, a^2 r^2) r^(-2 sigma) + T(r)``, ``Q`` the regularised upper incomplete
@@ -39,9 +40,9 @@ leading term) is a tensor Gauss rule of the pyramid (:func:`bem.coated_kernel.bo
 many points a direction as make its error below ``1e-17 s0``, ``T`` itself by Chebyshev panels. The
 terms are kept up to the smallest at ``R``, and while above ``1e-20 s0`` there.
 
-Cost: the region's coefficients at the ``(n_rows/2 + 1) (n_cols/2 + 1)`` minimum-image offsets (a
-quarter of the cell, by symmetry) and one element rule a distinct offset; independent of ``tau``
-(benchmarks/coated_symbol.py).
+Cost: the region's coefficients at about ``(2 I + 1) (2 J + 1) N / 4`` offsets (a quarter of the
+kept images' box, by symmetry: :func:`table_size`, at most :data:`MAX_OFFSETS`) and one element
+rule an offset; independent of ``tau`` where ``I = J = 0`` (benchmarks/coated_symbol.py).
 """
 
 from __future__ import annotations
@@ -55,21 +56,37 @@ from ..coating import Bodies, factor_taylor, mode_compliance
 from ..template import template
 from .kernel import alias_sum
 
-__all__ = ["admits", "image_reach", "reach", "thin_part", "MIN_REACH"]
+__all__ = ["admits", "image_reach", "images_for", "reach", "refusal", "table_size", "thin_part", "MAX_OFFSETS",
+           "MIN_REACH"]
 
 _SQRT3 = math.sqrt(3.0)
 #: Steps: the nearest other image at least this far (the split's scale ``1/a >= R/9`` against the element).
 MIN_REACH = 8.0
+#: The most region coefficients one real-space template tabulates (memory and time bound).
+MAX_OFFSETS = 16_000_000
 _ORDER = 40  # Taylor coefficients of phi kept for the tail
 _Q_FLOOR = 1e-17  # the real-space part of the split, relative to the term, at the nearest other image
 _CHEB = 16  # Chebyshev points a panel of the smooth part
 _Z_CUT = 42.0  # the Fourier part stops at |k|^2 / (4 a^2) = 42 (e^-42 = 6e-19)
 
 
-def image_reach(n_rows, n_cols):
-    """``R = min(Lx, Ly)/2 - 1`` [steps]: every image but the nearest is this far from any point of the
-    pyramid at a node offset."""
-    return min(float(n_cols), n_rows * _SQRT3 / 2) / 2 - 1.0
+def image_reach(n_rows, n_cols, images=(0, 0)):
+    """``R = min((I + 1/2) Lx, (J + 1/2) Ly) - 1`` [steps]: the images ``(i Lx, j Ly)`` with ``|i| <= I``,
+    ``|j| <= J`` around the nearest kept, every other is this far from any point of the pyramid at a
+    node offset."""
+    I, J = images
+    return min((I + 0.5) * n_cols, (J + 0.5) * n_rows * _SQRT3 / 2) - 1.0
+
+
+def images_for(n_rows, n_cols, need):
+    """The fewest ``(I, J)`` with :func:`image_reach` at least ``need`` [steps]."""
+    return tuple(max(0, math.ceil((need + 1.0) / period - 0.5)) for period in (n_cols, n_rows * _SQRT3 / 2))
+
+
+def table_size(n_rows, n_cols, images):
+    """Region coefficients the route tabulates for ``images = (I, J)``: about ``(2 I + 1) (2 J + 1) N / 4``."""
+    I, J = images
+    return ((2 * J + 1) * n_rows // 2 + 1) * ((2 * I + 1) * n_cols // 2 + 1)
 
 
 def _one(bodies, i):
@@ -83,11 +100,17 @@ def reach(bodies, i, step):
     return max(MIN_REACH, series_reach(_one(bodies, i), step))
 
 
+def refusal(n_rows, n_cols, step, bodies, i):
+    """The clause of a refusal that names what the route would tabulate for body ``i``."""
+    r = reach(bodies, i, step)
+    return (f"its real-space route would tabulate {table_size(n_rows, n_cols, images_for(n_rows, n_cols, r)):.2g} "
+            f"region coefficients (at most {MAX_OFFSETS:.0e}: the images within {r * step:.3g} of a node)")
+
+
 def admits(n_rows, n_cols, step, bodies, i):
-    """Whether body ``i``'s coating can take the real-space route on this cell (:func:`reach`; a cell
-    with its images nearer than 8 steps is refused before the coating's kernel is tabulated)."""
-    far = image_reach(n_rows, n_cols)
-    return far >= MIN_REACH and far >= reach(bodies, i, step)
+    """Whether body ``i``'s coating can take the real-space route on this cell: the images within its
+    :func:`reach` tabulated at :data:`MAX_OFFSETS` region coefficients at most."""
+    return table_size(n_rows, n_cols, images_for(n_rows, n_cols, reach(bodies, i, step))) <= MAX_OFFSETS
 
 
 def _tail(bodies, which, step, r_min, s_scale):
@@ -192,17 +215,22 @@ class _Smooth:
         return y * b1 - b2 + self.cheb[p, 0]
 
 
-def _offsets(n_rows, n_cols):
-    """Offsets ``(x, y)`` [steps] of the quarter table (rows ``0 .. n_rows/2``, columns ``0 .. n_cols//2``:
-    ``x = (2 t + n mod 2) / 2``) and the index of each node's minimum image in it."""
-    n = np.arange(n_rows // 2 + 1)[:, None]
-    t = np.arange(n_cols // 2 + 1)[None, :]
+def _offsets(n_rows, n_cols, images):
+    """Offsets ``(x, y)`` [steps] of the quarter table (``x = (2 t + n mod 2) / 2``, ``y = n sqrt3/2``, rows
+    ``n <= (2 J + 1) n_rows / 2``, columns ``t <= (2 I + 1) n_cols / 2``) and, for each kept image, the
+    index in it of every node's offset ``x0 + (i Lx, j Ly)``, ``x0`` the minimum image."""
+    I, J = images
+    n = np.arange((2 * J + 1) * n_rows // 2 + 1)[:, None]
+    t = np.arange((2 * I + 1) * n_cols // 2 + 1)[None, :]
     x, y = (2 * t + n % 2) / 2.0 + 0.0 * n, n * (_SQRT3 / 2) + 0.0 * t
     q = np.arange(n_rows)[:, None]
     r = np.arange(n_cols)[None, :]
-    row = np.minimum(q, n_rows - q) + 0 * r
-    col = np.minimum(2 * r + q % 2, 2 * n_cols - 2 * r - q % 2) // 2  # (2 |x0| - parity) / 2
-    return x, y, row, col
+    row0 = np.where(q <= n_rows // 2, q, q - n_rows) + 0 * r  # signed minimum-image row
+    x2 = 2 * r + q % 2  # twice the minimum-image x, in (-n_cols, n_cols]
+    x2 = np.where(x2 > n_cols, x2 - 2 * n_cols, x2)
+    index = [(np.abs(row0 + j * n_rows), (np.abs(x2 + 2 * i * n_cols) - q % 2) // 2)
+             for i in range(-I, I + 1) for j in range(-J, J + 1)]
+    return x, y, index
 
 
 def thin_part(n_rows, n_cols, step, bodies, which):
@@ -217,8 +245,8 @@ def thin_part(n_rows, n_cols, step, bodies, which):
     bodies : bem.Bodies
         The two bodies.
     which : tuple of int
-        The coated bodies (1, 2) that take this route; :func:`image_reach` of the cell at least
-        :func:`reach` of each.
+        The coated bodies (1, 2) that take this route (the images kept: :func:`images_for` the
+        largest :func:`reach`).
 
     Returns
     -------
@@ -227,7 +255,8 @@ def thin_part(n_rows, n_cols, step, bodies, which):
         removed.
     """
     E_star = bodies.E_star
-    x, y, row, col = _offsets(n_rows, n_cols)
+    images = images_for(n_rows, n_cols, max(reach(bodies, i, step) for i in which))
+    x, y, index = _offsets(n_rows, n_cols, images)
     quarter = np.zeros(x.shape)
     s_scale = 1.0 / E_star
     for i in which:
@@ -235,7 +264,7 @@ def thin_part(n_rows, n_cols, step, bodies, which):
         s0 = float(mode_compliance(0.0, one.E1, one.nu1) + mode_compliance(0.0, one.E2, one.nu2))
         table = coated_table(step, (x.shape[0], x.shape[1] - 1), one)
         quarter += table * (math.pi / step) - s0 * template(x, y)
-    r_min = image_reach(n_rows, n_cols)
+    r_min = image_reach(n_rows, n_cols, images)
     c, sigmas = _tail(bodies, which, step, r_min, s_scale)
     from scipy.special import gamma, gammainccinv
 
@@ -256,6 +285,6 @@ def thin_part(n_rows, n_cols, step, bodies, which):
             out += cm * math.pi / gamma(s) * a ** (2 * s - 2) * _exp_integral(s, z)
         return out
 
-    w = E_star * (quarter[row, col] + alias_sum(n_rows, n_cols, radial, 2 * alphas.max() * math.sqrt(_Z_CUT)))
+    w = E_star * (sum(quarter[row, col] for row, col in index) + alias_sum(n_rows, n_cols, radial, 2 * alphas.max() * math.sqrt(_Z_CUT)))
     w.setflags(write=False)
     return w

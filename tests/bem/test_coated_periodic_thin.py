@@ -9,7 +9,7 @@ import bem
 from bem import layers
 from bem.coating import mode_compliance
 from bem.periodic import PeriodicCell, PeriodicOperator
-from bem.periodic import coated
+from bem.periodic import coated, coated_thin
 from bem.periodic.kernel import periodic_template, pyramid_transform
 
 _SQRT3 = math.sqrt(3.0)
@@ -18,26 +18,33 @@ _SQRT3 = math.sqrt(3.0)
 def _template(monkeypatch, cell, bodies, per_node):
     """The coated template with the routes' switch at ``per_node`` alias terms a node (0: real space where it holds)."""
     monkeypatch.setattr(coated, "ALIAS_PER_NODE", per_node)
+    monkeypatch.setattr(coated, "ALIAS_FLOOR", 0)
     coated._cached.cache_clear()
     return coated.coated_template(cell.n_rows, cell.n_cols, cell.step, bodies), \
         coated.routes(cell.n_rows, cell.n_cols, cell.step, bodies)
 
 
-@pytest.mark.parametrize("n, bodies", [
-    (128, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(1.0, 1.0, 0.3))),
-    (128, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(0.5, 0.02, 0.49))),
-    (128, bem.Bodies(math.inf, 0.3, 3.0, 0.2, bem.Coating(1.0, 1.0, 0.3))),
-    (128, bem.Bodies(2.0, 0.3, 3.0, 0.2, bem.Coating(0.7, 0.2, 0.45), bem.Coating(0.4, 6.0, 0.25))),
-    (64, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(0.3, 0.5, 0.3))),
+@pytest.mark.parametrize("rows, cols, bodies, images", [
+    (128, 128, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(1.0, 1.0, 0.3)), (0, 0)),
+    (128, 128, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(0.5, 0.02, 0.49)), (0, 0)),
+    (128, 128, bem.Bodies(math.inf, 0.3, 3.0, 0.2, bem.Coating(1.0, 1.0, 0.3)), (0, 0)),
+    (128, 128, bem.Bodies(2.0, 0.3, 3.0, 0.2, bem.Coating(0.7, 0.2, 0.45), bem.Coating(0.4, 6.0, 0.25)), (0, 0)),
+    (64, 64, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(0.3, 0.5, 0.3)), (0, 0)),
+    (16, 16, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(0.5, 1.0, 0.3)), (1, 1)),
+    (8, 8, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(0.3, 0.5, 0.3)), (2, 2)),
+    (12, 40, bem.Bodies(2.0, 0.3, math.inf, 0.0, bem.Coating(0.4, 0.3, 0.4)), (1, 2)),
 ])
-def test_the_real_space_route_equals_the_alias_sum_where_both_hold(monkeypatch, n, bodies):
-    """Both routes are exact: soft, nearly incompressible, rigid-substrate and two coated bodies, t = 0.3 .. 1 c."""
-    cell = PeriodicCell(1.0, n, n)
+def test_the_real_space_route_equals_the_alias_sum_where_both_hold(monkeypatch, rows, cols, bodies, images):
+    """Both routes are exact: soft, nearly incompressible, rigid-substrate and two coated bodies, t = 0.3 .. 1 c;
+    on the small cells with the images within the coating's reach ``(I, J)`` taken from the region's table."""
+    cell = PeriodicCell(1.0, cols, rows)
+    coated_body = 1 if bodies.coating1 is not None else 2
+    assert coated_thin.images_for(rows, cols, coated_thin.reach(bodies, coated_body, 1.0)) == images
     alias, routes = _template(monkeypatch, cell, bodies, math.inf)
     assert routes[1] == ()
     real, routes = _template(monkeypatch, cell, bodies, 0.0)
     assert routes[0] == () and routes[1]
-    plain = bodies.E_star * periodic_template(n, n) / bem.Bodies(bodies.E1, bodies.nu1, bodies.E2, bodies.nu2).E_star
+    plain = bodies.E_star * periodic_template(rows, cols) / bem.Bodies(bodies.E1, bodies.nu1, bodies.E2, bodies.nu2).E_star
     assert np.abs(real - plain).max() >= 0.1 * alias[0, 0]  # the coating matters
     assert np.abs(real - alias).max() <= 1e-13 * alias[0, 0]  # measured 1.8e-15 .. 1.0e-14
     coated._cached.cache_clear()
