@@ -24,8 +24,9 @@ Routes
     The sum has about ``0.069 N g^2`` terms for ``N`` nodes and the cut ``g`` [1/step], with
     ``g`` close to ``20 c / t`` for the thinnest coating: it grows like ``(c / t)^2``, and is the
     same for every level of nested iteration (``N c^2`` is the cell's area). A coating whose own
-    sum would exceed :data:`ALIAS_PER_NODE` terms a node and :data:`ALIAS_FLOOR` (or :data:`MAX_TERMS`) takes the
-    real-space route of :mod:`bem.periodic.coated_thin` where the cell admits it
+    sum would exceed :data:`ALIAS_PER_NODE` terms a node and :data:`ALIAS_FLOOR` terms (or
+    :data:`MAX_TERMS`) takes the real-space route of :mod:`bem.periodic.coated_thin` where the cell
+    admits it
     (:func:`bem.periodic.coated_thin.admits`: the images within the coating's reach, 8 steps at
     least, about ``40 t`` for a soft coating, ``6600 t`` at ``E_c = 100 E_s``, at most
     :data:`bem.periodic.coated_thin.MAX_OFFSETS` coefficients of the half-space region): its part of
@@ -136,8 +137,8 @@ def routes(n_rows, n_cols, step, bodies):
 
     A coating goes the real-space way (:mod:`bem.periodic.coated_thin`) when its own alias sum would
     exceed :data:`ALIAS_PER_NODE` terms a node and :data:`ALIAS_FLOOR` terms (or :data:`MAX_TERMS`)
-    and the cell admits it (:func:`bem.periodic.coated_thin.admits`); the alias sum otherwise. Both are exact where
-    they run; the switch is one of cost.
+    and the cell admits it (:func:`bem.periodic.coated_thin.admits`); the alias sum otherwise. Both
+    are exact where they run; the switch is one of cost.
     """
     alias, real = [], []
     for i, (E, nu, coating) in enumerate(_bodies(bodies), start=1):

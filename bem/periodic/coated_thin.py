@@ -123,7 +123,8 @@ def _tail(bodies, which, step, r_min, s_scale):
     g = 2.0 ** m * gamma((m + 1) / 2) / gamma((1 - m) / 2)
     c = np.zeros(m.size)
     for i in which:
-        E, nu, coating = (bodies.E1, bodies.nu1, bodies.coating1) if i == 1 else (bodies.E2, bodies.nu2, bodies.coating2)
+        E, nu, coating = ((bodies.E1, bodies.nu1, bodies.coating1) if i == 1
+                          else (bodies.E2, bodies.nu2, bodies.coating2))
         phi, _ = factor_taylor(coating, E, nu, order=_ORDER)
         tau = coating.thickness / step
         c += (1.0 - coating.nu ** 2) / coating.E * phi[m] * tau ** m * g
@@ -285,6 +286,7 @@ def thin_part(n_rows, n_cols, step, bodies, which):
             out += cm * math.pi / gamma(s) * a ** (2 * s - 2) * _exp_integral(s, z)
         return out
 
-    w = E_star * (sum(quarter[row, col] for row, col in index) + alias_sum(n_rows, n_cols, radial, 2 * alphas.max() * math.sqrt(_Z_CUT)))
+    fourier = alias_sum(n_rows, n_cols, radial, 2 * alphas.max() * math.sqrt(_Z_CUT))
+    w = E_star * (sum(quarter[row, col] for row, col in index) + fourier)
     w.setflags(write=False)
     return w

@@ -107,7 +107,8 @@ def test_a_coating_a_thousandth_of_a_step_on_a_cell_is_the_substrate_with_its_th
 
 
 def test_a_stiff_coating_a_thousandth_of_a_step_solves_with_kkt_against_its_dense_matrix():
-    """E_c = 100 E_s, t = c / 1000 (reach 6.6 steps, the cell's images 9 away): KKT 1e-10, and the KKT conditions hold against the dense coated matrix."""
+    """E_c = 100 E_s, t = c / 1000 (reach 6.6 steps, the cell's images 9 away): KKT 1e-10, and the KKT
+    conditions hold against the dense coated matrix."""
     cell, h = _wavy(20, 24)
     coating = bem.Coating(cell.step / 1000, 100.0, 0.3)
     kw = dict(domain=cell, E1=1.0, nu1=0.3, E2=math.inf, nu2=0.0, mean_pressure=1e-3)
