@@ -49,17 +49,18 @@ Accuracy and cost: ``tests/bem/test_coated_kernel.py``, ``benchmarks/coated_hert
 
 from __future__ import annotations
 
+import copy
 import math
 from functools import lru_cache
 
 import numpy as np
 
 from .checks import check_positive
-from .coating import Bodies, coating_factor, factor_taylor, mode_compliance
+from .coating import Bodies, Coating, coating_factor, factor_taylor, mode_compliance
 from .errors import InputError
 from .template import template
 
-__all__ = ["coated_table", "point_kernel"]
+__all__ = ["box_rule", "coated_table", "point_kernel", "series_reach"]
 
 B_RAISE = 2.0
 """Height of the raised point load per coating thickness, ``beta = B_RAISE t`` [-]."""
@@ -212,7 +213,8 @@ class _Kernel:
             if coating is None or (coating.E == E and coating.nu == nu):
                 self.S_c += float(mode_compliance(0.0, E, nu))
                 continue
-            rem = _Remainder(E, nu, coating, coating.thickness / step)
+            rem = copy.copy(_remainder(E, nu, coating.E, coating.nu))
+            rem.tau = coating.thickness / step
             self.S_c += rem.s_c
             self.parts.append(rem)
 
@@ -225,8 +227,19 @@ class _Kernel:
 
 
 @lru_cache(maxsize=8)
+def _remainder(E, nu, E_c, nu_c):
+    """The tabulated remainder of a coating on its substrate, in ``r / t`` (any thickness and step: set ``tau``)."""
+    return _Remainder(E, nu, Coating(1.0, E_c, nu_c), 1.0)
+
+
+@lru_cache(maxsize=8)
 def _kernel(bodies, step):
     return _Kernel(bodies, step)
+
+
+def series_reach(bodies, step):
+    """Distance [steps] beyond which each coated body's remainder kernel is its large-``r`` series (``rho_sw t / c``)."""
+    return max((rem.rho_sw * rem.tau for rem in _kernel(bodies, check_positive("step", step)).parts), default=0.0)
 
 
 def point_kernel(r, bodies, *, step=1.0):
@@ -291,8 +304,8 @@ def _polar_rule(apex, p1, p2, f, grade, n_s=16, n_u=32):
     return apex + S[:, None] * e, W
 
 
-def _box_rule(n):
-    """Tensor Gauss rule of the box spline ``a e1 + b e2 + c e3``; ``(points, weights)``."""
+def box_rule(n):
+    """Tensor Gauss rule (``n`` a direction) of the pyramid as the box spline ``a e1 + b e2 + c e3``; ``(points, weights)``."""
     g, w = _gauss(n, -0.5, 0.5)
     A, Bb, C = (a.ravel() for a in np.meshgrid(g, g, g, indexing="ij"))
     W = np.einsum("i,j,k->ijk", w, w, w).ravel() * (_SQRT3 / 2)
@@ -340,7 +353,7 @@ def _element(kernel, x, y, grade):
         upper = _FAR[k + 1][0] if k + 1 < len(_FAR) else math.inf
         band = (r >= lower) & (r < upper)
         if band.any():
-            out[band] = _apply(kernel, x[band], y[band], *_box_rule(n))
+            out[band] = _apply(kernel, x[band], y[band], *box_rule(n))
         lower = upper
     return out
 

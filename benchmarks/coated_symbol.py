@@ -33,7 +33,7 @@ _CHILD = """
 import json, math, sys, time
 import bem
 from bem.periodic import PeriodicCell, PeriodicOperator
-from bem.periodic.coated import alias_cut
+from bem.periodic.coated import alias_cut, routes
 n, t = int(sys.argv[1]), float(sys.argv[2])
 cell = PeriodicCell(1.0, n, n)
 E, nu = 210e9, 0.3
@@ -47,7 +47,9 @@ PeriodicOperator(cell, E_star, **kw)
 w1, c1 = time.perf_counter(), time.process_time()
 PeriodicOperator(cell, E_star, **kw)
 w2 = time.perf_counter()
-print(json.dumps(dict(wall=w1 - w0, cpu=c1 - c0, warm=w2 - w1, cut=cut, terms=0.069 * n * n * cut * cut)))
+route = "-" if t == 0 else ("real space" if routes(n, n, 1.0, bodies)[1] else "alias sum")
+print(json.dumps(dict(wall=w1 - w0, cpu=c1 - c0, warm=w2 - w1, cut=cut, terms=0.069 * n * n * cut * cut,
+                      route=route)))
 """
 
 
@@ -94,13 +96,14 @@ def main(argv=None):
     ap.add_argument("--solve", type=int, default=0, metavar="N", help="also time a rough solve on N x N nodes")
     args = ap.parse_args(argv)
     print(f"cell {args.size} x {args.size} nodes, load {os.getloadavg()[0]:.2f}")
-    print(f"{'t / c':>8} {'cut g':>8} {'terms':>10} {'wall s':>8} {'cpu s':>8} {'warm s':>8}")
+    print(f"{'t / c':>8} {'cut g':>8} {'terms':>10} {'route':>11} {'wall s':>8} {'cpu s':>8} {'warm s':>8}")
     for t in [0.0, *args.thickness]:
         out = subprocess.run([sys.executable, "-c", _CHILD, str(args.size), str(t)], capture_output=True, text=True,
                              check=True)
         r = json.loads(out.stdout)
         label = "none" if t == 0 else f"{t:g}"
-        print(f"{label:>8} {r['cut']:8.3g} {r['terms']:10.3g} {r['wall']:8.2f} {r['cpu']:8.2f} {r['warm']:8.2f}")
+        print(f"{label:>8} {r['cut']:8.3g} {r['terms']:10.3g} {r['route']:>11} {r['wall']:8.2f} {r['cpu']:8.2f} "
+              f"{r['warm']:8.2f}")
     if args.solve:
         _solve_rows(args.solve)
     print(f"load {os.getloadavg()[0]:.2f} at the end ({time.strftime('%H:%M:%S')})")

@@ -20,12 +20,24 @@ second, the correction, decays like ``(k t)^2 exp(-2 k t)`` in each coating's ``
 materials give a correction of exactly zero (``s = s_inf``), a thick coating (``k t`` above 350 at
 the cell's longest wave) gives the coating's operator, and every term is formed without overflow.
 
-Cost
+Routes
     The sum has about ``0.069 N g^2`` terms for ``N`` nodes and the cut ``g`` [1/step], with
     ``g`` close to ``20 c / t`` for the thinnest coating: it grows like ``(c / t)^2``, and is the
-    same for every level of nested iteration (``N c^2`` is the cell's area).
-    :data:`MAX_TERMS` bounds it; a thinner coating is refused with the step that would resolve it
-    (benchmarks/coated_symbol.py measures the build).
+    same for every level of nested iteration (``N c^2`` is the cell's area). A coating whose own
+    sum would exceed :data:`ALIAS_PER_NODE` terms a node and :data:`ALIAS_FLOOR` terms (or
+    :data:`MAX_TERMS`) takes the real-space route of :mod:`bem.periodic.coated_thin` where the cell
+    admits it
+    (:func:`bem.periodic.coated_thin.admits`: the images within the coating's reach, 8 steps at
+    least, about ``40 t`` for a soft coating, ``6600 t`` at ``E_c = 100 E_s``, at most
+    :data:`bem.periodic.coated_thin.MAX_OFFSETS` coefficients of the half-space region): its part of
+    the template split at the substrate's ``s(0)`` instead of ``s_inf``, the half-space region's
+    coefficients at the images within the reach and the tail of the others in closed form, at a
+    cost that does not depend on ``t`` on a cell longer than twice the reach. Both routes are
+    exact where they run (tests/bem/test_coated_periodic_thin.py); the switch is one of cost
+    (:func:`routes`, per coated body). A coating that neither takes (its sum above
+    :data:`MAX_TERMS`, its images within reach above
+    :data:`bem.periodic.coated_thin.MAX_OFFSETS` coefficients) is refused with the step that
+    would take it (benchmarks/coated_symbol.py measures the build).
 """
 
 from __future__ import annotations
@@ -37,12 +49,18 @@ import numpy as np
 
 from ..coating import factor_constants, mode_compliance
 from ..errors import InputError
+from .coated_thin import admits, refusal, thin_part
 from .kernel import alias_sum, periodic_template
 
-__all__ = ["coated_template", "alias_cut", "thin_limit", "MAX_TERMS"]
+__all__ = ["coated_template", "alias_cut", "routes", "thin_limit", "ALIAS_FLOOR", "ALIAS_PER_NODE", "MAX_TERMS"]
 
 #: The largest number of alias terms one coated periodic template sums (memory and time bound).
 MAX_TERMS = 400_000_000
+#: Alias terms a node above which a coating takes the real-space route where it can (cost, not accuracy).
+ALIAS_PER_NODE = 30.0
+#: Alias terms below which a coating keeps the alias sum (the real-space route's fixed cost: the tabulation
+#: of the coating's remainder kernel, up to seconds for a stiff coating).
+ALIAS_FLOOR = 10_000_000
 _TERM_FLOOR = 1e-17  # terms below this fraction of E* s_inf are left out
 _HAT_BOUND = 2.31  # |hat(k)| <= 2.31 / |k|^2 (hat <= sqrt3/2 everywhere)
 _SQRT3 = math.sqrt(3.0)
@@ -56,12 +74,11 @@ def _s_inf(E, nu, coating):
     return float(mode_compliance(0.0, E, nu))
 
 
-def _excess(k, bodies, step):
-    """``s(k / c) - s_inf`` at the wavenumbers ``k`` [1/step] (the coated bodies' terms) [1/pressure]."""
+def _excess(k, parts, step):
+    """``s(k / c) - s_inf`` of the coated bodies ``parts`` at the wavenumbers ``k`` [1/step] [1/pressure]."""
     out = np.zeros(np.shape(k))
-    for E, nu, coating in _bodies(bodies):
-        if coating is not None:
-            out += mode_compliance(np.asarray(k) / step, E, nu, coating) - _s_inf(E, nu, coating)
+    for E, nu, coating in parts:
+        out += mode_compliance(np.asarray(k) / step, E, nu, coating) - _s_inf(E, nu, coating)
     return out
 
 
@@ -102,12 +119,38 @@ def _thin_hint(lam):
 
 def alias_cut(bodies, step):
     """The largest ``|G|`` [1/step] of the correction sum: beyond it every term is below ``1e-17 E* s_inf``."""
-    t_min = min(c.thickness for _, _, c in _bodies(bodies) if c is not None) / step
+    return _cut([b for b in _bodies(bodies) if b[2] is not None], bodies, step)
+
+
+def _cut(parts, bodies, step):
+    """:func:`alias_cut` of the coated bodies ``parts`` alone."""
+    t_min = min(c.thickness for _, _, c in parts) / step
     s_inf = sum(_s_inf(*b) for b in _bodies(bodies))
     k = np.linspace(0.0, _X_MAX, 4001)[1:] / t_min
-    bound = 2 * math.pi / k * np.abs(_excess(k, bodies, step)) * np.minimum(_SQRT3 / 2, _HAT_BOUND / (k * k))
+    bound = 2 * math.pi / k * np.abs(_excess(k, parts, step)) * np.minimum(_SQRT3 / 2, _HAT_BOUND / (k * k))
     above = np.nonzero(bound > _TERM_FLOOR * s_inf)[0]
     return float(k[min(above[-1] + 1, k.size - 1)]) if above.size else float(k[0])
+
+
+def routes(n_rows, n_cols, step, bodies):
+    """The coated bodies (1, 2) of the alias sum and of the real-space route on this cell, ``(alias, real)``.
+
+    A coating goes the real-space way (:mod:`bem.periodic.coated_thin`) when its own alias sum would
+    exceed :data:`ALIAS_PER_NODE` terms a node and :data:`ALIAS_FLOOR` terms (or :data:`MAX_TERMS`)
+    and the cell admits it (:func:`bem.periodic.coated_thin.admits`); the alias sum otherwise. Both
+    are exact where they run; the switch is one of cost.
+    """
+    alias, real = [], []
+    for i, (E, nu, coating) in enumerate(_bodies(bodies), start=1):
+        if coating is None:
+            continue
+        terms = 0.069 * n_rows * n_cols * _cut([(E, nu, coating)], bodies, step) ** 2
+        if terms > min(max(ALIAS_PER_NODE * n_rows * n_cols, ALIAS_FLOOR), MAX_TERMS) and admits(
+                n_rows, n_cols, step, bodies, i):
+            real.append(i)
+        else:
+            alias.append(i)
+    return tuple(alias), tuple(real)
 
 
 def coated_template(n_rows, n_cols, step, bodies):
@@ -139,21 +182,34 @@ def coated_template(n_rows, n_cols, step, bodies):
 @lru_cache(maxsize=8)  # the levels of nested iteration of one or two cells
 def _cached(n_rows, n_cols, step, bodies):
     E_star = bodies.E_star
-    s_inf = sum(_s_inf(*b) for b in _bodies(bodies))
-    g_cut = alias_cut(bodies, step)
-    terms = 0.069 * n_rows * n_cols * g_cut * g_cut  # (sqrt3/2) N g^2 / (4 pi): the G in the disc
-    if terms > MAX_TERMS:
-        t = min(c.thickness for _, _, c in _bodies(bodies) if c is not None)
-        fine = step * math.sqrt(MAX_TERMS / terms)
-        raise InputError(
-            f"thickness = {t!r} is not allowed with step = {step!r} on this cell of {n_rows * n_cols} nodes: the "
-            f"periodic coated symbol would sum about {terms:.2g} alias terms (at most {MAX_TERMS:.0e}, which a step "
-            f"of {fine:.3g} or a cell of fewer nodes keeps). {_thin_hint(thin_limit(bodies))}")
+    alias, real = routes(n_rows, n_cols, step, bodies)
+    parts = [b for i, b in enumerate(_bodies(bodies), start=1) if i in alias]
+    if parts:
+        g_cut = _cut(parts, bodies, step)
+        terms = 0.069 * n_rows * n_cols * g_cut * g_cut  # (sqrt3/2) N g^2 / (4 pi): the G in the disc
+        if terms > MAX_TERMS:
+            _refuse(n_rows, n_cols, step, bodies, parts, terms)
+    s_base = sum(float(mode_compliance(0.0, E, nu)) if i in real else _s_inf(E, nu, c)
+                 for i, (E, nu, c) in enumerate(_bodies(bodies), start=1))
+    w = E_star * s_base * periodic_template(n_rows, n_cols)
+    if parts:
+        def radial(k):
+            return 2 * math.pi / k * E_star * _excess(k, parts, step)
 
-    def radial(k):
-        return 2 * math.pi / k * E_star * _excess(k, bodies, step)
-
-    w = E_star * s_inf * periodic_template(n_rows, n_cols) + alias_sum(n_rows, n_cols, radial, g_cut)
-    w -= w.mean()  # zero to round-off already: hat vanishes on the nonzero aliases of G = 0
+        w = w + alias_sum(n_rows, n_cols, radial, g_cut)
+    if real:
+        w = w + thin_part(n_rows, n_cols, step, bodies, real)
+    w -= w.mean()  # the G = 0 term (the alias sum's mean is zero to round-off: hat vanishes on the aliases of 0)
     w.setflags(write=False)
     return w
+
+
+def _refuse(n_rows, n_cols, step, bodies, parts, terms):
+    t = min(c.thickness for _, _, c in parts)
+    i = 1 if bodies.coating1 is not None and bodies.coating1.thickness == t else 2
+    fine = step * math.sqrt(MAX_TERMS / terms)
+    raise InputError(
+        f"thickness = {t!r} is not allowed with step = {step!r} on this cell of {n_rows * n_cols} nodes: the "
+        f"periodic coated symbol would sum about {terms:.2g} alias terms (at most {MAX_TERMS:.0e}, which a step "
+        f"of {fine:.3g} or a cell of fewer nodes keeps), and {refusal(n_rows, n_cols, step, bodies, i)}. "
+        f"{_thin_hint(thin_limit(bodies))}")

@@ -8,6 +8,7 @@ import pytest
 import bem
 from bem.coating import mode_compliance, oedometric_compliance
 from bem.periodic import PeriodicCell, PeriodicOperator
+from bem.periodic import coated, coated_thin
 from bem.periodic.coated import MAX_TERMS, thin_limit
 
 ES, NUS = 2.0, 0.3  # the substrate of body 1
@@ -205,7 +206,7 @@ def test_a_coating_needs_the_substrate_and_a_coating_object():
         bem.solve(h, domain=cell, E1=1.0, nu1=0.3, E2=1.0, nu2=0.3, coating2={"thickness": 1}, mean_pressure=1.0)
 
 
-def test_periodic_operator_refuses_bodies_of_another_modulus_and_too_thin_coatings():
+def test_periodic_operator_refuses_bodies_of_another_modulus_and_too_thin_coatings(monkeypatch):
     cell = PeriodicCell(1.0, 8, 8)
     bodies = bem.Bodies(ES, NUS, math.inf, 0.0, coating1=bem.Coating(0.5, 1.0, 0.3))
     with pytest.raises(bem.InputError, match=r"^E_star = 1.0 is not allowed with bodies"):
@@ -213,12 +214,17 @@ def test_periodic_operator_refuses_bodies_of_another_modulus_and_too_thin_coatin
     with pytest.raises(bem.InputError, match=r"^bodies = 3 is not allowed"):
         PeriodicOperator(cell, 1.0, bodies=3)
     thin = bem.Bodies(ES, NUS, math.inf, 0.0, coating1=bem.Coating(1e-4, 1.0, 0.3))
+    assert PeriodicOperator(cell, thin.E_star, bodies=thin).diagonal > 0  # its real-space route: 169 coefficients
+    monkeypatch.setattr(coated_thin, "MAX_OFFSETS", 100)
+    coated._cached.cache_clear()
     with pytest.raises(bem.InputError, match=r"^thickness = 0.0001 is not allowed with step = 1.0") as err:
         PeriodicOperator(cell, thin.E_star, bodies=thin)
     assert f"{MAX_TERMS:.0e}" in str(err.value) and f"lam = {thin_limit(thin):.6g} (bem.layers.Linear" in str(err.value)
-    stiff = bem.Bodies(ES, NUS, math.inf, 0.0, coating1=bem.Coating(1e-4, 100.0, 0.3))
+    assert "real-space route would tabulate 1.7e+02 region coefficients (at most 1e+02: the images within 8 " in str(err.value)
+    stiff = bem.Bodies(ES, NUS, math.inf, 0.0, coating1=bem.Coating(1e-4, 10.0, 0.3))
     with pytest.raises(bem.InputError, match=r"stiffens the substrate's surface by the compliance -"):
         PeriodicOperator(cell, stiff.E_star, bodies=stiff)
+    coated._cached.cache_clear()
 
 
 def test_both_domains_take_the_bodies():
