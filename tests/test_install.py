@@ -80,7 +80,7 @@ def test_extras_layout():
     assert _extra("peers") == {"aspher", "tamaas", "contactmechanics"}
     assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask") | _extra("rough")
     assert _extra("test") == _extra("all") | _extra("3d") | _extra("docs") | {
-        "pytest", "html5lib", "pyyaml", "array-api-strict", "array-api-compat"}
+        "pytest", "pytest-xdist", "html5lib", "pyyaml", "array-api-strict", "array-api-compat"}
 
 
 def test_every_import_is_declared():
@@ -197,7 +197,7 @@ def test_ci_runs_the_readme_commands():
     readme = (ROOT / "README.md").read_text()
     install = 'python -m pip install -e ".[test]"'
     assert install in ci and install in readme
-    assert "python -m pytest -q" in ci and "python -m pytest" in readme
+    assert "python -m pytest -q -n auto" in ci and "python -m pytest -n auto" in readme
     packages = "libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 libgomp1"
     assert packages in ci and packages in readme
     assert ci.index("apt-get install") < ci.index(install) < ci.index("python -m pytest")
