@@ -19,7 +19,8 @@ quantity, from the last three levels (each step half the one before): the observ
 of ``p(r)``: at the finest levels with the FEM's ``p(r)`` linear between its nodes (:func:`rms_nodes`,
 ``rms``), and per paired level (``pressure``) with it edge-aware (:func:`fem_profile`), split into the
 interior and the edge band (:func:`rms_parts`), with its order and extrapolation. One case carries a root layer ``w = lam sqrt(p)`` on the coating
-(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``). Interface stresses:
+(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``); one case (``refined_case``) is solved one level
+finer in each method for the RMS of ``p(r)`` (:func:`refined_pressure`). Interface stresses:
 :mod:`validation.studies.coating_fem_stress`.
 """
 
@@ -36,7 +37,7 @@ from .coating_winkler import _coating, _listed, problem
 
 __all__ = ["SETTINGS", "QUICK", "QUANTITIES", "EDGE_BAND", "RMS_MEASURES", "STEM", "OUTPUT_NAMES", "richardson",
            "bem_edge", "fem_profile", "rms_parts", "rms_nodes",
-           "bem_levels", "fem_levels", "compare_case", "run_coating_fem", "summary_lines", "main"]
+           "bem_levels", "fem_levels", "compare_case", "refined_pressure", "run_coating_fem", "summary_lines", "main"]
 
 STEM = __name__.rpartition(".")[2]
 OUTPUT_NAMES = ("coating_fem.json", "coating_fem.md", "coating_fem.png")
@@ -51,9 +52,10 @@ RMS_MEASURES = ("linear", "total", "interior", "edge")
 #: the full study (SI units); ``*_levels``: ``a_H / step`` of the BEM, ``n_contact_elements`` of the FEM
 SETTINGS = dict(R=0.01, E_s=200e9, nu_s=0.3, a_H=1e-4, a_over_t=(0.1, 1.0, 10.0),
                 modulus_ratios=(0.01, 0.1, 10.0, 100.0), nu_c=(0.25, 0.45), bem_levels=(10, 20, 40),
-                fem_levels=(6, 12, 24), root_case=(1.0, 0.1, 0.25), root_lam=0.1, stresses=True)
+                fem_levels=(6, 12, 24), root_case=(1.0, 0.1, 0.25), root_lam=0.1, stresses=True,
+                refined_case=(1.0, 10.0, 0.25))
 #: the small run (``contactlab study coating-fem --quick``): one case
-QUICK = dict(SETTINGS, a_over_t=(1.0,), modulus_ratios=(10.0,), nu_c=(0.25,), root_case=None)
+QUICK = dict(SETTINGS, a_over_t=(1.0,), modulus_ratios=(10.0,), nu_c=(0.25,), root_case=None, refined_case=None)
 
 
 def richardson(values):
@@ -242,6 +244,22 @@ def compare_case(case, s, *, layer=None):
     return row
 
 
+def refined_pressure(case, s):
+    """The RMS of ``p(r)`` one level beyond the study's finest in each method: the BEM at the last two of
+    ``bem_levels`` doubled once, the FEM likewise; every BEM level against every FEM level (``rows``: ``bem``,
+    ``fem``, ``linear`` and the :func:`rms_parts`)."""
+    finer = dict(s, bem_levels=(s["bem_levels"][-1], 2 * s["bem_levels"][-1]),
+                 fem_levels=(s["fem_levels"][-1], 2 * s["fem_levels"][-1]), stresses=False)
+    t0 = time.perf_counter()
+    bs, fs = [], []
+    bem_levels(case, finer, None, bs)
+    fem_levels(case, finer, None, fs)
+    rows = [dict(bem=nb, fem=nf, linear=rms_nodes(b, f), **rms_parts(b, f))
+            for nb, b in zip(finer["bem_levels"], bs) for nf, f in zip(finer["fem_levels"], fs)]
+    return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], rows=rows,
+                converged=all(x.converged for x in bs + fs), wall_time_s=time.perf_counter() - t0)
+
+
 def _root(s):
     from bem.layers import Root
 
@@ -260,8 +278,9 @@ def run_coating_fem(settings=None, *, quick=False, progress=None):
     rows = [compare_case(c, s, layer=lay) for c, lay in
             each(cases, progress, lambda c: "a/t = {:g}, Ec/Es = {:g}, nu_c = {:g}".format(*c[0])
                  + (" + root layer" if c[1] is not None else ""))]
+    refined = refined_pressure(tuple(s["refined_case"]), s) if s.get("refined_case") else None
     return {"study": STEM, "mode": "quick" if quick else "full", "settings": {k: _listed(v) for k, v in s.items()},
-            "rows": rows, "wall_time_s": time.perf_counter() - t0}
+            "rows": rows, "refined": refined, "wall_time_s": time.perf_counter() - t0}
 
 
 def summary_lines(data):

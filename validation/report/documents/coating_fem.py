@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ..render import Figure, Section, Table
 
-__all__ = ["coating_fem_sections", "comparison_table", "pressure_table", "stress_table"]
+__all__ = ["coating_fem_sections", "comparison_table", "pressure_table", "refined_table", "stress_table"]
 
 
 def _order(x):
@@ -78,6 +78,14 @@ def stress_table(data):
     return heads, rows
 
 
+def refined_table(data):
+    """``(headings, rows)``: the refined case's RMS of p(r), every BEM level against every FEM level."""
+    heads = ("a_H/step (BEM)", "elements across a (FEM)", "RMS p linear", "RMS p edge-aware", "interior",
+             "edge band")
+    return heads, [(r["bem"], r["fem"], _pct(r["linear"]), _pct(r["total"]), _pct(r["interior"]), _pct(r["edge"]))
+                   for r in data["refined"]["rows"]]
+
+
 def coating_fem_sections(data, work=None):
     """The figure (with a figures folder ``work``) and the two tables."""
     s = data.get("settings", {})
@@ -110,6 +118,12 @@ def coating_fem_sections(data, work=None):
     heads, rows = pressure_table(data)
     items.append(Table(heads, tuple(rows), caption="Per case: RMS of the BEM nodes' pressure against the FEM's "
                                                    "p(r) per paired level, orders, parts, run time."))
+    if data.get("refined"):
+        heads, rows = refined_table(data)
+        c = data["refined"]
+        items.append(Table(heads, tuple(rows), caption=f"The case a_H/t = {c['a_over_t']:g}, E_c/E_s = "
+                           f"{c['modulus_ratio']:g}, nu_c = {c['nu_c']:g} one level finer in each method: RMS of "
+                           "p(r) of every BEM level against every FEM level."))
     heads, rows = stress_table(data)
     items.append(Table(heads, tuple(rows), caption="Per case: interface stresses of the BEM against the FEM's "
                                                    "one-sided recovery (finest levels) and the per-level orders."))
