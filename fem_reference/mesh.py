@@ -15,8 +15,7 @@ A body may carry a coating of thickness ``t`` (``coating_thickness``): a line at
 (upper) or ``z = -t`` (lower) splits its rectangle into the coating and the substrate, meshed
 conformingly (bonded: the two share the nodes of that line), with at least
 ``N_ACROSS_COATING`` elements across ``t`` in the fine zone and elements no larger than ``t``
-along the whole coating; a bond deeper than the contact radius is refined around the axis in
-proportion to its depth (:func:`_size_field`).
+along the whole coating; a bond deeper than the contact is refined near the axis (:func:`_size_field`).
 
 Both rectangles are meshed in one gmsh model that shares the interface curve,
 so the two sides of the interface get the same 1-D mesh; the nodes on it are
@@ -205,8 +204,7 @@ def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=()
 
     ``coatings``: ``(z_low, z_high, t)`` per coating strip. Each caps the size at ``t`` along the
     whole strip and at ``t / N_ACROSS_COATING`` in its part within ``fine_radius`` (both growing
-    with the same slope outside), the smallest size applying. A bond deeper than ``a_est``
-    (``t > a_est``) gets the contact zone's resolution scaled by its depth: sizes
+    with the same slope outside), the smallest size applying. A bond deeper than ``a_est`` gets sizes
     ``h_fine t / a_est`` within ``fine_radius t / a_est`` of its point on the axis.
     """
     fld = gmsh.model.mesh.field

@@ -17,8 +17,9 @@ quantity, from the last three levels (each step half the one before): the observ
 ``log2(|q1 - q2| / |q2 - q3|)`` and the Richardson value ``q3 + (q3 - q2) / (2^order - 1)``
 (:func:`richardson`). The BEM-vs-FEM differences of the extrapolated and of the finest values. The RMS
 of ``p(r)``: at the finest levels with the FEM's ``p(r)`` linear between its nodes (:func:`rms_nodes`,
-``rms``), and per paired level (``pressure``) with it edge-aware (:func:`fem_profile`), split into the
-interior and the edge band (:func:`rms_parts`), with its order and extrapolation. One case carries a root layer ``w = lam sqrt(p)`` on the coating
+``rms``), and per paired level (``pressure``) with it edge-aware (:func:`fem_profile`; linear with a
+layer, whose pressure has no square-root edge), split into the interior and the edge band
+(:func:`rms_parts`), with its order and extrapolation. One case carries a root layer ``w = lam sqrt(p)`` on the coating
 (``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``); one case (``refined_case``) is solved one level
 finer in each method for the RMS of ``p(r)`` (:func:`refined_pressure`). Interface stresses:
 :mod:`validation.studies.coating_fem_stress`.
@@ -46,7 +47,7 @@ QUANTITIES = ("p_max", "radius", "approach")
 #: the edge band of :func:`rms_parts`: ``r >= (1 - EDGE_BAND)`` times the FEM's contact radius
 EDGE_BAND = 0.1
 #: the RMS measures of ``p(r)`` per paired level: the FEM's ``p(r)`` linear (``linear``), edge-aware
-#: (``total``), and the latter's ``interior`` and ``edge`` parts (:func:`rms_parts`)
+#: (``total``; linear with a layer), and the latter's ``interior`` and ``edge`` parts (:func:`rms_parts`)
 RMS_MEASURES = ("linear", "total", "interior", "edge")
 
 #: the full study (SI units); ``*_levels``: ``a_H / step`` of the BEM, ``n_contact_elements`` of the FEM
@@ -197,11 +198,12 @@ def _best(x):
     return x["extrapolated"] if x["extrapolated"] is not None else x["finest"]
 
 
-def _pressure_levels(bs, fs):
+def _pressure_levels(bs, fs, smooth=True):
     """The RMS measures of ``p(r)`` per paired level (coarsest first; ``None`` where a solve did not
-    converge), their orders and extrapolations."""
-    rows = [dict(linear=rms_nodes(b, f), **rms_parts(b, f)) if b.converged and f.converged else
-            dict.fromkeys(RMS_MEASURES) for b, f in zip(bs, fs)]
+    converge), their orders and extrapolations. ``smooth``: bodies without a layer, whose pressure has a
+    square-root edge (read edge-aware); with a layer it vanishes smoothly and ``total`` reads it linearly."""
+    rows = [dict(linear=rms_nodes(b, f), **rms_parts(b, f, edge_aware=smooth)) if b.converged and f.converged
+            else dict.fromkeys(RMS_MEASURES) for b, f in zip(bs, fs)]
     return dict(levels=rows, **_extrapolate(rows, RMS_MEASURES))
 
 
@@ -235,7 +237,7 @@ def compare_case(case, s, *, layer=None):
     row = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], thickness=_coating(case, s).thickness,
                layer=None if layer is None else layer.to_dict() if hasattr(layer, "to_dict") else repr(layer),
                converged=all(r["converged"] for r in b_rows + f_rows), bem=b_rows, fem=f_rows, bem_x=bx, fem_x=fx,
-               diff=diff, rms=rms_nodes(b, f), pressure=_pressure_levels(bs, fs))
+               diff=diff, rms=rms_nodes(b, f), pressure=_pressure_levels(bs, fs, layer is None))
     row["worst_extrapolated"] = max(abs(d["extrapolated"]) for d in diff.values())
     row["worst_finest"] = max(abs(d["finest"]) for d in diff.values())
     if s.get("stresses") and f.converged:
