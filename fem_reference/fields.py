@@ -7,8 +7,13 @@ Stresses (Hooke's law per body, axisymmetric)::
     von_mises = sqrt(((s_rr - s_zz)^2 + (s_zz - s_tt)^2 + (s_tt - s_rr)^2) / 2 + 3 s_rz^2)
 
 are evaluated at the quadrature points and L2-projected onto the continuous quadratic
-space of each body (the bodies share no node, so nothing is averaged across the
-interface). ``tr(eps) = eps_rr + eps_zz + eps_tt``; tension positive.
+space of each body (:func:`nodal_stresses`; the bodies share no node, so nothing is averaged
+across the contact interface, but a coating and its substrate share the nodes of their bond,
+where the projection takes a mean of the two materials' jumping stresses). One-sided recovery
+(:func:`one_sided_stresses`): each element's own stress at its six nodes, averaged over the
+chosen elements that share a node (one material: a coating's elements, or its substrate's), so
+that each side of a bond keeps its own value. ``tr(eps) = eps_rr + eps_zz + eps_tt``; tension
+positive.
 """
 
 from __future__ import annotations
@@ -18,20 +23,32 @@ import numpy as np
 from scipy.sparse.linalg import splu
 
 
-__all__ = ["nodal_stresses", "body_stresses", "field_mesh", "STRESS_NAMES"]
+__all__ = ["nodal_stresses", "one_sided_stresses", "body_stresses", "field_mesh", "STRESS_NAMES"]
 
 STRESS_NAMES = ("sigma_rr", "sigma_zz", "sigma_tt", "sigma_rz", "von_mises")
 
 
-def _quadrature_stresses(model, u):
+def _quadrature_stresses(model, u, basis=None, lam=None, mu=None):
+    """``(s_rr, s_zz, s_tt, s_rz)`` at the points of ``basis`` (default: the model's quadrature).
+
+    On the axis (``r = 0``, where ``u_r = 0``) the hoop strain ``u_r / r`` is its limit ``du_r/dr``.
+    """
     from .model import _strain
 
-    ui = model.basis.interpolate(u)
-    r = np.asarray(model.basis.global_coordinates())[0]
-    e_rr, e_zz, e_tt, g_rz = _strain(ui, r)
-    lam, mu = model.lam_w, model.mu_w
+    basis = model.basis if basis is None else basis
+    ui = basis.interpolate(u)
+    r = np.asarray(basis.global_coordinates())[0]
+    on_axis = r == 0.0
+    e_rr, e_zz, e_tt, g_rz = _strain(ui, np.where(on_axis, 1.0, r))
+    e_tt = np.where(on_axis, e_rr, e_tt)
+    lam = model.lam_w if lam is None else lam
+    mu = model.mu_w if mu is None else mu
     tr = lam * (e_rr + e_zz + e_tt)
     return tr + 2 * mu * e_rr, tr + 2 * mu * e_zz, tr + 2 * mu * e_tt, mu * g_rz
+
+
+def _von_mises(s_rr, s_zz, s_tt, s_rz):
+    return np.sqrt(0.5 * ((s_rr - s_zz) ** 2 + (s_zz - s_tt) ** 2 + (s_tt - s_rr) ** 2) + 3.0 * s_rz**2)
 
 
 def nodal_stresses(model, u):
@@ -65,9 +82,50 @@ def nodal_stresses(model, u):
     out = {}
     for name, s in zip(STRESS_NAMES[:4], _quadrature_stresses(model, u)):
         out[name] = lu.solve(asm(load, basis, s=s))
-    s_rr, s_zz, s_tt, s_rz = (out[k] for k in STRESS_NAMES[:4])
-    out["von_mises"] = np.sqrt(0.5 * ((s_rr - s_zz) ** 2 + (s_zz - s_tt) ** 2 + (s_tt - s_rr) ** 2)
-                               + 3.0 * s_rz**2)
+    out["von_mises"] = _von_mises(*(out[k] for k in STRESS_NAMES[:4]))
+    return out
+
+
+def one_sided_stresses(model, u, elements):
+    """Nodal stresses [pressure] from the chosen elements only, on the scalar quadratic nodes.
+
+    Each chosen element's stress (Hooke's law of its own material) is evaluated at its own six
+    nodes; a node's value is the mean over the chosen elements that hold it. Chosen as the
+    elements of one material, the stresses at a bond are that material's side of the jump.
+
+    Parameters
+    ----------
+    model : fem_reference.model.AxiModel
+        The assembled model.
+    u : ndarray, shape (model.n_dofs,)
+        Displacement [length].
+    elements : ndarray of bool, shape (n_elements,)
+        The elements to recover from (e.g. ``model.amesh.coated & (model.amesh.body == 1)``).
+
+    Returns
+    -------
+    dict
+        ``sigma_rr``, ``sigma_zz``, ``sigma_tt``, ``sigma_rz``, ``von_mises``: arrays of shape
+        ``(model.scalar_basis.N,)``, NaN at the nodes of no chosen element; ``nodes``: the bool
+        mask of the nodes that have a value.
+    """
+    from skfem import Basis, ElementTriP2, ElementVector
+
+    elements = np.nonzero(np.asarray(elements, dtype=bool))[0]
+    element = ElementTriP2()
+    points = np.ascontiguousarray(element.doflocs.T)  # the six reference nodes, in local DOF order
+    basis = Basis(model.amesh.mesh, ElementVector(element), quadrature=(points, np.full(6, 1.0 / 12.0)),
+                  elements=elements)
+    lam, mu = (np.asarray(w)[elements, :1] + np.zeros((1, 6)) for w in (model.lam_w, model.mu_w))
+    dofs = model.scalar_basis.element_dofs[:, elements]  # (6, n_chosen): node of local DOF j
+    n = model.scalar_basis.N
+    count = np.bincount(dofs.ravel(), minlength=n)
+    out = {}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for name, s in zip(STRESS_NAMES[:4], _quadrature_stresses(model, u, basis, lam, mu)):
+            out[name] = np.bincount(dofs.ravel(), weights=np.asarray(s).T.ravel(), minlength=n) / count
+    out["von_mises"] = _von_mises(*(out[k] for k in STRESS_NAMES[:4]))
+    out["nodes"] = count > 0
     return out
 
 

@@ -15,7 +15,7 @@ A body may carry a coating of thickness ``t`` (``coating_thickness``): a line at
 (upper) or ``z = -t`` (lower) splits its rectangle into the coating and the substrate, meshed
 conformingly (bonded: the two share the nodes of that line), with at least
 ``N_ACROSS_COATING`` elements across ``t`` in the fine zone and elements no larger than ``t``
-along the whole coating.
+along the whole coating; a bond deeper than the contact is refined near the axis (:func:`_size_field`).
 
 Both rectangles are meshed in one gmsh model that shares the interface curve,
 so the two sides of the interface get the same 1-D mesh; the nodes on it are
@@ -50,16 +50,9 @@ __all__ = ["AxiMesh", "build_mesh", "BOUNDARIES"]
 log = logging.getLogger(__name__)
 
 #: skfem boundary name -> (gmsh physical group, body)
-BOUNDARIES = {
-    "interface_upper": ("interface", "upper"),
-    "interface_lower": ("interface", "lower"),
-    "axis_upper": ("axis", "upper"),
-    "axis_lower": ("axis", "lower"),
-    "top": ("top", "upper"),
-    "bottom": ("bottom", "lower"),
-    "outer_upper": ("outer", "upper"),
-    "outer_lower": ("outer", "lower"),
-}
+BOUNDARIES = {"interface_upper": ("interface", "upper"), "interface_lower": ("interface", "lower"),
+              "axis_upper": ("axis", "upper"), "axis_lower": ("axis", "lower"), "top": ("top", "upper"),
+              "bottom": ("bottom", "lower"), "outer_upper": ("outer", "upper"), "outer_lower": ("outer", "lower")}
 BODIES = ("upper", "lower")
 #: Elements across a coating's thickness in the fine zone (at least).
 N_ACROSS_COATING = 4
@@ -195,27 +188,38 @@ def _geometry(gmsh, R, H, thickness=(None, None)):
     return p0, surfaces, curves, groups
 
 
-def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=()):
+def _threshold(fld, distance, size, h_coarse, radius, growth):
+    """Size ``size`` where the field ``distance`` is below ``radius``, growing with slope ``growth``."""
+    thr = fld.add("Threshold")
+    fld.setNumber(thr, "InField", distance)
+    fld.setNumber(thr, "SizeMin", size)
+    fld.setNumber(thr, "SizeMax", h_coarse)
+    fld.setNumber(thr, "DistMin", radius)
+    fld.setNumber(thr, "DistMax", radius + max(h_coarse - size, 0.0) / growth)
+    return thr
+
+
+def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=(), a_est=None):
     """Size ``h_fine`` within ``fine_radius`` of the origin, growing linearly (slope ``growth``).
 
     ``coatings``: ``(z_low, z_high, t)`` per coating strip. Each caps the size at ``t`` along the
     whole strip and at ``t / N_ACROSS_COATING`` in its part within ``fine_radius`` (both growing
-    with the same slope outside), the smallest size applying.
+    with the same slope outside), the smallest size applying. A bond deeper than ``a_est`` gets sizes
+    ``h_fine t / a_est`` within ``fine_radius t / a_est`` of its point on the axis.
     """
     fld = gmsh.model.mesh.field
     dist = fld.add("Distance")
     fld.setNumbers(dist, "PointsList", [origin])
-    thr = fld.add("Threshold")
-    fld.setNumber(thr, "InField", dist)
-    fld.setNumber(thr, "SizeMin", h_fine)
-    fld.setNumber(thr, "SizeMax", h_coarse)
-    fld.setNumber(thr, "DistMin", fine_radius)
-    fld.setNumber(thr, "DistMax", fine_radius + (h_coarse - h_fine) / growth)
+    thr = _threshold(fld, dist, h_fine, h_coarse, fine_radius, growth)
     if not coatings:
         fld.setAsBackgroundMesh(thr)
         return
     fields = [thr]
     for z_low, z_high, t in coatings:
+        if t > a_est:  # a deep bond: sizes h_fine t / a_est within fine_radius t / a_est of its axis point
+            bond = fld.add("MathEval")
+            fld.setString(bond, "F", f"Sqrt(x^2 + (y - ({z_high if z_low < 0 else z_low!r}))^2)")
+            fields.append(_threshold(fld, bond, h_fine * t / a_est, h_coarse, fine_radius * t / a_est, growth))
         boxes = [(math.inf, t)]
         if t / N_ACROSS_COATING < h_fine:
             boxes.append((fine_radius, t / N_ACROSS_COATING))
@@ -381,7 +385,7 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
         gmsh.model.add("contactlab_axisymmetric")
         origin, surfaces, curves, groups = _geometry(gmsh, R, H, thickness)
         strips = [(0.0, t, t) if k == 0 else (-t, 0.0, t) for k, t in enumerate(thickness) if t]
-        _size_field(gmsh, origin, h_fine, h_coarse, fine_radius * a_est, growth, strips)
+        _size_field(gmsh, origin, h_fine, h_coarse, fine_radius * a_est, growth, strips, a_est)
         gmsh.model.mesh.generate(2)
         gmsh.model.mesh.setOrder(2)
         xy, parts = _extract(gmsh, surfaces, curves, thickness)

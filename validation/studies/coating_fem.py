@@ -15,9 +15,13 @@ Measured per level: ``p_max``, the contact radius (the edge of the loaded zone, 
 for the BEM; :func:`fem_reference.result.edge_radius` for the FEM) and the approach. Per method and
 quantity, from the last three levels (each step half the one before): the observed order
 ``log2(|q1 - q2| / |q2 - q3|)`` and the Richardson value ``q3 + (q3 - q2) / (2^order - 1)``
-(:func:`richardson`). The BEM-vs-FEM differences of the extrapolated and of the finest values, and the
-RMS of ``p(r)`` (:func:`rms_nodes`). One case carries a root layer ``w = lam sqrt(p)`` on the coating
-(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``). Interface stresses:
+(:func:`richardson`). The BEM-vs-FEM differences of the extrapolated and of the finest values. The RMS
+of ``p(r)``: at the finest levels with the FEM's ``p(r)`` linear between its nodes (:func:`rms_nodes`,
+``rms``), and per paired level (``pressure``) with it edge-aware (:func:`fem_profile`; linear with a
+layer, whose pressure has no square-root edge), split into the interior and the edge band
+(:func:`rms_parts`), with its order and extrapolation. One case carries a root layer ``w = lam sqrt(p)`` on the coating
+(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``); one case (``refined_case``) is solved one level
+finer in each method for the RMS of ``p(r)`` (:func:`refined_pressure`). Interface stresses:
 :mod:`validation.studies.coating_fem_stress`.
 """
 
@@ -32,20 +36,27 @@ from ..progress import each
 from . import no_scene, save
 from .coating_winkler import _coating, _listed, problem
 
-__all__ = ["SETTINGS", "QUICK", "QUANTITIES", "STEM", "OUTPUT_NAMES", "richardson", "bem_edge", "rms_nodes",
-           "bem_levels", "fem_levels", "compare_case", "run_coating_fem", "summary_lines", "main"]
+__all__ = ["SETTINGS", "QUICK", "QUANTITIES", "EDGE_BAND", "RMS_MEASURES", "STEM", "OUTPUT_NAMES", "richardson",
+           "bem_edge", "fem_profile", "rms_parts", "rms_nodes",
+           "bem_levels", "fem_levels", "compare_case", "refined_pressure", "run_coating_fem", "summary_lines", "main"]
 
 STEM = __name__.rpartition(".")[2]
 OUTPUT_NAMES = ("coating_fem.json", "coating_fem.md", "coating_fem.png")
 #: the compared scalars of a solution
 QUANTITIES = ("p_max", "radius", "approach")
+#: the edge band of :func:`rms_parts`: ``r >= (1 - EDGE_BAND)`` times the FEM's contact radius
+EDGE_BAND = 0.1
+#: the RMS measures of ``p(r)`` per paired level: the FEM's ``p(r)`` linear (``linear``), edge-aware
+#: (``total``; linear with a layer), and the latter's ``interior`` and ``edge`` parts (:func:`rms_parts`)
+RMS_MEASURES = ("linear", "total", "interior", "edge")
 
 #: the full study (SI units); ``*_levels``: ``a_H / step`` of the BEM, ``n_contact_elements`` of the FEM
 SETTINGS = dict(R=0.01, E_s=200e9, nu_s=0.3, a_H=1e-4, a_over_t=(0.1, 1.0, 10.0),
                 modulus_ratios=(0.01, 0.1, 10.0, 100.0), nu_c=(0.25, 0.45), bem_levels=(10, 20, 40),
-                fem_levels=(6, 12, 24), root_case=(1.0, 0.1, 0.25), root_lam=0.1, stresses=True)
+                fem_levels=(6, 12, 24), root_case=(1.0, 0.1, 0.25), root_lam=0.1, stresses=True,
+                refined_case=(1.0, 10.0, 0.25))
 #: the small run (``contactlab study coating-fem --quick``): one case
-QUICK = dict(SETTINGS, a_over_t=(1.0,), modulus_ratios=(10.0,), nu_c=(0.25,), root_case=None)
+QUICK = dict(SETTINGS, a_over_t=(1.0,), modulus_ratios=(10.0,), nu_c=(0.25,), root_case=None, refined_case=None)
 
 
 def richardson(values):
@@ -92,11 +103,36 @@ def bem_edge(res, *, layer=False):
     return float(edge)
 
 
+def fem_profile(fem, r, *, edge_aware=False):
+    """The FEM's ``p(r)`` [pressure] at the radii ``r``: linear between its nodes, zero beyond; ``edge_aware``:
+    ``p^2`` linear between its loaded nodes and on to zero at its ``edge_radius`` (a square-root edge is
+    linear in ``p^2``; without contact, zero)."""
+    if not edge_aware:
+        return np.interp(r, fem.r, fem.p, right=0.0)
+    loaded = np.nonzero(fem.p > 0)[0]
+    if not loaded.size:
+        return np.zeros(np.shape(r))
+    k = int(loaded[-1])
+    return np.sqrt(np.interp(r, np.r_[fem.r[:k + 1], max(fem.edge_radius, fem.r[k])], np.r_[fem.p[:k + 1] ** 2, 0.0],
+                             right=0.0))
+
+
+def rms_parts(res, fem, *, edge_aware=True):
+    """RMS of the BEM nodes' pressure against the FEM's ``p(r)`` (:func:`fem_profile`) at their radii,
+    relative: ``sqrt(sum (p_n - p_FEM(r_n))^2 / sum p_FEM(r_n)^2)`` (a uniform lattice: area weights), as
+    ``{"total", "interior", "edge"}``: the sums over every node, over ``r < (1 - EDGE_BAND) a_FEM`` and over
+    the rest (``interior^2 + edge^2 = total^2``)."""
+    r = np.hypot(res.x, res.y)
+    pf = fem_profile(fem, r, edge_aware=edge_aware)
+    sq, ref = (res.p - pf) ** 2, np.sum(pf**2)
+    inside = r < (1.0 - EDGE_BAND) * fem.edge_radius
+    return {k: float(math.sqrt(np.sum(sq[m]) / ref)) for k, m in (("total", slice(None)), ("interior", inside),
+                                                                   ("edge", ~inside))}
+
+
 def rms_nodes(res, fem):
-    """RMS of the BEM nodes' pressure against the FEM's ``p(r)`` (linear between its nodes) at their radii,
-    relative: ``sqrt(sum (p_n - p_FEM(r_n))^2 / sum p_FEM(r_n)^2)`` (a uniform lattice: area weights)."""
-    pf = np.interp(np.hypot(res.x, res.y), fem.r, fem.p, right=0.0)
-    return float(math.sqrt(np.sum((res.p - pf) ** 2) / np.sum(pf**2)))
+    """:func:`rms_parts` ``["total"]`` with the FEM's ``p(r)`` linear between its nodes."""
+    return rms_parts(res, fem, edge_aware=False)["total"]
 
 
 def _gap(s):
@@ -105,8 +141,9 @@ def _gap(s):
     return Paraboloid(s["R"])
 
 
-def bem_levels(case, s, layer=None):
-    """The BEM at every ``s["bem_levels"]``: ``(rows, finest result)``."""
+def bem_levels(case, s, layer=None, keep=None):
+    """The BEM at every ``s["bem_levels"]``: ``(rows, finest result)``; each level's result appended to the
+    list ``keep`` when given."""
     import bem
 
     rows, res = [], None
@@ -118,12 +155,20 @@ def bem_levels(case, s, layer=None):
                          radius=bem_edge(res, layer=layer is not None), area_radius=float(res.contact_radius),
                          approach=float(res.approach), iterations=int(res.iterations), nodes=int(res.p.size),
                          wall_time_s=time.perf_counter() - t0))
+        if keep is not None:
+            keep.append(res)
     return rows, res
 
 
-def fem_levels(case, s, layer=None):
-    """The FEM reference at every ``s["fem_levels"]``: ``(rows, finest result)``."""
+def fem_levels(case, s, layer=None, keep=None):
+    """The FEM reference at every ``s["fem_levels"]``: ``(rows, finest result)``; with ``s["stresses"]`` each
+    converged level's row carries ``stress`` (:func:`~validation.studies.coating_fem_stress.fem_scalars`);
+    each level's ``p(r)`` (``r``, ``p``, ``edge_radius``, ``converged``) appended to the list ``keep`` when given."""
+    from types import SimpleNamespace
+
     from fem_reference import solve
+
+    from .coating_fem_stress import fem_scalars
 
     rows, res = [], None
     for n in s["fem_levels"]:
@@ -133,22 +178,56 @@ def fem_levels(case, s, layer=None):
         rows.append(dict(level=n, converged=bool(res.converged), message=res.message, p_max=float(res.p_max),
                          radius=float(res.edge_radius), approach=float(res.approach), elements=int(res.n_elements),
                          wall_time_s=time.perf_counter() - t0))
+        if s.get("stresses") and res.converged:
+            rows[-1]["stress"] = fem_scalars(res, _coating(case, s))
+        if keep is not None:
+            keep.append(SimpleNamespace(r=res.r, p=res.p, edge_radius=float(res.edge_radius), converged=res.converged))
     return rows, res
 
 
-def _extrapolate(rows):
+def _extrapolate(rows, names=QUANTITIES):
     out = {}
-    for q in QUANTITIES:
-        order, value = richardson([r[q] for r in rows])
-        out[q] = dict(order=order, extrapolated=value, finest=rows[-1][q])
+    for q in names:
+        values = [r[q] for r in rows]
+        order, value = richardson(values) if None not in values and len(values) >= 3 else (None, None)
+        out[q] = dict(order=order, extrapolated=value, finest=values[-1])
+    return out
+
+
+def _best(x):
+    return x["extrapolated"] if x["extrapolated"] is not None else x["finest"]
+
+
+def _pressure_levels(bs, fs, smooth=True):
+    """The RMS measures of ``p(r)`` per paired level (coarsest first; ``None`` where a solve did not
+    converge), their orders and extrapolations. ``smooth``: bodies without a layer, whose pressure has a
+    square-root edge (read edge-aware); with a layer it vanishes smoothly and ``total`` reads it linearly."""
+    rows = [dict(linear=rms_nodes(b, f), **rms_parts(b, f, edge_aware=smooth)) if b.converged and f.converged
+            else dict.fromkeys(RMS_MEASURES) for b, f in zip(bs, fs)]
+    return dict(levels=rows, **_extrapolate(rows, RMS_MEASURES))
+
+
+def _stress_levels(case, s, bs, f_rows, f):
+    """Interface stresses: finest levels compared, and the per-level scalars of both methods."""
+    from .coating_fem_stress import STRESS_SCALARS, bem_scalars, interface_stresses
+
+    coating = _coating(case, s)
+    out, points = interface_stresses(bs[-1], f, coating, s)
+    b_rows = [bem_scalars(b, coating, s, points) for b in bs]
+    f_rows = [r.get("stress", {q: None for q in STRESS_SCALARS}) for r in f_rows]
+    bx, fx = _extrapolate(b_rows, STRESS_SCALARS), _extrapolate(f_rows, STRESS_SCALARS)
+    out["levels"] = dict(bem=b_rows, fem=f_rows, bem_x=bx, fem_x=fx,
+                         diff={q: None if None in (_best(bx[q]), _best(fx[q])) or _best(fx[q]) == 0 else
+                               _best(bx[q]) / _best(fx[q]) - 1.0 for q in STRESS_SCALARS})
     return out
 
 
 def compare_case(case, s, *, layer=None):
     """One case: both methods' levels, orders, extrapolated values, differences and interface stresses."""
     t0 = time.perf_counter()
-    b_rows, b = bem_levels(case, s, layer)
-    f_rows, f = fem_levels(case, s, layer)
+    bs, fs = [], []
+    b_rows, b = bem_levels(case, s, layer, bs)
+    f_rows, f = fem_levels(case, s, layer, fs)
     bx, fx = _extrapolate(b_rows), _extrapolate(f_rows)
     diff = {}
     for q in QUANTITIES:
@@ -158,15 +237,29 @@ def compare_case(case, s, *, layer=None):
     row = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], thickness=_coating(case, s).thickness,
                layer=None if layer is None else layer.to_dict() if hasattr(layer, "to_dict") else repr(layer),
                converged=all(r["converged"] for r in b_rows + f_rows), bem=b_rows, fem=f_rows, bem_x=bx, fem_x=fx,
-               diff=diff, rms=rms_nodes(b, f))
+               diff=diff, rms=rms_nodes(b, f), pressure=_pressure_levels(bs, fs, layer is None))
     row["worst_extrapolated"] = max(abs(d["extrapolated"]) for d in diff.values())
     row["worst_finest"] = max(abs(d["finest"]) for d in diff.values())
     if s.get("stresses") and f.converged:
-        from .coating_fem_stress import interface_stresses
-
-        row["stresses"] = interface_stresses(b, f, _coating(case, s), s)
+        row["stresses"] = _stress_levels(case, s, bs, f_rows, f)
     row["wall_time_s"] = time.perf_counter() - t0
     return row
+
+
+def refined_pressure(case, s):
+    """The RMS of ``p(r)`` one level beyond the study's finest in each method: the BEM at the last two of
+    ``bem_levels`` doubled once, the FEM likewise; every BEM level against every FEM level (``rows``: ``bem``,
+    ``fem``, ``linear`` and the :func:`rms_parts`)."""
+    finer = dict(s, bem_levels=(s["bem_levels"][-1], 2 * s["bem_levels"][-1]),
+                 fem_levels=(s["fem_levels"][-1], 2 * s["fem_levels"][-1]), stresses=False)
+    t0 = time.perf_counter()
+    bs, fs = [], []
+    bem_levels(case, finer, None, bs)
+    fem_levels(case, finer, None, fs)
+    rows = [dict(bem=nb, fem=nf, linear=rms_nodes(b, f), **rms_parts(b, f))
+            for nb, b in zip(finer["bem_levels"], bs) for nf, f in zip(finer["fem_levels"], fs)]
+    return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], rows=rows,
+                converged=all(x.converged for x in bs + fs), wall_time_s=time.perf_counter() - t0)
 
 
 def _root(s):
@@ -187,8 +280,9 @@ def run_coating_fem(settings=None, *, quick=False, progress=None):
     rows = [compare_case(c, s, layer=lay) for c, lay in
             each(cases, progress, lambda c: "a/t = {:g}, Ec/Es = {:g}, nu_c = {:g}".format(*c[0])
                  + (" + root layer" if c[1] is not None else ""))]
+    refined = refined_pressure(tuple(s["refined_case"]), s) if s.get("refined_case") else None
     return {"study": STEM, "mode": "quick" if quick else "full", "settings": {k: _listed(v) for k, v in s.items()},
-            "rows": rows, "wall_time_s": time.perf_counter() - t0}
+            "rows": rows, "refined": refined, "wall_time_s": time.perf_counter() - t0}
 
 
 def summary_lines(data):
@@ -196,7 +290,12 @@ def summary_lines(data):
     return [f"a/t = {r['a_over_t']:g}, Ec/Es = {r['modulus_ratio']:g}, nu_c = {r['nu_c']:g}"
             + (" (root layer)" if r["layer"] else "") + ": "
             + ", ".join(f"{q} {r['diff'][q]['extrapolated']:+.2%}" for q in QUANTITIES)
-            + f", RMS p {r['rms']:.2%}" for r in data["rows"]]
+            + f", RMS p {r['rms']:.2%}" + _edge_aware(r) for r in data["rows"]]
+
+
+def _edge_aware(row):
+    value = (row.get("pressure") or {}).get("total", {}).get("finest")
+    return "" if value is None else f" (edge-aware {value:.2%})"
 
 
 def main(*, out=None, scene=None, quick=False, progress=None):

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ..render import Figure, Section, Table
 
-__all__ = ["coating_fem_sections", "comparison_table", "levels_table"]
+__all__ = ["coating_fem_sections", "comparison_table", "pressure_table", "refined_table", "stress_table"]
 
 
 def _order(x):
@@ -30,17 +30,60 @@ def comparison_table(data):
     return heads, rows
 
 
-def levels_table(data):
-    """``(headings, rows)``: per case, RMS of p(r), the interface stresses and the run time."""
-    heads = ("a_H/t", "E_c/E_s", "nu_c", "layer", "converged", "RMS p", "sigma_zz at bond", "sigma_rz at bond",
-             "von Mises coating", "von Mises substrate", "time [s]")
+def _pct(x, digits=2):
+    return "-" if x is None else f"{x:.{digits}%}"
+
+
+def pressure_table(data):
+    """``(headings, rows)``: per case, the RMS of p(r): the linear measure at the finest levels, the edge-aware
+    one per paired level with its order and extrapolation, its interior and edge-band parts, the run time."""
+    heads = ("a_H/t", "E_c/E_s", "nu_c", "layer", "converged", "RMS p linear, finest", "RMS p edge-aware per level",
+             "order", "extrapolated", "interior, finest", "edge band, finest", "time [s]")
+    rows = []
+    for r in data["rows"]:
+        pr = r.get("pressure")
+        if pr is None:
+            rows.append((*_case(r), r["converged"], _pct(r["rms"]), "-", "-", "-", "-", "-", f"{r['wall_time_s']:.0f}"))
+            continue
+        t = pr["total"]
+        rows.append((*_case(r), r["converged"], _pct(r["rms"]), " / ".join(_pct(v["total"]) for v in pr["levels"]),
+                     _order(t["order"]), _pct(t["extrapolated"]), _pct(pr["interior"]["finest"]),
+                     _pct(pr["edge"]["finest"]), f"{r['wall_time_s']:.0f}"))
+    return heads, rows
+
+
+def stress_table(data):
+    """``(headings, rows)``: per case, the interface stresses (finest levels) and the per-level scalars'
+    orders (BEM / FEM) and differences of their extrapolated values."""
+    heads = ("a_H/t", "E_c/E_s", "nu_c", "layer", "sigma_zz / sigma_rz at bond, of max traction",
+             "of own max", "projected, of own max", "FEM sides", "von Mises coating", "von Mises substrate",
+             "sigma_zz axis: orders, diff", "max sigma_rz: orders, diff")
     rows = []
     for r in data["rows"]:
         st = r.get("stresses") or {}
         cell = (lambda k: f"{st[k]:+.2%}" if st.get(k) is not None else "-")  # noqa: E731
-        rows.append((*_case(r), r["converged"], f"{r['rms']:.2%}", cell("szz"), cell("srz"), cell("vm_coating"),
-                     cell("vm_substrate"), f"{r['wall_time_s']:.0f}"))
+        pair = (lambda a, b: f"{_pct(st.get(a))} / {_pct(st.get(b))}")  # noqa: E731
+        lv = st.get("levels") or {}
+
+        def scalar(q, lv=lv):
+            if not lv:
+                return "-"
+            d = lv["diff"][q]
+            return (f"{_order(lv['bem_x'][q]['order'])} / {_order(lv['fem_x'][q]['order'])}, "
+                    + ("-" if d is None else f"{d:+.2%}"))
+
+        rows.append((*_case(r), pair("szz", "srz"), pair("szz_own", "srz_own"),
+                     pair("szz_projected", "srz_projected"), _pct(st.get("fem_sides")), cell("vm_coating"),
+                     cell("vm_substrate"), scalar("szz_axis"), scalar("srz_max")))
     return heads, rows
+
+
+def refined_table(data):
+    """``(headings, rows)``: the refined case's RMS of p(r), every BEM level against every FEM level."""
+    heads = ("a_H/step (BEM)", "elements across a (FEM)", "RMS p linear", "RMS p edge-aware", "interior",
+             "edge band")
+    return heads, [(r["bem"], r["fem"], _pct(r["linear"]), _pct(r["total"]), _pct(r["interior"]), _pct(r["edge"]))
+                   for r in data["refined"]["rows"]]
 
 
 def coating_fem_sections(data, work=None):
@@ -51,9 +94,18 @@ def coating_fem_sections(data, work=None):
             f"the BEM on lattices a_H/step = {s.get('bem_levels')}, the FEM with {s.get('fem_levels')} elements "
             "across the contact radius. Orders from the last three levels; extrapolated values by Richardson with "
             "the observed order where it lies in [0.5, 6] and the differences keep their sign (else the finest "
-            "value, '-'). diff = BEM / FEM - 1. Stresses: the BEM's ring-averaged pressure through the coated "
-            "half-space's Hankel fields against the FEM's nodal stresses (relative to the FEM's largest value at "
-            "the bond; von Mises at the FEM's maximum node per material)."]
+            "value, '-'). diff = BEM / FEM - 1. RMS of p(r): every BEM node against the FEM's p(r) at its "
+            "radius, relative; 'linear': the FEM's p linear between its nodes (finest levels); 'edge-aware': "
+            "p^2 linear between the FEM's loaded nodes and on to zero at its contact radius (with a layer, "
+            "whose pressure has no square-root edge: linear), per paired level "
+            "(coarsest first), split into the nodes inside 0.9 FEM contact radii and the edge band beyond. "
+            "Stresses: the BEM's ring-averaged pressure through the coated half-space's Hankel fields against "
+            "the FEM's one-sided nodal stresses (each material's own elements), on the bond within 1.5 "
+            "max(a, t) (substrate side) relative to the FEM's largest traction magnitude there and to each "
+            "component's own largest value; 'projected': the FEM's continuous projection within 1.5 a; "
+            "'FEM sides': the FEM's coating side against its substrate side (of the largest traction); von "
+            "Mises at the FEM's maximum node per material, the bond included on each side. Orders of "
+            "sigma_zz on the axis at the bond and of the largest |sigma_rz| there from each method's levels."]
     items = []
     if work is not None and data.get("rows"):
         from ..figures.coating_fem import plot_coating_fem
@@ -64,7 +116,16 @@ def coating_fem_sections(data, work=None):
     heads, rows = comparison_table(data)
     items.append(Table(heads, tuple(rows), caption="Per case and quantity: extrapolated values, observed orders "
                                                    "and BEM-vs-FEM differences."))
-    heads, rows = levels_table(data)
+    heads, rows = pressure_table(data)
     items.append(Table(heads, tuple(rows), caption="Per case: RMS of the BEM nodes' pressure against the FEM's "
-                                                   "p(r) (finest levels), interface stresses, run time."))
+                                                   "p(r) per paired level, orders, parts, run time."))
+    if data.get("refined"):
+        heads, rows = refined_table(data)
+        c = data["refined"]
+        items.append(Table(heads, tuple(rows), caption=f"The case a_H/t = {c['a_over_t']:g}, E_c/E_s = "
+                           f"{c['modulus_ratio']:g}, nu_c = {c['nu_c']:g} one level finer in each method: RMS of "
+                           "p(r) of every BEM level against every FEM level."))
+    heads, rows = stress_table(data)
+    items.append(Table(heads, tuple(rows), caption="Per case: interface stresses of the BEM against the FEM's "
+                                                   "one-sided recovery (finest levels) and the per-level orders."))
     return [Section("Coatings: the coated BEM against the FEM", "validation", text, tuple(items))]

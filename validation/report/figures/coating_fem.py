@@ -30,10 +30,14 @@ def plot_coating_fem(data, out, *, name="coating_fem.png"):
             top.semilogy(x, [max(abs(r["diff"][q]["extrapolated"]), floor) for r in rows], m, ls="none", label=q)
         top.semilogy(x, [max(r["rms"], floor) for r in rows], "x", ls="none", color="0.3",
                      label="RMS of p(r), finest levels")
+        edge_aware = [(i, r["pressure"]["total"]["finest"]) for i, r in zip(x, rows) if r.get("pressure")]
+        if edge_aware:
+            top.semilogy([i for i, _ in edge_aware], [max(v, floor) for _, v in edge_aware], "+", ls="none",
+                         color="tab:purple", label="RMS of p(r), edge-aware, finest levels")
         top.axhline(5e-3, color="tab:red", lw=0.8, ls="--", label="0.5 %")
         top.set_ylim(floor / 2, 1.0)
         top.set_ylabel("|BEM / FEM - 1|, extrapolated")
-        top.legend(fontsize="small", ncols=5, loc="upper left")
+        top.legend(fontsize="small", ncols=3, loc="upper left")
         for method, colour in (("bem", "tab:blue"), ("fem", "tab:orange")):
             for q, m in _MARKERS.items():
                 orders = [r[f"{method}_x"][q]["order"] for r in rows]
