@@ -90,3 +90,29 @@ def test_quick_study_writes_json_markdown_and_figure(tmp_path):
     assert row["converged"] and (row["a_over_t"], row["modulus_ratio"], row["nu_c"]) == CASE
     assert row["worst_extrapolated"] < 5e-3  # the study's target
     assert "The coated BEM against the FEM" in (out / "coating_fem.md").read_text()
+
+
+def test_the_cases_above_refine_above_and_only_they_are_solved_one_level_finer(monkeypatch):
+    from validation.report.documents.coating_fem import refined_table
+    from validation.studies import coating_fem
+
+    rms = {(0.1, 10.0, 0.25): 0.0073, (1.0, 10.0, 0.25): 0.0040, (10.0, 10.0, 0.25): 0.0051}
+
+    def case_row(case, s, *, layer=None):
+        return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], layer=None,
+                    pressure={"total": {"finest": rms[case]}})
+
+    def finer(case, s):
+        return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2],
+                    rows=[dict(bem=40, fem=24, linear=0.01, total=rms[case], interior=1e-4, edge=rms[case])])
+
+    monkeypatch.setattr(coating_fem, "compare_case", case_row)
+    monkeypatch.setattr(coating_fem, "refined_pressure", finer)
+    data = coating_fem.run_coating_fem(dict(a_over_t=(0.1, 1.0, 10.0), modulus_ratios=(10.0,), nu_c=(0.25,),
+                                            root_case=None, refine_above=0.005))
+    assert [(c["a_over_t"], c["modulus_ratio"], c["nu_c"]) for c in data["refined"]] == [(0.1, 10.0, 0.25),
+                                                                                         (10.0, 10.0, 0.25)]
+    heads, rows = refined_table(data)
+    assert len(rows) == 2 and rows[0][:3] == ("0.1", "10", "0.25") and rows[1][0] == "10"
+    quick = coating_fem.run_coating_fem(dict(a_over_t=(0.1,), modulus_ratios=(10.0,), nu_c=(0.25,)), quick=True)
+    assert quick["refined"] == []  # the quick run refines nothing

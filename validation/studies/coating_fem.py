@@ -20,8 +20,9 @@ of ``p(r)``: at the finest levels with the FEM's ``p(r)`` linear between its nod
 ``rms``), and per paired level (``pressure``) with it edge-aware (:func:`fem_profile`; linear with a
 layer, whose pressure has no square-root edge), split into the interior and the edge band
 (:func:`rms_parts`), with its order and extrapolation. One case carries a root layer ``w = lam sqrt(p)`` on the coating
-(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``); one case (``refined_case``) is solved one level
-finer in each method for the RMS of ``p(r)`` (:func:`refined_pressure`). Interface stresses:
+(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``); every case whose edge-aware RMS of ``p(r)`` at
+the finest levels is above ``refine_above`` is solved one level finer in each method
+(:func:`refined_pressure`). Interface stresses:
 :mod:`validation.studies.coating_fem_stress`.
 """
 
@@ -54,9 +55,9 @@ RMS_MEASURES = ("linear", "total", "interior", "edge")
 SETTINGS = dict(R=0.01, E_s=200e9, nu_s=0.3, a_H=1e-4, a_over_t=(0.1, 1.0, 10.0),
                 modulus_ratios=(0.01, 0.1, 10.0, 100.0), nu_c=(0.25, 0.45), bem_levels=(10, 20, 40),
                 fem_levels=(6, 12, 24), root_case=(1.0, 0.1, 0.25), root_lam=0.1, stresses=True,
-                refined_case=(1.0, 10.0, 0.25))
+                refine_above=0.005)
 #: the small run (``contactlab study coating-fem --quick``): one case
-QUICK = dict(SETTINGS, a_over_t=(1.0,), modulus_ratios=(10.0,), nu_c=(0.25,), root_case=None, refined_case=None)
+QUICK = dict(SETTINGS, a_over_t=(1.0,), modulus_ratios=(10.0,), nu_c=(0.25,), root_case=None, refine_above=None)
 
 
 def richardson(values):
@@ -280,7 +281,11 @@ def run_coating_fem(settings=None, *, quick=False, progress=None):
     rows = [compare_case(c, s, layer=lay) for c, lay in
             each(cases, progress, lambda c: "a/t = {:g}, Ec/Es = {:g}, nu_c = {:g}".format(*c[0])
                  + (" + root layer" if c[1] is not None else ""))]
-    refined = refined_pressure(tuple(s["refined_case"]), s) if s.get("refined_case") else None
+    above = [r for r in rows if s.get("refine_above") is not None and r["layer"] is None
+             and _finest_rms(r) > s["refine_above"]]
+    refined = [refined_pressure((r["a_over_t"], r["modulus_ratio"], r["nu_c"]), s) for r in
+               each(above, progress, lambda r: "one level finer: a/t = {a_over_t:g}, Ec/Es = {modulus_ratio:g}, "
+                    "nu_c = {nu_c:g}".format(**r))]
     return {"study": STEM, "mode": "quick" if quick else "full", "settings": {k: _listed(v) for k, v in s.items()},
             "rows": rows, "refined": refined, "wall_time_s": time.perf_counter() - t0}
 
@@ -293,8 +298,13 @@ def summary_lines(data):
             + f", RMS p {r['rms']:.2%}" + _edge_aware(r) for r in data["rows"]]
 
 
+def _finest_rms(row):
+    """The edge-aware RMS of ``p(r)`` at the finest levels of a case (``None`` where not measured)."""
+    return (row.get("pressure") or {}).get("total", {}).get("finest")
+
+
 def _edge_aware(row):
-    value = (row.get("pressure") or {}).get("total", {}).get("finest")
+    value = _finest_rms(row)
     return "" if value is None else f" (edge-aware {value:.2%})"
 
 
