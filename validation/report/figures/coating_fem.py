@@ -34,6 +34,12 @@ def plot_coating_fem(data, out, *, name="coating_fem.png"):
         if edge_aware:
             top.semilogy([i for i, _ in edge_aware], [max(v, floor) for _, v in edge_aware], "+", ls="none",
                          color="tab:purple", label="RMS of p(r), edge-aware, finest levels")
+        where = {(r["a_over_t"], r["modulus_ratio"], r["nu_c"]): i for i, r in zip(x, rows) if not r["layer"]}
+        finer = [(where[k], c["rows"][-1]["total"]) for c in data.get("refined") or ()
+                 if (k := (c["a_over_t"], c["modulus_ratio"], c["nu_c"])) in where]
+        if finer:
+            top.semilogy([i for i, _ in finer], [max(v, floor) for _, v in finer], "*", ls="none", ms=9,
+                         color="tab:purple", label="the same, one level finer in both")
         top.axhline(5e-3, color="tab:red", lw=0.8, ls="--", label="0.5 %")
         top.set_ylim(floor / 2, 1.0)
         top.set_ylabel("|BEM / FEM - 1|, extrapolated")
