@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from ..render import Figure, Section, Table
+from .coating_winkler import problem_sentence
 
 __all__ = ["coating_fem_sections", "comparison_table", "pressure_table", "refined_table", "stress_table"]
 
@@ -88,12 +89,12 @@ def refined_table(data):
 
 
 def coating_fem_sections(data, work=None):
-    """The figure (with a figures folder ``work``) and the two tables."""
+    """The figure (with a figures folder ``work``) and the tables: per quantity, p(r) per level, the refined
+    cases, the interface stresses."""
     s = data.get("settings", {})
-    text = [f"An elastic sphere (R = {s.get('R')} m, E_s = {s.get('E_s'):g} Pa, nu_s = {s.get('nu_s')}) on a flat "
-            f"with a bonded coating, under the force of the Hertz radius a_H = {s.get('a_H')} m of the uncoated pair; "
-            f"the BEM on lattices a_H/step = {s.get('bem_levels')}, the FEM with {s.get('fem_levels')} elements "
-            "across the contact radius. Orders from the last three levels; extrapolated values by Richardson with "
+    text = [f"{problem_sentence(s)}; the BEM on lattices a_H/step = {s.get('bem_levels')}, the FEM with "
+            f"{s.get('fem_levels')} elements across the contact radius. Orders from the last three levels; "
+            "extrapolated values by Richardson with "
             "the observed order where it lies in [0.5, 6] and the differences keep their sign (else the finest "
             "value, '-'). diff = BEM / FEM - 1. RMS of p(r): every BEM node against the FEM's p(r) at its "
             "radius, relative; 'linear': the FEM's p linear between its nodes (finest levels); 'edge-aware': "

@@ -5,7 +5,14 @@ from __future__ import annotations
 
 from ..render import Figure, Section, Table
 
-__all__ = ["coating_winkler_sections", "rule_table", "errors_table"]
+__all__ = ["coating_winkler_sections", "rule_table", "errors_table", "problem_sentence"]
+
+
+def problem_sentence(s):
+    """The coating studies' problem in words, from their settings ``s`` (SI units)."""
+    return (f"An elastic sphere (R = {s.get('R')} m, the substrate's material E_s = {s.get('E_s'):g} Pa, nu_s = "
+            f"{s.get('nu_s')}) on a flat with a bonded coating, under the force of the Hertz radius a_H = "
+            f"{s.get('a_H')} m of the uncoated pair")
 
 
 def rule_table(data, model="oed", level=0.05):
@@ -34,9 +41,7 @@ def errors_table(data):
 def coating_winkler_sections(data, work=None):
     """The map (with a figures folder ``work``), the rule tables, the checks of the truth and every case."""
     s = data.get("settings", {})
-    text = [f"An elastic sphere (R = {s.get('R')} m, the substrate's material E_s = {s.get('E_s'):g} Pa, nu_s = "
-            f"{s.get('nu_s')}) on a flat with a bonded coating, under the force of the Hertz radius a_H = "
-            f"{s.get('a_H')} m of the uncoated pair, against the same sphere on the bare substrate carrying the "
+    text = [f"{problem_sentence(s)}, against the same sphere on the bare substrate carrying the "
             "Winkler layer w = lam p: the oedometric lam = t (1 + nu_c)(1 - 2 nu_c) / ((1 - nu_c) E_c) and the "
             "best lam >= 0 (least RMS pressure error). Errors relative to the coated solution "
             f"(truth: {data.get('truth')}); worst = the largest of p_max, contact radius, approach and RMS of p(r)."]
