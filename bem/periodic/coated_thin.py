@@ -70,7 +70,7 @@ _CHEB = 16  # Chebyshev points a panel of the smooth part
 _Z_CUT = 42.0  # the Fourier part stops at |k|^2 / (4 a^2) = 42 (e^-42 = 6e-19)
 
 
-def image_reach(n_rows, n_cols, images=(0, 0)):
+def image_reach(n_rows, n_cols, images):
     """``R = min((I + 1/2) Lx, (J + 1/2) Ly) - 1`` [steps]: the images ``(i Lx, j Ly)`` with ``|i| <= I``,
     ``|j| <= J`` around the nearest kept, every other is this far from any point of the pyramid at a
     node offset."""

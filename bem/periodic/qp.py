@@ -245,7 +245,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
         nonlocal contact, idx, g_c, p_c0, delta, g_min
         contact = p > 0
-        idx = bk.select(contact)  # a boolean array: several times faster than flatnonzero(p)
+        idx = bk.select(contact)  # the contact nodes from the boolean mask (faster than flatnonzero(p) on NumPy)
         gap()  # the gap is g - delta: delta is subtracted on the contact only
         g_c, p_c0 = bk.take(g, idx), bk.take(p, idx)
         if force is not None:

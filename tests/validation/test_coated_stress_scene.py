@@ -80,7 +80,8 @@ def test_result_json_holds_what_bem_coated_stress_gives_on_the_same_result(coate
     assert c.interface_min_sigma_zz < 0 < c.interface_max_shear  # compression and shear across the bond
     # the body's maxima cover both materials; body 2 (uncoated) keeps bem.subsurface_stress
     body1, body2 = result.stress.bodies["body1"], result.stress.bodies["body2"]
-    assert body1.max_von_mises >= max(c.max_von_mises_coating, c.max_von_mises_substrate) * (1 - 1e-12)
+    # the body's maximum is the larger material's (here at a sampled depth, so no parabola moves it: measured equal)
+    assert body1.max_von_mises == pytest.approx(max(c.max_von_mises_coating, c.max_von_mises_substrate), rel=1e-12)
     assert body1.nu == 0.3 and body2.coated is None
     plain = bem.subsurface_stress(outcome.bem, depths, nu=0.3, body=2)
     assert body2.max_von_mises == pytest.approx(plain.max_von_mises, rel=1e-12)

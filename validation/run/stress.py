@@ -96,14 +96,16 @@ def run_stress(scene, res, fem=None):
     for name in spec["bodies"]:
         body = int(name.removeprefix("body"))
         if name in layers:
-            bodies[name], coated[name] = coated_body_stress(res, depths, body, layers[name][1], layers[name][0])
+            thickness, rigid = layers[name]
+            bodies[name], coated[name] = coated_body_stress(res, depths, body, rigid=rigid, thickness=thickness)
         else:
             bodies[name] = bem.subsurface_stress(res, depths, nu=scene.materials[BODIES[name]], body=body)
     run = StressRun(bodies=bodies, depths=depths, scale=scale, coated=coated)
-    if fem is not None:
+    if fem is not None and set(bodies) - set(coated):
         fem_stresses = fem_body_stresses(fem)
         run.fem = {name: compare_with_fem(res, st, fem_stresses[name]) for name, st in bodies.items()
                    if name not in coated}
+    if fem is not None:
         run.notes += [f"stress: {name} is coated; its stresses are not compared with the FEM's, whose nodal "
                       "recovery averages them across the coating/substrate interface." for name in coated]
     run.wall_time_s = time.perf_counter() - t0

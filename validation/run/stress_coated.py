@@ -36,16 +36,11 @@ _FEW = 3
 
 
 def coated_layers(scene):
-    """``{body name: (thickness [length], rigid substrate)}`` of the coated bodies in the scene's ``stress.bodies``."""
-    if scene.coatings is None:
-        return {}
-    out = {}
-    for name in scene.stress["bodies"]:
-        k = name.removeprefix("body")
-        c = scene.coatings[f"coating{k}"]
-        if c is not None:
-            out[name] = (c["thickness"], math.isinf(scene.materials[f"E{k}"]))
-    return out
+    """``{body name: (thickness [length], rigid substrate)}`` of the coated bodies in the scene's ``stress.bodies``
+    (:func:`validation.scene.coatings.coated_stress_bodies`)."""
+    from ..scene.coatings import coated_stress_bodies
+
+    return coated_stress_bodies(scene.stress, scene.materials, scene.coatings)
 
 
 def interface_depths(depths, layers):

@@ -3,9 +3,12 @@ or bound (``[analytic]``; ``[stress] depths`` below a rigid substrate)."""
 
 from __future__ import annotations
 
+import math
+
 from . import checks as ck
 
-__all__ = ["COATING_KEYS", "COATING_FIELDS", "coating", "coated_sections", "coated_stress_depths"]
+__all__ = ["COATING_KEYS", "COATING_FIELDS", "coating", "coated_sections", "coated_stress_depths",
+           "coated_stress_bodies"]
 
 #: the coating of each body, a table ``{thickness, E, nu}`` (:class:`bem.Coating`)
 COATING_KEYS = ("coating1", "coating2")
@@ -38,21 +41,34 @@ def coated_sections(coatings, raw, stress=None, materials=None):
     return coated_stress_depths(stress, materials, coatings)
 
 
-def coated_stress_depths(stress, materials, coatings):
-    """``[stress] depths`` (a list) of a coated body on a rigid substrate (``bodies.E1`` or ``E2 = inf``) lie
-    in its coating (at most its thickness): a rigid substrate has no stresses. Returns ``stress``."""
-    if stress is None or coatings is None or stress["depths"] == "auto":
-        return stress
+def coated_stress_bodies(stress, materials, coatings):
+    """``{body name: (thickness [length], rigid substrate)}`` of the coated bodies among ``stress["bodies"]``
+    (``materials``: the bodies' ``E1, nu1, E2, nu2``; a rigid substrate has ``E = inf``)."""
+    if stress is None or coatings is None:
+        return {}
+    out = {}
     for name in stress["bodies"]:
         k = name.removeprefix("body")
         c = coatings[f"coating{k}"]
-        if c is None or materials[f"E{k}"] != float("inf"):
+        if c is not None:
+            out[name] = (c["thickness"], math.isinf(materials[f"E{k}"]))
+    return out
+
+
+def coated_stress_depths(stress, materials, coatings):
+    """``[stress] depths`` (a list) of a coated body on a rigid substrate (``bodies.E1`` or ``E2 = inf``) lie
+    in its coating (at most its thickness): a rigid substrate has no stresses. Returns ``stress``."""
+    if stress is None or stress["depths"] == "auto":
+        return stress
+    for name, (thickness, rigid) in coated_stress_bodies(stress, materials, coatings).items():
+        if not rigid:
             continue
+        k = name.removeprefix("body")
         for i, depth in enumerate(stress["depths"]):
-            if depth > c["thickness"]:
+            if depth > thickness:
                 raise ck.SceneError(
                     f"stress.depths[{i}] = {depth!r} is not allowed with bodies.E{k} = inf and bodies.coating{k}: "
                     f"the rigid substrate has no stresses, so {name}'s depths must be at most the coating thickness "
-                    f"bodies.coating{k}.thickness = {c['thickness']!r}; list depths within it or leave {name} out "
+                    f"bodies.coating{k}.thickness = {thickness!r}; list depths within it or leave {name} out "
                     "of stress.bodies.")
     return stress

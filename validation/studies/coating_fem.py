@@ -208,14 +208,14 @@ def _pressure_levels(bs, fs, smooth=True):
     return dict(levels=rows, **_extrapolate(rows, RMS_MEASURES))
 
 
-def _stress_levels(case, s, bs, f_rows, f):
+def _stress_levels(case, s, bs, fem_rows, f):
     """Interface stresses: finest levels compared, and the per-level scalars of both methods."""
     from .coating_fem_stress import STRESS_SCALARS, bem_scalars, interface_stresses
 
     coating = _coating(case, s)
     out, points = interface_stresses(bs[-1], f, coating, s)
     b_rows = [bem_scalars(b, coating, s, points) for b in bs]
-    f_rows = [r.get("stress", {q: None for q in STRESS_SCALARS}) for r in f_rows]
+    f_rows = [r.get("stress", {q: None for q in STRESS_SCALARS}) for r in fem_rows]
     bx, fx = _extrapolate(b_rows, STRESS_SCALARS), _extrapolate(f_rows, STRESS_SCALARS)
     out["levels"] = dict(bem=b_rows, fem=f_rows, bem_x=bx, fem_x=fx,
                          diff={q: None if None in (_best(bx[q]), _best(fx[q])) or _best(fx[q]) == 0 else
@@ -232,11 +232,9 @@ def compare_case(case, s, *, layer=None):
     bx, fx = _extrapolate(b_rows), _extrapolate(f_rows)
     diff = {}
     for q in QUANTITIES:
-        fe = fx[q]["extrapolated"] if fx[q]["extrapolated"] is not None else fx[q]["finest"]
-        be = bx[q]["extrapolated"] if bx[q]["extrapolated"] is not None else bx[q]["finest"]
-        diff[q] = dict(extrapolated=be / fe - 1.0, finest=bx[q]["finest"] / fx[q]["finest"] - 1.0)
+        diff[q] = dict(extrapolated=_best(bx[q]) / _best(fx[q]) - 1.0, finest=bx[q]["finest"] / fx[q]["finest"] - 1.0)
     row = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], thickness=_coating(case, s).thickness,
-               layer=None if layer is None else layer.to_dict() if hasattr(layer, "to_dict") else repr(layer),
+               layer=None if layer is None else layer.to_dict(),
                converged=all(r["converged"] for r in b_rows + f_rows), bem=b_rows, fem=f_rows, bem_x=bx, fem_x=fx,
                diff=diff, rms=rms_nodes(b, f), pressure=_pressure_levels(bs, fs, layer is None))
     row["worst_extrapolated"] = max(abs(d["extrapolated"]) for d in diff.values())

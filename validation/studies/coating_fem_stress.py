@@ -41,7 +41,7 @@ def radial_profile(res):
     return (np.bincount(k, weights=r)[keep] / n[keep], np.bincount(k, weights=res.p)[keep] / n[keep])
 
 
-def _fem_sides(f, coating):
+def _fem_sides(f):
     """The FEM's one-sided stresses ``{"coating": ..., "substrate": ...}`` and its node coordinates."""
     from fem_reference.fields import one_sided_stresses
 
@@ -63,7 +63,7 @@ def _windows(r, depth, t, a):
 
 def fem_scalars(f, coating):
     """The FEM's :data:`STRESS_SCALARS` of one level (one-sided; von Mises: its largest node per material)."""
-    sides, r, depth = _fem_sides(f, coating)
+    sides, r, depth = _fem_sides(f)
     bond, vm = _windows(r, depth, coating.thickness, float(f.edge_radius))
     sub = sides["substrate"]
     axis = np.nonzero(bond & (r == 0.0))[0]
@@ -121,7 +121,7 @@ def interface_stresses(b, f, coating, s):
 
     t, E, nu = coating.thickness, s["E_s"], s["nu_s"]
     p, edge = _profile_function(b)
-    sides, r, depth = _fem_sides(f, coating)
+    sides, r, depth = _fem_sides(f)
     a = float(f.edge_radius)
     bond, vm = _windows(r, depth, t, a)
     ours = axisymmetric_stress(p, edge, r[bond], [t], coating, E, nu, side="substrate")

@@ -166,14 +166,15 @@ def stress(res, work):
     rows = [(name, fmt(b.nu), fmt(b.max_von_mises / s), fmt(b.depth_of_max / a),
              f"{fmt(b.location_of_max[0] / a)}, {fmt(b.location_of_max[1] / a)}", fmt(b.max_tresca / s),
              fmt(b.depth_of_max_tresca / a)) for name, b in block.bodies.items()]
+    coated_rows = _coated_rows(block, a, s)
     items = [Table(("body", "nu", f"max von Mises / {s_name}", f"its depth / {l_name}", f"at x, y / {l_name}",
                     f"max shear / {s_name}", f"its depth / {l_name}"), tuple(rows),
                    caption="Largest von Mises stress and largest maximum shear (s1 - s3)/2 of each body over all "
                            "candidate nodes and depths, refined in depth by a parabola through the largest sample and "
                            "its neighbours" + ("; of a coated body (nu: its substrate's), in each material apart, its "
-                                               "interface from both sides" if _coated_rows(block, a, s) else "")
+                                               "interface from both sides" if coated_rows else "")
                            + f".{_scales_text(res, a, s, l_name, s_name)}")]
-    if coated_rows := _coated_rows(block, a, s):
+    if coated_rows:
         items.append(Table(("body", "quantity", f"value / {s_name}", f"at x, y, z / {l_name}"), tuple(coated_rows),
                            caption="A coated body (bem.coated_stress): the largest von Mises stress in its coating and "
                                    "in its substrate, and the extreme tractions on the coating/substrate interface "
