@@ -218,7 +218,7 @@ def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=()
     for z_low, z_high, t in coatings:
         if t > a_est:  # a deep bond: sizes h_fine t / a_est within fine_radius t / a_est of its axis point
             bond = fld.add("MathEval")
-            fld.setString(bond, "F", f"Sqrt(x^2 + (y - ({z_high if z_low < 0 else z_low!r}))^2)")
+            fld.setString(bond, "F", f"Sqrt(x^2 + (y - ({z_low if z_low < 0 else z_high!r}))^2)")
             fields.append(_threshold(fld, bond, h_fine * t / a_est, h_coarse, fine_radius * t / a_est, growth))
         boxes = [(math.inf, t)]
         if t / N_ACROSS_COATING < h_fine:

@@ -46,16 +46,22 @@ def test_each_side_of_the_bond_keeps_its_own_materials_stress():
     assert np.all(np.abs(projected - rr[1]) > 0.05 * np.abs(rr[0]))
 
 
-def _bond_sizes(mesh, t):
+def _bond_facets_between(mesh, t, r0, r1):
+    """Lengths of the mesh facets lying on the bond z = -t whose midpoints have r0 <= r <= r1."""
     x, f = mesh.mesh.p, mesh.mesh.facets
-    length = np.hypot(*(x[:, f[0]] - x[:, f[1]]))
-    mid = 0.5 * (x[:, f[0]] + x[:, f[1]])
-    return length[np.hypot(mid[0], mid[1] + t) < 0.5 * t]
+    on_bond = np.isclose(x[1, f[0]], -t, rtol=0, atol=1e-12) & np.isclose(x[1, f[1]], -t, rtol=0, atol=1e-12)
+    mid_r = 0.5 * (x[0, f[0]] + x[0, f[1]])
+    chosen = on_bond & (mid_r >= r0) & (mid_r <= r1)
+    return np.hypot(*(x[:, f[0]] - x[:, f[1]]))[chosen]
 
 
 @pytest.mark.parametrize("n", [8, 16])
 def test_a_deep_bond_is_meshed_at_the_contact_zones_resolution_scaled_by_its_depth(n):
     t = 4.0  # four contact radii deep: outside the contact's fine zone (sizes 0.7 to 0.8 there by its grading)
-    sizes = _bond_sizes(build_mesh(1.0, n_contact_elements=n, coating_thickness=(None, t)), t)
-    h_bond = t / n  # h_fine t / a_est
-    assert 0.7 * h_bond < np.median(sizes) < 1.05 * h_bond and sizes.max() < 1.3 * h_bond
+    mesh = build_mesh(1.0, n_contact_elements=n, coating_thickness=(None, t))
+    h_bond = t / n  # h_fine t / a_est, within fine_radius t / a_est of the bond's point on the axis
+    near_axis, off_axis = _bond_facets_between(mesh, t, 0.0, 0.5 * t), _bond_facets_between(mesh, t, t, 1.5 * t)
+    assert near_axis.size > 2 and off_axis.size > 2
+    assert 0.7 * h_bond < np.median(near_axis) < 1.05 * h_bond and near_axis.max() < 1.1 * h_bond
+    # a bond radius away from the axis the size is still h_bond (the refinement is centred on the bond)
+    assert off_axis.max() < 1.1 * h_bond
