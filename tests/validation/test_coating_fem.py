@@ -96,15 +96,18 @@ def test_the_cases_above_refine_above_and_only_they_are_solved_one_level_finer(m
     from validation.report.documents.coating_fem import refined_table
     from validation.studies import coating_fem
 
-    rms = {(0.1, 10.0, 0.25): 0.0073, (1.0, 10.0, 0.25): 0.0040, (10.0, 10.0, 0.25): 0.0051}
+    # (RMS of p(r), radius difference): the first above by its RMS, the last by its radius only
+    worst = {(0.1, 10.0, 0.25): (0.0073, 0.001), (1.0, 10.0, 0.25): (0.0040, -0.004), (10.0, 10.0, 0.25): (0.001, -0.006)}
 
     def case_row(case, s, *, layer=None):
-        return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], layer=None,
-                    pressure={"total": {"finest": rms[case]}})
+        diff = {q: dict(extrapolated=worst[case][1] if q == "radius" else 0.0) for q in coating_fem.QUANTITIES}
+        return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], layer=None, diff=diff,
+                    pressure={"total": {"finest": worst[case][0]}})
 
-    def finer(case, s):
+    def finer(case, s, row):
+        assert row["a_over_t"] == case[0]
         return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2],
-                    rows=[dict(bem=40, fem=24, linear=0.01, total=rms[case], interior=1e-4, edge=rms[case])])
+                    rows=[dict(bem=40, fem=24, linear=0.01, total=worst[case][0], interior=1e-4, edge=worst[case][0])])
 
     monkeypatch.setattr(coating_fem, "compare_case", case_row)
     monkeypatch.setattr(coating_fem, "refined_pressure", finer)
@@ -116,3 +119,41 @@ def test_the_cases_above_refine_above_and_only_they_are_solved_one_level_finer(m
     assert len(rows) == 2 and rows[0][:3] == ("0.1", "10", "0.25") and rows[1][0] == "10"
     quick = coating_fem.run_coating_fem(dict(a_over_t=(0.1,), modulus_ratios=(10.0,), nu_c=(0.25,)), quick=True)
     assert quick["refined"] == []  # the quick run refines nothing
+
+
+def test_one_level_finer_extends_each_methods_sequence_for_its_orders_and_extrapolations(monkeypatch):
+    """refined_pressure's ``after``: the orders and Richardson values from the last three levels of each method,
+    the coarser two from the case's row; values q = q0 (1 + c / n^2) give order 2 and q0 exactly."""
+    from types import SimpleNamespace
+
+    from validation.studies import coating_fem
+
+    q0 = {"bem": dict(p_max=2.0, radius=1.0, approach=3.0), "fem": dict(p_max=2.02, radius=0.99, approach=3.0)}
+
+    def level(method, n, c):
+        return dict(level=n, converged=True, **{q: v * (1.0 + c / n**2) for q, v in q0[method].items()})
+
+    def levels(method, c):
+        def run(case, s, layer=None, keep=None):
+            ns = s[f"{method}_levels"]
+            keep.extend(SimpleNamespace(n=n, converged=True) for n in ns)
+            return [level(method, n, c) for n in ns], None
+        return run
+
+    monkeypatch.setattr(coating_fem, "bem_levels", levels("bem", 0.5))
+    monkeypatch.setattr(coating_fem, "fem_levels", levels("fem", -2.0))
+    monkeypatch.setattr(coating_fem, "rms_nodes", lambda b, f: 0.0)
+    monkeypatch.setattr(coating_fem, "rms_parts", lambda b, f: dict(total=0.0, interior=0.0, edge=0.0))
+    s = dict(coating_fem.SETTINGS, bem_levels=(10, 20, 40), fem_levels=(6, 12, 24))
+    # the case's row: its coarse levels perturbed beyond the quadratic law, so only the last three can give order 2
+    row = dict(a_over_t=1.0, bem=[level("bem", 10, 9.0), level("bem", 20, 0.5), level("bem", 40, 0.5)],
+               fem=[level("fem", 6, 7.0), level("fem", 12, -2.0), level("fem", 24, -2.0)])
+    out = coating_fem.refined_pressure((1.0, 10.0, 0.25), s, row)
+    assert [r["level"] for r in out["bem"]] == [40, 80] and [r["level"] for r in out["fem"]] == [24, 48]
+    assert [(r["bem"], r["fem"]) for r in out["rows"]] == [(40, 24), (40, 48), (80, 24), (80, 48)]
+    after = out["after"]
+    for q in coating_fem.QUANTITIES:
+        for method in ("bem", "fem"):
+            x = after[f"{method}_x"][q]
+            assert abs(x["order"] - 2.0) < 1e-9 and abs(x["extrapolated"] / q0[method][q] - 1.0) < 1e-12
+        assert abs(after["diff"][q]["extrapolated"] - (q0["bem"][q] / q0["fem"][q] - 1.0)) < 1e-12

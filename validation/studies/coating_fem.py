@@ -20,9 +20,11 @@ of ``p(r)``: at the finest levels with the FEM's ``p(r)`` linear between its nod
 ``rms``), and per paired level (``pressure``) with it edge-aware (:func:`fem_profile`; linear with a
 layer, whose pressure has no square-root edge), split into the interior and the edge band
 (:func:`rms_parts`), with its order and extrapolation. One case carries a root layer ``w = lam sqrt(p)`` on the coating
-(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``); every case whose edge-aware RMS of ``p(r)`` at
-the finest levels is above ``refine_above`` is solved one level finer in each method
-(:func:`refined_pressure`). Interface stresses:
+(``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``); every case without a layer whose edge-aware RMS
+of ``p(r)`` at the finest levels, or whose difference of an extrapolated ``p_max``, radius or approach, is above
+``refine_above`` is solved one level finer in each method (:func:`refined_pressure`): the RMS of ``p(r)`` of
+every BEM level against every FEM level, and each method's scalars with their orders and extrapolations from
+its last three levels (``after``). Interface stresses:
 :mod:`validation.studies.coating_fem_stress`.
 """
 
@@ -245,20 +247,30 @@ def compare_case(case, s, *, layer=None):
     return row
 
 
-def refined_pressure(case, s):
-    """The RMS of ``p(r)`` one level beyond the study's finest in each method: the BEM at the last two of
-    ``bem_levels`` doubled once, the FEM likewise; every BEM level against every FEM level (``rows``: ``bem``,
-    ``fem``, ``linear`` and the :func:`rms_parts`)."""
+def refined_pressure(case, s, row=None):
+    """One level beyond the study's finest in each method: the BEM at the last two of ``bem_levels`` doubled
+    once, the FEM likewise. ``rows``: every BEM level against every FEM level (``bem``, ``fem``, ``linear`` and
+    the :func:`rms_parts`); ``bem``, ``fem``: the two levels' rows of :func:`bem_levels`, :func:`fem_levels`.
+    With the case's ``row`` of :func:`compare_case`: ``after``, each method's orders and extrapolations of
+    :data:`QUANTITIES` from its last three levels (the coarser ones from ``row``) and their differences
+    (``diff``, as in :func:`compare_case`)."""
     finer = dict(s, bem_levels=(s["bem_levels"][-1], 2 * s["bem_levels"][-1]),
                  fem_levels=(s["fem_levels"][-1], 2 * s["fem_levels"][-1]), stresses=False)
     t0 = time.perf_counter()
     bs, fs = [], []
-    bem_levels(case, finer, None, bs)
-    fem_levels(case, finer, None, fs)
+    b_rows, _ = bem_levels(case, finer, None, bs)
+    f_rows, _ = fem_levels(case, finer, None, fs)
     rows = [dict(bem=nb, fem=nf, linear=rms_nodes(b, f), **rms_parts(b, f))
             for nb, b in zip(finer["bem_levels"], bs) for nf, f in zip(finer["fem_levels"], fs)]
-    return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], rows=rows,
-                converged=all(x.converged for x in bs + fs), wall_time_s=time.perf_counter() - t0)
+    out = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], rows=rows, bem=b_rows, fem=f_rows,
+               converged=all(x.converged for x in bs + fs))
+    if row is not None:
+        bx, fx = _extrapolate(row["bem"][:-1] + b_rows), _extrapolate(row["fem"][:-1] + f_rows)
+        out["after"] = dict(bem_x=bx, fem_x=fx, diff={q: dict(extrapolated=_best(bx[q]) / _best(fx[q]) - 1.0,
+                                                              finest=bx[q]["finest"] / fx[q]["finest"] - 1.0)
+                                                      for q in QUANTITIES})
+    out["wall_time_s"] = time.perf_counter() - t0
+    return out
 
 
 def _root(s):
@@ -280,8 +292,8 @@ def run_coating_fem(settings=None, *, quick=False, progress=None):
             each(cases, progress, lambda c: "a/t = {:g}, Ec/Es = {:g}, nu_c = {:g}".format(*c[0])
                  + (" + root layer" if c[1] is not None else ""))]
     above = [r for r in rows if s.get("refine_above") is not None and r["layer"] is None
-             and _finest_rms(r) > s["refine_above"]]
-    refined = [refined_pressure((r["a_over_t"], r["modulus_ratio"], r["nu_c"]), s) for r in
+             and _worst(r) > s["refine_above"]]
+    refined = [refined_pressure((r["a_over_t"], r["modulus_ratio"], r["nu_c"]), s, r) for r in
                each(above, progress, lambda r: "one level finer: a/t = {a_over_t:g}, Ec/Es = {modulus_ratio:g}, "
                     "nu_c = {nu_c:g}".format(**r))]
     return {"study": STEM, "mode": "quick" if quick else "full", "settings": {k: _listed(v) for k, v in s.items()},
@@ -299,6 +311,12 @@ def summary_lines(data):
 def _finest_rms(row):
     """The edge-aware RMS of ``p(r)`` at the finest levels of a case (``None`` where not measured)."""
     return (row.get("pressure") or {}).get("total", {}).get("finest")
+
+
+def _worst(row):
+    """The largest of a case's edge-aware RMS of ``p(r)`` at the finest levels and its differences of the
+    extrapolated :data:`QUANTITIES` (the measures :func:`refined_pressure` refines)."""
+    return max([_finest_rms(row) or 0.0] + [abs(row["diff"][q]["extrapolated"]) for q in QUANTITIES])
 
 
 def _edge_aware(row):
