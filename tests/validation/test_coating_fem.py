@@ -157,3 +157,18 @@ def test_one_level_finer_extends_each_methods_sequence_for_its_orders_and_extrap
             x = after[f"{method}_x"][q]
             assert abs(x["order"] - 2.0) < 1e-9 and abs(x["extrapolated"] / q0[method][q] - 1.0) < 1e-12
         assert abs(after["diff"][q]["extrapolated"] - (q0["bem"][q] / q0["fem"][q] - 1.0)) < 1e-12
+
+
+def test_the_after_table_reads_each_refined_cases_finer_levels_and_differences():
+    from validation.report.documents.coating_fem import after_table
+
+    x = {q: dict(order=2.0, extrapolated=1.0, finest=1.0) for q in ("p_max", "radius", "approach")}
+    case = dict(a_over_t=0.1, modulus_ratio=100.0, nu_c=0.25, rows=[],
+                bem=[dict(p_max=2.0, radius=0.5, approach=3.0), dict(p_max=2.5, radius=0.75, approach=3.5)],
+                fem=[dict(p_max=1.0, radius=0.25, approach=4.0), dict(p_max=1.5, radius=0.125, approach=4.5)],
+                after=dict(bem_x=x, fem_x=x, diff={q: dict(extrapolated=0.001 * k, finest=-0.002 * k)
+                                                   for k, q in enumerate(("p_max", "radius", "approach"))}))
+    heads, rows = after_table({"refined": [case, dict(case, after=None)]})
+    assert len(rows) == 3 and [r[3] for r in rows] == ["p_max", "radius", "approach"]
+    assert rows[1][:3] == ("0.1", "100", "0.25") and rows[1][4] == "0.5 / 0.75" and rows[1][6] == "0.25 / 0.125"
+    assert rows[2][-2:] == ("+0.200%", "-0.400%")

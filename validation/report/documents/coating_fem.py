@@ -6,7 +6,7 @@ from __future__ import annotations
 from ..render import Figure, Section, Table
 from .coating_winkler import problem_sentence
 
-__all__ = ["coating_fem_sections", "comparison_table", "pressure_table", "refined_table", "stress_table"]
+__all__ = ["after_table", "coating_fem_sections", "comparison_table", "pressure_table", "refined_table", "stress_table"]
 
 
 def _order(x):
@@ -88,6 +88,25 @@ def refined_table(data):
                    for c in data["refined"] for r in c["rows"]]
 
 
+def after_table(data):
+    """``(headings, rows)``: the refined cases' scalars after refinement: per quantity, each method's order and
+    extrapolated value from its last three levels (one beyond the study's finest) and their differences."""
+    heads = ("a_H/t", "E_c/E_s", "nu_c", "quantity", "BEM levels", "BEM order", "FEM levels", "FEM order",
+             "diff extrapolated", "diff finest")
+    rows = []
+    for c in data["refined"]:
+        after = c.get("after")
+        if after is None:
+            continue
+        for q in ("p_max", "radius", "approach"):
+            b, f, d = after["bem_x"][q], after["fem_x"][q], after["diff"][q]
+            rows.append((f"{c['a_over_t']:g}", f"{c['modulus_ratio']:g}", f"{c['nu_c']:g}", q,
+                         " / ".join(f"{x[q]:.6g}" for x in c["bem"]), _order(b["order"]),
+                         " / ".join(f"{x[q]:.6g}" for x in c["fem"]), _order(f["order"]),
+                         f"{d['extrapolated']:+.3%}", f"{d['finest']:+.3%}"))
+    return heads, rows
+
+
 def coating_fem_sections(data, work=None):
     """The figure (with a figures folder ``work``) and the tables: per quantity, p(r) per level, the refined
     cases, the interface stresses."""
@@ -124,8 +143,14 @@ def coating_fem_sections(data, work=None):
     if data.get("refined"):
         heads, rows = refined_table(data)
         items.append(Table(heads, tuple(rows), caption="The cases whose edge-aware RMS of p(r) at the finest "
-                           f"levels is above {data['settings'].get('refine_above', 0.005):.2%}, one level finer in "
+                           "levels, or whose difference of an extrapolated p_max, radius or approach, is above "
+                           f"{data['settings'].get('refine_above', 0.005):.2%}, one level finer in "
                            "each method: RMS of p(r) of every BEM level against every FEM level."))
+        heads, rows = after_table(data)
+        if rows:
+            items.append(Table(heads, tuple(rows), caption="The same cases' p_max, contact radius and approach "
+                               "after refinement: the two finer levels of each method, the orders and extrapolated "
+                               "values from each method's last three levels, and the differences."))
     heads, rows = stress_table(data)
     items.append(Table(heads, tuple(rows), caption="Per case: interface stresses of the BEM against the FEM's "
                                                    "one-sided recovery (finest levels) and the per-level orders."))
