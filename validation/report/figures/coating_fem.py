@@ -40,6 +40,12 @@ def plot_coating_fem(data, out, *, name="coating_fem.png"):
         if finer:
             top.semilogy([i for i, _ in finer], [max(v, floor) for _, v in finer], "*", ls="none", ms=9,
                          color="tab:purple", label="the same, one level finer in both")
+        after = [(where[k], max(abs(d["extrapolated"]) for d in c["after"]["diff"].values()))
+                 for c in data.get("refined") or () if c.get("after")
+                 and (k := (c["a_over_t"], c["modulus_ratio"], c["nu_c"])) in where]
+        if after:
+            top.semilogy([i for i, _ in after], [max(v, floor) for _, v in after], "D", ls="none", mfc="none",
+                         color="tab:green", label="worst of p_max, radius, approach, one level finer in both")
         top.axhline(5e-3, color="tab:red", lw=0.8, ls="--", label="0.5 %")
         top.set_ylim(floor / 2, 1.0)
         top.set_ylabel("|BEM / FEM - 1|, extrapolated")
