@@ -40,7 +40,7 @@ from .coating import Coating
 from .coating_fields import mode_fields
 from .mode_sum import mode_stress
 from .result import ContactResult
-from .stress import VOIGT, subsurface_stress
+from .stress import VOIGT, subsurface_stress, von_mises_voigt
 
 __all__ = ["CoatedStress", "coated_stress", "coating_of_substrate"]
 
@@ -181,7 +181,7 @@ class CoatedStress:
             rows.append((t, True, self.interface_substrate))
         rows.sort(key=lambda row: row[:2])
         sigma = np.stack([row[2] for row in rows])
-        return (np.array([row[0] for row in rows]), sigma, _von_mises(sigma),
+        return (np.array([row[0] for row in rows]), sigma, von_mises_voigt(sigma),
                 np.array([not row[1] for row in rows]))
 
     def nearest(self, x0=0.0, y0=0.0):
@@ -202,11 +202,6 @@ class CoatedStress:
                 "interface_min_sigma_zz": float(tr["zz"][k_zz]),
                 "interface_max_sigma_zz": float(np.max(tr["zz"])),
                 "n_depths": int(self.z.size), "n_points": int(self.x.size), "wall_time_s": self.wall_time_s}
-
-
-def _von_mises(s):
-    xx, yy, zz, yz, xz, xy = np.moveaxis(s, -1, 0)
-    return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2) + 3.0 * (yz * yz + xz * xz + xy * xy))
 
 
 def _body(result, body):
@@ -376,7 +371,7 @@ def coated_stress(result, z, *, body=None, x=None, y=None, pad=4.0):
             zero = [-nu / (1 - nu), -nu / (1 - nu), -1.0, 0.0, 0.0, 0.0]
         out[k] += pointwise(embed(mode_stress(cell, radial, g_cut, zero=zero))).T
     n_z = z.size
-    sigma, vm = out[:n_z], _von_mises(out)
+    sigma, vm = out[:n_z], von_mises_voigt(out)
     iface_c = out[n_z]
     iface_s = out[n_z + 1] if out.shape[0] > n_z + 1 else None  # a rigid substrate has no stresses
     maxima = []

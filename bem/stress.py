@@ -45,7 +45,7 @@ from .coating import check_uncoated_body
 from .kernel_convolution import SymmetricKernelConvolution
 from .result import ContactResult
 
-__all__ = ["subsurface_stress", "SubsurfaceStress", "VOIGT", "principal_stresses", "peak_in_depth"]
+__all__ = ["subsurface_stress", "SubsurfaceStress", "VOIGT", "principal_stresses", "peak_in_depth", "von_mises_voigt"]
 
 log = logging.getLogger(__name__)
 
@@ -90,7 +90,8 @@ def principal_stresses(sigma):
     return np.stack([s1, s2, s3], axis=-1)
 
 
-def _von_mises(s, axis=-1):
+def von_mises_voigt(s, axis=-1):
+    """The von Mises stress [pressure] of Voigt tensors ``s`` (``xx, yy, zz, yz, xz, xy`` along ``axis``)."""
     xx, yy, zz, yz, xz, xy = np.moveaxis(s, axis, 0)
     return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2) + 3.0 * (yz * yz + xz * xz + xy * xy))
 
@@ -280,7 +281,7 @@ def _convolve_depths(lattice, grid, loaded, depths, nu, x, y, on_nodes, store, v
         else:
             for comp in range(6):
                 store[k, comp] = lattice.interpolate(fields[comp], x, y)
-        vm[k] = _von_mises(store[k], axis=0)
+        vm[k] = von_mises_voigt(store[k], axis=0)
 
     if threads == 1:
         for k in range(len(depths)):

@@ -22,6 +22,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.sparse.linalg import splu
 
+from bem.coating_fields import von_mises
+
 
 __all__ = ["nodal_stresses", "one_sided_stresses", "body_stresses", "field_mesh", "STRESS_NAMES"]
 
@@ -45,10 +47,6 @@ def _quadrature_stresses(model, u, basis=None, lam=None, mu=None):
     mu = model.mu_w if mu is None else mu
     tr = lam * (e_rr + e_zz + e_tt)
     return tr + 2 * mu * e_rr, tr + 2 * mu * e_zz, tr + 2 * mu * e_tt, mu * g_rz
-
-
-def _von_mises(s_rr, s_zz, s_tt, s_rz):
-    return np.sqrt(0.5 * ((s_rr - s_zz) ** 2 + (s_zz - s_tt) ** 2 + (s_tt - s_rr) ** 2) + 3.0 * s_rz**2)
 
 
 def nodal_stresses(model, u):
@@ -82,7 +80,7 @@ def nodal_stresses(model, u):
     out = {}
     for name, s in zip(STRESS_NAMES[:4], _quadrature_stresses(model, u)):
         out[name] = lu.solve(asm(load, basis, s=s))
-    out["von_mises"] = _von_mises(*(out[k] for k in STRESS_NAMES[:4]))
+    out["von_mises"] = von_mises(out["sigma_rr"], out["sigma_tt"], out["sigma_zz"], out["sigma_rz"])
     return out
 
 
@@ -124,7 +122,7 @@ def one_sided_stresses(model, u, elements):
     with np.errstate(invalid="ignore", divide="ignore"):
         for name, s in zip(STRESS_NAMES[:4], _quadrature_stresses(model, u, basis, lam, mu)):
             out[name] = np.bincount(dofs.ravel(), weights=np.asarray(s).T.ravel(), minlength=n) / count
-    out["von_mises"] = _von_mises(*(out[k] for k in STRESS_NAMES[:4]))
+    out["von_mises"] = von_mises(out["sigma_rr"], out["sigma_tt"], out["sigma_zz"], out["sigma_rz"])
     out["nodes"] = count > 0
     return out
 

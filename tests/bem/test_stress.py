@@ -261,3 +261,14 @@ def test_the_deepest_allowed_depth_gives_the_point_force_stress(hertz_ladder):
     st = bem.subsurface_stress(res, z, nu=0.3, x=[0.0], y=[0.0])
     assert np.all(np.isfinite(st.von_mises))
     assert st.sigma[0, 0, 2] == pytest.approx(-3 * res.force / (2 * math.pi * z**2), rel=1e-6)
+
+
+def test_von_mises_voigt_of_closed_form_states():
+    """Uniaxial stress s: von Mises |s|; pure shear t in any plane: sqrt(3) t; a hydrostatic state: 0."""
+    from bem.stress import von_mises_voigt
+
+    states = np.array([[2.5, 0, 0, 0, 0, 0], [0, 0, -4.0, 0, 0, 0], [0, 0, 0, 1.5, 0, 0], [0, 0, 0, 0, 0, -2.0],
+                       [3.0, 3.0, 3.0, 0, 0, 0]])
+    np.testing.assert_allclose(von_mises_voigt(states), [2.5, 4.0, math.sqrt(3) * 1.5, math.sqrt(3) * 2.0, 0.0],
+                               rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(von_mises_voigt(states.T, axis=0), von_mises_voigt(states), rtol=0, atol=0)
