@@ -250,8 +250,7 @@ def _convolve_depths(lattice, grid, loaded, depths, nu, x, y, on_nodes, store, v
     m = _MARGIN
     cores = max(1, os.cpu_count() or 1)
     threads = min(cores, len(depths)) if grid.size >= _PARALLEL_NODES and backend.is_numpy else 1
-    conv = SymmetricKernelConvolution(lattice, (r0 - m, r1 + m), (q0 - m, q1 + m),
-                                      workers=max(1, cores // threads))
+    conv = SymmetricKernelConvolution(lattice, (r0 - m, r1 + m), (q0 - m, q1 + m), workers=max(1, cores // threads))
     filtered = conv.transform(bq.filter_pressure(lattice, p_box, r0, m))
     direct = conv.transform(np.pad(p_box, m)) if (depths < bq.R_NEAR).any() else None
     offsets = conv.offsets()
