@@ -42,6 +42,15 @@ TERMINATED = ["contactlab: terminated (no partial output was left)"]
 INTERRUPTED = ["contactlab: interrupted (no partial output was left)"]
 
 
+@pytest.fixture(autouse=True)
+def _sigint_as_from_a_terminal():
+    """The commands start with Ctrl-C's default action, as from a terminal, also where this test process was
+    started with ``SIGINT`` ignored (a background job of a non-interactive shell), which a child inherits."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 def _hook(tmp_path, point, signum):
     """A sitecustomize folder sending ``signum`` at ``point``: a key of :data:`POINTS` or such a tuple."""
     module, name, condition, when = POINTS.get(point, point)
