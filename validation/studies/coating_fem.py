@@ -201,6 +201,13 @@ def _best(x):
     return x["extrapolated"] if x["extrapolated"] is not None else x["finest"]
 
 
+def _differences(bx, fx):
+    """``BEM/FEM - 1`` per :data:`QUANTITIES` of two methods' :func:`_extrapolate` values: ``extrapolated``
+    (the best value of each, :func:`_best`) and ``finest``."""
+    return {q: dict(extrapolated=_best(bx[q]) / _best(fx[q]) - 1.0, finest=bx[q]["finest"] / fx[q]["finest"] - 1.0)
+            for q in QUANTITIES}
+
+
 def _pressure_levels(bs, fs, smooth=True):
     """The RMS measures of ``p(r)`` per paired level (coarsest first; ``None`` where a solve did not
     converge), their orders and extrapolations. ``smooth``: bodies without a layer, whose pressure has a
@@ -232,9 +239,7 @@ def compare_case(case, s, *, layer=None):
     b_rows, b = bem_levels(case, s, layer, bs)
     f_rows, f = fem_levels(case, s, layer, fs)
     bx, fx = _extrapolate(b_rows), _extrapolate(f_rows)
-    diff = {}
-    for q in QUANTITIES:
-        diff[q] = dict(extrapolated=_best(bx[q]) / _best(fx[q]) - 1.0, finest=bx[q]["finest"] / fx[q]["finest"] - 1.0)
+    diff = _differences(bx, fx)
     row = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], thickness=_coating(case, s).thickness,
                layer=None if layer is None else layer.to_dict(),
                converged=all(r["converged"] for r in b_rows + f_rows), bem=b_rows, fem=f_rows, bem_x=bx, fem_x=fx,
@@ -266,9 +271,7 @@ def refined_pressure(case, s, row=None):
                converged=all(x.converged for x in bs + fs))
     if row is not None:
         bx, fx = _extrapolate(row["bem"][:-1] + b_rows), _extrapolate(row["fem"][:-1] + f_rows)
-        out["after"] = dict(bem_x=bx, fem_x=fx, diff={q: dict(extrapolated=_best(bx[q]) / _best(fx[q]) - 1.0,
-                                                              finest=bx[q]["finest"] / fx[q]["finest"] - 1.0)
-                                                      for q in QUANTITIES})
+        out["after"] = dict(bem_x=bx, fem_x=fx, diff=_differences(bx, fx))
     out["wall_time_s"] = time.perf_counter() - t0
     return out
 
