@@ -188,7 +188,7 @@ def _cached(n_rows, n_cols, step, bodies):
         g_cut = _cut(parts, bodies, step)
         terms = 0.069 * n_rows * n_cols * g_cut * g_cut  # (sqrt3/2) N g^2 / (4 pi): the G in the disc
         if terms > MAX_TERMS:
-            _refuse(n_rows, n_cols, step, bodies, parts, terms)
+            _refuse(n_rows, n_cols, step, bodies, alias, terms)
     s_base = sum(float(mode_compliance(0.0, E, nu)) if i in real else _s_inf(E, nu, c)
                  for i, (E, nu, c) in enumerate(_bodies(bodies), start=1))
     w = E_star * s_base * periodic_template(n_rows, n_cols)
@@ -204,9 +204,11 @@ def _cached(n_rows, n_cols, step, bodies):
     return w
 
 
-def _refuse(n_rows, n_cols, step, bodies, parts, terms):
-    t = min(c.thickness for _, _, c in parts)
-    i = 1 if bodies.coating1 is not None and bodies.coating1.thickness == t else 2
+def _refuse(n_rows, n_cols, step, bodies, alias, terms):
+    """Refuse the cell: the alias sum of the bodies ``alias`` (1, 2) is too long; named by the thinnest coating."""
+    coating = {i: c for i, (_, _, c) in enumerate(_bodies(bodies), start=1)}
+    i = min(alias, key=lambda k: coating[k].thickness)
+    t = coating[i].thickness
     fine = step * math.sqrt(MAX_TERMS / terms)
     raise InputError(
         f"thickness = {t!r} is not allowed with step = {step!r} on this cell of {n_rows * n_cols} nodes: the "

@@ -104,8 +104,8 @@ def test_the_cases_above_refine_above_and_only_they_are_solved_one_level_finer(m
         return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], layer=None, diff=diff,
                     pressure={"total": {"finest": worst[case][0]}})
 
-    def finer(case, s, row):
-        assert row["a_over_t"] == case[0]
+    def finer(row, s):
+        case = (row["a_over_t"], row["modulus_ratio"], row["nu_c"])
         return dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2],
                     rows=[dict(bem=40, fem=24, linear=0.01, total=worst[case][0], interior=1e-4, edge=worst[case][0])])
 
@@ -146,9 +146,9 @@ def test_one_level_finer_extends_each_methods_sequence_for_its_orders_and_extrap
     monkeypatch.setattr(coating_fem, "rms_parts", lambda b, f: dict(total=0.0, interior=0.0, edge=0.0))
     s = dict(coating_fem.SETTINGS, bem_levels=(10, 20, 40), fem_levels=(6, 12, 24))
     # the case's row: its coarse levels perturbed beyond the quadratic law, so only the last three can give order 2
-    row = dict(a_over_t=1.0, bem=[level("bem", 10, 9.0), level("bem", 20, 0.5), level("bem", 40, 0.5)],
+    row = dict(a_over_t=1.0, modulus_ratio=10.0, nu_c=0.25, bem=[level("bem", 10, 9.0), level("bem", 20, 0.5), level("bem", 40, 0.5)],
                fem=[level("fem", 6, 7.0), level("fem", 12, -2.0), level("fem", 24, -2.0)])
-    out = coating_fem.refined_pressure((1.0, 10.0, 0.25), s, row)
+    out = coating_fem.refined_pressure(row, s)
     assert [r["level"] for r in out["bem"]] == [40, 80] and [r["level"] for r in out["fem"]] == [24, 48]
     assert [(r["bem"], r["fem"]) for r in out["rows"]] == [(40, 24), (40, 48), (80, 24), (80, 48)]
     after = out["after"]

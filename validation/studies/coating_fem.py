@@ -208,11 +208,11 @@ def _differences(bx, fx):
             for q in QUANTITIES}
 
 
-def _pressure_levels(bs, fs, smooth=True):
+def _pressure_levels(bs, fs, edge_aware=True):
     """The RMS measures of ``p(r)`` per paired level (coarsest first; ``None`` where a solve did not
-    converge), their orders and extrapolations. ``smooth``: bodies without a layer, whose pressure has a
+    converge), their orders and extrapolations. ``edge_aware``: bodies without a layer, whose pressure has a
     square-root edge (read edge-aware); with a layer it vanishes smoothly and ``total`` reads it linearly."""
-    rows = [dict(linear=rms_nodes(b, f), **rms_parts(b, f, edge_aware=smooth)) if b.converged and f.converged
+    rows = [dict(linear=rms_nodes(b, f), **rms_parts(b, f, edge_aware=edge_aware)) if b.converged and f.converged
             else dict.fromkeys(RMS_MEASURES) for b, f in zip(bs, fs)]
     return dict(levels=rows, **_extrapolate(rows, RMS_MEASURES))
 
@@ -252,16 +252,17 @@ def compare_case(case, s, *, layer=None):
     return row
 
 
-def refined_pressure(case, s, row=None):
-    """One level beyond the study's finest in each method: the BEM at the last two of ``bem_levels`` doubled
-    once, the FEM likewise. ``rows``: every BEM level against every FEM level (``bem``, ``fem``, ``linear`` and
-    the :func:`rms_parts`); ``bem``, ``fem``: the two levels' rows of :func:`bem_levels`, :func:`fem_levels`.
-    With the case's ``row`` of :func:`compare_case`: ``after``, each method's orders and extrapolations of
+def refined_pressure(row, s):
+    """One level beyond the study's finest in each method for the case of ``row`` (of :func:`compare_case`): the
+    BEM at the last two of ``bem_levels`` doubled once, the FEM likewise. ``rows``: every BEM level against every
+    FEM level (``bem``, ``fem``, ``linear`` and the :func:`rms_parts`); ``bem``, ``fem``: the two levels' rows of
+    :func:`bem_levels`, :func:`fem_levels`; ``after``: each method's orders and extrapolations of
     :data:`QUANTITIES` from its last three levels (the coarser ones from ``row``) and their differences
     (``diff``, as in :func:`compare_case`)."""
     finer = dict(s, bem_levels=(s["bem_levels"][-1], 2 * s["bem_levels"][-1]),
                  fem_levels=(s["fem_levels"][-1], 2 * s["fem_levels"][-1]), stresses=False)
     t0 = time.perf_counter()
+    case = (row["a_over_t"], row["modulus_ratio"], row["nu_c"])
     bs, fs = [], []
     b_rows, _ = bem_levels(case, finer, None, bs)
     f_rows, _ = fem_levels(case, finer, None, fs)
@@ -269,9 +270,8 @@ def refined_pressure(case, s, row=None):
             for nb, b in zip(finer["bem_levels"], bs) for nf, f in zip(finer["fem_levels"], fs)]
     out = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], rows=rows, bem=b_rows, fem=f_rows,
                converged=all(x.converged for x in bs + fs))
-    if row is not None:
-        bx, fx = _extrapolate(row["bem"][:-1] + b_rows), _extrapolate(row["fem"][:-1] + f_rows)
-        out["after"] = dict(bem_x=bx, fem_x=fx, diff=_differences(bx, fx))
+    bx, fx = _extrapolate(row["bem"][:-1] + b_rows), _extrapolate(row["fem"][:-1] + f_rows)
+    out["after"] = dict(bem_x=bx, fem_x=fx, diff=_differences(bx, fx))
     out["wall_time_s"] = time.perf_counter() - t0
     return out
 
@@ -296,7 +296,7 @@ def run_coating_fem(settings=None, *, quick=False, progress=None):
                  + (" + root layer" if c[1] is not None else ""))]
     above = [r for r in rows if s.get("refine_above") is not None and r["layer"] is None
              and _worst(r) > s["refine_above"]]
-    refined = [refined_pressure((r["a_over_t"], r["modulus_ratio"], r["nu_c"]), s, r) for r in
+    refined = [refined_pressure(r, s) for r in
                each(above, progress, lambda r: "one level finer: a/t = {a_over_t:g}, Ec/Es = {modulus_ratio:g}, "
                     "nu_c = {nu_c:g}".format(**r))]
     return {"study": STEM, "mode": "quick" if quick else "full", "settings": {k: _listed(v) for k, v in s.items()},
