@@ -157,8 +157,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         stiff = D <= threshold * diag
         sel = stiff & (p > 0)
         lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
-        # the Jacobi estimate 1 / (C_nn + D) at the nodes that need it (whole only for the bounded step)
-        jacobi = 1.0 / (diag + D) if hardness is not None else None
+        jacobi = 1.0 / (diag + D)  # the Jacobi estimate 1 / (C_nn + D), read at the soft and entering nodes
         soft = None if bool(xp.all(stiff)) else ~stiff
     else:
         lam_pc, jacobi = lam, 1.0 / (diag + lam)
@@ -189,8 +188,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         z = xp.astype(bk.take(op.brick(op.mix(x, M, out=x), overwrite=True), nodes), xp.float64)
         return z if soft is None else xp.where(bk.take(soft, nodes), jacobi_at(nodes) * r_c, z)
 
-    def jacobi_at(nodes):  # 1 / (C_nn + D) at the nodes: the numbers of the whole array
-        return 1.0 / (diag + bk.take(D, nodes))
+    def jacobi_at(nodes):  # 1 / (C_nn + D) at the nodes
+        return bk.take(jacobi, nodes)
 
     def add_at(x, nodes, values):  # x += values at the nodes, in x's precision
         bk.put(x, nodes, xp.astype(bk.take(x, nodes) + values, x.dtype, copy=False))
