@@ -16,6 +16,7 @@ A body may carry a coating of thickness ``t`` (``coating_thickness``): a line at
 conformingly (bonded: the two share the nodes of that line), with at least
 ``N_ACROSS_COATING`` elements across ``t`` in the fine zone and elements no larger than ``t``
 along the whole coating; a bond deeper than the contact is refined near the axis (:func:`_size_field`).
+An optional edge band (``edge``) refines the interface around a known contact edge.
 
 Both rectangles are meshed in one gmsh model that shares the interface curve,
 so the two sides of the interface get the same 1-D mesh; the nodes on it are
@@ -41,7 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bem.checks import InputError, check_int, check_positive
+from bem.checks import InputError, check_int, check_positive, fail
 
 from .gmsh_session import start_gmsh
 
@@ -93,6 +94,10 @@ class AxiMesh:
         Far-field element size [length].
     coating_thickness : tuple
         Coating thickness of the upper and the lower body [length], ``None`` for none.
+    n_across_coating : int
+        Elements across a coating's thickness in the fine zone (at least).
+    edge : tuple or None
+        ``(r_e, k)`` of an edge band (:func:`build_mesh`), ``None`` for none.
     mesh_time_s : float
         Wall-clock time of meshing and conversion [s].
     """
@@ -110,6 +115,8 @@ class AxiMesh:
     h_coarse: float
     coated: np.ndarray = None
     coating_thickness: tuple = (None, None)
+    n_across_coating: int = N_ACROSS_COATING
+    edge: tuple = None
     mesh_time_s: float = 0.0
     physical_groups: dict = field(default_factory=dict)
 
@@ -199,30 +206,32 @@ def _threshold(fld, distance, size, h_coarse, radius, growth):
     return thr
 
 
-def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=(), a_est=None):
+def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=(), a_est=None, across=N_ACROSS_COATING,
+                edge=None):
     """Size ``h_fine`` within ``fine_radius`` of the origin, growing linearly (slope ``growth``).
 
     ``coatings``: ``(z_low, z_high, t)`` per coating strip. Each caps the size at ``t`` along the
-    whole strip and at ``t / N_ACROSS_COATING`` in its part within ``fine_radius`` (both growing
+    whole strip and at ``t / across`` in its part within ``fine_radius`` (both growing
     with the same slope outside), the smallest size applying. A bond deeper than ``a_est`` gets sizes
-    ``h_fine t / a_est`` within ``fine_radius t / a_est`` of its point on the axis.
+    ``h_fine t / a_est`` within ``fine_radius t / a_est`` of its point on the axis. ``edge = (r_e, k)``:
+    sizes ``h_fine / k`` within ``h_fine`` of the interface point ``(r_e, 0)``.
     """
     fld = gmsh.model.mesh.field
     dist = fld.add("Distance")
     fld.setNumbers(dist, "PointsList", [origin])
-    thr = _threshold(fld, dist, h_fine, h_coarse, fine_radius, growth)
-    if not coatings:
-        fld.setAsBackgroundMesh(thr)
-        return
-    fields = [thr]
+    fields = [_threshold(fld, dist, h_fine, h_coarse, fine_radius, growth)]
+    if edge is not None:
+        ring = fld.add("MathEval")
+        fld.setString(ring, "F", f"Sqrt((x - {float(edge[0])!r})^2 + y^2)")
+        fields.append(_threshold(fld, ring, h_fine / edge[1], h_coarse, h_fine, growth))
     for z_low, z_high, t in coatings:
         if t > a_est:  # a deep bond: sizes h_fine t / a_est within fine_radius t / a_est of its axis point
             bond = fld.add("MathEval")
             fld.setString(bond, "F", f"Sqrt(x^2 + (y - ({z_low if z_low < 0 else z_high!r}))^2)")
             fields.append(_threshold(fld, bond, h_fine * t / a_est, h_coarse, fine_radius * t / a_est, growth))
         boxes = [(math.inf, t)]
-        if t / N_ACROSS_COATING < h_fine:
-            boxes.append((fine_radius, t / N_ACROSS_COATING))
+        if t / across < h_fine:
+            boxes.append((fine_radius, t / across))
         for x_max, size in boxes:
             box = fld.add("Box")
             fld.setNumber(box, "VIn", size)
@@ -335,8 +344,18 @@ def _thicknesses(coating_thickness):
                  for k, t in enumerate(coating_thickness))
 
 
+def _edge(edge, fine):
+    """``edge = (r_e, k)`` of :func:`build_mesh`, checked."""
+    if not (isinstance(edge, (tuple, list)) and len(edge) == 2):
+        fail("edge", edge, "a pair (r_e, k): the edge radius [length] and the refinement factor")
+    r_e = check_positive("edge[0]", edge[0])
+    if r_e >= fine:
+        fail("edge[0]", r_e, f"inside the fine zone, below fine_radius * a_est = {fine!r}")
+    return r_e, check_int("edge[1]", edge[1], minimum=2)
+
+
 def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None,
-               coating_thickness=(None, None)):
+               coating_thickness=(None, None), n_across_coating=N_ACROSS_COATING, edge=None):
     """Mesh the two bodies with gmsh and convert the mesh to scikit-fem.
 
     Parameters
@@ -357,6 +376,11 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
     coating_thickness : tuple of (float or None), optional
         Coating thickness of the upper and the lower body [length] (``None``: no coating): the
         body's elements within it form its coating (``AxiMesh.coated``).
+    n_across_coating : int
+        Elements across a coating's thickness in the fine zone (at least ``N_ACROSS_COATING``).
+    edge : tuple of (float, int), optional
+        ``(r_e, k)``: sizes ``h_fine / k`` within ``h_fine`` of the interface point ``(r_e, 0)``
+        (a contact edge at radius ``r_e`` [length], ``0 < r_e < fine_radius a_est``; ``k >= 2``).
 
     Returns
     -------
@@ -372,6 +396,9 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
         raise InputError(f"domain_factor = {domain_factor!r} is not allowed: it must be >= 4 * fine_radius = "
                          f"{4 * fine_radius!r}.")
     thickness = _thicknesses(coating_thickness)
+    across = check_int("n_across_coating", n_across_coating, minimum=N_ACROSS_COATING)
+    if edge is not None:
+        edge = _edge(edge, fine_radius * a_est)
     R = H = domain_factor * max([a_est] + [t for t in thickness if t])
     h_fine = a_est / int(n_contact_elements)
     h_coarse = R / 8.0 if h_coarse is None else check_positive("h_coarse", h_coarse)
@@ -381,11 +408,11 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
 
     start_gmsh(gmsh)
     try:
-        _options(gmsh, min([h_fine] + [t / N_ACROSS_COATING for t in thickness if t]), h_coarse)
+        _options(gmsh, min([h_fine / (edge[1] if edge else 1)] + [t / across for t in thickness if t]), h_coarse)
         gmsh.model.add("contactlab_axisymmetric")
         origin, surfaces, curves, groups = _geometry(gmsh, R, H, thickness)
         strips = [(0.0, t, t) if k == 0 else (-t, 0.0, t) for k, t in enumerate(thickness) if t]
-        _size_field(gmsh, origin, h_fine, h_coarse, fine_radius * a_est, growth, strips, a_est)
+        _size_field(gmsh, origin, h_fine, h_coarse, fine_radius * a_est, growth, strips, a_est, across, edge)
         gmsh.model.mesh.generate(2)
         gmsh.model.mesh.setOrder(2)
         xy, parts = _extract(gmsh, surfaces, curves, thickness)
@@ -396,5 +423,6 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
     log.info("mesh: %d triangles, h_fine = %.3g, R = H = %.3g (%.2f s)", body.size, h_fine, R, elapsed)
     return AxiMesh(mesh=mesh, body=body, nodes6=nodes6, cells6=cells6, a_est=a_est, h_fine=h_fine,
                    n_contact_elements=int(n_contact_elements), radius=R, depth=H, fine_radius=fine_radius * a_est,
-                   h_coarse=h_coarse, coated=coated, coating_thickness=thickness, mesh_time_s=elapsed,
+                   h_coarse=h_coarse, coated=coated, coating_thickness=thickness, n_across_coating=across,
+                   edge=edge, mesh_time_s=elapsed,
                    physical_groups={k: v[0] for k, v in groups.items()})

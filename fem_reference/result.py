@@ -102,7 +102,7 @@ class FemResult:
         Wall-clock seconds: ``mesh``, ``assembly``, ``factorize``, ``compliance`` (interface
         compliance and truncation correction), ``newton``, ``recover`` (full field and
         reactions), ``solve`` (= factorize + compliance + newton + recover), ``total``.
-        After a re-mesh, ``mesh`` and ``total`` include both meshes, the others the last one.
+        After a re-mesh or an edge band, ``mesh`` and ``total`` include every mesh, the others the last one.
     n_dofs : int
         Displacement DOFs of both bodies.
     n_elements : int
@@ -122,7 +122,8 @@ class FemResult:
         ``applied`` (bool), ``radius``, ``depth`` [length].
     mesh : dict
         ``a_est`` [length], ``h_fine`` [length], ``n_contact_elements`` (elements across
-        ``a_est``), ``domain_factor`` (domain radius over ``a_est``), ``remeshed`` (bool).
+        ``a_est``), ``domain_factor`` (domain radius over ``a_est``), ``remeshed`` (bool), ``edge``
+        (``[r_e, k]`` of the edge band of ``refine_edge``, ``None`` without), ``n_across_coating``.
     history : dict
         Newton history (last mesh).
     E_star : float

@@ -35,7 +35,7 @@ from bem.materials import effective_modulus
 from bem.reference import estimate_contact_radius
 
 from .interface import InterfaceLaw
-from .mesh import AxiMesh, build_mesh
+from .mesh import N_ACROSS_COATING, AxiMesh, build_mesh
 from .model import AxiModel, check_coatings, check_materials
 from .newton import solve_interface
 from .result import FemResult, axis_pressure, edge_radius
@@ -87,7 +87,8 @@ def _one_mesh(amesh, gap, materials, E_star, layer, penalty, force, approach, tr
 
 def solve(gap, *, E1, nu1, E2, nu2, coating1=None, coating2=None, force=None, approach=None, layer=None, a_est=None,
           n_contact_elements=24, domain_factor=40.0, fine_radius=1.5, growth=0.25, mesh=None, penalty=1e5,
-          truncation_correction=True, remesh=True, rtol=1e-9, maxiter=60):
+          truncation_correction=True, remesh=True, refine_edge=None, n_across_coating=N_ACROSS_COATING, rtol=1e-9,
+          maxiter=60):
     """Axisymmetric FEM reference solution of the layered contact of two elastic bodies.
 
     Body 1 (``E1, nu1``) is the upper body ``z >= 0``, body 2 the lower one; the interface
@@ -126,6 +127,14 @@ def solve(gap, *, E1, nu1, E2, nu2, coating1=None, coating2=None, force=None, ap
         raw top displacement as ``approach``.
     remesh : bool
         Re-mesh once around the computed radius when it leaves ``[0.6, 1.25] a_est``.
+    refine_edge : int, optional
+        ``k >= 2``: solve once more on a mesh whose interface elements within ``h_fine`` of the
+        computed contact edge are ``k`` times smaller (:func:`fem_reference.build_mesh`'s ``edge``),
+        which places the edge of a smooth contact far better than the nodes' spacing. ``None``: no
+        edge band. Not with a prebuilt ``mesh``.
+    n_across_coating : int
+        Elements across a coating's thickness in the fine zone (at least
+        ``fem_reference.mesh.N_ACROSS_COATING``).
     rtol : float
         Newton stopping rule (:mod:`fem_reference.newton`), in ``(0, bem.checks.RTOL_MAX]`` as for
         :func:`bem.solve`: a looser one accepts a wrong answer as converged.
@@ -156,23 +165,26 @@ def solve(gap, *, E1, nu1, E2, nu2, coating1=None, coating2=None, force=None, ap
     maxiter = check_int("maxiter", maxiter)
     truncation_correction = check_bool("truncation_correction", truncation_correction)
     remesh = check_bool("remesh", remesh)
+    if refine_edge is not None:
+        refine_edge = check_int("refine_edge", refine_edge, minimum=2)
+    n_across_coating = check_int("n_across_coating", n_across_coating, minimum=N_ACROSS_COATING)
     if mesh is not None and not isinstance(mesh, AxiMesh):
         fail("mesh", mesh, "a fem_reference.mesh.AxiMesh (from fem_reference.build_mesh) or None")
     if mesh is not None:
         check_coatings(coating1, coating2, mesh.coating_thickness)
+        if refine_edge is not None:
+            fail("refine_edge", refine_edge, "None with a prebuilt mesh (the edge band is meshed here)")
     E_star = effective_modulus(E1, nu1, E2, nu2)
     if mesh is None and a_est is None:
         a_est = estimate_contact_radius(gap, E_star=E_star, force=force, approach=approach, layer=layer)
     elif mesh is None:
         a_est = check_positive("a_est", a_est)
-    remeshed, mesh_time = False, 0.0
-    for attempt in range(2):
-        if mesh is None or remeshed:
-            amesh = build_mesh(a_est, n_contact_elements=n_contact_elements, domain_factor=domain_factor,
-                               fine_radius=fine_radius, growth=growth, coating_thickness=thickness)
-        else:
-            amesh = mesh
-        mesh_time += amesh.mesh_time_s if (mesh is None or remeshed) else 0.0
+    options = dict(n_contact_elements=n_contact_elements, domain_factor=domain_factor, fine_radius=fine_radius,
+                   growth=growth, coating_thickness=thickness, n_across_coating=n_across_coating)
+    remeshed, edge, mesh_time = False, None, 0.0
+    for attempt in range(3):
+        amesh = mesh if mesh is not None and not remeshed and edge is None else build_mesh(a_est, edge=edge, **options)
+        mesh_time += amesh.mesh_time_s if amesh is not mesh else 0.0
         model, sol, h, law, dc, timings = _one_mesh(
             amesh, gap, (E1, nu1, E2, nu2, coating1, coating2), E_star, layer, penalty, force, approach,
             truncation_correction, rtol, maxiter)
@@ -185,6 +197,15 @@ def solve(gap, *, E1, nu1, E2, nu2, coating1=None, coating2=None, force=None, ap
                      a_c, _LOW, _HIGH, a_est)
             a_est, remeshed = a_c, True
             continue
+        if (refine_edge is not None and edge is None and sol.converged
+                and 0.0 < a_c < amesh.fine_radius and p[-1] == 0.0):
+            log.info("re-meshing with elements %d times smaller around the edge r = %.4g", refine_edge, a_c)
+            edge = (a_c, refine_edge)
+            continue
+        if refine_edge is not None and edge is None:
+            log.warning("refine_edge = %d not applied: the first solve %s", refine_edge,
+                        "did not converge" if not sol.converged else f"has its edge at r = {a_c:.4g}, outside the "
+                        f"fine zone (0, {amesh.fine_radius:.4g})")
         break
     return _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty, E_star,
                    layer, remeshed, amesh)
@@ -226,7 +247,8 @@ def _finish(model, sol, p, h, a_c, law, dc, timings, mesh_time, t_start, penalty
         truncation={"compliance": dc, "correction": dc * force, "approach_far": delta_far,
                     "applied": bool(dc != 0.0), "radius": amesh.radius, "depth": amesh.depth},
         mesh={"a_est": amesh.a_est, "h_fine": amesh.h_fine, "n_contact_elements": amesh.n_contact_elements,
-              "domain_factor": amesh.radius / amesh.a_est, "remeshed": remeshed},
+              "domain_factor": amesh.radius / amesh.a_est, "remeshed": remeshed,
+              "edge": None if amesh.edge is None else list(amesh.edge), "n_across_coating": amesh.n_across_coating},
         E_star=E_star, history=sol.history, model=model, displacement_dofs=u,
     )
     if not converged:

@@ -5,6 +5,7 @@ import pytest
 from .fem_cases import E, E_SOFT, NU, NU_SOFT, P, R, e_star, hertz, hertz_pressure
 
 import fem_reference as fr
+from bem.checks import InputError
 
 COARSE = {"n_contact_elements": 8, "domain_factor": 30.0}
 
@@ -102,3 +103,22 @@ def test_contact_reaching_the_outer_boundary_is_not_an_answer(gap, hertz_same):
                    remesh=False)
     assert not res.converged and res.status == res.summary()["status"] == "boundary"
     assert np.all(np.isfinite(res.p))
+
+
+def test_an_edge_band_places_the_hertz_edge_between_the_nodes(gap, hertz_same, coarse_mesh):
+    """``refine_edge = 4`` at 16 elements across ``a``: the edge within 0.3 % of Hertz's (measured +0.11 %; the
+    same mesh without the band: +0.93 %, the edge estimated from nodes ``a / 32`` apart) and ``p(r)`` within
+    0.3 % of ``p0`` in RMS over the contact (measured 0.18 %; without: 0.40 %)."""
+    a, p0, _ = hertz_same
+    res = fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, n_contact_elements=16, domain_factor=30.0, refine_edge=4)
+    assert res.converged, res.message
+    r_e, k = res.mesh["edge"]
+    assert k == 4 and abs(r_e / a - 1.0) < 0.02  # centred on the first mesh's edge
+    assert abs(res.edge_radius / a - 1.0) < 3e-3
+    inside = res.r < a
+    rms = np.sqrt(np.mean((res.p[inside] - hertz_pressure(res.r[inside], a, p0)) ** 2))
+    assert rms < 3e-3 * p0
+    with pytest.raises(InputError, match=r"^refine_edge = 4 .*prebuilt mesh"):
+        fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, mesh=coarse_mesh, refine_edge=4)
+    with pytest.raises(InputError, match=r"^refine_edge = 1 "):
+        fr.solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, force=P, refine_edge=1)

@@ -105,7 +105,34 @@ def test_gmsh_finalized_on_error(monkeypatch):
     assert gmsh.isInitialized() == 0
 
 
+def _interface_facets(amesh):
+    mesh = amesh.mesh
+    r = mesh.p[0, mesh.facets[:, mesh.boundaries["interface_upper"]]]
+    return np.abs(r[1] - r[0]), 0.5 * (r[0] + r[1])
+
+
+def test_an_edge_band_refines_the_interface_around_the_edge_only(hertz_same):
+    """``edge = (r_e, k)``: interface elements within ``h_fine`` of ``r_e`` are ``k`` times smaller; the
+    rest of the contact zone keeps ``h_fine``."""
+    a = hertz_same[0]
+    plain = build_mesh(a, n_contact_elements=8, domain_factor=30.0)
+    banded = build_mesh(a, n_contact_elements=8, domain_factor=30.0, edge=(0.93 * a, 4))
+    assert banded.edge == (0.93 * a, 4) and plain.edge is None
+    h = banded.h_fine
+    for amesh, size in ((plain, h), (banded, h / 4)):
+        length, mid = _interface_facets(amesh)
+        band = np.abs(mid - 0.93 * a) < 0.5 * h
+        assert band.sum() >= (1 if amesh is plain else 3)
+        assert length[band].max() < 1.3 * size and length[band].min() > 0.6 * size
+    length, mid = _interface_facets(banded)
+    inner = mid < 0.93 * a - 4 * h  # beyond the band and its grading
+    assert inner.any() and length[inner].min() > 0.6 * h
+
+
 @pytest.mark.parametrize("kwargs, name", [
+    ({"a_est": 1.0, "edge": (0.9, 1)}, r"edge\[1\]"), ({"a_est": 1.0, "edge": (2.0, 4)}, r"edge\[0\]"),
+    ({"a_est": 1.0, "edge": 0.9}, "edge"), ({"a_est": 1.0, "edge": (-0.5, 4)}, r"edge\[0\]"),
+    ({"a_est": 1.0, "n_across_coating": 2}, "n_across_coating"),
     ({"a_est": -1.0}, "a_est"), ({"a_est": 1.0, "n_contact_elements": 1}, "n_contact_elements"),
     ({"a_est": 1.0, "n_contact_elements": 4.5}, "n_contact_elements"),
     ({"a_est": 1.0, "domain_factor": 2.0}, "domain_factor"),

@@ -16,7 +16,7 @@ import validation.run.runner as runner
 from bem.files import lattice_triangles
 from validation.io import OutputError, atomic_directory, atomic_write_json
 from validation.run import execute_scene, run_scene
-from validation.scene import load_scene
+from validation.scene import SceneError, load_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 FAST = ["bem.nodes_across=16"]
@@ -238,3 +238,15 @@ def test_bem_only_runs_import_no_heavy_package(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip().splitlines()[-1] == "[]"
     assert (tmp_path / "b" / "result.json").is_file() and not (tmp_path / "b" / "fem_field.vtu").exists()
+
+
+def test_the_fem_edge_band_of_a_scene_is_recorded(tmp_path):
+    """``[fem] refine_edge``: the FEM solves once more on a mesh refined around its contact edge, and the
+    result records the band (``fem.mesh.edge = [r_e, k]``, ``r_e`` the first mesh's edge near Hertz's)."""
+    r = run_scene("hertz", tmp_path / "e", overrides=["bem.nodes_across=16", "fem.n_contact_elements=8",
+                                                      "fem.refine_edge=4"])
+    record = json.loads((tmp_path / "e" / "result.json").read_text())
+    r_e, k = record["fem"]["mesh"]["edge"]
+    assert k == 4 and abs(r_e / r.fem.edge_radius - 1.0) < 0.02
+    with pytest.raises(SceneError, match=r"^fem\.refine_edge = 1 is not allowed: it must be an integer >= 2"):
+        load_scene("hertz", overrides=["fem.refine_edge=1"])

@@ -136,13 +136,15 @@ class BemPart(_Part):
 @dataclass
 class FemMesh(_Part):
     """The FEM mesh: estimated contact radius ``a_est`` and element size ``h_fine`` [length] at the
-    contact, elements across it ``n_contact_elements``, domain radius / contact radius ``domain_factor``."""
+    contact, elements across it ``n_contact_elements``, domain radius / contact radius ``domain_factor``;
+    ``edge``: ``[r_e, k]`` of the edge band (``refine_edge``) or ``None``."""
 
     a_est: float
     h_fine: float
     n_contact_elements: int
     domain_factor: float
     remeshed: bool
+    edge: list | None = None
 
 
 @dataclass

@@ -109,7 +109,7 @@ def _fem_part(fem):
                    timings={k: float(v) for k, v in fem.timings.items()}, penalty=dict(fem.penalty),
                    truncation=dict(fem.truncation),
                    mesh=FemMesh(a_est=mesh["a_est"], h_fine=mesh["h_fine"], n_contact_elements=mesh["n_contact_elements"],
-                                domain_factor=mesh["domain_factor"], remeshed=mesh["remeshed"]))
+                                domain_factor=mesh["domain_factor"], remeshed=mesh["remeshed"], edge=mesh["edge"]))
 
 
 def bem_part(res, **extra):

@@ -40,7 +40,8 @@ BODY_KEYS = ("E1", "nu1", "E2", "nu2")
 #: the ``[fem]`` options and their checks, in the order they are checked
 _FEM_OPTIONS = {"n_contact_elements": partial(ck.integer, minimum=4, maximum=400),
                 **dict.fromkeys(("domain_factor", "fine_radius", "growth", "penalty"), ck.positive), "rtol": ck.rtol,
-                "maxiter": partial(ck.integer, minimum=1), "remesh": ck.boolean, "truncation_correction": ck.boolean}
+                "maxiter": partial(ck.integer, minimum=1), "remesh": ck.boolean, "truncation_correction": ck.boolean,
+                "refine_edge": partial(ck.integer, minimum=2, maximum=16)}
 #: keys of the sections whose keys do not depend on a gap type or layer law (see :func:`scene_keys`)
 KEYS = {"scene": ("name", "title", "description", "units"), "bodies": ("E_star", *BODY_KEYS, *COATING_KEYS, "hardness"),
         "load": ("force", "approach", "mean_pressure"), "bem": (*BEM_KEYS, *PERIODIC_KEYS),

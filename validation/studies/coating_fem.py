@@ -9,7 +9,10 @@ uncoated pair on a flat coated with a bonded layer of thickness ``t = a_H / (a_H
 - by the BEM (:func:`bem.solve` with ``coating2``) on lattices of step ``a_H / n``, ``n`` in
   ``bem_levels``;
 - by the FEM reference (:func:`fem_reference.solve` with ``coating2``, quadratic triangles, the
-  coating its own material) with ``n_contact_elements`` in ``fem_levels``.
+  coating its own material) with ``n_contact_elements`` in ``fem_levels``, each level with
+  ``fem_across * n / fem_levels[0]`` elements across the coating in the contact zone (so that a thin
+  coating's elements are halved with the level too) and an edge band ``refine_edge = fem_refine_edge``
+  (the interface elements around the computed contact edge that many times smaller).
 
 Measured per level: ``p_max``, the contact radius (the edge of the loaded zone, :func:`bem_edge`
 for the BEM; :func:`fem_reference.result.edge_radius` for the FEM) and the approach. Per method and
@@ -22,7 +25,7 @@ layer, whose pressure has no square-root edge), split into the interior and the 
 (:func:`rms_parts`), with its order and extrapolation. One case carries a root layer ``w = lam sqrt(p)`` on the coating
 (``root_case``, ``root_lam`` in units of ``d_H / sqrt(p_H)``); every case without a layer whose edge-aware RMS
 of ``p(r)`` at the finest levels, or whose difference of an extrapolated ``p_max``, radius or approach, is above
-``refine_above`` is solved one level finer in each method (:func:`refined_pressure`): the RMS of ``p(r)`` of
+``refine_above``, or one of whose levels did not converge, is solved one level finer in each method (:func:`refined_pressure`): the RMS of ``p(r)`` of
 every BEM level against every FEM level, and each method's scalars with their orders and extrapolations from
 its last three levels (``after``). Interface stresses:
 :mod:`validation.studies.coating_fem_stress`.
@@ -55,9 +58,9 @@ RMS_MEASURES = ("linear", "total", "interior", "edge")
 
 #: the full study (SI units); ``*_levels``: ``a_H / step`` of the BEM, ``n_contact_elements`` of the FEM
 SETTINGS = dict(R=0.01, E_s=200e9, nu_s=0.3, a_H=1e-4, a_over_t=(0.1, 1.0, 10.0),
-                modulus_ratios=(0.01, 0.1, 10.0, 100.0), nu_c=(0.25, 0.45), bem_levels=(10, 20, 40),
-                fem_levels=(6, 12, 24), root_case=(1.0, 0.1, 0.25), root_lam=0.1, stresses=True,
-                refine_above=0.005)
+                modulus_ratios=(0.01, 0.1, 10.0, 100.0), nu_c=(0.25, 0.45), bem_levels=(20, 40, 80),
+                fem_levels=(6, 12, 24), fem_across=4, fem_refine_edge=4, root_case=(1.0, 0.1, 0.25), root_lam=0.1,
+                stresses=True, refine_above=0.005)
 #: the small run (``contactlab study coating-fem --quick``): one case
 QUICK = dict(SETTINGS, a_over_t=(1.0,), modulus_ratios=(10.0,), nu_c=(0.25,), root_case=None, refine_above=None)
 
@@ -82,15 +85,17 @@ def richardson(values):
 def bem_edge(res, *, layer=False):
     """The edge of the BEM's loaded zone [length], from its nodes.
 
-    Smooth bodies: ``p^2`` (which vanishes linearly at a square-root edge) over the loaded nodes; with a
-    layer: the overlap taken by the layer, ``w(p)`` inside and ``-gap`` outside (smooth across the edge).
-    A quadratic in ``r`` fitted to it within ``0.4`` area radii of the area radius gives a root; a second
-    fit within three lattice steps of that root gives the edge.
+    Smooth bodies: ``p^2`` (which vanishes linearly at a square-root edge) over the loaded nodes: a
+    quadratic in ``r`` fitted to it within ``0.4`` area radii of the area radius gives a root, a second fit
+    within three lattice steps of that root the edge. With a layer: the overlap taken by the layer,
+    ``w(p)`` inside and ``-gap`` outside, which is smooth and changes sign at the edge (where the area
+    radius lies within a step or two of it, and a wide quadratic misses it by several steps): two fits in
+    turn within three lattice steps, the first around the area radius.
     """
     r = np.hypot(res.x, res.y)
     a = edge = res.contact_radius
     y = np.where(res.p > 0, res.layer.w(res.p), -res.gap) if layer else res.p**2
-    for half in (0.4 * a, 3.0 * res.step):  # a wide fit, then a local one around its root
+    for half in ((3.0 * res.step,) * 2 if layer else (0.4 * a, 3.0 * res.step)):
         band = np.abs(r - edge) < half
         if not layer:
             band &= res.p > 0
@@ -163,6 +168,12 @@ def bem_levels(case, s, layer=None, keep=None):
     return rows, res
 
 
+def _across(s, n):
+    """Elements across the coating at the FEM level ``n``: ``fem_across`` at the study's coarsest level
+    (``fem_base``, default the first of ``fem_levels``), in proportion to ``n`` above it."""
+    return max(s["fem_across"], round(s["fem_across"] * n / s.get("fem_base", s["fem_levels"][0])))
+
+
 def fem_levels(case, s, layer=None, keep=None):
     """The FEM reference at every ``s["fem_levels"]``: ``(rows, finest result)``; with ``s["stresses"]`` each
     converged level's row carries ``stress`` (:func:`~validation.studies.coating_fem_stress.fem_scalars`);
@@ -177,7 +188,8 @@ def fem_levels(case, s, layer=None, keep=None):
     for n in s["fem_levels"]:
         t0 = time.perf_counter()
         res = solve(_gap(s), E1=s["E_s"], nu1=s["nu_s"], E2=s["E_s"], nu2=s["nu_s"], coating2=_coating(case, s),
-                    force=problem(s)[1], layer=layer, n_contact_elements=n)
+                    force=problem(s)[1], layer=layer, n_contact_elements=n, refine_edge=s["fem_refine_edge"],
+                    n_across_coating=_across(s, n))
         rows.append(dict(level=n, converged=bool(res.converged), message=res.message, p_max=float(res.p_max),
                          radius=float(res.edge_radius), approach=float(res.approach), elements=int(res.n_elements),
                          wall_time_s=time.perf_counter() - t0))
@@ -232,8 +244,12 @@ def _stress_levels(case, s, bs, fem_rows, f):
     return out
 
 
-def compare_case(case, s, *, layer=None):
-    """One case: both methods' levels, orders, extrapolated values, differences and interface stresses."""
+def compare_case(case, s, *, layer=None, keep=None):
+    """One case: both methods' levels, orders, extrapolated values, differences and interface stresses;
+    the finest levels' pressures (the BEM's nodes ``x``, ``y``, ``p``; the profile of :func:`fem_levels`) stored in
+    the dict ``keep`` (``"bem"``, ``"fem"``, with ``converged``) when given, for :func:`refined_pressure`."""
+    from types import SimpleNamespace
+
     t0 = time.perf_counter()
     bs, fs = [], []
     b_rows, b = bem_levels(case, s, layer, bs)
@@ -249,25 +265,39 @@ def compare_case(case, s, *, layer=None):
     if s.get("stresses") and f.converged:
         row["stresses"] = _stress_levels(case, s, bs, f_rows, f)
     row["wall_time_s"] = time.perf_counter() - t0
+    if keep is not None:
+        b = bs[-1]
+        keep.update(bem=SimpleNamespace(x=b.x, y=b.y, p=b.p, converged=bool(b.converged)), fem=fs[-1])
     return row
 
 
-def refined_pressure(row, s):
+def refined_pressure(row, s, *, finest=None):
     """One level beyond the study's finest in each method for the case of ``row`` (of :func:`compare_case`): the
     BEM at the last two of ``bem_levels`` doubled once, the FEM likewise. ``rows``: every BEM level against every
     FEM level (``bem``, ``fem``, ``linear`` and the :func:`rms_parts`); ``bem``, ``fem``: the two levels' rows of
     :func:`bem_levels`, :func:`fem_levels`; ``after``: each method's orders and extrapolations of
     :data:`QUANTITIES` from its last three levels (the coarser ones from ``row``) and their differences
-    (``diff``, as in :func:`compare_case`)."""
-    finer = dict(s, bem_levels=(s["bem_levels"][-1], 2 * s["bem_levels"][-1]),
-                 fem_levels=(s["fem_levels"][-1], 2 * s["fem_levels"][-1]), stresses=False)
+    (``diff``, as in :func:`compare_case`). ``finest``: the ``keep`` of :func:`compare_case` for this case (the
+    study's finest levels are then not solved again)."""
+    last = dict(bem_levels=s["bem_levels"][-1:], fem_levels=s["fem_levels"][-1:], fem_base=s["fem_levels"][0])
+    finer = dict(s, **last, stresses=False)
+    finer.update(bem_levels=(2 * last["bem_levels"][0],), fem_levels=(2 * last["fem_levels"][0],))
     t0 = time.perf_counter()
     case = (row["a_over_t"], row["modulus_ratio"], row["nu_c"])
-    bs, fs = [], []
+    if finest is None:
+        bs, fs = [], []
+        bem_levels(case, dict(finer, **last), None, bs)
+        fem_levels(case, dict(finer, **last), None, fs)
+    else:
+        bs, fs = [finest["bem"]], [finest["fem"]]
     b_rows, _ = bem_levels(case, finer, None, bs)
     f_rows, _ = fem_levels(case, finer, None, fs)
-    rows = [dict(bem=nb, fem=nf, linear=rms_nodes(b, f), **rms_parts(b, f))
-            for nb, b in zip(finer["bem_levels"], bs) for nf, f in zip(finer["fem_levels"], fs)]
+    b_rows = row["bem"][-1:] + b_rows
+    f_rows = [{k: v for k, v in r.items() if k != "stress"} for r in row["fem"][-1:]] + f_rows
+    b_levels, f_levels = last["bem_levels"] + finer["bem_levels"], last["fem_levels"] + finer["fem_levels"]
+    levels = [(nb, nf) for nb in b_levels for nf in f_levels]
+    pairs = [(b, f) for b in bs for f in fs]
+    rows = [dict(bem=nb, fem=nf, linear=rms_nodes(b, f), **rms_parts(b, f)) for (nb, nf), (b, f) in zip(levels, pairs)]
     out = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], rows=rows, bem=b_rows, fem=f_rows,
                converged=all(x.converged for x in bs + fs))
     bx, fx = _extrapolate(row["bem"][:-1] + b_rows), _extrapolate(row["fem"][:-1] + f_rows)
@@ -291,14 +321,15 @@ def run_coating_fem(settings=None, *, quick=False, progress=None):
     if s.get("root_case"):
         cases.append((tuple(s["root_case"]), _root(s)))
     t0 = time.perf_counter()
-    rows = [compare_case(c, s, layer=lay) for c, lay in
-            each(cases, progress, lambda c: "a/t = {:g}, Ec/Es = {:g}, nu_c = {:g}".format(*c[0])
-                 + (" + root layer" if c[1] is not None else ""))]
-    above = [r for r in rows if s.get("refine_above") is not None and r["layer"] is None
-             and _worst(r) > s["refine_above"]]
-    refined = [refined_pressure(r, s) for r in
-               each(above, progress, lambda r: "one level finer: a/t = {a_over_t:g}, Ec/Es = {modulus_ratio:g}, "
-                    "nu_c = {nu_c:g}".format(**r))]
+    kept = [{} for _ in cases]
+    rows = [compare_case(c, s, layer=lay, keep=k) for (c, lay), k in
+            zip(each(cases, progress, lambda c: "a/t = {:g}, Ec/Es = {:g}, nu_c = {:g}".format(*c[0])
+                     + (" + root layer" if c[1] is not None else "")), kept)]
+    above = [(r, k) for r, k in zip(rows, kept) if s.get("refine_above") is not None and r["layer"] is None
+             and (_worst(r) > s["refine_above"] or _unordered(r))]
+    refined = [refined_pressure(r, s, finest=k) for r, k in
+               each(above, progress, lambda rk: "one level finer: a/t = {a_over_t:g}, Ec/Es = {modulus_ratio:g}, "
+                    "nu_c = {nu_c:g}".format(**rk[0]))]
     return {"study": STEM, "mode": "quick" if quick else "full", "settings": {k: _listed(v) for k, v in s.items()},
             "rows": rows, "refined": refined, "wall_time_s": time.perf_counter() - t0}
 
@@ -320,6 +351,12 @@ def _worst(row):
     """The largest of a case's edge-aware RMS of ``p(r)`` at the finest levels and its differences of the
     extrapolated :data:`QUANTITIES` (the measures :func:`refined_pressure` refines)."""
     return max([_finest_rms(row) or 0.0] + [abs(row["diff"][q]["extrapolated"]) for q in QUANTITIES])
+
+
+def _unordered(row):
+    """Whether a method of the case has a level that did not converge (its orders then rest on fewer than
+    three levels; :func:`refined_pressure` adds one)."""
+    return not all(r["converged"] for r in row.get("bem", []) + row.get("fem", []))
 
 
 def _edge_aware(row):

@@ -111,8 +111,13 @@ def coating_fem_sections(data, work=None):
     """The figure (with a figures folder ``work``) and the tables: per quantity, p(r) per level, the refined
     cases, the interface stresses."""
     s = data.get("settings", {})
+    band = (f", each solved again with its interface elements {s['fem_refine_edge']} times smaller within one "
+            "element of its contact edge" if s.get("fem_refine_edge") else "")
+    across = (f" and {s['fem_across']} elements across the coating at the coarsest level, in proportion above it"
+              if s.get("fem_across") else "")
     text = [f"{problem_sentence(s)}; the BEM on lattices a_H/step = {s.get('bem_levels')}, the FEM with "
-            f"{s.get('fem_levels')} elements across the contact radius. Orders from the last three levels; "
+            f"{s.get('fem_levels')} elements across the contact radius{across}{band}. Orders from the last three "
+            "levels; "
             "extrapolated values by Richardson with "
             "the observed order where it lies in [0.5, 6] and the differences keep their sign (else the finest "
             "value, '-'). diff = BEM / FEM - 1. RMS of p(r): every BEM node against the FEM's p(r) at its "
@@ -144,8 +149,9 @@ def coating_fem_sections(data, work=None):
         heads, rows = refined_table(data)
         items.append(Table(heads, tuple(rows), caption="The cases whose edge-aware RMS of p(r) at the finest "
                            "levels, or whose difference of an extrapolated p_max, radius or approach, is above "
-                           f"{data['settings'].get('refine_above', 0.005):.2%}, one level finer in "
-                           "each method: RMS of p(r) of every BEM level against every FEM level."))
+                           f"{data['settings'].get('refine_above', 0.005):.2%}, or with a level that did not "
+                           "converge, one level finer in each method: RMS of p(r) of every BEM level against every "
+                           "FEM level."))
         heads, rows = after_table(data)
         if rows:
             items.append(Table(heads, tuple(rows), caption="The same cases' p_max, contact radius and approach "
