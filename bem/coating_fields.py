@@ -205,9 +205,9 @@ def axisymmetric_stress(p, r_max, r, z, coating, E_substrate, nu_substrate, *, s
         Hankel transform of ``p`` (Gauss-Legendre panels graded towards ``r_max``); compression is
         negative. The Hankel integrals converge for ``z > 0``: at the surface itself use ``p``. The radial
         panels are no wider than the shallowest depth; the wavenumber panels are geometric, which resolves
-        the oscillation of ``P(q)`` (period ``2 pi / r_max``) up to ``q ~ 1/z`` for ``z`` down to about
-        ``r_max / 50`` (Hertz on the axis: 1.4e-5 at ``z = r_max/50``, 5.5e-4 at ``r_max/100`` with
-        ``n_q = 2048``); shallower points need a larger ``n_q``.
+        the oscillation of ``P(q)`` (period ``2 pi / r_max``) up to ``q ~ 1/z`` less well the shallower the
+        point (Hertz on the axis with ``n_q = 2048``: 2.4e-5 at ``z = r_max/50``, 1.7e-3 at ``r_max/100``;
+        with the default ``n_q``, 2.6e-3 at ``r_max/400``): shallower points need a larger ``n_q``.
     """
     from scipy.special import j0, j1
 

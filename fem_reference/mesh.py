@@ -15,7 +15,7 @@ A body may carry a coating of thickness ``t`` (``coating_thickness``): a line at
 (upper) or ``z = -t`` (lower) splits its rectangle into the coating and the substrate, meshed
 conformingly (bonded: the two share the nodes of that line), with at least
 ``N_ACROSS_COATING`` elements across ``t`` in the fine zone and elements no larger than ``t``
-along the whole coating; a bond deeper than the contact is refined near the axis (:func:`_size_field`).
+along the whole coating; a bond deeper than the contact is refined near the axis (:func:`fem_reference.sizes.size_field`).
 An optional edge band (``edge``) refines the interface around a known contact edge.
 
 Both rectangles are meshed in one gmsh model that shares the interface curve,
@@ -36,15 +36,15 @@ boundaries split per body (``interface_upper``, ``interface_lower``,
 from __future__ import annotations
 
 import logging
-import math
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from bem.checks import InputError, check_int, check_positive, fail
+from bem.checks import InputError, check_int, check_positive
 
 from .gmsh_session import start_gmsh
+from .sizes import N_ACROSS_COATING, check_edge, size_field
 
 __all__ = ["AxiMesh", "build_mesh", "BOUNDARIES"]
 
@@ -55,8 +55,6 @@ BOUNDARIES = {"interface_upper": ("interface", "upper"), "interface_lower": ("in
               "axis_upper": ("axis", "upper"), "axis_lower": ("axis", "lower"), "top": ("top", "upper"),
               "bottom": ("bottom", "lower"), "outer_upper": ("outer", "upper"), "outer_lower": ("outer", "lower")}
 BODIES = ("upper", "lower")
-#: Elements across a coating's thickness in the fine zone (at least).
-N_ACROSS_COATING = 4
 _TRIANGLE6 = 9  # gmsh element type: 6-node second-order triangle
 _LINE3 = 8  # gmsh element type: 3-node second-order line
 
@@ -195,60 +193,6 @@ def _geometry(gmsh, R, H, thickness=(None, None)):
     return p0, surfaces, curves, groups
 
 
-def _threshold(fld, distance, size, h_coarse, radius, growth):
-    """Size ``size`` where the field ``distance`` is below ``radius``, growing with slope ``growth``."""
-    thr = fld.add("Threshold")
-    fld.setNumber(thr, "InField", distance)
-    fld.setNumber(thr, "SizeMin", size)
-    fld.setNumber(thr, "SizeMax", h_coarse)
-    fld.setNumber(thr, "DistMin", radius)
-    fld.setNumber(thr, "DistMax", radius + max(h_coarse - size, 0.0) / growth)
-    return thr
-
-
-def _size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=(), a_est=None, across=N_ACROSS_COATING,
-                edge=None):
-    """Size ``h_fine`` within ``fine_radius`` of the origin, growing linearly (slope ``growth``).
-
-    ``coatings``: ``(z_low, z_high, t)`` per coating strip. Each caps the size at ``t`` along the
-    whole strip and at ``t / across`` in its part within ``fine_radius`` (both growing
-    with the same slope outside), the smallest size applying. A bond deeper than ``a_est`` gets sizes
-    ``h_fine t / a_est`` within ``fine_radius t / a_est`` of its point on the axis. ``edge = (r_e, k)``:
-    sizes ``h_fine / k`` within ``h_fine`` of the interface point ``(r_e, 0)``.
-    """
-    fld = gmsh.model.mesh.field
-    dist = fld.add("Distance")
-    fld.setNumbers(dist, "PointsList", [origin])
-    fields = [_threshold(fld, dist, h_fine, h_coarse, fine_radius, growth)]
-    if edge is not None:
-        ring = fld.add("MathEval")
-        fld.setString(ring, "F", f"Sqrt((x - {float(edge[0])!r})^2 + y^2)")
-        fields.append(_threshold(fld, ring, h_fine / edge[1], h_coarse, h_fine, growth))
-    for z_low, z_high, t in coatings:
-        if t > a_est:  # a deep bond: sizes h_fine t / a_est within fine_radius t / a_est of its axis point
-            bond = fld.add("MathEval")
-            fld.setString(bond, "F", f"Sqrt(x^2 + (y - ({z_low if z_low < 0 else z_high!r}))^2)")
-            fields.append(_threshold(fld, bond, h_fine * t / a_est, h_coarse, fine_radius * t / a_est, growth))
-        boxes = [(math.inf, t)]
-        if t / across < h_fine:
-            boxes.append((fine_radius, t / across))
-        for x_max, size in boxes:
-            box = fld.add("Box")
-            fld.setNumber(box, "VIn", size)
-            fld.setNumber(box, "VOut", h_coarse)
-            fld.setNumber(box, "XMin", -1.0)
-            fld.setNumber(box, "XMax", min(x_max, 1e300))
-            fld.setNumber(box, "YMin", z_low)
-            fld.setNumber(box, "YMax", z_high)
-            fld.setNumber(box, "ZMin", -1.0)
-            fld.setNumber(box, "ZMax", 1.0)
-            fld.setNumber(box, "Thickness", max(h_coarse - size, 0.0) / growth)
-            fields.append(box)
-    smallest = fld.add("Min")
-    fld.setNumbers(smallest, "FieldsList", fields)
-    fld.setAsBackgroundMesh(smallest)
-
-
 def _extract(gmsh, surfaces, curves, thickness=(None, None)):
     """Per-body node/element arrays with the interface nodes duplicated."""
     tags, coords, _ = gmsh.model.mesh.getNodes()
@@ -344,16 +288,6 @@ def _thicknesses(coating_thickness):
                  for k, t in enumerate(coating_thickness))
 
 
-def _edge(edge, fine):
-    """``edge = (r_e, k)`` of :func:`build_mesh`, checked."""
-    if not (isinstance(edge, (tuple, list)) and len(edge) == 2):
-        fail("edge", edge, "a pair (r_e, k): the edge radius [length] and the refinement factor")
-    r_e = check_positive("edge[0]", edge[0])
-    if r_e >= fine:
-        fail("edge[0]", r_e, f"inside the fine zone, below fine_radius * a_est = {fine!r}")
-    return r_e, check_int("edge[1]", edge[1], minimum=2)
-
-
 def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=1.5, growth=0.25, h_coarse=None,
                coating_thickness=(None, None), n_across_coating=N_ACROSS_COATING, edge=None):
     """Mesh the two bodies with gmsh and convert the mesh to scikit-fem.
@@ -398,7 +332,7 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
     thickness = _thicknesses(coating_thickness)
     across = check_int("n_across_coating", n_across_coating, minimum=N_ACROSS_COATING)
     if edge is not None:
-        edge = _edge(edge, fine_radius * a_est)
+        edge = check_edge(edge, fine_radius * a_est)
     R = H = domain_factor * max([a_est] + [t for t in thickness if t])
     h_fine = a_est / int(n_contact_elements)
     h_coarse = R / 8.0 if h_coarse is None else check_positive("h_coarse", h_coarse)
@@ -412,7 +346,7 @@ def build_mesh(a_est, *, n_contact_elements=16, domain_factor=40.0, fine_radius=
         gmsh.model.add("contactlab_axisymmetric")
         origin, surfaces, curves, groups = _geometry(gmsh, R, H, thickness)
         strips = [(0.0, t, t) if k == 0 else (-t, 0.0, t) for k, t in enumerate(thickness) if t]
-        _size_field(gmsh, origin, h_fine, h_coarse, fine_radius * a_est, growth, strips, a_est, across, edge)
+        size_field(gmsh, origin, h_fine, h_coarse, fine_radius * a_est, growth, strips, a_est, across, edge)
         gmsh.model.mesh.generate(2)
         gmsh.model.mesh.setOrder(2)
         xy, parts = _extract(gmsh, surfaces, curves, thickness)

@@ -104,7 +104,7 @@ def solve(gap, *, E1, nu1, E2, nu2, coating1=None, coating2=None, force=None, ap
         substrate where the body is coated.
     coating1, coating2 : bem.coating.Coating, optional
         A coating bonded to body 1 or 2 (``nu <= 0.499``), meshed as its own material with
-        at least ``fem_reference.mesh.N_ACROSS_COATING`` elements across its thickness in the
+        at least ``fem_reference.sizes.N_ACROSS_COATING`` elements across its thickness in the
         contact zone. ``E_star`` (penalty scale, radius estimate) stays the substrates'.
     force, approach : float
         Exactly one: total force ``P`` [force] (force control: ``delta`` is an extra
@@ -134,7 +134,7 @@ def solve(gap, *, E1, nu1, E2, nu2, coating1=None, coating2=None, force=None, ap
         edge band. Not with a prebuilt ``mesh``.
     n_across_coating : int
         Elements across a coating's thickness in the fine zone (at least
-        ``fem_reference.mesh.N_ACROSS_COATING``).
+        ``fem_reference.sizes.N_ACROSS_COATING``).
     rtol : float
         Newton stopping rule (:mod:`fem_reference.newton`), in ``(0, bem.checks.RTOL_MAX]`` as for
         :func:`bem.solve`: a looser one accepts a wrong answer as converged.

@@ -11,7 +11,7 @@ from bem.checks import InputError
 from bem.coating import Coating, mode_compliance
 from bem.gaps import Paraboloid
 from fem_reference import build_mesh, solve
-from fem_reference.mesh import N_ACROSS_COATING
+from fem_reference.sizes import N_ACROSS_COATING
 from fem_reference.model import AxiModel
 
 E, NU = 1.0, 0.3

@@ -209,3 +209,25 @@ def test_the_bem_edge_with_a_layer_is_where_the_overlap_changes_sign():
         k = int(np.nonzero(y > 0)[0][-1])
         crossing = x[k] + (x[k + 1] - x[k]) * y[k] / (y[k] - y[k + 1])
         assert abs(bem_edge(res, layer=True) - crossing) < 0.25 * res.step, n
+
+
+def test_a_level_that_stops_is_solved_again_on_a_mesh_sized_by_the_finest_converged_radius(monkeypatch):
+    """fem_levels: a level that did not converge is solved once more with ``a_est`` = the contact radius of the
+    finest converged level; its row keeps the first attempt (``first``)."""
+    from validation.studies import coating_fem
+
+    calls = []
+
+    def level(case, s, layer, n, a_est=None):
+        calls.append((n, a_est))
+        ok = n > 6 or a_est is not None
+        res = SimpleNamespace(converged=ok, edge_radius=1e-4 * n / 12, r=np.zeros(2), p=np.zeros(2))
+        return dict(level=n, converged=ok, a_est=a_est), res
+
+    monkeypatch.setattr(coating_fem, "_fem_level", level)
+    keep = []
+    rows, finest = coating_fem.fem_levels(CASE, dict(SETTINGS), keep=keep)
+    assert calls == [(6, None), (12, None), (24, None), (6, 2e-4)]
+    assert [r["converged"] for r in rows] == [True] * 3 and rows[0]["first"] == dict(level=6, converged=False,
+                                                                                        a_est=None)
+    assert [k.converged for k in keep] == [True] * 3 and finest.edge_radius == 2e-4

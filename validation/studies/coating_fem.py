@@ -174,30 +174,52 @@ def _across(s, n):
     return max(s["fem_across"], round(s["fem_across"] * n / s.get("fem_base", s["fem_levels"][0])))
 
 
-def fem_levels(case, s, layer=None, keep=None):
-    """The FEM reference at every ``s["fem_levels"]``: ``(rows, finest result)``; with ``s["stresses"]`` each
-    converged level's row carries ``stress`` (:func:`~validation.studies.coating_fem_stress.fem_scalars`);
-    each level's ``p(r)`` (``r``, ``p``, ``edge_radius``, ``converged``) appended to the list ``keep`` when given."""
-    from types import SimpleNamespace
-
+def _fem_level(case, s, layer, n, a_est=None):
+    """One FEM level: its row and result."""
     from fem_reference import solve
 
     from .coating_fem_stress import fem_scalars
 
-    rows, res = [], None
+    t0 = time.perf_counter()
+    res = solve(_gap(s), E1=s["E_s"], nu1=s["nu_s"], E2=s["E_s"], nu2=s["nu_s"], coating2=_coating(case, s),
+                force=problem(s)[1], layer=layer, n_contact_elements=n, refine_edge=s["fem_refine_edge"],
+                n_across_coating=_across(s, n), a_est=a_est)
+    row = dict(level=n, converged=bool(res.converged), message=res.message, p_max=float(res.p_max),
+               radius=float(res.edge_radius), approach=float(res.approach), elements=int(res.n_elements),
+               a_est=res.mesh["a_est"], wall_time_s=time.perf_counter() - t0)
+    if s.get("stresses") and res.converged:
+        row["stress"] = fem_scalars(res, _coating(case, s))
+    return row, res
+
+
+def fem_levels(case, s, layer=None, keep=None):
+    """The FEM reference at every ``s["fem_levels"]``: ``(rows, finest result)``; with ``s["stresses"]`` each
+    converged level's row carries ``stress`` (:func:`~validation.studies.coating_fem_stress.fem_scalars`);
+    each level's ``p(r)`` (``r``, ``p``, ``edge_radius``, ``converged``) appended to the list ``keep`` when given.
+
+    A level that does not converge on the mesh sized by the estimated radius (the FEM's default ``a_est``, the
+    substrate's Hertz radius) is solved once more on a mesh sized by the contact radius of the finest level that
+    converged (as the FEM's own re-mesh does after a converged solve): a thick soft coating makes the contact
+    several times larger than the estimate, and the coarsest meshes sized by the estimate can give a truncation
+    correction that leaves the interface compliance indefinite. Its row keeps ``first``, the first attempt's row.
+    """
+    from types import SimpleNamespace
+
+    rows, results = [], []
     for n in s["fem_levels"]:
-        t0 = time.perf_counter()
-        res = solve(_gap(s), E1=s["E_s"], nu1=s["nu_s"], E2=s["E_s"], nu2=s["nu_s"], coating2=_coating(case, s),
-                    force=problem(s)[1], layer=layer, n_contact_elements=n, refine_edge=s["fem_refine_edge"],
-                    n_across_coating=_across(s, n))
-        rows.append(dict(level=n, converged=bool(res.converged), message=res.message, p_max=float(res.p_max),
-                         radius=float(res.edge_radius), approach=float(res.approach), elements=int(res.n_elements),
-                         wall_time_s=time.perf_counter() - t0))
-        if s.get("stresses") and res.converged:
-            rows[-1]["stress"] = fem_scalars(res, _coating(case, s))
-        if keep is not None:
-            keep.append(SimpleNamespace(r=res.r, p=res.p, edge_radius=float(res.edge_radius), converged=res.converged))
-    return rows, res
+        row, res = _fem_level(case, s, layer, n)
+        rows.append(row)
+        results.append(res)
+    done = [res for res in results if res.converged]
+    for i, res in enumerate(results):
+        if not res.converged and done:
+            first = rows[i]
+            rows[i], results[i] = _fem_level(case, s, layer, s["fem_levels"][i], float(done[-1].edge_radius))
+            rows[i]["first"] = first
+    if keep is not None:
+        keep.extend(SimpleNamespace(r=res.r, p=res.p, edge_radius=float(res.edge_radius), converged=res.converged)
+                    for res in results)
+    return rows, results[-1]
 
 
 def _extrapolate(rows, names=QUANTITIES):
