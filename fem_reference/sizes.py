@@ -24,7 +24,7 @@ def _threshold(fld, distance, size, h_coarse, radius, growth):
 
 
 def size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=(), a_est=None, across=N_ACROSS_COATING,
-                edge=None):
+               edge=None):
     """Size ``h_fine`` within ``fine_radius`` of the origin, growing linearly (slope ``growth``).
 
     ``coatings``: ``(z_low, z_high, t)`` per coating strip. Each caps the size at ``t`` along the
@@ -66,9 +66,8 @@ def size_field(gmsh, origin, h_fine, h_coarse, fine_radius, growth, coatings=(),
     fld.setAsBackgroundMesh(smallest)
 
 
-
 def check_edge(edge, fine):
-    """``edge = (r_e, k)`` of :func:`build_mesh`, checked."""
+    """``edge = (r_e, k)`` of :func:`fem_reference.build_mesh` with ``fine = fine_radius a_est``, checked."""
     if not (isinstance(edge, (tuple, list)) and len(edge) == 2):
         fail("edge", edge, "a pair (r_e, k): the edge radius [length] and the refinement factor")
     r_e = check_positive("edge[0]", edge[0])

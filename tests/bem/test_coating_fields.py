@@ -99,7 +99,7 @@ def test_hertz_pressure_on_equal_materials_gives_johnsons_stresses_on_the_axis()
     assert np.argmax(vm) == 2 and vm[2] == pytest.approx(0.62 * p0, rel=0.01)  # the maximum at z = 0.48 a
     # shallow points: the radial panels follow the shallowest depth (measured 1.7e-3 at z = 0.01 a and 9.9e-6 at
     # 0.02 a; with 16 uniform panels over [0, a/2] whatever the depth: 0.21 and 1.9e-3); a single point at
-    # a / 400 with the default n_q: 2.6e-3 (with the fixed panels 38 times p0 off at n_q = 2048)
+    # a / 400 with the default n_q: 2.6e-3 (with the fixed panels 23 times off)
     x = np.array([0.01, 0.02])
     s = axisymmetric_stress(lambda r: p0 * np.sqrt(np.clip(1 - (r / a) ** 2, 0, None)), a, [0.0], x * a,
                             Coating(0.5 * a, 2e11, nu), 2e11, nu, n_q=2048)

@@ -124,3 +124,17 @@ def test_bad_coatings_are_refused():
         solve(gap, E1=E, nu1=NU, E2=E, nu2=NU, coating2=Coating(0.1, E, 0.3), force=1e-3, mesh=mesh)
     with pytest.raises(InputError, match=r"^coating_thickness\[1\] = -1\.0 "):
         build_mesh(0.1, coating_thickness=(None, -1.0))
+
+
+def test_more_elements_across_the_coating_when_asked():
+    """``n_across_coating = 8``: the coating's elements in the fine zone at most 1.5 t / 8 (the default four:
+    not)."""
+    t = 0.2
+    for across in (N_ACROSS_COATING, 8):
+        m = build_mesh(1.0, n_contact_elements=6, domain_factor=30.0, coating_thickness=(None, t),
+                       n_across_coating=across)
+        p, tri = m.mesh.p, m.mesh.t
+        near = m.coated & (p[:, tri].mean(axis=1)[0] < m.fine_radius - t)
+        longest = np.linalg.norm(np.roll(p[:, tri[:, near]], 1, axis=1) - p[:, tri[:, near]], axis=0).max()
+        assert m.n_across_coating == across
+        assert (longest <= 1.5 * t / 8) == (across == 8), (across, longest / (t / 8))

@@ -137,12 +137,14 @@ def test_one_level_finer_extends_each_methods_sequence_for_its_orders_and_extrap
     def level(method, n, c):
         return dict(level=n, converged=True, **{q: v * (1.0 + c / n**2) for q, v in q0[method].items()})
 
-    calls = []
+    calls, across = [], []
 
     def levels(method, c):
         def run(case, s, layer=None, keep=None):
             ns = s[f"{method}_levels"]
             calls.append((method, tuple(ns)))
+            if method == "fem":  # the coating's elements at the study's scale: 4 n / 6 across
+                across.extend(coating_fem._across(s, n) for n in ns)
             keep.extend(SimpleNamespace(n=n, converged=True) for n in ns)
             return [level(method, n, c) for n in ns], None
         return run
@@ -160,10 +162,11 @@ def test_one_level_finer_extends_each_methods_sequence_for_its_orders_and_extrap
     monkeypatch.setattr(coating_fem, "rms_parts", lambda b, f: solved.append((b.n, f.n)) or parts)
     finest = dict(bem=SimpleNamespace(n=40, converged=True), fem=SimpleNamespace(n=24, converged=True))
     for given in (None, finest):  # the finest levels solved again, or taken from compare_case's keep
-        solved.clear(), calls.clear()
+        solved.clear(), calls.clear(), across.clear()
         out = coating_fem.refined_pressure(row, s, finest=given)
         again = [("bem", (40,)), ("fem", (24,))] if given is None else []
         assert calls == again + [("bem", (80,)), ("fem", (48,))]
+        assert across == ([16] if given is None else []) + [32]
         assert [r["level"] for r in out["bem"]] == [40, 80] and [r["level"] for r in out["fem"]] == [24, 48]
         assert [(r["bem"], r["fem"]) for r in out["rows"]] == [(40, 24), (40, 48), (80, 24), (80, 48)] == solved
         after = out["after"]

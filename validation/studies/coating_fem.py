@@ -301,25 +301,20 @@ def refined_pressure(row, s, *, finest=None):
     :data:`QUANTITIES` from its last three levels (the coarser ones from ``row``) and their differences
     (``diff``, as in :func:`compare_case`). ``finest``: the ``keep`` of :func:`compare_case` for this case (the
     study's finest levels are then not solved again)."""
-    last = dict(bem_levels=s["bem_levels"][-1:], fem_levels=s["fem_levels"][-1:], fem_base=s["fem_levels"][0])
-    finer = dict(s, **last, stresses=False)
-    finer.update(bem_levels=(2 * last["bem_levels"][0],), fem_levels=(2 * last["fem_levels"][0],))
+    nb, nf = s["bem_levels"][-1], s["fem_levels"][-1]
+    base = dict(s, stresses=False, fem_base=s["fem_levels"][0])  # the coating's elements keep the study's scale
     t0 = time.perf_counter()
     case = (row["a_over_t"], row["modulus_ratio"], row["nu_c"])
+    bs, fs = ([], []) if finest is None else ([finest["bem"]], [finest["fem"]])
     if finest is None:
-        bs, fs = [], []
-        bem_levels(case, dict(finer, **last), None, bs)
-        fem_levels(case, dict(finer, **last), None, fs)
-    else:
-        bs, fs = [finest["bem"]], [finest["fem"]]
-    b_rows, _ = bem_levels(case, finer, None, bs)
-    f_rows, _ = fem_levels(case, finer, None, fs)
+        bem_levels(case, dict(base, bem_levels=(nb,)), None, bs)
+        fem_levels(case, dict(base, fem_levels=(nf,)), None, fs)
+    b_rows, _ = bem_levels(case, dict(base, bem_levels=(2 * nb,)), None, bs)
+    f_rows, _ = fem_levels(case, dict(base, fem_levels=(2 * nf,)), None, fs)
     b_rows = row["bem"][-1:] + b_rows
     f_rows = [{k: v for k, v in r.items() if k != "stress"} for r in row["fem"][-1:]] + f_rows
-    b_levels, f_levels = last["bem_levels"] + finer["bem_levels"], last["fem_levels"] + finer["fem_levels"]
-    levels = [(nb, nf) for nb in b_levels for nf in f_levels]
-    pairs = [(b, f) for b in bs for f in fs]
-    rows = [dict(bem=nb, fem=nf, linear=rms_nodes(b, f), **rms_parts(b, f)) for (nb, nf), (b, f) in zip(levels, pairs)]
+    rows = [dict(bem=i, fem=j, linear=rms_nodes(b, f), **rms_parts(b, f))
+            for i, b in zip((nb, 2 * nb), bs) for j, f in zip((nf, 2 * nf), fs)]
     out = dict(a_over_t=case[0], modulus_ratio=case[1], nu_c=case[2], rows=rows, bem=b_rows, fem=f_rows,
                converged=all(x.converged for x in bs + fs))
     bx, fx = _extrapolate(row["bem"][:-1] + b_rows), _extrapolate(row["fem"][:-1] + f_rows)
