@@ -311,7 +311,7 @@ def _masked_gap(bk, mask, h):
 
 
 def constrained_cg(op, h, *, lam=0.0, precondition=True, contact=None, **kw):
-    """:func:`solve_qp` with the preconditioner of ``op``: the FFT inverse of ``C + lam``
+    """:func:`solve_qp` with the preconditioner of ``op``: the FFT inverse of ``C + lam`` in single precision
     (:meth:`bem.operator.InfluenceOperator.preconditioner`) for a uniform ``lam``, and
     :func:`compliance_preconditioner` on ``contact`` for a ``lam`` per node; none unless
     ``precondition``. The constrained-CG step of an operator without one of its own."""
@@ -320,7 +320,7 @@ def constrained_cg(op, h, *, lam=0.0, precondition=True, contact=None, **kw):
     elif is_per_node(lam):
         precond = compliance_preconditioner(op, lam, contact)
     else:
-        precond = op.preconditioner(lam=lam)
+        precond = op.preconditioner(lam=lam, single=True)
     return solve_qp(op, h, lam=lam, preconditioner=precond, **kw)
 
 
@@ -329,14 +329,14 @@ def compliance_preconditioner(op, D, contact, threshold=4.0):
 
     Nodes whose layer compliance dominates (``D > threshold * C_nn``) are nearly
     decoupled: Jacobi ``r / (C_nn + D)``. The others get the FFT inverse of
-    ``C + lam`` with ``lam`` the median of their ``D`` on the contact.
+    ``C + lam`` (in single precision) with ``lam`` the median of their ``D`` on the contact.
     """
     bk, _ = operator_backend(op)
     xp = bk.xp
     stiff = D <= threshold * op.diagonal
     sel = stiff & contact
     lam = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
-    fft = op.preconditioner(lam=lam)
+    fft = op.preconditioner(lam=lam, single=True)
     jacobi = 1.0 / (op.diagonal + D)
     if bool(xp.all(stiff)):
         return fft

@@ -229,14 +229,18 @@ class InfluenceOperator:
         box = self._reuse("C", box, size) or box
         return box, self._cached(("C", box), lambda: self._kernel_spectra(full, box))
 
-    def _convolve(self, spectra, shape, v, in_box, out_box, out):
-        """``out[out_box] = sum_b S_ab v_b[in_box]``; other entries of ``out`` are left alone."""
+    def _convolve(self, spectra, shape, v, in_box, out_box, out, single=False):
+        """``out[out_box] = sum_b S_ab v_b[in_box]``; other entries of ``out`` are left alone (``single``: the
+        transforms in single precision, with single-precision spectra)."""
         (i_rows, (iq, bq)), (o_rows, (oq, nq)) = in_box, out_box
         bk = self.backend
-        data = bk.xp.zeros((2, max(r[1] for r in i_rows), bq), dtype=bk.float64)
+        xp = bk.xp
+        dtype = xp.float32 if single else bk.float64
+        data = xp.zeros((2, max(r[1] for r in i_rows), bq), dtype=dtype)
         for b, s in enumerate(self._start):  # the rows of parity b: brick rows s, s + 2, ...
             k0, nb = i_rows[b]
-            data[b, :nb, :] = v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq]
+            rows = v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq]
+            data[b, :nb, :] = rows if rows.dtype == dtype else xp.astype(rows, dtype)
         V = block_product(spectra, bk.forward(data, shape))
         del data
         split = V[0, ...].size > SPLIT_INVERSE  # large: one parity at a time, half the inverse's output held at once
@@ -244,7 +248,7 @@ class InfluenceOperator:
         for a, s in enumerate(self._start):
             k0, na = o_rows[a]
             part = bk.inverse(V[a, ...], shape, (na, nq)) if split else both[a, :na, :]
-            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = part
+            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = part if part.dtype == out.dtype else xp.astype(part, out.dtype)
         if self._masked_last:
             out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 
@@ -273,7 +277,7 @@ class InfluenceOperator:
 
         return constrained_cg(self, h, lam=lam, precondition=precondition, contact=contact, **kw)
 
-    def preconditioner(self, lam=0.0, floor=0.5, box="support"):
+    def preconditioner(self, lam=0.0, floor=0.5, box="support", single=False):
         """FFT preconditioner ``z ~ (C + lam I)^-1 r`` for the conjugate gradients.
 
         The inverse of the 2 x 2 block symbol of the zero-padded (circulant)
@@ -297,6 +301,11 @@ class InfluenceOperator:
             whole candidate region, one SPD operator for every ``r``. Where the
             contact is small ``"support"`` is cheaper for as many iterations
             (``benchmarks/side_by_side.py``; ``docs/performance.md``).
+        single : bool
+            Apply it in single precision (its symbol rounded to single precision, the transforms of ``r``
+            in single precision; the output in double precision): half the memory of the symbol and
+            about half the time of the transforms, for a preconditioner of the constrained CG, which only
+            approximates ``(C + lam I)^-1``.
 
         Returns
         -------
@@ -320,16 +329,22 @@ class InfluenceOperator:
                 box = self._full()
             if box not in symbols:
                 symbols.clear()  # one box at a time: the contact moves rarely
-                symbols[box] = self._inverse_symbol(box, lam, floor)  # its spectra are not kept
+                symbols[box] = self._inverse_symbol(box, lam, floor, single)  # its spectra are not kept
             shape, spectra = symbols[box]
-            self._convolve(spectra, shape, r, box, box, out)
+            self._convolve(spectra, shape, r, box, box, out, single)
             return out
 
         return apply
 
-    def _inverse_symbol(self, box, lam, floor):
-        """``(shape, S)``: the spectra of ``(K + lam)^-1`` for the symbol ``K`` of ``box`` (:func:`bem.block_symbol.inverse_symbol`)."""
-        return inverse_symbol(self.backend, lambda: self._kernel_spectra(box, box), lam, floor, self.diagonal)
+    def _inverse_symbol(self, box, lam, floor, single=False):
+        """``(shape, S)``: the spectra of ``(K + lam)^-1`` for the symbol ``K`` of ``box`` (:func:`bem.block_symbol.inverse_symbol`),
+        rounded to single precision where ``single``."""
+        shape, S = inverse_symbol(self.backend, lambda: self._kernel_spectra(box, box), lam, floor, self.diagonal)
+        if single:  # the diagonal blocks are real, S_10 = conj(S_01) is not stored
+            xp = self.backend.xp
+            (s00, s01), (_, s11) = S
+            S = ((xp.astype(s00, xp.float32), xp.astype(s01, xp.complex64)), (None, xp.astype(s11, xp.float32)))
+        return shape, S
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""

@@ -316,7 +316,7 @@ class PeriodicOperator:
 
         return constrained_cg(self, h, lam=lam, precondition=precondition, contact=contact, **kw)
 
-    def preconditioner(self, lam=0.0):
+    def preconditioner(self, lam=0.0, single=False):
         """``z = (C + lam I)^-1 r`` on the whole cell, by the inverse 2 x 2 block symbol.
 
         Exact for a contact over the whole cell. The constant mode, where ``C`` vanishes
@@ -327,12 +327,24 @@ class PeriodicOperator:
         ----------
         lam : float
             Uniform layer compliance [length/pressure] added on the diagonal.
+        single : bool
+            On NumPy: the symbol and the transforms in single precision (the output in double
+            precision), as the preconditioner of :func:`bem.periodic.qp.solve_periodic_qp`; on a
+            device it runs in double precision.
 
         Returns
         -------
         callable
             ``M(r)`` on brick arrays.
         """
+        if self.backend.is_numpy and single:
+            m32 = self.symbol(lam, inverse=True, single=True)
+
+            def apply32(r):
+                x = self.spectrum(np.asarray(r, dtype=np.float32))
+                return self.brick(self.mix(x, m32, out=x), overwrite=True).astype(np.float64)
+
+            return apply32
         if self.backend.is_numpy:
             i00, i01, i10, i11 = self.symbol(lam, inverse=True), None, None, None
         else:

@@ -157,7 +157,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         stiff = D <= threshold * diag
         sel = stiff & (p > 0)
         lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
-        jacobi = 1.0 / (diag + D)  # the Jacobi estimate 1 / (C_nn + D), read at the soft and entering nodes
+        jacobi = 1.0 / (diag + D) if hardness is not None else None  # 1 / (C_nn + D), for bounded_move
         soft = None if bool(xp.all(stiff)) else ~stiff
     else:
         lam_pc, jacobi = lam, 1.0 / (diag + lam)
@@ -172,7 +172,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if buf32 is None:
             return bk.put(xp.zeros(lat.shape, dtype=xp.float32), nodes, xp.astype(values, xp.float32))
         buf32.fill(0.0)  # a fill: faster than zeroing the nodes of the last step
-        buf32.reshape(-1)[nodes] = values
+        buf32.reshape(-1)[nodes] = values.astype(np.float32)  # rounded first: a faster scatter, the same values
         return buf32
 
     def product(v):
@@ -183,13 +183,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         x = op.spectrum(v)
         return op.mix(x, A, out=x)
 
-    def precondition(r32, nodes, r_c):  # M r at the nodes: r_c = r there, r32 = r (float32) at the stiff nodes
-        x = op.spectrum(r32)
+    def precondition(r32, nodes, r_c, soft_c, jac_c):  # M r at the nodes: r_c = r there, r32 = r (float32) at the
+        x = op.spectrum(r32)  # stiff nodes; soft_c, jac_c: the soft nodes and 1 / (C_nn + D) there (None: none soft)
         z = xp.astype(bk.take(op.brick(op.mix(x, M, out=x), overwrite=True), nodes), xp.float64)
-        return z if soft is None else xp.where(bk.take(soft, nodes), jacobi_at(nodes) * r_c, z)
+        return z if soft_c is None else xp.where(soft_c, jac_c * r_c, z)
 
-    def jacobi_at(nodes):  # 1 / (C_nn + D) at the nodes
-        return bk.take(jacobi, nodes)
+    def jacobi_at(nodes, D_n=None):  # 1 / (C_nn + D) at the nodes (D_n: D there, where the caller has it)
+        return 1.0 / (diag + (bk.take(D, nodes) if D_n is None else D_n))
 
     def add_at(x, nodes, values):  # x += values at the nodes, in x's precision
         bk.put(x, nodes, xp.astype(bk.take(x, nodes) + values, x.dtype, copy=False))
@@ -282,8 +282,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if bounded and not bk.count(idx):  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
         t_old = bk.take(t, idx)  # the last direction on the contact (float32)
+        D_c = bk.take(D, idx) if per_node else None  # D, its soft nodes and 1 / (C_nn + D) on the contact
+        soft_c = None if soft is None else ~(D_c <= threshold * diag)
+        jac_c = None if soft is None else jacobi_at(idx, D_c)
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        z = precondition(f32_at(idx, g_c if soft is None else xp.where(bk.take(stiff, idx), g_c, 0.0)), idx, g_c)
+        z = precondition(f32_at(idx, g_c if soft is None else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
         if force is not None and soft is None:
             z -= xp.mean(z)
         elif force is not None:
@@ -293,7 +296,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 x = op.spectrum(xp.astype((p > 0) & stiff, xp.float32))  # M (contact & stiff)
                 m_full = op.brick(op.mix(x, M, out=x), overwrite=True)  # single precision, kept so
             # and the Jacobi estimate at the soft nodes
-            m_one = xp.where(bk.take(soft, idx), jacobi_at(idx), xp.astype(bk.take(m_full, idx), xp.float64))
+            m_one = xp.where(soft_c, jac_c, xp.astype(bk.take(m_full, idx), xp.float64))
             if not float(xp.sum(m_one)) > 0:  # a contact far from the starting one: the mean instead
                 m_one = xp.ones(bk.count(idx), dtype=xp.float64)
             z -= m_one * (float(xp.sum(z)) / float(xp.sum(m_one)))
@@ -315,7 +318,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         R = r_hat = op.mix(T, A32, out=r_hat)  # (C + lam) t, single precision
         tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
         if per_node:
-            D_c = bk.take(D, idx)
             tt += weighted_square(bk, D_c, t_c)
         if not bool(xp.any(t_c != 0)):
             tau = 0.0  # a single contact node under force control: only entering nodes can move

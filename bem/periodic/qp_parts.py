@@ -1,5 +1,6 @@
 """Parts of the periodic cell's constrained CG (:mod:`bem.periodic.qp`) with one form on NumPy and one on
-every other array namespace (the same numbers, by the operations each namespace has)."""
+every other array namespace (the same quantities, by the operations each namespace has; the rounding each
+states)."""
 
 from __future__ import annotations
 
@@ -27,8 +28,9 @@ class LastPreconditionedGap:
     """The last preconditioned gap ``z`` of the iteration on its contact, read at the nodes of the next contact
     (0 at the nodes that were off it): the ``z_old`` of the Polak-Ribiere+ coefficient.
 
-    On NumPy its (sorted) flat nodes and values, looked up by ``searchsorted``; on other namespaces a brick
-    array, 0 off its contact (a node selection of :class:`bem.backend.Backend` may be a boolean array there).
+    A brick array, 0 off its contact: on NumPy in single precision (a gather from it costs less time than looking
+    the new contact's nodes up among the last one's, for 4 bytes a node); on other namespaces in double precision
+    (a node selection of :class:`bem.backend.Backend` may be a boolean array there).
 
     Parameters
     ----------
@@ -40,24 +42,23 @@ class LastPreconditionedGap:
 
     def __init__(self, bk, shape):
         self.bk, self.shape = bk, shape
-        self.nodes = self.values = None
+        self.values = None
 
     def keep(self, nodes, z):
         """Keep ``z`` (1-D), the values at the node selection ``nodes``."""
-        if self.bk.is_numpy:
-            self.nodes, self.values = nodes, z.copy()
-        else:
-            self.values = self.bk.spread(self.shape, nodes, z)
+        bk = self.bk
+        if not bk.is_numpy:
+            self.values = bk.spread(self.shape, nodes, z)
+            return
+        if self.values is None:
+            self.values = np.empty(self.shape, dtype=np.float32)
+        self.values.fill(0.0)  # a fill of the brick: faster than zeroing the last contact's nodes
+        self.values.reshape(-1)[nodes] = z.astype(np.float32)
 
     def at(self, nodes):
         """The kept ``z`` at the node selection ``nodes`` (1-D, float64), 0 where it was not kept."""
         bk = self.bk
         if self.values is None:
             return bk.xp.zeros(bk.count(nodes), dtype=bk.xp.float64)
-        if not bk.is_numpy:
-            return bk.take(self.values, nodes)
-        if not self.nodes.size:
-            return np.zeros(nodes.size)
-        pos = np.searchsorted(self.nodes, nodes)
-        np.minimum(pos, self.nodes.size - 1, out=pos)
-        return np.where(self.nodes[pos] == nodes, self.values[pos], 0.0)
+        z = bk.take(self.values, nodes)
+        return z.astype(np.float64) if bk.is_numpy else z

@@ -97,3 +97,30 @@ def test_matvec_does_not_modify_input():
     keep = p.copy()
     op.matvec(p)
     np.testing.assert_array_equal(p, keep)
+
+
+@pytest.mark.parametrize("box", ["support", "full"])
+def test_single_precision_preconditioner_is_the_double_one_rounded(box):
+    """``single=True``: the same operator to single precision, double-precision output, input untouched."""
+    lat = Lattice.from_extent(0.05, 1.0)
+    op = InfluenceOperator(lat, 1.0)
+    rng = np.random.default_rng(5)
+    r = np.where(rng.random(lat.shape) < 0.3, rng.standard_normal(lat.shape), 0.0) * lat.mask
+    keep = r.copy()
+    exact = op.preconditioner(lam=0.1, box=box)(r)
+    single = op.preconditioner(lam=0.1, box=box, single=True)(r)
+    np.testing.assert_array_equal(r, keep)
+    assert single.dtype == np.float64 and np.all(single[~lat.mask] == 0)
+    err = np.abs(single - exact).max() / np.abs(exact).max()
+    assert 1e-9 < err < 1e-5  # rounded (not the double product), to single precision
+
+
+def test_periodic_single_precision_preconditioner_is_the_double_one_rounded():
+    from bem.periodic import PeriodicCell, PeriodicOperator
+
+    cell = PeriodicCell(0.1, 32, 24)
+    op = PeriodicOperator(cell, 1.0)
+    r = np.random.default_rng(6).standard_normal(cell.shape)
+    exact, single = op.preconditioner(0.05)(r), op.preconditioner(0.05, single=True)(r)
+    assert single.dtype == np.float64
+    assert 1e-9 < np.abs(single - exact).max() / np.abs(exact).max() < 1e-5
