@@ -248,7 +248,8 @@ class InfluenceOperator:
         for a, s in enumerate(self._start):
             k0, na = o_rows[a]
             part = bk.inverse(V[a, ...], shape, (na, nq)) if split else both[a, :na, :]
-            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = part if part.dtype == out.dtype else xp.astype(part, out.dtype)
+            dest = _rows(s, k0, na, out.shape[0])
+            out[dest, oq : oq + nq] = part if part.dtype == out.dtype else xp.astype(part, out.dtype)
         if self._masked_last:
             out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 
@@ -337,14 +338,20 @@ class InfluenceOperator:
         return apply
 
     def _inverse_symbol(self, box, lam, floor, single=False):
-        """``(shape, S)``: the spectra of ``(K + lam)^-1`` for the symbol ``K`` of ``box`` (:func:`bem.block_symbol.inverse_symbol`),
-        rounded to single precision where ``single``."""
+        """``(shape, S)``: the spectra of ``(K + lam)^-1`` for the symbol ``K`` of ``box``
+        (:func:`bem.block_symbol.inverse_symbol`), rounded to single precision where ``single``."""
         shape, S = inverse_symbol(self.backend, lambda: self._kernel_spectra(box, box), lam, floor, self.diagonal)
-        if single:  # the diagonal blocks are real, S_10 = conj(S_01) is not stored
-            xp = self.backend.xp
-            (s00, s01), (_, s11) = S
-            S = ((xp.astype(s00, xp.float32), xp.astype(s01, xp.complex64)), (None, xp.astype(s11, xp.float32)))
-        return shape, S
+        if not single:
+            return shape, S
+        # the diagonal blocks are real, S_10 = conj(S_01) is not stored; one block at a time, each double-precision
+        # block let go as it is rounded
+        xp = self.backend.xp
+        (s00, s01), (_, s11) = S
+        del S
+        s00 = xp.astype(s00, xp.float32)
+        s01 = xp.astype(s01, xp.complex64)
+        s11 = xp.astype(s11, xp.float32)
+        return shape, ((s00, s01), (None, s11))
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""

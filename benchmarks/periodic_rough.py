@@ -21,13 +21,16 @@ Cases (``--cases``):
 - ``rss``: the peak resident set (``ru_maxrss``) of a fresh process that solves ``main``.
 - ``products``: the cost of one product ``C p``, one preconditioner application ``M r`` and a
   bare ``rfft2``/``irfft2`` pair of the same number of points, at ``N x N`` (medians of 30).
+- ``floor``: the time of one iteration on the finest ``N x N`` cell (the median interval between
+  ``callback`` calls of a warm smooth solve) over a bare ``rfft2``/``irfft2`` pair of the cell in
+  single and in double precision (medians of 30), with the iterations and the products ``C p``.
 
 Every timed solve includes the build of the periodic kernel unless the row says "warm". Each row
 gives the wall time and the CPU time of the process (``time.process_time``, all its threads),
 and the 1-minute load average: on a shared machine the wall time grows with the load, the CPU
 time much less; compare ratios within a run, not absolute times across runs.
 
-Run: ``python benchmarks/periodic_rough.py [--cases main ladder fractions rss] [--size 1024]``
+Run: ``python benchmarks/periodic_rough.py [--cases main ladder fractions rss products floor] [--size 1024]``
 """
 
 from __future__ import annotations
@@ -229,9 +232,35 @@ def case_products(n, repeat=30):
                               load=_load())), flush=True)
 
 
+def case_floor(n, repeat=30):
+    """The time of an iteration on the finest cell against one transform pair of the cell (single and double
+    precision): the median interval between callbacks of a warm solve, over the median pair."""
+    cell = PeriodicCell(1.0 / n, n, n)
+    h = surface_on_cell(cell)
+    _ours(h, cell, 0.01)  # the kernel and the plans made
+    stamps = []
+    res, wall, _ = _ours(h, cell, 0.01, callback=lambda k, p: stamps.append(time.perf_counter()))
+    per_iteration = float(np.median(np.diff(stamps)))
+    workers = bem.fft.threads()
+    pairs = {}
+    for dtype in (np.float32, np.float64):
+        v = np.random.default_rng(SEED).standard_normal(cell.shape).astype(dtype)
+        times = []
+        for _ in range(repeat):
+            t = time.perf_counter()
+            sfft.irfft2(sfft.rfft2(v, workers=workers), s=v.shape, workers=workers)
+            times.append(time.perf_counter() - t)
+        pairs[np.dtype(dtype).name] = float(np.median(times))
+    print(json.dumps(dict(case="floor", n=n, iterations=res.iterations, products=res.n_matvec, wall_s=round(wall, 3),
+                          iteration_ms=round(per_iteration * 1e3, 2),
+                          pair_ms={k: round(v * 1e3, 2) for k, v in pairs.items()},
+                          iteration_over_pair={k: round(per_iteration / v, 2) for k, v in pairs.items()},
+                          load=_load())), flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", nargs="+", default=["main", "ladder", "fractions", "rss", "products"])
+    parser.add_argument("--cases", nargs="+", default=["main", "ladder", "fractions", "rss", "products", "floor"])
     parser.add_argument("--size", type=int, default=1024)
     parser.add_argument("--ladder-size", type=int, default=512)
     parser.add_argument("--fraction-size", type=int, default=512)
@@ -241,7 +270,7 @@ def main():
     for case in args.cases:
         {"main": lambda: case_main(args.size), "ladder": lambda: case_ladder(args.ladder_size),
          "fractions": lambda: case_fractions(args.fraction_size), "rss": lambda: case_rss(args.size),
-         "products": lambda: case_products(args.size)}[case]()
+         "products": lambda: case_products(args.size), "floor": lambda: case_floor(args.size)}[case]()
 
 
 if __name__ == "__main__":

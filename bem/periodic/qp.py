@@ -183,8 +183,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         x = op.spectrum(v)
         return op.mix(x, A, out=x)
 
-    def precondition(r32, nodes, r_c, soft_c, jac_c):  # M r at the nodes: r_c = r there, r32 = r (float32) at the
-        x = op.spectrum(r32)  # stiff nodes; soft_c, jac_c: the soft nodes and 1 / (C_nn + D) there (None: none soft)
+    def precondition(r32, nodes, r_c, soft_c, jac_c):
+        # M r at the nodes: r_c = r there, r32 = r (float32) at the stiff nodes; soft_c, jac_c: the soft nodes
+        # and 1 / (C_nn + D) there (None: no soft node)
+        x = op.spectrum(r32)
         z = xp.astype(bk.take(op.brick(op.mix(x, M, out=x), overwrite=True), nodes), xp.float64)
         return z if soft_c is None else xp.where(soft_c, jac_c * r_c, z)
 
