@@ -24,7 +24,7 @@ from .backend import operator_backend
 from .plastic import carry_force, clip, fill_force, leaving_pressure, plastic_approach, plastic_start
 
 __all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule",
-           "entering_pressure", "is_per_node", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS", "RIGID_SHARE", "BoundedSets", "bounded_sets", "bounded_move"]
+           "entering_pressure", "is_per_node", "is_stiff", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS", "RIGID_SHARE", "BoundedSets", "bounded_sets", "bounded_move"]
 
 log = logging.getLogger(__name__)
 
@@ -258,6 +258,12 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
     new, s, capped = filled
     p[...] = new
     return hit or moved or capped, moved, s, None, short or capped
+
+
+def is_stiff(D, diagonal, threshold):
+    """The nodes whose compliance ``D`` leaves the FFT preconditioner in charge, ``D <= threshold C_nn``
+    (Jacobi ``1 / (C_nn + D)`` elsewhere: :func:`bem.kalker.compliance_preconditioner`)."""
+    return D <= threshold * diagonal
 
 
 def is_per_node(lam):

@@ -18,7 +18,7 @@ import numpy as np
 
 from .backend import operator_backend
 from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, entering_pressure,
-                       initial_pressure, is_per_node, iterate_residual, run_constrained_cg)
+                       initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
 from .plastic import carry_force, note_fully_plastic
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
@@ -333,7 +333,7 @@ def compliance_preconditioner(op, D, contact, threshold=4.0):
     """
     bk, _ = operator_backend(op)
     xp = bk.xp
-    stiff = D <= threshold * op.diagonal
+    stiff = is_stiff(D, op.diagonal, threshold)
     sel = stiff & contact
     lam = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
     fft = op.preconditioner(lam=lam, single=True)

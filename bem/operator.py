@@ -239,8 +239,7 @@ class InfluenceOperator:
         data = xp.zeros((2, max(r[1] for r in i_rows), bq), dtype=dtype)
         for b, s in enumerate(self._start):  # the rows of parity b: brick rows s, s + 2, ...
             k0, nb = i_rows[b]
-            rows = v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq]
-            data[b, :nb, :] = rows if rows.dtype == dtype else xp.astype(rows, dtype)
+            data[b, :nb, :] = xp.astype(v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq], dtype, copy=False)
         V = block_product(spectra, bk.forward(data, shape))
         del data
         split = V[0, ...].size > SPLIT_INVERSE  # large: one parity at a time, half the inverse's output held at once
@@ -248,8 +247,7 @@ class InfluenceOperator:
         for a, s in enumerate(self._start):
             k0, na = o_rows[a]
             part = bk.inverse(V[a, ...], shape, (na, nq)) if split else both[a, :na, :]
-            dest = _rows(s, k0, na, out.shape[0])
-            out[dest, oq : oq + nq] = part if part.dtype == out.dtype else xp.astype(part, out.dtype)
+            out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = xp.astype(part, out.dtype, copy=False)
         if self._masked_last:
             out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 

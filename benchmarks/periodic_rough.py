@@ -214,20 +214,29 @@ def case_rss(n):
     print(out.stdout.strip().splitlines()[-1], flush=True)
 
 
+def _median_times(f, repeat):
+    """Median wall and CPU time of ``repeat`` calls of ``f()`` [s]."""
+    times = []
+    for _ in range(repeat):
+        t, c = time.perf_counter(), time.process_time()
+        f()
+        times.append((time.perf_counter() - t, time.process_time() - c))
+    return np.median(times, axis=0)
+
+
+def _pair(v):
+    """A bare ``rfft2`` + ``irfft2`` pair of ``v`` (in its precision), on the FFT threads of ``bem``."""
+    workers = bem.fft.threads()
+    return sfft.irfft2(sfft.rfft2(v, workers=workers), s=v.shape, workers=workers)
+
+
 def case_products(n, repeat=30):
     cell = PeriodicCell(1.0 / n, n, n)
     op = bem.PeriodicOperator(cell, 1.0)
     precondition = op.preconditioner()
     v = np.random.default_rng(SEED).standard_normal(cell.shape)
-    workers = bem.fft.threads()
-    pair = lambda: sfft.irfft2(sfft.rfft2(v, workers=workers), s=v.shape, workers=workers)  # noqa: E731
-    for name, f in (("C p", lambda: op.matvec(v)), ("M r", lambda: precondition(v)), ("rfft2 + irfft2", pair)):
-        times = []
-        for _ in range(repeat):
-            t, c = time.perf_counter(), time.process_time()
-            f()
-            times.append((time.perf_counter() - t, time.process_time() - c))
-        wall, cpu = np.median(times, axis=0) * 1e3
+    for name, f in (("C p", lambda: op.matvec(v)), ("M r", lambda: precondition(v)), ("rfft2 + irfft2", lambda: _pair(v))):
+        wall, cpu = _median_times(f, repeat) * 1e3
         print(json.dumps(dict(case="products", n=n, what=name, wall_ms=round(wall, 2), cpu_ms=round(cpu, 2),
                               load=_load())), flush=True)
 
@@ -241,16 +250,11 @@ def case_floor(n, repeat=30):
     stamps = []
     res, wall, _ = _ours(h, cell, 0.01, callback=lambda k, p: stamps.append(time.perf_counter()))
     per_iteration = float(np.median(np.diff(stamps)))
-    workers = bem.fft.threads()
+    v = np.random.default_rng(SEED).standard_normal(cell.shape)
     pairs = {}
     for dtype in (np.float32, np.float64):
-        v = np.random.default_rng(SEED).standard_normal(cell.shape).astype(dtype)
-        times = []
-        for _ in range(repeat):
-            t = time.perf_counter()
-            sfft.irfft2(sfft.rfft2(v, workers=workers), s=v.shape, workers=workers)
-            times.append(time.perf_counter() - t)
-        pairs[np.dtype(dtype).name] = float(np.median(times))
+        x = v.astype(dtype)  # outside the clock
+        pairs[np.dtype(dtype).name] = float(_median_times(lambda: _pair(x), repeat)[0])
     print(json.dumps(dict(case="floor", n=n, iterations=res.iterations, products=res.n_matvec, wall_s=round(wall, 3),
                           iteration_ms=round(per_iteration * 1e3, 2),
                           pair_ms={k: round(v * 1e3, 2) for k, v in pairs.items()},

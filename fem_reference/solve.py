@@ -35,10 +35,11 @@ from bem.materials import effective_modulus
 from bem.reference import estimate_contact_radius
 
 from .interface import InterfaceLaw
-from .mesh import N_ACROSS_COATING, AxiMesh, build_mesh
+from .mesh import AxiMesh, build_mesh
 from .model import AxiModel, check_coatings, check_materials
 from .newton import solve_interface
 from .result import FemResult, axis_pressure, edge_radius
+from .sizes import N_ACROSS_COATING
 
 __all__ = ["solve"]
 

@@ -275,12 +275,14 @@ class PeriodicOperator:
             b[:, 1] = s10
         return d, b
 
-    def _apply(self, v, s00, s01, s10, s11):
-        """``out_a = sum_b S_ab v_b`` by the spectra ``S`` of a 2 x 2 block symbol (NumPy: ``s00`` is ``(D, B)``)."""
+    def _apply(self, v, s00, s01, s10, s11, single=False):
+        """``out_a = sum_b S_ab v_b`` by the spectra ``S`` of a 2 x 2 block symbol (NumPy: ``s00`` is ``(D, B)``;
+        ``single``: a single-precision ``(D, B)``, the transforms in single precision, the result in double)."""
         bk = self.backend
         if bk.is_numpy:
-            x = self.spectrum(np.asarray(v, dtype=float))
-            return self.brick(self.mix(x, s00, out=x), overwrite=True)
+            x = self.spectrum(np.asarray(v, dtype=np.float32 if single else float))
+            out = self.brick(self.mix(x, s00, out=x), overwrite=True)
+            return out.astype(np.float64) if single else out
 
         P = self._forward(bk.asarray(v))
         u1 = s10 * P[0, ...]
@@ -337,22 +339,15 @@ class PeriodicOperator:
         callable
             ``M(r)`` on brick arrays.
         """
-        if self.backend.is_numpy and single:
-            m32 = self.symbol(lam, inverse=True, single=True)
-
-            def apply32(r):
-                x = self.spectrum(np.asarray(r, dtype=np.float32))
-                return self.brick(self.mix(x, m32, out=x), overwrite=True).astype(np.float64)
-
-            return apply32
+        single = single and self.backend.is_numpy
         if self.backend.is_numpy:
-            i00, i01, i10, i11 = self.symbol(lam, inverse=True), None, None, None
+            i00, i01, i10, i11 = self.symbol(lam, inverse=True, single=single), None, None, None
         else:
             a, b = self._inverse_blocks(lam)
             i00, i01, i10, i11 = a, b, self.backend.xp.conj(b), a
 
         def apply(r):
-            return self._apply(r, i00, i01, i10, i11)
+            return self._apply(r, i00, i01, i10, i11, single)
 
         return apply
 

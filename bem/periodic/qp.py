@@ -75,7 +75,7 @@ import numpy as np
 
 from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
-                        entering_pressure, initial_pressure, is_per_node, iterate_residual, run_constrained_cg)
+                        entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, note_fully_plastic
 from .qp_parts import LastPreconditionedGap, weighted_square
 
@@ -154,7 +154,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
     soft = stiff = None
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
-        stiff = D <= threshold * diag
+        stiff = is_stiff(D, diag, threshold)
         sel = stiff & (p > 0)
         lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
         jacobi = 1.0 / (diag + D) if hardness is not None else None  # 1 / (C_nn + D), for bounded_move
@@ -285,7 +285,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
         t_old = bk.take(t, idx)  # the last direction on the contact (float32)
         D_c = bk.take(D, idx) if per_node else None  # D, its soft nodes and 1 / (C_nn + D) on the contact
-        soft_c = None if soft is None else ~(D_c <= threshold * diag)
+        soft_c = None if soft is None else ~is_stiff(D_c, diag, threshold)
         jac_c = None if soft is None else jacobi_at(idx, D_c)
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         z = precondition(f32_at(idx, g_c if soft is None else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)

@@ -152,11 +152,11 @@ def test_one_level_finer_extends_each_methods_sequence_for_its_orders_and_extrap
     monkeypatch.setattr(coating_fem, "bem_levels", levels("bem", 0.5))
     monkeypatch.setattr(coating_fem, "fem_levels", levels("fem", -2.0))
     monkeypatch.setattr(coating_fem, "rms_nodes", lambda b, f: 0.0)
-    monkeypatch.setattr(coating_fem, "rms_parts", lambda b, f: dict(total=0.0, interior=0.0, edge=0.0))
     s = dict(coating_fem.SETTINGS, bem_levels=(10, 20, 40), fem_levels=(6, 12, 24))
     # the case's row: its coarse levels perturbed beyond the quadratic law, so only the last three can give order 2
     row = dict(a_over_t=1.0, modulus_ratio=10.0, nu_c=0.25,
-               bem=[level("bem", 10, 9.0), level("bem", 20, 0.5), level("bem", 40, 0.5)], fem=[level("fem", 6, 7.0), level("fem", 12, -2.0), level("fem", 24, -2.0)])
+               bem=[level("bem", 10, 9.0), level("bem", 20, 0.5), level("bem", 40, 0.5)],
+               fem=[level("fem", 6, 7.0), level("fem", 12, -2.0), level("fem", 24, -2.0)])
     solved = []
     parts = dict(total=0.0, interior=0.0, edge=0.0)
     monkeypatch.setattr(coating_fem, "rms_parts", lambda b, f: solved.append((b.n, f.n)) or parts)

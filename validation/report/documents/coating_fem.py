@@ -117,8 +117,7 @@ def coating_fem_sections(data, work=None):
               if s.get("fem_across") else "")
     text = [f"{problem_sentence(s)}; the BEM on lattices a_H/step = {s.get('bem_levels')}, the FEM with "
             f"{s.get('fem_levels')} elements across the contact radius{across}{band}. Orders from the last three "
-            "levels; "
-            "extrapolated values by Richardson with "
+            "levels; extrapolated values by Richardson with "
             "the observed order where it lies in [0.5, 6] and the differences keep their sign (else the finest "
             "value, '-'). diff = BEM / FEM - 1. RMS of p(r): every BEM node against the FEM's p(r) at its "
             "radius, relative; 'linear': the FEM's p linear between its nodes (finest levels); 'edge-aware': "
