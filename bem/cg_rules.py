@@ -21,7 +21,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .backend import operator_backend
-from .plastic import carry_force, clip, fill_force, leaving_pressure, plastic_approach, plastic_start
+from .plastic import carry_force, clipped_start, fill_force, leaving_pressure, plastic_approach, plastic_start
 
 __all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule",
            "entering_pressure", "is_per_node", "is_stiff", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS", "RIGID_SHARE", "BoundedSets", "bounded_sets", "bounded_move"]
@@ -82,7 +82,7 @@ def _quantile(bk, values, q):
     return a + (b - a) * t if t < 0.5 else b - (b - a) * (1 - t)
 
 
-def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
+def initial_pressure(op, h, lam, force, approach, x0, hardness=None, overwrite_x0=False):
     """The starting pressure of the constrained CG (brick array): ``x0`` clipped at 0, or under force
     control a uniform pressure on the quarter of the nodes with the smallest gap, or under approach
     control the Jacobi estimate ``(delta - h)_+ / (C_nn + lam)``; scaled to carry ``force``.
@@ -91,12 +91,15 @@ def initial_pressure(op, h, lam, force, approach, x0, hardness=None):
     pressure covers enough nodes to stay below ``0.8 H`` and is scaled by
     :func:`bem.plastic.fill_force`; where the rigid-plastic pressure (:func:`bem.plastic.plastic_start`) nearly keeps
     its order under its own displacement (:data:`RIGID_SHARE`) it is the start instead, and an ``x0`` whose
-    nodes cannot carry the force below ``H`` is joined by it (:func:`bem.plastic.carry_force`)."""
+    nodes cannot carry the force below ``H`` is joined by it (:func:`bem.plastic.carry_force`).
+
+    ``overwrite_x0``: a writeable float64 NumPy ``x0`` may be overwritten (clipped in place by
+    :func:`bem.plastic.clipped_start`, so that no second array of its size is made); otherwise ``x0`` is not modified."""
     lat = op.lattice
     bk, mask = operator_backend(op)
     xp = bk.xp
     if x0 is not None:
-        p = xp.where(mask, clip(xp, bk.asarray(x0), hardness), 0.0)
+        p = clipped_start(bk, x0, mask, hardness, overwrite_x0)
     elif force is not None:
         # rigid-punch-like start: pressure where the gap is smallest
         hm = xp.where(mask, h, xp.inf)

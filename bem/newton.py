@@ -34,7 +34,7 @@ from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 from .newton_moves import release, scaled, settle_plastic
-from .plastic import carry_force, clip, fully_plastic_note
+from .plastic import carry_force, clip, clipped_start, fully_plastic_note
 
 __all__ = ["solve_newton"]
 
@@ -153,7 +153,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
                              preconditioner=op.preconditioner(lam=lam) if precondition else None, hardness=hardness)
         p = start.p
     else:
-        p = xp.where(mask, clip(xp, bk.asarray(x0), hardness), 0.0)
+        p = clipped_start(bk, x0, mask, hardness)
         if force is not None and hardness is None:
             p *= force / op.lattice.node_area / float(xp.sum(p))
         elif force is not None:  # its nodes below H carry the force, or the nodes of smallest gap help them
@@ -200,6 +200,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         D = masked(tangent(bk, layer, p, gap, p_ref))
         gap = None  # recomputed at the next step; not held through the model's solve
         b = h + wp - D * p
+        wp = None  # made again where needed: not held through the model's solve
         # forcing term: _FORCING, or the last step's reduction of the residual where that is smaller
         eta = min(_FORCING, kkt / hist["residual"][-2]) if len(hist["residual"]) > 1 else _FORCING
         inner = max(rtol / 3, min(1e-2, eta * kkt))
@@ -213,6 +214,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         cd = sub.displacement - u
         t = _line_search(bk, layer, p, d, u, cd, h, delta, mask)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
+            wp = masked(bk.asarray(layer.w(p)))
             scale = float(xp.max(xp.abs(u + wp)))
             D = majorant(op, layer, p, sub.p, D, mask)
             b = h + wp - D * p

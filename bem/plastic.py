@@ -20,8 +20,10 @@ residual (:mod:`bem.kkt`).
 
 from __future__ import annotations
 
-__all__ = ["plastic_approach", "fill_force", "plastic_start", "carry_force", "clip", "leaving_pressure",
-           "note_fully_plastic", "fully_plastic_note"]
+import numpy as np
+
+__all__ = ["plastic_approach", "fill_force", "plastic_start", "carry_force", "clip", "clipped_start", "in_place",
+           "leaving_pressure", "note_fully_plastic", "fully_plastic_note"]
 
 #: Rounds of :func:`fill_force` (each caps at least one more node at ``H``).
 _FILL_ROUNDS = 64
@@ -31,6 +33,23 @@ def clip(xp, p, hardness):
     """``p`` clipped at 0 and, with a hardness, at ``H`` (``hardness`` None: at 0 only)."""
     p = xp.maximum(p, 0.0)
     return p if hardness is None else xp.minimum(p, hardness)
+
+
+def in_place(x):
+    """Whether ``x`` can be overwritten in place: a writeable, C-contiguous float64 NumPy array."""
+    return isinstance(x, np.ndarray) and x.dtype == np.float64 and x.flags.c_contiguous and x.flags.writeable
+
+
+def clipped_start(bk, x0, mask, hardness=None, overwrite_x0=False):
+    """A start ``x0`` clipped at 0 (and at ``hardness``), 0 off ``mask``: ``x0`` itself, clipped in place, where
+    ``overwrite_x0`` and :func:`in_place` allow it on NumPy; else a new array (``x0`` not modified)."""
+    if not (overwrite_x0 and bk.is_numpy and in_place(x0)):
+        return bk.xp.where(mask, clip(bk.xp, bk.asarray(x0), hardness), 0.0)
+    p = np.maximum(x0, 0.0, out=x0)
+    if hardness is not None:
+        np.minimum(p, hardness, out=p)
+    p[~mask] = 0.0
+    return p
 
 
 def plastic_approach(lowest_open, highest_plastic):

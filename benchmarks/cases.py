@@ -97,12 +97,16 @@ def machine():
 # -- the surfaces ------------------------------------------------------------------------------
 
 
+_CHUNK = 1 << 20  # points per chunk of Roughness.__call__
+
+
 class Roughness:
     """The self-affine Fourier series of :mod:`periodic_rough` with period ``(lx, ly)``, evaluated exactly.
 
     ``z(x, y) = Re sum Z_mn exp(i (gx_m x + gy_n y))``. Points on rows (a lattice or a grid:
     few distinct ``y``, few distinct ``x``) cost two matrix products: ``A[row, m] = sum_n Z_mn
-    exp(i gy_n y_row)``, then ``B[row, col] = Re sum_m A[row, m] exp(i gx_m x_col)``.
+    exp(i gy_n y_row)``, then ``B[row, col] = Re sum_m A[row, m] exp(i gx_m x_col)``, over chunks of
+    ``2**20`` points (the temporaries of a chunk, not of the whole lattice).
     ``seconds`` and ``cpu_seconds`` sum the wall and CPU time spent in calls (the solvers that
     take a callable pay it inside their solve; the benchmarks subtract it).
     """
@@ -119,13 +123,17 @@ class Roughness:
     def __call__(self, x, y):
         t, c = time.perf_counter(), time.process_time()
         x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
-        ux, ix = np.unique(x, return_inverse=True)
-        uy, iy = np.unique(y, return_inverse=True)
-        a = np.exp(1j * np.outer(uy, self.gy)) @ self.z  # (rows, m)
-        out = (a @ np.exp(1j * np.outer(self.gx, ux))).real[iy.ravel(), ix.ravel()].reshape(x.shape)
+        flat_x, flat_y = x.reshape(-1), y.reshape(-1)
+        out = np.empty(flat_x.size)
+        for start in range(0, out.size, _CHUNK):  # in chunks: temporaries of a chunk, not of the whole lattice
+            part = slice(start, start + _CHUNK)
+            ux, ix = np.unique(flat_x[part], return_inverse=True)
+            uy, iy = np.unique(flat_y[part], return_inverse=True)
+            a = np.exp(1j * np.outer(uy, self.gy)) @ self.z  # (rows, m)
+            out[part] = (a @ np.exp(1j * np.outer(self.gx, ux))).real[iy, ix]
         self.seconds += time.perf_counter() - t
         self.cpu_seconds += time.process_time() - c
-        return out
+        return out.reshape(x.shape)
 
 
 class RoughSphere:

@@ -50,11 +50,13 @@ def love_spectrum(n, h, e_star):
     return sfft.rfft2(kern, workers=_workers()), float(kern[0, 0])
 
 
-def solve_pk(n, *, side=1.0, radius=1.0, e_star=1.0, force, layer=None, rtol=1e-10, maxiter=5000):
-    """Contact of a sphere (paraboloid ``r^2 / 2R``) on an ``n x n`` grid; returns a dict."""
+def solve_pk(n, *, side=1.0, radius=1.0, e_star=1.0, force, layer=None, rtol=1e-10, maxiter=5000, gap=None):
+    """Contact of a sphere (paraboloid ``r^2 / 2R``), or of the ``n x n`` array ``gap`` at the cell centres,
+    on an ``n x n`` grid; returns a dict."""
     h = side / n
-    x = (np.arange(n) - (n - 1) / 2) * h
-    gap = (x[:, None] ** 2 + x[None, :] ** 2) / (2 * radius)
+    if gap is None:
+        x = (np.arange(n) - (n - 1) / 2) * h
+        gap = (x[:, None] ** 2 + x[None, :] ** 2) / (2 * radius)
     spec, k00 = love_spectrum(n, h, e_star)
     workers = _workers()
 

@@ -132,8 +132,13 @@ class PeriodicCell:
         return PeriodicOperator(cell, E_star, device=backend, bodies=bodies)
 
     def solve_level(self, run, make_op, cell, h, kw, delta, solver):
-        """One level of nested iteration, on the whole cell; the solution and the operator used."""
+        """One level of nested iteration, on the whole cell; the solution and the operator used.
+
+        The start ``kw["x0"]`` of :func:`bem.solve` is a new array (the coarser level's solution interpolated,
+        or the caller's ``x0`` copied): Kalker's QP holds its iterate in it (one array of the cell fewer)."""
         op = make_op(cell)
+        if solver == "kalker" and kw.get("x0") is not None:
+            kw = dict(kw, overwrite_x0=True)
         return run(op, h, kw), [op]
 
     def refine(self, coarse, p, fine):

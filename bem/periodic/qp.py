@@ -76,7 +76,7 @@ import numpy as np
 from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
                         entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
-from ..plastic import carry_force, note_fully_plastic
+from ..plastic import carry_force, in_place, note_fully_plastic
 from .qp_parts import LastPreconditionedGap, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
@@ -86,7 +86,8 @@ SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_AB
 
 
 def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
-                      callback=None, scale=None, u0=None, confirm=True, threshold=4.0, hardness=None):
+                      callback=None, scale=None, u0=None, confirm=True, threshold=4.0, hardness=None,
+                      overwrite_x0=False):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell.
 
     Parameters
@@ -103,6 +104,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         on the contact of ``x0``).
     x0 : ndarray, optional
         Initial pressure (brick array); negative entries are clipped.
+    overwrite_x0 : bool
+        Whether a float64 NumPy ``x0`` may hold the iterate (not copied: one array of the cell fewer).
     rtol : float
         Tolerance on the KKT residual (the rule of :func:`bem.kalker.solve_qp`, checked on an
         exactly recomputed ``C p`` unless ``confirm`` is False).
@@ -111,13 +114,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     callback : callable, optional
         ``callback(k, p)`` after every iteration.
     scale, u0, confirm
-        As for :func:`bem.kalker.solve_qp`: the displacement scale of the KKT residual [length],
-        ``C x0`` where the caller has it (the iterate then starts from ``x0`` as given), and
-        whether to confirm the stopping check on an exact product. Unconfirmed, a solve that
-        stops at ``rtol >= SINGLE_ABOVE`` returns ``C p`` to single precision.
+        As for :func:`bem.kalker.solve_qp`: the displacement scale of the KKT residual [length], ``C x0`` where
+        the caller has it (the iterate then starts from ``x0`` as given), and whether to confirm the stopping
+        check on an exact product. Unconfirmed, a stop at ``rtol >= SINGLE_ABOVE`` returns ``C p`` in single precision.
     threshold : float
-        With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner,
-        as in :func:`bem.kalker.compliance_preconditioner`.
+        With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner (as in
+        :func:`bem.kalker.compliance_preconditioner`).
     hardness : float, optional
         The bound ``p <= H`` [pressure] (:mod:`bem.plastic`): the search direction lives on the elastic
         contact ``0 < p < H`` and the step is :func:`bem.cg_rules.bounded_move`.
@@ -139,8 +141,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     if maxiter is None:
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
-    if u0 is None or x0 is None:
-        p = initial_pressure(op, h, D if per_node else lam, force, approach, x0, hardness)
+    if u0 is None or x0 is None:  # a new array, or x0 itself with overwrite_x0
+        p = initial_pressure(op, h, D if per_node else lam, force, approach, x0, hardness, overwrite_x0)
         if target is not None:
             p = p if float(xp.sum(p)) > 0 else xp.ones(lat.shape, dtype=xp.float64)
             if hardness is None:
@@ -149,8 +151,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 p = carry_force(xp, p, target, hardness, xp.ones(lat.shape, dtype=xp.bool))
         u0 = None
     else:  # the caller's iterate and its product, as they are
-        p = x0
-    p = bk.copy(bk.asarray(p))  # updated in place below
+        p = bk.asarray(x0) if overwrite_x0 and in_place(x0) else bk.copy(bk.asarray(x0))  # updated in place below
     A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
     soft = stiff = None
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
@@ -164,11 +165,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     M = op.symbol(lam_pc, inverse=True, single=True)
     A32 = op.symbol(lam, single=True)
     r_hat = None  # the spectrum of (C + lam) t, kept from step to step (NumPy)
-    # a float32 brick with values at some nodes, 0 elsewhere: on NumPy one buffer, refilled, that holds the gap on the
-    # contact the preconditioner transforms and then the search direction (whose values at the contact are taken first)
+    # a float32 brick with values at some nodes, 0 elsewhere (NumPy: one buffer, refilled): the gap on the contact
     buf32 = np.zeros(lat.shape, dtype=np.float32) if bk.is_numpy else None
 
-    def f32_at(nodes, values):
+    def f32_at(nodes, values):  # then the search direction (its values at the contact taken first)
         if buf32 is None:
             return bk.put(xp.zeros(lat.shape, dtype=xp.float32), nodes, xp.astype(values, xp.float32))
         buf32.fill(0.0)  # a fill: faster than zeroing the nodes of the last step

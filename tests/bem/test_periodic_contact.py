@@ -202,6 +202,21 @@ def test_approach_control_gives_the_force_control_solution():
     assert by_force.mean_gap == pytest.approx(float(np.mean(GAP(CELL.x, CELL.y))) - by_force.approach, rel=1e-12)
 
 
+@pytest.mark.parametrize("shape", ["brick", "nodes"])
+def test_a_callers_start_and_gap_are_not_modified(shape):
+    """The cell's QP holds its iterate in the start it is given (``overwrite_x0``): that is a copy of the
+    caller's ``x0``, which keeps its values, as does the gap array."""
+    h = GAP(CELL.x, CELL.y)
+    first = solve_periodic(h, step=CELL.step, E_star=E_STAR, mean_pressure=PBAR, method="kalker", rtol=1e-3)
+    x0 = first.p.reshape(CELL.shape) if shape == "brick" else first.p.copy()
+    x0_before, h_before = x0.copy(), h.copy()
+    res = solve_periodic(h, step=CELL.step, E_star=E_STAR, mean_pressure=PBAR, method="kalker", x0=x0)
+    assert res.converged
+    np.testing.assert_array_equal(x0, x0_before)
+    np.testing.assert_array_equal(h, h_before)
+    assert not np.shares_memory(res.p, x0)
+
+
 def test_a_gap_array_and_a_callable_give_one_answer():
     from_callable = solve_periodic(GAP, cell=CELL, E_star=E_STAR, mean_pressure=PBAR)
     from_array = solve_periodic(GAP(CELL.x, CELL.y), step=CELL.step, E_star=E_STAR, mean_pressure=PBAR)

@@ -220,3 +220,44 @@ def test_an_unconfirmed_loose_periodic_qp_stays_in_single_precision(monkeypatch)
     kkt = kkt_residual(res.p.ravel(), g, displacement_scale=float(np.abs(u).max()), force=force,
                        node_area=cell.node_area)
     assert kkt <= rtol
+
+
+@pytest.mark.parametrize("with_u0", [False, True])
+def test_overwrite_x0_holds_the_iterate_in_x0_and_without_it_x0_is_untouched(with_u0):
+    """``overwrite_x0``: the same answer, computed in the caller's array (returned as the solution's ``p``);
+    without it the caller's ``x0`` keeps its values, negative entries included."""
+    cell = CELL
+    h = _rough(cell, seed=3)
+    op = PeriodicOperator(cell, E_STAR)
+    force = 0.03 * cell.area
+    start = solve_periodic_qp(op, h, force=force, rtol=1e-2).p
+    start[0, :3] = -1.0  # entries the solver clips
+    kw = dict(force=force, rtol=1e-10, u0=op.matvec(np.maximum(start, 0.0)) if with_u0 else None)
+    if with_u0:  # the caller's iterate as it is (the u0 path clips nothing)
+        start = np.maximum(start, 0.0)
+    x0 = start.copy()
+    kept = solve_periodic_qp(op, h, x0=x0, **kw)
+    np.testing.assert_array_equal(x0, start)  # not modified
+    assert not np.shares_memory(kept.p, x0)
+    own = solve_periodic_qp(op, h, x0=x0, overwrite_x0=True, **kw)
+    assert own.converged and own.p is x0  # the iterate lived in x0
+    np.testing.assert_array_equal(own.p, kept.p)
+    assert own.iterations == kept.iterations
+
+
+def test_overwrite_x0_copies_an_array_it_cannot_hold_the_iterate_in():
+    """A float32 or read-only ``x0`` is not written even with ``overwrite_x0``."""
+    cell = CELL
+    h = _rough(cell, seed=3)
+    op = PeriodicOperator(cell, E_STAR)
+    force = 0.03 * cell.area
+    start = solve_periodic_qp(op, h, force=force, rtol=1e-2).p
+    ref = solve_periodic_qp(op, h, x0=start.copy(), force=force, rtol=1e-10)
+    for x0 in (start.astype(np.float32), start.copy()):
+        x0.flags.writeable = x0.dtype == np.float32  # the float64 one read-only
+        before = x0.copy()
+        res = solve_periodic_qp(op, h, x0=x0, force=force, rtol=1e-10, overwrite_x0=True)
+        np.testing.assert_array_equal(x0, before)
+        assert res.converged and res.p is not x0
+        if x0.dtype == np.float64:
+            np.testing.assert_array_equal(res.p, ref.p)
