@@ -81,3 +81,24 @@ def test_record_keeps_the_iterates(paper):
     res = paper(paper_laws(10.0)["elastic_rigid"], "variable_compliance", record=True)
     assert len(res.history["p"]) == res.iterations
     np.testing.assert_allclose(res.history["p"][-1], res.p)
+
+
+def test_newton_retries_with_a_majorised_model_where_a_step_finds_no_descent(paper, monkeypatch):
+    """Where the line search finds no useful descent, Newton solves the model again with the majorised
+    compliance from the closure made anew, and still meets the KKT conditions: the first line search of the
+    finest level is made to find none."""
+    import bem.newton as newton
+
+    calls, real = [], newton._line_search
+
+    def first_finds_none(*args):
+        calls.append(len(calls))
+        return 0.0 if len(calls) == 1 else real(*args)
+
+    layer = paper_laws(0.3)["root"]
+    reference = paper(layer, nested=False)  # one level: the first search is the finest level's
+    monkeypatch.setattr(newton, "_line_search", first_finds_none)
+    res = paper(layer, nested=False)
+    assert len(calls) >= 2  # the refused search and the retry's
+    assert res.converged and res.kkt_residual <= 1e-10
+    _agree(res, reference, tol=1e-7)
