@@ -171,8 +171,11 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     def masked(x):
         return x if full else xp.where(mask, x, 0.0)
 
+    def closure(p):  # w(p), 0 off the mask
+        return masked(bk.asarray(layer.w(p)))
+
     for k in range(maxiter + 1):
-        wp = masked(bk.asarray(layer.w(p)))  # the closure w(p)
+        wp = closure(p)
         gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp,
                                          hardness=hardness)
         if kkt <= rtol and not exact:  # confirm on an exact product before stopping
@@ -214,7 +217,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         cd = sub.displacement - u
         t = _line_search(bk, layer, p, d, u, cd, h, delta, mask)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
-            wp = masked(bk.asarray(layer.w(p)))
+            wp = closure(p)
             scale = float(xp.max(xp.abs(u + wp)))
             D = majorant(op, layer, p, sub.p, D, mask)
             b = h + wp - D * p

@@ -35,15 +35,17 @@ def clip(xp, p, hardness):
     return p if hardness is None else xp.minimum(p, hardness)
 
 
-def in_place(x):
-    """Whether ``x`` can be overwritten in place: a writeable, C-contiguous float64 NumPy array."""
-    return isinstance(x, np.ndarray) and x.dtype == np.float64 and x.flags.c_contiguous and x.flags.writeable
+def in_place(bk, x):
+    """Whether a solver on the backend ``bk`` can hold its iterate in ``x``: NumPy, and ``x`` a writeable,
+    C-contiguous float64 NumPy array."""
+    return (bk.is_numpy and isinstance(x, np.ndarray) and x.dtype == np.float64 and x.flags.c_contiguous
+            and x.flags.writeable)
 
 
 def clipped_start(bk, x0, mask, hardness=None, overwrite_x0=False):
     """A start ``x0`` clipped at 0 (and at ``hardness``), 0 off ``mask``: ``x0`` itself, clipped in place, where
-    ``overwrite_x0`` and :func:`in_place` allow it on NumPy; else a new array (``x0`` not modified)."""
-    if not (overwrite_x0 and bk.is_numpy and in_place(x0)):
+    ``overwrite_x0`` and :func:`in_place` allow it; else a new array (``x0`` not modified)."""
+    if not (overwrite_x0 and in_place(bk, x0)):
         return bk.xp.where(mask, clip(bk.xp, bk.asarray(x0), hardness), 0.0)
     p = np.maximum(x0, 0.0, out=x0)
     if hardness is not None:

@@ -151,7 +151,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 p = carry_force(xp, p, target, hardness, xp.ones(lat.shape, dtype=xp.bool))
         u0 = None
     else:  # the caller's iterate and its product, as they are
-        p = bk.asarray(x0) if overwrite_x0 and in_place(x0) else bk.copy(bk.asarray(x0))  # updated in place below
+        p = x0 if overwrite_x0 and in_place(bk, x0) else bk.copy(bk.asarray(x0))  # updated in place below
     A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
     soft = stiff = None
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere

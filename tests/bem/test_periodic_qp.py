@@ -245,18 +245,21 @@ def test_overwrite_x0_holds_the_iterate_in_x0_and_without_it_x0_is_untouched(wit
     assert own.iterations == kept.iterations
 
 
-def test_overwrite_x0_copies_an_array_it_cannot_hold_the_iterate_in():
-    """A float32 or read-only ``x0`` is not written even with ``overwrite_x0``."""
+@pytest.mark.parametrize("with_u0", [False, True])
+def test_overwrite_x0_copies_an_array_it_cannot_hold_the_iterate_in(with_u0):
+    """A float32 or read-only ``x0`` is not written even with ``overwrite_x0``, started from it alone or with
+    its product."""
     cell = CELL
     h = _rough(cell, seed=3)
     op = PeriodicOperator(cell, E_STAR)
     force = 0.03 * cell.area
     start = solve_periodic_qp(op, h, force=force, rtol=1e-2).p
-    ref = solve_periodic_qp(op, h, x0=start.copy(), force=force, rtol=1e-10)
+    kw = dict(force=force, rtol=1e-10, u0=op.matvec(start) if with_u0 else None)
+    ref = solve_periodic_qp(op, h, x0=start.copy(), **kw)
     for x0 in (start.astype(np.float32), start.copy()):
         x0.flags.writeable = x0.dtype == np.float32  # the float64 one read-only
         before = x0.copy()
-        res = solve_periodic_qp(op, h, x0=x0, force=force, rtol=1e-10, overwrite_x0=True)
+        res = solve_periodic_qp(op, h, x0=x0, overwrite_x0=True, **kw)
         np.testing.assert_array_equal(x0, before)
         assert res.converged and res.p is not x0
         if x0.dtype == np.float64:
