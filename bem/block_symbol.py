@@ -1,11 +1,12 @@
-"""The 2 x 2 block symbols of the half-space operator (:class:`bem.InfluenceOperator`): their product with
-a pair of spectra, and the inverse symbol of its FFT preconditioner.
+"""The 2 x 2 block symbols of the half-space operator (:class:`bem.InfluenceOperator`): the spectra of its
+kernel between two boxes, their product with a pair of spectra, and the inverse symbol of its FFT preconditioner.
 
 The rows of a lattice split by parity into two rectangular lattices, and a convolution of the
 lattice is a 2 x 2 block convolution of theirs: in the Fourier basis ``V_a <- sum_b S_ab V_b``
 (:func:`block_product`). The preconditioner inverts the symmetric symbol of a zero-padded box
 frequency by frequency (:func:`inverse_symbol`); its symbol is Hermitian, so ``S_10 = conj(S_01)``
-is not stored. On NumPy both run in place with temporaries of a block of :data:`bem.fft.BLOCK`
+is not stored; so is the symbol of the operator over a box onto itself (:func:`kernel_spectra`), whose
+diagonal blocks are real besides. On NumPy both run in place with temporaries of a block of :data:`bem.fft.BLOCK`
 entries or of one block of the symbol, the same operations as the whole-array formulas
 (``tests/bem/test_memory.py``).
 """
@@ -16,7 +17,7 @@ import numpy as np
 
 from . import fft
 
-__all__ = ["block_product", "inverse_symbol"]
+__all__ = ["block_product", "inverse_symbol", "kernel_spectra"]
 
 
 def _conj(x):
@@ -61,7 +62,7 @@ def block_product(S, V):
     return V
 
 
-def inverse_symbol(backend, spectra, lam, floor, diagonal):
+def inverse_symbol(backend, spectra, lam, floor, diagonal, single=False):
     """``(shape, S)``: the spectra ``S`` of ``(K + lam)^-1`` for a symmetric 2 x 2 block symbol ``K`` (eigenvalues
     floored at ``floor * diagonal + lam``), for :func:`block_product`.
 
@@ -70,15 +71,19 @@ def inverse_symbol(backend, spectra, lam, floor, diagonal):
     backend : bem.backend.Backend
         Where the spectra live.
     spectra : callable
-        ``spectra()`` gives ``(shape, K)``: the padded shape ``(Lk, Lq)`` and the kernel spectra ``K[a, b]``
-        divided by ``Lk Lq`` (:meth:`bem.InfluenceOperator._kernel_spectra`). Called here, so that on NumPy
-        ``K`` is let go once the off-diagonal block of ``S`` is made.
+        ``spectra()`` gives ``(shape, K)``: the padded shape ``(Lk, Lq)`` and the kernel spectra divided by
+        ``Lk Lq`` of a box onto itself, ``K = ((K_00, K_01), (None, K_11))`` with real diagonal blocks
+        (:meth:`bem.InfluenceOperator._kernel_spectra` with ``hermitian=True``). Called here, so that on NumPy
+        ``K`` is held only while ``S`` is made.
     lam : float
         Uniform layer compliance [length/pressure] added on the diagonal.
     floor : float
         Eigenvalue floor as a fraction of ``diagonal``.
     diagonal : float
         The diagonal coefficient ``C_nn`` [length/pressure].
+    single : bool
+        On NumPy: ``S`` rounded to single precision (float32, complex64) band by band (elsewhere the caller
+        rounds it).
 
     Returns
     -------
@@ -86,11 +91,11 @@ def inverse_symbol(backend, spectra, lam, floor, diagonal):
         ``S = ((S00, S01), (None, S11))``: ``S_10 = conj(S_01)`` is not stored.
     """
     if backend.is_numpy:
-        return _inverse_symbol_numpy(spectra, lam, floor, diagonal)
+        return _inverse_symbol_numpy(spectra, lam, floor, diagonal, single)
     shape, K = spectra()
     xp = backend.xp
     lam_hat = lam / (shape[0] * shape[1])  # spectra carry the 1/(Lk Lq) of the inverse FFT
-    A, D, B = xp.real(K[0, 0, ...]) + lam_hat, xp.real(K[1, 1, ...]) + lam_hat, K[0, 1, ...]
+    A, D, B = K[0][0] + lam_hat, K[1][1] + lam_hat, K[0][1]
     m = (A + D) / 2
     d = xp.sqrt(((A - D) / 2) ** 2 + xp.abs(B) ** 2)
     low = (floor * diagonal + lam) / (shape[0] * shape[1])
@@ -107,22 +112,38 @@ def inverse_symbol(backend, spectra, lam, floor, diagonal):
     return shape, (((inv_lo + xp.where(safe, (A - m + d) * half, 0.5) * diff) * scale, pb * scale),
                    (None, (inv_lo + xp.where(safe, (D - m + d) * half, 0.5) * diff) * scale))
 
-def _inverse_symbol_numpy(spectra, lam, floor, diagonal):
-    """:func:`inverse_symbol` on NumPy: the same operations, in place where they can be (fewer temporaries
-    of the box's size), and ``K`` let go once ``S_01`` is made."""
+def _inverse_symbol_numpy(spectra, lam, floor, diagonal, single=False):
+    """:func:`inverse_symbol` on NumPy: the same operations, a band of rows of :data:`bem.fft.BLOCK` entries at a
+    time into the blocks of ``S`` (temporaries of a band, not of the box), rounded there to single precision where
+    ``single``."""
     shape, K = spectra()
     size = shape[0] * shape[1]
+    k00, k01, k11 = K[0][0], K[0][1], K[1][1]
+    del K
+    real, cplx = (np.float32, np.complex64) if single else (np.float64, np.complex128)
+    s00, s01, s11 = np.empty(k00.shape, real), np.empty(k01.shape, cplx), np.empty(k11.shape, real)
+    rows = k00.shape[0]
+    step = max(1, fft.BLOCK // max(1, k00[0].size))
+    for lo in range(0, rows, step):
+        r = slice(lo, min(lo + step, rows))
+        s00[r], s01[r], s11[r] = _inverse_band(k00[r], k01[r], k11[r], lam, floor, diagonal, size)
+    # S_10 = conj(S_01): not stored (None), block_product conjugates S_01
+    return shape, ((s00, s01), (None, s11))
+
+
+def _inverse_band(k00, k01, k11, lam, floor, diagonal, size):
+    """The blocks ``(S_00, S_01, S_11)`` of :func:`inverse_symbol` on a band of frequencies (NumPy, in place on
+    the band's temporaries)."""
     lam_hat = lam / size  # spectra carry the 1/(Lk Lq) of the inverse FFT
-    A, D = K[0, 0].real + lam_hat, K[1, 1].real + lam_hat
+    A, D = k00 + lam_hat, k11 + lam_hat
     m = A + D
     m /= 2
     d = A - D
     d /= 2
     np.square(d, out=d)
-    b2 = np.abs(K[0, 1])
+    b2 = np.abs(k01)
     np.square(b2, out=b2)
     d += b2
-    del b2
     np.sqrt(d, out=d)
     low = (floor * diagonal + lam) / size
     inv_hi = m + d
@@ -137,16 +158,13 @@ def _inverse_symbol_numpy(spectra, lam, floor, diagonal):
         half = np.where(safe, d, 1.0)
         np.divide(0.5, half, out=half)
     unsafe = ~safe
-    del safe
     half[unsafe] = 0.0
     diff = inv_hi
     diff -= inv_lo  # inv_hi - inv_lo
     scale = 1.0 / size**2  # inverse of a 1/(Lk Lq) symbol, times 1/(Lk Lq)
-    pb = K[0, 1] * half
-    del K
+    pb = k01 * half
     pb *= diff
     pb *= scale
-    blocks = []
     for X in (D, A):  # (inv_lo + where(safe, (X - m + d) half, 0.5) diff) scale, in place on X
         X -= m
         X += d
@@ -155,7 +173,63 @@ def _inverse_symbol_numpy(spectra, lam, floor, diagonal):
         X *= diff
         X += inv_lo
         X *= scale
-        blocks.append(X)
-    # S_10 = conj(S_01): not stored (None), block_product conjugates S_01
-    return shape, ((blocks[1], pb), (None, blocks[0]))
+    return A, pb, D
 
+
+def kernel_spectra(backend, table, start, out_box, in_box, hermitian=False):
+    """Spectra ``S_ab`` of the blocks mapping ``in_box`` data to ``out_box`` values.
+
+    A box is ``((k0_even, rows_even), (k0_odd, rows_odd)), (q0, cols)`` in parity
+    row and column indices. The input block sits at the origin of the padded
+    array and the kernel is stored shifted so that the output lands at the
+    origin too; the padding ``out + in - 1`` per axis leaves no wrap-around.
+    Returns the padded shape and the spectra divided by the padded size. ``table``: the influence
+    coefficients at every lattice offset (:class:`bem.InfluenceOperator`), ``start``: the first brick row of
+    each parity, ``backend``: where the spectra live (made on the host).
+
+    ``hermitian`` (``out_box == in_box``): the symbol of a box onto itself is Hermitian, its diagonal
+    blocks are the spectra of even kernels, real, and ``S_10 = conj(S_01)`` (their imaginary parts and
+    differences are round-off, ``tests/bem/test_operator.py``). Then only ``S_00``, ``S_01`` and
+    ``S_11`` are made, as ``((S_00.real, S_01), (None, S_11.real))`` for :func:`block_product`:
+    half the memory of the four complex blocks.
+    """
+    if hermitian and out_box != in_box:
+        raise ValueError(f"hermitian = True needs out_box == in_box, got {out_box!r} and {in_box!r}")
+    (o_rows, (oq, nq)), (i_rows, (iq, bq)) = out_box, in_box
+    lk = fft.fast_length(max(o[1] for o in o_rows) + max(i[1] for i in i_rows) - 1, real=False)
+    lq = fft.fast_length(nq + bq - 1, real=True)
+    f = np.r_[0:nq, -(bq - 1) : 0]  # circular column positions
+    dq = f + oq - iq  # column offset output - input
+    # on NumPy one block at a time into the spectra (the same numbers as the batch: each line is
+    # transformed alone), so that the padded kernels are never all held at once
+    numpy = backend.is_numpy
+    blocks = ((0, 0), (0, 1), (1, 1)) if hermitian else ((0, 0), (0, 1), (1, 0), (1, 1))
+    if numpy and hermitian:
+        out = {}
+    else:
+        out = np.empty((2, 2, lk, lq // 2 + 1), dtype=complex) if numpy else np.zeros((2, 2, lk, lq))
+    for a, b in blocks:
+        (oa, na), (ib, nb) = o_rows[a], i_rows[b]
+        e = np.r_[0:na, -(nb - 1) : 0]
+        dr = start[a] - start[b] + 2 * (e + oa - ib)  # brick row offset
+        t = (np.abs(2 * dq + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
+        block = table.take(np.abs(dr), axis=0).take(t, axis=1)  # rows e, columns f
+        kernel = np.zeros((lk, lq)) if numpy else out[a, b]
+        for rows, src_r in ((slice(0, na), slice(0, na)), (slice(lk - nb + 1, lk), slice(na, None))):
+            for cols, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq + 1, lq), slice(nq, None))):
+                kernel[rows, cols] = block[src_r, src_c]
+        del block
+        if numpy:
+            kernel /= lk * lq
+            spectrum = fft.forward(kernel, (lk, lq))
+            del kernel
+            out[a, b] = spectrum.real.copy() if hermitian and a == b else spectrum
+            del spectrum
+    if numpy:
+        return (lk, lq), (((out[0, 0], out[0, 1]), (None, out[1, 1])) if hermitian else out)
+    out /= lk * lq
+    K = backend.forward(backend.asarray(out), (lk, lq))
+    if not hermitian:
+        return (lk, lq), K
+    xp = backend.xp
+    return (lk, lq), ((xp.real(K[0, 0, ...]), K[0, 1, ...]), (None, xp.real(K[1, 1, ...])))

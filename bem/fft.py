@@ -35,9 +35,11 @@ from __future__ import annotations
 import os
 from concurrent.futures import ThreadPoolExecutor
 
+import numpy as np
 import scipy.fft as _sfft
 
-__all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "in_parts", "BLOCK"]
+__all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "forward_parts", "inverse_into", "in_parts",
+           "BLOCK"]
 
 _ENV = "CONTACTLAB_THREADS"
 _override = None
@@ -45,6 +47,8 @@ _override = None
 #: block, not a spectrum)
 BLOCK = 1 << 15
 _PARTS_MIN = 1 << 17  # entries below which in_parts runs in the calling thread
+_BAND = 1 << 19  # entries of the bands of rows :func:`forward` and :func:`inverse` transform one after the other:
+# their temporaries are a band's, not the whole array's (bands of fewer entries cost more calls than they save)
 _pool, _pool_size = None, 0
 
 
@@ -157,8 +161,75 @@ def forward(x, shape):
     """
     lk, lq = shape
     workers = threads()
-    rows = _sfft.rfft(x, n=lq, axis=-1, workers=workers)
-    return _sfft.fft(rows, n=lk, axis=-2, overwrite_x=True, workers=workers)
+    n_rows = x.shape[-2]
+    out = np.empty(x.shape[:-2] + (lk, lq // 2 + 1), dtype=np.result_type(x.dtype, np.complex64))
+    out[..., n_rows:, :] = 0.0  # the padding rows
+    # the real transforms of the rows into the padded array in bands of _BAND entries (not the whole padded
+    # input and unpadded spectrum held beside it), then the complex transform along the rows in place
+    band = _band(n_rows, out.size)
+    for lo in range(0, n_rows, band):
+        hi = min(lo + band, n_rows)
+        out[..., lo:hi, :] = _sfft.rfft(x[..., lo:hi, :], n=lq, axis=-1, workers=workers)
+    return _sfft.fft(out, axis=-2, overwrite_x=True, workers=workers)
+
+
+def _band(rows, size):
+    """Rows of an array of ``size`` entries that a banded transform takes at once: all up to :data:`_BAND`
+    entries, else bands of about :data:`_BAND` entries."""
+    return rows if size <= 2 * _BAND else max(1, rows * _BAND // size)
+
+
+def forward_parts(parts, shape, dtype=np.float64):
+    """:func:`forward` of a batch given as its entries: 2-D real arrays (views allowed, not modified), each
+    zero-padded to ``shape`` and rounded to ``dtype`` band by band (no gathered copy of the batch).
+
+    Parameters
+    ----------
+    parts : sequence of ndarray, shapes ``(rows_b, cols_b)``
+        ``rows_b <= Lk``, ``cols_b <= Lq``.
+    shape : (int, int)
+        Padded size ``(Lk, Lq)``.
+    dtype : numpy dtype
+        ``float64``, or ``float32`` for a single-precision spectrum.
+
+    Returns
+    -------
+    ndarray, shape ``(len(parts), Lk, Lq // 2 + 1)``
+        The spectra, complex128 (complex64 for ``float32``).
+    """
+    lk, lq = shape
+    workers = threads()
+    out = np.empty((len(parts), lk, lq // 2 + 1), dtype=np.result_type(dtype, np.complex64))
+    for b, x in enumerate(parts):
+        n_rows = x.shape[0]
+        out[b, n_rows:, :] = 0.0  # the padding rows
+        band = _band(n_rows, out[b].size)
+        for lo in range(0, n_rows, band):
+            hi = min(lo + band, n_rows)
+            out[b, lo:hi, :] = _sfft.rfft(x[lo:hi].astype(dtype, copy=False), n=lq, axis=-1, workers=workers)
+    return _sfft.fft(out, axis=-2, overwrite_x=True, workers=workers)
+
+
+def inverse_into(spectrum, shape, dest):
+    """:func:`inverse` of one spectrum written into ``dest`` (a view allowed; values cast to its dtype).
+
+    Parameters
+    ----------
+    spectrum : ndarray, shape ``(Lk, Lq // 2 + 1)``
+        Overwritten.
+    shape : (int, int)
+        Padded size ``(Lk, Lq)``.
+    dest : ndarray, shape ``(rows, cols)``
+        Receives the rows and columns kept from the origin, without the ``1 / (Lk Lq)`` factor.
+    """
+    lq = shape[1]
+    workers = threads()
+    cols = _sfft.ifft(spectrum, axis=-2, norm="forward", overwrite_x=True, workers=workers)
+    k0, k1 = dest.shape
+    band = _band(k0, k0 * k1)
+    for lo in range(0, k0, band):
+        hi = min(lo + band, k0)
+        dest[lo:hi] = _sfft.irfft(cols[lo:hi], n=lq, axis=-1, norm="forward", workers=workers)[:, :k1]
 
 
 def inverse(spectrum, shape, keep):
@@ -176,10 +247,16 @@ def inverse(spectrum, shape, keep):
     Returns
     -------
     ndarray, shape ``(..., keep[0], keep[1])``
-        A view into a fresh array; the caller scales it.
+        A fresh array; the caller scales it.
     """
     lq = shape[1]
     workers = threads()
     cols = _sfft.ifft(spectrum, axis=-2, norm="forward", overwrite_x=True, workers=workers)
-    out = _sfft.irfft(cols[..., : keep[0], :], n=lq, axis=-1, norm="forward", workers=workers)
-    return out[..., : keep[1]]
+    k0, k1 = keep
+    out = np.empty(cols.shape[:-2] + (k0, k1), dtype=cols.real.dtype)
+    # the real transforms of the kept rows in bands, each cropped to the kept columns as it is made
+    band = _band(k0, out.size)
+    for lo in range(0, k0, band):
+        hi = min(lo + band, k0)
+        out[..., lo:hi, :] = _sfft.irfft(cols[..., lo:hi, :], n=lq, axis=-1, norm="forward", workers=workers)[..., :k1]
+    return out

@@ -34,7 +34,7 @@ from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 from .newton_moves import release, scaled, settle_plastic
-from .plastic import carry_force, clip, clipped_start, fully_plastic_note
+from .plastic import carry_force, clip, clipped_start, fully_plastic_note, in_place
 
 __all__ = ["solve_newton"]
 
@@ -51,13 +51,15 @@ _FORCING = 0.3
 # when the other cores are busy; np.einsum is not (docs/performance.md, "The FFT back end").
 
 
-def _line_search(bk, layer, p, d, u, cd, h, delta, mask):
-    """Exact minimiser of ``Phi(p + t d)`` on ``(0, 1]``: root of ``d.grad Phi(p + t d)``.
+def _line_search(bk, layer, p, q, u, uq, h, delta, mask):
+    """Exact minimiser of ``Phi(p + t d)``, ``d = q - p``, on ``(0, 1]``: root of ``d.grad Phi(p + t d)``
+    (``u = C p``, ``uq = C q``; ``d`` and ``C d`` are formed on the nodes that move only).
 
     Under force control ``sum d = 0``, so ``delta`` drops out of the derivative.
     """
-    sel = bk.select(mask & (d != 0))
-    ps, ds, us, cds, hs = (bk.take(x, sel) for x in (p, d, u, cd, h))
+    sel = bk.select(mask & (q != p))
+    ps, us, hs = (bk.take(x, sel) for x in (p, u, h))
+    ds, cds = bk.take(q, sel) - ps, bk.take(uq, sel) - us
 
     def slope(t):
         return bk.dot(ds, us + t * cds + layer.w(bk.xp.maximum(ps + t * ds, 0.0)) + hs - delta)
@@ -68,6 +70,29 @@ def _line_search(bk, layer, p, d, u, cd, h, delta, mask):
     if s1 <= 0:
         return 1.0
     return brent_root(slope, 0.0, 1.0, s0, s1, xtol=1e-14, rtol=4 * np.finfo(float).eps)
+
+
+def _advance(bk, p, u, sub, t, force, node_area, hardness):
+    """``(p + t d, u + t C d)`` for the step ``d = q - p`` to the model's solution ``q = sub.p`` (``C q`` its
+    displacement), ``p + t d`` clipped to the bounds and scaled to the force. On NumPy in the buffers of ``q`` and
+    ``C q``, which the step consumes (the same numbers as the new arrays elsewhere)."""
+    q, uq = sub.p, sub.displacement
+    if not (in_place(bk, q) and in_place(bk, uq)) or q is p or uq is u:
+        return scaled(clip(bk.xp, p + t * (q - p), hardness), force, node_area, hardness), u + t * (uq - u)
+    q -= p  # d, then t d, then p + t d
+    q *= t
+    q += p
+    np.maximum(q, 0.0, out=q)
+    if hardness is not None:
+        np.minimum(q, hardness, out=q)
+    if force is not None and hardness is None:
+        q *= force / node_area / float(np.sum(q))
+    else:
+        q = scaled(q, force, node_area, hardness)
+    uq -= u  # C d, then t C d, then u + t C d
+    uq *= t
+    uq += u
+    return q, uq
 
 
 def _model_qp(op, b, D, contact, precondition, **kw):
@@ -84,7 +109,7 @@ def _count_inner(hist, sub):
 
 
 def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10, maxiter=100,
-                 precondition=True, callback=None, record=False, inner_maxiter=300, hardness=None):
+                 precondition=True, callback=None, record=False, inner_maxiter=300, hardness=None, overwrite_x0=False):
     """Newton's method with exact line search for the layered contact problem.
 
     Parameters
@@ -116,6 +141,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     hardness : float, optional
         The bound ``p <= H`` [pressure] (:mod:`bem.plastic`): the inner QPs are bounded, so the
         step ``d = q - p`` stays in the box ``0 <= p <= H`` for ``t in (0, 1]``.
+    overwrite_x0 : bool
+        Whether a float64 NumPy ``x0`` may hold the iterate: each step's pressure is copied into it (one
+        array of the lattice fewer where the caller holds ``x0`` anyway; the callback gets a copy).
 
     Returns
     -------
@@ -153,11 +181,13 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
                              preconditioner=op.preconditioner(lam=lam) if precondition else None, hardness=hardness)
         p = start.p
     else:
-        p = clipped_start(bk, x0, mask, hardness)
+        p = clipped_start(bk, x0, mask, hardness, overwrite_x0)
         if force is not None and hardness is None:
             p *= force / op.lattice.node_area / float(xp.sum(p))
         elif force is not None:  # its nodes below H carry the force, or the nodes of smallest gap help them
             p = carry_force(xp, p, force / op.lattice.node_area, hardness, mask, h)
+    own = p if overwrite_x0 and p is x0 else None  # the caller's x0, holding the iterate
+    x0 = None
     u = op.matvec(p)
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "step": [], "inner_iterations": [],
             "inner_missed": 0, "inner_worst": 0.0}
@@ -212,28 +242,31 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         # the root-layer problem of benchmarks/side_by_side.py)
         sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p, rtol=inner,
                         maxiter=inner_maxiter, u0=u, confirm=False, **bound)
+        b = None  # the model's gap: not held through the line search
         _count_inner(hist, sub)
-        d = sub.p - p
-        cd = sub.displacement - u
-        t = _line_search(bk, layer, p, d, u, cd, h, delta, mask)
+        # the step d = q - p of the model's solution q (C d = uq - u) is formed where it is used, not held
+        t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, mask)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
             wp = closure(p)
             scale = float(xp.max(xp.abs(u + wp)))
             D = majorant(op, layer, p, sub.p, D, mask)
             b = h + wp - D * p
+            wp = None
+            sub = None
             sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p,
                             rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False,
                             **bound)
+            b = None
             _count_inner(hist, sub)
-            d = sub.p - p
-            cd = sub.displacement - u
-            t = _line_search(bk, layer, p, d, u, cd, h, delta, mask)
+            t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, mask)
+        D = None
         judged = None
         if t == 0.0:
             # No decrease of Phi measurable along d: the change of Phi falls below its round-off
             # while nodes of tiny pressure (where w' is huge, e.g. a power law with small s)
             # still violate their gap. The step is then chosen by the KKT residual instead:
             # t = 1, 1/2, 1/4, 1/8, the first that lowers it.
+            d = sub.p - p
             for t_try in (1.0, 0.5, 0.25, 0.125):
                 trial = scaled(clip(xp, p + t_try * d, hardness), force, op.lattice.node_area, hardness)
                 u_trial = op.matvec(trial)
@@ -249,15 +282,23 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             message = f"line search found no descent (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
             status = "stalled"
             break
-        else:
-            p = scaled(clip(xp, p + t * d, hardness), force, op.lattice.node_area, hardness)
-            u, exact = u + t * cd, False
-        p, u = release(op, layer, h, p, u, sub.p, delta, force=force, hardness=hardness)
+        d = trial = u_trial = None
+        # the nodes the model releases, and with a hardness those it puts at H (the moves of bem.newton_moves)
+        released = sub.p == 0
+        at_bound = None if hardness is None else sub.p >= hardness
+        if judged is None:
+            p, u = _advance(bk, p, u, sub, t, force, op.lattice.node_area, hardness)
+            exact = False
+        sub = None
+        p, u = release(op, layer, h, p, u, released, delta, force=force, hardness=hardness)
         if hardness is not None:
-            p, u = settle_plastic(op, layer, h, p, u, sub.p, delta, force=force, hardness=hardness)
+            p, u = settle_plastic(op, layer, h, p, u, at_bound, delta, force=force, hardness=hardness)
+        if own is not None and p is not own:  # the step's pressure into the caller's x0
+            own[...] = p
+            p = own
         if callback is not None:
-            callback(k + 1, p)
-        sub = d = cd = b = D = trial = u_trial = None  # not held through the next step's model solve
+            callback(k + 1, p if own is None else bk.copy(p))
+        released = at_bound = None  # not held through the next step's model solve
     if converged and hardness is not None and force is not None and (
             bracket := _plastic_bracket(bk, mask, p, gap + delta, hardness)) is not None:
         hist["approach_bracket"] = list(bracket)

@@ -46,8 +46,8 @@ def scaled(p, force, node_area, hardness=None):
     return p if filled is None else filled[0]
 
 
-def release(op, layer, h, p, u, q, delta, *, force, hardness=None):
-    """Set to 0 the nodes the model solution ``q`` releases, if that lowers ``Phi``.
+def release(op, layer, h, p, u, released, delta, *, force, hardness=None):
+    """Set to 0 the nodes the model solution releases (``released``: boolean, its pressure 0), if that lowers ``Phi``.
 
     Where ``w`` is concave (power ``s < 1``) a node that leaves the contact is only
     approached geometrically by damped steps (``p -> (1 - t) p``), where ``w'`` grows
@@ -63,7 +63,7 @@ def release(op, layer, h, p, u, q, delta, *, force, hardness=None):
     """
     bk, mask = operator_backend(op)
     xp = bk.xp
-    out = bk.select(mask & (q == 0) & (p > 0))
+    out = bk.select(mask & released & (p > 0))
     if not bk.count(out):
         return p, u
     if force is not None:
@@ -91,8 +91,8 @@ def release(op, layer, h, p, u, q, delta, *, force, hardness=None):
 
 
 
-def settle_plastic(op, layer, h, p, u, q, delta, *, force, hardness):
-    """Set to ``H`` the nodes the model solution ``q`` puts at the hardness, if that lowers ``Phi``.
+def settle_plastic(op, layer, h, p, u, at_bound, delta, *, force, hardness):
+    """Set to ``H`` the nodes the model solution puts at the hardness (``at_bound``: boolean), if that lowers ``Phi``.
 
     A node just below ``H`` whose model puts it at ``H`` is only approached by damped steps
     (``p -> p + t (H - p)``), and its gap, set by its plastic neighbours, stays violated while the
@@ -101,7 +101,7 @@ def settle_plastic(op, layer, h, p, u, q, delta, *, force, hardness):
     """
     bk, mask = operator_backend(op)
     xp = bk.xp
-    up = bk.select(mask & (q >= hardness) & (p < hardness))
+    up = bk.select(mask & at_bound & (p < hardness))
     if not bk.count(up):
         return p, u
     trial = scaled(bk.put(bk.copy(p), up, hardness), force, op.lattice.node_area, hardness)

@@ -33,7 +33,7 @@ import numpy as np
 
 from . import fft
 from .backend import get_backend
-from .block_symbol import block_product, inverse_symbol
+from .block_symbol import block_product, inverse_symbol, kernel_spectra
 from .checks import check_positive
 from .template import template
 
@@ -160,44 +160,9 @@ class InfluenceOperator:
     def _full(self):
         return tuple((0, n) for n in self._n), (0, self.lattice.shape[1])
 
-    def _kernel_spectra(self, out_box, in_box):
-        """Spectra ``S_ab`` of the blocks mapping ``in_box`` data to ``out_box`` values.
-
-        A box is ``((k0_even, rows_even), (k0_odd, rows_odd)), (q0, cols)`` in parity
-        row and column indices. The input block sits at the origin of the padded
-        array and the kernel is stored shifted so that the output lands at the
-        origin too; the padding ``out + in - 1`` per axis leaves no wrap-around.
-        Returns the padded shape and the spectra divided by the padded size.
-        """
-        (o_rows, (oq, nq)), (i_rows, (iq, bq)) = out_box, in_box
-        lk = fft.fast_length(max(o[1] for o in o_rows) + max(i[1] for i in i_rows) - 1, real=False)
-        lq = fft.fast_length(nq + bq - 1, real=True)
-        f = np.r_[0:nq, -(bq - 1) : 0]  # circular column positions
-        dq = f + oq - iq  # column offset output - input
-        # on NumPy one block at a time into the spectra (the same numbers as the batch: each line is
-        # transformed alone), so that the padded kernels are never all held at once
-        numpy = self.backend.is_numpy
-        out = np.empty((2, 2, lk, lq // 2 + 1), dtype=complex) if numpy else np.zeros((2, 2, lk, lq))
-        for a in (0, 1):
-            for b in (0, 1):
-                (oa, na), (ib, nb) = o_rows[a], i_rows[b]
-                e = np.r_[0:na, -(nb - 1) : 0]
-                dr = self._start[a] - self._start[b] + 2 * (e + oa - ib)  # brick row offset
-                t = (np.abs(2 * dq + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
-                block = self._table.take(np.abs(dr), axis=0).take(t, axis=1)  # rows e, columns f
-                kernel = np.zeros((lk, lq)) if numpy else out[a, b]
-                for rows, src_r in ((slice(0, na), slice(0, na)), (slice(lk - nb + 1, lk), slice(na, None))):
-                    for cols, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq + 1, lq), slice(nq, None))):
-                        kernel[rows, cols] = block[src_r, src_c]
-                del block
-                if numpy:
-                    kernel /= lk * lq
-                    out[a, b] = fft.forward(kernel, (lk, lq))
-                    del kernel
-        if numpy:
-            return (lk, lq), out
-        out /= lk * lq
-        return (lk, lq), self.backend.forward(self.backend.asarray(out), (lk, lq))
+    def _kernel_spectra(self, out_box, in_box, hermitian=False):
+        """:func:`bem.block_symbol.kernel_spectra` of this operator's coefficient table."""
+        return kernel_spectra(self.backend, self._table, self._start, out_box, in_box, hermitian)
 
     def _cached(self, key, build):
         if key in self._spectra:
@@ -227,11 +192,27 @@ class InfluenceOperator:
         if size(box) > _FULL_ABOVE * size(full):
             box = full
         box = self._reuse("C", box, size) or box
-        return box, self._cached(("C", box), lambda: self._kernel_spectra(full, box))
+        return box, self._cached(("C", box), lambda: self._kernel_spectra(full, box, hermitian=box == full))
 
     def _convolve(self, spectra, shape, v, in_box, out_box, out, single=False):
         """``out[out_box] = sum_b S_ab v_b[in_box]``; other entries of ``out`` are left alone (``single``: the
         transforms in single precision, with single-precision spectra)."""
+        (i_rows, (iq, bq)), (o_rows, (oq, nq)) = in_box, out_box
+        bk = self.backend
+        if bk.is_numpy:  # the parities' rows transformed where they are, the products written where they go
+            parts = [v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq] for s, (k0, nb) in zip(self._start, i_rows)]
+            V = block_product(spectra, fft.forward_parts(parts, shape, np.float32 if single else np.float64))
+            del parts
+            for a, s in enumerate(self._start):
+                k0, na = o_rows[a]
+                fft.inverse_into(V[a], shape, out[_rows(s, k0, na, out.shape[0]), oq : oq + nq])
+        else:
+            self._convolve_device(spectra, shape, v, in_box, out_box, out, single)
+        if self._masked_last:
+            out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
+
+    def _convolve_device(self, spectra, shape, v, in_box, out_box, out, single):
+        """:meth:`_convolve` off NumPy: the parities gathered into one batch, its products split off."""
         (i_rows, (iq, bq)), (o_rows, (oq, nq)) = in_box, out_box
         bk = self.backend
         xp = bk.xp
@@ -248,8 +229,6 @@ class InfluenceOperator:
             k0, na = o_rows[a]
             part = bk.inverse(V[a, ...], shape, (na, nq)) if split else both[a, :na, :]
             out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = xp.astype(part, out.dtype, copy=False)
-        if self._masked_last:
-            out[self._start[1] :: 2, -1] = 0.0  # the masked last node of the odd rows
 
     # -- public products ---------------------------------------------------------------------------
 
@@ -338,8 +317,9 @@ class InfluenceOperator:
     def _inverse_symbol(self, box, lam, floor, single=False):
         """``(shape, S)``: the spectra of ``(K + lam)^-1`` for the symbol ``K`` of ``box``
         (:func:`bem.block_symbol.inverse_symbol`), rounded to single precision where ``single``."""
-        shape, S = inverse_symbol(self.backend, lambda: self._kernel_spectra(box, box), lam, floor, self.diagonal)
-        if not single:
+        shape, S = inverse_symbol(self.backend, lambda: self._kernel_spectra(box, box, hermitian=True), lam, floor,
+                                  self.diagonal, single)
+        if not single or self.backend.is_numpy:  # NumPy: rounded as it is made
             return shape, S
         # the diagonal blocks are real, S_10 = conj(S_01) is not stored; one block at a time, each double-precision
         # block let go as it is rounded

@@ -135,9 +135,9 @@ class PeriodicCell:
         """One level of nested iteration, on the whole cell; the solution and the operator used.
 
         The start ``kw["x0"]`` of :func:`bem.solve` is a new array (the coarser level's solution interpolated,
-        or the caller's ``x0`` copied): Kalker's QP holds its iterate in it (one array of the cell fewer)."""
+        or the caller's ``x0`` copied): Kalker's QP and Newton hold their iterate in it (one array of the cell fewer)."""
         op = make_op(cell)
-        if solver == "kalker" and kw.get("x0") is not None:
+        if solver in ("kalker", "newton") and kw.get("x0") is not None:
             kw = dict(kw, overwrite_x0=True)
         return run(op, h, kw), [op]
 

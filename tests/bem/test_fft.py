@@ -78,3 +78,49 @@ def test_in_parts_gives_the_numbers_of_one_thread(monkeypatch):
     Y = X.copy()
     assert op.mix(Y, (d, b), out=Y) is Y  # in place, as the solvers call it
     np.testing.assert_array_equal(Y, one)
+
+
+def _gathered_forward(parts, shape, dtype):
+    """The batch gathered into one zero-filled array, then the plain padded transform pair of SciPy."""
+    import scipy.fft as sfft
+
+    data = np.zeros((len(parts), max(p.shape[0] for p in parts), max(p.shape[1] for p in parts)), dtype=dtype)
+    for b, p in enumerate(parts):
+        data[b, : p.shape[0], : p.shape[1]] = p.astype(dtype)
+    rows = sfft.rfft(data, n=shape[1], axis=-1)
+    return sfft.fft(rows, n=shape[0], axis=-2)
+
+
+@pytest.mark.parametrize("band", [None, 3])  # None: the default bands (one here); 3: bands of a few rows
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_forward_parts_of_strided_rows_is_the_gathered_transform_bit_for_bit(monkeypatch, band, dtype):
+    if band is not None:
+        monkeypatch.setattr(fft, "_BAND", band)
+    v = np.random.default_rng(1).standard_normal((23, 17))
+    parts = [v[0::2, 2:13], v[1::2, 2:13]]  # 12 and 11 rows, views with a row stride
+    keep = v.copy()
+    shape = (fft.fast_length(24, real=False), fft.fast_length(21, real=True))
+    got = fft.forward_parts(parts, shape, dtype)
+    want = _gathered_forward(parts, shape, dtype)
+    np.testing.assert_array_equal(v, keep)
+    assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("band", [None, 3])
+def test_banded_forward_and_inverse_are_the_plain_pair_bit_for_bit(monkeypatch, band):
+    import scipy.fft as sfft
+
+    if band is not None:
+        monkeypatch.setattr(fft, "_BAND", band)
+    x = np.random.default_rng(2).random((2, 9, 7))
+    shape = (fft.fast_length(17, real=False), fft.fast_length(13, real=True))
+    spectrum = fft.forward(x, shape)
+    assert np.array_equal(spectrum, _gathered_forward(list(x), shape, np.float64))
+    plain = sfft.irfft(sfft.ifft(spectrum, axis=-2, norm="forward")[..., :9, :], n=shape[1], axis=-1,
+                       norm="forward")[..., :7]
+    back = fft.inverse(spectrum.copy(), shape, (9, 7))
+    assert back.shape == (2, 9, 7) and np.array_equal(back, plain)
+    out = np.full((18, 11), -1.0)
+    fft.inverse_into(spectrum[1].copy(), shape, out[1::2, 3:10])  # a strided destination, the rest untouched
+    assert np.array_equal(out[1::2, 3:10], plain[1])
+    assert np.all(out[0::2] == -1.0) and np.all(out[:, :3] == -1.0) and np.all(out[:, 10:] == -1.0)

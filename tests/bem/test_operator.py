@@ -124,3 +124,57 @@ def test_periodic_single_precision_preconditioner_is_the_double_one_rounded():
     exact, single = op.preconditioner(0.05)(r), op.preconditioner(0.05, single=True)(r)
     assert single.dtype == np.float64
     assert 1e-9 < np.abs(single - exact).max() / np.abs(exact).max() < 1e-5
+
+
+def _boxes(op, rng):
+    """The whole region and three random support boxes of ``op``'s lattice."""
+    yield op._full()
+    for _ in range(3):
+        v = np.zeros(op.lattice.shape)
+        r0, c0 = rng.integers(0, op.lattice.shape[0] // 2), rng.integers(0, op.lattice.shape[1] // 2)
+        v[r0 : r0 + rng.integers(1, op.lattice.shape[0] // 2), c0 : c0 + rng.integers(1, op.lattice.shape[1] // 2)] = 1
+        yield op._box(v)
+
+
+@pytest.mark.parametrize("extent, coated", [((1.0, 0.8), False), ((0.55, 1.0), False), ((0.73, 0.81), False),
+                                            ((0.6, 0.5), True)])
+def test_the_symbol_of_a_box_onto_itself_is_hermitian_with_real_diagonal_blocks(extent, coated):
+    """The compact spectra (``hermitian=True``) drop only round-off: the four complex blocks have diagonal blocks
+    with imaginary parts, and ``S_10 - conj(S_01)``, below 1e-15 of the largest entry; the stored blocks are the
+    four-block spectra's own numbers."""
+    bodies = bem.Bodies(210e9, 0.3, 210e9, 0.3, coating1=bem.Coating(0.05, 3.0, 0.3)) if coated else None
+    op = InfluenceOperator(Lattice.from_extent(0.05, extent), 1.0 if bodies is None else bodies.E_star, bodies=bodies)
+    rng = np.random.default_rng(3)
+    for box in _boxes(op, rng):
+        shape, K = op._kernel_spectra(box, box)
+        shape_h, ((s00, s01), (s10, s11)) = op._kernel_spectra(box, box, hermitian=True)
+        scale = np.abs(K).max()
+        assert shape_h == shape and s10 is None and s00.dtype == s11.dtype == np.float64
+        assert np.abs(K[0, 0].imag).max() < 1e-15 * scale and np.abs(K[1, 1].imag).max() < 1e-15 * scale
+        assert np.abs(K[1, 0] - K[0, 1].conj()).max() < 1e-15 * scale
+        assert np.array_equal(s00, K[0, 0].real) and np.array_equal(s11, K[1, 1].real)
+        assert np.array_equal(s01, K[0, 1])
+
+
+def test_hermitian_spectra_need_a_box_onto_itself():
+    op = InfluenceOperator(Lattice.from_extent(0.1, 1.0), 1.0)
+    v = np.zeros(op.lattice.shape)
+    v[2:5, 3:6] = 1.0
+    with pytest.raises(ValueError, match="hermitian = True needs out_box == in_box"):
+        op._kernel_spectra(op._full(), op._box(v), hermitian=True)
+
+
+def test_the_product_over_the_whole_region_keeps_the_compact_spectra():
+    """A product whose support spans the region uses the compact spectra of the whole box (half the memory of
+    four complex blocks), and gives the product of a window's four-block spectra to round-off."""
+    lat = Lattice.from_extent(0.05, (1.0, 0.8))
+    op = InfluenceOperator(lat, 1.0)
+    p = np.random.default_rng(4).random(lat.shape) * lat.mask
+    u = op.matvec(p)
+    (key, value), = op._spectra.items()
+    assert key == ("C", op._full()) and value[1][1][0] is None and value[1][0][0].dtype == np.float64
+    box = op._full()
+    out = np.zeros(lat.shape)
+    shape, K = op._kernel_spectra(box, box)  # the four blocks, through the same convolution
+    op._convolve(K, shape, p, box, box, out)
+    assert np.abs(u - out).max() <= 1e-15 * np.abs(u).max()

@@ -203,14 +203,17 @@ def test_approach_control_gives_the_force_control_solution():
 
 
 @pytest.mark.parametrize("shape", ["brick", "nodes"])
-def test_a_callers_start_and_gap_are_not_modified(shape):
-    """The cell's QP holds its iterate in the start it is given (``overwrite_x0``): that is a copy of the
-    caller's ``x0``, which keeps its values, as does the gap array."""
+@pytest.mark.parametrize("method", ["kalker", "newton"])
+def test_a_callers_start_and_gap_are_not_modified(shape, method):
+    """The cell's QP and Newton hold their iterate in the start they are given (``overwrite_x0``): that is a
+    copy of the caller's ``x0``, which keeps its values, as does the gap array."""
     h = GAP(CELL.x, CELL.y)
-    first = solve_periodic(h, step=CELL.step, E_star=E_STAR, mean_pressure=PBAR, method="kalker", rtol=1e-3)
+    layer = layers.Root(0.3 * bem.diagonal_coefficient(CELL.step, E_STAR)) if method == "newton" else None
+    kw = dict(step=CELL.step, E_star=E_STAR, mean_pressure=PBAR, method=method, layer=layer)
+    first = solve_periodic(h, rtol=1e-3, **kw)
     x0 = first.p.reshape(CELL.shape) if shape == "brick" else first.p.copy()
     x0_before, h_before = x0.copy(), h.copy()
-    res = solve_periodic(h, step=CELL.step, E_star=E_STAR, mean_pressure=PBAR, method="kalker", x0=x0)
+    res = solve_periodic(h, x0=x0, **kw)
     assert res.converged
     np.testing.assert_array_equal(x0, x0_before)
     np.testing.assert_array_equal(h, h_before)

@@ -1,0 +1,86 @@
+"""Newton's arrays (:mod:`bem.newton`): the step consumes the model's solution in place and the iterate may live
+in the caller's start, with the numbers of the plain formulas and the caller's arrays as documented."""
+
+import math
+
+import numpy as np
+import pytest
+
+import bem
+from bem import layers
+from bem.backend import get_backend
+from bem.cg_rules import QPSolution
+from bem import newton
+from bem.periodic import PeriodicCell, PeriodicOperator
+from bem.plastic import clip
+
+CELL = PeriodicCell(1.0 / 48, 48, 48)
+LAYER = layers.Root(0.3 * bem.diagonal_coefficient(CELL.step, 1.0))
+
+
+def _surface(cell, seed=5, modes=8):
+    rng = np.random.default_rng(seed)
+    lx, ly = cell.size
+    h = np.zeros(cell.shape)
+    for m in range(1, modes + 1):
+        kx, ky = 2 * math.pi * rng.integers(-m, m + 1) / lx, 2 * math.pi * m / ly
+        h += 0.01 * np.cos(kx * cell.x + ky * cell.y + rng.uniform(0, 2 * math.pi)) / m
+    return h - h.min()
+
+
+def _plain(p, u, q, uq, t, force, area, hardness):
+    """The step's formulas on new arrays."""
+    new = clip(np, p + t * (q - p), hardness)
+    if force is not None and hardness is None:
+        new = new * (force / area / float(np.sum(new)))
+    return new, u + t * (uq - u)
+
+
+@pytest.mark.parametrize("force, hardness", [(None, None), (0.5, None), (None, 0.8)])
+@pytest.mark.parametrize("writeable", [True, False])
+def test_the_step_is_the_plain_formula_bit_for_bit_in_the_models_buffers(force, hardness, writeable):
+    rng = np.random.default_rng(1)
+    p, u, q, uq = (rng.standard_normal((9, 11)) for _ in range(4))
+    p, q = np.abs(p), np.maximum(q, 0.0)
+    keep = [x.copy() for x in (p, u, q, uq)]
+    want = _plain(p, u, q, uq, 0.37, force, 0.01, hardness)
+    if not writeable:
+        q.flags.writeable = uq.flags.writeable = False
+    sub = QPSolution(p=q, approach=0.0, iterations=1, converged=True, message="", status="converged",
+                     kkt_residual=0.0, displacement=uq, history={})
+    new_p, new_u = newton._advance(get_backend("cpu"), p, u, sub, 0.37, force, 0.01, hardness)
+    assert np.array_equal(new_p, want[0]) and np.array_equal(new_u, want[1])
+    np.testing.assert_array_equal(p, keep[0])  # the iterate and its product are not written
+    np.testing.assert_array_equal(u, keep[1])
+    if writeable:  # the model's solution and its product became the step's
+        assert new_p is q and new_u is uq
+    else:
+        np.testing.assert_array_equal(q, keep[2])
+        np.testing.assert_array_equal(uq, keep[3])
+
+
+def _newton(x0, **kw):
+    op = PeriodicOperator(CELL, 1.0)
+    return newton.solve_newton(op, _surface(CELL), layer=LAYER, force=0.02, x0=x0, **kw)
+
+
+def test_newton_holds_its_iterate_in_a_start_it_may_overwrite():
+    x0 = np.full(CELL.shape, 0.02 / CELL.area)
+    plain = _newton(x0.copy())
+    steps = []
+    held = _newton(x0, overwrite_x0=True, callback=lambda k, p: steps.append(p))
+    assert plain.converged and held.converged and held.iterations == plain.iterations >= 2
+    assert held.p is x0 and np.array_equal(held.p, plain.p)
+    # the callback gets each step's pressure as it was, not the array that goes on changing
+    assert len(steps) == held.iterations and not any(np.shares_memory(s, x0) for s in steps)
+    assert not np.array_equal(steps[0], steps[-1]) and np.array_equal(steps[-1], held.p)
+
+
+@pytest.mark.parametrize("start", ["float32", "read-only", "no overwrite"])
+def test_newton_leaves_a_start_it_may_not_hold_its_iterate_in(start):
+    x0 = np.full(CELL.shape, 0.02 / CELL.area, dtype=np.float32 if start == "float32" else np.float64)
+    x0.flags.writeable = start != "read-only"
+    keep = x0.copy()
+    res = _newton(x0, overwrite_x0=start != "no overwrite")
+    assert res.converged and res.p is not x0
+    np.testing.assert_array_equal(x0, keep)
