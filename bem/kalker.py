@@ -25,7 +25,8 @@ __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
-             maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True, hardness=None):
+             maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True, hardness=None,
+             overwrite_x0=False):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` (``0 <= p <= H`` with a hardness).
 
     Parameters
@@ -41,6 +42,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         (the variable-compliance method of eq. 22 passes an array).
     x0 : ndarray, optional
         Initial pressure (brick array); negative entries are clipped.
+    overwrite_x0 : bool
+        Whether a float64 NumPy ``x0`` may hold the iterate (clipped and masked in place, not copied: one array
+        of the lattice fewer). Without ``u0`` only.
     rtol : float
         Tolerance on the KKT residual.
     maxiter : int, optional
@@ -98,7 +102,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
     if u0 is None or x0 is None:
-        p = xp.where(mask, initial_pressure(op, h, lam, force, approach, x0, hardness), 0.0)
+        p = initial_pressure(op, h, lam, force, approach, x0, hardness, overwrite_x0)
+        if p is not x0:  # x0 itself where overwrite_x0 allows: clipped and masked in place
+            p = xp.where(mask, p, 0.0)
         if target is not None:
             p = p if float(xp.sum(p)) > 0 else xp.astype(mask, bk.float64)
             if hardness is None:
@@ -244,26 +250,26 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
         p_c = xp.where(clipped, 0.0, p_c)
-        p_new = spread(idx, p_c)
-        # re-entering nodes (p_new = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi
+        p[...] = 0.0  # p_c on the contact, 0 elsewhere: in p itself, no second array of the lattice
+        bk.put(p, idx, p_c)
+        # re-entering nodes (p = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi
         # estimate -g / (C_nn + lam) so that a node with a large layer compliance cannot overshoot
         low = bk.select(g < 0)
-        overlap = bk.subset(low, bk.take(p_new, low) == 0)  # off-mask nodes have g = 0
+        overlap = bk.subset(low, bk.take(p, low) == 0)  # off-mask nodes have g = 0
         n_overlap = bk.count(overlap)
         if n_overlap:
             lam_o = bk.take(lam, overlap) if per_node else lam
-            bk.put(p_new, overlap, entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o), per_node))
+            bk.put(p, overlap, entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o), per_node))
         restart = bool(n_overlap)
         s = 1.0
         if target is not None:
-            s = target / float(xp.sum(p_new))  # the full sum: Newton's round-off floor depends on it
+            s = target / float(xp.sum(p))  # the full sum: Newton's round-off floor depends on it
             if math.isfinite(s):
-                p_new *= s  # nonzero only at the contact and the overlap: the same as scaling those
+                p *= s  # nonzero only at the contact and the overlap: the same as scaling those
             else:
-                bk.put(p_new, idx, bk.take(p_new, idx) * s)
+                bk.put(p, idx, bk.take(p, idx) * s)
                 entering = bk.subset(overlap, ~bk.take(contact, overlap))  # a clipped contact node may re-enter
-                bk.put(p_new, entering, bk.take(p_new, entering) * s)
-        p = p_new  # the last iterate goes before the product
+                bk.put(p, entering, bk.take(p, entering) * s)
         if bool(xp.any(clipped)) or restart or stale >= RECOMPUTE_EVERY:
             u = r = None
             u, stale = apply(p), 0

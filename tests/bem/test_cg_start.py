@@ -41,3 +41,38 @@ def test_clipped_start_leaves_x0_alone_unless_allowed_and_able():
         assert clipped_start(BK, other, mask, overwrite_x0=True) is not other
         np.testing.assert_array_equal(other, kept)
     assert not in_place(BK, [1.0, 2.0]) and in_place(BK, np.zeros(3))
+
+
+def _sphere(**kw):
+    import bem
+
+    return bem.solve(bem.gaps.Paraboloid(1.0), E_star=1.0, force=4 * 0.1**3 / 3, step=0.02, extent=0.3, **kw)
+
+
+def test_the_half_space_qp_holds_its_iterate_in_a_start_it_may_overwrite():
+    import bem
+
+    first = _sphere(rtol=1e-3)
+    op = bem.InfluenceOperator(first.lattice, 1.0)
+    h = np.where(first.lattice.mask, bem.gaps.Paraboloid(1.0)(first.lattice.x, first.lattice.y), 0.0)
+    x0 = np.zeros(first.lattice.shape)
+    x0[first.lattice.mask] = first.p
+    x0[~first.lattice.mask] = 5.0  # off the candidate nodes: masked in place
+    plain = op.qp(h, force=4 * 0.1**3 / 3, x0=x0.copy())
+    held = op.qp(h, force=4 * 0.1**3 / 3, x0=x0, overwrite_x0=True)
+    assert held.converged and held.p is x0 and np.array_equal(held.p, plain.p)
+    assert held.iterations == plain.iterations and np.all(x0[~first.lattice.mask] == 0)
+
+
+@pytest.mark.parametrize("method, layer", [("kalker", None), ("newton", "root")])
+def test_a_callers_start_on_a_half_space_region_is_not_modified(method, layer):
+    import bem
+
+    law = bem.layers.Root(0.3 * bem.diagonal_coefficient(0.02, 1.0)) if layer else None
+    first = _sphere(rtol=1e-3, method=method, layer=law)
+    x0 = first.p.copy()
+    before = x0.copy()
+    res = _sphere(x0=x0, method=method, layer=law)
+    assert res.converged
+    np.testing.assert_array_equal(x0, before)
+    assert not np.shares_memory(res.p, x0)
