@@ -27,7 +27,13 @@ Pruned transforms
     are kept (inverse); the complex FFT along the first data axis does the
     zero padding. Against a plain ``rfft2``/``irfft2`` pair of the padded
     size this skips the transforms of the zero rows (about 25 % of the work
-    when the data fill half the padded rows).
+    when the data fill half the padded rows). The real transforms run in bands of
+    rows (:data:`_BAND` entries), written into the padded spectrum or the output
+    as they are made, so that no whole unpadded spectrum or padded input is held
+    beside them; :func:`forward_parts` and :func:`inverse_into` take the batch as
+    its entries (strided views of a brick array's row parities) and write the
+    product where it goes (no gathered copy). Banded or not, the numbers are
+    the same (``tests/bem/test_fft.py``).
 """
 
 from __future__ import annotations
