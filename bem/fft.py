@@ -165,23 +165,14 @@ def forward(x, shape):
     ndarray, shape ``(..., Lk, Lq // 2 + 1)``, complex128
         Unnormalised 2-D DFT of the padded arrays.
     """
-    lk, lq = shape
-    workers = threads()
-    n_rows = x.shape[-2]
-    out = np.empty(x.shape[:-2] + (lk, lq // 2 + 1), dtype=np.result_type(x.dtype, np.complex64))
-    out[..., n_rows:, :] = 0.0  # the padding rows
-    # the real transforms of the rows into the padded array in bands of _BAND entries (not the whole padded
-    # input and unpadded spectrum held beside it), then the complex transform along the rows in place
-    band = _band(n_rows, out.size)
-    for lo in range(0, n_rows, band):
-        hi = min(lo + band, n_rows)
-        out[..., lo:hi, :] = _sfft.rfft(x[..., lo:hi, :], n=lq, axis=-1, workers=workers)
-    return _sfft.fft(out, axis=-2, overwrite_x=True, workers=workers)
+    lead = x.shape[:-2]
+    spectra = forward_parts(x.reshape((-1,) + x.shape[-2:]), shape, x.dtype)
+    return spectra.reshape(lead + spectra.shape[1:])
 
 
 def _band(rows, size):
-    """Rows of an array of ``size`` entries that a banded transform takes at once: all up to :data:`_BAND`
-    entries, else bands of about :data:`_BAND` entries."""
+    """Rows of an array of ``size`` entries that a banded transform takes at once: all of them up to twice
+    :data:`_BAND` entries, else bands of about :data:`_BAND` entries."""
     return rows if size <= 2 * _BAND else max(1, rows * _BAND // size)
 
 
@@ -255,14 +246,7 @@ def inverse(spectrum, shape, keep):
     ndarray, shape ``(..., keep[0], keep[1])``
         A fresh array; the caller scales it.
     """
-    lq = shape[1]
-    workers = threads()
-    cols = _sfft.ifft(spectrum, axis=-2, norm="forward", overwrite_x=True, workers=workers)
-    k0, k1 = keep
-    out = np.empty(cols.shape[:-2] + (k0, k1), dtype=cols.real.dtype)
-    # the real transforms of the kept rows in bands, each cropped to the kept columns as it is made
-    band = _band(k0, out.size)
-    for lo in range(0, k0, band):
-        hi = min(lo + band, k0)
-        out[..., lo:hi, :] = _sfft.irfft(cols[..., lo:hi, :], n=lq, axis=-1, norm="forward", workers=workers)[..., :k1]
+    out = np.empty(spectrum.shape[:-2] + tuple(keep), dtype=spectrum.real.dtype)
+    for entry, dest in zip(spectrum.reshape((-1,) + spectrum.shape[-2:]), out.reshape((-1,) + tuple(keep))):
+        inverse_into(entry, shape, dest)
     return out

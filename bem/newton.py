@@ -77,7 +77,7 @@ def _advance(bk, p, u, sub, t, force, node_area, hardness):
     displacement), ``p + t d`` clipped to the bounds and scaled to the force. On NumPy in the buffers of ``q`` and
     ``C q``, which the step consumes (the same numbers as the new arrays elsewhere)."""
     q, uq = sub.p, sub.displacement
-    if not (in_place(bk, q) and in_place(bk, uq)) or q is p or uq is u:
+    if not (in_place(bk, q) and in_place(bk, uq)):
         return scaled(clip(bk.xp, p + t * (q - p), hardness), force, node_area, hardness), u + t * (uq - u)
     q -= p  # d, then t d, then p + t d
     q *= t

@@ -251,6 +251,9 @@ def _solve_on(region, gap, problem, x0, t_start):
                   rtol=rtol if finest else max(rtol, coarse_rtol), callback=problem.callback if finest else None)
         if problem.maxiter is not None:
             kw["maxiter"] = problem.maxiter
+        if guess is not None and problem.solver in ("kalker", "newton"):
+            # the start is the solve's own (initial_guess copies, refine makes it): the solver holds its iterate in it
+            kw["overwrite_x0"] = True
         if problem.hardness is not None:
             _check_capacity(region, lat, problem)
             kw["hardness"] = problem.hardness

@@ -77,8 +77,6 @@ def solve_in_window(run, make_op, lat, h, kw, delta, solver):
     make_op(lattice)``; returns the solution and the operators used.
     """
     window = candidate_window(lat, h, delta)
-    if solver in ("kalker", "newton") and kw["x0"] is not None:  # a start of its own (bem.solve): it holds the iterate
-        kw = dict(kw, overwrite_x0=True)
     ops = []
     if window is not None:
         op = make_op(window)

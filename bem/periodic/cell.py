@@ -132,13 +132,8 @@ class PeriodicCell:
         return PeriodicOperator(cell, E_star, device=backend, bodies=bodies)
 
     def solve_level(self, run, make_op, cell, h, kw, delta, solver):
-        """One level of nested iteration, on the whole cell; the solution and the operator used.
-
-        The start ``kw["x0"]`` of :func:`bem.solve` is a new array (the coarser level's solution interpolated,
-        or the caller's ``x0`` copied): Kalker's QP and Newton hold their iterate in it (one array of the cell fewer)."""
+        """One level of nested iteration, on the whole cell; the solution and the operator used."""
         op = make_op(cell)
-        if solver in ("kalker", "newton") and kw.get("x0") is not None:
-            kw = dict(kw, overwrite_x0=True)
         return run(op, h, kw), [op]
 
     def refine(self, coarse, p, fine):

@@ -304,17 +304,16 @@ class PeriodicOperator:
 
     __call__ = matvec
 
-    def qp(self, h, *, lam=0.0, precondition=True, contact=None, overwrite_x0=False, **kw):
+    def qp(self, h, *, lam=0.0, precondition=True, contact=None, **kw):
         """The constrained-CG step of Kalker's QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0``
         on the cell: preconditioned, in the Fourier basis on every device
         (:func:`bem.periodic.qp.solve_periodic_qp`, whose preconditioner for a ``lam`` per node
-        starts from the contact of ``x0``, and which may hold its iterate in ``x0`` with
-        ``overwrite_x0``), else :func:`bem.kalker.constrained_cg` (``x0`` never modified); a
-        :class:`bem.cg_rules.QPSolution`."""
+        starts from the contact of ``x0``), else :func:`bem.kalker.constrained_cg`; either may hold its
+        iterate in ``x0`` with ``overwrite_x0``; a :class:`bem.cg_rules.QPSolution`."""
         if precondition:
             from .qp import solve_periodic_qp
 
-            return solve_periodic_qp(self, h, lam=lam, overwrite_x0=overwrite_x0, **kw)
+            return solve_periodic_qp(self, h, lam=lam, **kw)
         from ..kalker import constrained_cg
 
         return constrained_cg(self, h, lam=lam, precondition=precondition, contact=contact, **kw)
