@@ -17,7 +17,7 @@ import numpy as np
 
 from . import fft
 
-__all__ = ["block_product", "inverse_symbol", "kernel_spectra"]
+__all__ = ["block_product", "block_quadratic", "inverse_symbol", "kernel_spectra"]
 
 
 def _conj(x):
@@ -60,6 +60,42 @@ def block_product(S, V):
         v0 *= S[0][0][r]
         v0 += t[:n]
     return V
+
+
+def block_quadratic(S, V, n_cols, xp=np):
+    """``sum_q sum_ab conj(V_a) S_ab V_b`` over the whole spectrum of a pair of real arrays [the units of ``S``
+    times those of ``V`` squared], from their half spectra ``V`` (shape ``(2, rows, n_cols // 2 + 1)``, of
+    :func:`bem.fft.forward`) and a Hermitian symbol ``S`` of :func:`kernel_spectra` (``S_10`` not stored).
+
+    With ``S`` the spectra of ``C`` over a box onto itself and ``V`` the padded spectra of ``v`` on that box, the
+    quadratic form ``v.C v``. The columns of the half spectrum but the first (and the last, for an even
+    ``n_cols``) stand for two conjugate frequencies each. Summed in double precision; on NumPy by bands of
+    rows of :data:`bem.fft.BLOCK` entries (no temporary of the spectrum's size).
+    """
+    (s00, s01), (_, s11) = S
+    if S[1][0] is not None:
+        raise ValueError("S must be a Hermitian symbol ((S_00, S_01), (None, S_11)) of kernel_spectra(hermitian=True)")
+    last = V.shape[-1] - 1 if n_cols % 2 == 0 else None  # the Nyquist column
+
+    def terms(s00, s01, s11, v0, v1, xp):  # S_00 |V_0|^2 + S_11 |V_1|^2 + 2 Re(conj(V_0) S_01 V_1)
+        re, im = xp.real, xp.imag
+        a, b, c, d = re(v0), im(v0), re(v1), im(v1)
+        cross = (a * c + b * d) * re(s01) - (a * d - b * c) * im(s01)
+        return s00 * (a * a + b * b) + s11 * (c * c + d * d) + 2 * cross
+
+    def weighted(e, xp):
+        total = 2 * float(xp.sum(xp.astype(e, xp.float64))) - float(xp.sum(xp.astype(e[:, 0], xp.float64)))
+        return total - float(xp.sum(xp.astype(e[:, last], xp.float64))) if last is not None else total
+
+    if not isinstance(V, np.ndarray):
+        return weighted(terms(s00, s01, s11, V[0, ...], V[1, ...], xp), xp)
+    rows = V.shape[1]
+    step = max(1, fft.BLOCK // max(1, V.shape[2]))
+    total = 0.0  # NumPy: by bands of rows
+    for lo in range(0, rows, step):
+        r = slice(lo, min(lo + step, rows))
+        total += weighted(terms(s00[r], s01[r], s11[r], V[0, r], V[1, r], np), np)
+    return total
 
 
 def inverse_symbol(backend, spectra, lam, floor, diagonal, single=False):

@@ -176,7 +176,7 @@ def _band(rows, size):
     return rows if size <= 2 * _BAND else max(1, rows * _BAND // size)
 
 
-def forward_parts(parts, shape, dtype=np.float64):
+def forward_parts(parts, shape, dtype=np.float64, scale=None):
     """:func:`forward` of a batch given as its entries: 2-D real arrays (views allowed, not modified), each
     zero-padded to ``shape`` and rounded to ``dtype`` band by band (no gathered copy of the batch).
 
@@ -188,6 +188,8 @@ def forward_parts(parts, shape, dtype=np.float64):
         Padded size ``(Lk, Lq)``.
     dtype : numpy dtype
         ``float64``, or ``float32`` for a single-precision spectrum.
+    scale : float, optional
+        A factor applied to the data before it is rounded to ``dtype`` (band by band: no scaled copy of a part).
 
     Returns
     -------
@@ -203,7 +205,8 @@ def forward_parts(parts, shape, dtype=np.float64):
         band = _band(n_rows, out[b].size)
         for lo in range(0, n_rows, band):
             hi = min(lo + band, n_rows)
-            out[b, lo:hi, :] = _sfft.rfft(x[lo:hi].astype(dtype, copy=False), n=lq, axis=-1, workers=workers)
+            band_data = x[lo:hi] if scale is None else x[lo:hi] * scale
+            out[b, lo:hi, :] = _sfft.rfft(band_data.astype(dtype, copy=False), n=lq, axis=-1, workers=workers)
     return _sfft.fft(out, axis=-2, overwrite_x=True, workers=workers)
 
 

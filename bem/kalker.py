@@ -8,6 +8,11 @@ optional FFT preconditioner built from the inverse symbol of ``C + lam`` in
 the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005). :func:`solve_qp` is the step
 of the half-space operator (on every device) in the one loop
 :func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
+
+A step costs one product ``C t`` of the search direction, which updates ``C p``; where nodes enter the
+contact, ``C p`` is recomputed after the step instead, and the step length takes its curvature ``t.C t``
+from the operator's ``quadratic`` where it has one (:meth:`bem.InfluenceOperator.quadratic`: a forward
+transform over the support's box in single precision, no product).
 """
 
 from __future__ import annotations
@@ -135,6 +140,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     prev_contact = p > 0
     m_one = None
+    quadratic = getattr(op, "quadratic", None)
     fixed_scale = scale
     # With a per-node compliance the preconditioner holds Jacobi blocks that differ by
     # decades, and plain mean subtraction would wreck it: project obliquely. For a uniform
@@ -232,11 +238,18 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             t_c -= m_one * (xp.sum(t_c) / xp.sum(m_one)) if oblique and m_one is not None else xp.mean(t_c)
         t = spread(idx, t_c)
         gz_old = gz
-        r = apply(t)
-        r_c = bk.take(r, idx)
-        if force is not None:
-            r_c -= xp.mean(r_c)
-        tt = float(xp.sum(t_c * r_c))
+        low = None if bounded else bk.select(g < 0)
+        # open nodes with g < 0 enter the contact below and C p is then recomputed: C t would serve only the
+        # curvature t.(C + lam) t, which op.quadratic gives without the product
+        if quadratic is not None and low is not None and bool(xp.any(bk.take(p, low) == 0)):
+            r = None
+            tt = quadratic(t) + float(xp.sum((bk.take(lam, idx) if per_node else lam) * t_c * t_c))
+        else:
+            r = apply(t)
+            r_c = bk.take(r, idx)
+            if force is not None:
+                r_c -= xp.mean(r_c)
+            tt = float(xp.sum(t_c * r_c))
         if not bool(xp.any(t_c != 0)):
             # a single contact node under force control leaves no direction that keeps the
             # force: only nodes entering the contact (below) can move the iterate
@@ -254,7 +267,6 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         bk.put(p, idx, p_c)
         # re-entering nodes (p = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi
         # estimate -g / (C_nn + lam) so that a node with a large layer compliance cannot overshoot
-        low = bk.select(g < 0)
         overlap = bk.subset(low, bk.take(p, low) == 0)  # off-mask nodes have g = 0
         n_overlap = bk.count(overlap)
         if n_overlap:

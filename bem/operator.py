@@ -33,7 +33,7 @@ import numpy as np
 
 from . import fft
 from .backend import get_backend
-from .block_symbol import block_product, inverse_symbol, kernel_spectra
+from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel_spectra
 from .checks import check_positive
 from .template import template
 
@@ -125,6 +125,7 @@ class InfluenceOperator:
             self._table *= lattice.step / (math.pi * self.E_star)
             self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
         self._spectra = OrderedDict()
+        self._quad = None
 
     # -- geometry of the 2 x 2 block convolution -------------------------------------------------
 
@@ -194,15 +195,27 @@ class InfluenceOperator:
         box = self._reuse("C", box, size) or box
         return box, self._cached(("C", box), lambda: self._kernel_spectra(full, box, hermitian=box == full))
 
+    def _parts(self, v, box):
+        """The rows of each parity of ``v`` in ``box`` (views), for :func:`bem.fft.forward_parts`."""
+        i_rows, (iq, bq) = box
+        return [v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq] for s, (k0, nb) in zip(self._start, i_rows)]
+
+    def _batch(self, v, box, dtype, scale=None):
+        """:meth:`_parts` gathered into one zero-filled ``(2, rows, cols)`` array of ``dtype`` (times ``scale``)."""
+        xp = self.backend.xp
+        data = xp.zeros((2, max(r[1] for r in box[0]), box[1][1]), dtype=dtype)
+        for b, part in enumerate(self._parts(v, box)):  # the rows of parity b: brick rows s, s + 2, ...
+            data[b, : part.shape[0], :] = xp.astype(part if scale is None else part * scale, dtype, copy=False)
+        return data
+
     def _convolve(self, spectra, shape, v, in_box, out_box, out, single=False):
         """``out[out_box] = sum_b S_ab v_b[in_box]``; other entries of ``out`` are left alone (``single``: the
         transforms in single precision, with single-precision spectra)."""
-        (i_rows, (iq, bq)), (o_rows, (oq, nq)) = in_box, out_box
+        o_rows, (oq, nq) = out_box
         bk = self.backend
         if bk.is_numpy:  # the parities' rows transformed where they are, the products written where they go
-            parts = [v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq] for s, (k0, nb) in zip(self._start, i_rows)]
-            V = block_product(spectra, fft.forward_parts(parts, shape, np.float32 if single else np.float64))
-            del parts
+            dtype = np.float32 if single else np.float64
+            V = block_product(spectra, fft.forward_parts(self._parts(v, in_box), shape, dtype))
             for a, s in enumerate(self._start):
                 k0, na = o_rows[a]
                 fft.inverse_into(V[a], shape, out[_rows(s, k0, na, out.shape[0]), oq : oq + nq])
@@ -213,22 +226,42 @@ class InfluenceOperator:
 
     def _convolve_device(self, spectra, shape, v, in_box, out_box, out, single):
         """:meth:`_convolve` off NumPy: the parities gathered into one batch, its products split off."""
-        (i_rows, (iq, bq)), (o_rows, (oq, nq)) = in_box, out_box
+        o_rows, (oq, nq) = out_box
         bk = self.backend
         xp = bk.xp
-        dtype = xp.float32 if single else bk.float64
-        data = xp.zeros((2, max(r[1] for r in i_rows), bq), dtype=dtype)
-        for b, s in enumerate(self._start):  # the rows of parity b: brick rows s, s + 2, ...
-            k0, nb = i_rows[b]
-            data[b, :nb, :] = xp.astype(v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq], dtype, copy=False)
-        V = block_product(spectra, bk.forward(data, shape))
-        del data
+        V = block_product(spectra, bk.forward(self._batch(v, in_box, xp.float32 if single else bk.float64), shape))
         split = V[0, ...].size > SPLIT_INVERSE  # large: one parity at a time, half the inverse's output held at once
         both = None if split else bk.inverse(V, shape, (max(r[1] for r in o_rows), nq))
         for a, s in enumerate(self._start):
             k0, na = o_rows[a]
             part = bk.inverse(V[a, ...], shape, (na, nq)) if split else both[a, :na, :]
             out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] = xp.astype(part, out.dtype, copy=False)
+
+    def quadratic(self, v):
+        """``v.C v`` of a brick array ``v`` [pressure] -> [length pressure^2], without the product ``C v``: over the
+        padded box of the support of ``v`` onto itself (:func:`bem.block_symbol.block_quadratic`), one forward
+        transform of ``v / max |v|`` in single precision, the box's symbol rounded to single precision (kept for the
+        next call on that box), the sum in double precision; relative error about ``1e-7``."""
+        bk = self.backend
+        xp = bk.xp
+        v = bk.asarray(v)
+        box = self._box(v)
+        if box is None:
+            return 0.0
+        if self._quad is None or self._quad[0] != box:
+            self._quad = None  # one box at a time: the last one goes before the next is made
+            shape, ((k00, k01), (_, k11)) = self._kernel_spectra(box, box, hermitian=True)
+            self._quad = box, shape, ((xp.astype(k00, xp.float32), xp.astype(k01, xp.complex64)),
+                                      (None, xp.astype(k11, xp.float32)))
+        _, shape, symbol = self._quad
+        s = max(float(xp.max(v)), -float(xp.min(v)))  # v / s in single precision: no overflow
+        if not math.isfinite(s):
+            return math.nan
+        if bk.is_numpy:
+            V = fft.forward_parts(self._parts(v, box), shape, np.float32, scale=1.0 / s)
+        else:
+            V = bk.forward(self._batch(v, box, xp.float32, 1.0 / s), shape)
+        return block_quadratic(symbol, V, shape[1], xp) * s * s
 
     # -- public products ---------------------------------------------------------------------------
 
@@ -363,3 +396,4 @@ class InfluenceOperator:
             return self._table[n, (m - n % 2) // 2]
         scale = self.lattice.step / (math.pi * self.E_star)
         return scale * template(x[:, None] - x[None, :], y[:, None] - y[None, :])
+
