@@ -37,13 +37,11 @@ GROW = 1.5
 #: ... at most this many times.
 MAX_GROW = 3
 _COARSEST_NODES = 4096  # nested iteration stops coarsening below this many nodes
-# KKT residual to which the coarser lattices of nested iteration are solved. Kalker's QP solves them to
-# 1e-4: its finest lattice takes the same iterations or up to two more while the coarser ones take about
-# half as many (the rough sphere at 512^2 to 2048^2, spheres with 3 % and 28 % contact at 1024^2: 4-8 %
-# fewer products in all); from 1e-3 the finest iterations grow at 2048^2 (31 -> 37). The other solvers
-# keep 1e-6.
-_COARSE_RTOL = {"kalker": 1e-4}
-_COARSE_RTOL_DEFAULT = 1e-6
+# KKT residual to which the coarser lattices of nested iteration are solved. Looser coarse solves cost the
+# finest lattice more iterations as the levels grow: Kalker's QP on the rough sphere of benchmarks/cases.py
+# from 1e-4 took 4-8 % fewer products at 512^2 and 1024^2, but 33 finest iterations at 2048^2 (31 from 1e-6)
+# and 45 at 4096^2 (34), 1e-3 gave 37 at 2048^2.
+_COARSE_RTOL = 1e-6
 
 
 def inner_domain(gap):
@@ -144,7 +142,7 @@ class HalfSpaceRegion:
 
     def coarse_rtol(self, solver):
         """KKT residual to which the coarser lattices of nested iteration are solved."""
-        return _COARSE_RTOL.get(solver, _COARSE_RTOL_DEFAULT)
+        return _COARSE_RTOL
 
     def operator(self, lattice, E_star, backend, *, bodies=None):
         """The influence operator ``C`` of the half-space on ``lattice`` (of coated ``bodies`` where given)."""

@@ -1,7 +1,6 @@
 """bem.solve over a domain: one set of checks for a half-space region and a periodic cell, the growth
 of a region, and the alias solve_periodic."""
 
-import importlib
 import math
 import re
 
@@ -115,21 +114,3 @@ def test_the_checks_table_has_a_row_for_every_argument_of_solve():
 def test_both_domains_refuse_more_nodes_than_the_limit_before_building_them(build):
     with pytest.raises(bem.InputError, match=r"nodes \(limit [0-9.e+]+ on this machine\)"):
         build()
-
-
-@pytest.mark.parametrize("method, coarse", [("kalker", 1e-4), ("newton", 1e-6)])
-def test_the_coarser_lattices_of_a_region_are_solved_to_the_rule_of_their_solver(monkeypatch, method, coarse):
-    """Nested iteration on a half-space region: Kalker's QP solves the coarser lattices to 1e-4, Newton (a root
-    layer) to 1e-6, the finest to ``rtol``."""
-    solve_module = importlib.import_module("bem.solve")
-    dispatch, tolerances = solve_module._dispatch, []
-
-    def recording(solver, op, h, layer, precondition, kw, options):
-        tolerances.append(kw["rtol"])
-        return dispatch(solver, op, h, layer, precondition, kw, options)
-
-    monkeypatch.setattr(solve_module, "_dispatch", recording)
-    layer = None if method == "kalker" else bem.layers.Root(1e-3)
-    res = bem.solve(Paraboloid(1.0), E_star=1.0, force=0.01, step=0.004, extent=0.6, layer=layer, method=method)
-    assert res.converged and len(tolerances) >= 2
-    assert tolerances[-1] == 1e-10 and set(tolerances[:-1]) == {coarse}
