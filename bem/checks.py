@@ -58,7 +58,7 @@ SCALE_RANGE = (1e-60, 1e60)
 #: (8 bytes a node), times 1.1. A gap callable's own temporaries come on top. A surface grid
 #: becomes the gap of a periodic cell of as many nodes. Keys: how the ``what`` of
 #: :func:`check_node_count` ends (``"the mirrored periodic cell"`` is a periodic cell).
-BYTES_PER_NODE = {"candidate region": 200, "periodic cell": 190, "surface grid": 190}
+BYTES_PER_NODE = {"candidate region": 210, "periodic cell": 190, "surface grid": 190}
 
 
 def machine_memory():
