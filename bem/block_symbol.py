@@ -17,7 +17,7 @@ import numpy as np
 
 from . import fft
 
-__all__ = ["block_product", "block_quadratic", "inverse_symbol", "kernel_spectra"]
+__all__ = ["block_product", "block_quadratic", "inverse_symbol", "kernel_spectra", "single_symbol"]
 
 
 def _conj(x):
@@ -96,6 +96,13 @@ def block_quadratic(S, V, n_cols, xp=np):
         r = slice(lo, min(lo + step, rows))
         total += weighted(terms(s00[r], s01[r], s11[r], V[0, r], V[1, r], np), np)
     return total
+
+
+def single_symbol(xp, S):
+    """A Hermitian symbol ``((S_00, S_01), (None, S_11))`` rounded to single precision (float32 diagonal blocks,
+    complex64 ``S_01``)."""
+    (s00, s01), (_, s11) = S
+    return (xp.astype(s00, xp.float32), xp.astype(s01, xp.complex64)), (None, xp.astype(s11, xp.float32))
 
 
 def inverse_symbol(backend, spectra, lam, floor, diagonal, single=False):

@@ -33,7 +33,7 @@ import numpy as np
 
 from . import fft
 from .backend import get_backend
-from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel_spectra
+from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel_spectra, single_symbol
 from .checks import check_positive
 from .template import template
 
@@ -250,9 +250,8 @@ class InfluenceOperator:
             return 0.0
         if self._quad is None or self._quad[0] != box:
             self._quad = None  # one box at a time: the last one goes before the next is made
-            shape, ((k00, k01), (_, k11)) = self._kernel_spectra(box, box, hermitian=True)
-            self._quad = box, shape, ((xp.astype(k00, xp.float32), xp.astype(k01, xp.complex64)),
-                                      (None, xp.astype(k11, xp.float32)))
+            shape, K = self._kernel_spectra(box, box, hermitian=True)
+            self._quad = box, shape, single_symbol(xp, K)
         _, shape, symbol = self._quad
         s = max(float(xp.max(v)), -float(xp.min(v)))  # v / s in single precision: no overflow
         if not math.isfinite(s):
@@ -354,15 +353,7 @@ class InfluenceOperator:
                                   self.diagonal, single)
         if not single or self.backend.is_numpy:  # NumPy: rounded as it is made
             return shape, S
-        # the diagonal blocks are real, S_10 = conj(S_01) is not stored; one block at a time, each double-precision
-        # block let go as it is rounded
-        xp = self.backend.xp
-        (s00, s01), (_, s11) = S
-        del S
-        s00 = xp.astype(s00, xp.float32)
-        s01 = xp.astype(s01, xp.complex64)
-        s11 = xp.astype(s11, xp.float32)
-        return shape, ((s00, s01), (None, s11))
+        return shape, single_symbol(self.backend.xp, S)
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""

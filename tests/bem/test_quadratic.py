@@ -97,3 +97,15 @@ def test_quadratic_of_large_and_non_finite_values():
     assert op.quadratic(1e30 * v) == pytest.approx(1e60 * op.quadratic(v), rel=1e-6)
     v[2, 3] = np.inf
     assert np.isnan(op.quadratic(v))
+
+
+def test_quadratic_on_an_array_api_namespace_equals_the_numpy_one():
+    """Off NumPy (``array_api_strict``: the gathered batch, the whole-spectrum sum in the namespace) the form is
+    NumPy's to single precision, on a box and on the whole region."""
+    xs = pytest.importorskip("array_api_strict")
+    lat = Lattice.from_extent(0.05, (0.73, 0.81))
+    host, device = InfluenceOperator(lat, 1.0), InfluenceOperator(lat, 1.0, device=xs)
+    rng = np.random.default_rng(8)
+    for v in (np.where(rng.random(lat.shape) < 0.3, rng.standard_normal(lat.shape), 0.0) * lat.mask,
+              np.pad(rng.random((7, 9)), ((4, lat.shape[0] - 11), (5, lat.shape[1] - 14)))):
+        assert device.quadratic(xs.asarray(v)) == pytest.approx(host.quadratic(v), rel=1e-6)
