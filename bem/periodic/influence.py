@@ -29,6 +29,7 @@ from ..checks import check_positive
 from ..operator import diagonal_coefficient
 from .coated import coated_template
 from .kernel import periodic_template
+from .spectra import mixed, weighted_dot
 
 __all__ = ["PeriodicOperator"]
 
@@ -190,20 +191,22 @@ class PeriodicOperator:
         d, b = symbol
         if not isinstance(spectrum, np.ndarray):
             return d * spectrum + b * backend_of(spectrum).xp.flip(spectrum, axis=1)
-        out = np.empty_like(spectrum) if out is None else out
-        rows = max(1, fft.BLOCK // (spectrum.size // max(spectrum.shape[0], 1) or 1))
+        return mixed(spectrum, symbol, np.empty_like(spectrum) if out is None else out, None)[0]
 
-        def part(s):  # rows s of every array: the parity swap stays inside a row
-            work = np.empty((min(rows, s.stop - s.start),) + spectrum.shape[1:], dtype=spectrum.dtype)
-            for lo in range(s.start, s.stop, rows):
-                r = slice(lo, min(lo + rows, s.stop))
-                w = work[:r.stop - lo]
-                np.multiply(b[r], spectrum[r, ::-1, :], out=w)
-                np.multiply(d[r], spectrum[r], out=out[r])
-                np.add(out[r], w, out=out[r])
+    def mix_inner(self, spectrum, symbol, out=None):
+        """:meth:`mix` and the :meth:`inner` of ``X`` and the product: ``(out, sum x y)``.
 
-        fft.in_parts(part, spectrum.shape[0], spectrum.size)
-        return out
+        On NumPy the sum is taken block by block as the product is made (no second pass over the two
+        spectra), in double precision; ``out`` (default: a new array) must not be ``spectrum``.
+        """
+        n_rows, n_cols = self.lattice.shape
+        if not isinstance(spectrum, np.ndarray):
+            out = self.mix(spectrum, symbol)
+            return out, self.inner(spectrum, out)
+        if out is spectrum:
+            raise ValueError("out: the product cannot overwrite the spectrum whose inner product it takes")
+        out, sums = mixed(spectrum, symbol, np.empty_like(spectrum) if out is None else out, n_cols % 2 == 0)
+        return out, sum(sums[k] for k in sorted(sums)) / (n_rows // 2 * n_cols)
 
     def inner(self, x, y):
         """``sum x y`` over the cell of two real brick arrays from their spectra (:meth:`spectrum`)."""
@@ -217,17 +220,7 @@ class PeriodicOperator:
             w = (xp.astype(xp.real(x), xp.float64) * xp.astype(xp.real(y), xp.float64)
                  + xp.astype(xp.imag(x), xp.float64) * xp.astype(xp.imag(y), xp.float64))
             return float(xp.sum(w * weight)) / (n_rows // 2 * n_cols)  # one transfer to the host
-
-        def dot(a, b):  # Re sum conj(a) b of two small arrays
-            return float(np.sum(a.real * b.real + a.imag * b.imag, dtype=np.float64))
-
-        # the rfft holds the columns m and n_cols - m once: weight 2, but for m = 0 and n_cols / 2
-        real = x.real.dtype  # float32 for complex64 spectra, summed in double precision
-        total = 2.0 * float(np.einsum("i,i->", x.view(real).reshape(-1), y.view(real).reshape(-1), dtype=np.float64))
-        total -= dot(x[..., 0], y[..., 0])
-        if n_cols % 2 == 0:
-            total -= dot(x[..., -1], y[..., -1])
-        return total / (n_rows // 2 * n_cols)
+        return weighted_dot(x, y, n_cols % 2 == 0) / (n_rows // 2 * n_cols)
 
     def symbol(self, lam=0.0, inverse=False, single=False):
         """The 2 x 2 block symbol of ``C + lam I``, or of :meth:`preconditioner` (``inverse``), for :meth:`mix`.
@@ -384,3 +377,4 @@ class PeriodicOperator:
         i, j = q - r // 2, r  # lattice coordinates
         di, dj = i[:, None] - i[None, :], j[:, None] - j[None, :]
         return self.kernel[np.mod(dj, n_rows), np.mod(di + np.floor_divide(dj, 2), n_cols)]
+

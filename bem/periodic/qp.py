@@ -3,68 +3,65 @@
 The step of the periodic operator (:meth:`bem.periodic.PeriodicOperator.qp`) in the one loop
 :func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
 
-The iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active
-set, Polonsky & Keer 1999, with the FFT preconditioner, the same entering rule, Jacobi cap and
-stopping rule), specialised to :class:`bem.periodic.PeriodicOperator`, where ``C`` is
-diagonal in the Fourier basis of the cell (a 2 x 2 block per frequency, one block row per row
-parity) and every node is a candidate. It does not restart the conjugate directions when nodes
-enter the contact: the new direction is ``t = z + beta t_old`` on the current contact with the
-Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)``, and the step is the
-minimum along ``t``, ``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the contact does not
-change, the conjugate-gradient step); where ``g.t <= 0`` the step falls back to ``t = z``. On a
-rough surface, whose contact set changes at most iterations until it settles, the general loop
-restarts at every change and degrades to preconditioned steepest descent
-(``tests/bem/test_periodic_qp.py``: 88 iterations against 57 on a 256 x 256 self-affine cell).
-Nodes that enter the contact (``p = 0``, ``g < 0``) take the step of the preconditioned iteration
-with a share of the Jacobi estimate of the preconditioner at that node, ``p = -f min(tau, 1) g / (C_nn + lam)``
-(``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`, chosen by the iteration counts stated there):
-``tau`` is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give an entering node
-``tau C_nn`` of its Jacobi pressure, a fraction that falls with the step (on a 672 x 776 rough cell,
-1e-4 of the mean contact pressure: a cycle of nodes entering with almost no pressure and leaving,
-at a constant KKT residual, ``tests/bem/test_periodic_robustness.py``). Further:
+The iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active set, Polonsky & Keer
+1999, with the FFT preconditioner, the same entering rule, Jacobi cap and stopping rule), specialised to
+:class:`bem.periodic.PeriodicOperator`, where ``C`` is diagonal in the Fourier basis of the cell (a 2 x 2 block per
+frequency, one block row per row parity) and every node is a candidate. It does not restart the conjugate directions
+when nodes enter the contact: the new direction is ``t = z + beta t_old`` on the current contact with the
+Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)``, and the step is the minimum along ``t``,
+``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the contact does not change, the conjugate-gradient step); where
+``g.t <= 0`` the step falls back to ``t = z``. On a rough surface, whose contact set changes at most iterations
+until it settles, the general loop restarts at every change and degrades to preconditioned steepest descent
+(``tests/bem/test_periodic_qp.py``: 88 iterations against 57 on a 256 x 256 self-affine cell). Nodes that enter the
+contact (``p = 0``, ``g < 0``) take the step of the preconditioned iteration with a share of the Jacobi estimate of
+the preconditioner at that node, ``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` =
+:data:`bem.cg_rules.ENTERING_FRACTION`, chosen by the iteration counts stated there): ``tau`` is dimensionless here
+(``t`` is ``M g``), and ``-tau g`` would give an entering node ``tau C_nn`` of its Jacobi pressure, a fraction that
+falls with the step (on a 672 x 776 rough cell, 1e-4 of the mean contact pressure: a cycle of nodes entering with
+almost no pressure and leaving, at a constant KKT residual, ``tests/bem/test_periodic_robustness.py``). Further:
 
-- the iteration keeps ``u = (C + lam) p`` in double precision. After a step without a change
-  of the contact set it is updated by ``tau (C + lam) t``, the product of the search direction,
-  which runs in single precision: its rounding is a relative ``1e-7`` of the step, and the
-  step falls with the residual. After a change of the contact set, and after every 20 updates,
-  ``u`` is recomputed from ``p``;
-- the curvature ``t.(C + lam) t`` is a sum over the spectrum of that product (Parseval,
-  summed in double precision);
+- the iteration keeps ``u = (C + lam) p`` in double precision. After a step without a change of the contact set it
+  is updated by ``tau (C + lam) t``, the product of the search direction, which runs in single precision: its
+  rounding is a relative ``1e-7`` of the step, and the step falls with the residual. After a change of the contact
+  set, and after every 20 updates, ``u`` is recomputed from ``p``;
+- the curvature ``t.(C + lam) t`` is a sum over the spectrum of that product (Parseval, summed in double precision,
+  block by block as the product is made: :func:`bem.periodic.spectra.mixed`);
 - the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
-- so does the recomputed ``u`` while the KKT residual is above ``1e-4`` (:data:`SINGLE_ABOVE`),
-  in a solve that starts above ``1e-2`` (:data:`SINGLE_START` times that) or stops above
-  ``1e-4`` (``rtol >= SINGLE_ABOVE``, a Newton step's model far from the answer), where the rounding
-  of single precision (a relative ``1e-7`` of ``C p``) is far below what the iteration
-  resolves: halved transforms in the early iterations, where the contact set settles. At the
-  first residual below it (or at ``rtol`` when the stopping check is confirmed) ``u`` is
-  recomputed in double precision, and so it is from there on; the stopping check, when
-  confirmed, is always on a double-precision product.
+- so does the recomputed ``u`` while the KKT residual is above ``1e-4`` (:data:`SINGLE_ABOVE`), in a solve that
+  starts above ``1e-2`` (:data:`SINGLE_START` times that) or stops above ``1e-4`` (``rtol >= SINGLE_ABOVE``, a
+  Newton step's model far from the answer), where the rounding of single precision (a relative ``1e-7`` of ``C p``)
+  is far below what the iteration resolves: halved transforms in the early iterations, where the contact set
+  settles. At the first residual below it (or at ``rtol`` when the stopping check is confirmed) ``u`` is recomputed
+  in double precision, and so it is from there on; the stopping check, when confirmed, is always on a
+  double-precision product;
+- after a step that let no node enter and left every contact node a positive pressure, the contact is the same: the
+  next iteration reuses its nodes, the step's pressures and direction there and ``D`` on it
+  (:class:`bem.periodic.qp_parts.ContactNodes`), the same numbers with no selection and no gathers.
 
-With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are
-those of ``C`` alone, ``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner
-is that of :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique
-projection under force control (by ``M 1`` of the starting contact).
+With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are those of ``C`` alone,
+``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner is that of
+:func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique projection under force control (by
+``M 1`` of the starting contact).
 
-With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H``
-and the step is that of every constrained-CG step (:func:`bem.cg_rules.bounded_move`). The directions
-restart (``beta = 0``) after a step that was shortened, or capped at ``H``, to carry the force: the fill
-of the force at the bound breaks the conjugacy, and a Polak-Ribiere+ direction kept there repeats the step
-that failed (on a 64-column self-affine cell at 18 % of ``H``, ``tests/bem/test_hardness_units.py``: no
-convergence in 688 iterations without). Nodes that enter or leave keep the directions, as without a
-hardness (a 512^2 law of 20 pressures at ``H = E* h'_rms``: 531 iterations, 695 when those restart too).
+With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H`` and the step is
+that of every constrained-CG step (:func:`bem.cg_rules.bounded_move`). The directions restart (``beta = 0``) after a
+step that was shortened, or capped at ``H``, to carry the force: the fill of the force at the bound breaks the
+conjugacy, and a Polak-Ribiere+ direction kept there repeats the step that failed (on a 64-column self-affine cell
+at 18 % of ``H``, ``tests/bem/test_hardness_units.py``: no convergence in 688 iterations without). Nodes that enter
+or leave keep the directions, as without a hardness (a 512^2 law of 20 pressures at ``H = E* h'_rms``: 531
+iterations, 695 when those restart too).
 
-A step costs four transforms of the cell in single precision while the contact set does not
-change (two for the preconditioner, one forward for the search direction, one inverse for its
-product), five where it changes, two of them in double precision once the residual is below
-``SINGLE_ABOVE`` (the general loop: four or six in double precision, or up to eight with a
-compliance per node).
+A step costs four transforms of the cell in single precision while the contact set does not change (two for the
+preconditioner, one forward for the search direction, one inverse for its product), five where it changes, two of
+them in double precision once the residual is below ``SINGLE_ABOVE`` (the general loop: four or six in double
+precision, or up to eight with a compliance per node).
 
-The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any
-array API namespace with ``xp.fft``), every array on the device; the host receives the scalars of the step
-(the KKT residual's extremes, the sums of the force, the inner products, the counts of the contact and its
-changes: about 16 a step, more with a compliance per node or a hardness, and the sizes of three node
-selections). Other transforms round differently and take the same iterations
-(``tests/bem/test_backend_namespace.py``); NumPy reuses buffers in place (:mod:`bem.periodic.qp_parts`).
+The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any array API
+namespace with ``xp.fft``), every array on the device; the host receives the scalars of the step (the KKT residual's
+extremes, the sums of the force, the inner products, the counts of the contact and its changes: about 16 a step,
+more with a compliance per node or a hardness, and the sizes of three node selections). Other transforms round
+differently and take the same iterations (``tests/bem/test_backend_namespace.py``); NumPy reuses buffers in place
+(:mod:`bem.periodic.qp_parts`).
 """
 
 from __future__ import annotations
@@ -77,7 +74,7 @@ from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
                         entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, in_place, note_fully_plastic
-from .qp_parts import LastPreconditionedGap, weighted_square
+from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -114,9 +111,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     callback : callable, optional
         ``callback(k, p)`` after every iteration.
     scale, u0, confirm
-        As for :func:`bem.kalker.solve_qp`: the displacement scale of the KKT residual [length], ``C x0`` where
-        the caller has it (the iterate then starts from ``x0`` as given), and whether to confirm the stopping
-        check on an exact product. Unconfirmed, a stop at ``rtol >= SINGLE_ABOVE`` returns ``C p`` in single precision.
+        As for :func:`bem.kalker.solve_qp`: the displacement scale of the KKT residual [length], ``C x0`` where the
+        caller has it (the iterate then starts from ``x0`` as given), and whether to confirm the stopping check on
+        an exact product. Unconfirmed, a stop at ``rtol >= SINGLE_ABOVE`` returns ``C p`` in single precision.
     threshold : float
         With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner (as in
         :func:`bem.kalker.compliance_preconditioner`).
@@ -165,15 +162,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     M = op.symbol(lam_pc, inverse=True, single=True)
     A32 = op.symbol(lam, single=True)
     r_hat = None  # the spectrum of (C + lam) t, kept from step to step (NumPy)
-    # a float32 brick with values at some nodes, 0 elsewhere (NumPy: one buffer, refilled): the gap on the contact
-    buf32 = np.zeros(lat.shape, dtype=np.float32) if bk.is_numpy else None
-
-    def f32_at(nodes, values):  # then the search direction (its values at the contact taken first)
-        if buf32 is None:
-            return bk.put(xp.zeros(lat.shape, dtype=xp.float32), nodes, xp.astype(values, xp.float32))
-        buf32.fill(0.0)  # a fill: faster than zeroing the nodes of the last step
-        buf32.reshape(-1)[nodes] = values.astype(np.float32)  # rounded first: a faster scatter, the same values
-        return buf32
+    brick = ContactBrick(bk, lat.shape)  # the gap on the contact, then the search direction t (float32)
 
     def product(v):
         op.n_matvec += 1
@@ -183,47 +172,50 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         x = op.spectrum(v)
         return op.mix(x, A, out=x)
 
-    def precondition(r32, nodes, r_c, soft_c, jac_c):
-        # M r at the nodes: r_c = r there, r32 = r (float32) at the stiff nodes; soft_c, jac_c: the soft nodes
-        # and 1 / (C_nn + D) there (None: no soft node)
+    def precondition(r32, sel, r_c, soft_c, jac_c):
+        # M r at the selected nodes: r_c = r there, r32 = r (float32) at the stiff nodes; soft_c, jac_c: the soft
+        # nodes and 1 / (C_nn + D) there (None: no soft node)
         x = op.spectrum(r32)
-        z = xp.astype(bk.take(op.brick(op.mix(x, M, out=x), overwrite=True), nodes), xp.float64)
+        z = xp.astype(bk.take(op.brick(op.mix(x, M, out=x), overwrite=True), sel), xp.float64)
         return z if soft_c is None else xp.where(soft_c, jac_c * r_c, z)
 
-    def jacobi_at(nodes, D_n=None):  # 1 / (C_nn + D) at the nodes (D_n: D there, where the caller has it)
-        return 1.0 / (diag + (bk.take(D, nodes) if D_n is None else D_n))
+    def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
+        return 1.0 / (diag + (bk.take(D, sel) if D_n is None else D_n))
 
-    def add_at(x, nodes, values):  # x += values at the nodes, in x's precision
-        bk.put(x, nodes, xp.astype(bk.take(x, nodes) + values, x.dtype, copy=False))
+    def add_at(x, sel, values):  # x += values at the selected nodes, in x's precision
+        bk.put(x, sel, xp.astype(bk.take(x, sel) + values, x.dtype, copy=False))
 
     def add_into(x, y):  # x += y in x's precision (NumPy: in place)
-        return np.add(x, y, out=x) if buf32 is not None else xp.astype(x + y, x.dtype, copy=False)
+        return np.add(x, y, out=x) if bk.is_numpy else xp.astype(x + y, x.dtype, copy=False)
+
+    g = np.empty(lat.shape) if bk.is_numpy else None  # u + h (NumPy: a buffer; holds D p where no gap is needed)
+
+    def times_p(c):  # c p for a compliance c (per node or uniform), in g's buffer on NumPy
+        return np.multiply(c, p, out=g) if bk.is_numpy else c * p
 
     def exact_u():  # (C + lam) p, and D p per node
         u = op.brick(product(p), overwrite=True)
-        return add_into(u, D * p) if per_node else u
+        return add_into(u, times_p(D)) if per_node else u
 
     single = False  # the first product in double precision: it sets the scale of the KKT residual
     if u0 is None:
         u, stale = exact_u(), 0
     else:  # C x0 from the caller, confirmed like an incremental update
-        u, stale = add_into(bk.copy(bk.asarray(u0)), D * p) if per_node else bk.copy(bk.asarray(u0)), 1
-    t, g = (buf32, np.empty(lat.shape)) if bk.is_numpy else (xp.zeros(lat.shape, dtype=xp.float32), None)  # t, u + h
+        u, stale = add_into(bk.copy(bk.asarray(u0)), times_p(D)) if per_node else bk.copy(bk.asarray(u0)), 1
     last_z = LastPreconditionedGap(bk, lat.shape)  # the last preconditioned gap, on its contact only
     gz_old, m_one, m_full = 1.0, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
-    was_on = p > 0  # the contact of the previous iterate
-    n_prev = int(xp.count_nonzero(was_on))
+    nodes = ContactNodes(bk, p)  # the contact of the iterate; steady: the last step's, whose D_c, ... it keeps
     fixed_scale = scale
-    contact = idx = g_c = p_c0 = g_min = None
+    idx = g_c = p_c0 = g_min = None
 
     bounded, sets = hardness is not None, None
     restart = False  # with a hardness: the last step was shortened to carry the force, the direction restarts
-    was_plastic = p >= hardness if bounded else None
+    was_on, was_plastic = nodes.was_on, p >= hardness if bounded else None
 
     def gap():  # u + h (NumPy: in one buffer)
         nonlocal g
-        g = u + h if buf32 is None else np.add(u, h, out=g)
+        g = np.add(u, h, out=g) if bk.is_numpy else u + h
 
     def residual(k, contact_gap, force_error, plastic_gap=None):
         nonlocal single
@@ -244,11 +236,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                         sets.plastic_gap)
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
-        nonlocal contact, idx, g_c, p_c0, delta, g_min
-        contact = p > 0
-        idx = bk.select(contact)  # the contact nodes from the boolean mask (faster than flatnonzero(p) on NumPy)
+        nonlocal idx, g_c, p_c0, delta, g_min
+        idx, p_c0 = nodes.read(p)
         gap()  # the gap is g - delta: delta is subtracted on the contact only
-        g_c, p_c0 = bk.take(g, idx), bk.take(p, idx)
+        g_c = bk.take(g, idx)
         if force is not None:
             delta = float(xp.mean(g_c)) if bk.count(idx) else math.nan
         g_c -= delta
@@ -272,23 +263,24 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return bk.max0(p), n_touch, changes, n_touch == 0 and g_min >= 0
 
     def observe():
-        nonlocal was_on, n_prev
-        n = bk.count(idx)
-        kept = int(xp.count_nonzero(bk.take(was_on, idx)))  # nodes in both contacts
-        changes = (n - kept) + (n_prev - kept)
-        was_on, n_prev = contact, n
+        n, changes = nodes.changes()
         return bk.max0(p_c0), n, changes, n == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, gz_old, r_hat, u, stale, t
+        nonlocal m_full, m_one, gz_old, r_hat, u, stale
         if bounded and not bk.count(idx):  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
-        t_old = bk.take(t, idx)  # the last direction on the contact (float32)
-        D_c = bk.take(D, idx) if per_node else None  # D, its soft nodes and 1 / (C_nn + D) on the contact
-        soft_c = None if soft is None else ~is_stiff(D_c, diag, threshold)
-        jac_c = None if soft is None else jacobi_at(idx, D_c)
+        steady = nodes.steady  # the last direction on the contact (float32) as written, D and what follows there
+        if steady:
+            t_old, (D_c, soft_c, jac_c) = brick.last, nodes.kept
+        else:
+            t_old = bk.take(brick.values, idx)
+            D_c = bk.take(D, idx) if per_node else None
+            soft_c = None if soft is None else ~is_stiff(D_c, diag, threshold)
+            jac_c = None if soft is None else jacobi_at(idx, D_c)
+            nodes.kept = D_c, soft_c, jac_c
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        z = precondition(f32_at(idx, g_c if soft is None else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
+        z = precondition(brick.write(idx, g_c if soft is None else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
         if force is not None and soft is None:
             z -= xp.mean(z)
         elif force is not None:
@@ -298,9 +290,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 x = op.spectrum(xp.astype((p > 0) & stiff, xp.float32))  # M (contact & stiff)
                 m_full = op.brick(op.mix(x, M, out=x), overwrite=True)  # single precision, kept so
             # and the Jacobi estimate at the soft nodes
-            m_one = xp.where(soft_c, jac_c, xp.astype(bk.take(m_full, idx), xp.float64))
-            if not float(xp.sum(m_one)) > 0:  # a contact far from the starting one: the mean instead
-                m_one = xp.ones(bk.count(idx), dtype=xp.float64)
+            if not steady:
+                m_one = xp.where(soft_c, jac_c, xp.astype(bk.take(m_full, idx), xp.float64))
+                if not float(xp.sum(m_one)) > 0:  # a contact far from the starting one: the mean instead
+                    m_one = xp.ones(bk.count(idx), dtype=xp.float64)
             z -= m_one * (float(xp.sum(z)) / float(xp.sum(m_one)))
         gz = bk.dot(g_c, z)  # no threaded BLAS
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
@@ -313,12 +306,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         gt = bk.dot(g_c, t_c)
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
-        t = f32_at(idx, t_c)
         gz_old = gz
-        T = op.spectrum(t)
+        T = op.spectrum(brick.write(idx, t_c))
         op.n_matvec += 1
-        R = r_hat = op.mix(T, A32, out=r_hat)  # (C + lam) t, single precision
-        tt = op.inner(T, R)  # t.(C + lam) t; t has zero sum on the contact under force control
+        # (C + lam) t, single precision, and t.(C + lam) t; t has zero sum on the contact under force control
+        R, tt = op.mix_inner(T, A32, out=r_hat)
+        r_hat = R
         if per_node:
             tt += weighted_square(bk, D_c, t_c)
         if not bool(xp.any(t_c != 0)):
@@ -355,6 +348,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             if s != 1.0:
                 p_o *= s
             bk.put(p, overlap, p_o)
+        nodes.stepped(p_c, entered)
         if bool(xp.any(clipped)) or entered or stale >= RECOMPUTE_EVERY:
             u = None
             u, stale = op.brick(product(p), overwrite=True), 0
@@ -369,7 +363,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def update_u(R, tau, t_c, D_c, s):  # u - tau (C + lam) t (from its spectrum R) - tau D t, times s
         nonlocal u, stale
         cr = op.brick(R, overwrite=True)
-        cr *= np.float32(tau) if buf32 is not None else tau
+        cr *= np.float32(tau) if bk.is_numpy else tau
         u -= cr
         if D_c is not None:
             add_at(u, idx, -tau * (D_c * t_c))
@@ -395,6 +389,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     kkt = run_constrained_cg(step, record, maxiter, callback)
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not bk.count(idx))
     # C p: the layer's closure is not a displacement
-    elastic = u - (D if per_node else lam) * p if per_node or lam else xp.astype(u, xp.float64, copy=False)
+    if not (per_node or lam):
+        elastic = xp.astype(u, xp.float64, copy=False)
+    elif bk.is_numpy:  # in the gap's buffer, free now (u may be in single precision)
+        elastic = np.subtract(u, times_p(D if per_node else lam), out=g)
+    else:
+        elastic = u - (D if per_node else lam) * p
     return record.solution(p, delta, kkt, elastic, "Kalker QP (periodic)")
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LastPreconditionedGap", "weighted_square"]
+__all__ = ["ContactBrick", "ContactNodes", "LastPreconditionedGap", "weighted_square"]
 
 
 def weighted_square(bk, d, t):
@@ -24,13 +24,99 @@ def weighted_square(bk, d, t):
     return float(bk.xp.sum(d * t * t))
 
 
+class ContactNodes:
+    """The contact ``p > 0`` of the iterate as the constrained CG reads it, and how it changed.
+
+    After a step on the contact's nodes that no node entered and after which every one of them kept a positive
+    pressure (:meth:`stepped`), the next contact is the same: :meth:`read` gives the same node selection and the
+    step's pressures there, with no comparison over the cell, no selection and no gather, and the step may keep
+    what it made on the contact (``kept``).
+
+    Parameters
+    ----------
+    bk : bem.backend.Backend
+        The backend of the iteration.
+    p : array
+        The starting pressure (brick array).
+    """
+
+    def __init__(self, bk, p):
+        self.bk = bk
+        self.was_on = p > 0  # the contact of the last count of changes
+        self.n_was = int(bk.xp.count_nonzero(self.was_on))
+        self.steady, self.idx, self.on, self.p_c, self.kept = False, None, None, None, None
+
+    def read(self, p):
+        """``(idx, p_c)``: the contact's node selection and the pressures there."""
+        if self.steady:
+            return self.idx, self.p_c
+        self.on = p > 0
+        self.idx = self.bk.select(self.on)  # from the boolean mask (faster than flatnonzero(p) on NumPy)
+        return self.idx, self.bk.take(p, self.idx)
+
+    def changes(self):
+        """``(n, changes)``: the contact nodes of the last :meth:`read` and the nodes that entered or left it since
+        the last call."""
+        bk = self.bk
+        n = bk.count(self.idx)
+        if self.steady:  # was_on is this contact
+            return n, 0
+        kept = int(bk.xp.count_nonzero(bk.take(self.was_on, self.idx)))  # nodes in both contacts
+        changes = (n - kept) + (self.n_was - kept)
+        self.was_on, self.n_was = self.on, n
+        return n, changes
+
+    def stepped(self, p_c, entered):
+        """Note a step that left the pressures ``p_c`` at the nodes of the last :meth:`read` (``entered``: nodes
+        entered elsewhere)."""
+        self.steady, self.p_c = not entered and bool(self.bk.xp.all(p_c > 0)), p_c
+
+
+class ContactBrick:
+    """A float32 brick array holding values at some nodes and 0 elsewhere: the gap on the contact for the
+    preconditioner, then the search direction.
+
+    On NumPy one buffer, refilled: a write at the node selection of the last write (the same object) needs no
+    fill, as every node it holds is written again; other namespaces get a new array at every write. ``last``
+    is the last write's values rounded to single precision (the brick's values at its nodes).
+
+    Parameters
+    ----------
+    bk, shape
+        The backend of the iteration and the shape of the cell's brick arrays (as for
+        :class:`LastPreconditionedGap`).
+    """
+
+    def __init__(self, bk, shape):
+        self.bk, self.shape = bk, shape
+        self.values = np.zeros(shape, dtype=np.float32) if bk.is_numpy else bk.xp.zeros(shape, dtype=bk.xp.float32)
+        self.nodes = self.last = None
+
+    def write(self, nodes, values):
+        """The brick with ``values`` (1-D) at the node selection ``nodes``, rounded to float32, 0 elsewhere."""
+        bk = self.bk
+        if not bk.is_numpy:
+            xp = bk.xp
+            self.last = xp.astype(values, xp.float32)
+            self.values = bk.put(xp.zeros(self.shape, dtype=xp.float32), nodes, self.last)
+            return self.values
+        if nodes is not self.nodes:
+            self.values.fill(0.0)  # a fill: faster than zeroing the nodes of the last write
+        self.last = values.astype(np.float32)  # rounded first: a faster scatter, the same values
+        self.values.reshape(-1)[nodes] = self.last
+        self.nodes = nodes
+        return self.values
+
+
 class LastPreconditionedGap:
     """The last preconditioned gap ``z`` of the iteration on its contact, read at the nodes of the next contact
     (0 at the nodes that were off it): the ``z_old`` of the Polak-Ribiere+ coefficient.
 
-    A brick array, 0 off its contact: on NumPy in single precision (a gather from it costs less time than looking
-    the new contact's nodes up among the last one's, for 4 bytes a node); on other namespaces in double precision
-    (a node selection of :class:`bem.backend.Backend` may be a boolean array there).
+    On NumPy in single precision: at the kept node selection itself (the same object: the contact did not
+    change) the kept values; at other nodes a gather from a brick array that holds them, 0 off their nodes
+    (faster than looking the new contact's nodes up among the last one's, for 4 bytes a node), filled at the
+    first such read after a keep. On other namespaces in double precision, a brick array at every keep (a node
+    selection of :class:`bem.backend.Backend` may be a boolean array there).
 
     Parameters
     ----------
@@ -42,7 +128,8 @@ class LastPreconditionedGap:
 
     def __init__(self, bk, shape):
         self.bk, self.shape = bk, shape
-        self.values = None
+        self.values = self.nodes = self.z = None
+        self.filled = False
 
     def keep(self, nodes, z):
         """Keep ``z`` (1-D), the values at the node selection ``nodes``."""
@@ -50,15 +137,22 @@ class LastPreconditionedGap:
         if not bk.is_numpy:
             self.values = bk.spread(self.shape, nodes, z)
             return
-        if self.values is None:
-            self.values = np.empty(self.shape, dtype=np.float32)
-        self.values.fill(0.0)  # a fill of the brick: faster than zeroing the last contact's nodes
-        self.values.reshape(-1)[nodes] = z.astype(np.float32)
+        self.nodes, self.z, self.filled = nodes, z.astype(np.float32), False
 
     def at(self, nodes):
         """The kept ``z`` at the node selection ``nodes`` (1-D, float64), 0 where it was not kept."""
         bk = self.bk
-        if self.values is None:
-            return bk.xp.zeros(bk.count(nodes), dtype=bk.xp.float64)
-        z = bk.take(self.values, nodes)
-        return z.astype(np.float64) if bk.is_numpy else z
+        if not bk.is_numpy:
+            return bk.take(self.values, nodes) if self.values is not None else bk.xp.zeros(
+                bk.count(nodes), dtype=bk.xp.float64)
+        if self.z is None:
+            return np.zeros(bk.count(nodes), dtype=np.float64)
+        if nodes is self.nodes:
+            return self.z.astype(np.float64)
+        if not self.filled:
+            if self.values is None:
+                self.values = np.empty(self.shape, dtype=np.float32)
+            self.values.fill(0.0)
+            self.values.reshape(-1)[self.nodes] = self.z
+            self.filled = True
+        return bk.take(self.values, nodes).astype(np.float64)
