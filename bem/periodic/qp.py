@@ -211,7 +211,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
 
     bounded, sets = hardness is not None, None
     restart = False  # with a hardness: the last step was shortened to carry the force, the direction restarts
-    was_on, was_plastic = nodes.was_on, p >= hardness if bounded else None
+    was_on, was_plastic = (nodes.was_on, p >= hardness) if bounded else (None, None)  # the bound's own counts
 
     def gap():  # u + h (NumPy: in one buffer)
         nonlocal g
