@@ -68,14 +68,14 @@ def block_quadratic(S, V, n_cols, xp=np):
     :func:`bem.fft.forward`) and a Hermitian symbol ``S`` of :func:`kernel_spectra` (``S_10`` not stored).
 
     With ``S`` the spectra of ``C`` over a box onto itself and ``V`` the padded spectra of ``v`` on that box, the
-    quadratic form ``v.C v``. The columns of the half spectrum but the first (and the last, for an even
-    ``n_cols``) stand for two conjugate frequencies each. Summed in double precision; on NumPy by bands of
-    rows of :data:`bem.fft.BLOCK` entries (no temporary of the spectrum's size).
+    quadratic form ``v.C v``. The columns of the half spectrum weigh as :func:`bem.fft.half_spectrum_weights`.
+    Summed in double precision; on NumPy by bands of rows of :data:`bem.fft.BLOCK` entries (no temporary of the
+    spectrum's size).
     """
     (s00, s01), (_, s11) = S
     if S[1][0] is not None:
         raise ValueError("S must be a Hermitian symbol ((S_00, S_01), (None, S_11)) of kernel_spectra(hermitian=True)")
-    last = V.shape[-1] - 1 if n_cols % 2 == 0 else None  # the Nyquist column
+    weight = fft.half_spectrum_weights(n_cols, xp)
 
     def terms(s00, s01, s11, v0, v1, xp):  # S_00 |V_0|^2 + S_11 |V_1|^2 + 2 Re(conj(V_0) S_01 V_1)
         re, im = xp.real, xp.imag
@@ -83,9 +83,8 @@ def block_quadratic(S, V, n_cols, xp=np):
         cross = (a * c + b * d) * re(s01) - (a * d - b * c) * im(s01)
         return s00 * (a * a + b * b) + s11 * (c * c + d * d) + 2 * cross
 
-    def weighted(e, xp):
-        total = 2 * float(xp.sum(xp.astype(e, xp.float64))) - float(xp.sum(xp.astype(e[:, 0], xp.float64)))
-        return total - float(xp.sum(xp.astype(e[:, last], xp.float64))) if last is not None else total
+    def weighted(e, xp):  # one sum: one scalar to the host off NumPy
+        return float(xp.sum(xp.astype(e, xp.float64) * weight))
 
     if not isinstance(V, np.ndarray):
         return weighted(terms(s00, s01, s11, V[0, ...], V[1, ...], xp), xp)

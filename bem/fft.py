@@ -45,7 +45,7 @@ import numpy as np
 import scipy.fft as _sfft
 
 __all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "forward_parts", "inverse_into", "in_parts",
-           "BLOCK"]
+           "half_spectrum_weights", "BLOCK"]
 
 _ENV = "CONTACTLAB_THREADS"
 _override = None
@@ -134,6 +134,17 @@ def in_parts(kernel, n, size):
     bounds = [n * i // k for i in range(k + 1)]
     for f in [_pool.submit(kernel, slice(lo, hi)) for lo, hi in zip(bounds[:-1], bounds[1:])]:
         f.result()
+
+
+def half_spectrum_weights(n_cols, xp=np):
+    """Weights of the columns of a real FFT's half spectrum (last axis of ``n_cols`` points, ``n_cols // 2 + 1``
+    columns) in a sum over the whole spectrum: 2, as a column stands for two conjugate frequencies, but 1 for
+    column 0 and, ``n_cols`` even, the Nyquist column ``n_cols / 2`` (float64, in the namespace ``xp``)."""
+    weight = xp.full((n_cols // 2 + 1,), 2.0, dtype=xp.float64)
+    weight[0] = 1.0
+    if n_cols % 2 == 0:
+        weight[-1] = 1.0
+    return weight
 
 
 def fast_length(n, real):

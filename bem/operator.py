@@ -387,4 +387,3 @@ class InfluenceOperator:
             return self._table[n, (m - n % 2) // 2]
         scale = self.lattice.step / (math.pi * self.E_star)
         return scale * template(x[:, None] - x[None, :], y[:, None] - y[None, :])
-

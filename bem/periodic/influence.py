@@ -213,10 +213,7 @@ class PeriodicOperator:
         n_rows, n_cols = self.lattice.shape
         if not self.backend.is_numpy:  # in double precision on the device, as below
             xp = self.backend.xp
-            weight = xp.full((x.shape[-1],), 2.0, dtype=xp.float64)
-            weight[0] = 1.0
-            if n_cols % 2 == 0:
-                weight[-1] = 1.0
+            weight = fft.half_spectrum_weights(n_cols, xp)
             w = (xp.astype(xp.real(x), xp.float64) * xp.astype(xp.real(y), xp.float64)
                  + xp.astype(xp.imag(x), xp.float64) * xp.astype(xp.imag(y), xp.float64))
             return float(xp.sum(w * weight)) / (n_rows // 2 * n_cols)  # one transfer to the host

@@ -17,9 +17,9 @@ __all__ = ["mixed", "weighted_dot"]
 def weighted_dot(x, y, even):
     """``sum Re conj(x) y`` over the full spectrum from the half spectra ``x``, ``y`` of real FFTs along the rows.
 
-    The half spectrum holds the columns ``m`` and ``n_cols - m`` once (weight 2), but for ``m = 0`` and, where
-    ``even`` (``n_cols`` even), ``m = n_cols / 2``. Summed in double precision; times ``1 / (n_rows/2 n_cols)``
-    it is ``sum x y`` over the cell of the two brick arrays.
+    The columns weigh as :func:`bem.fft.half_spectrum_weights` (``even``: ``n_cols`` even), here as twice the sum
+    less the first and the Nyquist column (one ``einsum`` over the spectra, no weighted copy). Summed in double
+    precision; times ``1 / (n_rows/2 n_cols)`` it is ``sum x y`` over the cell of the two brick arrays.
     """
 
     def dot(a, b):  # Re sum conj(a) b of two small arrays
