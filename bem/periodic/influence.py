@@ -206,7 +206,7 @@ class PeriodicOperator:
         if out is spectrum:
             raise ValueError("out: the product cannot overwrite the spectrum whose inner product it takes")
         out, sums = mixed(spectrum, symbol, np.empty_like(spectrum) if out is None else out, n_cols % 2 == 0)
-        return out, sum(sums[k] for k in sorted(sums)) / (n_rows // 2 * n_cols)
+        return out, sum(sums) / (n_rows // 2 * n_cols)
 
     def inner(self, x, y):
         """``sum x y`` over the cell of two real brick arrays from their spectra (:meth:`spectrum`)."""

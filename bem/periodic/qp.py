@@ -1,9 +1,7 @@
 """Kalker's QP on a periodic cell: the conjugate gradients of :func:`bem.kalker.solve_qp` in the Fourier basis.
 
-The step of the periodic operator (:meth:`bem.periodic.PeriodicOperator.qp`) in the one loop
-:func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
-
-The iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active set, Polonsky & Keer
+The step of :meth:`bem.periodic.PeriodicOperator.qp` in the one loop :func:`bem.cg_rules.run_constrained_cg`. The
+iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active set, Polonsky & Keer
 1999, with the FFT preconditioner, the same entering rule, Jacobi cap and stopping rule), specialised to
 :class:`bem.periodic.PeriodicOperator`, where ``C`` is diagonal in the Fourier basis of the cell (a 2 x 2 block per
 frequency, one block row per row parity) and every node is a candidate. It does not restart the conjugate directions
@@ -36,7 +34,9 @@ almost no pressure and leaving, at a constant KKT residual, ``tests/bem/test_per
   double-precision product;
 - after a step that let no node enter and left every contact node a positive pressure, the contact is the same: the
   next iteration reuses its nodes, the step's pressures and direction there and ``D`` on it
-  (:class:`bem.periodic.qp_parts.ContactNodes`), the same numbers with no selection and no gathers.
+  (:class:`bem.periodic.qp_parts.ContactNodes`), the same numbers with no selection and no gathers;
+- on a large cell, with numba, the block products and three passes over the whole cell run compiled on the FFT
+  threads (:mod:`bem.periodic.passes`).
 
 With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are those of ``C`` alone,
 ``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner is that of
@@ -74,6 +74,7 @@ from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
                         entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, in_place, note_fully_plastic
+from .passes import kernels
 from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
@@ -150,6 +151,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     else:  # the caller's iterate and its product, as they are
         p = x0 if overwrite_x0 and in_place(bk, x0) else bk.copy(bk.asarray(x0))  # updated in place below
     A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
+    passes = kernels(lat.n_nodes, bk)  # the passes over the whole cell (bem.periodic.passes)
     soft = stiff = None
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
         stiff = is_stiff(D, diag, threshold)
@@ -176,7 +178,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         # M r at the selected nodes: r_c = r there, r32 = r (float32) at the stiff nodes; soft_c, jac_c: the soft
         # nodes and 1 / (C_nn + D) there (None: no soft node)
         x = op.spectrum(r32)
-        z = xp.astype(bk.take(op.brick(op.mix(x, M, out=x), overwrite=True), sel), xp.float64)
+        z = passes.gather(op.brick(op.mix(x, M, out=x), overwrite=True), sel)
         return z if soft_c is None else xp.where(soft_c, jac_c * r_c, z)
 
     def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
@@ -207,19 +209,20 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     nodes = ContactNodes(bk, p)  # the contact of the iterate; steady: the last step's, whose D_c, ... it keeps
     fixed_scale = scale
-    idx = g_c = p_c0 = g_min = None
+    idx = g_c = p_c0 = g_min = u_range = None  # u_range: max u, min u
 
     bounded, sets = hardness is not None, None
     restart = False  # with a hardness: the last step was shortened to carry the force, the direction restarts
     was_on, was_plastic = (nodes.was_on, p >= hardness) if bounded else (None, None)  # the bound's own counts
 
-    def gap():  # u + h (NumPy: in one buffer)
-        nonlocal g
-        g = np.add(u, h, out=g) if bk.is_numpy else u + h
+    def gap():  # u + h (NumPy: in one buffer); its minimum, and the extremes of u for the residual's scale
+        nonlocal g, u_range
+        g, g_low, *u_range = passes.gap(u, h, g)
+        return g_low
 
     def residual(k, contact_gap, force_error, plastic_gap=None):
         nonlocal single
-        scale = max(float(xp.max(u)), -float(xp.min(u))) if fixed_scale is None else fixed_scale
+        scale = max(u_range[0], -u_range[1]) if fixed_scale is None else fixed_scale
         kkt = iterate_residual(contact_gap, g_min, scale, lambda: float(xp.max(xp.abs(g - delta))), force_error,
                                plastic_gap=plastic_gap)
         if k == 1:  # single precision pays for its closing product only well above SINGLE_ABOVE
@@ -238,12 +241,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
         nonlocal idx, g_c, p_c0, delta, g_min
         idx, p_c0 = nodes.read(p)
-        gap()  # the gap is g - delta: delta is subtracted on the contact only
+        g_low = gap()  # the gap is g - delta: delta is subtracted on the contact only
         g_c = bk.take(g, idx)
         if force is not None:
             delta = float(xp.mean(g_c)) if bk.count(idx) else math.nan
         g_c -= delta
-        g_min = float(xp.min(g)) - delta
+        g_min = g_low - delta
         return residual(k, bk.max0(xp.abs(g_c)), None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
 
     def confirms(kkt):  # recompute C p exactly at the tolerance, or in double precision below SINGLE_ABOVE
@@ -362,9 +365,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
 
     def update_u(R, tau, t_c, D_c, s):  # u - tau (C + lam) t (from its spectrum R) - tau D t, times s
         nonlocal u, stale
-        cr = op.brick(R, overwrite=True)
-        cr *= np.float32(tau) if bk.is_numpy else tau
-        u -= cr
+        passes.subtract_scaled(u, op.brick(R, overwrite=True), tau)
         if D_c is not None:
             add_at(u, idx, -tau * (D_c * t_c))
         if s != 1.0:

@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from .. import fft
+from .passes import kernels
 
-__all__ = ["mixed", "weighted_dot"]
+__all__ = ["mixed", "numpy_mixed", "weighted_dot"]
 
 
 def weighted_dot(x, y, even):
@@ -36,9 +37,23 @@ def weighted_dot(x, y, even):
 def mixed(spectrum, symbol, out, even):
     """:meth:`bem.periodic.PeriodicOperator.mix` of ``spectrum`` into ``out``, block by block on threads; with
     ``even`` not None also the :func:`weighted_dot` of ``spectrum`` and ``out`` of each block of rows as it is made
-    (a dict by the block's first row; ``out`` must then not be ``spectrum``). Returns ``(out, sums)``."""
-    d, b = symbol
+    (``out`` must then not be ``spectrum``). Returns ``(out, sums)``, ``sums`` the blocks' sums in the order of the
+    blocks (empty with ``even`` None).
+
+    On a cell that takes the compiled passes (:mod:`bem.periodic.passes`) one compiled loop over each block makes
+    the product and its sum, else :func:`numpy_mixed`. The compiled products round as NumPy's do without fused
+    multiply-adds (NumPy's loops may fuse them: the two may differ in the last bit of single or double precision),
+    and the sum of a block is taken in the order of its entries.
+    """
     rows = max(1, fft.BLOCK // (spectrum.size // max(spectrum.shape[0], 1) or 1))
+    compiled = kernels(2 * spectrum.size)  # a spectrum has about half as many entries as the cell has nodes
+    return (compiled.mix if compiled.compiled else numpy_mixed)(spectrum, symbol, out, even, rows)
+
+
+def numpy_mixed(spectrum, symbol, out, even, rows):
+    """:func:`mixed` in NumPy, over blocks of ``rows`` rows: three passes over each block (the product ``B X'`` in a
+    buffer of one block), the sum by :func:`weighted_dot`."""
+    d, b = symbol
     sums = {}
 
     def part(s):  # rows s of every array: the parity swap stays inside a row
@@ -53,4 +68,4 @@ def mixed(spectrum, symbol, out, even):
                 sums[lo] = weighted_dot(spectrum[r], out[r], even)
 
     fft.in_parts(part, spectrum.shape[0], spectrum.size)
-    return out, sums
+    return out, [sums[k] for k in sorted(sums)]

@@ -1,6 +1,6 @@
 """The periodic cell's QP in the Fourier basis (bem.periodic.qp) on NumPy and on another array namespace:
 the cases and the comparison of tests/bem/test_backend_namespace.py (array_api_strict) and
-tests/bem/test_gpu.py (CuPy)."""
+tests/bem/test_gpu.py (CuPy); the check that two ways to the same iteration gave the same solution bit for bit."""
 
 import math
 
@@ -78,3 +78,13 @@ def compare(case, device, to_device, monkeypatch):
     if case == "hardness":
         assert 0 < np.count_nonzero(ref.p >= 4.0) < np.count_nonzero(ref.p > 0)
     return res
+
+
+def assert_same_bits(a, b, products_a, products_b):
+    """Two solutions of the QP (``bem.cg_rules.QPSolution``) converged with the same pressures, displacement and
+    history bit for bit, after the same number of products."""
+    assert a.converged and b.converged
+    np.testing.assert_array_equal(a.p, b.p)
+    np.testing.assert_array_equal(a.displacement, b.displacement)
+    assert a.history == b.history
+    assert products_a == products_b

@@ -1,0 +1,234 @@
+"""Element-wise passes of :mod:`bem.periodic.qp` over the whole cell, and the block products of its spectra, as
+compiled kernels on the FFT threads.
+
+With numba installed (the optional extra ``contactlab[fast]``) and a cell of at least :data:`MIN_NODES` nodes, the
+periodic QP on NumPy makes these passes with the kernels of this module, each split into :func:`bem.fft.threads`
+contiguous parts run at once (:func:`bem.fft.in_parts`):
+
+- ``gap``: ``g = u + h`` with ``min g``, ``max u`` and ``min u`` (the KKT residual and its scale) in one pass
+  instead of four;
+- ``subtract_scaled``: the update ``u -= tau (C + lam) t`` from the product in single precision, one pass
+  instead of two;
+- ``gather``: the preconditioned gap (single precision) at the contact's nodes, in double precision;
+- ``mix``: the 2 x 2 block product of a spectrum (:func:`bem.periodic.spectra.mixed`, every product with ``C``
+  or its inverse) and, for the curvature of the step, its weighted sum with the spectrum, one pass instead of
+  four.
+
+Without numba, or on a smaller cell, the same passes run as the NumPy forms (:func:`numpy_kernels`,
+:func:`bem.periodic.spectra.numpy_mixed`). The first three give NumPy's numbers bit for bit: each makes the same
+operations in the same precision at every node, and their reductions are minima and maxima, whose value does not
+depend on their order; a NaN propagates as in NumPy. The block product rounds each operation as written (NumPy's
+loops may fuse a multiply and an add: the two can differ in the last bit) and sums each block of rows in the order
+of its entries (``tests/bem/test_periodic_passes.py``). Selections and most gathers stay NumPy's, faster than a
+compiled loop at these sizes (``docs/performance.md``, "Compiled passes").
+
+Loading the kernels costs the process numba's import and its cached machine code, once (:func:`load`; the first
+run after an install compiles them into ``__pycache__``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import fft
+
+__all__ = ["MIN_NODES", "kernels", "load", "numpy_kernels"]
+
+MIN_NODES = 1 << 18  # below it a pass is too short for the threads' start
+_COMPILED = []  # the compiled kernels, made at the first call of kernels()
+
+
+class _NumPyKernels:
+    """The NumPy forms of the kernels (the reference of the compiled ones)."""
+
+    compiled = False
+
+    @staticmethod
+    def gap(u, h, g):
+        """``(g, min g, max u, min u)`` for ``g = u + h``, made in ``g``'s buffer."""
+        np.add(u, h, out=g)
+        return g, float(g.min()), float(u.max()), float(u.min())
+
+    @staticmethod
+    def subtract_scaled(u, r, tau):
+        """``u -= r * tau`` with ``r * tau`` rounded to ``r``'s precision (float32) first; ``r`` is overwritten."""
+        r *= np.float32(tau)
+        u -= r
+
+    @staticmethod
+    def gather(x, idx):
+        """``x`` (float32) at the flat indices ``idx``, in double precision."""
+        return np.take(x.reshape(-1), idx).astype(np.float64)
+
+
+class _NamespaceKernels:
+    """The forms on another array namespace (:class:`bem.backend.Backend` ``bk``): new arrays where NumPy reuses
+    buffers (``g`` is not used)."""
+
+    compiled = False
+
+    def __init__(self, bk):
+        self.bk = bk
+
+    def gap(self, u, h, g):
+        xp = self.bk.xp
+        g = u + h
+        return g, float(xp.min(g)), float(xp.max(u)), float(xp.min(u))
+
+    def subtract_scaled(self, u, r, tau):
+        r *= tau
+        u -= r
+
+    def gather(self, x, idx):
+        return self.bk.xp.astype(self.bk.take(x, idx), self.bk.xp.float64)
+
+
+def numpy_kernels():
+    """The NumPy forms of the kernels."""
+    return _NumPyKernels
+
+
+def kernels(n_nodes, bk=None):
+    """The kernels for a cell of ``n_nodes`` nodes: compiled where numba is installed and the cell has at least
+    :data:`MIN_NODES` nodes, else :func:`numpy_kernels`; off NumPy their forms in the backend's namespace.
+
+    Parameters
+    ----------
+    n_nodes : int
+        Nodes of the cell.
+    bk : bem.backend.Backend, optional
+        The arrays' backend (default: NumPy).
+
+    Returns
+    -------
+    class
+        Methods ``gap(u, h, g)``, ``subtract_scaled(u, r, tau)``, ``gather(x, idx)`` (and, compiled,
+        ``mix(spectrum, symbol, out, even, rows)``) and the flag ``compiled``.
+    """
+    if bk is not None and not bk.is_numpy:
+        return _NamespaceKernels(bk)
+    if n_nodes < MIN_NODES:
+        return _NumPyKernels
+    if not _COMPILED:
+        _COMPILED.append(_compile())
+    return _COMPILED[0] or _NumPyKernels
+
+
+def load():
+    """Load the compiled kernels now, for every precision the QP passes them, rather than at the first large cell.
+
+    A clock started after it does not count numba's import and the load of the kernels' cached machine code (a
+    fraction of a second a process, ``benchmarks/cases.py`` measures it; seconds of compilation at the first run
+    after an install). Does nothing without numba.
+
+    Returns
+    -------
+    bool
+        Whether the compiled kernels are in use on large cells.
+    """
+    k = kernels(MIN_NODES)
+    if k.compiled:
+        x64, x32, idx = np.zeros(4), np.zeros(4, dtype=np.float32), np.arange(2)
+        for u in (x64, x32):  # the iterate's product in double or in single precision
+            k.gap(u, x64, np.empty(4))
+            k.subtract_scaled(u, x32.copy(), 1.0)
+        k.gather(x32, idx)
+        for real, cplx in ((np.float32, np.complex64), (np.float64, np.complex128)):  # the spectra's precisions
+            x = np.zeros((2, 2, 3), dtype=cplx)
+            k.mix(x, (np.zeros((2, 1, 3), dtype=real), x.copy()), x, True, 1)
+    return k.compiled
+
+
+def _compile():
+    """The compiled kernels (a class of static methods with the NumPy forms' signatures), or None without numba."""
+    try:
+        import numba
+    except ImportError:
+        return None
+    from numba import njit
+
+    opts = dict(cache=True, nogil=True)  # nogil: the parts run at once on the threads of bem.fft.in_parts
+
+    @njit(**opts)
+    def _gap(u, h, g, lo, hi):
+        g_min, u_max, u_min, g_nan, u_nan = np.inf, -np.inf, np.inf, False, False
+        for i in range(lo, hi):
+            x = u[i]
+            y = x + h[i]
+            g[i] = y
+            g_nan |= y != y  # a NaN compares false: noted apart, as NumPy's extremes propagate it
+            u_nan |= x != x
+            g_min = min(g_min, y)
+            u_max = max(u_max, x)
+            u_min = min(u_min, x)
+        return np.nan if g_nan else g_min, np.nan if u_nan else u_max, np.nan if u_nan else u_min
+
+    @njit(**opts)
+    def _subtract_scaled(u, r, tau, lo, hi):
+        for i in range(lo, hi):
+            u[i] -= r[i] * tau
+
+    @njit(**opts)
+    def _gather(x, idx, out, lo, hi):
+        for j in range(lo, hi):
+            out[j] = x[idx[j]]
+
+    @njit(**opts)
+    def _mix(x, d, b, out, rows, lo, hi, sums, even):  # blocks lo..hi of `rows` rows; sums: one a block, or empty
+        n_rows, n_cols = x.shape[0], x.shape[2]
+        shared = d.shape[1] == 1
+        for k in range(lo, hi):
+            total = 0.0
+            for r in range(k * rows, min((k + 1) * rows, n_rows)):
+                for c in range(n_cols):
+                    x0, x1, b0, b1 = x[r, 0, c], x[r, 1, c], b[r, 0, c], b[r, 1, c]
+                    d0 = d[r, 0, c]
+                    d1 = d0 if shared else d[r, 1, c]
+                    y0r = d0 * x0.real + (b0.real * x1.real - b0.imag * x1.imag)
+                    y0i = d0 * x0.imag + (b0.real * x1.imag + b0.imag * x1.real)
+                    y1r = d1 * x1.real + (b1.real * x0.real - b1.imag * x0.imag)
+                    y1i = d1 * x1.imag + (b1.real * x0.imag + b1.imag * x0.real)
+                    out[r, 0, c] = complex(y0r, y0i)
+                    out[r, 1, c] = complex(y1r, y1i)
+                    if sums.size:
+                        v = (np.float64(x0.real) * np.float64(y0r) + np.float64(x0.imag) * np.float64(y0i)
+                             + np.float64(x1.real) * np.float64(y1r) + np.float64(x1.imag) * np.float64(y1i))
+                        total += v if c == 0 or (even and c == n_cols - 1) else 2.0 * v
+            if sums.size:
+                sums[k] = total
+
+    def run(kernel, n):  # kernel(lo, hi) on the parts of range(n); their results in the order of the parts
+        res = {}
+        fft.in_parts(lambda part: res.__setitem__(part.start, kernel(part.start, part.stop)), n, n)
+        return [res[k] for k in sorted(res)]
+
+    class Compiled:
+        compiled = True
+
+        @staticmethod
+        def gap(u, h, g):
+            uf, hf, gf = u.reshape(-1), h.reshape(-1), g.reshape(-1)
+            e = np.array(run(lambda lo, hi: _gap(uf, hf, gf, lo, hi), uf.size))
+            return g, float(e[:, 0].min()), float(e[:, 1].max()), float(e[:, 2].min())
+
+        @staticmethod
+        def subtract_scaled(u, r, tau):
+            u, r, tau = u.reshape(-1), r.reshape(-1), np.float32(tau)
+            run(lambda lo, hi: _subtract_scaled(u, r, tau, lo, hi), u.size)
+
+        @staticmethod
+        def mix(spectrum, symbol, out, even, rows):
+            d, b = symbol
+            blocks = -(-spectrum.shape[0] // rows)
+            sums = np.zeros(blocks if even is not None else 0)
+            fft.in_parts(lambda part: _mix(spectrum, d, b, out, rows, part.start, part.stop, sums, bool(even)),
+                         blocks, spectrum.size)
+            return out, sums
+
+        @staticmethod
+        def gather(x, idx):
+            x, out = x.reshape(-1), np.empty(idx.size)
+            run(lambda lo, hi: _gather(x, idx, out, lo, hi), idx.size)
+            return out
+
+    return Compiled

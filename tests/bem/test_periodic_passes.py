@@ -1,0 +1,192 @@
+"""The compiled passes of the periodic QP (bem.periodic.passes) against their NumPy forms (bit for bit, the block
+product to the last bit of its precision), and the QP with them against the QP without them."""
+
+import math
+import sys
+
+import numpy as np
+import pytest
+
+import bem
+import bem.periodic.passes as passes
+import bem.periodic.spectra as spectra
+from bem import fft
+from bem.periodic import PeriodicCell, PeriodicOperator
+from bem.periodic.qp import solve_periodic_qp
+
+from .fourier_qp_cases import assert_same_bits
+
+numba = pytest.importorskip("numba", reason="the compiled passes need numba (contactlab[fast])")
+
+N = (1 << 17) + 5  # over bem.fft's threshold for parts: split over the threads, parts of unequal length
+
+
+@pytest.fixture
+def two_threads():
+    previous = fft.set_threads(2)
+    yield
+    fft.set_threads(previous)
+
+
+def _compiled():
+    k = passes.kernels(passes.MIN_NODES)
+    assert k.compiled
+    return k
+
+
+def _identical(a, b):
+    return np.array_equal(a, b, equal_nan=True) and np.asarray(a).dtype == np.asarray(b).dtype
+
+
+@pytest.mark.parametrize("single", [False, True])
+def test_the_compiled_passes_give_the_numpy_forms_numbers(two_threads, single):
+    """``gap``, ``subtract_scaled`` and ``gather`` give bit for bit the numbers of the NumPy forms, with the
+    iterate's product in double and in single precision, and leave their inputs as they were."""
+    rng = np.random.default_rng(7)
+    ref, fast = passes.numpy_kernels(), _compiled()
+    u = rng.standard_normal(N).astype(np.float32 if single else np.float64)
+    h = rng.standard_normal(N) * 1e-3
+    u[N - 1], h[3] = 10.0, -20.0  # the extremes in the last node of the last part and in the first part
+    u0, h0 = u.copy(), h.copy()
+    g_ref, g_fast = np.empty(N), np.full(N, np.nan)
+    a, b = ref.gap(u, h, g_ref), fast.gap(u, h, g_fast)
+    assert a[0] is g_ref and b[0] is g_fast and a[1:] == b[1:]
+    assert _identical(g_fast, g_ref)
+    assert _identical(u, u0) and _identical(h, h0)
+    r = rng.standard_normal(N).astype(np.float32)
+    tau = 0.37 + 1e-9
+    for k in (ref, fast):
+        v, w = u0.copy(), r.copy()
+        k.subtract_scaled(v, w, tau)
+        if k is ref:
+            expected = v
+    assert _identical(v, expected)
+    assert not _identical(expected, u0)
+    idx = np.flatnonzero(rng.random(N) < 0.3)
+    x = r.copy()
+    got = fast.gather(x, idx)
+    assert _identical(got, ref.gather(x, idx)) and got.dtype == np.float64
+    assert _identical(x, r)
+    assert fast.gather(x, idx[:0]).shape == (0,)
+
+
+def test_a_nan_propagates_as_in_numpy(two_threads):
+    """A NaN in ``u`` makes every extreme NaN; a NaN in ``h`` only the gap's minimum (NumPy's extremes)."""
+    ref, fast = passes.numpy_kernels(), _compiled()
+    for where in ("u", "h"):
+        u, h = np.linspace(-1.0, 1.0, N), np.zeros(N)
+        (u if where == "u" else h)[N - 10] = np.nan
+        a, b = ref.gap(u, h, np.empty(N))[1:], fast.gap(u, h, np.empty(N))[1:]
+        assert _identical(np.array(a), np.array(b))
+        assert np.isnan(a[0]) and np.isnan(a[1]) == (where == "u")
+
+
+def test_small_cells_and_no_numba_take_the_numpy_forms(monkeypatch):
+    assert passes.kernels(passes.MIN_NODES - 1) is passes.numpy_kernels()
+    assert passes.load() is True
+    monkeypatch.setitem(sys.modules, "numba", None)  # an import of numba fails
+    assert passes._compile() is None
+    monkeypatch.setattr(passes, "_COMPILED", [None])  # as _compile() gave it
+    assert passes.kernels(10 * passes.MIN_NODES) is passes.numpy_kernels()
+    assert passes.load() is False
+
+
+def _cell_problem(case):
+    cell = PeriodicCell(1.0 / 96, 96, 96)
+    x, y = cell.x, cell.y
+    lx, ly = cell.size
+    h = 0.01 * (2 - np.cos(2 * np.pi * x / lx) - np.cos(2 * np.pi * (x / lx + 2 * y / ly)))
+    h += 0.002 * np.sin(2 * np.pi * (3 * x / lx + 5 * y / ly))
+    if case == "coated":  # a stiff coating: the symbol of the coated bodies
+        bodies = bem.Bodies(1.0, 0.3, math.inf, 0.0, bem.Coating(0.05, 10.0, 0.25))
+        op = PeriodicOperator(cell, bodies.E_star, bodies=bodies)
+    else:
+        op = PeriodicOperator(cell, 1.0)
+    kw = dict(force=0.2 * cell.area * 0.01, rtol=1e-11)
+    if case == "per_node":
+        kw["lam"] = np.where(np.arange(h.size).reshape(h.shape) % 7 == 0, 20.0, 0.5) * op.diagonal
+    elif case == "hardness":
+        kw["hardness"] = 0.03
+    return op, h, kw
+
+
+class _Counted:
+    """The compiled kernels, the names of the kernels called kept in ``calls``."""
+
+    compiled = True
+
+    def __init__(self, calls):
+        self.calls, self.real = calls, _compiled()
+
+    def __getattr__(self, name):
+        self.calls.append(name)
+        return getattr(self.real, name)
+
+
+@pytest.mark.parametrize("case", ["smooth", "per_node", "hardness"])
+def test_the_qp_with_the_compiled_passes_is_the_qp_without(monkeypatch, two_threads, case):
+    """On a cell made to take the compiled element-wise passes (threshold lowered; the block products NumPy's) the QP
+    gives bit for bit the pressures, displacement, history and products of the QP with the NumPy forms, and the
+    passes were used."""
+    op, h, kw = _cell_problem(case)
+    calls = []
+    monkeypatch.setattr(passes, "MIN_NODES", 1)
+    monkeypatch.setattr(passes, "_COMPILED", [_Counted(calls)])
+    monkeypatch.setattr(spectra, "kernels", lambda n: passes.numpy_kernels())
+    with_kernels = solve_periodic_qp(op, h, **kw)
+    n_with = op.n_matvec
+    assert {"gap", "subtract_scaled", "gather"} <= set(calls)
+    monkeypatch.setattr(passes, "MIN_NODES", 10**12)
+    op.n_matvec = 0
+    without = solve_periodic_qp(op, h, **kw)
+    assert_same_bits(with_kernels, without, n_with, op.n_matvec)
+
+
+@pytest.mark.parametrize("single", [False, True])
+@pytest.mark.parametrize("inverse", [False, True])
+@pytest.mark.parametrize("n_cols", [64, 63])  # with and without a Nyquist column
+def test_the_compiled_block_product_is_the_numpy_one(two_threads, single, inverse, n_cols):
+    """The compiled 2 x 2 block product equals NumPy's to the last bits of its precision (NumPy's loops may fuse a
+    multiply and an add), in place and not, and its sum equals the weighted sum of the spectrum and the product
+    and the cell's ``sum v.Cv``; a sum for each block of rows."""
+    cell = PeriodicCell(1.0 / n_cols, n_cols, 4200)  # 2100 x 2 x 33 entries: over the threshold for parts
+    op = PeriodicOperator(cell, 1.0)
+    v = np.random.default_rng(2).standard_normal(cell.shape)
+    X = op.spectrum(v.astype(np.float32) if single else v)
+    symbol = op.symbol(0.3 * op.diagonal, inverse=inverse, single=single)
+    rows = 97  # blocks of unequal count over the parts, the last one short
+    ref, ref_sums = spectra.numpy_mixed(X, symbol, np.empty_like(X), n_cols % 2 == 0, rows)
+    out, sums = _compiled().mix(X, symbol, np.empty_like(X), n_cols % 2 == 0, rows)
+    eps = np.finfo(np.float32 if single else np.float64).eps
+    assert out.dtype == X.dtype and len(sums) == -(-X.shape[0] // rows)
+    np.testing.assert_allclose(out, ref, rtol=0, atol=4 * eps * np.abs(ref).max())
+    assert sum(sums) == pytest.approx(sum(ref_sums), rel=1e-5 if single else 1e-12)
+    exact = spectra.weighted_dot(X.astype(np.complex128), out.astype(np.complex128), n_cols % 2 == 0)
+    assert sum(sums) == pytest.approx(exact, rel=1e-13)
+    if not inverse:
+        u = op.brick(out.copy())
+        assert sum(sums) / (cell.n_rows // 2 * n_cols) == pytest.approx(float(np.sum(v * u)), rel=1e-5 if single
+                                                                          else 1e-12)
+    inplace = X.copy()
+    got, none = _compiled().mix(inplace, symbol, inplace, None, rows)
+    assert got is inplace and len(none) == 0
+    np.testing.assert_array_equal(inplace, out)
+
+
+@pytest.mark.parametrize("case", ["smooth", "per_node", "hardness", "coated"])
+def test_the_qp_with_every_compiled_pass_solves_the_same_problem(monkeypatch, two_threads, case):
+    """With the compiled block products too the QP converges to the answer of the NumPy QP (to the tolerance's
+    order), in as many iterations give or take one. The stiff coating's count moves with any rounding of the
+    single-precision products (38 to 42 iterations with NumPy's symbol scaled by 1 -+ 1e-7, 33 compiled): there
+    only the answer is compared."""
+    op, h, kw = _cell_problem(case)
+    calls = []
+    monkeypatch.setattr(passes, "MIN_NODES", 1)
+    monkeypatch.setattr(passes, "_COMPILED", [_Counted(calls)])
+    fast = solve_periodic_qp(op, h, **kw)
+    assert "mix" in calls
+    monkeypatch.setattr(passes, "MIN_NODES", 10**12)
+    plain = solve_periodic_qp(op, h, **kw)
+    assert fast.converged and plain.converged and fast.kkt_residual <= kw["rtol"]
+    assert case == "coated" or abs(fast.iterations - plain.iterations) <= 1
+    np.testing.assert_allclose(fast.p, plain.p, rtol=0, atol=1e-8 * plain.p.max())
