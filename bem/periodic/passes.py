@@ -207,12 +207,16 @@ def _compile():
 
         @staticmethod
         def gap(u, h, g):
+            if not all(a.flags.c_contiguous for a in (u, h, g)):  # a flat view of each is needed
+                return _NumPyKernels.gap(u, h, g)
             uf, hf, gf = u.reshape(-1), h.reshape(-1), g.reshape(-1)
             e = np.array(run(lambda lo, hi: _gap(uf, hf, gf, lo, hi), uf.size))
             return g, float(e[:, 0].min()), float(e[:, 1].max()), float(e[:, 2].min())
 
         @staticmethod
         def subtract_scaled(u, r, tau):
+            if not (u.flags.c_contiguous and r.flags.c_contiguous):
+                return _NumPyKernels.subtract_scaled(u, r, tau)
             u, r, tau = u.reshape(-1), r.reshape(-1), np.float32(tau)
             run(lambda lo, hi: _subtract_scaled(u, r, tau, lo, hi), u.size)
 

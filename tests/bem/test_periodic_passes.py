@@ -62,6 +62,18 @@ def test_the_compiled_passes_give_the_numpy_forms_numbers(two_threads, single):
             expected = v
     assert _identical(v, expected)
     assert not _identical(expected, u0)
+    shape = (400, 320)  # 2-D views that are not contiguous (no flat view): written in place all the same
+    v2, r2 = u0[:np.prod(shape)].reshape(shape), r[:np.prod(shape)].reshape(shape)
+    whole, g_whole = np.zeros((400, 640), dtype=u0.dtype), np.zeros((400, 640))
+    view, g_view = whole[:, :320], g_whole[:, 320:]
+    view[...] = v2
+    fast.subtract_scaled(view, r2.copy(), tau)
+    expected2 = v2.copy()
+    ref.subtract_scaled(expected2, r2.copy(), tau)
+    assert _identical(view, expected2)
+    assert fast.gap(v2, h[:np.prod(shape)].reshape(shape), g_view)[1:] == ref.gap(
+        v2, h[:np.prod(shape)].reshape(shape), np.empty(shape))[1:]
+    assert _identical(g_view, v2 + h[:np.prod(shape)].reshape(shape))
     idx = np.flatnonzero(rng.random(N) < 0.3)
     x = r.copy()
     got = fast.gather(x, idx)
