@@ -37,7 +37,7 @@ RADIUS, SIDE, A_HERTZ, A_ROUGH, ROOT_K = 1.0, 1.0, 0.1, 0.3, 0.04
 PBAR = 0.01
 PROBLEMS = ("periodic", "periodic-root", "hertz", "hertz-root", "hertz-wide", "rough-sphere")
 RTOL = 1e-10
-LOAD_S = None  # seconds of the last prepare()'s load of the compiled passes
+LOAD_S = None  # seconds of the last prepare()'s load of the compiled passes (None: not a periodic cell)
 
 
 def hertz_force(a):
@@ -209,6 +209,7 @@ def prepare(problem, n):
     global LOAD_S
     import bem
 
+    LOAD_S = None
     if problem.startswith("periodic"):
         from bem.periodic import passes
         from periodic_rough import _root

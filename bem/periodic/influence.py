@@ -374,4 +374,3 @@ class PeriodicOperator:
         i, j = q - r // 2, r  # lattice coordinates
         di, dj = i[:, None] - i[None, :], j[:, None] - j[None, :]
         return self.kernel[np.mod(dj, n_rows), np.mod(di + np.floor_divide(dj, 2), n_cols)]
-

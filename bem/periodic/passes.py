@@ -101,7 +101,7 @@ def kernels(n_nodes, bk=None):
 
     Returns
     -------
-    class
+    class or object
         Methods ``gap(u, h, g)``, ``subtract_scaled(u, r, tau)``, ``gather(x, idx)`` (and, compiled,
         ``mix(spectrum, symbol, out, even, rows)``) and the flag ``compiled``.
     """

@@ -1,6 +1,7 @@
 """The periodic cell's QP in the Fourier basis (bem.periodic.qp) on NumPy and on another array namespace:
 the cases and the comparison of tests/bem/test_backend_namespace.py (array_api_strict) and
-tests/bem/test_gpu.py (CuPy); the check that two ways to the same iteration gave the same solution bit for bit."""
+tests/bem/test_gpu.py (CuPy); a small cell's QP and the check that two ways to the same iteration gave the same
+solution bit for bit (tests/bem/test_periodic_qp_parts.py, tests/bem/test_periodic_passes.py)."""
 
 import math
 
@@ -88,3 +89,22 @@ def assert_same_bits(a, b, products_a, products_b):
     np.testing.assert_array_equal(a.displacement, b.displacement)
     assert a.history == b.history
     assert products_a == products_b
+
+
+def cell_qp(case):
+    """``(op, h, kw)``: the QP of a 96 x 96 cell under a smooth two-mode gap at a fifth of full contact, ``case``
+    ``"smooth"``, ``"per_node"`` (a compliance per node, soft at every seventh node), ``"hardness"`` or ``"coated"``
+    (a stiff coating on the substrate), to ``rtol = 1e-11``."""
+    cell = PeriodicCell(1.0 / 96, 96, 96)
+    x, y = cell.x, cell.y
+    lx, ly = cell.size
+    h = 0.01 * (2 - np.cos(2 * np.pi * x / lx) - np.cos(2 * np.pi * (x / lx + 2 * y / ly)))
+    h += 0.002 * np.sin(2 * np.pi * (3 * x / lx + 5 * y / ly))
+    bodies = bem.Bodies(1.0, 0.3, math.inf, 0.0, bem.Coating(0.05, 10.0, 0.25)) if case == "coated" else None
+    op = PeriodicOperator(cell, 1.0 if bodies is None else bodies.E_star, bodies=bodies)
+    kw = dict(force=0.2 * cell.area * 0.01, rtol=1e-11)
+    if case == "per_node":
+        kw["lam"] = np.where(np.arange(h.size).reshape(h.shape) % 7 == 0, 20.0, 0.5) * op.diagonal
+    elif case == "hardness":
+        kw["hardness"] = 0.03
+    return op, h, kw

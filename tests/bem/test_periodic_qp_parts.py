@@ -10,7 +10,7 @@ from bem.periodic import PeriodicCell, PeriodicOperator
 from bem.periodic.qp import solve_periodic_qp
 from bem.periodic.qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, weighted_square
 
-from .fourier_qp_cases import assert_same_bits
+from .fourier_qp_cases import assert_same_bits, cell_qp
 
 
 def test_last_preconditioned_gap_reads_the_kept_values_at_new_nodes():
@@ -116,14 +116,7 @@ def test_the_steady_contact_changes_no_number_of_the_qp(monkeypatch, per_node):
     """The QP that keeps the contact, its pressures, the direction and D over steps that no node entered or left
     gives bit for bit the answer, the iterations and the products of the QP that reads them at every iteration;
     and it does keep them at some iterations."""
-    cell = PeriodicCell(1.0 / 96, 96, 96)
-    x, y = cell.x, cell.y
-    lx, ly = cell.size
-    h = 0.01 * (2 - np.cos(2 * np.pi * x / lx) - np.cos(2 * np.pi * (x / lx + 2 * y / ly)))
-    h += 0.002 * np.sin(2 * np.pi * (3 * x / lx + 5 * y / ly))
-    op = PeriodicOperator(cell, 1.0)
-    lam = np.where(np.arange(h.size).reshape(h.shape) % 7 == 0, 20.0, 0.5) * op.diagonal if per_node else 0.0
-    kw = dict(force=0.2 * cell.area * 0.01, lam=lam, rtol=1e-11)
+    op, h, kw = cell_qp("per_node" if per_node else "smooth")
     steps = []
     stepped = ContactNodes.stepped
 
