@@ -3,16 +3,22 @@
 Damped Newton steps approach a bound of ``p`` geometrically and never reach it: a node that the model
 releases (``q = 0``) where ``w`` is concave (:func:`release`), and, with a hardness ``H``
 (:mod:`bem.plastic`), a node that the model puts at ``H`` while the line search stops short of it
-(:func:`settle_plastic`). Each move is tried once per step and kept when ``Phi`` of eq. 15 decreases
-(:func:`energy_change`).
+(:func:`settle_plastic`). Where ``w'`` varies fast (a root law at small pressures) the step along
+``d = q - p`` is poor for the nodes the layer dominates, and the move to the pressure whose closure is the
+model's (:func:`closure_move`) is better. Each move is tried once per step and kept when ``Phi`` of eq. 15
+decreases (:func:`energy_change`).
 """
 
 from __future__ import annotations
 
-from .backend import backend_of, operator_backend
-from .plastic import fill_force
+import math
 
-__all__ = ["energy_change", "scaled", "release", "settle_plastic"]
+import numpy as np
+
+from .backend import backend_of, operator_backend
+from .plastic import fill_force, in_place
+
+__all__ = ["energy_change", "scaled", "release", "settle_plastic", "model_closure", "closure_move"]
 
 
 def energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
@@ -110,3 +116,49 @@ def settle_plastic(op, layer, h, p, u, at_bound, delta, *, force, hardness):
     if energy_change(bk, layer, p, dp, u, c_dp, h, delta, mask) < 0:
         return trial, u + c_dp
     return p, u
+
+
+def model_closure(bk, layer, p, q, D, t):
+    """``w(p) + t D (q - p)`` [length]: the closure of a Newton step's model (compliance ``D`` per node) at
+    ``p + t (q - p)``. On NumPy in the buffer of ``D``, which it consumes."""
+    if not in_place(bk, D):
+        return bk.asarray(layer.w(p)) + t * D * (q - p)
+    D *= t
+    D *= np.subtract(q, p)
+    D += layer.w(p)
+    return D
+
+
+def closure_move(op, layer, h, p, u, closure, kept, delta, *, force):
+    """Move to the pressure ``w^-1(closure)`` at the nodes of ``kept`` (boolean), 0 elsewhere, if that lowers ``Phi``.
+
+    ``closure`` is the model's (:func:`model_closure`) at the step's pressure ``p`` (``u = C p``). The model
+    linearises ``w`` about the last pressure; at a node the layer dominates (``w'`` large against ``C_nn``) its
+    closure is right where its pressure is not: for a root law ``w = lam sqrt(p)`` and a node that carries its
+    load by the layer alone, ``w^-1`` of the model's closure is the answer in one step, where the full step along
+    ``d`` from below the answer ``p*`` leaves ``1 - p_new / p* = (1 - sqrt(p / p*))^2``. The nodes off ``kept``
+    (those the model releases) go to 0, a node where ``w^-1`` is not finite (a rigid branch) keeps ``p``; under
+    force control the move is scaled to the force. It costs one product with ``C``. Returns ``(p, u, moved)``; on NumPy ``p`` and ``u``
+    are updated in place.
+    """
+    bk, mask = operator_backend(op)
+    xp = bk.xp
+    with bk.errstate(over="ignore", invalid="ignore"):
+        trial = bk.asarray(layer.inverse(xp.maximum(closure, 0.0)))
+    closure = None
+    trial = xp.where(kept & xp.isfinite(trial), trial, xp.where(kept, p, 0.0))
+    if force is not None:
+        total = float(xp.sum(trial))
+        if not (total > 0 and math.isfinite(total)):
+            return p, u, False
+        trial *= force / op.lattice.node_area / total
+    trial -= p  # the move dp: under force control sum dp = 0, and Phi does not depend on delta
+    c_dp = op.matvec(trial)
+    if not energy_change(bk, layer, p, trial, u, c_dp, h, delta, mask) < 0:
+        return p, u, False
+    if not (in_place(bk, p) and in_place(bk, u)):
+        return xp.maximum(p + trial, 0.0), u + c_dp, True
+    p += trial
+    np.maximum(p, 0.0, out=p)  # p + (w^-1 - p) rounds below 0 only where w^-1 is below 1e-16 p
+    u += c_dp
+    return p, u, True

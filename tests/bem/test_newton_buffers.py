@@ -1,8 +1,6 @@
 """Newton's arrays (:mod:`bem.newton`): the step consumes the model's solution in place and the iterate may live
 in the caller's start, with the numbers of the plain formulas and the caller's arrays as documented."""
 
-import math
-
 import numpy as np
 import pytest
 
@@ -11,21 +9,12 @@ from bem import layers
 from bem.backend import get_backend
 from bem.cg_rules import QPSolution
 from bem import newton
-from bem.periodic import PeriodicCell, PeriodicOperator
+from bem.periodic import PeriodicOperator
 from bem.plastic import clip
 
-CELL = PeriodicCell(1.0 / 48, 48, 48)
+from .newton_cases import CELL, waves
+
 LAYER = layers.Root(0.3 * bem.diagonal_coefficient(CELL.step, 1.0))
-
-
-def _surface(cell, seed=5, modes=8):
-    rng = np.random.default_rng(seed)
-    lx, ly = cell.size
-    h = np.zeros(cell.shape)
-    for m in range(1, modes + 1):
-        kx, ky = 2 * math.pi * rng.integers(-m, m + 1) / lx, 2 * math.pi * m / ly
-        h += 0.01 * np.cos(kx * cell.x + ky * cell.y + rng.uniform(0, 2 * math.pi)) / m
-    return h - h.min()
 
 
 def _plain(p, u, q, uq, t, force, area, hardness):
@@ -61,7 +50,7 @@ def test_the_step_is_the_plain_formula_bit_for_bit_in_the_models_buffers(force, 
 
 def _newton(x0, **kw):
     op = PeriodicOperator(CELL, 1.0)
-    return newton.solve_newton(op, _surface(CELL), layer=LAYER, force=0.02, x0=x0, **kw)
+    return newton.solve_newton(op, waves(CELL), layer=LAYER, force=0.02, x0=x0, **kw)
 
 
 def test_newton_holds_its_iterate_in_a_start_it_may_overwrite():
