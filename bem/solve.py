@@ -155,7 +155,7 @@ def solve(gap, *, E_star=None, E1=None, nu1=None, E2=None, nu2=None, coating1=No
 
     - Kalker's QP: ``r_k <= rtol``, checked on an exactly recomputed ``C p``.
     - Newton: ``r_k <= rtol`` on an exact product; each inner QP is solved to
-      ``max(rtol / 3, min(1e-2, eta_k r_k))``, ``eta_k = min(0.3, r_k / r_(k-1))``.
+      ``max(rtol / 3, min(1e-2, eta_k r_k))``, ``eta_k = min(0.3, 0.9 (r_k / r_(k-1))^1.618)``.
     - Augmented gap: the increments of eq. 20,
       ``||w(p_k) - w(p_{k-1})|| / ||w(p_k)|| <= eps_h`` and
       ``||p_k - p_{k-1}|| / ||p_k|| <= eps_p``, AND ``r_k <= rtol``.

@@ -129,3 +129,17 @@ def test_the_models_closure_is_its_formula_in_the_buffer_of_d(writeable):
     assert (out is D) == writeable
     np.testing.assert_array_equal(p, keep[0])
     np.testing.assert_array_equal(q, keep[1])
+
+
+def test_a_steep_power_law_on_a_sphere_converges_in_a_few_steps(monkeypatch):
+    # w = 0.05 p^0.05: w' spans decades over the contact, the case Newton's steps along d take longest on
+    def sphere():
+        return bem.solve(bem.gaps.Paraboloid(1.0), E_star=1.0, force=4 * 0.1**3 / 3, step=1 / 32, extent=0.5,
+                         layer=layers.Power(0.05, 0.05))
+
+    moved = sphere()
+    _without_move(monkeypatch)
+    plain = sphere()
+    assert moved.converged and plain.converged and moved.kkt_residual <= 1e-10
+    assert moved.iterations <= 6 and plain.iterations >= 2 * moved.iterations
+    np.testing.assert_allclose(moved.p, plain.p, rtol=0, atol=1e-8 * plain.p.max())
