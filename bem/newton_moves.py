@@ -138,15 +138,16 @@ def closure_move(op, layer, h, p, u, closure, kept, delta, *, force):
     load by the layer alone, ``w^-1`` of the model's closure is the answer in one step, where the full step along
     ``d`` from below the answer ``p*`` leaves ``1 - p_new / p* = (1 - sqrt(p / p*))^2``. The nodes off ``kept``
     (those the model releases) go to 0, a node where ``w^-1`` is not finite (a rigid branch) keeps ``p``; under
-    force control the move is scaled to the force. It costs one product with ``C``. Returns ``(p, u, moved)``; on NumPy ``p`` and ``u``
-    are updated in place.
+    force control the move is scaled to the force. ``w^-1`` is evaluated at the nodes of ``kept`` only. It costs
+    one product with ``C``. Returns ``(p, u, moved)``; on NumPy ``p`` and ``u`` are updated in place.
     """
     bk, mask = operator_backend(op)
     xp = bk.xp
+    sel = bk.select(kept)
     with bk.errstate(over="ignore", invalid="ignore"):
-        trial = bk.asarray(layer.inverse(xp.maximum(closure, 0.0)))
+        reach = bk.asarray(layer.inverse(xp.maximum(bk.take(closure, sel), 0.0)))
     closure = None
-    trial = xp.where(kept & xp.isfinite(trial), trial, xp.where(kept, p, 0.0))
+    trial = bk.spread(p.shape, sel, xp.where(xp.isfinite(reach), reach, bk.take(p, sel)))
     if force is not None:
         total = float(xp.sum(trial))
         if not (total > 0 and math.isfinite(total)):
