@@ -314,3 +314,11 @@ def test_run_summary_prints_any_value_of_a_result():
     text = _summary(result, "out")
     assert "p_max      - Pa   (FEM 0)   (hertz -)" in text and "approach - m" in text
     assert "area 1e+308 m^2" in text and "at depth 1e+308 m" in text and "KKT residual -" in text
+
+
+def test_a_newton_runs_history_holds_its_counts_beside_its_lists(builtin_runs):
+    history = builtin_runs["paper_root"]["result"].bem.history
+    steps = len(history["step"])
+    assert steps >= 1 and len(history["residual"]) == steps + 1
+    assert history["inner_missed"] == 0 and history["inner_worst"] == 0.0
+    assert isinstance(history["closure_moves"], int) and 1 <= history["closure_moves"] <= steps

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from dataclasses import fields
 
+import math
+
 import numpy as np
 
 from ..compare import RADIUS_KEYS
@@ -46,9 +48,12 @@ def unit_symbols(units):
 
 
 def _history(res):
-    """Per-iteration scalar lists of the BEM history (iterates left out)."""
+    """Per-iteration scalar lists of the BEM history and its finite scalars (iterates left out)."""
     out = {}
     for key, values in (res.history or {}).items():
+        if isinstance(values, (int, float, np.integer, np.floating)) and math.isfinite(values):
+            out[key] = values.item() if isinstance(values, np.generic) else values
+            continue
         if key == "p" or not isinstance(values, (list, tuple, np.ndarray)):
             continue
         arr = np.asarray(values)
