@@ -265,13 +265,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         p_c = xp.where(clipped, 0.0, p_c)
         p[...] = 0.0  # p_c on the contact, 0 elsewhere: in p itself, no second array of the lattice
         bk.put(p, idx, p_c)
-        # re-entering nodes (p = 0, g < 0): Polonsky-Keer's -tau g, capped by the Jacobi
-        # estimate -g / (C_nn + lam) so that a node with a large layer compliance cannot overshoot
+        # re-entering nodes (p = 0, g < 0): Polonsky-Keer's -tau g capped by the Jacobi estimate
+        # -g / (C_nn + lam), or with a preconditioner (tau then dimensionless) a share of that estimate
         overlap = bk.subset(low, bk.take(p, low) == 0)  # off-mask nodes have g = 0
         n_overlap = bk.count(overlap)
         if n_overlap:
             lam_o = bk.take(lam, overlap) if per_node else lam
-            bk.put(p, overlap, entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o), per_node))
+            bk.put(p, overlap, entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o), per_node,
+                                                 preconditioned=preconditioner is not None))
         restart = bool(n_overlap)
         s = 1.0
         if target is not None:
