@@ -51,6 +51,8 @@ def test_the_compiled_passes_give_the_numpy_forms_numbers(two_threads, single):
     assert a[0] is g_ref and b[0] is g_fast and a[1:] == b[1:]
     assert _identical(g_fast, g_ref)
     assert _identical(u, u0) and _identical(h, h0)
+    below = -np.abs(u0)  # u below 0 at every node: its maximum must not come out as 0
+    assert fast.gap(below, -h0, np.empty(N))[1:] == ref.gap(below, -h0, np.empty(N))[1:]
     r = rng.standard_normal(N).astype(np.float32)
     tau = 0.37 + 1e-9
     expected, v = u0.copy(), u0.copy()

@@ -8,9 +8,8 @@ made the result (:mod:`validation.provenance`).
 
 from __future__ import annotations
 
-from dataclasses import fields
-
 import math
+from dataclasses import fields
 
 import numpy as np
 
