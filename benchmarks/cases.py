@@ -76,6 +76,14 @@ def reset_peak():
         return False
 
 
+def write_whole(path, text):
+    """Write ``text`` to ``path`` whole or not at all (a temporary file beside it, then renamed)."""
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
 def loadavg():
     """The 1-, 5- and 15-minute load averages."""
     return [round(v, 2) for v in os.getloadavg()]

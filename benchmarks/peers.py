@@ -172,13 +172,6 @@ def plot(table, path):
     plt.close(fig)
 
 
-def _write(path, text):
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", help="results folder (required)")
@@ -213,9 +206,9 @@ def main(argv=None):
                 print(json.dumps(runs[-1]), flush=True)
     info["load_end"] = cases.loadavg()
     table = summarise(runs)
-    _write(os.path.join(args.out, "peers.json"),
+    cases.write_whole(os.path.join(args.out, "peers.json"),
            json.dumps(dict(machine=info, skipped=skipped, runs=runs, table=table), indent=1))
-    _write(os.path.join(args.out, "peers.md"), markdown(table, info, skipped))
+    cases.write_whole(os.path.join(args.out, "peers.md"), markdown(table, info, skipped))
     plot(table, os.path.join(args.out, "peers.png"))
     print(markdown(table, info, skipped))
 

@@ -48,13 +48,6 @@ def _load(path):
     return dict(machine=cases.machine(), rows=[])
 
 
-def _write(path, text):
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
-
-
 def markdown(data):
     m = data["machine"]
     lines = [f"Machine: {m['cpu']}, {m['cores']} cores ({m['affinity']} in the affinity mask), {m['memory_gb']} GB, "
@@ -139,10 +132,10 @@ def main(argv=None):
             row = fresh(problem, n)
             print(json.dumps(row), flush=True)
             data["rows"] = [r for r in data["rows"] if not (r["problem"] == problem and r["n"] == n)] + [row]
-            _write(path, json.dumps(data, indent=1))
-            _write(os.path.join(args.out, "scaling.md"), markdown(data))
+            cases.write_whole(path, json.dumps(data, indent=1))
+            cases.write_whole(os.path.join(args.out, "scaling.md"), markdown(data))
             plot(data, os.path.join(args.out, "scaling.png"))
-    _write(os.path.join(args.out, "scaling.md"), markdown(data))
+    cases.write_whole(os.path.join(args.out, "scaling.md"), markdown(data))
     plot(data, os.path.join(args.out, "scaling.png"))
     print(markdown(data))
 

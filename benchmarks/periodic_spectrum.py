@@ -1,0 +1,233 @@
+"""Benchmark: why the finest cell takes its iterations (the spectrum of the preconditioned contact).
+
+On the finest cell the constrained conjugate gradients of :mod:`bem.periodic.qp` reduce the KKT residual
+by about the same factor at every iteration, whether or not the contact set still moves: the rate is the
+preconditioner's. This script measures that rate on the contact set of the converged solution, held fixed.
+
+For each size ``N`` the rough cell of :mod:`cases` (``periodic``, mean pressure ``0.01 E*``) is solved
+(KKT residual ``1e-12``); on its contact ``A`` the linear problem of the last iterations,
+``C_AA p = delta - h_A`` with ``sum p`` fixed (the force), is solved by preconditioned conjugate
+gradients written here, from the uniform pressure on ``A`` to a residual ``1e-8`` of the first, with
+
+- ``cell``: the preconditioner of the cell's QP, ``z = M_AA r`` (``M = (C + C_nn 11'/N)^-1`` on the
+  whole cell, restricted to ``A``: one transform pair);
+- ``halo``: ``M_AA - M_AH diag(M_HH)^-1 M_HA`` with ``H`` the non-contact nodes next to the contact
+  (a Schur correction of ``M_AA`` towards the exact ``C_AA^-1 = M_AA - M_AI M_II^-1 M_IA``,
+  ``I`` every node off the contact: two transform pairs).
+
+The coefficients of the conjugate gradients give the Lanczos estimates of the extreme eigenvalues of
+the preconditioned operator (``lambda_min``, ``lambda_max``, their ratio ``kappa``); the Ritz vector of
+the largest tells where the slow modes live: its share of the squared norm on the contact's edge
+nodes (nodes with a neighbour off the contact) against the edge nodes' share of the contact.
+
+Run: ``python benchmarks/periodic_spectrum.py --out benchmarks/results/periodic_spectrum [--sizes 256 512 1024]``
+(``spectrum.json``, ``spectrum.md`` and ``spectrum.png`` in ``--out``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.dirname(HERE)]
+
+import cases  # noqa: E402
+
+import bem  # noqa: E402
+from bem.periodic.influence import PeriodicOperator  # noqa: E402
+from validation.run.periodic import contact_spots  # noqa: E402
+
+PRECONDITIONERS = ("cell", "halo")
+RTOL = 1e-8
+
+
+def _neighbour_shifts(shape):
+    """Index arrays of the six neighbours of each node of a periodic brick array (rows wrap, odd rows shifted)."""
+    n_rows, n_cols = shape
+    idx = np.arange(n_rows * n_cols).reshape(shape)
+    odd = (np.arange(n_rows) % 2 == 1)[:, None]
+    out = [np.roll(idx, -1, axis=1), np.roll(idx, 1, axis=1)]
+    for step in (-1, 1):  # the row above and the row below: the nodes half a step to either side
+        row = np.roll(idx, step, axis=0)
+        out += [row, np.where(odd, np.roll(row, -1, axis=1), np.roll(row, 1, axis=1))]
+    return [a.ravel() for a in out]
+
+
+def edges_and_halo(contact):
+    """``(edge, halo)``: contact nodes with a neighbour off the contact; non-contact nodes next to the contact."""
+    c = contact.ravel()
+    edge, halo = np.zeros_like(c), np.zeros_like(c)
+    for nb in _neighbour_shifts(contact.shape):
+        edge |= c & ~c[nb]
+        halo |= ~c & c[nb]
+    return edge.reshape(contact.shape), halo.reshape(contact.shape)
+
+
+def preconditioner(op, contact, kind):
+    """``z(r)`` on the contact's nodes (flat), the zero-sum projection applied after."""
+    M = op.preconditioner()
+    e = np.zeros(op.lattice.shape)
+    e[0, 0] = 1.0
+    m_nn = float(M(e)[0, 0])
+    halo = edges_and_halo(contact)[1]
+
+    def apply(r):
+        v = np.zeros(contact.shape)
+        v[contact] = r
+        w = M(v)
+        if kind == "halo":
+            w -= M(np.where(halo, w, 0.0) / m_nn)
+        z = w[contact]
+        return z - z.mean()
+
+    return apply
+
+
+def fixed_contact_cg(op, contact, h, force_sum, precondition, keep_vectors=False, maxiter=500):
+    """Conjugate gradients for ``C_AA p = delta - h_A``, ``sum p = force_sum``, from the uniform ``p``.
+
+    Returns the iterations, the relative residuals, the Lanczos tridiagonal's eigenvalues and (with
+    ``keep_vectors``) the Ritz vector of the largest one on the contact's nodes.
+    """
+    m = int(np.count_nonzero(contact))
+
+    def C_A(x):
+        v = np.zeros(contact.shape)
+        v[contact] = x
+        y = op.matvec(v)[contact]
+        return y - y.mean()  # the force constraint: the mean is the change of delta
+
+    x = np.full(m, force_sum / m)
+    r = -(h[contact] + C_A(x))
+    r -= r.mean()
+    r0 = np.linalg.norm(r)
+    z = precondition(r)
+    d, rz = z.copy(), float(r @ z)
+    alphas, betas, vectors, history = [], [], [], [1.0]
+    for k in range(1, maxiter + 1):
+        if keep_vectors:  # the Lanczos vectors: the preconditioned residuals, normalised, signs alternating
+            vectors.append((-1) ** (k - 1) * z / math.sqrt(rz))
+        q = C_A(d)
+        a = rz / float(d @ q)
+        x += a * d
+        r -= a * q
+        alphas.append(a)
+        history.append(float(np.linalg.norm(r) / r0))
+        if history[-1] < RTOL:
+            break
+        z = precondition(r)
+        rz_new = float(r @ z)
+        betas.append(rz_new / rz)
+        rz = rz_new
+        d = z + betas[-1] * d
+    T = np.diag([1 / a + (b / a0 if i else 0.0) for i, (a, a0, b) in
+                 enumerate(zip(alphas, [1.0] + alphas[:-1], [0.0] + betas))])
+    off = [math.sqrt(b) / a for a, b in zip(alphas[:-1], betas)]
+    T += np.diag(off, 1) + np.diag(off, -1)
+    eig, Y = np.linalg.eigh(T)
+    top = np.array(vectors).T @ Y[:, -1] if keep_vectors else None
+    return k, history, eig, top
+
+
+def case(n):
+    """The rows of one size: the converged contact, then each preconditioner on it."""
+    cell, h = cases.periodic_cell(n)
+    t0 = time.perf_counter()
+    res = bem.solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=cases.PBAR, rtol=1e-12)
+    p = res.p.reshape(cell.shape)
+    contact = p > 0
+    edge, _ = edges_and_halo(contact)
+    _, n_spots = contact_spots(contact)
+    op = PeriodicOperator(cell, 1.0)
+    base = dict(n=n, nodes=cell.n_nodes, solve_iterations=res.iterations, solve_s=round(time.perf_counter() - t0, 2),
+                contact_fraction=round(float(contact.mean()), 4), spots=n_spots,
+                edge_share_of_contact=round(float(edge[contact].mean()), 3))
+    rows, tops = [], {}
+    for kind in PRECONDITIONERS:
+        t0 = time.perf_counter()
+        k, hist, eig, top = fixed_contact_cg(op, contact, h, p.sum(), preconditioner(op, contact, kind), keep_vectors=True)
+        w = top**2 / float(top @ top)
+        tops[kind] = (contact, w)
+        rows.append(dict(base, preconditioner=kind, pairs_per_iteration=2 if kind == "cell" else 3, iterations=k,
+                         seconds=round(time.perf_counter() - t0, 2), lambda_min=round(float(eig[0]), 3),
+                         lambda_max=round(float(eig[-1]), 2), kappa=round(float(eig[-1] / eig[0]), 2),
+                         top_share_on_edges=round(float(w[edge[contact]].sum()), 3)))
+    return rows, tops
+
+
+def markdown(rows):
+    head = ("| N | contact | spots | edge nodes / contact | preconditioner | transform pairs / iteration | iterations "
+            "| lambda_min | lambda_max | kappa | top mode on edges |")
+    lines = [head, "|" + "---|" * 11]
+    for r in rows:
+        lines.append(f"| {r['n']}^2 | {r['contact_fraction']} | {r['spots']} | {r['edge_share_of_contact']} | "
+                     f"{r['preconditioner']} | {r['pairs_per_iteration']} | {r['iterations']} | {r['lambda_min']} | "
+                     f"{r['lambda_max']} | {r['kappa']} | {r['top_share_on_edges']} |")
+    return "\n".join(lines) + "\n"
+
+
+def plot(rows, tops, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax_m, ax_k) = plt.subplots(1, 2, figsize=(11, 4.6))
+    contact, w = tops
+    size = min(96, contact.shape[0])
+    amp = np.zeros(contact.shape)
+    amp[contact] = w
+    r0, c0 = np.unravel_index(int(np.argmax(amp)), amp.shape)  # the window centred on the mode's largest node
+    shift = (size // 2 - r0 + (r0 % 2), size // 2 - c0)  # an even row shift keeps the rows' parities
+    amp, on = (np.roll(a, shift, axis=(0, 1))[:size, :size] for a in (amp, contact))
+    ax_m.imshow(~on, cmap="Greys", vmin=0, vmax=4, interpolation="nearest")
+    im = ax_m.imshow(np.ma.masked_where(~on, amp / amp.max()), cmap="magma_r", vmin=0, vmax=1,
+                     interpolation="nearest")
+    fig.colorbar(im, ax=ax_m, label="squared amplitude / its maximum in the window")
+    ax_m.set_title(f"slowest mode (largest eigenvalue, preconditioner 'cell'): {size} x {size} nodes\n"
+                   f"of the {contact.shape[0]}^2 cell around its largest value; grey: off the contact", fontsize=9)
+    ax_m.set_xlabel("column")
+    ax_m.set_ylabel("row")
+    for kind, marker in zip(PRECONDITIONERS, "os"):
+        rs = sorted((r for r in rows if r["preconditioner"] == kind), key=lambda r: r["nodes"])
+        ax_k.plot([r["nodes"] for r in rs], [r["kappa"] for r in rs], marker + "-", label=f"{kind}: kappa")
+        ax_k.plot([r["nodes"] for r in rs], [r["iterations"] for r in rs], marker + "--", mfc="none",
+                  label=f"{kind}: iterations to 1e-8")
+    ax_k.set_xscale("log")
+    ax_k.set_xlabel("nodes of the cell")
+    ax_k.grid(True, which="both", alpha=0.3)
+    ax_k.legend(fontsize=8)
+    ax_k.set_title("preconditioned contact operator, contact held fixed", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True, help="results folder")
+    parser.add_argument("--sizes", nargs="+", type=int, default=[256, 512, 1024])
+    args = parser.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    rows, tops = [], None
+    for n in args.sizes:
+        new, top = case(n)
+        rows += new
+        tops = top["cell"]  # the last size's, shown in the figure
+        for r in new:
+            print(json.dumps(r), flush=True)
+    cases.write_whole(os.path.join(args.out, "spectrum.json"), json.dumps(dict(machine=cases.machine(), rows=rows), indent=1))
+    cases.write_whole(os.path.join(args.out, "spectrum.md"), markdown(rows))
+    plot(rows, tops, os.path.join(args.out, "spectrum.png"))
+    print(markdown(rows))
+
+
+if __name__ == "__main__":
+    main()
