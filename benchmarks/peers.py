@@ -207,7 +207,7 @@ def main(argv=None):
     info["load_end"] = cases.loadavg()
     table = summarise(runs)
     cases.write_whole(os.path.join(args.out, "peers.json"),
-           json.dumps(dict(machine=info, skipped=skipped, runs=runs, table=table), indent=1))
+                      json.dumps(dict(machine=info, skipped=skipped, runs=runs, table=table), indent=1))
     cases.write_whole(os.path.join(args.out, "peers.md"), markdown(table, info, skipped))
     plot(table, os.path.join(args.out, "peers.png"))
     print(markdown(table, info, skipped))
