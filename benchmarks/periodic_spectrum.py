@@ -42,41 +42,34 @@ import cases  # noqa: E402
 
 import bem  # noqa: E402
 from bem.periodic.influence import PeriodicOperator  # noqa: E402
-from validation.run.periodic import contact_spots  # noqa: E402
+from validation.run.periodic import contact_spots, lattice_neighbours  # noqa: E402
 
 PRECONDITIONERS = ("cell", "halo")
 RTOL = 1e-8
-
-
-def _neighbour_shifts(shape):
-    """Index arrays of the six neighbours of each node of a periodic brick array (rows wrap, odd rows shifted)."""
-    n_rows, n_cols = shape
-    idx = np.arange(n_rows * n_cols).reshape(shape)
-    odd = (np.arange(n_rows) % 2 == 1)[:, None]
-    out = [np.roll(idx, -1, axis=1), np.roll(idx, 1, axis=1)]
-    for step in (-1, 1):  # the row above and the row below: the nodes half a step to either side
-        row = np.roll(idx, step, axis=0)
-        out += [row, np.where(odd, np.roll(row, -1, axis=1), np.roll(row, 1, axis=1))]
-    return [a.ravel() for a in out]
 
 
 def edges_and_halo(contact):
     """``(edge, halo)``: contact nodes with a neighbour off the contact; non-contact nodes next to the contact."""
     c = contact.ravel()
     edge, halo = np.zeros_like(c), np.zeros_like(c)
-    for nb in _neighbour_shifts(contact.shape):
-        edge |= c & ~c[nb]
-        halo |= ~c & c[nb]
+    idx, neighbours = lattice_neighbours(contact.shape)
+    for nb in (n.ravel() for n in neighbours):  # three of the six neighbours; the other three seen from them
+        split = c != c[nb]  # node and neighbour on either side of the contact's edge
+        for inside, outside in ((idx.ravel(), nb), (nb, idx.ravel())):
+            across = split & c[inside]  # inside in contact, outside not
+            edge[inside[across]] = True
+            halo[outside[across]] = True
     return edge.reshape(contact.shape), halo.reshape(contact.shape)
 
 
 def preconditioner(op, contact, kind):
     """``z(r)`` on the contact's nodes (flat), the zero-sum projection applied after."""
     M = op.preconditioner()
-    e = np.zeros(op.lattice.shape)
-    e[0, 0] = 1.0
-    m_nn = float(M(e)[0, 0])
-    halo = edges_and_halo(contact)[1]
+    if kind == "halo":
+        e = np.zeros(op.lattice.shape)
+        e[0, 0] = 1.0
+        m_nn = float(M(e)[0, 0])  # M's diagonal
+        halo = edges_and_halo(contact)[1]
 
     def apply(r):
         v = np.zeros(contact.shape)
@@ -90,11 +83,11 @@ def preconditioner(op, contact, kind):
     return apply
 
 
-def fixed_contact_cg(op, contact, h, force_sum, precondition, keep_vectors=False, maxiter=500):
+def fixed_contact_cg(op, contact, h, force_sum, precondition, maxiter=500):
     """Conjugate gradients for ``C_AA p = delta - h_A``, ``sum p = force_sum``, from the uniform ``p``.
 
-    Returns the iterations, the relative residuals, the Lanczos tridiagonal's eigenvalues and (with
-    ``keep_vectors``) the Ritz vector of the largest one on the contact's nodes.
+    Returns the iterations, the relative residuals, the Lanczos tridiagonal's eigenvalues and the Ritz
+    vector of the largest one on the contact's nodes.
     """
     m = int(np.count_nonzero(contact))
 
@@ -112,8 +105,7 @@ def fixed_contact_cg(op, contact, h, force_sum, precondition, keep_vectors=False
     d, rz = z.copy(), float(r @ z)
     alphas, betas, vectors, history = [], [], [], [1.0]
     for k in range(1, maxiter + 1):
-        if keep_vectors:  # the Lanczos vectors: the preconditioned residuals, normalised, signs alternating
-            vectors.append((-1) ** (k - 1) * z / math.sqrt(rz))
+        vectors.append((-1) ** (k - 1) * z / math.sqrt(rz))  # Lanczos: z normalised, signs alternating
         q = C_A(d)
         a = rz / float(d @ q)
         x += a * d
@@ -127,12 +119,10 @@ def fixed_contact_cg(op, contact, h, force_sum, precondition, keep_vectors=False
         betas.append(rz_new / rz)
         rz = rz_new
         d = z + betas[-1] * d
-    T = np.diag([1 / a + (b / a0 if i else 0.0) for i, (a, a0, b) in
-                 enumerate(zip(alphas, [1.0] + alphas[:-1], [0.0] + betas))])
+    diagonal = [1 / alphas[0]] + [1 / a + b / a0 for a, a0, b in zip(alphas[1:], alphas[:-1], betas)]
     off = [math.sqrt(b) / a for a, b in zip(alphas[:-1], betas)]
-    T += np.diag(off, 1) + np.diag(off, -1)
-    eig, Y = np.linalg.eigh(T)
-    top = np.array(vectors).T @ Y[:, -1] if keep_vectors else None
+    eig, Y = np.linalg.eigh(np.diag(diagonal) + np.diag(off, 1) + np.diag(off, -1))
+    top = np.array(vectors).T @ Y[:, -1]
     return k, history, eig, top
 
 
@@ -149,17 +139,18 @@ def case(n):
     base = dict(n=n, nodes=cell.n_nodes, solve_iterations=res.iterations, solve_s=round(time.perf_counter() - t0, 2),
                 contact_fraction=round(float(contact.mean()), 4), spots=n_spots,
                 edge_share_of_contact=round(float(edge[contact].mean()), 3))
-    rows, tops = [], {}
+    rows = []
     for kind in PRECONDITIONERS:
         t0 = time.perf_counter()
-        k, hist, eig, top = fixed_contact_cg(op, contact, h, p.sum(), preconditioner(op, contact, kind), keep_vectors=True)
+        k, _, eig, top = fixed_contact_cg(op, contact, h, p.sum(), preconditioner(op, contact, kind))
         w = top**2 / float(top @ top)
-        tops[kind] = (contact, w)
+        if kind == "cell":
+            shown = contact, w
         rows.append(dict(base, preconditioner=kind, pairs_per_iteration=2 if kind == "cell" else 3, iterations=k,
                          seconds=round(time.perf_counter() - t0, 2), lambda_min=round(float(eig[0]), 3),
                          lambda_max=round(float(eig[-1]), 2), kappa=round(float(eig[-1] / eig[0]), 2),
                          top_share_on_edges=round(float(w[edge[contact]].sum()), 3)))
-    return rows, tops
+    return rows, shown
 
 
 def markdown(rows):
@@ -173,14 +164,14 @@ def markdown(rows):
     return "\n".join(lines) + "\n"
 
 
-def plot(rows, tops, path):
+def plot(rows, shown, path):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, (ax_m, ax_k) = plt.subplots(1, 2, figsize=(11, 4.6))
-    contact, w = tops
+    contact, w = shown  # the slowest mode of the preconditioner "cell"
     size = min(96, contact.shape[0])
     amp = np.zeros(contact.shape)
     amp[contact] = w
@@ -216,16 +207,15 @@ def main(argv=None):
     parser.add_argument("--sizes", nargs="+", type=int, default=[256, 512, 1024])
     args = parser.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    rows, tops = [], None
+    rows, shown = [], None
     for n in args.sizes:
-        new, top = case(n)
+        new, shown = case(n)  # the last size's mode is shown in the figure
         rows += new
-        tops = top["cell"]  # the last size's, shown in the figure
         for r in new:
             print(json.dumps(r), flush=True)
     cases.write_whole(os.path.join(args.out, "spectrum.json"), json.dumps(dict(machine=cases.machine(), rows=rows), indent=1))
     cases.write_whole(os.path.join(args.out, "spectrum.md"), markdown(rows))
-    plot(rows, tops, os.path.join(args.out, "spectrum.png"))
+    plot(rows, shown, os.path.join(args.out, "spectrum.png"))
     print(markdown(rows))
 
 

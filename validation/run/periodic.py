@@ -14,16 +14,23 @@ import numpy as np
 
 from .parts import PeriodicPart, SpotSummary
 
-__all__ = ["Cell", "contact_spots"]
+__all__ = ["Cell", "contact_spots", "lattice_neighbours"]
 
 
-def _neighbours(shape):
+def lattice_neighbours(shape):
     """Index arrays of three of the six neighbours of every node of a periodic brick array.
 
     Node ``(q, r)`` of row ``r`` (``x = q + (r mod 2)/2`` steps) touches ``(q +- 1, r)`` and, in
     the rows ``r +- 1``, the two nodes half a step to either side: ``(q - 1, r + 1)`` and
     ``(q, r + 1)`` for even ``r``, ``(q, r + 1)`` and ``(q + 1, r + 1)`` for odd ``r``; indices
     wrap around the cell. The other three are these seen from the neighbour.
+
+    Returns
+    -------
+    idx : ndarray of int, shape ``shape``
+        The flat index of every node.
+    neighbours : tuple of three ndarray of int, shape ``shape``
+        The flat index of the neighbour at ``(q + 1, r)``, in the row above, and diagonally there.
     """
     n_rows, n_cols = shape
     idx = np.arange(n_rows * n_cols).reshape(shape)
@@ -57,7 +64,7 @@ def contact_spots(contact):
     from scipy.sparse.csgraph import connected_components
 
     c = np.asarray(contact, dtype=bool)
-    idx, neighbours = _neighbours(c.shape)
+    idx, neighbours = lattice_neighbours(c.shape)
     flat = c.ravel()
     rows = [idx[c]]
     cols = [idx[c]]
