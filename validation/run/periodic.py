@@ -30,7 +30,7 @@ def lattice_neighbours(shape):
     idx : ndarray of int, shape ``shape``
         The flat index of every node.
     neighbours : tuple of three ndarray of int, shape ``shape``
-        The flat index of the neighbour at ``(q + 1, r)``, in the row above, and diagonally there.
+        The flat index of the neighbour at ``(q + 1, r)`` and of the two in row ``r + 1`` (as above).
     """
     n_rows, n_cols = shape
     idx = np.arange(n_rows * n_cols).reshape(shape)
