@@ -29,8 +29,9 @@ def _conj(x):
 def block_product(S, V):
     """``V_a <- sum_b S_ab V_b`` in place on a pair of spectra (``V`` of shape ``(2, rows, cols)``).
 
-    Two temporaries: on NumPy of the rows of :data:`bem.fft.BLOCK` entries each (the rows one after the other, the
-    same numbers), elsewhere of a whole spectrum each."""
+    Two temporaries: on NumPy of the rows of :data:`bem.fft.BLOCK` entries each per thread (the rows one block after
+    the other, in parts on the threads of :func:`bem.fft.in_parts`; the same numbers), elsewhere of a whole spectrum
+    each."""
     if not isinstance(S, tuple):  # the kernel spectra of a window, one array S[a, b, ...]
         S = ((S[0, 0, ...], S[0, 1, ...]), (S[1, 0, ...], S[1, 1, ...]))
     conj = S[1][0] is None  # a Hermitian symbol: S_10 = conj(S_01), not stored
@@ -43,22 +44,26 @@ def block_product(S, V):
         return V
     rows = V.shape[1]
     step = max(1, fft.BLOCK // max(1, V.shape[2]))
-    t = np.empty((min(step, rows),) + V.shape[2:], dtype=np.result_type(S[0][1], V))
-    w = np.empty_like(t)
-    for lo in range(0, rows, step):
-        r = slice(lo, min(lo + step, rows))
-        n = r.stop - lo
-        v0, v1 = V[0, r], V[1, r]
-        np.multiply(S[0][1][r], v1, out=t[:n])
-        v1 *= S[1][1][r]
-        if conj:
-            np.conjugate(S[0][1][r], out=w[:n])
-            w[:n] *= v0
-        else:
-            np.multiply(S[1][0][r], v0, out=w[:n])
-        v1 += w[:n]
-        v0 *= S[0][0][r]
-        v0 += t[:n]
+
+    def part(blocks):  # the blocks of rows of a part, on the threads of bem.fft.in_parts
+        t = np.empty((min(step, rows),) + V.shape[2:], dtype=np.result_type(S[0][1], V))
+        w = np.empty_like(t)
+        for lo in range(blocks.start * step, min(blocks.stop * step, rows), step):
+            r = slice(lo, min(lo + step, rows))
+            n = r.stop - lo
+            v0, v1 = V[0, r], V[1, r]
+            np.multiply(S[0][1][r], v1, out=t[:n])
+            v1 *= S[1][1][r]
+            if conj:
+                np.conjugate(S[0][1][r], out=w[:n])
+                w[:n] *= v0
+            else:
+                np.multiply(S[1][0][r], v0, out=w[:n])
+            v1 += w[:n]
+            v0 *= S[0][0][r]
+            v0 += t[:n]
+
+    fft.in_parts(part, -(-rows // step), V.size)
     return V
 
 

@@ -15,10 +15,16 @@ Back end
     per shape (every support window has its own); with ``FFTW_ESTIMATE`` it is slower
     than pocketfft, which plans in microseconds and caches its plans.
 
-Element-wise work
-    :func:`in_parts` runs an element-wise kernel on :func:`threads` contiguous parts of an
-    array on a pool of threads (NumPy's ufuncs release the GIL), as the transforms use
-    ``workers``; arrays below ``2**17`` entries stay in the calling thread.
+Parts on threads
+    :func:`in_parts` runs a kernel on :func:`threads` contiguous parts of an array at once
+    (NumPy's ufuncs, numba's ``nogil`` kernels and pocketfft release the GIL): the calling
+    thread takes the last part itself and a pool of ``threads() - 1`` threads the others;
+    arrays below ``2**17`` entries stay in the calling thread. The transforms of the solvers'
+    iterations run so too (:func:`rfft_into`, :func:`cfft_in_place`, :func:`irfft_into`, and the
+    pruned transforms below), one single-threaded pocketfft call per part, rather than with
+    pocketfft's ``workers``, whose calling thread sleeps while its pool works and whose pool
+    threads the scheduler may wake on one core, where they take turns (measured in
+    ``docs/performance.md``, "Threads that share a core"). The numbers are the same either way.
 
 Pruned transforms
     :func:`forward` and :func:`inverse` are the two halves of a zero-padded
@@ -44,8 +50,13 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import scipy.fft as _sfft
 
+try:  # pocketfft's own entry points write into a given array (scipy.fft's allocate their output)
+    from scipy.fft._pocketfft import pypocketfft as _pocketfft
+except ImportError:  # pragma: no cover - a SciPy without them: scipy.fft and one copy of each part more
+    _pocketfft = None
+
 __all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "forward_parts", "inverse_into", "in_parts",
-           "half_spectrum_weights", "BLOCK"]
+           "rfft_into", "cfft_in_place", "irfft_into", "half_spectrum_weights", "BLOCK"]
 
 _ENV = "CONTACTLAB_THREADS"
 _override = None
@@ -114,12 +125,15 @@ def set_threads(n):
 def in_parts(kernel, n, size):
     """Call ``kernel(part)`` on contiguous slices ``part`` of ``range(n)``, on :func:`threads` threads.
 
+    The calling thread runs the last part, a pool of ``threads() - 1`` threads the others.
+
     Parameters
     ----------
     kernel : callable
-        ``kernel(part)`` with ``part`` a ``slice``; the calls must touch disjoint data.
+        ``kernel(part)`` with ``part`` a ``slice``; the calls must touch disjoint data and must not
+        call :func:`in_parts` themselves (the pool's threads would wait for one another).
     n : int
-        Length of the axis that is split (the first axis of the caller's arrays).
+        Length of the axis that is split.
     size : int
         Entries of the caller's arrays: below ``2**17``, or with one thread, ``kernel``
         runs once on the whole axis in the calling thread.
@@ -129,11 +143,82 @@ def in_parts(kernel, n, size):
     if k < 2 or size < _PARTS_MIN:
         kernel(slice(0, n))
         return
-    if _pool_size < k:
-        _pool, _pool_size = ThreadPoolExecutor(max_workers=k, thread_name_prefix="contactlab"), k
+    if _pool_size < k - 1:
+        _pool, _pool_size = ThreadPoolExecutor(max_workers=k - 1, thread_name_prefix="contactlab"), k - 1
     bounds = [n * i // k for i in range(k + 1)]
-    for f in [_pool.submit(kernel, slice(lo, hi)) for lo, hi in zip(bounds[:-1], bounds[1:])]:
-        f.result()
+    others = [_pool.submit(kernel, slice(lo, hi)) for lo, hi in zip(bounds[:-2], bounds[1:-1])]
+    try:
+        kernel(slice(bounds[-2], bounds[-1]))
+    finally:  # the other parts end before the caller goes on (or raises), as they touch its arrays
+        for f in others:
+            f.result()
+
+
+def _by_parts(call, shape, split, size):
+    """``call(index)`` with ``index`` selecting contiguous parts of the axis ``split`` of an array of ``shape``
+    (:func:`in_parts`)."""
+    lead = (slice(None),) * split
+    in_parts(lambda part: call(lead + (part,)), shape[split], size)
+
+
+def rfft_into(x, out, axis, split=0):
+    """Real FFT of ``x`` along ``axis`` (unnormalised) written into ``out``, in parts of the axis ``split``.
+
+    Parameters
+    ----------
+    x : ndarray
+        Real data (float32 or float64; views allowed). Not modified.
+    out : ndarray
+        ``x``'s shape with ``axis`` of length ``x.shape[axis] // 2 + 1``, complex of ``x``'s precision.
+    axis, split : int
+        The transformed axis and the axis whose parts the :func:`in_parts` threads take (non-negative,
+        different).
+
+    Returns
+    -------
+    ndarray
+        ``out``.
+    """
+    def call(i):
+        if _pocketfft is None:
+            out[i] = _sfft.rfft(x[i], axis=axis, workers=1)
+        else:
+            _pocketfft.r2c(x[i], (axis,), True, 0, out[i], 1)
+
+    _by_parts(call, x.shape, split, x.size)
+    return out
+
+
+def cfft_in_place(x, axis, split, inverse=False, normalise=True):
+    """Complex FFT of ``x`` along ``axis``, in place, in parts of the axis ``split`` (:func:`rfft_into`).
+
+    ``inverse``: the inverse transform, divided by the axis' length where ``normalise``
+    (``scipy.fft.ifft``'s ``norm="backward"``; ``norm="forward"`` without). Returns ``x``.
+    """
+    def call(i):
+        if _pocketfft is not None:
+            _pocketfft.c2c(x[i], (axis,), not inverse, 2 if inverse and normalise else 0, x[i], 1)
+            return
+        norm = "forward" if inverse and not normalise else "backward"
+        y = (_sfft.ifft if inverse else _sfft.fft)(x[i], axis=axis, norm=norm, overwrite_x=True, workers=1)
+        if not np.shares_memory(y, x):
+            x[i] = y
+
+    _by_parts(call, x.shape, split, x.size)
+    return x
+
+
+def irfft_into(x, out, n, axis, split=0, normalise=True):
+    """Inverse real FFT of ``x`` along ``axis`` (``n`` points) written into ``out``, in parts of the axis
+    ``split`` (:func:`rfft_into`); divided by ``n`` where ``normalise``. ``x`` is not modified. Returns ``out``."""
+    def call(i):
+        if _pocketfft is None:
+            out[i] = _sfft.irfft(x[i], n=n, axis=axis, norm="backward" if normalise else "forward", workers=1)
+        else:
+            _pocketfft.c2r(x[i], (axis,), n, False, 2 if normalise else 0, out[i], 1)
+
+    _by_parts(call, out.shape, split, out.size)
+    return out
 
 
 def half_spectrum_weights(n_cols, xp=np):
@@ -208,17 +293,23 @@ def forward_parts(parts, shape, dtype=np.float64, scale=None):
         The spectra, complex128 (complex64 for ``float32``).
     """
     lk, lq = shape
-    workers = threads()
     out = np.empty((len(parts), lk, lq // 2 + 1), dtype=np.result_type(dtype, np.complex64))
+
+    def rows(x, dest):  # dest = the padded real FFT of the rows x, a part of them per thread
+        def call(i):
+            data = x[i] if scale is None else x[i] * scale
+            dest[i] = _sfft.rfft(data.astype(dtype, copy=False), n=lq, axis=-1, workers=1)
+
+        _by_parts(call, dest.shape, 0, dest.size)
+
     for b, x in enumerate(parts):
         n_rows = x.shape[0]
         out[b, n_rows:, :] = 0.0  # the padding rows
         band = _band(n_rows, out[b].size)
         for lo in range(0, n_rows, band):
             hi = min(lo + band, n_rows)
-            band_data = x[lo:hi] if scale is None else x[lo:hi] * scale
-            out[b, lo:hi, :] = _sfft.rfft(band_data.astype(dtype, copy=False), n=lq, axis=-1, workers=workers)
-    return _sfft.fft(out, axis=-2, overwrite_x=True, workers=workers)
+            rows(x[lo:hi], out[b, lo:hi, :])
+    return cfft_in_place(out, 1, 2)
 
 
 def inverse_into(spectrum, shape, dest):
@@ -234,13 +325,17 @@ def inverse_into(spectrum, shape, dest):
         Receives the rows and columns kept from the origin, without the ``1 / (Lk Lq)`` factor.
     """
     lq = shape[1]
-    workers = threads()
-    cols = _sfft.ifft(spectrum, axis=-2, norm="forward", overwrite_x=True, workers=workers)
+    cols = cfft_in_place(spectrum, 0, 1, inverse=True, normalise=False)
     k0, k1 = dest.shape
     band = _band(k0, k0 * k1)
     for lo in range(0, k0, band):
         hi = min(lo + band, k0)
-        dest[lo:hi] = _sfft.irfft(cols[lo:hi], n=lq, axis=-1, norm="forward", workers=workers)[:, :k1]
+        part, rows = cols[lo:hi], dest[lo:hi]
+
+        def call(i, part=part, rows=rows):
+            rows[i] = _sfft.irfft(part[i], n=lq, axis=-1, norm="forward", workers=1)[:, :k1]
+
+        _by_parts(call, rows.shape, 0, part.size)
 
 
 def inverse(spectrum, shape, keep):

@@ -160,11 +160,10 @@ class PeriodicOperator:
         if not self.backend.is_numpy:
             xp = self.backend.xp
             return xp.fft.fft(xp.fft.rfft(xp.reshape(v, (n_rows // 2, 2, n_cols)), axis=2), axis=0)
-        workers = fft.threads()
         # the two 1-D passes of rfft2, the second in place: the same numbers, 10-15 % faster
-        # (benchmarks/periodic_rough.py --cases products)
-        rows = sfft.rfft(v.reshape(n_rows // 2, 2, n_cols), axis=2, workers=workers)
-        return sfft.fft(rows, axis=0, overwrite_x=True, workers=workers)
+        # (benchmarks/periodic_rough.py --cases products); each on the threads of bem.fft.in_parts
+        out = np.empty((n_rows // 2, 2, n_cols // 2 + 1), dtype=np.result_type(v.dtype, np.complex64))
+        return fft.cfft_in_place(fft.rfft_into(v.reshape(n_rows // 2, 2, n_cols), out, 2), 0, 2)
 
     def brick(self, spectrum, overwrite=False):
         """The brick array of a spectrum laid out as :meth:`spectrum` gives it (the inverse of it)."""
@@ -172,9 +171,9 @@ class PeriodicOperator:
         if not self.backend.is_numpy:
             xp = self.backend.xp
             return xp.reshape(xp.fft.irfft(xp.fft.ifft(spectrum, axis=0), n=n_cols, axis=2), (n_rows, n_cols))
-        workers = fft.threads()
-        cols = sfft.ifft(spectrum, axis=0, overwrite_x=overwrite, workers=workers)  # irfft2 in two passes
-        return sfft.irfft(cols, n=n_cols, axis=2, overwrite_x=True, workers=workers).reshape(n_rows, n_cols)
+        cols = fft.cfft_in_place(spectrum if overwrite else spectrum.copy(), 0, 2, inverse=True)  # irfft2 in two passes
+        out = np.empty((n_rows // 2, 2, n_cols), dtype=cols.real.dtype)
+        return fft.irfft_into(cols, out, n_cols, 2).reshape(n_rows, n_cols)
 
     @staticmethod
     def mix(spectrum, symbol, out=None):

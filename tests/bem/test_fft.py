@@ -124,3 +124,84 @@ def test_banded_forward_and_inverse_are_the_plain_pair_bit_for_bit(monkeypatch, 
     fft.inverse_into(spectrum[1].copy(), shape, out[1::2, 3:10])  # a strided destination, the rest untouched
     assert np.array_equal(out[1::2, 3:10], plain[1])
     assert np.all(out[0::2] == -1.0) and np.all(out[:, :3] == -1.0) and np.all(out[:, 10:] == -1.0)
+
+
+def test_in_parts_runs_a_part_in_the_calling_thread_and_waits_for_the_others(monkeypatch):
+    import threading
+    import time
+
+    monkeypatch.setattr(fft, "_override", 3)
+    caller, ran = threading.get_ident(), {}
+
+    def kernel(part):
+        if part.start == 0:
+            time.sleep(0.05)  # a slow part in the pool: the caller waits for it
+        ran[part.start] = threading.get_ident()
+
+    fft.in_parts(kernel, 300, 1 << 20)
+    assert sorted(ran) == [0, 100, 200]
+    assert ran[200] == caller and ran[0] != caller and ran[100] != caller
+
+    def failing(part):
+        if part.start == 200:
+            raise RuntimeError("the caller's part failed")
+        time.sleep(0.05)
+        ran[part.start] = "done"
+
+    with pytest.raises(RuntimeError, match="caller's part"):
+        fft.in_parts(failing, 300, 1 << 20)
+    assert ran[0] == ran[100] == "done"  # the other parts ended before the error reached the caller
+
+
+@pytest.mark.parametrize("entry_points", [True, False], ids=["pocketfft", "scipy.fft"])
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_transforms_in_parts_equal_scipy_fft(monkeypatch, entry_points, dtype):
+    """rfft_into, cfft_in_place and irfft_into on two threads give scipy.fft's numbers bit for bit, with
+    pocketfft's own entry points and with the scipy.fft fallback, and leave the inputs they do not write as
+    they were."""
+    import scipy.fft as sfft
+
+    if not entry_points:
+        monkeypatch.setattr(fft, "_pocketfft", None)
+    monkeypatch.setattr(fft, "_override", 2)
+    x = np.random.default_rng(3).standard_normal((256, 2, 512)).astype(dtype)  # 2**18 entries: in two parts
+    x0 = x.copy()
+    ctype = np.result_type(dtype, np.complex64)
+    spectrum = fft.rfft_into(x, np.empty((256, 2, 257), ctype), 2)
+    np.testing.assert_array_equal(x, x0)
+    np.testing.assert_array_equal(spectrum, sfft.rfft(x, axis=2))
+    reference = sfft.fft(spectrum, axis=0)
+    assert fft.cfft_in_place(spectrum, 0, 2) is spectrum  # along axis 0, the parts along axis 2
+    np.testing.assert_array_equal(spectrum, reference)
+    back = spectrum.copy()
+    fft.cfft_in_place(back, 0, 2, inverse=True)
+    np.testing.assert_array_equal(back, sfft.ifft(spectrum, axis=0))
+    unscaled = spectrum.copy()
+    fft.cfft_in_place(unscaled, 0, 1, inverse=True, normalise=False)
+    np.testing.assert_array_equal(unscaled, sfft.ifft(spectrum, axis=0, norm="forward"))
+    kept = back.copy()
+    out = fft.irfft_into(back, np.empty(x.shape, dtype), 512, 2)
+    np.testing.assert_array_equal(back, kept)
+    np.testing.assert_array_equal(out, sfft.irfft(kept, n=512, axis=2))
+    np.testing.assert_allclose(out, x, rtol=0, atol=(1e-5 if dtype == np.float32 else 1e-13) * np.abs(x).max())
+    raw = fft.irfft_into(back, np.empty(x.shape, dtype), 512, 2, normalise=False)
+    np.testing.assert_array_equal(raw, sfft.irfft(kept, n=512, axis=2, norm="forward"))
+
+
+def test_padded_transforms_on_threads_equal_one_thread(monkeypatch):
+    """forward_parts and inverse_into (the half-space's pruned pair) in parts on two threads give the numbers of
+    one thread, bit for bit, banded or not."""
+    x = np.random.default_rng(4).standard_normal((2, 300, 500))
+    shape = (fft.fast_length(599, real=False), fft.fast_length(999, real=True))
+    results = []
+    for n_threads, band in ((1, 1 << 19), (2, 1 << 19), (2, 1 << 16)):
+        monkeypatch.setattr(fft, "_override", n_threads)
+        monkeypatch.setattr(fft, "_BAND", band)
+        spectra = fft.forward_parts(list(x), shape)
+        dest = np.empty((300, 500))
+        fft.inverse_into(spectra[1].copy(), shape, dest)
+        results.append((spectra, dest))
+    for spectra, dest in results[1:]:
+        np.testing.assert_array_equal(spectra, results[0][0])
+        np.testing.assert_array_equal(dest, results[0][1])
+    np.testing.assert_allclose(results[0][1] / (shape[0] * shape[1]), x[1], rtol=0, atol=1e-13)
