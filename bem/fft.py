@@ -190,10 +190,24 @@ def rfft_into(x, out, axis, split=0):
 
 
 def cfft_in_place(x, axis, split, inverse=False, normalise=True):
-    """Complex FFT of ``x`` along ``axis``, in place, in parts of the axis ``split`` (:func:`rfft_into`).
+    """Complex FFT of ``x`` along ``axis``, in place, in parts of the axis ``split``.
 
-    ``inverse``: the inverse transform, divided by the axis' length where ``normalise``
-    (``scipy.fft.ifft``'s ``norm="backward"``; ``norm="forward"`` without). Returns ``x``.
+    Parameters
+    ----------
+    x : ndarray
+        Complex data (complex64 or complex128; views allowed), overwritten by its transform.
+    axis, split : int
+        As for :func:`rfft_into`.
+    inverse : bool
+        The inverse transform (a positive exponent).
+    normalise : bool
+        With ``inverse``: divided by the length of ``axis`` (``scipy.fft.ifft``'s ``norm="backward"``);
+        without, not (``norm="forward"``). The forward transform is never scaled.
+
+    Returns
+    -------
+    ndarray
+        ``x``.
     """
     def call(i):
         if _pocketfft is not None:
@@ -209,8 +223,26 @@ def cfft_in_place(x, axis, split, inverse=False, normalise=True):
 
 
 def irfft_into(x, out, n, axis, split=0, normalise=True):
-    """Inverse real FFT of ``x`` along ``axis`` (``n`` points) written into ``out``, in parts of the axis
-    ``split`` (:func:`rfft_into`); divided by ``n`` where ``normalise``. ``x`` is not modified. Returns ``out``."""
+    """Inverse real FFT of ``x`` along ``axis`` written into ``out``, in parts of the axis ``split``.
+
+    Parameters
+    ----------
+    x : ndarray
+        A half spectrum (complex64 or complex128; views allowed). Not modified.
+    out : ndarray
+        ``x``'s shape with ``axis`` of length ``n``, real of ``x``'s precision.
+    n : int
+        Points of the real transform along ``axis``.
+    axis, split : int
+        As for :func:`rfft_into`.
+    normalise : bool
+        Divided by ``n`` (``scipy.fft.irfft``'s ``norm="backward"``) or not (``norm="forward"``).
+
+    Returns
+    -------
+    ndarray
+        ``out``.
+    """
     def call(i):
         if _pocketfft is None:
             out[i] = _sfft.irfft(x[i], n=n, axis=axis, norm="backward" if normalise else "forward", workers=1)
