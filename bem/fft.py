@@ -1,45 +1,38 @@
 """FFT back end of the influence operator: thread count, fast sizes, pruned padded transforms.
 
 Thread count
-    :func:`threads` is the number of CPUs this process may run on,
-    ``len(os.sched_getaffinity(0))`` (``os.cpu_count()`` where the platform has
-    no affinity call), so a job confined by ``taskset``, cgroups or a batch
-    system does not oversubscribe its cores. Override it with the environment
-    variable ``CONTACTLAB_THREADS`` (read at every call) or with
-    :func:`set_threads` (takes precedence; ``set_threads(None)`` undoes it).
+    :func:`threads` is the number of CPUs this process may run on, ``len(os.sched_getaffinity(0))``
+    (``os.cpu_count()`` where the platform has no affinity call), so a job confined by ``taskset``, cgroups or a
+    batch system does not oversubscribe its cores. Override it with the environment variable
+    ``CONTACTLAB_THREADS`` (read at every call) or with :func:`set_threads` (takes precedence;
+    ``set_threads(None)`` undoes it).
 
 Back end
-    ``scipy.fft`` (pocketfft), chosen by measurement against pyFFTW
-    (``benchmarks/fft_floor.py``; the table is in ``docs/performance.md``). pyFFTW wins
-    only with ``FFTW_MEASURE`` plans, whose planning takes longer than a whole solve,
-    per shape (every support window has its own); with ``FFTW_ESTIMATE`` it is slower
-    than pocketfft, which plans in microseconds and caches its plans.
+    ``scipy.fft`` (pocketfft), chosen by measurement against pyFFTW (``benchmarks/fft_floor.py``; the table is in
+    ``docs/performance.md``). pyFFTW wins only with ``FFTW_MEASURE`` plans, whose planning takes longer than a
+    whole solve, per shape (every support window has its own); with ``FFTW_ESTIMATE`` it is slower than
+    pocketfft, which plans in microseconds and caches its plans.
 
 Parts on threads
-    :func:`in_parts` runs a kernel on :func:`threads` contiguous parts of an array at once
-    (NumPy's ufuncs, numba's ``nogil`` kernels and pocketfft release the GIL): the calling
-    thread takes the last part itself and a pool of ``threads() - 1`` threads the others;
-    arrays below ``2**17`` entries stay in the calling thread. The transforms of the solvers'
-    iterations run so too (:func:`rfft_into`, :func:`cfft_in_place`, :func:`irfft_into`, and the
-    pruned transforms below), one single-threaded pocketfft call per part, rather than with
-    pocketfft's ``workers``, whose calling thread sleeps while its pool works and whose pool
-    threads the scheduler may wake on one core, where they take turns (measured in
-    ``docs/performance.md``, "Threads that share a core"). The numbers are the same either way.
+    :func:`in_parts` runs a kernel on :func:`threads` contiguous parts of an array at once (NumPy's ufuncs,
+    numba's ``nogil`` kernels and pocketfft release the GIL): the calling thread takes the last part itself and a
+    pool of ``threads() - 1`` threads the others; arrays below ``2**17`` entries stay in the calling thread. The
+    transforms of the solvers' iterations run so too (:func:`rfft_into`, :func:`cfft_in_place`,
+    :func:`irfft_into`, and the pruned transforms below), one single-threaded pocketfft call per part, rather
+    than with pocketfft's ``workers``, whose calling thread sleeps while its pool works and whose pool threads the
+    scheduler may wake on one core, where they take turns (measured in ``docs/performance.md``, "Threads that
+    share a core"). The numbers are the same either way.
 
 Pruned transforms
-    :func:`forward` and :func:`inverse` are the two halves of a zero-padded
-    (non-periodic) convolution of a batch of real 2-D arrays. The real FFT
-    along the last axis runs only over the rows that hold data (forward) or
-    are kept (inverse); the complex FFT along the first data axis does the
-    zero padding. Against a plain ``rfft2``/``irfft2`` pair of the padded
-    size this skips the transforms of the zero rows (about 25 % of the work
-    when the data fill half the padded rows). The real transforms run in bands of
-    rows (:data:`_BAND` entries), written into the padded spectrum or the output
-    as they are made, so that no whole unpadded spectrum or padded input is held
-    beside them; :func:`forward_parts` and :func:`inverse_into` take the batch as
-    its entries (strided views of a brick array's row parities) and write the
-    product where it goes (no gathered copy). Banded or not, the numbers are
-    the same (``tests/bem/test_fft.py``).
+    :func:`forward` and :func:`inverse` are the two halves of a zero-padded (non-periodic) convolution of a batch
+    of real 2-D arrays. The real FFT along the last axis runs only over the rows that hold data (forward) or are
+    kept (inverse); the complex FFT along the first data axis does the zero padding. Against a plain
+    ``rfft2``/``irfft2`` pair of the padded size this skips the transforms of the zero rows (about 25 % of the
+    work when the data fill half the padded rows). The real transforms run in bands of rows (:data:`_BAND`
+    entries), written into the padded spectrum or the output as they are made, so that no whole unpadded spectrum
+    or padded input is held beside them; :func:`forward_parts` and :func:`inverse_into` take the batch as its
+    entries (strided views of a brick array's row parities) and write the product where it goes (no gathered
+    copy). Banded or not, the numbers are the same (``tests/bem/test_fft.py``).
 """
 
 from __future__ import annotations
@@ -50,10 +43,24 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import scipy.fft as _sfft
 
-try:  # pocketfft's own entry points write into a given array (scipy.fft's allocate their output)
-    from scipy.fft._pocketfft import pypocketfft as _pocketfft
-except ImportError:  # pragma: no cover - a SciPy without them: scipy.fft and one copy of each part more
-    _pocketfft = None
+
+def _entry_points():
+    """pocketfft's own entry points in SciPy, which write into a given array (``scipy.fft``'s allocate their
+    output), where they exist with the signatures used here and give NumPy's numbers on a small array; else
+    ``None`` (the transforms then call ``scipy.fft``, one copy of each part more)."""
+    try:
+        from scipy.fft._pocketfft import pypocketfft as pp
+
+        x = np.arange(8.0).reshape(2, 4)
+        s = pp.c2c(pp.r2c(x, (1,), True, 0, np.empty((2, 3), dtype=complex), 1), (0,), True, 0, None, 1)
+        back = pp.c2r(pp.c2c(s, (0,), False, 2, None, 1), (1,), 4, False, 2, np.empty((2, 4)), 1)
+        ok = np.allclose(s, np.fft.rfft2(x), rtol=0, atol=1e-12) and np.allclose(back, x, rtol=0, atol=1e-12)
+    except Exception:  # a private module: any SciPy that lacks or changed it falls back  # noqa: BLE001
+        return None
+    return pp if ok else None
+
+
+_pocketfft = _entry_points()
 
 __all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "forward_parts", "inverse_into", "in_parts",
            "rfft_into", "cfft_in_place", "irfft_into", "half_spectrum_weights", "BLOCK"]

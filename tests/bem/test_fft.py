@@ -205,3 +205,21 @@ def test_padded_transforms_on_threads_equal_one_thread(monkeypatch):
         np.testing.assert_array_equal(spectra, results[0][0])
         np.testing.assert_array_equal(dest, results[0][1])
     np.testing.assert_allclose(results[0][1] / (shape[0] * shape[1]), x[1], rtol=0, atol=1e-13)
+
+
+def test_pocketfft_entry_points_are_used_only_where_they_check_out(monkeypatch):
+    """The private entry points are taken only if they exist with the signatures used and give NumPy's numbers:
+    a changed signature or wrong numbers fall back to scipy.fft (whose path the test above checks)."""
+    from scipy.fft._pocketfft import pypocketfft
+
+    assert fft._entry_points() is pypocketfft  # this SciPy's pass
+
+    def changed(*args, **kwargs):
+        raise TypeError("r2c() takes a new signature")
+
+    monkeypatch.setattr(pypocketfft, "r2c", changed)
+    assert fft._entry_points() is None
+    monkeypatch.undo()
+    real = pypocketfft.c2r
+    monkeypatch.setattr(pypocketfft, "c2r", lambda *a: 2 * real(*a))
+    assert fft._entry_points() is None
