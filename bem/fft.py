@@ -168,6 +168,11 @@ def _by_parts(call, shape, split, size):
     in_parts(lambda part: call(lead + (part,)), shape[split], size)
 
 
+def _rows_by_parts(transform, src, dest):
+    """``dest[i] = transform(src[i])`` for contiguous parts ``i`` of the rows (:func:`in_parts`)."""
+    _by_parts(lambda i: dest.__setitem__(i, transform(src[i])), dest.shape, 0, dest.size)
+
+
 def rfft_into(x, out, axis, split=0):
     """Real FFT of ``x`` along ``axis`` (unnormalised) written into ``out``, in parts of the axis ``split``.
 
@@ -221,9 +226,7 @@ def cfft_in_place(x, axis, split, inverse=False, normalise=True):
             _pocketfft.c2c(x[i], (axis,), not inverse, 2 if inverse and normalise else 0, x[i], 1)
             return
         norm = "forward" if inverse and not normalise else "backward"
-        y = (_sfft.ifft if inverse else _sfft.fft)(x[i], axis=axis, norm=norm, overwrite_x=True, workers=1)
-        if not np.shares_memory(y, x):
-            x[i] = y
+        x[i] = (_sfft.ifft if inverse else _sfft.fft)(x[i], axis=axis, norm=norm, overwrite_x=True, workers=1)
 
     _by_parts(call, x.shape, split, x.size)
     return x
@@ -334,12 +337,8 @@ def forward_parts(parts, shape, dtype=np.float64, scale=None):
     lk, lq = shape
     out = np.empty((len(parts), lk, lq // 2 + 1), dtype=np.result_type(dtype, np.complex64))
 
-    def rows(x, dest):  # dest = the padded real FFT of the rows x, a part of them per thread
-        def call(i):
-            data = x[i] if scale is None else x[i] * scale
-            dest[i] = _sfft.rfft(data.astype(dtype, copy=False), n=lq, axis=-1, workers=1)
-
-        _by_parts(call, dest.shape, 0, dest.size)
+    def rows(x):  # the padded real FFT of rows x
+        return _sfft.rfft((x if scale is None else x * scale).astype(dtype, copy=False), n=lq, axis=-1, workers=1)
 
     for b, x in enumerate(parts):
         n_rows = x.shape[0]
@@ -347,7 +346,7 @@ def forward_parts(parts, shape, dtype=np.float64, scale=None):
         band = _band(n_rows, out[b].size)
         for lo in range(0, n_rows, band):
             hi = min(lo + band, n_rows)
-            rows(x[lo:hi], out[b, lo:hi, :])
+            _rows_by_parts(rows, x[lo:hi], out[b, lo:hi, :])
     return cfft_in_place(out, 1, 2)
 
 
@@ -369,12 +368,8 @@ def inverse_into(spectrum, shape, dest):
     band = _band(k0, k0 * k1)
     for lo in range(0, k0, band):
         hi = min(lo + band, k0)
-        part, rows = cols[lo:hi], dest[lo:hi]
-
-        def call(i, part=part, rows=rows):
-            rows[i] = _sfft.irfft(part[i], n=lq, axis=-1, norm="forward", workers=1)[:, :k1]
-
-        _by_parts(call, rows.shape, 0, part.size)
+        _rows_by_parts(lambda x: _sfft.irfft(x, n=lq, axis=-1, norm="forward", workers=1)[:, :k1], cols[lo:hi],
+                       dest[lo:hi])
 
 
 def inverse(spectrum, shape, keep):

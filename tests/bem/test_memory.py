@@ -71,9 +71,12 @@ def test_the_periodic_operator_keeps_its_packed_symbol_only():
     assert np.array_equal(op.kernel, w)
 
 
-def test_the_block_products_equal_the_whole_array_formulas_bit_for_bit(monkeypatch):
+@pytest.mark.parametrize("n_threads", [1, 3])
+def test_the_block_products_equal_the_whole_array_formulas_bit_for_bit(monkeypatch, n_threads):
     rng = np.random.default_rng(3)
     monkeypatch.setattr(fft, "BLOCK", 96)  # several blocks, the last one short
+    monkeypatch.setattr(fft, "_override", n_threads)
+    monkeypatch.setattr(fft, "_PARTS_MIN", 1)  # three threads: the blocks in three parts (bem.fft.in_parts)
     cell = PeriodicCell(0.1, 22, 26)
     op = PeriodicOperator(cell, 1.0)
     x = op.spectrum(rng.standard_normal(cell.shape))
