@@ -7,8 +7,8 @@ contiguous parts run at once (:func:`bem.fft.in_parts`):
 
 - ``gap``: ``g = u + h`` with ``min g``, ``max u`` and ``min u`` (the KKT residual and its scale) in one pass
   instead of four;
-- ``subtract_scaled``: the update ``u -= tau (C + lam) t`` from the product in single precision, one pass
-  instead of two;
+- ``subtract_scaled``: the update ``u = s (u - tau (C + lam) t)`` from the product in single precision (``s`` the
+  rescaling to the force), one pass instead of three;
 - ``gather``: the preconditioned gap (single precision) at the contact's nodes, in double precision;
 - ``mix``: the 2 x 2 block product of a spectrum (:func:`bem.periodic.spectra.mixed`, every product with ``C``
   or its inverse) and, for the curvature of the step, its weighted sum with the spectrum, one pass instead of
@@ -50,10 +50,13 @@ class _NumPyKernels:
         return g, float(g.min()), float(u.max()), float(u.min())
 
     @staticmethod
-    def subtract_scaled(u, r, tau):
-        """``u -= r * tau`` with ``r * tau`` rounded to ``r``'s precision (float32) first; ``r`` is overwritten."""
+    def subtract_scaled(u, r, tau, s=1.0):
+        """``u = (u - r * tau) * s`` with ``r * tau`` rounded to ``r``'s precision (float32) first and ``s`` to
+        ``u``'s; ``r`` is overwritten."""
         r *= np.float32(tau)
         u -= r
+        if s != 1.0:
+            u *= u.dtype.type(s)  # in u's precision
 
     @staticmethod
     def gather(x, idx):
@@ -75,9 +78,11 @@ class _NamespaceKernels:
         g = u + h
         return g, float(xp.min(g)), float(xp.max(u)), float(xp.min(u))
 
-    def subtract_scaled(self, u, r, tau):
+    def subtract_scaled(self, u, r, tau, s=1.0):
         r *= tau
         u -= r
+        if s != 1.0:
+            u *= s
 
     def gather(self, x, idx):
         return self.bk.xp.astype(self.bk.take(x, idx), self.bk.xp.float64)
@@ -102,7 +107,7 @@ def kernels(n_nodes, bk=None):
     Returns
     -------
     class or object
-        Methods ``gap(u, h, g)``, ``subtract_scaled(u, r, tau)``, ``gather(x, idx)`` (and, compiled,
+        Methods ``gap(u, h, g)``, ``subtract_scaled(u, r, tau, s=1.0)``, ``gather(x, idx)`` (and, compiled,
         ``mix(spectrum, symbol, out, even, rows)``) and the flag ``compiled``.
     """
     if bk is not None and not bk.is_numpy:
@@ -131,7 +136,7 @@ def load():
         x64, x32, idx = np.zeros(4), np.zeros(4, dtype=np.float32), np.arange(2)
         for u in (x64, x32):  # the iterate's product in double or in single precision
             k.gap(u, x64, np.empty(4))
-            k.subtract_scaled(u, x32.copy(), 1.0)
+            k.subtract_scaled(u, x32.copy(), 1.0, 2.0)
         k.gather(x32, idx)
         for real, cplx in ((np.float32, np.complex64), (np.float64, np.complex128)):  # the spectra's precisions
             x = np.zeros((2, 2, 3), dtype=cplx)
@@ -164,9 +169,13 @@ def _compile():
         return np.nan if g_nan else g_min, np.nan if u_nan else u_max, np.nan if u_nan else u_min
 
     @njit(**opts)
-    def _subtract_scaled(u, r, tau, lo, hi):
-        for i in range(lo, hi):
-            u[i] -= r[i] * tau
+    def _subtract_scaled(u, r, tau, s, lo, hi):
+        if s == 1.0:
+            for i in range(lo, hi):
+                u[i] -= r[i] * tau
+        else:
+            for i in range(lo, hi):
+                u[i] = (u[i] - r[i] * tau) * s
 
     @njit(**opts)
     def _gather(x, idx, out, lo, hi):
@@ -214,11 +223,11 @@ def _compile():
             return g, float(e[:, 0].min()), float(e[:, 1].max()), float(e[:, 2].min())
 
         @staticmethod
-        def subtract_scaled(u, r, tau):
+        def subtract_scaled(u, r, tau, s=1.0):
             if not (u.flags.c_contiguous and r.flags.c_contiguous):
-                return _NumPyKernels.subtract_scaled(u, r, tau)
-            u, r, tau = u.reshape(-1), r.reshape(-1), np.float32(tau)
-            run(lambda lo, hi: _subtract_scaled(u, r, tau, lo, hi), u.size)
+                return _NumPyKernels.subtract_scaled(u, r, tau, s)
+            u, r, tau, s = u.reshape(-1), r.reshape(-1), np.float32(tau), u.dtype.type(s)
+            run(lambda lo, hi: _subtract_scaled(u, r, tau, s, lo, hi), u.size)
 
         @staticmethod
         def mix(spectrum, symbol, out, even, rows):

@@ -30,11 +30,10 @@ almost no pressure and leaving, at a constant KKT residual, ``tests/bem/test_per
   Newton step's model far from the answer), where the rounding of single precision (a relative ``1e-7`` of ``C p``)
   is far below what the iteration resolves: halved transforms in the early iterations, where the contact set
   settles. At the first residual below it (or at ``rtol`` when the stopping check is confirmed) ``u`` is recomputed
-  in double precision, and so it is from there on; the stopping check, when confirmed, is always on a
-  double-precision product;
+  in double precision, and so from there on; the stopping check, when confirmed, is on a double-precision product;
 - after a step that let no node enter and left every contact node a positive pressure, the contact is the same: the
-  next iteration reuses its nodes, the step's pressures and direction there and ``D`` on it
-  (:class:`bem.periodic.qp_parts.ContactNodes`), the same numbers with no selection and no gathers;
+  next iteration reuses its nodes, the step's pressures and direction there and ``D`` on it, with no selection and no
+  gathers; after another, the next contact is made from the step's arrays (:class:`bem.periodic.qp_parts.ContactNodes`);
 - on a large cell, with numba, the block products and three passes over the whole cell run compiled on the FFT
   threads (:mod:`bem.periodic.passes`).
 
@@ -174,11 +173,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         x = op.spectrum(v)
         return op.mix(x, A, out=x)
 
+    def apply_m(r32):  # M r, single precision (the spectrum not held beyond the call)
+        return op.brick(op.mix(x := op.spectrum(r32), M, out=x), overwrite=True)
+
     def precondition(r32, sel, r_c, soft_c, jac_c):
         # M r at the selected nodes: r_c = r there, r32 = r (float32) at the stiff nodes; soft_c, jac_c: the soft
         # nodes and 1 / (C_nn + D) there (None: no soft node)
-        x = op.spectrum(r32)
-        z = passes.gather(op.brick(op.mix(x, M, out=x), overwrite=True), sel)
+        z = passes.gather(apply_m(r32), sel)
         return z if soft_c is None else xp.where(soft_c, jac_c * r_c, z)
 
     def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
@@ -205,7 +206,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     else:  # C x0 from the caller, confirmed like an incremental update
         u, stale = add_into(bk.copy(bk.asarray(u0)), times_p(D)) if per_node else bk.copy(bk.asarray(u0)), 1
     last_z = LastPreconditionedGap(bk, lat.shape)  # the last preconditioned gap, on its contact only
-    gz_old, m_one, m_full = 1.0, None, None
+    gz_old, m_one, m_full, m_at = 1.0, None, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     nodes = ContactNodes(bk, p)  # the contact of the iterate; steady: the last step's, whose D_c, ... it keeps
     fixed_scale = scale
@@ -270,17 +271,16 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return bk.max0(p_c0), n, changes, n == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, gz_old, r_hat, u, stale
+        nonlocal m_full, m_one, m_at, gz_old, r_hat, u, stale
         if bounded and not bk.count(idx):  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
         steady = nodes.steady  # the last direction on the contact (float32) as written, D and what follows there
         if steady:
             t_old, (D_c, soft_c, jac_c) = brick.last, nodes.kept
-        else:
-            t_old = bk.take(brick.values, idx)
-            D_c = bk.take(D, idx) if per_node else None
-            soft_c = None if soft is None else ~is_stiff(D_c, diag, threshold)
-            jac_c = None if soft is None else jacobi_at(idx, D_c)
+        else:  # gathers, at the entering nodes only where the contact was made from the step (ContactNodes.over)
+            t_old = nodes.over(idx, lambda n: bk.take(brick.values, n), brick.last)
+            D_c = nodes.over(idx, lambda n: bk.take(D, n), nodes.kept[0]) if per_node else None
+            soft_c, jac_c = (None, None) if soft is None else (~is_stiff(D_c, diag, threshold), jacobi_at(idx, D_c))
             nodes.kept = D_c, soft_c, jac_c
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         z = precondition(brick.write(idx, g_c if soft is None else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
@@ -289,19 +289,19 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         elif force is not None:
             # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
-            if m_full is None:
-                x = op.spectrum(xp.astype((p > 0) & stiff, xp.float32))  # M (contact & stiff)
-                m_full = op.brick(op.mix(x, M, out=x), overwrite=True)  # single precision, kept so
+            if m_full is None:  # M (contact & stiff), single precision, kept so
+                m_full = apply_m(xp.astype((p > 0) & stiff, xp.float32))
             # and the Jacobi estimate at the soft nodes
-            if not steady:
-                m_one = xp.where(soft_c, jac_c, xp.astype(bk.take(m_full, idx), xp.float64))
+            if not steady:  # m_at: M 1 at the contact's nodes
+                m_at = nodes.over(idx, lambda n: xp.astype(bk.take(m_full, n), xp.float64), m_at)
+                m_one = xp.where(soft_c, jac_c, m_at)
                 if not float(xp.sum(m_one)) > 0:  # a contact far from the starting one: the mean instead
                     m_one = xp.ones(bk.count(idx), dtype=xp.float64)
             z -= m_one * (float(xp.sum(z)) / float(xp.sum(m_one)))
         gz = bk.dot(g_c, z)  # no threaded BLAS
         # Polak-Ribiere+ on the current contact (z_prev is 0 at the nodes that entered it)
         beta = 0.0 if k == 1 or gz_old == 0 or restart else max(  # gz_old = 0: one contact node under force control
-            0.0, (gz - bk.dot(g_c, last_z.at(idx))) / gz_old)
+            0.0, (gz - bk.dot(g_c, last_z.at(idx, nodes))) / gz_old)
         last_z.keep(idx, z)
         t_c = z + beta * t_old
         if force is not None:  # nodes that left the contact broke the zero sum of t
@@ -328,16 +328,14 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
         p_c = xp.where(clipped, 0.0, p_c)
-        bk.put(p, idx, p_c)  # p is 0 off idx
+        if not (positive := bool(xp.all(p_c > 0))):  # else p = 0 at the same nodes (p_c0 > 0): put once below
+            bk.put(p, idx, p_c)  # p is 0 off idx
         # re-entering nodes (p = 0, g < 0): the step tau of the preconditioned direction with the Jacobi
         # estimate of M there, -f min(tau, 1) g / (C_nn + lam) (module docstring: entering nodes)
-        low = bk.select(g < delta)
-        overlap = bk.subset(low, bk.take(p, low) == 0)
+        overlap = bk.select((g < delta) & (p == 0))
         entered = bool(bk.count(overlap))
-        p_o = None
-        if entered:
-            cap = jacobi_at(overlap) if per_node else jacobi
-            p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, cap, per_node, preconditioned=True)
+        p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, jacobi_at(overlap) if per_node else jacobi,
+                                per_node, preconditioned=True) if entered else None
         s = 1.0
         if target is not None:
             total = float(xp.sum(p_c)) + (float(xp.sum(p_o)) if entered else 0.0)
@@ -346,12 +344,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 return "the iteration produced a non-finite value", "nonfinite"
             s = target / total
             p_c *= s
+        if target is not None or positive:
             bk.put(p, idx, p_c)
         if entered:
             if s != 1.0:
                 p_o *= s
             bk.put(p, overlap, p_o)
-        nodes.stepped(p_c, entered)
         if bool(xp.any(clipped)) or entered or stale >= RECOMPUTE_EVERY:
             u = None
             u, stale = op.brick(product(p), overwrite=True), 0
@@ -361,15 +359,16 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                     add_at(u, overlap, bk.take(D, overlap) * p_o)
         else:  # p = s (p - tau t) on the contact: u = s (u - tau (C + lam) t), plus D t per node
             update_u(R, tau, t_c, D_c if per_node else None, s)
+        nodes.stepped(p_c, entered, overlap, p_o)  # after the product: the next contact is not held through it
         return None
 
     def update_u(R, tau, t_c, D_c, s):  # u - tau (C + lam) t (from its spectrum R) - tau D t, times s
         nonlocal u, stale
-        passes.subtract_scaled(u, op.brick(R, overwrite=True), tau)
+        passes.subtract_scaled(u, op.brick(R, overwrite=True), tau, s if D_c is None else 1.0)  # s: one pass
         if D_c is not None:
             add_at(u, idx, -tau * (D_c * t_c))
-        if s != 1.0:
-            u *= s
+            if s != 1.0:
+                u *= s
         stale += 1
 
     def bounded_step(tau, t_c, R, D_c):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product

@@ -30,7 +30,9 @@ class ContactNodes:
     After a step on the contact's nodes that no node entered and after which every one of them kept a positive
     pressure (:meth:`stepped`), the next contact is the same: :meth:`read` gives the same node selection and the
     step's pressures there, with no comparison over the cell, no selection and no gather, and the step may keep
-    what it made on the contact (``kept``).
+    what it made on the contact (``kept``). After any other step on NumPy the next contact is made from the step's
+    arrays (its nodes with a positive pressure, and the entering ones merged in order): the same selection and
+    pressures as a comparison over the cell, in a pass over the contact.
 
     Parameters
     ----------
@@ -44,13 +46,18 @@ class ContactNodes:
         self.bk = bk
         self.was_on = p > 0  # the contact of the last count of changes
         self.n_was = int(bk.xp.count_nonzero(self.was_on))
-        self.steady, self.idx, self.on, self.p_c, self.kept = False, None, None, None, None
+        self.steady, self.idx, self.on, self.p_c, self.kept = False, None, None, None, (None, None, None)
+        self.next = self.moved = None  # the contact made from the last step; its nodes that left and entered
+        self.from_step = None  # (stayed, at, entering) where the contact of the last read was made from the step
 
     def read(self, p):
         """``(idx, p_c)``: the contact's node selection and the pressures there."""
         if self.steady:
             return self.idx, self.p_c
-        self.on = p > 0
+        if self.next is not None:
+            (self.idx, p_c, *self.from_step), self.next = self.next, None
+            return self.idx, p_c
+        self.on, self.moved, self.from_step = p > 0, None, None
         self.idx = self.bk.select(self.on)  # from the boolean mask (faster than flatnonzero(p) on NumPy)
         return self.idx, self.bk.take(p, self.idx)
 
@@ -61,15 +68,47 @@ class ContactNodes:
         n = bk.count(self.idx)
         if self.steady:  # was_on is this contact
             return n, 0
+        if self.moved is not None:  # the contact of the last read came from the step: was_on follows it
+            left, entering, both = self.moved
+            self.was_on.reshape(-1)[left] = False
+            self.was_on.reshape(-1)[entering] = True
+            self.n_was, self.moved = n, None
+            return n, left.size + entering.size - 2 * both
         kept = int(bk.xp.count_nonzero(bk.take(self.was_on, self.idx)))  # nodes in both contacts
         changes = (n - kept) + (self.n_was - kept)
         self.was_on, self.n_was = self.on, n
         return n, changes
 
-    def stepped(self, p_c, entered):
+    def stepped(self, p_c, entered, entering=None, p_o=None):
         """Note a step that left the pressures ``p_c`` at the nodes of the last :meth:`read` (``entered``: nodes
-        entered elsewhere)."""
-        self.steady, self.p_c = not entered and bool(self.bk.xp.all(p_c > 0)), p_c
+        entered elsewhere, ``p_o`` at the nodes ``entering``; every other node at 0)."""
+        positive = p_c > 0
+        self.steady = not entered and bool(self.bk.xp.all(positive))
+        self.p_c = p_c if self.steady else None  # not held beside the next contact
+        if self.steady or not self.bk.is_numpy:
+            return
+        idx, left = self.idx[positive], self.idx[~positive]
+        p_c, new, both = p_c[positive], left[:0], 0
+        at = new  # where the entering nodes go among those that stayed
+        if entered:
+            on = p_o > 0
+            new = entering[on]
+            at = np.searchsorted(idx, new)  # the sorted merge of two disjoint sorted selections
+            if new.size:
+                idx, p_c = np.insert(idx, at, new), np.insert(p_c, at, p_o[on])
+            if left.size:  # nodes the step set to 0 that entered again: in both contacts
+                both = np.intersect1d(left, new, assume_unique=True).size
+        self.next, self.moved = (idx, p_c, positive, at, new), (left, new, both)
+
+    def over(self, idx, make, old=None):
+        """Values at the contact's nodes ``idx``: ``make(nodes)``, a gather at the given nodes; where the contact of
+        the last :meth:`read` was made from the step and ``old`` holds the values at the nodes of the contact before
+        it, ``old`` at the nodes that stayed and ``make`` at the entering nodes only, merged in order."""
+        if self.from_step is None or old is None:
+            return make(idx)
+        positive, at, new = self.from_step
+        kept = old[positive]
+        return np.insert(kept, at, make(new)) if new.size else kept
 
 
 class ContactBrick:
@@ -113,10 +152,11 @@ class LastPreconditionedGap:
     (0 at the nodes that were off it): the ``z_old`` of the Polak-Ribiere+ coefficient.
 
     On NumPy in single precision: at the kept node selection itself (the same object: the contact did not
-    change) the kept values; at other nodes a gather from a brick array that holds them, 0 off their nodes
-    (faster than looking the new contact's nodes up among the last one's, for 4 bytes a node), filled at the
-    first such read after a keep. On other namespaces in double precision, a brick array at every keep (a node
-    selection of :class:`bem.backend.Backend` may be a boolean array there).
+    change) the kept values; at a contact made from the step (:meth:`ContactNodes.over`) the kept values at the
+    nodes that stayed and a lookup at the entering ones; at other nodes a gather from a brick array that holds
+    them, 0 off their nodes (faster than looking the new contact's nodes up among the last one's, for 4 bytes a
+    node), filled at the first such read after a keep. On other namespaces in double precision, a brick array at
+    every keep (a node selection of :class:`bem.backend.Backend` may be a boolean array there).
 
     Parameters
     ----------
@@ -139,8 +179,9 @@ class LastPreconditionedGap:
             return
         self.nodes, self.z, self.filled = nodes, z.astype(np.float32), False
 
-    def at(self, nodes):
-        """The kept ``z`` at the node selection ``nodes`` (1-D, float64), 0 where it was not kept."""
+    def at(self, nodes, contact=None):
+        """The kept ``z`` at the node selection ``nodes`` (1-D, float64), 0 where it was not kept; ``contact`` the
+        :class:`ContactNodes` of ``nodes``, whose selection at the last keep was the contact before its last step."""
         bk = self.bk
         if not bk.is_numpy:
             return bk.take(self.values, nodes) if self.values is not None else bk.xp.zeros(
@@ -149,6 +190,8 @@ class LastPreconditionedGap:
             return np.zeros(bk.count(nodes), dtype=np.float64)
         if nodes is self.nodes:
             return self.z.astype(np.float64)
+        if contact is not None and contact.from_step is not None and self.nodes.size:  # a lookup at the entering nodes
+            return contact.over(nodes, self._lookup, self.z).astype(np.float64)
         if not self.filled:
             if self.values is None:
                 self.values = np.empty(self.shape, dtype=np.float32)
@@ -156,3 +199,7 @@ class LastPreconditionedGap:
             self.values.reshape(-1)[self.nodes] = self.z
             self.filled = True
         return bk.take(self.values, nodes).astype(np.float64)
+
+    def _lookup(self, nodes):  # the kept z at a few sorted nodes, 0 where it was not kept
+        at = np.minimum(np.searchsorted(self.nodes, nodes), self.nodes.size - 1)
+        return np.where(self.nodes[at] == nodes, self.z[at], np.float32(0))

@@ -90,8 +90,32 @@ def test_contact_nodes_read_the_contact_and_count_its_changes():
     idx_r, _ = nodes.read(q)
     np.testing.assert_array_equal(idx_r, np.flatnonzero(q))
     assert nodes.changes() == (idx_r.size, 1)
-    nodes.stepped(q.reshape(-1)[idx_r], entered=True)  # a node entered elsewhere: read again
+    # a step that sets two nodes to 0, one of which enters again, and lets two more enter: the next contact
+    # is made from the step's arrays, the same as a read of the pressure
+    step = q.reshape(-1)[idx_r].copy()
+    step[[1, 2]] = 0.0
+    off = np.flatnonzero(q == 0)[:2]
+    entering = np.sort(np.concatenate([idx_r[[1]], off]))
+    p_o = np.full(entering.size, 0.25)
+    q.reshape(-1)[idx_r] = step
+    q.reshape(-1)[entering] = p_o
+    last = LastPreconditionedGap(bk, shape)
+    z = rng.standard_normal(idx_r.size)
+    last.keep(idx_r, z)  # the last preconditioned gap on the contact before the step
+    nodes.stepped(step, True, entering, p_o)
     assert not nodes.steady
+    idx_s, p_s = nodes.read(np.full(shape, np.nan))  # p is not read
+    values = rng.standard_normal(shape).ravel()  # values on the contact carried over, gathered at entering nodes
+    np.testing.assert_array_equal(nodes.over(idx_s, values.take, values[idx_r]), values[idx_s])
+    spread = np.zeros(np.prod(shape), dtype=np.float32)
+    spread[idx_r] = z
+    np.testing.assert_array_equal(last.at(idx_s, nodes), spread[idx_s].astype(np.float64))
+    np.testing.assert_array_equal(idx_s, np.flatnonzero(q))
+    np.testing.assert_array_equal(p_s, q.ravel()[idx_s])
+    assert nodes.changes() == (idx_s.size, 3)  # one left, two entered
+    full = ContactNodes(bk, q)  # the counts go on from the contact made from the step
+    full.read(q)
+    np.testing.assert_array_equal(nodes.was_on, full.was_on)
 
 
 def test_mix_inner_is_the_mix_and_the_inner_product():
@@ -111,25 +135,45 @@ def test_mix_inner_is_the_mix_and_the_inner_product():
                 op.mix_inner(X, symbol, out=X)
 
 
-@pytest.mark.parametrize("per_node", [False, True])
-def test_the_steady_contact_changes_no_number_of_the_qp(monkeypatch, per_node):
-    """The QP that keeps the contact, its pressures, the direction and D over steps that no node entered or left
-    gives bit for bit the answer, the iterations and the products of the QP that reads them at every iteration;
-    and it does keep them at some iterations."""
-    op, h, kw = cell_qp("per_node" if per_node else "smooth")
-    steps = []
+def _rough_cell_qp(per_node):
+    """A 128 x 128 cell under a seeded rough gap at mean pressure 0.01 E*: nodes enter, leave and re-enter."""
+    cell = PeriodicCell(1.0 / 128, 128, 128)
+    rng = np.random.default_rng(17)
+    spectrum = np.fft.rfft2(rng.standard_normal(cell.shape))
+    q = np.hypot(*np.meshgrid(np.fft.fftfreq(128), np.fft.rfftfreq(128), indexing="ij"))
+    h = np.fft.irfft2(spectrum * np.where(q > 0, np.maximum(q, 1 / 32) ** -1.8, 0.0), s=cell.shape)
+    op = PeriodicOperator(cell, 1.0)
+    h = 0.05 * cell.step * (h.max() - h) / h.std()
+    kw = dict(force=0.01 * cell.area, rtol=1e-11)
+    if per_node:
+        kw["lam"] = np.where(np.arange(h.size).reshape(h.shape) % 7 == 0, 20.0, 0.5) * op.diagonal
+    return op, h, kw
+
+
+@pytest.mark.parametrize("case", ["smooth", "per_node", "rough", "rough_per_node"])
+def test_the_kept_and_the_stepped_contact_change_no_number_of_the_qp(monkeypatch, case):
+    """The QP that keeps the contact, its pressures, the direction and D over steps that no node entered or left,
+    and makes the next contact from the step's arrays after the others, gives bit for bit the answer, the history
+    (the contact's size and changes at every iteration), the iterations and the products of the QP that reads the
+    contact from the pressure at every iteration; and it does both at some iterations."""
+    op, h, kw = _rough_cell_qp(case.endswith("per_node")) if case.startswith("rough") else cell_qp(case)
+    steady, made, reentered = [], [], []
     stepped = ContactNodes.stepped
 
-    def counted(self, p_c, entered):
-        stepped(self, p_c, entered)
-        steps.append(self.steady)
+    def counted(self, p_c, entered, entering=None, p_o=None):
+        stepped(self, p_c, entered, entering, p_o)
+        steady.append(self.steady)
+        made.append(self.next is not None)
+        reentered.append(self.moved[2] if self.moved else 0)
 
     monkeypatch.setattr(qp_parts.ContactNodes, "stepped", counted)
     kept = solve_periodic_qp(op, h, **kw)
     n_kept = op.n_matvec
-    assert sum(steps) >= 3
+    assert sum(steady) >= 3 and sum(made) >= 3
+    if case.startswith("rough"):
+        assert sum(kept.history["changes"]) > 100 and sum(reentered) > 0  # nodes set to 0 that entered again
 
-    def never(self, p_c, entered):
+    def never(self, p_c, entered, entering=None, p_o=None):
         self.steady = False
 
     monkeypatch.setattr(qp_parts.ContactNodes, "stepped", never)
