@@ -173,6 +173,12 @@ def _rows_by_parts(transform, src, dest):
     _by_parts(lambda i: dest.__setitem__(i, transform(src[i])), dest.shape, 0, dest.size)
 
 
+def _transform_parts(fast, fallback, shape, split, size):
+    """``fast(index)`` (pocketfft's own entry points, :func:`_entry_points`) or, where SciPy lacks them,
+    ``fallback(index)`` (``scipy.fft``) on the parts of the axis ``split`` (:func:`_by_parts`)."""
+    _by_parts(fallback if _pocketfft is None else fast, shape, split, size)
+
+
 def rfft_into(x, out, axis, split=0):
     """Real FFT of ``x`` along ``axis`` (unnormalised) written into ``out``, in parts of the axis ``split``.
 
@@ -191,13 +197,8 @@ def rfft_into(x, out, axis, split=0):
     ndarray
         ``out``.
     """
-    def call(i):
-        if _pocketfft is None:
-            out[i] = _sfft.rfft(x[i], axis=axis, workers=1)
-        else:
-            _pocketfft.r2c(x[i], (axis,), True, 0, out[i], 1)
-
-    _by_parts(call, x.shape, split, x.size)
+    _transform_parts(lambda i: _pocketfft.r2c(x[i], (axis,), True, 0, out[i], 1),
+                     lambda i: out.__setitem__(i, _sfft.rfft(x[i], axis=axis, workers=1)), x.shape, split, x.size)
     return out
 
 
@@ -221,14 +222,11 @@ def cfft_in_place(x, axis, split, inverse=False, normalise=True):
     ndarray
         ``x``.
     """
-    def call(i):
-        if _pocketfft is not None:
-            _pocketfft.c2c(x[i], (axis,), not inverse, 2 if inverse and normalise else 0, x[i], 1)
-            return
-        norm = "forward" if inverse and not normalise else "backward"
-        x[i] = (_sfft.ifft if inverse else _sfft.fft)(x[i], axis=axis, norm=norm, overwrite_x=True, workers=1)
-
-    _by_parts(call, x.shape, split, x.size)
+    norm = "forward" if inverse and not normalise else "backward"
+    fallback = _sfft.ifft if inverse else _sfft.fft
+    _transform_parts(lambda i: _pocketfft.c2c(x[i], (axis,), not inverse, 2 if inverse and normalise else 0, x[i], 1),
+                     lambda i: x.__setitem__(i, fallback(x[i], axis=axis, norm=norm, overwrite_x=True, workers=1)),
+                     x.shape, split, x.size)
     return x
 
 
@@ -253,13 +251,10 @@ def irfft_into(x, out, n, axis, split=0, normalise=True):
     ndarray
         ``out``.
     """
-    def call(i):
-        if _pocketfft is None:
-            out[i] = _sfft.irfft(x[i], n=n, axis=axis, norm="backward" if normalise else "forward", workers=1)
-        else:
-            _pocketfft.c2r(x[i], (axis,), n, False, 2 if normalise else 0, out[i], 1)
-
-    _by_parts(call, out.shape, split, out.size)
+    norm = "backward" if normalise else "forward"
+    _transform_parts(lambda i: _pocketfft.c2r(x[i], (axis,), n, False, 2 if normalise else 0, out[i], 1),
+                     lambda i: out.__setitem__(i, _sfft.irfft(x[i], n=n, axis=axis, norm=norm, workers=1)),
+                     out.shape, split, out.size)
     return out
 
 

@@ -169,13 +169,9 @@ def _compile():
         return np.nan if g_nan else g_min, np.nan if u_nan else u_max, np.nan if u_nan else u_min
 
     @njit(**opts)
-    def _subtract_scaled(u, r, tau, s, lo, hi):
-        if s == 1.0:
-            for i in range(lo, hi):
-                u[i] -= r[i] * tau
-        else:
-            for i in range(lo, hi):
-                u[i] = (u[i] - r[i] * tau) * s
+    def _subtract_scaled(u, r, tau, s, lo, hi):  # s = 1: the same numbers as u -= r tau (x 1.0 is exact)
+        for i in range(lo, hi):
+            u[i] = (u[i] - r[i] * tau) * s
 
     @njit(**opts)
     def _gather(x, idx, out, lo, hi):

@@ -68,15 +68,16 @@ class ContactNodes:
         n = bk.count(self.idx)
         if self.steady:  # was_on is this contact
             return n, 0
-        if self.moved is not None:  # the contact of the last read came from the step: was_on follows it
-            left, entering, both = self.moved
-            self.was_on.reshape(-1)[left] = False
-            self.was_on.reshape(-1)[entering] = True
-            self.n_was, self.moved = n, None
-            return n, left.size + entering.size - 2 * both
         kept = int(bk.xp.count_nonzero(bk.take(self.was_on, self.idx)))  # nodes in both contacts
         changes = (n - kept) + (self.n_was - kept)
-        self.was_on, self.n_was = self.on, n
+        if self.moved is None:
+            self.was_on = self.on
+        else:  # the contact of the last read came from the step (no mask of it): was_on follows it in place
+            left, entering = self.moved
+            self.was_on.reshape(-1)[left] = False
+            self.was_on.reshape(-1)[entering] = True
+            self.moved = None
+        self.n_was = n
         return n, changes
 
     def stepped(self, p_c, entered, entering=None, p_o=None):
@@ -88,7 +89,7 @@ class ContactNodes:
         if self.steady or not self.bk.is_numpy:
             return
         idx, left = self.idx[positive], self.idx[~positive]
-        p_c, new, both = p_c[positive], left[:0], 0
+        p_c, new = p_c[positive], left[:0]
         at = new  # where the entering nodes go among those that stayed
         if entered:
             on = p_o > 0
@@ -96,9 +97,7 @@ class ContactNodes:
             at = np.searchsorted(idx, new)  # the sorted merge of two disjoint sorted selections
             if new.size:
                 idx, p_c = np.insert(idx, at, new), np.insert(p_c, at, p_o[on])
-            if left.size:  # nodes the step set to 0 that entered again: in both contacts
-                both = np.intersect1d(left, new, assume_unique=True).size
-        self.next, self.moved = (idx, p_c, positive, at, new), (left, new, both)
+        self.next, self.moved = (idx, p_c, positive, at, new), (left, new)
 
     def over(self, idx, make, old=None):
         """Values at the contact's nodes ``idx``: ``make(nodes)``, a gather at the given nodes; where the contact of
