@@ -9,6 +9,14 @@ the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005). :func:`solve_qp` 
 of the half-space operator (on every device) in the one loop
 :func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
 
+The direction is kept when the contact changes: ``t = z + beta t_old`` on the current contact with the
+Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)`` (``z`` the preconditioned gap, ``z_old``
+0 at the nodes that entered), the step the minimum along ``t``, ``tau = g.t / t.(C + lam) t``, and ``t = z`` where
+``g.t <= 0``: the rule of :mod:`bem.periodic.qp`. On a fixed contact it is the conjugate-gradient step; restarting
+at every entering node (Polonsky and Keer) costs the nested rough sphere of ``benchmarks/cases.py`` 31 finest
+iterations against 24 at 2048^2 (``docs/performance.md``). With a hardness the directions restart after a step at
+which nodes entered or left the bounds (:func:`bem.cg_rules.bounded_move`).
+
 A step costs one product ``C t`` of the search direction, which updates ``C p``; where nodes enter the
 contact, ``C p`` is recomputed after the step instead, and the step length takes its curvature ``t.C t``
 from the operator's ``quadratic`` where it has one (:meth:`bem.InfluenceOperator.quadratic`: a forward
@@ -137,6 +145,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         u += lam * p
     t = xp.zeros(lat.shape, dtype=bk.float64)
     gz_old, restart = 1.0, True
+    last_z = None  # (nodes, z): the last preconditioned gap on its contact, for the Polak-Ribiere+ coefficient
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     prev_contact = p > 0
     m_one = None
@@ -215,7 +224,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         return bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0
 
     def advance(k):  # one step of the constrained CG; (message, status) where it cannot be taken
-        nonlocal m_one, gz_old, t, restart, u, stale, p
+        nonlocal m_one, gz_old, t, restart, u, stale, p, last_z
         if bounded and not n_idx:  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros_like(g_c), None)
         if preconditioner is None:
@@ -232,10 +241,21 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                     m_one = bk.take(preconditioner(xp.astype(contact, bk.float64)), idx)
                 z -= m_one * (xp.sum(z) / xp.sum(m_one))
         gz = float(xp.sum(g_c * z))
-        beta = 0.0 if restart or gz_old == 0 else gz / gz_old  # gz_old = 0: one contact node under force control
+        if bounded:  # restarted where nodes entered or left the bounds (bem.cg_rules.bounded_move)
+            beta = 0.0 if restart or gz_old == 0 else gz / gz_old  # gz_old = 0: one contact node under force control
+        else:  # Polak-Ribiere+ on the current contact (z_old is 0 at the nodes that entered it)
+            beta = 0.0 if last_z is None or gz_old == 0 else max(0.0, (gz - float(xp.sum(g_c * _kept_at(
+                bk, lat.shape, last_z, idx, changes)))) / gz_old)
+            last_z = None  # not held beside the new one
+            last_z = (idx, z)
         t_c = z + beta * bk.take(t, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (xp.sum(t_c) / xp.sum(m_one)) if oblique and m_one is not None else xp.mean(t_c)
+        gt = gz  # g.t: g.z on a conjugate direction
+        if beta:
+            gt = float(xp.sum(g_c * t_c))
+            if not gt > 0:  # no descent along t after a change of the contact: steepest descent
+                t_c, gt = z, gz
         t = spread(idx, t_c)
         gz_old = gz
         low = None if bounded else bk.select(g < 0)
@@ -257,7 +277,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         elif tt <= 0 or not math.isfinite(tt):
             return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
         else:
-            tau = gz / tt
+            tau = gt / tt  # the minimum along t
         if bounded:
             return bounded_step(tau, t_c, r)
         p_c = p_c0 - tau * t_c
@@ -317,6 +337,16 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not n_idx)
     elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
     return record.solution(p, delta, kkt, elastic, "Kalker QP")
+
+
+def _kept_at(bk, shape, kept, idx, changes):
+    """The kept values ``kept = (nodes, values)`` at the node selection ``idx`` (1-D), 0 at nodes not kept: the
+    values themselves where the contact did not change (``changes == 0``, the same nodes), else a gather from a
+    brick array that holds them for this read only."""
+    nodes, values = kept
+    if not changes and bk.count(nodes) == bk.count(idx):
+        return values
+    return bk.take(bk.spread(shape, nodes, values), idx)
 
 
 def _masked_gap(bk, mask, h):

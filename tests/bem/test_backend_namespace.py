@@ -100,6 +100,11 @@ def test_hardness_and_coatings_run_on_the_strict_namespace(strict, case):
     extra = (dict(E_star=1.0, hardness=0.5) if case == "hardness"
              else dict(COATING, coating1=bem.Coating(0.2, 3.0, 0.3)))
     kw = {k: v for k, v in KW.items() if k != "E_star"} | extra
+    if case == "coating":
+        # the single-precision products of NumPy and of the namespace differ by 1e-7 from the first step on, and
+        # the directions kept when nodes enter the contact carry that on: solved to KKT 1e-14, the answers agree
+        # to 1e-12 as answers, not as one path (at the default 1e-10 they differ by 1.4e-12 of p_max)
+        kw["rtol"] = 1e-14
     ref = bem.solve(Paraboloid(1.0), **kw)
     seen, callback = _iterates(strict)
     _same(ref, bem.solve(Paraboloid(1.0), device=strict, callback=callback, **kw))

@@ -12,6 +12,8 @@ from bem.kkt import kkt_residual
 from bem.periodic import PeriodicCell, PeriodicOperator
 from bem.periodic.qp import solve_periodic_qp
 
+from .restarted_cg import restarted_cg
+
 E_STAR = 1.0
 
 
@@ -116,19 +118,22 @@ def _self_affine(cell, seed=2026, hurst=0.8, rolloff=4, cutoff=128):
 
 
 def test_periodic_qp_keeps_its_conjugate_directions_when_the_contact_changes():
-    """On a rough cell whose contact set changes over most of the iterations, the QP reaches the
-    answer of the general loop (which restarts the conjugate gradients at every change) in fewer
-    iterations (57 against 88 from the default start)."""
+    """On a rough cell whose contact set changes over most of the iterations, the QP in the Fourier basis and the
+    general loop (which keeps its directions by the same rule) reach the answer of a constrained CG that restarts
+    at every entering node (tests/bem/restarted_cg.py) in fewer iterations (57 and 57 against 88 measured)."""
     cell = PeriodicCell(1.0 / 256, 256, 256)
     h = _self_affine(cell)
     op = PeriodicOperator(cell, E_STAR)
     force = 0.03 * cell.area
-    ref = solve_qp(op, h, force=force, preconditioner=op.preconditioner(), rtol=1e-10)
+    pre = op.preconditioner()
+    ref, restarted = restarted_cg(op.matvec, pre, op.diagonal, h, np.ones(cell.shape, bool), force / cell.node_area)
+    general = solve_qp(op, h, force=force, preconditioner=pre, rtol=1e-10)
     fast = solve_periodic_qp(op, h, force=force, rtol=1e-10)
-    assert ref.converged and fast.converged
-    assert sum(ref.history["changes"]) > 50 * ref.iterations  # the contact set moves a lot
-    assert np.abs(fast.p - ref.p).max() <= 1e-8 * ref.p.max()
-    assert fast.iterations <= 0.75 * ref.iterations
+    assert general.converged and fast.converged
+    assert sum(general.history["changes"]) > 50 * general.iterations  # the contact set moves a lot
+    for sol in (general, fast):
+        assert np.abs(sol.p - ref).max() <= 1e-8 * ref.max()
+        assert sol.iterations <= 0.75 * restarted
 
 
 @pytest.mark.parametrize("control", ["force", "approach"])

@@ -1,0 +1,38 @@
+"""The constrained CG of the half-space (:func:`bem.kalker.solve_qp`) keeps its conjugate directions when nodes
+enter the contact (Polak-Ribiere+): the answer of a loop written in the test that restarts them, in no more
+iterations. (On a cell whose contact moves over most iterations the same rule takes two thirds of the restarted
+loop's iterations: ``tests/bem/test_periodic_qp.py``.)"""
+
+import numpy as np
+
+import bem
+from bem.kalker import solve_qp
+from bem.lattice import Lattice
+
+from .restarted_cg import restarted_cg
+
+
+def _rough_sphere(x, y, seed=3):
+    """A sphere of radius 1 with 40 seeded waves of wavenumbers 20-120 (amplitude ``k^-1.8``, rms ``2e-3``)."""
+    rng = np.random.default_rng(seed)
+    z = np.zeros_like(x)
+    for _ in range(40):
+        k, angle, phase = rng.uniform(20, 120), rng.uniform(0, np.pi), rng.uniform(0, 2 * np.pi)
+        z += k ** -1.8 * np.cos(k * (np.cos(angle) * x + np.sin(angle) * y) + phase)
+    return (x * x + y * y) / 2 - 2e-3 * z / np.sqrt(np.mean(z * z))
+
+
+def test_the_half_space_qp_keeps_its_conjugate_directions_when_nodes_enter_the_contact():
+    force = 3e-3
+    lat = Lattice.from_extent(1 / 192, 0.3)
+    op = bem.InfluenceOperator(lat, 1.0)
+    h = np.where(lat.mask, _rough_sphere(lat.x, lat.y), 0.0)
+    pre = op.preconditioner()
+    ref, restarted = restarted_cg(op.matvec, pre, op.diagonal, h, lat.mask, force / lat.node_area)
+    sol = solve_qp(op, h, force=force, preconditioner=pre)
+    assert sol.converged
+    assert sum(sol.history["changes"]) > 50 * sol.iterations  # nodes enter and leave over the iterations
+    assert 0.05 < np.mean(ref[lat.mask] > 0) < 0.5 and not ref[lat.border].any()
+    # measured 8.8e-10 of p_max, 22 iterations against 26
+    assert np.abs(sol.p - ref).max() <= 1e-8 * ref.max()
+    assert sol.iterations <= restarted
