@@ -303,3 +303,26 @@ def test_a_broken_pipe_that_is_not_the_output_is_not_hidden(monkeypatch):
     monkeypatch.setattr(scenes, "run", _lost_worker)
     with pytest.raises(BrokenPipeError, match="a worker's pipe"):
         cli("scenes")
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
+def test_a_process_forked_while_sigterm_is_handled_ends_by_sigterm_without_a_traceback():
+    """A sweep's worker is forked with the command's SIGTERM handler and sets the default action in its
+    initializer; a SIGTERM before that (the sweep stopped as it starts) ends it by the default action, not by an
+    exception raised in it (its traceback on stderr)."""
+    import warnings
+
+    from validation.cli import _terminate_as_interrupt
+
+    with _terminate_as_interrupt():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)  # fork with threads (Python >= 3.12)
+            pid = os.fork()
+        if pid == 0:  # the child: reaches os._exit only where the handler raised
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(10)
+            finally:
+                os._exit(3)
+        _, status = os.waitpid(pid, 0)
+    assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM, status

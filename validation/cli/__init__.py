@@ -90,16 +90,26 @@ class Terminated(KeyboardInterrupt):
     """Raised in the main thread when the process receives ``SIGTERM``: unwinds like Ctrl-C."""
 
 
+_HANDLER_PID = None  # the process that handles SIGTERM by _raise_terminated
+
+
 def _raise_terminated(signum, frame):
+    if os.getpid() != _HANDLER_PID:
+        # a worker forked with this handler, terminated before its initializer restored the default action
+        # (validation.run.pool): it ends by that action, without a traceback
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        os.kill(os.getpid(), signal.SIGTERM)
     raise Terminated()
 
 
 @contextlib.contextmanager
 def _terminate_as_interrupt():
     """Handle ``SIGTERM`` like ``SIGINT`` while a command runs (main thread only)."""
+    global _HANDLER_PID
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _HANDLER_PID = os.getpid()
     previous = signal.signal(signal.SIGTERM, _raise_terminated)
     try:
         yield
