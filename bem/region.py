@@ -37,11 +37,14 @@ GROW = 1.5
 #: ... at most this many times.
 MAX_GROW = 3
 _COARSEST_NODES = 4096  # nested iteration stops coarsening below this many nodes
-# KKT residual to which the coarser lattices of nested iteration are solved. Looser coarse solves cost the
-# finest lattice more iterations as the levels grow: Kalker's QP on the rough sphere of benchmarks/cases.py
-# from 1e-4 took 4-8 % fewer products at 512^2 and 1024^2, but 33 finest iterations at 2048^2 (31 from 1e-6)
-# and 45 at 4096^2 (34), 1e-3 gave 37 at 2048^2.
-_COARSE_RTOL = 1e-6
+# KKT residual to which the coarser lattices of nested iteration are solved, per solver (the layer methods:
+# the default). Kalker's QP, whose directions are kept when the contact changes, takes on the finest lattice of the
+# rough sphere of benchmarks/cases.py from 1e-4 about the iterations it takes from 1e-6 (26, 28, 25, 25 against
+# 26, 26, 24, 24 from 512^2 to 4096^2), and the coarser lattices take two fifths fewer; from 1e-3 the finest
+# lattice takes longer at 2048^2 (27 iterations). The layer methods: Newton's paths gain nothing measurable
+# (docs/performance.md).
+_COARSE_RTOL = {"kalker": 1e-4}
+_COARSE_RTOL_DEFAULT = 1e-6
 
 
 def inner_domain(gap):
@@ -142,7 +145,7 @@ class HalfSpaceRegion:
 
     def coarse_rtol(self, solver):
         """KKT residual to which the coarser lattices of nested iteration are solved."""
-        return _COARSE_RTOL
+        return _COARSE_RTOL.get(solver, _COARSE_RTOL_DEFAULT)
 
     def operator(self, lattice, E_star, backend, *, bodies=None):
         """The influence operator ``C`` of the half-space on ``lattice`` (of coated ``bodies`` where given)."""
