@@ -14,8 +14,12 @@ Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)`` (``z``
 0 at the nodes that entered), the step the minimum along ``t``, ``tau = g.t / t.(C + lam) t``, and ``t = z`` where
 ``g.t <= 0``: the rule of :mod:`bem.periodic.qp`. On a fixed contact it is the conjugate-gradient step; restarting
 at every entering node (Polonsky and Keer) costs the nested rough sphere of ``benchmarks/cases.py`` 31 finest
-iterations against 24 at 2048^2 (``docs/performance.md``). With a hardness the directions restart after a step at
-which nodes entered or left the bounds (:func:`bem.cg_rules.bounded_move`).
+iterations against 24 at 2048^2 (``docs/performance.md``). The direction restarts (``beta = 0``) where the
+preconditioned residual grew, ``g.z > g_old.z_old``: nodes entered with most of it, and a ``beta`` that large would
+keep the last direction where the gap is closed (a sphere that enters its contact from a few nodes: 16 iterations
+against 6 without this restart); and, with a hardness, after a step that was shortened or capped at ``H`` to carry
+the force (:func:`bem.cg_rules.bounded_move`), as on the cell. Nodes that enter or leave the bounds keep it (the
+rough sphere with a hardness of a quarter of its contact's nodes plastic at 512^2: 36 iterations against 56).
 
 A step costs one product ``C t`` of the search direction, which updates ``C p``; where nodes enter the
 contact, ``C p`` is recomputed after the step instead, and the step length takes its curvature ``t.C t``
@@ -144,7 +148,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         u, stale = xp.where(mask, u0, 0.0), 1
         u += lam * p
     t = xp.zeros(lat.shape, dtype=bk.float64)
-    gz_old, restart = 1.0, True
+    gz_old, restart = 1.0, False  # restart: with a hardness, the last step was shortened to carry the force
     last_z = None  # (nodes, z): the last preconditioned gap on its contact, for the Polak-Ribiere+ coefficient
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     prev_contact = p > 0
@@ -224,7 +228,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         return bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0
 
     def advance(k):  # one step of the constrained CG; (message, status) where it cannot be taken
-        nonlocal m_one, gz_old, t, restart, u, stale, p, last_z
+        nonlocal m_one, gz_old, t, u, stale, p, last_z
         if bounded and not n_idx:  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros_like(g_c), None)
         if preconditioner is None:
@@ -241,13 +245,13 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                     m_one = bk.take(preconditioner(xp.astype(contact, bk.float64)), idx)
                 z -= m_one * (xp.sum(z) / xp.sum(m_one))
         gz = float(xp.sum(g_c * z))
-        if bounded:  # restarted where nodes entered or left the bounds (bem.cg_rules.bounded_move)
-            beta = 0.0 if restart or gz_old == 0 else gz / gz_old  # gz_old = 0: one contact node under force control
-        else:  # Polak-Ribiere+ on the current contact (z_old is 0 at the nodes that entered it)
-            beta = 0.0 if last_z is None or gz_old == 0 else max(0.0, (gz - float(xp.sum(g_c * _kept_at(
-                bk, lat.shape, last_z, idx, changes)))) / gz_old)
-            last_z = None  # not held beside the new one
-            last_z = (idx, z)
+        # Polak-Ribiere+ on the current contact (z_old is 0 at the nodes that entered it), restarted where the
+        # preconditioned residual grew (gz > gz_old: nodes entered with much of it) or, with a hardness, the last step
+        # was shortened to carry the force; gz_old = 0: one contact node under force control
+        beta = 0.0 if last_z is None or not gz_old > 0 or gz > gz_old or restart else max(
+            0.0, (gz - float(xp.sum(g_c * _kept_at(bk, lat.shape, last_z, idx, changes)))) / gz_old)
+        last_z = None  # not held beside the new one
+        last_z = (idx, z)
         t_c = z + beta * bk.take(t, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (xp.sum(t_c) / xp.sum(m_one)) if oblique and m_one is not None else xp.mean(t_c)
@@ -293,7 +297,6 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             lam_o = bk.take(lam, overlap) if per_node else lam
             bk.put(p, overlap, entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o), per_node,
                                                  preconditioned=preconditioner is not None))
-        restart = bool(n_overlap)
         s = 1.0
         if target is not None:
             s = target / float(xp.sum(p))  # the full sum: Newton's round-off floor depends on it
@@ -303,7 +306,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 bk.put(p, idx, bk.take(p, idx) * s)
                 entering = bk.subset(overlap, ~bk.take(contact, overlap))  # a clipped contact node may re-enter
                 bk.put(p, entering, bk.take(p, entering) * s)
-        if bool(xp.any(clipped)) or restart or stale >= RECOMPUTE_EVERY:
+        if bool(xp.any(clipped)) or n_overlap or stale >= RECOMPUTE_EVERY:
             u = r = None
             u, stale = apply(p), 0
         else:
@@ -316,7 +319,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
         nonlocal restart, u, stale
-        changed, restart, s, failure, _ = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
+        changed, _, s, failure, restart = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
                                                     hardness, preconditioned=preconditioner is not None, mask=mask)
         if failure is not None:
             return failure
