@@ -9,17 +9,15 @@ the spirit of Vollebregt 2014 (doi:10.1016/j.jcp.2013.10.005). :func:`solve_qp` 
 of the half-space operator (on every device) in the one loop
 :func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
 
-The direction is kept when the contact changes: ``t = z + beta t_old`` on the current contact with the
-Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)`` (``z`` the preconditioned gap, ``z_old``
-0 at the nodes that entered), the step the minimum along ``t``, ``tau = g.t / t.(C + lam) t``, and ``t = z`` where
-``g.t <= 0``: the rule of :mod:`bem.periodic.qp`. On a fixed contact it is the conjugate-gradient step; restarting
-at every entering node (Polonsky and Keer) costs the nested rough sphere of ``benchmarks/cases.py`` 31 finest
-iterations against 24 at 2048^2 (``docs/performance.md``). The direction restarts (``beta = 0``) where the
-preconditioned residual grew, ``g.z > g_old.z_old``: nodes entered with most of it, and a ``beta`` that large would
-keep the last direction where the gap is closed (a sphere that enters its contact from a few nodes: 16 iterations
-against 6 without this restart); and, with a hardness, after a step that was shortened or capped at ``H`` to carry
-the force (:func:`bem.cg_rules.bounded_move`), as on the cell. Nodes that enter or leave the bounds keep it (the
-rough sphere with a hardness of a quarter of its contact's nodes plastic at 512^2: 36 iterations against 56).
+With the preconditioner the direction is kept when the contact changes: ``t = z + beta t_old`` on the current
+contact, ``beta = max(0, g.(z - z_old) / g_old.z_old)`` (Polak-Ribiere+; ``z`` the preconditioned gap, ``z_old`` 0 at
+entering nodes), the step to the minimum along ``t``, ``g.t / t.(C + lam) t``, and ``t = z`` where ``g.t <= 0``, as
+in :mod:`bem.periodic.qp`; it restarts where the preconditioned residual grew (``g.z > g_old.z_old``: nodes entered
+with most of it) and, with a hardness, after a step shortened or capped at ``H`` to carry the force
+(:func:`bem.cg_rules.bounded_move`). Restarting at every entering node (Polonsky and Keer) costs the nested rough
+sphere of ``benchmarks/cases.py`` 31 finest iterations against 24 at 2048^2, 56 against 36 with a hardness at 512^2
+(``docs/performance.md``). Without the preconditioner the loop is Polonsky and Keer's: Fletcher-Reeves directions,
+restarted where nodes entered (kept directions took up to five times the iterations there).
 
 A step costs one product ``C t`` of the search direction, which updates ``C p``; where nodes enter the
 contact, ``C p`` is recomputed after the step instead, and the step length takes its curvature ``t.C t``
@@ -148,7 +146,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         u, stale = xp.where(mask, u0, 0.0), 1
         u += lam * p
     t = xp.zeros(lat.shape, dtype=bk.float64)
-    gz_old, restart = 1.0, False  # restart: with a hardness, the last step was shortened to carry the force
+    gz_old, restart = 1.0, False  # restart the direction (the rules in advance)
     last_z = None  # (nodes, z): the last preconditioned gap on its contact, for the Polak-Ribiere+ coefficient
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     prev_contact = p > 0
@@ -228,7 +226,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         return bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0
 
     def advance(k):  # one step of the constrained CG; (message, status) where it cannot be taken
-        nonlocal m_one, gz_old, t, u, stale, p, last_z
+        nonlocal m_one, gz_old, t, u, stale, p, last_z, restart
         if bounded and not n_idx:  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros_like(g_c), None)
         if preconditioner is None:
@@ -245,18 +243,18 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                     m_one = bk.take(preconditioner(xp.astype(contact, bk.float64)), idx)
                 z -= m_one * (xp.sum(z) / xp.sum(m_one))
         gz = float(xp.sum(g_c * z))
-        # Polak-Ribiere+ on the current contact (z_old is 0 at the nodes that entered it), restarted where the
-        # preconditioned residual grew (gz > gz_old: nodes entered with much of it) or, with a hardness, the last step
-        # was shortened to carry the force; gz_old = 0: one contact node under force control
-        beta = 0.0 if last_z is None or not gz_old > 0 or gz > gz_old or restart else max(
-            0.0, (gz - float(xp.sum(g_c * _kept_at(bk, lat.shape, last_z, idx, changes)))) / gz_old)
-        last_z = None  # not held beside the new one
-        last_z = (idx, z)
+        if preconditioner is None:  # Polonsky and Keer (gz_old = 0: one contact node under force control)
+            beta = 0.0 if restart or not gz_old > 0 else gz / gz_old
+        else:  # Polak-Ribiere+ on the current contact, z_old 0 at entering nodes (the rules: module docstring)
+            beta = 0.0 if last_z is None or not gz_old > 0 or gz > gz_old or restart else max(
+                0.0, (gz - float(xp.sum(g_c * _kept_at(bk, lat.shape, last_z, idx, changes)))) / gz_old)
+            last_z = None  # not held beside the new one
+            last_z = (idx, z)
         t_c = z + beta * bk.take(t, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (xp.sum(t_c) / xp.sum(m_one)) if oblique and m_one is not None else xp.mean(t_c)
         gt = gz  # g.t: g.z on a conjugate direction
-        if beta:
+        if beta and preconditioner is not None:
             gt = float(xp.sum(g_c * t_c))
             if not gt > 0:  # no descent along t after a change of the contact: steepest descent
                 t_c, gt = z, gz
@@ -306,6 +304,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 bk.put(p, idx, bk.take(p, idx) * s)
                 entering = bk.subset(overlap, ~bk.take(contact, overlap))  # a clipped contact node may re-enter
                 bk.put(p, entering, bk.take(p, entering) * s)
+        restart = preconditioner is None and bool(n_overlap)
         if bool(xp.any(clipped)) or n_overlap or stale >= RECOMPUTE_EVERY:
             u = r = None
             u, stale = apply(p), 0
@@ -319,8 +318,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
         nonlocal restart, u, stale
-        changed, _, s, failure, restart = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
+        changed, entered, s, failure, shortened = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
                                                     hardness, preconditioned=preconditioner is not None, mask=mask)
+        restart = entered if preconditioner is None else shortened
         if failure is not None:
             return failure
         if changed or r is None or stale >= RECOMPUTE_EVERY:

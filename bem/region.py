@@ -41,7 +41,8 @@ _COARSEST_NODES = 4096  # nested iteration stops coarsening below this many node
 # the default). Kalker's QP, whose directions are kept when the contact changes, takes on the finest lattice of the
 # rough sphere of benchmarks/cases.py from 1e-4 about the iterations it takes from 1e-6 (26, 28, 25, 25 against
 # 26, 26, 24, 24 from 512^2 to 4096^2), and the coarser lattices take two fifths fewer; from 1e-3 the finest
-# lattice takes longer at 2048^2 (27 iterations). The layer methods: Newton's paths gain nothing measurable
+# lattice takes longer at 2048^2 (27 iterations). The layer methods: Newton's paths gain nothing measurable; the
+# plain loop (no preconditioner, restarted at entering nodes) takes 253 iterations at 256^2 from 1e-4 against 96
 # (docs/performance.md).
 _COARSE_RTOL = {"kalker": 1e-4}
 _COARSE_RTOL_DEFAULT = 1e-6
@@ -143,9 +144,10 @@ class HalfSpaceRegion:
             levels.append(coarse)
         return [(lat, h if lat is lattice else self.nodal_gap(gap, lat)) for lat in levels[::-1]]
 
-    def coarse_rtol(self, solver):
-        """KKT residual to which the coarser lattices of nested iteration are solved."""
-        return _COARSE_RTOL.get(solver, _COARSE_RTOL_DEFAULT)
+    def coarse_rtol(self, solver, precondition=True):
+        """KKT residual to which the coarser lattices of nested iteration are solved (the plain loop of Polonsky
+        and Keer, ``precondition=False``: the default of the layer methods)."""
+        return _COARSE_RTOL.get(solver, _COARSE_RTOL_DEFAULT) if precondition else _COARSE_RTOL_DEFAULT
 
     def operator(self, lattice, E_star, backend, *, bodies=None):
         """The influence operator ``C`` of the half-space on ``lattice`` (of coated ``bodies`` where given)."""

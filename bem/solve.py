@@ -233,7 +233,7 @@ def _solve_on(region, gap, problem, x0, t_start):
     if x0 is not None:
         guess, nested = initial_guess(x0, lattice), False
     levels = region.levels(lattice, h, gap, nested)
-    coarse_rtol = region.coarse_rtol(problem.solver)
+    coarse_rtol = region.coarse_rtol(problem.solver, problem.precondition)
 
     def make_op(lat):
         if problem.bodies is None:

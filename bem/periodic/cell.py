@@ -123,8 +123,9 @@ class PeriodicCell:
             levels.append((coarse, coarse_gap(gap, fine, hf, coarse)))
         return levels[::-1]
 
-    def coarse_rtol(self, solver):
-        """KKT residual to which the coarser cells of nested iteration are solved."""
+    def coarse_rtol(self, solver, precondition=True):
+        """KKT residual to which the coarser cells of nested iteration are solved (the same with or without the
+        preconditioner)."""
         return _COARSE_RTOL.get(solver, _COARSE_RTOL_DEFAULT)
 
     def operator(self, cell, E_star, backend, *, bodies=None):
