@@ -10,14 +10,14 @@ of the half-space operator (on every device) in the one loop
 :func:`bem.cg_rules.run_constrained_cg`, with the rules of :mod:`bem.cg_rules`.
 
 With the preconditioner the direction is kept when the contact changes: ``t = z + beta t_old`` on the current
-contact, ``beta = max(0, g.(z - z_old) / g_old.z_old)`` (Polak-Ribiere+; ``z`` the preconditioned gap, ``z_old`` 0 at
-entering nodes), the step to the minimum along ``t``, ``g.t / t.(C + lam) t``, and ``t = z`` where ``g.t <= 0``, as
-in :mod:`bem.periodic.qp`; it restarts where the preconditioned residual grew (``g.z > g_old.z_old``: nodes entered
-with most of it) and, with a hardness, after a step shortened or capped at ``H`` to carry the force
-(:func:`bem.cg_rules.bounded_move`). Restarting at every entering node (Polonsky and Keer) costs the nested rough
-sphere of ``benchmarks/cases.py`` 31 finest iterations against 24 at 2048^2, 56 against 36 with a hardness at 512^2
-(``docs/performance.md``). Without the preconditioner the loop is Polonsky and Keer's: Fletcher-Reeves directions,
-restarted where nodes entered (kept directions took up to five times the iterations there).
+contact, ``beta = max(0, g.(z - z_old) / g_old.z_old)`` (Polak-Ribiere+, Gilbert & Nocedal 1992,
+doi:10.1137/0802003; ``z`` the preconditioned gap, ``z_old`` 0 at entering nodes), the step to the minimum along
+``t``, and ``t = z`` where ``g.t <= 0``, as in :mod:`bem.periodic.qp`; it restarts where the preconditioned residual
+grew (``g.z > g_old.z_old``: nodes entered with most of it) and, with a hardness, after a step shortened or capped at
+``H`` to carry the force (:func:`bem.cg_rules.bounded_move`). Restarting at every entering node (Polonsky and Keer)
+costs the nested rough sphere of ``benchmarks/cases.py`` 31 finest iterations against 24 at 2048^2, 56 against 36
+with a hardness at 512^2 (``docs/performance.md``). Without the preconditioner the loop is Polonsky and Keer's:
+Fletcher-Reeves directions, restarted where nodes entered (kept directions took up to five times the iterations).
 
 A step costs one product ``C t`` of the search direction, which updates ``C p``; where nodes enter the
 contact, ``C p`` is recomputed after the step instead, and the step length takes its curvature ``t.C t``
@@ -318,8 +318,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
         nonlocal restart, u, stale
-        changed, entered, s, failure, shortened = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node, target,
-                                                    hardness, preconditioned=preconditioner is not None, mask=mask)
+        changed, entered, s, failure, shortened = bounded_move(bk, p, sets, p_c0, t_c, tau, g + delta, jacobi, per_node,
+                                                               target, hardness, mask=mask,
+                                                               preconditioned=preconditioner is not None)
         restart = entered if preconditioner is None else shortened
         if failure is not None:
             return failure
