@@ -204,8 +204,8 @@ def bounded_move(bk, p, sets, p_c0, t_c, tau, v, jacobi, per_node, target, hardn
     pressure is the rigid-plastic one of the deformed gap ``v`` (:func:`bem.plastic.plastic_start` on ``mask``, ``None``:
     every node): a contact that is (nearly) fully plastic. Elsewhere, where the force cannot be carried, the step
     is halved up to ``halvings`` times (the periodic step: :data:`BACKTRACK_HALVINGS`; the general step none: the
-    same iterations on the rough sphere with a hardness of ``benchmarks/cases.py``) and, where none of those can either, goes up to the
-    first bound. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
+    same iterations on the rough sphere of ``benchmarks/cases.py`` with a hardness) and, where none of those can
+    either, goes up to the first bound. ``jacobi = 1 / (C_nn + lam)`` (a brick array where ``per_node``).
     ``changed``: a node reached a bound, entered, left or was capped (``C p`` is then to be recomputed);
     ``entered``: a node entered the contact or left the plastic set; ``s``: the factor of the elastic nodes;
     ``failure``: ``(message, status)`` where no step can be taken; ``restart``:
