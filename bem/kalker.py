@@ -17,7 +17,7 @@ grew (``g.z > g_old.z_old``: nodes entered with most of it) and, with a hardness
 ``H`` to carry the force (:func:`bem.cg_rules.bounded_move`). Restarting at every entering node (Polonsky and Keer)
 costs the nested rough sphere of ``benchmarks/cases.py`` 31 finest iterations against 24 at 2048^2, 56 against 36
 with a hardness at 512^2 (``docs/performance.md``). Without the preconditioner the loop is Polonsky and Keer's:
-Fletcher-Reeves directions, restarted where nodes entered (kept directions took up to five times the iterations).
+Fletcher-Reeves directions, restarted where nodes entered (kept directions took up to six times the iterations).
 
 A step costs one product ``C t`` of the search direction, which updates ``C p``; where nodes enter the
 contact, ``C p`` is recomputed after the step instead, and the step length takes its curvature ``t.C t``
@@ -248,7 +248,6 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         else:  # Polak-Ribiere+ on the current contact, z_old 0 at entering nodes (the rules: module docstring)
             beta = 0.0 if last_z is None or not gz_old > 0 or gz > gz_old or restart else max(
                 0.0, (gz - float(xp.sum(g_c * _kept_at(bk, lat.shape, last_z, idx, changes)))) / gz_old)
-            last_z = None  # not held beside the new one
             last_z = (idx, z)
         t_c = z + beta * bk.take(t, idx)
         if force is not None:  # nodes that left the contact broke the zero sum of t

@@ -1,7 +1,7 @@
 """The constrained CG of the half-space (:func:`bem.kalker.solve_qp`) keeps its conjugate directions when nodes
-enter the contact (Polak-Ribiere+): the answer of a loop written in the test that restarts them, in no more
-iterations. (On a cell whose contact moves over most iterations the same rule takes two thirds of the restarted
-loop's iterations: ``tests/bem/test_periodic_qp.py``.)"""
+enter the contact (Polak-Ribiere+): the answer of a loop written in the test that restarts them, and fewer
+iterations than with restarts on a nested self-affine sphere. (On a cell whose contact moves over most iterations
+the same rule takes two thirds of the restarted loop's iterations: ``tests/bem/test_periodic_qp.py``.)"""
 
 import numpy as np
 
@@ -22,7 +22,7 @@ def _rough_sphere(x, y, seed=3):
     return (x * x + y * y) / 2 - 2e-3 * z / np.sqrt(np.mean(z * z))
 
 
-def test_the_half_space_qp_keeps_its_conjugate_directions_when_nodes_enter_the_contact():
+def test_the_half_space_qp_reaches_the_answer_of_a_loop_that_restarts_its_directions():
     force = 3e-3
     lat = Lattice.from_extent(1 / 192, 0.3)
     op = bem.InfluenceOperator(lat, 1.0)
@@ -38,10 +38,8 @@ def test_the_half_space_qp_keeps_its_conjugate_directions_when_nodes_enter_the_c
     assert sol.iterations <= restarted
 
 
-def test_without_the_preconditioner_the_loop_restarts_where_nodes_enter():
-    """Polonsky and Keer's plain loop (``precondition=False``): Fletcher-Reeves directions restarted where nodes
-    enter the contact. On a nested sphere with a seeded self-affine surface, 256 nodes across, it takes 177
-    iterations; the directions kept across changes of the contact (the rule with the preconditioner) took 327."""
+def _self_affine_sphere():
+    """A sphere of radius 1 carrying a seeded self-affine surface (rms slope 0.05) on ``|x|, |y| <= 0.35``."""
     from scipy.interpolate import RegularGridInterpolator
 
     from bem.rough import self_affine
@@ -53,6 +51,35 @@ def test_without_the_preconditioner_the_loop_restarts_where_nodes_enter():
     def gap(x, y):
         return (x * x + y * y) / 2 - surface((y, x))
 
-    res = bem.solve(gap, E_star=1.0, force=3e-3, step=0.6 / 256, extent=0.3, precondition=False)
+    return gap
+
+
+def test_the_half_space_qp_keeps_its_directions_when_nodes_enter_the_contact():
+    """The nested self-affine sphere, 512 nodes across: 26 finest iterations; restarted where nodes enter, 29; with
+    the step ``g.z / t.C t`` along the kept direction instead of its minimum ``g.t / t.C t``, 34."""
+    res = bem.solve(_self_affine_sphere(), E_star=1.0, force=3e-3, step=0.6 / 512, extent=0.3)
+    assert res.converged and 0.05 < res.contact_area / 0.36 < 0.5
+    assert res.iterations <= 27
+
+
+def test_without_the_preconditioner_the_loop_restarts_where_nodes_enter():
+    """Polonsky and Keer's plain loop (``precondition=False``): Fletcher-Reeves directions restarted where nodes
+    enter the contact. On the nested self-affine sphere, 256 nodes across, it takes 177 iterations; the directions
+    kept across changes of the contact (the rule with the preconditioner) took 327."""
+    res = bem.solve(_self_affine_sphere(), E_star=1.0, force=3e-3, step=0.6 / 256, extent=0.3, precondition=False)
     assert res.converged and 0.05 < res.contact_area / 0.36 < 0.5
     assert res.iterations <= 250
+
+
+def test_the_direction_restarts_where_the_preconditioned_residual_grew():
+    """A sphere whose contact grows from a few nodes in its first step, with and without a hardness: 16 and 11
+    iterations; keeping the direction where ``g.z`` grew (nodes entered with most of it), 17 and 12."""
+    from bem.gaps import Paraboloid
+
+    R, force = 0.01, 100.0 / 115e9  # a steel sphere, lengths in m and pressures in units of E*
+    a = (3 * force * R / 4) ** (1 / 3)
+    p0 = 3 * force / (2 * np.pi * a * a)
+    for hardness, most in ((None, 16), (0.5 * p0, 11)):
+        res = bem.solve(Paraboloid(R), E_star=1.0, force=force, step=2 * a / 24, extent="auto", hardness=hardness)
+        assert res.converged and res.contact_area > 0
+        assert res.iterations <= most
