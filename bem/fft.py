@@ -163,7 +163,9 @@ def in_parts(kernel, n, size):
 
 def _by_parts(call, shape, split, size):
     """``call(index)`` with ``index`` selecting contiguous parts of the axis ``split`` of an array of ``shape``
-    (:func:`in_parts`)."""
+    (:func:`in_parts`); ``split = None``: once on the whole array, in the calling thread."""
+    if split is None:
+        return call((Ellipsis,))
     lead = (slice(None),) * split
     in_parts(lambda part: call(lead + (part,)), shape[split], size)
 
@@ -210,7 +212,7 @@ def cfft_in_place(x, axis, split, inverse=False, normalise=True):
     x : ndarray
         Complex data (complex64 or complex128; views allowed), overwritten by its transform.
     axis, split : int
-        As for :func:`rfft_into`.
+        As for :func:`rfft_into`; ``split = None``: in the calling thread (one of :func:`in_parts`'s, say).
     inverse : bool
         The inverse transform (a positive exponent).
     normalise : bool

@@ -35,6 +35,7 @@ from . import fft
 from .backend import get_backend
 from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel_spectra, single_symbol
 from .checks import check_positive
+from .column_bands import BANDS_ABOVE, convolve_by_bands
 from .template import template
 
 __all__ = ["InfluenceOperator", "diagonal_coefficient"]
@@ -213,7 +214,10 @@ class InfluenceOperator:
         transforms in single precision, with single-precision spectra)."""
         o_rows, (oq, nq) = out_box
         bk = self.backend
-        if bk.is_numpy:  # the parities' rows transformed where they are, the products written where they go
+        if bk.is_numpy and 2 * shape[0] * (shape[1] // 2 + 1) * (8 if single else 16) > BANDS_ABOVE:
+            dests = [out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] for s, (k0, na) in zip(self._start, o_rows)]
+            convolve_by_bands(spectra, shape, self._parts(v, in_box), dests, np.float32 if single else np.float64)
+        elif bk.is_numpy:  # the parities' rows transformed where they are, the products written where they go
             dtype = np.float32 if single else np.float64
             V = block_product(spectra, fft.forward_parts(self._parts(v, in_box), shape, dtype))
             for a, s in enumerate(self._start):

@@ -1,0 +1,97 @@
+"""The block convolution by bands of spectrum columns against the whole-array path and the dense matrix."""
+
+import numpy as np
+import pytest
+
+import bem.column_bands as column_bands
+from bem import fft
+from bem.block_symbol import block_product
+from bem.lattice import Lattice
+from bem.operator import InfluenceOperator
+
+
+def _whole(op, spectra, shape, v, in_box, out_box, dtype):
+    """The whole-array path written out: every row of the padded pair transformed, multiplied, inverted."""
+    out = np.zeros(op.lattice.shape)
+    V = block_product(spectra, fft.forward_parts(op._parts(v, in_box), shape, dtype))
+    o_rows, (oq, nq) = out_box
+    for a, s in enumerate(op._start):
+        k0, na = o_rows[a]
+        fft.inverse_into(V[a], shape, out[s + 2 * k0 : s + 2 * (k0 + na) : 2, oq : oq + nq])
+    return out
+
+
+def _by_bands(op, spectra, shape, v, in_box, out_box, dtype):
+    out = np.zeros(op.lattice.shape)
+    o_rows, (oq, nq) = out_box
+    dests = [out[s + 2 * k0 : s + 2 * (k0 + na) : 2, oq : oq + nq] for s, (k0, na) in zip(op._start, o_rows)]
+    column_bands.convolve_by_bands(spectra, shape, op._parts(v, in_box), dests, dtype)
+    return out
+
+
+def _support(lat, seed, rows, cols):
+    rng = np.random.default_rng(seed)
+    v = np.zeros(lat.shape)
+    v[rows, cols] = rng.standard_normal(v[rows, cols].shape)
+    return v * lat.mask
+
+
+@pytest.mark.parametrize("window", [False, True])
+@pytest.mark.parametrize("single", [False, True])
+def test_bands_give_the_numbers_of_the_whole_array(window, single, monkeypatch):
+    """A window's four complex blocks and a box's Hermitian symbol, in double and single precision, with bands of
+    4 columns (several bands, a last one narrower): the same products, to the last bits."""
+    monkeypatch.setattr(column_bands, "_BAND_BYTES", 1)  # bands of the minimum width
+    lat = Lattice.from_extent(0.04, (1.0, 0.8))
+    op = InfluenceOperator(lat, 1.3)
+    v = _support(lat, 3, slice(9, 31), slice(6, 19))
+    box = op._box(v)
+    if window:
+        shape, spectra = op._kernel_spectra(op._full(), box)
+        out_box = op._full()
+        assert spectra.shape[:2] == (2, 2)
+    else:
+        shape, spectra = op._kernel_spectra(box, box, hermitian=True)
+        out_box = box
+        assert spectra[1][0] is None
+    if single:
+        spectra = spectra.astype(np.complex64) if window else (
+            (spectra[0][0].astype(np.float32), spectra[0][1].astype(np.complex64)),
+            (None, spectra[1][1].astype(np.float32)))
+    dtype = np.float32 if single else np.float64
+    assert (shape[1] // 2 + 1) % 4 and shape[1] // 2 + 1 > 8
+    keep = v.copy()
+    whole = _whole(op, spectra, shape, v, box, out_box, dtype)
+    bands = _by_bands(op, spectra, shape, v, box, out_box, dtype)
+    np.testing.assert_array_equal(v, keep)  # the input is not modified
+    scale = np.abs(whole).max()
+    assert scale > 0
+    assert np.abs(bands - whole).max() <= (1e-6 if single else 1e-14) * scale
+
+
+def test_the_operator_by_bands_is_the_dense_product(monkeypatch):
+    """Above the size where bands are taken (lowered here to every product) ``C p`` of a window and of the whole
+    region is the dense matrix's, and the preconditioner is the one of the whole-array path."""
+    lat = Lattice.from_extent(0.05, (1.0, 0.7))
+    p_window = _support(lat, 4, slice(5, 14), slice(3, 11))
+    p_full = np.random.default_rng(5).random(lat.shape) * lat.mask
+    whole_op = InfluenceOperator(lat, 2.0)
+    reference = [whole_op.preconditioner(lam=0.2, single=single)(p_window) for single in (False, True)]
+    calls = []
+    original = column_bands.convolve_by_bands
+    monkeypatch.setattr("bem.operator.BANDS_ABOVE", 0)
+    monkeypatch.setattr("bem.operator.convolve_by_bands", lambda *a: calls.append(1) or original(*a))
+    op = InfluenceOperator(lat, 2.0)
+    dense = op.dense()
+    for p in (p_window, p_full):
+        ref = dense @ p[lat.mask]
+        assert np.abs(op.matvec(p)[lat.mask] - ref).max() <= 1e-13 * np.abs(ref).max()
+    for single, ref in zip((False, True), reference):
+        got = op.preconditioner(lam=0.2, single=single)(p_window)
+        assert np.abs(got - ref).max() <= (1e-6 if single else 1e-13) * np.abs(ref).max()
+    assert len(calls) == 4
+
+
+def test_band_width_follows_the_rows():
+    assert column_bands.band_columns(1024, 16) == (1 << 20) // (2 * 1024 * 16)
+    assert column_bands.band_columns(1 << 20, 16) == 4
