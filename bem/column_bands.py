@@ -9,8 +9,9 @@ sits in the cache, and only the rows that are read (``max(rows in, rows out)``, 
 whole spectrum. The numbers are those of the whole-array path, operation for operation
 (``tests/bem/test_column_bands.py``); on the benchmark sphere of ``benchmarks/cases.py`` the product of
 ``C`` with a direction takes less time from about 1M nodes and holds a spectrum of about half the rows
-(``docs/performance.md``, "The products by bands of columns"). Below :data:`BANDS_ABOVE` bytes of the whole
-spectrum (it then fits in the cache) the operator keeps the whole-array path.
+(``docs/performance.md``, "The products by bands of columns"). Up to :data:`BANDS_ABOVE` bytes of the whole
+spectrum pair (which the caches of the machine measured there hold) the operator keeps the whole-array path, which
+was faster there.
 """
 
 from __future__ import annotations
