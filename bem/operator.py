@@ -35,7 +35,8 @@ from . import fft
 from .backend import get_backend
 from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel_spectra, single_symbol
 from .checks import check_positive
-from .column_bands import BANDS_ABOVE, convolve_by_bands
+from .column_bands import BANDS_ABOVE, PairedSymbol, convolve_by_bands, paired_spectra
+from .matrix_views import dense, linear_operator
 from .template import template
 
 __all__ = ["InfluenceOperator", "diagonal_coefficient"]
@@ -67,6 +68,12 @@ def _contains(outer, inner):
         return i[1] == 0 or (o[0] <= i[0] and i[0] + i[1] <= o[0] + o[1])
 
     return all(within(o, i) for o, i in zip(outer[0], inner[0])) and within(outer[1], inner[1])
+
+
+def _pair_bytes(n_rows, n_cols, box):
+    """Bytes of the padded spectrum pair of a product with input on ``box`` and output on the whole region."""
+    lk = fft.fast_length(max(n_rows) + max(r[1] for r in box[0]) - 1, real=False)
+    return 2 * lk * (fft.fast_length(n_cols + box[1][1] - 1, real=True) // 2 + 1) * 16
 
 
 def _rows(s, k0, n, n_rows):
@@ -185,7 +192,10 @@ class InfluenceOperator:
         return best
 
     def _window(self, box):
-        """Kernel spectra for input on ``box`` (or a cached window containing it), output everywhere."""
+        """Kernel spectra for input on ``box`` (or a cached window containing it), output everywhere: above
+        ``BANDS_ABOVE`` bytes of the padded pair on NumPy :func:`bem.column_bands.paired_spectra` of the box widened
+        to the same rows of both parities (half the memory of the four blocks of
+        :func:`bem.block_symbol.kernel_spectra`), where every parity has those rows."""
         full, n_cols = self._full(), self.lattice.shape[1]
 
         def size(b):  # padded FFT points, up to the fast-length rounding
@@ -194,6 +204,13 @@ class InfluenceOperator:
         if size(box) > _FULL_ABOVE * size(full):
             box = full
         box = self._reuse("C", box, size) or box
+        first, end = min(r[0] for r in box[0]), max(r[0] + r[1] for r in box[0])
+        if (box != full and end <= min(self._n) and self.backend.is_numpy
+                and _pair_bytes(self._n, n_cols, box) > BANDS_ABOVE):
+            # the same rows of both parities (the box widened by at most a row): two blocks and the phase of the
+            # shift between the parities
+            box = (((first, end - first),) * 2, box[1])
+            return box, self._cached(("P", box), lambda: paired_spectra(self._table, self._start, self._n, n_cols, box))
         return box, self._cached(("C", box), lambda: self._kernel_spectra(full, box, hermitian=box == full))
 
     def _parts(self, v, box):
@@ -214,7 +231,8 @@ class InfluenceOperator:
         transforms in single precision, with single-precision spectra)."""
         o_rows, (oq, nq) = out_box
         bk = self.backend
-        if bk.is_numpy and 2 * shape[0] * (shape[1] // 2 + 1) * (8 if single else 16) > BANDS_ABOVE:
+        if isinstance(spectra, PairedSymbol) or (
+                bk.is_numpy and 2 * shape[0] * (shape[1] // 2 + 1) * (8 if single else 16) > BANDS_ABOVE):
             dests = [out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] for s, (k0, na) in zip(self._start, o_rows)]
             convolve_by_bands(spectra, shape, self._parts(v, in_box), dests, np.float32 if single else np.float64)
         elif bk.is_numpy:  # the parities' rows transformed where they are, the products written where they go
@@ -361,33 +379,10 @@ class InfluenceOperator:
 
     def as_linear_operator(self):
         """``scipy.sparse.linalg.LinearOperator`` acting on the flattened candidate nodes."""
-        from scipy.sparse.linalg import LinearOperator
-
-        mask = self.lattice.mask
-        n = int(mask.sum())
-
-        def mv(v):
-            p = np.zeros(self.lattice.shape)
-            p[mask] = np.ravel(v)
-            return self.matvec(p)[mask]
-
-        return LinearOperator((n, n), matvec=mv, rmatvec=mv, dtype=float)
+        return linear_operator(self)
 
     def dense(self):
-        """The dense matrix ``C`` over the flattened candidate nodes (small problems only).
-
-        Built directly from :func:`bem.template.template` at every node pair,
-        independently of the FFT path, so the two can be checked against each other (coated
-        bodies: the entries of the coefficient table at each node pair's offset).
-        """
-        mask = self.lattice.mask
-        x = self.lattice.x[mask] / self.lattice.step
-        y = self.lattice.y[mask] / self.lattice.step
-        if x.size > 20000:
-            raise MemoryError(f"dense C for {x.size} nodes would need {8 * x.size**2 / 1e9:.1f} GB")
-        if self.bodies is not None:  # coated: the table entry of each offset
-            n = np.rint(np.abs(y[:, None] - y[None, :]) / (math.sqrt(3.0) / 2)).astype(int)
-            m = np.rint(2 * np.abs(x[:, None] - x[None, :])).astype(int)
-            return self._table[n, (m - n % 2) // 2]
-        scale = self.lattice.step / (math.pi * self.E_star)
-        return scale * template(x[:, None] - x[None, :], y[:, None] - y[None, :])
+        """The dense matrix ``C`` over the flattened candidate nodes (small problems only):
+        :func:`bem.matrix_views.dense`, built at every node pair independently of the FFT path, so that the two can be
+        checked against each other."""
+        return dense(self.lattice, self.E_star, self._table if self.bodies is not None else None)

@@ -95,3 +95,63 @@ def test_the_operator_by_bands_is_the_dense_product(monkeypatch):
 def test_band_width_follows_the_rows():
     assert column_bands.band_columns(1024, 16) == (1 << 20) // (2 * 1024 * 16)
     assert column_bands.band_columns(1 << 20, 16) == 4
+
+
+@pytest.mark.parametrize("extent, rows, cols", [
+    ((1.0, 0.7), slice(5, 14), slice(8, 16)),  # first row even (start (0, 1)), off the centre
+    ((0.85, 0.9), slice(0, 6), slice(0, 5)),  # a corner
+    ((0.9, 0.75), slice(9, 30), slice(12, 26)),  # first row odd (start (1, 0)), to the last rows and columns
+    ((0.9, 0.75), slice(3, 8), slice(2, 9)),  # first row odd, off the centre
+])
+def test_the_paired_window_is_the_dense_product(extent, rows, cols, monkeypatch):
+    """Input on a window whose parities hold the same rows, output everywhere, by two blocks and the phase of the
+    shift between the parities (taken here for every window): the dense matrix's product, and the four blocks'."""
+    monkeypatch.setattr("bem.operator.BANDS_ABOVE", 0)
+    lat = Lattice.from_extent(0.05, extent)
+    op = InfluenceOperator(lat, 1.7)
+    dense = op.dense()
+    for seed in range(3):
+        p = _support(lat, seed, rows, cols)
+        box = op._window(op._box(p))[0]  # widened to the same rows of both parities
+        assert box != op._full() and box[0][0] == box[0][1]
+        ref = dense @ p[lat.mask]
+        got = op.matvec(p)
+        assert np.all(got[~lat.mask] == 0)
+        assert np.abs(got[lat.mask] - ref).max() <= 1e-13 * np.abs(ref).max()
+        shape, spectra = op._kernel_spectra(op._full(), box)
+        four = _by_bands(op, spectra, shape, p, box, op._full(), np.float64)
+        assert np.abs(got - four)[lat.mask].max() <= 1e-14 * np.abs(four).max()
+    assert [key[0] for key in op._spectra] == ["P"]
+    assert isinstance(op._spectra[("P", box)][1], column_bands.PairedSymbol)
+
+
+def test_a_window_on_the_last_row_of_one_parity_keeps_four_blocks(monkeypatch):
+    """A box that reaches the last row of the parity with more rows cannot be widened to the same rows of both."""
+    monkeypatch.setattr("bem.operator.BANDS_ABOVE", 0)
+    lat = Lattice.from_extent(0.05, (1.0, 0.7))
+    op = InfluenceOperator(lat, 1.7)
+    assert op._n == (17, 16) and op._start == (0, 1)
+    p = np.zeros(lat.shape)
+    p[30:33, 10:14] = 1.0  # brick rows 30-32: even-parity rows 15-16, odd row 15
+    p *= lat.mask
+    ref = op.dense() @ p[lat.mask]
+    got = op.matvec(p)
+    assert np.abs(got[lat.mask] - ref).max() <= 1e-13 * np.abs(ref).max()
+    assert [key[0] for key in op._spectra] == ["C"]
+
+
+@pytest.mark.parametrize("extent", [(1.0, 0.7), (0.9, 0.75), (0.95, 0.9)])
+@pytest.mark.parametrize("rows, cols", [((0, 5), (0, 7)), ((3, 9), (5, 11)), ((6, 10), (9, 23))])
+def test_paired_spectra_reach_every_offset_of_the_four_blocks(extent, rows, cols):
+    """Boxes not snapped, filled to their edges (every offset from the box to the region is met), both parity orders
+    (``sigma`` = +1 and -1) and equal or unequal rows of the parities: the four blocks' products."""
+    lat = Lattice.from_extent(0.05, extent)
+    op = InfluenceOperator(lat, 1.1)
+    box = ((rows, rows), cols)
+    full = op._full()
+    v = np.random.default_rng(sum(rows) + sum(cols)).standard_normal(lat.shape)
+    shape, four = op._kernel_spectra(full, box)
+    pair_shape, paired = column_bands.paired_spectra(op._table, op._start, op._n, lat.shape[1], box)
+    ref = _by_bands(op, four, shape, v, box, full, np.float64)
+    got = _by_bands(op, paired, pair_shape, v, box, full, np.float64)
+    assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
