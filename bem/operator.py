@@ -370,9 +370,18 @@ class InfluenceOperator:
 
     def _inverse_symbol(self, box, lam, floor, single=False):
         """``(shape, S)``: the spectra of ``(K + lam)^-1`` for the symbol ``K`` of ``box``
-        (:func:`bem.block_symbol.inverse_symbol`), rounded to single precision where ``single``."""
-        shape, S = inverse_symbol(self.backend, lambda: self._kernel_spectra(box, box, hermitian=True), lam, floor,
-                                  self.diagonal, single)
+        (:func:`bem.block_symbol.inverse_symbol`), rounded to single precision where ``single``; ``K`` is kept,
+        rounded, for :meth:`quadratic` on the same box (the support of a direction is the residual's)."""
+
+        def spectra():
+            if self._quad is not None and self._quad[0] != box:
+                self._quad = None  # one box at a time
+            shape, K = self._kernel_spectra(box, box, hermitian=True)
+            if self._quad is None:
+                self._quad = box, shape, single_symbol(self.backend.xp, K)
+            return shape, K
+
+        shape, S = inverse_symbol(self.backend, spectra, lam, floor, self.diagonal, single)
         if not single or self.backend.is_numpy:  # NumPy: rounded as it is made
             return shape, S
         return shape, single_symbol(self.backend.xp, S)

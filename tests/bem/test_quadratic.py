@@ -109,3 +109,26 @@ def test_quadratic_on_an_array_api_namespace_equals_the_numpy_one():
     for v in (np.where(rng.random(lat.shape) < 0.3, rng.standard_normal(lat.shape), 0.0) * lat.mask,
               np.pad(rng.random((7, 9)), ((4, lat.shape[0] - 11), (5, lat.shape[1] - 14)))):
         assert device.quadratic(xs.asarray(v)) == pytest.approx(host.quadratic(v), rel=1e-6)
+
+
+def test_the_preconditioner_and_the_quadratic_of_a_box_make_its_spectra_once(monkeypatch):
+    """The support preconditioner keeps the box's kernel spectra, rounded, for the quadratic form on that box: one
+    ``_kernel_spectra`` for both, the quadratic's value that of an operator that made them for itself; on another
+    box the quadratic makes its own."""
+    lat = Lattice.from_extent(0.05, 1.0)
+    rng = np.random.default_rng(11)
+    v = np.zeros(lat.shape)
+    v[8:20, 9:24] = rng.standard_normal((12, 15))
+    v *= lat.mask
+    fresh = InfluenceOperator(lat, 1.0).quadratic(v)
+    op = InfluenceOperator(lat, 1.0)
+    calls = []
+    made = op._kernel_spectra
+    monkeypatch.setattr(op, "_kernel_spectra", lambda *a, **k: calls.append(a[0]) or made(*a, **k))
+    op.preconditioner(lam=0.0, single=True)(v)
+    assert len(calls) == 1
+    assert op.quadratic(v) == fresh and len(calls) == 1
+    w = np.zeros(lat.shape)
+    w[2:6, 3:7] = 1.0
+    w *= lat.mask
+    assert op.quadratic(w) == InfluenceOperator(lat, 1.0).quadratic(w) and len(calls) == 2
