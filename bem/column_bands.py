@@ -45,8 +45,9 @@ def band_columns(lk, itemsize):
 @dataclass(frozen=True)
 class PairedSymbol:
     """The symbol of a window onto the whole region as two blocks: ``S_00 = S_11`` (``same``), ``S_01`` (``cross``)
-    and ``S_10 = S_01 exp(2 pi i (sigma k / Lk + q / Lq))`` (``row_phase[k] col_phase[q]``), each
-    ``(Lk, Lq // 2 + 1)`` [the units of the coefficient table, divided by ``Lk Lq``]."""
+    and ``S_10 = S_01 exp(2 pi i (sigma k / Lk + q / Lq))`` (``row_phase[k] col_phase[q]``, ``sigma`` the first brick
+    row of the odd parity less that of the even one), each ``(Lk, Lq // 2 + 1)`` [the units of the coefficient table,
+    divided by ``Lk Lq``]."""
 
     same: np.ndarray
     cross: np.ndarray
@@ -110,9 +111,10 @@ def convolve_by_bands(S, shape, parts, dests, dtype=np.float64):
 
     Parameters
     ----------
-    S : tuple or ndarray
+    S : tuple, ndarray or PairedSymbol
         The symbol: ``((S_00, S_01), (S_10, S_11))`` or an array ``S[a, b]`` of :func:`bem.block_symbol.kernel_spectra`,
-        or a Hermitian one ``((S_00, S_01), (None, S_11))`` (``S_10 = conj(S_01)``), each ``(Lk, Lq // 2 + 1)``.
+        a Hermitian one ``((S_00, S_01), (None, S_11))`` (``S_10 = conj(S_01)``), each ``(Lk, Lq // 2 + 1)``, or the
+        two blocks and the phase of :func:`paired_spectra`.
     shape : (int, int)
         The padded size ``(Lk, Lq)``.
     parts : sequence of two ndarray
