@@ -155,3 +155,18 @@ def test_paired_spectra_reach_every_offset_of_the_four_blocks(extent, rows, cols
     ref = _by_bands(op, four, shape, v, box, full, np.float64)
     got = _by_bands(op, paired, pair_shape, v, box, full, np.float64)
     assert np.abs(got - ref).max() <= 1e-14 * np.abs(ref).max()
+
+
+def test_a_coated_window_is_paired_too(monkeypatch):
+    """The coated half-space's coefficient table has the same offsets: its paired window is its dense product."""
+    import bem
+
+    monkeypatch.setattr("bem.operator.BANDS_ABOVE", 0)
+    bodies = bem.Bodies(210e9, 0.3, 210e9, 0.3, coating1=bem.Coating(0.05, 3.0, 0.3))
+    lat = Lattice.from_extent(0.05, (0.9, 0.75))
+    op = InfluenceOperator(lat, bodies.E_star, bodies=bodies)
+    p = _support(lat, 9, slice(6, 20), slice(5, 19))
+    ref = op.dense() @ p[lat.mask]
+    got = op.matvec(p)
+    assert np.abs(got[lat.mask] - ref).max() <= 1e-13 * np.abs(ref).max()
+    assert [key[0] for key in op._spectra] == ["P"]
