@@ -51,6 +51,8 @@ _SNAP = 16  # support boxes snap to a grid of 1/_SNAP of the region
 # larger than the support weakens M, and the s = 0.2 power-law Newton test then stalls.
 _REUSE_UP_TO = 2.0
 _FULL_ABOVE = 0.7  # a window with more FFT points than this fraction of the full padding uses the full one
+# for a paired window (bem.column_bands; the memory of Hermitian spectra a point, docs/performance.md)
+_PAIRED_REUSE_UP_TO, _PAIRED_FULL_ABOVE = 1.25, 0.85
 
 
 def diagonal_coefficient(step, E_star):
@@ -183,11 +185,11 @@ class InfluenceOperator:
             self._spectra.popitem(last=False)
         return value
 
-    def _reuse(self, kind, box, size):
-        """A cached box of this kind that contains ``box`` at most ``_REUSE_UP_TO`` times its size."""
+    def _reuse(self, kind, box, size, up_to=_REUSE_UP_TO):
+        """A cached box of this kind that contains ``box`` at most ``up_to`` times its size."""
         best = None
         for key in self._spectra:
-            if key[0] == kind and _contains(key[1], box) and size(key[1]) <= _REUSE_UP_TO * size(box):
+            if key[0] == kind and _contains(key[1], box) and size(key[1]) <= up_to * size(box):
                 best = key[1] if best is None or size(key[1]) < size(best) else best
         return best
 
@@ -201,12 +203,13 @@ class InfluenceOperator:
         def size(b):  # padded FFT points, up to the fast-length rounding
             return (max(self._n) + max(r[1] for r in b[0])) * (n_cols + b[1][1])
 
-        if size(box) > _FULL_ABOVE * size(full):
+        paired = self.backend.is_numpy and _pair_bytes(self._n, n_cols, box) > BANDS_ABOVE
+        if size(box) > (_PAIRED_FULL_ABOVE if paired else _FULL_ABOVE) * size(full):
             box = full
-        box = self._reuse("C", box, size) or box
+        up_to = _PAIRED_REUSE_UP_TO if paired else _REUSE_UP_TO
+        box = self._reuse("C", box, size, up_to) or (self._reuse("P", box, size, up_to) if paired else None) or box
         first, end = min(r[0] for r in box[0]), max(r[0] + r[1] for r in box[0])
-        if (box != full and end <= min(self._n) and self.backend.is_numpy
-                and _pair_bytes(self._n, n_cols, box) > BANDS_ABOVE):
+        if paired and box != full and end <= min(self._n):
             # the same rows of both parities (the box widened by at most a row): two blocks and the phase of the
             # shift between the parities
             box = (((first, end - first),) * 2, box[1])

@@ -170,3 +170,35 @@ def test_a_coated_window_is_paired_too(monkeypatch):
     got = op.matvec(p)
     assert np.abs(got[lat.mask] - ref).max() <= 1e-13 * np.abs(ref).max()
     assert [key[0] for key in op._spectra] == ["P"]
+
+
+def test_paired_windows_are_taken_up_to_their_own_bounds(monkeypatch):
+    """A paired window is kept up to ``_PAIRED_FULL_ABOVE`` of the whole region's padded points (the four blocks
+    give way to the whole region above ``_FULL_ABOVE``), and a cached one is reused for a smaller support up to
+    ``_PAIRED_REUSE_UP_TO`` times its points; every product is the dense matrix's."""
+    import bem.operator as operator
+
+    lat = Lattice.from_extent(0.05, (1.0, 0.8))
+    op = InfluenceOperator(lat, 1.0)
+    dense = op.dense()
+    full = op._full()
+
+    def size(b):
+        return (max(op._n) + max(r[1] for r in b[0])) * (lat.shape[1] + b[1][1])
+
+    wide = _support(lat, 1, slice(2, 20), slice(2, 37))  # a box of 0.7-0.85 of the whole padding
+    ratio = size(op._box(wide)) / size(full)
+    assert operator._FULL_ABOVE < ratio <= operator._PAIRED_FULL_ABOVE
+    assert op._window(op._box(wide))[0] == full  # four blocks: the whole region
+    monkeypatch.setattr("bem.operator.BANDS_ABOVE", 0)
+    op = InfluenceOperator(lat, 1.0)
+    boxes = []
+    for rows, cols in ((slice(2, 20), slice(2, 37)), (slice(4, 19), slice(4, 36)), (slice(8, 14), slice(10, 20))):
+        p = _support(lat, 2, rows, cols)
+        box = op._window(op._box(p))[0]
+        boxes.append((box, size(box) / size(op._box(p))))
+        ref = dense @ p[lat.mask]
+        assert np.abs(op.matvec(p)[lat.mask] - ref).max() <= 1e-13 * np.abs(ref).max()
+    assert boxes[0][0] != full and boxes[1][0] == boxes[0][0] and boxes[1][1] <= operator._PAIRED_REUSE_UP_TO
+    assert boxes[2][0] != boxes[0][0]  # a support far smaller: its own window
+    assert sorted(key[0] for key in op._spectra) == ["P", "P"]
