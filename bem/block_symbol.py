@@ -17,7 +17,8 @@ import numpy as np
 
 from . import fft
 
-__all__ = ["block_product", "block_quadratic", "inverse_symbol", "kernel_spectra", "single_symbol"]
+__all__ = ["block_product", "block_quadratic", "inverse_symbol", "kernel_spectra", "padded_kernel", "padded_shape",
+           "single_symbol"]
 
 
 def _conj(x):
@@ -223,6 +224,32 @@ def _inverse_band(k00, k01, k11, lam, floor, diagonal, size):
     return A, pb, D
 
 
+def padded_shape(out_box, in_box):
+    """``(Lk, Lq)``: the padding of the product of data on ``in_box`` onto ``out_box`` (:func:`kernel_spectra`),
+    ``out + in - 1`` per axis rounded up to a fast length."""
+    lk = fft.fast_length(max(o[1] for o in out_box[0]) + max(i[1] for i in in_box[0]) - 1, real=False)
+    return lk, fft.fast_length(out_box[1][1] + in_box[1][1] - 1, real=True)
+
+
+def padded_kernel(table, start, a, b, rows, cols, shift, shape, out=None, clip=False):
+    """The kernel from the rows of parity ``b`` to those of parity ``a`` in a zero-padded array of ``shape`` (``out``
+    where given): at the parity-row offsets ``e = 0 .. rows[0] - 1`` from its first row and ``-rows[1] .. -1`` in its
+    last rows, the column offsets ``f`` from ``cols`` alike, the coefficient of ``table`` at the brick-row offset
+    ``start[a] - start[b] + 2 (e + shift[0])`` and the half-step column offset ``2 (f + shift[1]) + a - b``.
+    ``clip``: offsets beyond the table take its last entries (offsets that no product meets)."""
+    e, f = np.r_[0 : rows[0], -rows[1] : 0], np.r_[0 : cols[0], -cols[1] : 0]
+    dr = start[a] - start[b] + 2 * (e + shift[0])  # brick row offset
+    t = (np.abs(2 * (f + shift[1]) + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
+    mode = "clip" if clip else "raise"
+    block = table.take(np.abs(dr), axis=0, mode=mode).take(t, axis=1, mode=mode)  # rows e, columns f
+    kernel = np.zeros(shape) if out is None else out
+    (lk, lq), (na, nb), (nq, bq) = shape, rows, cols
+    for r, src_r in ((slice(0, na), slice(0, na)), (slice(lk - nb, lk), slice(na, None))):
+        for c, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq, lq), slice(nq, None))):
+            kernel[r, c] = block[src_r, src_c]
+    return kernel
+
+
 def kernel_spectra(backend, table, start, out_box, in_box, hermitian=False):
     """Spectra ``S_ab`` of the blocks mapping ``in_box`` data to ``out_box`` values.
 
@@ -243,10 +270,7 @@ def kernel_spectra(backend, table, start, out_box, in_box, hermitian=False):
     if hermitian and out_box != in_box:
         raise ValueError(f"hermitian = True needs out_box == in_box, got {out_box!r} and {in_box!r}")
     (o_rows, (oq, nq)), (i_rows, (iq, bq)) = out_box, in_box
-    lk = fft.fast_length(max(o[1] for o in o_rows) + max(i[1] for i in i_rows) - 1, real=False)
-    lq = fft.fast_length(nq + bq - 1, real=True)
-    f = np.r_[0:nq, -(bq - 1) : 0]  # circular column positions
-    dq = f + oq - iq  # column offset output - input
+    lk, lq = padded_shape(out_box, in_box)
     # on NumPy one block at a time into the spectra (the same numbers as the batch: each line is
     # transformed alone), so that the padded kernels are never all held at once
     numpy = backend.is_numpy
@@ -257,15 +281,8 @@ def kernel_spectra(backend, table, start, out_box, in_box, hermitian=False):
         out = np.empty((2, 2, lk, lq // 2 + 1), dtype=complex) if numpy else np.zeros((2, 2, lk, lq))
     for a, b in blocks:
         (oa, na), (ib, nb) = o_rows[a], i_rows[b]
-        e = np.r_[0:na, -(nb - 1) : 0]
-        dr = start[a] - start[b] + 2 * (e + oa - ib)  # brick row offset
-        t = (np.abs(2 * dq + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
-        block = table.take(np.abs(dr), axis=0).take(t, axis=1)  # rows e, columns f
-        kernel = np.zeros((lk, lq)) if numpy else out[a, b]
-        for rows, src_r in ((slice(0, na), slice(0, na)), (slice(lk - nb + 1, lk), slice(na, None))):
-            for cols, src_c in ((slice(0, nq), slice(0, nq)), (slice(lq - bq + 1, lq), slice(nq, None))):
-                kernel[rows, cols] = block[src_r, src_c]
-        del block
+        kernel = padded_kernel(table, start, a, b, (na, nb - 1), (nq, bq - 1), (oa - ib, oq - iq), (lk, lq),
+                               None if numpy else out[a, b])
         if numpy:
             kernel /= lk * lq
             spectrum = fft.forward(kernel, (lk, lq))

@@ -24,16 +24,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.fft as sfft
 
 from . import fft
+from .block_symbol import padded_kernel
 
 __all__ = ["BANDS_ABOVE", "PairedSymbol", "band_columns", "convolve_by_bands", "paired_spectra"]
 
 #: bytes of the whole padded spectrum pair above which :class:`bem.InfluenceOperator` convolves by bands
 BANDS_ABOVE = 16 << 20
 _BAND_BYTES = 1 << 20  # bytes of a band of the padded pair: it and its product stay in the cache
-_ROW_BAND = 1 << 19  # entries of the bands of rows transformed at once
 
 
 def band_columns(lk, itemsize):
@@ -88,15 +87,10 @@ def paired_spectra(table, start, n_rows, n_cols, box):
     sigma = start[1] - start[0]
     na = max(n_rows)
     lk, lq = fft.fast_length(na + nb, real=False), fft.fast_length(n_cols + bq, real=True)
-    e = np.r_[0 : na + (sigma > 0), -(nb - 1 + (sigma < 0)) : 0]
-    f = np.r_[0 : n_cols + 1, -(bq - 1) : 0]  # column offsets from the input's first column
-    dq = f - iq
+    rows, cols = (na + (sigma > 0), nb - 1 + (sigma < 0)), (n_cols + 1, bq - 1)
     blocks = []
     for a, b in ((0, 0), (0, 1)):
-        dr = start[a] - start[b] + 2 * (e - ib)
-        t = (np.abs(2 * dq + (a - b)) - (a != b)) // 2
-        kernel = np.zeros((lk, lq))
-        kernel[np.ix_(e % lk, f % lq)] = table.take(np.abs(dr), axis=0, mode="clip").take(t, axis=1, mode="clip")
+        kernel = padded_kernel(table, start, a, b, rows, cols, (-ib, -iq), (lk, lq), clip=True)
         kernel /= lk * lq
         blocks.append(fft.forward(kernel, (lk, lq)))
         del kernel
@@ -136,7 +130,7 @@ def convolve_by_bands(S, shape, parts, dests, dtype=np.float64):
     cdtype = np.result_type(dtype, np.complex64)
     half = np.empty((2, max(rows_in + rows_out), n_half), dtype=cdtype)  # the row spectra, then the products
     for b, x in enumerate(parts):
-        _rows(lambda y: sfft.rfft(y.astype(dtype, copy=False), n=lq, axis=-1, workers=1), x, half[b, : rows_in[b]])
+        fft.rfft_rows(x, half[b, : rows_in[b]], lq, dtype)
     width = band_columns(lk, np.dtype(cdtype).itemsize)
 
     def bands(part):  # the bands of columns of a part, on the threads of bem.fft.in_parts
@@ -172,15 +166,4 @@ def convolve_by_bands(S, shape, parts, dests, dtype=np.float64):
 
     fft.in_parts(bands, -(-n_half // width), half.size)
     for a, dest in enumerate(dests):
-        cols = dest.shape[1]
-        _rows(lambda y: sfft.irfft(y, n=lq, axis=-1, norm="forward", workers=1)[:, :cols], half[a, : rows_out[a]],
-              dest)
-
-
-def _rows(transform, src, dest):
-    """``dest[i] = transform(src[i])`` for contiguous parts ``i`` of the rows, on the threads of
-    :func:`bem.fft.in_parts`, by bands of about ``_ROW_BAND`` entries (the temporaries are a band's)."""
-    band = max(1, _ROW_BAND // max(1, dest.shape[1]))
-    for lo in range(0, dest.shape[0], band):
-        s, d = src[lo : lo + band], dest[lo : lo + band]
-        fft.in_parts(lambda i: d.__setitem__(i, transform(s[i])), d.shape[0], d.size)
+        fft.irfft_rows(half[a, : rows_out[a]], dest, lq)

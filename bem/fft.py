@@ -63,7 +63,7 @@ def _entry_points():
 _pocketfft = _entry_points()
 
 __all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "forward_parts", "inverse_into", "in_parts",
-           "rfft_into", "cfft_in_place", "irfft_into", "half_spectrum_weights", "BLOCK"]
+           "rfft_into", "cfft_in_place", "irfft_into", "rfft_rows", "irfft_rows", "half_spectrum_weights", "BLOCK"]
 
 _ENV = "CONTACTLAB_THREADS"
 _override = None
@@ -333,18 +333,29 @@ def forward_parts(parts, shape, dtype=np.float64, scale=None):
     """
     lk, lq = shape
     out = np.empty((len(parts), lk, lq // 2 + 1), dtype=np.result_type(dtype, np.complex64))
-
-    def rows(x):  # the padded real FFT of rows x
-        return _sfft.rfft((x if scale is None else x * scale).astype(dtype, copy=False), n=lq, axis=-1, workers=1)
-
     for b, x in enumerate(parts):
-        n_rows = x.shape[0]
-        out[b, n_rows:, :] = 0.0  # the padding rows
-        band = _band(n_rows, out[b].size)
-        for lo in range(0, n_rows, band):
-            hi = min(lo + band, n_rows)
-            _rows_by_parts(rows, x[lo:hi], out[b, lo:hi, :])
+        out[b, x.shape[0] :, :] = 0.0  # the padding rows
+        rfft_rows(x, out[b, : x.shape[0]], lq, dtype, scale, size=out[b].size)
     return cfft_in_place(out, 1, 2)
+
+
+def rfft_rows(x, dest, n, dtype=np.float64, scale=None, size=None):
+    """``dest`` = the real FFT of the rows of ``x`` (times ``scale``, rounded to ``dtype``) zero-padded to ``n``
+    points, a band of rows after another (:func:`_band` of ``size`` entries, default ``dest.size``), each in parts."""
+    _rows_by_bands(lambda y: _sfft.rfft((y if scale is None else y * scale).astype(dtype, copy=False), n=n, axis=-1,
+                                        workers=1), x, dest, size)
+
+
+def irfft_rows(x, dest, n):
+    """``dest`` = the first ``dest.shape[1]`` points of the unnormalised inverse real FFT (``n`` points) of the rows
+    of the half spectra ``x``, a band of rows after another, each in parts."""
+    _rows_by_bands(lambda y: _sfft.irfft(y, n=n, axis=-1, norm="forward", workers=1)[:, : dest.shape[1]], x, dest)
+
+
+def _rows_by_bands(transform, src, dest, size=None):
+    band = _band(dest.shape[0], dest.size if size is None else size)
+    for lo in range(0, dest.shape[0], band):
+        _rows_by_parts(transform, src[lo : lo + band], dest[lo : lo + band])
 
 
 def inverse_into(spectrum, shape, dest):
@@ -359,14 +370,8 @@ def inverse_into(spectrum, shape, dest):
     dest : ndarray, shape ``(rows, cols)``
         Receives the rows and columns kept from the origin, without the ``1 / (Lk Lq)`` factor.
     """
-    lq = shape[1]
     cols = cfft_in_place(spectrum, 0, 1, inverse=True, normalise=False)
-    k0, k1 = dest.shape
-    band = _band(k0, k0 * k1)
-    for lo in range(0, k0, band):
-        hi = min(lo + band, k0)
-        _rows_by_parts(lambda x: _sfft.irfft(x, n=lq, axis=-1, norm="forward", workers=1)[:, :k1], cols[lo:hi],
-                       dest[lo:hi])
+    irfft_rows(cols[: dest.shape[0]], dest, shape[1])
 
 
 def inverse(spectrum, shape, keep):

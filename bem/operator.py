@@ -33,7 +33,7 @@ import numpy as np
 
 from . import fft
 from .backend import get_backend
-from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel_spectra, single_symbol
+from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel_spectra, padded_shape, single_symbol
 from .checks import check_positive
 from .column_bands import BANDS_ABOVE, PairedSymbol, convolve_by_bands, paired_spectra
 from .matrix_views import dense, linear_operator
@@ -72,10 +72,9 @@ def _contains(outer, inner):
     return all(within(o, i) for o, i in zip(outer[0], inner[0])) and within(outer[1], inner[1])
 
 
-def _pair_bytes(n_rows, n_cols, box):
-    """Bytes of the padded spectrum pair of a product with input on ``box`` and output on the whole region."""
-    lk = fft.fast_length(max(n_rows) + max(r[1] for r in box[0]) - 1, real=False)
-    return 2 * lk * (fft.fast_length(n_cols + box[1][1] - 1, real=True) // 2 + 1) * 16
+def _pair_bytes(shape, single=False):
+    """Bytes of a pair of half spectra of the padded ``shape`` (complex128, complex64 where ``single``)."""
+    return 2 * shape[0] * (shape[1] // 2 + 1) * (8 if single else 16)
 
 
 def _rows(s, k0, n, n_rows):
@@ -203,7 +202,7 @@ class InfluenceOperator:
         def size(b):  # padded FFT points, up to the fast-length rounding
             return (max(self._n) + max(r[1] for r in b[0])) * (n_cols + b[1][1])
 
-        paired = self.backend.is_numpy and _pair_bytes(self._n, n_cols, box) > BANDS_ABOVE
+        paired = self.backend.is_numpy and _pair_bytes(padded_shape(full, box)) > BANDS_ABOVE
         if size(box) > (_PAIRED_FULL_ABOVE if paired else _FULL_ABOVE) * size(full):
             box = full
         up_to = _PAIRED_REUSE_UP_TO if paired else _REUSE_UP_TO
@@ -235,7 +234,7 @@ class InfluenceOperator:
         o_rows, (oq, nq) = out_box
         bk = self.backend
         if isinstance(spectra, PairedSymbol) or (
-                bk.is_numpy and 2 * shape[0] * (shape[1] // 2 + 1) * (8 if single else 16) > BANDS_ABOVE):
+                bk.is_numpy and _pair_bytes(shape, single) > BANDS_ABOVE):
             dests = [out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] for s, (k0, na) in zip(self._start, o_rows)]
             convolve_by_bands(spectra, shape, self._parts(v, in_box), dests, np.float32 if single else np.float64)
         elif bk.is_numpy:  # the parities' rows transformed where they are, the products written where they go

@@ -202,3 +202,10 @@ def test_paired_windows_are_taken_up_to_their_own_bounds(monkeypatch):
     assert boxes[0][0] != full and boxes[1][0] == boxes[0][0] and boxes[1][1] <= operator._PAIRED_REUSE_UP_TO
     assert boxes[2][0] != boxes[0][0]  # a support far smaller: its own window
     assert sorted(key[0] for key in op._spectra) == ["P", "P"]
+
+
+def test_paired_spectra_need_the_same_rows_of_both_parities():
+    lat = Lattice.from_extent(0.05, (1.0, 0.7))
+    op = InfluenceOperator(lat, 1.0)
+    with pytest.raises(ValueError, match="same rows"):
+        column_bands.paired_spectra(op._table, op._start, op._n, lat.shape[1], (((2, 6), (1, 6)), (6, 12)))
