@@ -137,15 +137,12 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             out += lam * v
         return out
 
-    def spread(idx, values):  # brick array holding values at the selected nodes idx, 0 elsewhere
-        return bk.spread(lat.shape, idx, values)
-
     if u0 is None:
         u, stale = apply(p), 0
     else:  # from the caller: C x0 (+ lam x0), to be confirmed like an incremental update
         u, stale = xp.where(mask, u0, 0.0), 1
         u += lam * p
-    t = xp.zeros(lat.shape, dtype=bk.float64)
+    t_kept = None  # (nodes, values): the last search direction on its contact (kept compact, as last_z)
     gz_old, restart = 1.0, False  # restart the direction (the rules in advance)
     last_z = None  # (nodes, z): the last preconditioned gap on its contact, for the Polak-Ribiere+ coefficient
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
@@ -153,18 +150,13 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     m_one = None
     quadratic = getattr(op, "quadratic", None)
     fixed_scale = scale
-    # With a per-node compliance the preconditioner holds Jacobi blocks that differ by
-    # decades, and plain mean subtraction would wreck it: project obliquely. For a uniform
-    # compliance the FFT preconditioner is translation invariant and the mean is cheaper
-    # (fewer iterations on the Hertz problem of benchmarks/bem_hertz.py).
+    # With a per-node compliance the preconditioner holds Jacobi blocks that differ by decades, and plain mean
+    # subtraction would wreck it: project obliquely. For a uniform compliance the mean (fewer Hertz iterations).
     oblique = per_node
-    # The conjugate-gradient vectors live on the contact set: they are kept compact, at the
-    # flat indices idx of the contact nodes, and spread to brick arrays only for the FFT
-    # products; full-array work is left to the gap, the KKT check, the overlap search and the
-    # displacement update. Gathers and scatters go through the backend's node selections (on
-    # NumPy flat views, x.reshape(-1)[idx], every array here is C-contiguous: several times faster
-    # than x.flat[idx]).
-    contact = idx = n_idx = g = g_c = p_c0 = changes = None
+    # The conjugate-gradient vectors live on the contact set, compact at the flat indices idx of its nodes (the
+    # backend's node selections), spread to brick arrays only for the FFT products; full-array work is left to the
+    # gap, the KKT check and the displacement update.
+    contact = idx = n_idx = g = g_c = p_c0 = changes = g_min = low = None
     bounded = hardness is not None
     sets = None
     prev_plastic = p >= hardness if bounded else None
@@ -187,7 +179,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                                 plastic_gap=sets.plastic_gap)
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
-        nonlocal contact, idx, n_idx, g, delta, g_c, p_c0
+        nonlocal contact, idx, n_idx, g, delta, g_c, p_c0, g_min, low
         contact = p > 0
         idx = bk.select(contact)
         n_idx = bk.count(idx)
@@ -200,11 +192,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         scale = max(float(xp.max(u)), -float(xp.min(u))) if fixed_scale is None else fixed_scale
         g_c = bk.take(g, idx)
         p_c0 = bk.take(p, idx)
-        # kkt_residual(p[mask], g[mask], ...) without the copies: p = g = 0 off the mask, p >= 0,
-        # and max(max_contact |g|, max_free (-g)+) = max(max_contact |g|, (-min g)+) because
-        # contact nodes have -g <= max_contact |g|
-        return iterate_residual(bk.max0(xp.abs(g_c)), float(xp.min(g)), scale, lambda: float(xp.max(xp.abs(g))),
-                                None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
+        # kkt_residual(p[mask], g[mask], ...) without the copies: p = g = 0 off the mask, p >= 0, and
+        # max(max_contact |g|, max_free (-g)+) = max(max_contact |g|, (-min g)+) (contact nodes: -g <= max_contact |g|)
+        g_min = float(xp.min(g))
+        kkt = iterate_residual(bk.max0(xp.abs(g_c)), g_min, scale, lambda: float(xp.max(xp.abs(g))),
+                               None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
+        # the step needs the nodes of negative gap (those that may enter), not the gap: not held through its products
+        low, g = bk.select(g < 0), None
+        return kkt
 
     def confirms(kkt):  # an incrementally updated C p at the tolerance: recompute it and measure again
         nonlocal u, stale
@@ -223,10 +218,10 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             return bk.max0(p), n_touch, changes, n_touch == 0 and float(xp.min(g)) >= 0
         changes = int(xp.count_nonzero(contact != prev_contact))
         prev_contact = contact
-        return bk.max0(p_c0), n_idx, changes, n_idx == 0 and float(xp.min(g)) >= 0
+        return bk.max0(p_c0), n_idx, changes, n_idx == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG; (message, status) where it cannot be taken
-        nonlocal m_one, gz_old, t, u, stale, p, last_z, restart
+        nonlocal m_one, gz_old, t_kept, u, stale, p, last_z, restart, g_c, p_c0
         if bounded and not n_idx:  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros_like(g_c), None)
         if preconditioner is None:
@@ -234,7 +229,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             if force is not None:
                 z -= xp.mean(z)
         else:
-            z = bk.take(preconditioner(spread(idx, g_c)), idx)
+            z = bk.take(preconditioner(bk.spread(lat.shape, idx, g_c)), idx)
             if force is not None and not oblique:
                 z -= xp.mean(z)
             elif force is not None:
@@ -249,7 +244,8 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             beta = 0.0 if last_z is None or not gz_old > 0 or gz > gz_old or restart else max(
                 0.0, (gz - float(xp.sum(g_c * _kept_at(bk, lat.shape, last_z, idx, changes)))) / gz_old)
             last_z = (idx, z)
-        t_c = z + beta * bk.take(t, idx)
+        t_old = _kept_at(bk, lat.shape, t_kept, idx, changes) if t_kept else xp.zeros(n_idx, dtype=bk.float64)
+        t_c, t_old = z + beta * t_old, None
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (xp.sum(t_c) / xp.sum(m_one)) if oblique and m_one is not None else xp.mean(t_c)
         gt = gz  # g.t: g.z on a conjugate direction
@@ -257,17 +253,20 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             gt = float(xp.sum(g_c * t_c))
             if not gt > 0:  # no descent along t after a change of the contact: steepest descent
                 t_c, gt = z, gz
-        t = spread(idx, t_c)
-        gz_old = gz
-        low = None if bounded else bk.select(g < 0)
+        t_kept, t = (idx, t_c), bk.spread(lat.shape, idx, t_c)
+        gz_old, g_c = gz, None  # the gap at the contact is not held through the products
         # open nodes with g < 0 enter the contact below and C p is then recomputed: C t would serve only the
         # curvature t.(C + lam) t, which op.quadratic gives without the product
-        if quadratic is not None and low is not None and bool(xp.any(bk.take(p, low) == 0)):
-            r = None
-            tt = quadratic(t) + float(xp.sum((bk.take(lam, idx) if per_node else lam) * t_c * t_c))
+        if quadratic is not None and not bounded and bool(xp.any(bk.take(p, low) == 0)):
+            tt, r, t = quadratic(t) + float(xp.sum((bk.take(lam, idx) if per_node else lam) * t_c * t_c)), None, None
         else:
-            r = apply(t)
+            p_c0 = None  # (C + lam) t in the buffer of t, lam t added at the contact; p at the contact gathered after
+            r, t = op.matvec(t, overwrite_p=True), None
+            p_c0 = bk.take(p, idx)
             r_c = bk.take(r, idx)
+            if per_node or lam:
+                r_c += (bk.take(lam, idx) if per_node else lam) * t_c
+                bk.put(r, idx, r_c)
             if force is not None:
                 r_c -= xp.mean(r_c)
             tt = float(xp.sum(t_c * r_c))
@@ -290,9 +289,10 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         # -g / (C_nn + lam), or with a preconditioner (tau then dimensionless) a share of that estimate
         overlap = bk.subset(low, bk.take(p, low) == 0)  # off-mask nodes have g = 0
         n_overlap = bk.count(overlap)
-        if n_overlap:
+        if n_overlap:  # their gap u + h - delta (u not yet updated) as measured
             lam_o = bk.take(lam, overlap) if per_node else lam
-            bk.put(p, overlap, entering_pressure(xp, bk.take(g, overlap), tau, 1.0 / (op.diagonal + lam_o), per_node,
+            g_o = bk.take(u, overlap) + bk.take(h, overlap) - delta
+            bk.put(p, overlap, entering_pressure(xp, g_o, tau, 1.0 / (op.diagonal + lam_o), per_node,
                                                  preconditioned=preconditioner is not None))
         s = 1.0
         if target is not None:
@@ -372,7 +372,7 @@ def constrained_cg(op, h, *, lam=0.0, precondition=True, contact=None, **kw):
     elif is_per_node(lam):
         precond = compliance_preconditioner(op, lam, contact)
     else:
-        precond = op.preconditioner(lam=lam, single=True)
+        precond = op.preconditioner(lam=lam, single=True, overwrite_r=True)  # it may destroy its input
     return solve_qp(op, h, lam=lam, preconditioner=precond, **kw)
 
 

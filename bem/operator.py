@@ -288,15 +288,17 @@ class InfluenceOperator:
 
     # -- public products ---------------------------------------------------------------------------
 
-    def matvec(self, p):
-        """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]."""
+    def matvec(self, p, *, overwrite_p=False):
+        """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]; with ``overwrite_p`` the contents of
+        ``p`` may be destroyed: ``u`` is then written into a float64 ``p`` (one array of the lattice fewer)."""
         self.n_matvec += 1
         bk = self.backend
         p = bk.asarray(p)
         box = self._box(p)
         if box is None:
             return bk.xp.zeros(self.lattice.shape, dtype=bk.float64)
-        out = bk.xp.empty(self.lattice.shape, dtype=bk.float64)  # every entry is written below
+        # every entry is written below, after the input is read
+        out = p if overwrite_p and p.dtype == bk.float64 else bk.xp.empty(self.lattice.shape, dtype=bk.float64)
         box, (shape, spectra) = self._window(box)
         self._convolve(spectra, shape, p, box, self._full(), out)
         return out
@@ -311,16 +313,14 @@ class InfluenceOperator:
 
         return constrained_cg(self, h, lam=lam, precondition=precondition, contact=contact, **kw)
 
-    def preconditioner(self, lam=0.0, floor=0.5, box="support", single=False):
+    def preconditioner(self, lam=0.0, floor=0.5, box="support", single=False, overwrite_r=False):
         """FFT preconditioner ``z ~ (C + lam I)^-1 r`` for the conjugate gradients.
 
-        The inverse of the 2 x 2 block symbol of the zero-padded (circulant)
-        embedding of ``C + lam I`` over the snapped bounding box of the support
-        of ``r`` (Vollebregt 2014: the solvers apply it to residuals that vanish
-        off the contact, and mask its output to the contact). Truncating the
-        ``1/r`` kernel at the padding edge makes a few symbol eigenvalues small
-        or negative; they are raised to ``floor * C_nn + lam`` so that ``M``
-        stays positive definite.
+        The inverse of the 2 x 2 block symbol of the zero-padded (circulant) embedding of ``C + lam I`` over the
+        snapped bounding box of the support of ``r`` (Vollebregt 2014: the solvers apply it to residuals that vanish
+        off the contact, and mask its output to the contact). Truncating the ``1/r`` kernel at the padding edge makes
+        a few symbol eigenvalues small or negative; they are raised to ``floor * C_nn + lam`` so that ``M`` stays
+        positive definite.
 
         Parameters
         ----------
@@ -329,17 +329,17 @@ class InfluenceOperator:
         floor : float
             Eigenvalue floor as a fraction of the diagonal coefficient ``C_nn``.
         box : {"support", "full"}
-            ``"support"``: the embedding over the snapped bounding box of the
-            support of each ``r``, 0 outside it; for all ``r`` with one box it
-            is one symmetric positive definite operator. ``"full"``: over the
-            whole candidate region, one SPD operator for every ``r``. Where the
-            contact is small ``"support"`` is cheaper for as many iterations
-            (``benchmarks/side_by_side.py``; ``docs/performance.md``).
+            ``"support"``: the embedding over the snapped bounding box of the support of each ``r``, 0 outside it;
+            for all ``r`` with one box it is one symmetric positive definite operator. ``"full"``: over the whole
+            candidate region, one SPD operator for every ``r``. Where the contact is small ``"support"`` is cheaper
+            for as many iterations (``benchmarks/side_by_side.py``; ``docs/performance.md``).
         single : bool
             Apply it in single precision (its symbol rounded to single precision, the transforms of ``r``
             in single precision; the output in double precision): half the memory of the symbol and
             about half the time of the transforms, for a preconditioner of the constrained CG, which only
             approximates ``(C + lam I)^-1``.
+        overwrite_r : bool
+            Whether ``M`` may destroy the contents of ``r``: ``M r`` is then written into a float64 ``r``.
 
         Returns
         -------
@@ -349,22 +349,22 @@ class InfluenceOperator:
         from .checks import check_choice
 
         full = check_choice("box", box, ("support", "full")) == "full"
-        symbols = {}
-
-        bk = self.backend
+        symbols, bk = {}, self.backend
 
         def apply(r):
             r = bk.asarray(r)
-            out = bk.xp.zeros(self.lattice.shape, dtype=bk.float64)
             box = self._box(r)
             if box is None:
-                return out
+                return bk.xp.zeros(self.lattice.shape, dtype=bk.float64)
             if full:
                 box = self._full()
             if box not in symbols:
                 symbols.clear()  # one box at a time: the contact moves rarely
                 symbols[box] = self._inverse_symbol(box, lam, floor, single)  # its spectra are not kept
             shape, spectra = symbols[box]
+            # the output on the box, after its input is read; r = 0 off its box (the support's, or the whole region)
+            own = overwrite_r and r.dtype == bk.float64
+            out = r if own else bk.xp.zeros(self.lattice.shape, dtype=bk.float64)
             self._convolve(spectra, shape, r, box, box, out, single)
             return out
 

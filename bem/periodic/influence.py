@@ -284,8 +284,9 @@ class PeriodicOperator:
             rows[a::2, :] = bk.cfft(P[a, ...], axis=0, inverse=True)
         return bk.irfft(rows, n=self.lattice.n_cols, axis=-1)
 
-    def matvec(self, p):
-        """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]; ``u`` has zero mean."""
+    def matvec(self, p, *, overwrite_p=False):
+        """Return ``u = C p`` for a brick array ``p`` [pressure] -> [length]; ``u`` has zero mean (a new array: the
+        ``overwrite_p`` of :meth:`bem.InfluenceOperator.matvec` is accepted, and ``p`` kept)."""
         self.n_matvec += 1
         if self.backend.is_numpy:
             return self._apply(p, self.symbol(), None, None, None)

@@ -88,9 +88,9 @@ def test_n_matvec_counts_the_products_with_c(monkeypatch):
     calls = []
     real = bem.InfluenceOperator.matvec
 
-    def counting(self, p):
+    def counting(self, p, **kw):
         calls.append(self.lattice.n_nodes)
-        return real(self, p)
+        return real(self, p, **kw)
 
     monkeypatch.setattr(bem.InfluenceOperator, "matvec", counting)
     for kw in ({}, {"layer": layers.Root(0.05)}):
