@@ -141,15 +141,19 @@ def _traced_peak_per_node(solve):
     return (peak - base) / res.p.size
 
 
-# traced peaks per node of these problems (numpy 2.4): 89, 119, 86, 170 and 192 bytes; a solve that holds its
+# traced peaks per node of these problems (numpy 2.4): 89, 119, 86, 170, 192 and 145 bytes; a solve that holds its
 # coarser levels, the spectra its symbols are made of and its copies of the iterates traces 176, 275, 180 and 343;
 # Newton holding its step and the model's gap through the line search, and its iterate beside its start, 132 with
 # the root layer; a product over the whole region with four complex blocks of spectra, and transforms that hold the
-# whole unpadded spectrum beside the padded one, 269 on the whole-region sphere; the half-space QP holding its gap,
-# its search direction beside its product and the preconditioner's output beside its input, 189 and 210
+# whole unpadded spectrum beside the padded one, 269 on the whole-region sphere; the half-space QP holding its gap
+# through its step 177, 200 and 153, its search direction beside the direction's product 151 by bands (the whole
+# array's peak falls elsewhere), with the preconditioner's output beside its input as well 189 and 210
 @pytest.mark.parametrize("problem, bound", [("periodic", 105), ("periodic root layer", 130), ("sphere", 100),
-                                            ("wide sphere", 180), ("whole-region sphere", 200)])
-def test_the_traced_peak_of_a_solve_per_node_stays_below_its_bound(problem, bound):
+                                            ("wide sphere", 175), ("whole-region sphere", 196),
+                                            ("wide sphere by bands", 148)])
+def test_the_traced_peak_of_a_solve_per_node_stays_below_its_bound(problem, bound, monkeypatch):
+    if problem.endswith("by bands"):  # the products by bands of columns of the larger regions
+        monkeypatch.setattr("bem.operator.BANDS_ABOVE", 0)
     if problem.startswith("periodic"):
         cell = PeriodicCell(1.0 / 256, 256, 256)
         h = _rough(cell)
@@ -157,7 +161,7 @@ def test_the_traced_peak_of_a_solve_per_node_stays_below_its_bound(problem, boun
         peak = _traced_peak_per_node(lambda: bem.solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=0.01,
                                                                 layer=layer))
     else:
-        radius = {"sphere": 0.1, "wide sphere": 0.3, "whole-region sphere": 0.42}[problem]  # contact radius
+        radius = {"sphere": 0.1, "wide sphere": 0.3, "whole-region sphere": 0.42}[problem.removesuffix(" by bands")]
         step = math.sqrt(2 / math.sqrt(3)) / 256
         peak = _traced_peak_per_node(lambda: bem.solve(bem.gaps.Paraboloid(1.0), E_star=1.0, force=4 * radius**3 / 3,
                                                        step=step, extent=0.5))
