@@ -50,9 +50,9 @@ _SNAP = 16  # support boxes snap to a grid of 1/_SNAP of the region
 # way; saves kernel spectra while a contact shrinks). Preconditioner boxes are not reused: a box
 # larger than the support weakens M, and the s = 0.2 power-law Newton test then stalls.
 _REUSE_UP_TO = 2.0
-_FULL_ABOVE = 0.7  # a window with more FFT points than this fraction of the full padding uses the full one
-# for a paired window (bem.column_bands; the memory of Hermitian spectra a point, docs/performance.md)
-_PAIRED_REUSE_UP_TO, _PAIRED_FULL_ABOVE = 1.25, 0.85
+# A window with more FFT points than this fraction of the full padding uses the full one: on a device, and on NumPy
+# (four blocks below BANDS_ABOVE, paired above; measured in docs/performance.md); a paired window is reused so
+_FULL_ABOVE, _NUMPY_FULL_ABOVE, _PAIRED_REUSE_UP_TO = 0.7, 0.85, 1.25
 
 
 def diagonal_coefficient(step, E_star):
@@ -203,7 +203,7 @@ class InfluenceOperator:
             return (max(self._n) + max(r[1] for r in b[0])) * (n_cols + b[1][1])
 
         paired = self.backend.is_numpy and _pair_bytes(padded_shape(full, box)) > BANDS_ABOVE
-        if size(box) > (_PAIRED_FULL_ABOVE if paired else _FULL_ABOVE) * size(full):
+        if size(box) > (_NUMPY_FULL_ABOVE if self.backend.is_numpy else _FULL_ABOVE) * size(full):
             box = full
         up_to = _PAIRED_REUSE_UP_TO if paired else _REUSE_UP_TO
         box = self._reuse("C", box, size, up_to) or (self._reuse("P", box, size, up_to) if paired else None) or box

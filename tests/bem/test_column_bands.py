@@ -172,10 +172,10 @@ def test_a_coated_window_is_paired_too(monkeypatch):
     assert [key[0] for key in op._spectra] == ["P"]
 
 
-def test_paired_windows_are_taken_up_to_their_own_bounds(monkeypatch):
-    """A paired window is kept up to ``_PAIRED_FULL_ABOVE`` of the whole region's padded points (the four blocks
-    give way to the whole region above ``_FULL_ABOVE``), and a cached one is reused for a smaller support up to
-    ``_PAIRED_REUSE_UP_TO`` times its points; every product is the dense matrix's."""
+def test_windows_are_taken_up_to_their_own_bounds(monkeypatch):
+    """On NumPy a window is kept up to ``_NUMPY_FULL_ABOVE`` of the whole region's padded points, four blocks below
+    ``BANDS_ABOVE`` and paired above (on a device up to ``_FULL_ABOVE``), and a cached paired window is reused for a
+    smaller support up to ``_PAIRED_REUSE_UP_TO`` times its points; every product is the dense matrix's."""
     import bem.operator as operator
 
     lat = Lattice.from_extent(0.05, (1.0, 0.8))
@@ -188,8 +188,14 @@ def test_paired_windows_are_taken_up_to_their_own_bounds(monkeypatch):
 
     wide = _support(lat, 1, slice(2, 20), slice(2, 37))  # a box of 0.7-0.85 of the whole padding
     ratio = size(op._box(wide)) / size(full)
-    assert operator._FULL_ABOVE < ratio <= operator._PAIRED_FULL_ABOVE
-    assert op._window(op._box(wide))[0] == full  # four blocks: the whole region
+    assert operator._FULL_ABOVE < ratio <= operator._NUMPY_FULL_ABOVE
+    box = op._window(op._box(wide))[0]  # four blocks, a window
+    assert box != full and [key[0] for key in op._spectra] == ["C"]
+    ref = dense @ wide[lat.mask]
+    assert np.abs(op.matvec(wide)[lat.mask] - ref).max() <= 1e-13 * np.abs(ref).max()
+    with monkeypatch.context() as m:
+        m.setattr(op.backend, "is_numpy", False)  # the rule of a device (the window's choice only)
+        assert op._window(op._box(wide))[0] == full
     monkeypatch.setattr("bem.operator.BANDS_ABOVE", 0)
     op = InfluenceOperator(lat, 1.0)
     boxes = []
