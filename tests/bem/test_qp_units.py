@@ -5,7 +5,9 @@ scaled together), with and without the FFT preconditioner, and with a root layer
 node): the same iterations and the same scaled pressure to round-off. Nodes enter the contact in the first iterations
 of each lattice (53, 22, 8 and 6 nodes in four of the finest lattice's 14), so the rule that gives them their pressure
 (:func:`bem.cg_rules.entering_pressure`) is what this checks: a rule that mixed a length with a pressure would give
-the two runs different paths, and answers that differ by the tolerance rather than by round-off.
+the two runs different paths, and answers that differ by the tolerance rather than by round-off. Newton's runs are in
+units that are powers of two, where the two paths of a rule that is the same in every system of units are equal bit
+for bit.
 """
 
 from __future__ import annotations
