@@ -51,7 +51,8 @@ _SNAP = 16  # support boxes snap to a grid of 1/_SNAP of the region
 # larger than the support weakens M, and the s = 0.2 power-law Newton test then stalls.
 _REUSE_UP_TO = 2.0
 # A window with more FFT points than this fraction of the full padding uses the full one: on a device, and on NumPy
-# (four blocks below BANDS_ABOVE, paired above; measured in docs/performance.md); a paired window is reused so
+# (four blocks below BANDS_ABOVE, paired above; measured in docs/performance.md); a cached paired window is reused
+# up to this size ratio (the four blocks up to _REUSE_UP_TO)
 _FULL_ABOVE, _NUMPY_FULL_ABOVE, _PAIRED_REUSE_UP_TO = 0.7, 0.85, 1.25
 
 
