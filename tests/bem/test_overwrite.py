@@ -8,7 +8,6 @@ preconditioner's input to its output (``tests/bem/test_memory.py`` bounds what t
 import numpy as np
 import pytest
 
-import bem
 from bem.lattice import Lattice
 from bem.operator import InfluenceOperator
 from bem.periodic import PeriodicCell, PeriodicOperator
