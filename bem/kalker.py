@@ -254,18 +254,19 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             if not gt > 0:  # no descent along t after a change of the contact: steepest descent
                 t_c, gt = z, gz
         t_kept, t = (idx, t_c), bk.spread(lat.shape, idx, t_c)
+        lam_c = bk.take(lam, idx) if per_node else lam  # the compliance at the contact
         gz_old, g_c = gz, None  # the gap at the contact is not held through the products
         # open nodes with g < 0 enter the contact below and C p is then recomputed: C t would serve only the
         # curvature t.(C + lam) t, which op.quadratic gives without the product
         if quadratic is not None and not bounded and bool(xp.any(bk.take(p, low) == 0)):
-            tt, r, t = quadratic(t) + float(xp.sum((bk.take(lam, idx) if per_node else lam) * t_c * t_c)), None, None
+            tt, r, t = quadratic(t) + float(xp.sum(lam_c * t_c * t_c)), None, None
         else:
             p_c0 = None  # (C + lam) t in the buffer of t, lam t added at the contact; p at the contact gathered after
             r, t = op.matvec(t, overwrite_p=True), None
             p_c0 = bk.take(p, idx)
             r_c = bk.take(r, idx)
             if per_node or lam:
-                r_c += (bk.take(lam, idx) if per_node else lam) * t_c
+                r_c += lam_c * t_c
                 bk.put(r, idx, r_c)
             if force is not None:
                 r_c -= xp.mean(r_c)

@@ -73,9 +73,10 @@ def _contains(outer, inner):
     return all(within(o, i) for o, i in zip(outer[0], inner[0])) and within(outer[1], inner[1])
 
 
-def _pair_bytes(shape, single=False):
-    """Bytes of a pair of half spectra of the padded ``shape`` (complex128, complex64 where ``single``)."""
-    return 2 * shape[0] * (shape[1] // 2 + 1) * (8 if single else 16)
+def _by_bands(backend, shape, single=False):
+    """Whether a product of the padded ``shape`` runs by bands of columns: on NumPy above ``BANDS_ABOVE`` bytes of its
+    pair of half spectra (complex128, complex64 where ``single``)."""
+    return backend.is_numpy and 2 * shape[0] * (shape[1] // 2 + 1) * (8 if single else 16) > BANDS_ABOVE
 
 
 def _rows(s, k0, n, n_rows):
@@ -203,7 +204,7 @@ class InfluenceOperator:
         def size(b):  # padded FFT points, up to the fast-length rounding
             return (max(self._n) + max(r[1] for r in b[0])) * (n_cols + b[1][1])
 
-        paired = self.backend.is_numpy and _pair_bytes(padded_shape(full, box)) > BANDS_ABOVE
+        paired = _by_bands(self.backend, padded_shape(full, box))
         if size(box) > (_NUMPY_FULL_ABOVE if self.backend.is_numpy else _FULL_ABOVE) * size(full):
             box = full
         up_to = _PAIRED_REUSE_UP_TO if paired else _REUSE_UP_TO
@@ -234,8 +235,7 @@ class InfluenceOperator:
         transforms in single precision, with single-precision spectra)."""
         o_rows, (oq, nq) = out_box
         bk = self.backend
-        if isinstance(spectra, PairedSymbol) or (
-                bk.is_numpy and _pair_bytes(shape, single) > BANDS_ABOVE):
+        if isinstance(spectra, PairedSymbol) or _by_bands(bk, shape, single):
             dests = [out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] for s, (k0, na) in zip(self._start, o_rows)]
             convolve_by_bands(spectra, shape, self._parts(v, in_box), dests, np.float32 if single else np.float64)
         elif bk.is_numpy:  # the parities' rows transformed where they are, the products written where they go
@@ -364,8 +364,7 @@ class InfluenceOperator:
                 symbols[box] = self._inverse_symbol(box, lam, floor, single)  # its spectra are not kept
             shape, spectra = symbols[box]
             # the output on the box, after its input is read; r = 0 off its box (the support's, or the whole region)
-            own = overwrite_r and r.dtype == bk.float64
-            out = r if own else bk.xp.zeros(self.lattice.shape, dtype=bk.float64)
+            out = r if overwrite_r and r.dtype == bk.float64 else bk.xp.zeros(self.lattice.shape, dtype=bk.float64)
             self._convolve(spectra, shape, r, box, box, out, single)
             return out
 

@@ -141,7 +141,7 @@ def _traced_peak_per_node(solve):
     return (peak - base) / res.p.size
 
 
-# traced peaks per node of these problems (numpy 2.4): 89, 119, 86, 170, 192 and 145 bytes; a solve that holds its
+# traced peaks per node of these problems (numpy 2.4): 89, 119, 86, 168, 192 and 144 bytes; a solve that holds its
 # coarser levels, the spectra its symbols are made of and its copies of the iterates traces 176, 275, 180 and 343;
 # Newton holding its step and the model's gap through the line search, and its iterate beside its start, 132 with
 # the root layer; a product over the whole region with four complex blocks of spectra, and transforms that hold the

@@ -12,12 +12,7 @@ from bem.lattice import Lattice
 from bem.operator import InfluenceOperator
 from bem.periodic import PeriodicCell, PeriodicOperator
 
-
-def _support(lat, seed, rows, cols):
-    rng = np.random.default_rng(seed)
-    v = np.zeros(lat.shape)
-    v[rows, cols] = rng.standard_normal(v[rows, cols].shape)
-    return v * lat.mask
+from .test_column_bands import _support
 
 
 _CASES = [  # (bands, rows, cols): a window off the centre, a corner, the whole region

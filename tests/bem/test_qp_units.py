@@ -41,7 +41,7 @@ def test_a_rough_sphere_takes_the_same_path_in_si_units_and_in_units_of_order_on
     assert one.iterations == si.iterations
     assert one.n_matvec == si.n_matvec
     assert 0.02 < one.contact_area < 0.5  # a fraction of the region (side 1)
-    # the same path: the scaled pressures agree to round-off (measured 1.4e-13 and 1.7e-14 of p_max), far below the
+    # the same path: the scaled pressures agree to round-off (measured 1.3e-14 and 2.1e-14 of p_max), far below the
     # tolerance's 1e-10; entering pressures of -tau g in the preconditioned step (a length for a pressure) gave 1.9e-11
     assert np.abs(si.p / 115e9 - one.p).max() <= 1e-12 * one.p_max
 
@@ -53,8 +53,9 @@ def test_newton_on_a_root_layer_takes_the_same_path_in_si_units_and_in_units_of_
     # which every length, pressure and compliance of the two runs scale exactly: a rule that is the same in every
     # system of units gives the same path bit for bit, and one that mixes a length with a pressure a path that
     # differs by whole factors. With factors that are not powers of two the path at k = 1e-3 amplifies round-off
-    # to the size such a rule gave before (2.9e-12 of p_max): the gap times 1 + 2^-52 moves the answer of the
-    # order-one run by 1e-12 to 2e-11 of p_max, the same iterations
+    # to the size such a rule gave when it was found (2.9e-12 of p_max): the gap times 1 + 2^-52, 1 - 2^-53 or
+    # 1 + 2^-50 moves the answer of the order-one run by 2.4e-11 to 4.6e-11 of p_max, the same iterations
+    # (docs/performance.md)
     L, E = 2.0**-10, 2.0**38
 
     def solve(L, E):
