@@ -25,7 +25,7 @@ import scipy.fft as sfft
 
 from .. import fft
 from ..backend import backend_of, get_backend
-from ..checks import check_positive
+from ..checks import check_positive, fail
 from ..operator import diagonal_coefficient
 from .coated import coated_template
 from .kernel import periodic_template
@@ -47,6 +47,16 @@ def _checked_bodies(bodies, E_star):
         raise InputError(f"E_star = {E_star!r} is not allowed with bodies: it must be bodies.E_star = "
                          f"{bodies.E_star!r}, the substrates' effective modulus.")
     return bodies if bodies.is_coated else None
+
+
+def _checked_out(out, shape, dtype):
+    """``out`` where it is a C-contiguous NumPy array of ``shape`` and ``dtype``; a new array where it is None."""
+    if out is None:
+        return np.empty(shape, dtype=dtype)
+    if not (isinstance(out, np.ndarray) and out.shape == shape and out.dtype == dtype and out.flags.c_contiguous):
+        got = f"{type(out).__name__} of shape {getattr(out, 'shape', None)} and dtype {getattr(out, 'dtype', None)}"
+        fail("out", got, f"a C-contiguous NumPy array of shape {shape} and dtype {np.dtype(dtype)}")
+    return out
 
 
 def _spectra(w):
@@ -148,13 +158,14 @@ class PeriodicOperator:
             out[a, ...] = bk.cfft(rows[a::2, :], axis=0)
         return out
 
-    def spectrum(self, v):
+    def spectrum(self, v, out=None):
         """Spectra of the two parities of a brick array, shape ``(n_rows/2, 2, n_cols/2 + 1)``.
 
         ``[:, a, :]`` is the 2-D real FFT of the rows of parity ``a``: one ``rfft2`` over the
         axes 0 and 2 of the view ``(n_rows/2, 2, n_cols)`` of the brick array, no copy. A float32
         array gives a complex64 spectrum. In the namespace of the operator's device (``xp.fft``
-        off NumPy).
+        off NumPy). ``out``: a C-contiguous array of that shape and dtype that receives it (NumPy; default: a
+        new array, as off NumPy).
         """
         n_rows, n_cols = self.lattice.shape
         if not self.backend.is_numpy:
@@ -162,17 +173,20 @@ class PeriodicOperator:
             return xp.fft.fft(xp.fft.rfft(xp.reshape(v, (n_rows // 2, 2, n_cols)), axis=2), axis=0)
         # the two 1-D passes of rfft2, the second in place: the same numbers, 10-15 % faster
         # (benchmarks/periodic_rough.py --cases products); each on the threads of bem.fft.in_parts
-        out = np.empty((n_rows // 2, 2, n_cols // 2 + 1), dtype=np.result_type(v.dtype, np.complex64))
+        out = _checked_out(out, (n_rows // 2, 2, n_cols // 2 + 1), np.result_type(v.dtype, np.complex64))
         return fft.cfft_in_place(fft.rfft_into(v.reshape(n_rows // 2, 2, n_cols), out, 2), 0, 2)
 
-    def brick(self, spectrum, overwrite=False):
-        """The brick array of a spectrum laid out as :meth:`spectrum` gives it (the inverse of it)."""
+    def brick(self, spectrum, overwrite=False, out=None):
+        """The brick array of a spectrum laid out as :meth:`spectrum` gives it (the inverse of it).
+
+        ``overwrite``: the spectrum may be destroyed; ``out``: a C-contiguous array of the lattice's shape and the
+        spectrum's real dtype that receives it (NumPy; default: a new array, as off NumPy)."""
         n_rows, n_cols = self.lattice.shape
         if not self.backend.is_numpy:
             xp = self.backend.xp
             return xp.reshape(xp.fft.irfft(xp.fft.ifft(spectrum, axis=0), n=n_cols, axis=2), (n_rows, n_cols))
         cols = fft.cfft_in_place(spectrum if overwrite else spectrum.copy(), 0, 2, inverse=True)  # irfft2 in two passes
-        out = np.empty((n_rows // 2, 2, n_cols), dtype=cols.real.dtype)
+        out = _checked_out(out, (n_rows, n_cols), cols.real.dtype).reshape(n_rows // 2, 2, n_cols)
         return fft.irfft_into(cols, out, n_cols, 2).reshape(n_rows, n_cols)
 
     @staticmethod

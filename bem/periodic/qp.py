@@ -11,13 +11,13 @@ Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)``, and t
 ``g.t <= 0`` the step falls back to ``t = z`` (the rule of the general loop, :func:`bem.kalker.solve_qp`). On a
 rough surface, whose contact set changes at most iterations until it settles, a loop that restarts at every entering
 node degrades to preconditioned steepest descent (``tests/bem/test_periodic_qp.py``: 82 iterations of such a loop
-against 57 of both on a 256 x 256 self-affine cell). Nodes that enter the
-contact (``p = 0``, ``g < 0``) take the step of the preconditioned iteration with a share of the Jacobi estimate of
-the preconditioner at that node, ``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` =
-:data:`bem.cg_rules.ENTERING_FRACTION`, chosen by the iteration counts stated there): ``tau`` is dimensionless here
-(``t`` is ``M g``), and ``-tau g`` would give an entering node ``tau C_nn`` of its Jacobi pressure, a fraction that
-falls with the step (on a 672 x 776 rough cell, 1e-4 of the mean contact pressure: a cycle of nodes entering with
-almost no pressure and leaving, at a constant KKT residual, ``tests/bem/test_periodic_robustness.py``). Further:
+against 57 of both on a 256 x 256 self-affine cell). Nodes that enter the contact (``p = 0``, ``g < 0``) take the
+step of the preconditioned iteration with a share of the Jacobi estimate of the preconditioner at that node,
+``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`, chosen by the iteration
+counts stated there): ``tau`` is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give an entering node
+``tau C_nn`` of its Jacobi pressure, a fraction that falls with the step (on a 672 x 776 rough cell, 1e-4 of the
+mean contact pressure: a cycle of nodes entering with almost no pressure and leaving, at a constant KKT residual,
+``tests/bem/test_periodic_robustness.py``). Further:
 
 - the iteration keeps ``u = (C + lam) p`` in double precision. After a step without a change of the contact set it
   is updated by ``tau (C + lam) t``, the product of the search direction, which runs in single precision: its
@@ -60,8 +60,8 @@ The step runs on the array namespace of the operator's device (:mod:`bem.backend
 namespace with ``xp.fft``), every array on the device; the host receives the scalars of the step (the KKT residual's
 extremes, the sums of the force, the inner products, the counts of the contact and its changes: about 16 a step,
 more with a compliance per node or a hardness, and the sizes of three node selections). Other transforms round
-differently and take the same iterations (``tests/bem/test_backend_namespace.py``); NumPy reuses buffers in place
-(:mod:`bem.periodic.qp_parts`).
+differently and take the same iterations (``tests/bem/test_backend_namespace.py``); NumPy reuses arrays from step
+to step (:mod:`bem.periodic.qp_parts`).
 """
 
 from __future__ import annotations
@@ -75,7 +75,7 @@ from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bou
                         entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .passes import kernels
-from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, weighted_square
+from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, StepArrays, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -153,34 +153,31 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
     passes = kernels(lat.n_nodes, bk)  # the passes over the whole cell (bem.periodic.passes)
     soft = stiff = None
+    lam_pc, jacobi = lam, 1.0 / (diag + lam)
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
         stiff = is_stiff(D, diag, threshold)
         sel = stiff & (p > 0)
         lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
         jacobi = 1.0 / (diag + D) if hardness is not None else None  # 1 / (C_nn + D), for bounded_move
         soft = None if bool(xp.all(stiff)) else ~stiff
-    else:
-        lam_pc, jacobi = lam, 1.0 / (diag + lam)
-    M = op.symbol(lam_pc, inverse=True, single=True)
-    A32 = op.symbol(lam, single=True)
+    M, A32 = op.symbol(lam_pc, inverse=True, single=True), op.symbol(lam, single=True)
     r_hat = None  # the spectrum of (C + lam) t, kept from step to step (NumPy)
     brick = ContactBrick(bk, lat.shape)  # the gap on the contact, then the search direction t (float32)
+    work = StepArrays(bk, lat.shape)  # the spectra of the products and a float32 brick array, reused
 
-    def product(v):
+    def product(v):  # (C + lam) v, a spectrum in work's bytes
         op.n_matvec += 1
-        if single:
-            x = op.spectrum(xp.astype(v, xp.float32))
-            return op.mix(x, A32, out=x)
-        x = op.spectrum(v)
-        return op.mix(x, A, out=x)
+        x = op.spectrum(work.single(v) if single else v, out=work.spectrum(np.complex64 if single else np.complex128))
+        return op.mix(x, A32 if single else A, out=x)
 
-    def apply_m(r32):  # M r, single precision (the spectrum not held beyond the call)
-        return op.brick(op.mix(x := op.spectrum(r32), M, out=x), overwrite=True)
+    def apply_m(r32, out=None):  # M r, single precision (the spectrum in work's bytes), into out
+        x = op.spectrum(r32, out=work.spectrum(np.complex64))
+        return op.brick(op.mix(x, M, out=x), overwrite=True, out=out)
 
     def precondition(r32, sel, r_c, soft_c, jac_c):
         # M r at the selected nodes: r_c = r there, r32 = r (float32) at the stiff nodes; soft_c, jac_c: the soft
         # nodes and 1 / (C_nn + D) there (None: no soft node)
-        z = passes.gather(apply_m(r32), sel)
+        z = passes.gather(apply_m(r32, work.brick32()), sel)
         return z if soft_c is None else xp.where(soft_c, jac_c * r_c, z)
 
     def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
@@ -197,11 +194,16 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def times_p(c):  # c p for a compliance c (per node or uniform), in g's buffer on NumPy
         return np.multiply(c, p, out=g) if bk.is_numpy else c * p
 
-    def exact_u():  # (C + lam) p, and D p per node
-        u = op.brick(product(p), overwrite=True)
-        return add_into(u, times_p(D)) if per_node else u
+    def product_u():  # u = (C + lam) p, on NumPy in u's array where it has the product's precision (else not held)
+        nonlocal u
+        u = u if bk.is_numpy and u is not None and u.dtype == (np.float32 if single else np.float64) else None
+        u = op.brick(product(p), overwrite=True, out=u)
+        return u
 
-    single = False  # the first product in double precision: it sets the scale of the KKT residual
+    def exact_u():  # (C + lam) p, and D p per node
+        return add_into(product_u(), times_p(D)) if per_node else product_u()
+
+    single, u = False, None  # the first product in double precision: it sets the scale of the KKT residual
     if u0 is None:
         u, stale = exact_u(), 0
     else:  # C x0 from the caller, confirmed like an incremental update
@@ -255,7 +257,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         nonlocal single, u, stale
         if (kkt <= rtol and (stale or single) and confirm) or (single and kkt <= SINGLE_ABOVE):
             single = False  # confirm on an exact product, or go on in double precision
-            u = None  # the product replaces it: not both at once
             u, stale = exact_u(), 0
             return True
         return False
@@ -311,7 +312,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
         gz_old = gz
-        T = op.spectrum(brick.write(idx, t_c))
+        T = op.spectrum(brick.write(idx, t_c), out=work.spectrum(np.complex64))
         op.n_matvec += 1
         # (C + lam) t, single precision, and t.(C + lam) t; t has zero sum on the contact under force control
         R, tt = op.mix_inner(T, A32, out=r_hat)
@@ -352,8 +353,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 p_o *= s
             bk.put(p, overlap, p_o)
         if bool(xp.any(clipped)) or entered or stale >= RECOMPUTE_EVERY:
-            u = None
-            u, stale = op.brick(product(p), overwrite=True), 0
+            u, stale = product_u(), 0
             if per_node:  # u += D p, on the nodes where p > 0
                 add_at(u, idx, D_c * p_c)
                 if entered:
@@ -365,7 +365,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
 
     def update_u(R, tau, t_c, D_c, s):  # u - tau (C + lam) t (from its spectrum R) - tau D t, times s
         nonlocal u, stale
-        passes.subtract_scaled(u, op.brick(R, overwrite=True), tau, s if D_c is None else 1.0)  # s: one pass
+        passes.subtract_scaled(u, op.brick(R, overwrite=True, out=work.brick32()), tau, s if D_c is None else 1.0)
         if D_c is not None:
             add_at(u, idx, -tau * (D_c * t_c))
             if s != 1.0:
@@ -379,7 +379,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if failure is not None:
             return failure
         if changed or R is None or stale >= RECOMPUTE_EVERY:
-            u = None
             u, stale = exact_u(), 0
         else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
             update_u(R, tau, t_c, D_c, s)

@@ -4,9 +4,11 @@ states)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["ContactBrick", "ContactNodes", "LastPreconditionedGap", "weighted_square"]
+__all__ = ["ContactBrick", "ContactNodes", "LastPreconditionedGap", "StepArrays", "weighted_square"]
 
 
 def weighted_square(bk, d, t):
@@ -202,3 +204,47 @@ class LastPreconditionedGap:
     def _lookup(self, nodes):  # the kept z at a few sorted nodes, 0 where it was not kept
         at = np.minimum(np.searchsorted(self.nodes, nodes), self.nodes.size - 1)
         return np.where(self.nodes[at] == nodes, self.z[at], np.float32(0))
+
+
+class StepArrays:
+    """The bytes of a complex128 spectrum of the cell that the products of every step write into, on NumPy: a
+    complex128 spectrum (:meth:`spectrum`), or a complex64 spectrum in its first half beside a float32 brick array in
+    its second (:meth:`brick32`, which fits there). One array for the solve instead of fresh arrays at every product:
+    the pages of a fresh array above the allocator's mapping threshold (32 MB by default in glibc) are mapped and
+    zeroed by the kernel at each allocation, a cost of the order of the transforms on large cells
+    (``benchmarks/scaling.py``; ``docs/performance.md``). Off NumPy every method gives ``None`` (new arrays).
+
+    Parameters
+    ----------
+    bk : bem.backend.Backend
+        The backend of the iteration.
+    shape : tuple of int
+        The shape of the cell's brick arrays ``(n_rows, n_cols)``, ``n_rows`` even.
+    """
+
+    def __init__(self, bk, shape):
+        self.bk, self.shape = bk, tuple(shape)
+        self.spectrum_shape = (shape[0] // 2, 2, shape[1] // 2 + 1)
+        self.bytes = np.empty(16 * math.prod(self.spectrum_shape), dtype=np.uint8) if bk.is_numpy else None
+
+    def spectrum(self, dtype):
+        """The array as a spectrum of the layout of :meth:`bem.periodic.PeriodicOperator.spectrum` in ``dtype``
+        (complex64 or complex128)."""
+        if self.bytes is None:
+            return None
+        return self.bytes.view(dtype)[: math.prod(self.spectrum_shape)].reshape(self.spectrum_shape)
+
+    def brick32(self):
+        """A float32 brick array in the second half of the bytes (beside ``spectrum(np.complex64)``)."""
+        if self.bytes is None:
+            return None
+        half = self.bytes.size // 2
+        return self.bytes[half : half + 4 * math.prod(self.shape)].view(np.float32).reshape(self.shape)
+
+    def single(self, v):
+        """``v`` rounded to float32 (in :meth:`brick32` on NumPy)."""
+        if self.bytes is None:
+            return self.bk.xp.astype(v, self.bk.xp.float32)
+        out = self.brick32()
+        out[...] = v
+        return out

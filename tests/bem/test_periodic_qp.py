@@ -178,7 +178,7 @@ def test_periodic_qp_runs_its_early_products_in_single_precision_and_ends_in_dou
     lam = op.diagonal * np.random.default_rng(2).uniform(0.2, 2.0, cell.shape) if per_node else 0.0
     seen = []
     spectrum = op.spectrum
-    monkeypatch.setattr(op, "spectrum", lambda v: seen.append(v.dtype) or spectrum(v))
+    monkeypatch.setattr(op, "spectrum", lambda v, out=None: seen.append(v.dtype) or spectrum(v, out=out))
     res = solve_periodic_qp(op, h, force=force, lam=lam, rtol=1e-10)
     assert res.converged
     assert res.history["residual"][0] > qp.SINGLE_START * qp.SINGLE_ABOVE
@@ -212,7 +212,7 @@ def test_an_unconfirmed_loose_periodic_qp_stays_in_single_precision(monkeypatch)
     u0 = op.matvec(x0)
     seen = []
     spectrum = op.spectrum
-    monkeypatch.setattr(op, "spectrum", lambda v: seen.append(v.dtype) or spectrum(v))
+    monkeypatch.setattr(op, "spectrum", lambda v, out=None: seen.append(v.dtype) or spectrum(v, out=out))
     rtol = 10 * qp.SINGLE_ABOVE
     res = solve_periodic_qp(op, h, force=force, x0=x0, u0=u0, rtol=rtol, confirm=False)
     assert res.converged and res.iterations >= 3
