@@ -194,7 +194,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def times_p(c):  # c p for a compliance c (per node or uniform), in g's buffer on NumPy
         return np.multiply(c, p, out=g) if bk.is_numpy else c * p
 
-    def product_u():  # u = (C + lam) p, on NumPy in u's array where it has the product's precision (else not held)
+    def product_u():  # u = (C + lam) p; on NumPy in the last u where it has the product's precision (else let go first)
         nonlocal u
         u = u if bk.is_numpy and u is not None and u.dtype == (np.float32 if single else np.float64) else None
         u = op.brick(product(p), overwrite=True, out=u)
