@@ -197,20 +197,20 @@ class PeriodicOperator:
         ``(n_rows/2, 1, n_cols/2 + 1)`` where the two blocks are equal, as :meth:`symbol` gives
         it) and ``B[:, a] = S_a(1-a)``, so that ``out = D X + B X'`` with ``X'`` the spectrum with
         its parities swapped: three passes over blocks of :data:`bem.fft.BLOCK` entries (the product
-        ``B X'`` in a buffer of one block), on :func:`bem.fft.in_parts` threads. ``out``
-        (default: a new array) may be ``spectrum`` itself. Off NumPy, ``D X + B X'`` in the
-        spectrum's namespace (a new array; ``out`` is not used).
+        ``B X'`` in a buffer of one block), on :func:`bem.fft.in_parts` threads. ``out`` (default: a new
+        array; C-contiguous, of the spectrum's shape and dtype) may be ``spectrum`` itself. Off NumPy,
+        ``D X + B X'`` in the spectrum's namespace (a new array; ``out`` is not used).
         """
         d, b = symbol
         if not isinstance(spectrum, np.ndarray):
             return d * spectrum + b * backend_of(spectrum).xp.flip(spectrum, axis=1)
-        return mixed(spectrum, symbol, np.empty_like(spectrum) if out is None else out, None)[0]
+        return mixed(spectrum, symbol, _checked_out(out, spectrum.shape, spectrum.dtype), None)[0]
 
     def mix_inner(self, spectrum, symbol, out=None):
         """:meth:`mix` and the :meth:`inner` of ``X`` and the product: ``(out, sum x y)``.
 
         On NumPy the sum is taken block by block as the product is made (no second pass over the two
-        spectra), in double precision; ``out`` (default: a new array) must not be ``spectrum``.
+        spectra), in double precision; ``out`` (as for :meth:`mix`) must not be ``spectrum``.
         """
         n_rows, n_cols = self.lattice.shape
         if not isinstance(spectrum, np.ndarray):
@@ -218,7 +218,7 @@ class PeriodicOperator:
             return out, self.inner(spectrum, out)
         if out is spectrum:
             raise ValueError("out: the product cannot overwrite the spectrum whose inner product it takes")
-        out, sums = mixed(spectrum, symbol, np.empty_like(spectrum) if out is None else out, n_cols % 2 == 0)
+        out, sums = mixed(spectrum, symbol, _checked_out(out, spectrum.shape, spectrum.dtype), n_cols % 2 == 0)
         return out, sum(sums) / (n_rows // 2 * n_cols)
 
     def inner(self, x, y):

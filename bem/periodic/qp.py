@@ -161,9 +161,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         jacobi = 1.0 / (diag + D) if hardness is not None else None  # 1 / (C_nn + D), for bounded_move
         soft = None if bool(xp.all(stiff)) else ~stiff
     M, A32 = op.symbol(lam_pc, inverse=True, single=True), op.symbol(lam, single=True)
-    r_hat = None  # the spectrum of (C + lam) t, kept from step to step (NumPy)
     brick = ContactBrick(bk, lat.shape)  # the gap on the contact, then the search direction t (float32)
-    work = StepArrays(bk, lat.shape)  # the spectra of the products and a float32 brick array, reused
+    work = StepArrays(bk, lat.shape)  # the spectra and bricks of the products (NumPy: one array, reused)
 
     def product(v):  # (C + lam) v, a spectrum in work's bytes
         op.n_matvec += 1
@@ -273,7 +272,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return bk.max0(p_c0), n, changes, n == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, m_at, gz_old, r_hat, u, stale
+        nonlocal m_full, m_one, m_at, gz_old, u, stale
         if bounded and not bk.count(idx):  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
         steady = nodes.steady  # the last direction on the contact (float32) as written, D and what follows there
@@ -315,8 +314,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         T = op.spectrum(brick.write(idx, t_c), out=work.spectrum(np.complex64))
         op.n_matvec += 1
         # (C + lam) t, single precision, and t.(C + lam) t; t has zero sum on the contact under force control
-        R, tt = op.mix_inner(T, A32, out=r_hat)
-        r_hat = R
+        R, tt = op.mix_inner(T, A32, out=work.spectrum(np.complex64, second=True))
         if per_node:
             tt += weighted_square(bk, D_c, t_c)
         if not bool(xp.any(t_c != 0)):
@@ -365,7 +363,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
 
     def update_u(R, tau, t_c, D_c, s):  # u - tau (C + lam) t (from its spectrum R) - tau D t, times s
         nonlocal u, stale
-        passes.subtract_scaled(u, op.brick(R, overwrite=True, out=work.brick32()), tau, s if D_c is None else 1.0)
+        passes.subtract_scaled(u, op.brick(R, overwrite=True, out=work.brick32(second=False)), tau, s if D_c is None else 1.0)
         if D_c is not None:
             add_at(u, idx, -tau * (D_c * t_c))
             if s != 1.0:

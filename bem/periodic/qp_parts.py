@@ -208,11 +208,11 @@ class LastPreconditionedGap:
 
 class StepArrays:
     """The bytes of a complex128 spectrum of the cell that the products of every step write into, on NumPy: a
-    complex128 spectrum (:meth:`spectrum`), or a complex64 spectrum in its first half beside a float32 brick array in
-    its second (:meth:`brick32`, which fits there). One array for the solve instead of fresh arrays at every product:
-    the pages of a fresh array above the allocator's mapping threshold (32 MB by default in glibc) are mapped and
-    zeroed by the kernel at each allocation, a cost of the order of the transforms on large cells
-    (``benchmarks/scaling.py``; ``docs/performance.md``). Off NumPy every method gives ``None`` (new arrays).
+    complex128 spectrum, or in each half of the bytes a complex64 spectrum or a float32 brick array (which fits
+    there). One array for the solve instead of new arrays at every product: the pages of a new array above the
+    allocator's mapping threshold (32 MB by default in glibc) are mapped and zeroed by the kernel at each allocation,
+    a cost of the order of the transforms on large cells (``docs/performance.md``, "The arrays the cell's step
+    reuses"). Off NumPy every method gives ``None`` (new arrays).
 
     Parameters
     ----------
@@ -227,19 +227,24 @@ class StepArrays:
         self.spectrum_shape = (shape[0] // 2, 2, shape[1] // 2 + 1)
         self.bytes = np.empty(16 * math.prod(self.spectrum_shape), dtype=np.uint8) if bk.is_numpy else None
 
-    def spectrum(self, dtype):
-        """The array as a spectrum of the layout of :meth:`bem.periodic.PeriodicOperator.spectrum` in ``dtype``
-        (complex64 or complex128)."""
-        if self.bytes is None:
-            return None
-        return self.bytes.view(dtype)[: math.prod(self.spectrum_shape)].reshape(self.spectrum_shape)
-
-    def brick32(self):
-        """A float32 brick array in the second half of the bytes (beside ``spectrum(np.complex64)``)."""
-        if self.bytes is None:
-            return None
+    def _half(self, second):
         half = self.bytes.size // 2
-        return self.bytes[half : half + 4 * math.prod(self.shape)].view(np.float32).reshape(self.shape)
+        return self.bytes[half:] if second else self.bytes[:half]
+
+    def spectrum(self, dtype, second=False):
+        """The array as a spectrum of the layout of :meth:`bem.periodic.PeriodicOperator.spectrum` in ``dtype``:
+        complex128 in all the bytes, complex64 in their first half (``second``: in the second)."""
+        if self.bytes is None:
+            return None
+        n = math.prod(self.spectrum_shape)
+        data = self.bytes if np.dtype(dtype) == np.complex128 else self._half(second)
+        return data.view(dtype)[:n].reshape(self.spectrum_shape)
+
+    def brick32(self, second=True):
+        """A float32 brick array in the second half of the bytes (``second=False``: the first)."""
+        if self.bytes is None:
+            return None
+        return self._half(second)[: 4 * math.prod(self.shape)].view(np.float32).reshape(self.shape)
 
     def single(self, v):
         """``v`` rounded to float32 (in :meth:`brick32` on NumPy)."""

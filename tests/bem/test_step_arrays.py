@@ -59,7 +59,11 @@ def test_step_arrays_hold_a_double_spectrum_or_a_single_spectrum_beside_a_single
     s64, s128, b32 = work.spectrum(np.complex64), work.spectrum(np.complex128), work.brick32()
     assert s64.shape == s128.shape == spec_shape and b32.shape == shape and b32.dtype == np.float32
     assert s64.flags.c_contiguous and s128.flags.c_contiguous and b32.flags.c_contiguous
-    assert not np.shares_memory(s64, b32)  # the two single-precision arrays are used at once
+    assert not np.shares_memory(s64, b32)  # used at once: the preconditioner's spectrum and its brick,
+    first_b32, second_s64 = work.brick32(second=False), work.spectrum(np.complex64, second=True)
+    assert not np.shares_memory(s64, second_s64) and not np.shares_memory(first_b32, second_s64)  # a product, its brick
+    assert np.shares_memory(s64, first_b32) and np.shares_memory(b32, second_s64)
+    assert second_s64.shape == spec_shape and second_s64.flags.c_contiguous and first_b32.shape == shape
     assert np.shares_memory(s128, s64) and np.shares_memory(s128, b32)  # one array of the cell in all
     assert work.bytes.nbytes == s128.nbytes
     v = np.random.default_rng(1).standard_normal(shape)
@@ -72,7 +76,7 @@ def test_step_arrays_off_numpy_give_new_arrays():
     xp = pytest.importorskip("array_api_strict")
     bk = get_backend(xp)
     work = StepArrays(bk, (4, 6))
-    assert work.spectrum(np.complex64) is None and work.brick32() is None
+    assert work.spectrum(np.complex64) is None and work.brick32() is None and work.spectrum(np.complex128) is None
     v = xp.ones((4, 6), dtype=xp.float64)
     assert work.single(v).dtype == xp.float32
 
