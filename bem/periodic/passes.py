@@ -10,14 +10,17 @@ contiguous parts run at once (:func:`bem.fft.in_parts`):
 - ``subtract_scaled``: the update ``u = s (u - tau (C + lam) t)`` from the product in single precision (``s`` the
   rescaling to the force), one pass instead of three;
 - ``gather``: the preconditioned gap (single precision) at the contact's nodes, in double precision;
+- ``merge``: the next contact made from the step, its nodes that stayed and the entering ones merged in order, with
+  their pressures, into given arrays (:class:`bem.periodic.qp_parts.ContactNodes`), in one pass (serial);
 - ``mix``: the 2 x 2 block product of a spectrum (:func:`bem.periodic.spectra.mixed`, every product with ``C``
   or its inverse) and, for the curvature of the step, its weighted sum with the spectrum, one pass instead of
   four.
 
 Without numba, or on a smaller cell, the same passes run as the NumPy forms (:func:`numpy_kernels`,
-:func:`bem.periodic.spectra.numpy_mixed`). The first three give NumPy's numbers bit for bit: each makes the same
-operations in the same precision at every node, and their reductions are minima and maxima, whose value does not
-depend on their order; a NaN propagates as in NumPy. The block product rounds each operation as written (NumPy's
+:func:`bem.periodic.spectra.numpy_mixed`; the merge as ``numpy.insert`` in :class:`bem.periodic.qp_parts.ContactNodes`).
+The first three give NumPy's numbers bit for bit: each makes the same operations in the same precision at every
+node, and their reductions are minima and maxima, whose value does not depend on their order; a NaN propagates as in
+NumPy. The merge copies values. The block product rounds each operation as written (NumPy's
 loops may fuse a multiply and an add: the two can differ in the last bit) and sums each block of rows in the order
 of its entries (``tests/bem/test_periodic_passes.py``). Selections and most gathers stay NumPy's, faster than a
 compiled loop at these sizes (``docs/performance.md``, "Compiled passes").
@@ -108,7 +111,8 @@ def kernels(n_nodes, bk=None):
     -------
     class or object
         Methods ``gap(u, h, g)``, ``subtract_scaled(u, r, tau, s=1.0)``, ``gather(x, idx)`` (and, compiled,
-        ``mix(spectrum, symbol, out, even, rows)``) and the flag ``compiled``.
+        ``mix(spectrum, symbol, out, even, rows)`` and ``merge(idx, values, stayed, new, new_values, out_idx,
+        out_values, at)``) and the flag ``compiled``.
     """
     if bk is not None and not bk.is_numpy:
         return _NamespaceKernels(bk)
@@ -138,6 +142,8 @@ def load():
             k.gap(u, x64, np.empty(4))
             k.subtract_scaled(u, x32.copy(), 1.0, 2.0)
         k.gather(x32, idx)
+        at, flag = np.empty(1, dtype=np.intp), np.ones(2, dtype=bool)
+        k.merge(idx, x64[:2], flag, idx[:1], x64[:1], np.empty(3, dtype=idx.dtype), np.empty(3), at)
         for real, cplx in ((np.float32, np.complex64), (np.float64, np.complex128)):  # the spectra's precisions
             x = np.zeros((2, 2, 3), dtype=cplx)
             k.mix(x, (np.zeros((2, 1, 3), dtype=real), x.copy()), x, True, 1)
@@ -202,6 +208,22 @@ def _compile():
             if sums.size:
                 sums[k] = total
 
+    @njit(**opts)
+    def _merge(idx, vals, stayed, new, new_vals, out_idx, out_vals, at):
+        o = j = m = 0  # written, stayed so far, entering written
+        for i in range(idx.size):
+            if stayed[i]:
+                v = idx[i]
+                while m < new.size and new[m] < v:
+                    at[m], out_idx[o], out_vals[o] = j, new[m], new_vals[m]
+                    o, m = o + 1, m + 1
+                out_idx[o], out_vals[o] = v, vals[i]
+                o, j = o + 1, j + 1
+        while m < new.size:
+            at[m], out_idx[o], out_vals[o] = j, new[m], new_vals[m]
+            o, m = o + 1, m + 1
+        return o
+
     def run(kernel, n):  # kernel(lo, hi) on the parts of range(n); their results in the order of the parts
         res = {}
         fft.in_parts(lambda part: res.__setitem__(part.start, kernel(part.start, part.stop)), n, n)
@@ -233,6 +255,10 @@ def _compile():
             fft.in_parts(lambda part: _mix(spectrum, d, b, out, rows, part.start, part.stop, sums, bool(even)),
                          blocks, spectrum.size)
             return out, sums
+
+        @staticmethod
+        def merge(idx, vals, stayed, new, new_vals, out_idx, out_vals, at):
+            return _merge(idx, vals, stayed, new, new_vals, out_idx, out_vals, at)
 
         @staticmethod
         def gather(x, idx):

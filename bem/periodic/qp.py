@@ -210,7 +210,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     last_z = LastPreconditionedGap(bk, lat.shape)  # the last preconditioned gap, on its contact only
     gz_old, m_one, m_full, m_at = 1.0, None, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
-    nodes = ContactNodes(bk, p)  # the contact of the iterate; steady: the last step's, whose D_c, ... it keeps
+    nodes = ContactNodes(bk, p, getattr(passes, "merge", None))  # the iterate's contact (steady: the last step's)
     fixed_scale = scale
     idx = g_c = p_c0 = g_min = u_range = None  # u_range: max u, min u
 
@@ -363,7 +363,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
 
     def update_u(R, tau, t_c, D_c, s):  # u - tau (C + lam) t (from its spectrum R) - tau D t, times s
         nonlocal u, stale
-        passes.subtract_scaled(u, op.brick(R, overwrite=True, out=work.brick32(second=False)), tau, s if D_c is None else 1.0)
+        r = op.brick(R, overwrite=True, out=work.brick32(second=False))
+        passes.subtract_scaled(u, r, tau, s if D_c is None else 1.0)  # s: one pass
         if D_c is not None:
             add_at(u, idx, -tau * (D_c * t_c))
             if s != 1.0:

@@ -42,10 +42,16 @@ class ContactNodes:
         The backend of the iteration.
     p : array
         The starting pressure (brick array).
+    merge : callable, optional
+        The compiled merge of :mod:`bem.periodic.passes` (``merge(idx, values, stayed, new, new_values, out_idx,
+        out_values, at) -> n``): with it the next contact is written into one of two pairs of arrays the object
+        holds, in turn, rather than into new ones (their pages are not mapped again at every change of a large
+        contact); without it by ``numpy.insert``. The same selection and values either way.
     """
 
-    def __init__(self, bk, p):
-        self.bk = bk
+    def __init__(self, bk, p, merge=None):
+        self.bk, self.merge = bk, merge
+        self._pairs, self._turn = [None, None], 0  # the arrays of the contacts made from the step (with merge)
         self.was_on = p > 0  # the contact of the last count of changes
         self.n_was = int(bk.xp.count_nonzero(self.was_on))
         self.steady, self.idx, self.on, self.p_c, self.kept = False, None, None, None, (None, None, None)
@@ -90,16 +96,33 @@ class ContactNodes:
         self.p_c = p_c if self.steady else None  # not held beside the next contact
         if self.steady or not self.bk.is_numpy:
             return
-        idx, left = self.idx[positive], self.idx[~positive]
-        p_c, new = p_c[positive], left[:0]
-        at = new  # where the entering nodes go among those that stayed
-        if entered:
-            on = p_o > 0
-            new = entering[on]
-            at = np.searchsorted(idx, new)  # the sorted merge of two disjoint sorted selections
+        left = self.idx[~positive]
+        new, p_new = (entering[on := p_o > 0], p_o[on]) if entered else (left[:0], p_c[:0])
+        if self.merge is not None:  # the sorted merge of two disjoint sorted selections, into held arrays
+            out_idx, out_p = self._pair(int(np.count_nonzero(positive)) + new.size, p_c.dtype)
+            at = np.empty(new.size, dtype=np.intp)  # where the entering nodes go among those that stayed
+            n = self.merge(self.idx, p_c, positive, new, p_new, out_idx, out_p, at)
+            idx, p_c = out_idx[:n], out_p[:n]
+        else:
+            idx, p_c = self.idx[positive], p_c[positive]
+            at = np.searchsorted(idx, new)
             if new.size:
-                idx, p_c = np.insert(idx, at, new), np.insert(p_c, at, p_o[on])
+                idx, p_c = np.insert(idx, at, new), np.insert(p_c, at, p_new)
         self.next, self.moved = (idx, p_c, positive, at, new), (left, new)
+
+    def _pair(self, n, dtype):
+        """Arrays of at least ``n`` node indices and values for the next contact: the pair not holding the present
+        one (made anew, with an eighth to spare, where it is too small)."""
+        i = 1 - self._turn
+        if self._pairs[i] is not None and np.may_share_memory(self._pairs[i][0], self.idx):
+            i = self._turn
+        self._turn = i
+        pair = self._pairs[i]
+        if pair is None or pair[0].size < n or pair[1].dtype != dtype:
+            self._pairs[i] = None  # let go before the new pair is made
+            size = n + n // 8
+            pair = self._pairs[i] = np.empty(size, dtype=self.idx.dtype), np.empty(size, dtype=dtype)
+        return pair
 
     def over(self, idx, make, old=None):
         """Values at the contact's nodes ``idx``: ``make(nodes)``, a gather at the given nodes; where the contact of

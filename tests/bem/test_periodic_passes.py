@@ -135,7 +135,7 @@ def test_the_qp_with_the_compiled_passes_is_the_qp_without(monkeypatch, two_thre
     monkeypatch.setattr(spectra, "kernels", lambda n: passes.numpy_kernels())
     with_kernels = solve_periodic_qp(op, h, **kw)
     n_with = op.n_matvec
-    assert {"gap", "subtract_scaled", "gather"} <= set(calls)
+    assert {"gap", "subtract_scaled", "gather", "merge"} <= set(calls)
     monkeypatch.setattr(passes, "MIN_NODES", 10**12)
     op.n_matvec = 0
     without = solve_periodic_qp(op, h, **kw)
@@ -190,3 +190,66 @@ def test_the_qp_with_every_compiled_pass_solves_the_same_problem(monkeypatch, tw
     assert fast.converged and plain.converged and fast.kkt_residual <= kw["rtol"]
     assert case == "coated" or abs(fast.iterations - plain.iterations) <= 1
     np.testing.assert_allclose(fast.p, plain.p, rtol=0, atol=1e-8 * plain.p.max())
+
+
+@pytest.mark.parametrize("n, n_new, stay", [(40, 7, 0.8), (40, 0, 0.5), (40, 5, 0.0), (0, 4, 1.0), (25, 6, 1.0)])
+def test_the_compiled_merge_is_the_numpy_insert(n, n_new, stay):
+    """The next contact from the step: the nodes that stayed and the entering ones, disjoint and each sorted, merged
+    in order with their values, and where the entering ones went among those that stayed (``numpy.insert``'s
+    positions), including entering nodes before, between and after all others."""
+    rng = np.random.default_rng(n + n_new)
+    nodes = np.sort(rng.choice(200, n + n_new, replace=False))
+    old, new = np.sort(rng.permutation(nodes)[:n]), None
+    new = np.setdiff1d(nodes, old)
+    stayed = rng.random(n) < stay
+    vals, new_vals = rng.standard_normal(n), rng.standard_normal(new.size)
+    kept = old[stayed]
+    at_ref = np.searchsorted(kept, new)
+    out_idx, out_vals = np.full(n + n_new + 3, -1), np.full(n + n_new + 3, np.nan)
+    at = np.empty(new.size, dtype=np.intp)
+    m = _compiled().merge(old, vals, stayed, new, new_vals, out_idx, out_vals, at)
+    assert m == kept.size + new.size
+    np.testing.assert_array_equal(out_idx[:m], np.insert(kept, at_ref, new))
+    np.testing.assert_array_equal(out_vals[:m], np.insert(vals[stayed], at_ref, new_vals))
+    np.testing.assert_array_equal(at, at_ref)
+    assert np.all(out_idx[m:] == -1)  # nothing written beyond
+
+
+def test_contact_nodes_with_the_merge_make_the_contacts_of_numpy_insert_in_two_held_pairs():
+    """A sequence of steps that change the contact: with the compiled merge every contact read, its pressures and
+    what is carried over to it equal those made by ``numpy.insert``; each is written into one of two pairs of
+    arrays held from step to step, never the pair of the contact it replaces."""
+    from bem.backend import get_backend
+    from bem.periodic.qp_parts import ContactNodes
+
+    bk = get_backend("cpu")
+    rng = np.random.default_rng(3)
+    shape = (12, 10)
+    p = np.where(rng.random(shape) < 0.4, rng.random(shape), 0.0)
+    merged, plain = ContactNodes(bk, p, _compiled().merge), ContactNodes(bk, p)
+    buffers = set()
+    for k in range(12):
+        (idx_m, p_m), (idx_p, p_p) = merged.read(p), plain.read(p)
+        np.testing.assert_array_equal(idx_m, idx_p)
+        np.testing.assert_array_equal(p_m, p_p)
+        assert idx_m.dtype == idx_p.dtype and p_m.dtype == p_p.dtype
+        if k:  # made from the step: in a held pair
+            values = rng.standard_normal(p.size)
+            np.testing.assert_array_equal(merged.over(idx_m, values.take, values[before]),
+                                          plain.over(idx_p, values.take, values[before]))
+            held = [i for i, pair in enumerate(merged._pairs) if pair is not None and np.shares_memory(pair[0], idx_m)]
+            assert len(held) == 1 and np.shares_memory(merged._pairs[held[0]][1], p_m)
+            buffers.update(pair[0].__array_interface__["data"][0] for pair in merged._pairs if pair is not None)
+        step = p_m * rng.uniform(0.5, 1.5, p_m.size)
+        step[rng.random(step.size) < 0.2] = 0.0  # some leave
+        off = np.flatnonzero(p.ravel() == 0)
+        entering = np.sort(rng.choice(off, min(3, off.size), replace=False))
+        p_o = np.where(rng.random(entering.size) < 0.7, rng.random(entering.size), 0.0)  # one may not enter
+        for nodes in (merged, plain):
+            nodes.stepped(step, True, entering, p_o)
+        before = idx_m
+        replaced = [pair for pair in merged._pairs if pair is not None and np.shares_memory(pair[0], idx_m)]
+        assert not any(np.shares_memory(pair[0], merged.next[0]) for pair in replaced)
+        p.reshape(-1)[idx_m] = step
+        p.reshape(-1)[entering] = p_o
+    assert len(buffers) <= 4  # two pairs, made anew only where a contact outgrew them
