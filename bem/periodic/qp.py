@@ -332,7 +332,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             bk.put(p, idx, p_c)  # p is 0 off idx
         # re-entering nodes (p = 0, g < 0): the step tau of the preconditioned direction with the Jacobi
         # estimate of M there, -f min(tau, 1) g / (C_nn + lam) (module docstring: entering nodes)
-        overlap = bk.select((g < delta) & (p == 0))
+        overlap = bk.select(work.entering(g, delta, p))
         entered = bool(bk.count(overlap))
         p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, jacobi_at(overlap) if per_node else jacobi,
                                 per_node, preconditioned=True) if entered else None

@@ -269,6 +269,16 @@ class StepArrays:
             return None
         return self._half(second)[: 4 * math.prod(self.shape)].view(np.float32).reshape(self.shape)
 
+    def entering(self, g, delta, p):
+        """The mask of the nodes that may enter the contact, ``(g < delta) & (p == 0)`` (NumPy: in the first half of
+        the bytes, free between the product of a step's direction and the update of ``u``)."""
+        if self.bytes is None:
+            return (g < delta) & (p == 0)
+        n = math.prod(self.shape)
+        mask, zero = (self.bytes[i * n : (i + 1) * n].view(np.bool_).reshape(self.shape) for i in (0, 1))
+        np.less(g, delta, out=mask)
+        return np.logical_and(mask, np.equal(p, 0, out=zero), out=mask)
+
     def single(self, v):
         """``v`` rounded to float32 (in :meth:`brick32` on NumPy)."""
         if self.bytes is None:

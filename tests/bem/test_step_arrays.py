@@ -102,3 +102,27 @@ def test_a_periodic_qp_makes_its_products_in_its_step_arrays(per_node, monkeypat
     assert len(new) > 4 * res.iterations  # spectra and bricks of every step
     # the first product (spectrum and brick), the brick of the switch to double precision, M 1's brick per node
     assert sum(new) <= (4 if per_node else 3)
+
+
+@pytest.mark.parametrize("shape", [(16, 12), (16, 13), (2, 5)])
+def test_the_entering_mask_is_made_in_the_first_half_beside_the_product_of_the_direction(shape):
+    """``(g < delta) & (p == 0)`` in the half of the bytes that the step's product of its direction does not use (it
+    is read after the mask, to update ``u``)."""
+    work = StepArrays(get_backend("cpu"), shape)
+    rng = np.random.default_rng(5)
+    product = work.spectrum(np.complex64, second=True)
+    product[...] = rng.standard_normal(product.shape) + 1j * rng.standard_normal(product.shape)
+    keep = product.copy()
+    g, p = rng.standard_normal(shape), np.where(rng.random(shape) < 0.5, 0.0, rng.random(shape))
+    g_in, p_in = g.copy(), p.copy()
+    mask = work.entering(g, -0.2, p)
+    np.testing.assert_array_equal(mask, (g < -0.2) & (p == 0))
+    assert mask.any() and not mask.all()
+    assert np.shares_memory(mask, work.spectrum(np.complex64)) and not np.shares_memory(mask, product)
+    np.testing.assert_array_equal(product, keep)
+    np.testing.assert_array_equal(g, g_in)
+    np.testing.assert_array_equal(p, p_in)
+    xp = pytest.importorskip("array_api_strict")
+    other = StepArrays(get_backend(xp), shape)
+    got = other.entering(xp.asarray(g), -0.2, xp.asarray(p))
+    np.testing.assert_array_equal(np.asarray(got), mask)
