@@ -44,14 +44,15 @@ class ContactNodes:
         The starting pressure (brick array).
     merge : callable, optional
         The compiled merge of :mod:`bem.periodic.passes` (``merge(idx, values, stayed, new, new_values, out_idx,
-        out_values, at) -> n``): with it the next contact is written into one of two pairs of arrays the object
-        holds, in turn, rather than into new ones (their pages are not mapped again at every change of a large
-        contact); without it by ``numpy.insert``. The same selection and values either way.
+        out_values, at) -> n``): with it the next contact is written into the one of two pairs of arrays the
+        object holds that does not hold the present contact, rather than into new ones (their pages are not mapped
+        again at every change of a large contact); without it by ``numpy.insert``. The same selection and values
+        either way.
     """
 
     def __init__(self, bk, p, merge=None):
         self.bk, self.merge = bk, merge
-        self._pairs, self._turn = [None, None], 0  # the arrays of the contacts made from the step (with merge)
+        self._pairs = [None, None]  # the arrays of the contacts made from the step (with merge)
         self.was_on = p > 0  # the contact of the last count of changes
         self.n_was = int(bk.xp.count_nonzero(self.was_on))
         self.steady, self.idx, self.on, self.p_c, self.kept = False, None, None, None, (None, None, None)
@@ -113,10 +114,7 @@ class ContactNodes:
     def _pair(self, n, dtype):
         """Arrays of at least ``n`` node indices and values for the next contact: the pair not holding the present
         one (made anew, with an eighth to spare, where it is too small)."""
-        i = 1 - self._turn
-        if self._pairs[i] is not None and np.may_share_memory(self._pairs[i][0], self.idx):
-            i = self._turn
-        self._turn = i
+        i = int(self._pairs[0] is not None and np.may_share_memory(self._pairs[0][0], self.idx))
         pair = self._pairs[i]
         if pair is None or pair[0].size < n or pair[1].dtype != dtype:
             self._pairs[i] = None  # let go before the new pair is made

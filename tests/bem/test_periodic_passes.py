@@ -199,7 +199,7 @@ def test_the_compiled_merge_is_the_numpy_insert(n, n_new, stay):
     positions), including entering nodes before, between and after all others."""
     rng = np.random.default_rng(n + n_new)
     nodes = np.sort(rng.choice(200, n + n_new, replace=False))
-    old, new = np.sort(rng.permutation(nodes)[:n]), None
+    old = np.sort(rng.permutation(nodes)[:n])
     new = np.setdiff1d(nodes, old)
     stayed = rng.random(n) < stay
     vals, new_vals = rng.standard_normal(n), rng.standard_normal(new.size)
