@@ -1,28 +1,27 @@
 """Kalker's QP on a periodic cell: the conjugate gradients of :func:`bem.kalker.solve_qp` in the Fourier basis.
 
-The step of :meth:`bem.periodic.PeriodicOperator.qp` in the one loop :func:`bem.cg_rules.run_constrained_cg`. The
-iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active set, Polonsky & Keer
-1999, with the FFT preconditioner, the same entering rule, Jacobi cap and stopping rule), specialised to
-:class:`bem.periodic.PeriodicOperator`, where ``C`` is diagonal in the Fourier basis of the cell (a 2 x 2 block per
-frequency, one block row per row parity) and every node is a candidate. It does not restart the conjugate directions
-when nodes enter the contact: the new direction is ``t = z + beta t_old`` on the current contact with the
-Polak-Ribiere+ coefficient ``beta = max(0, g.(z - z_old) / g_old.z_old)``, and the step is the minimum along ``t``,
-``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the contact does not change, the conjugate-gradient step); where
-``g.t <= 0`` the step falls back to ``t = z`` (the rule of the general loop, :func:`bem.kalker.solve_qp`). On a
-rough surface, whose contact set changes at most iterations until it settles, a loop that restarts at every entering
-node degrades to preconditioned steepest descent (``tests/bem/test_periodic_qp.py``: 82 iterations of such a loop
-against 57 of both on a 256 x 256 self-affine cell). Nodes that enter the contact (``p = 0``, ``g < 0``) take the
-step of the preconditioned iteration with a share of the Jacobi estimate of the preconditioner at that node,
-``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`, chosen by the iteration
-counts stated there): ``tau`` is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give an entering node
-``tau C_nn`` of its Jacobi pressure, a fraction that falls with the step (on a 672 x 776 rough cell, 1e-4 of the
-mean contact pressure: a cycle of nodes entering with almost no pressure and leaving, at a constant KKT residual,
-``tests/bem/test_periodic_robustness.py``). Further:
+The step of :meth:`bem.periodic.PeriodicOperator.qp` in the one loop :func:`bem.cg_rules.run_constrained_cg`: the
+iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active set, Polonsky & Keer 1999,
+with the FFT preconditioner, the same entering rule, Jacobi cap and stopping rule) on
+:class:`bem.periodic.PeriodicOperator`, whose ``C`` is diagonal in the Fourier basis of the cell (a 2 x 2 block per
+frequency, one block row per row parity); every node is a candidate. Nodes entering the contact do not restart the
+directions: ``t = z + beta t_old`` on the current contact, ``beta = max(0, g.(z - z_old) / g_old.z_old)``
+(Polak-Ribiere+), the step the minimum along ``t``, ``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the contact
+does not change), and ``t = z`` where ``g.t <= 0``. On a rough surface, whose contact set changes at most iterations
+until it settles, a loop that restarts at every entering node degrades to preconditioned steepest descent
+(``tests/bem/test_periodic_qp.py``: 82 iterations against 57 on a 256 x 256 self-affine cell). An entering node
+(``p = 0``, ``g < 0``) takes the step with a share of the Jacobi estimate of the preconditioner there,
+``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`): ``tau`` is dimensionless
+here (``t`` is ``M g``), and ``-tau g`` would give it ``tau C_nn`` of its Jacobi pressure, a fraction that falls with
+the step (on a 672 x 776 rough cell at 1e-4 of the mean contact pressure, nodes entering with almost no pressure and
+leaving, at a constant KKT residual: ``tests/bem/test_periodic_robustness.py``). Further:
 
-- the iteration keeps ``u = (C + lam) p`` in double precision. After a step without a change of the contact set it
-  is updated by ``tau (C + lam) t``, the product of the search direction, which runs in single precision: its
-  rounding is a relative ``1e-7`` of the step, and the step falls with the residual. After a change of the contact
-  set, and after every 20 updates, ``u`` is recomputed from ``p``;
+- the iteration keeps ``u = (C + lam) p`` in double precision, updated after a step by the product of its move in
+  single precision (rounded to a relative ``1e-7`` of the step, which falls with the residual): where the contact set
+  did not change ``tau (C + lam) t``, the search direction's product; where it changed (NumPy) that of ``t'``,
+  ``tau t' = p - p_new / s``: ``t`` but at the clipped and entering nodes. ``u`` is recomputed from ``p`` after
+  every 20 updates, and at a change while the products run in single precision (below), before ``u`` was once
+  recomputed in double precision (from the caller's ``u0``) or off NumPy;
 - the curvature ``t.(C + lam) t`` is a sum over the spectrum of that product (Parseval, summed in double precision,
   block by block as the product is made: :func:`bem.periodic.spectra.mixed`);
 - the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
@@ -44,24 +43,20 @@ With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the p
 ``M 1`` of the starting contact).
 
 With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H`` and the step is
-that of every constrained-CG step (:func:`bem.cg_rules.bounded_move`). The directions restart (``beta = 0``) after a
-step that was shortened, or capped at ``H``, to carry the force: the fill of the force at the bound breaks the
-conjugacy, and a Polak-Ribiere+ direction kept there repeats the step that failed (on a 64-column self-affine cell
-at 18 % of ``H``, ``tests/bem/test_hardness_units.py``: no convergence in 688 iterations without). Nodes that enter
-or leave keep the directions, as without a hardness (a 512^2 law of 20 pressures at ``H = E* h'_rms``: 531
-iterations, 695 when those restart too).
+:func:`bem.cg_rules.bounded_move`; the directions restart (``beta = 0``) after a step shortened or capped at ``H`` to
+carry the force, which breaks the conjugacy (without: no convergence in 688 iterations on a 64-column self-affine
+cell at 18 % of ``H``, ``tests/bem/test_hardness_units.py``), not where nodes enter or leave (a 512^2 law of 20
+pressures at ``H = E* h'_rms``: 531 iterations, 695 when those restart too).
 
 A step costs four transforms of the cell in single precision while the contact set does not change (two for the
-preconditioner, one forward for the search direction, one inverse for its product), five where it changes, two of
-them in double precision once the residual is below ``SINGLE_ABOVE`` (the general loop: four or six in double
-precision, or up to eight with a compliance per node).
+preconditioner, one forward for the search direction, one inverse for its product), five where it changes (off
+NumPy two of them in double precision once the residual is below ``SINGLE_ABOVE``; the general loop: four or six in
+double precision, or up to eight with a compliance per node).
 
 The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any array API
-namespace with ``xp.fft``), every array on the device; the host receives the scalars of the step (the KKT residual's
-extremes, the sums of the force, the inner products, the counts of the contact and its changes: about 16 a step,
-more with a compliance per node or a hardness, and the sizes of three node selections). Other transforms round
-differently and take the same iterations (``tests/bem/test_backend_namespace.py``); NumPy reuses arrays from step
-to step (:mod:`bem.periodic.qp_parts`).
+namespace with ``xp.fft``); the host receives its scalars (about 16 a step, more with a compliance per node or a
+hardness, and the sizes of three node selections). Other transforms round differently and take the same iterations
+(``tests/bem/test_backend_namespace.py``); NumPy reuses arrays from step to step (:mod:`bem.periodic.qp_parts`).
 """
 
 from __future__ import annotations
@@ -75,7 +70,7 @@ from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bou
                         entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .passes import kernels
-from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, StepArrays, weighted_square
+from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, StepArrays, elastic_part, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -194,15 +189,17 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return np.multiply(c, p, out=g) if bk.is_numpy else c * p
 
     def product_u():  # u = (C + lam) p; on NumPy in the last u where it has the product's precision (else let go first)
-        nonlocal u
+        nonlocal u, exact_base
         u = u if bk.is_numpy and u is not None and u.dtype == (np.float32 if single else np.float64) else None
-        u = op.brick(product(p), overwrite=True, out=u)
+        u, exact_base = op.brick(product(p), overwrite=True, out=u), not single
         return u
 
     def exact_u():  # (C + lam) p, and D p per node
         return add_into(product_u(), times_p(D)) if per_node else product_u()
 
-    single, u = False, None  # the first product in double precision: it sets the scale of the KKT residual
+    # the first product in double precision: it sets the scale of the KKT residual; exact_base: u was last made by a
+    # product in double precision (not the caller's u0, nor in single precision), updated since by steps' products
+    single, u, exact_base = False, None, False
     if u0 is None:
         u, stale = exact_u(), 0
     else:  # C x0 from the caller, confirmed like an incremental update
@@ -328,6 +325,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         p_c = p_c0 - tau * t_c
         clipped = p_c < 0
         p_c = xp.where(clipped, 0.0, p_c)
+        changed = bool(xp.any(clipped))
         if not (positive := bool(xp.all(p_c > 0))):  # else p = 0 at the same nodes (p_c0 > 0): put once below
             bk.put(p, idx, p_c)  # p is 0 off idx
         # re-entering nodes (p = 0, g < 0): the step tau of the preconditioned direction with the Jacobi
@@ -336,6 +334,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         entered = bool(bk.count(overlap))
         p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, jacobi_at(overlap) if per_node else jacobi,
                                 per_node, preconditioned=True) if entered else None
+        moved = terms = None  # a change in double precision: u from the product of the move t' (module docstring)
+        if (changed or entered) and exact_base and not single and tau > 0 and stale < RECOMPUTE_EVERY and bk.is_numpy:
+            moved = brick.moved(clipped, p_c0[clipped] / tau, *((overlap, -p_o / tau) if entered else ()))
+            terms = [(idx, D_c * (p_c - p_c0))] + ([(overlap, bk.take(D, overlap) * p_o)] if entered else []) if (
+                per_node) else []  # D (p_new / s - p), before the scaling by s
         s = 1.0
         if target is not None:
             total = float(xp.sum(p_c)) + (float(xp.sum(p_o)) if entered else 0.0)
@@ -350,25 +353,30 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             if s != 1.0:
                 p_o *= s
             bk.put(p, overlap, p_o)
-        if bool(xp.any(clipped)) or entered or stale >= RECOMPUTE_EVERY:
+        if moved is not None or not (changed or entered or stale >= RECOMPUTE_EVERY):
+            # p = s (p - tau t) (t' where moved): u = s (u - tau (C + lam) t), plus D t per node
+            update_u(R, tau, s, terms if moved is not None else [(idx, -tau * (D_c * t_c))] if per_node else [], moved)
+        else:
             u, stale = product_u(), 0
             if per_node:  # u += D p, on the nodes where p > 0
                 add_at(u, idx, D_c * p_c)
                 if entered:
                     add_at(u, overlap, bk.take(D, overlap) * p_o)
-        else:  # p = s (p - tau t) on the contact: u = s (u - tau (C + lam) t), plus D t per node
-            update_u(R, tau, t_c, D_c if per_node else None, s)
         nodes.stepped(p_c, entered, overlap, p_o)  # after the product: the next contact is not held through it
         return None
 
-    def update_u(R, tau, t_c, D_c, s):  # u - tau (C + lam) t (from its spectrum R) - tau D t, times s
-        nonlocal u, stale
+    def update_u(R, tau, s, terms, moved=None):  # s (u - tau (C + lam) t + terms): R the spectrum of (C + lam) t, or
+        nonlocal u, stale  # moved the brick of t' (made here); terms: D's, a list of (nodes, values)
+        if moved is not None:
+            op.n_matvec += 1
+            R = op.mix(op.spectrum(moved, out=work.spectrum(np.complex64, second=True)), A32, out=R)
+            brick.restore()
         r = op.brick(R, overwrite=True, out=work.brick32(second=False))
-        passes.subtract_scaled(u, r, tau, s if D_c is None else 1.0)  # s: one pass
-        if D_c is not None:
-            add_at(u, idx, -tau * (D_c * t_c))
-            if s != 1.0:
-                u *= s
+        passes.subtract_scaled(u, r, tau, 1.0 if terms else s)  # s: one pass
+        for sel, values in terms:
+            add_at(u, sel, values)
+        if terms and s != 1.0:
+            u *= s
         stale += 1
 
     def bounded_step(tau, t_c, R, D_c):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
@@ -380,19 +388,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if changed or R is None or stale >= RECOMPUTE_EVERY:
             u, stale = exact_u(), 0
         else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
-            update_u(R, tau, t_c, D_c, s)
+            update_u(R, tau, s, [] if D_c is None else [(idx, -tau * (D_c * t_c))])
         return None
 
     step = CGStep(measure_bounded, confirms, observe_bounded, advance, lambda: bk.copy(p)) if bounded else CGStep(
         measure, confirms, observe, advance, lambda: bk.copy(p))
     kkt = run_constrained_cg(step, record, maxiter, callback)
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not bk.count(idx))
-    # C p: the layer's closure is not a displacement
-    if not (per_node or lam):
-        elastic = xp.astype(u, xp.float64, copy=False)
-    elif bk.is_numpy:  # in the gap's buffer, free now (u may be in single precision)
-        elastic = np.subtract(u, times_p(D if per_node else lam), out=g)
-    else:
-        elastic = u - (D if per_node else lam) * p
-    return record.solution(p, delta, kkt, elastic, "Kalker QP (periodic)")
+    # C p: the layer's closure is not a displacement (on NumPy in the gap's buffer, free now; u may be float32)
+    return record.solution(p, delta, kkt, elastic_part(bk, u, D if per_node else lam, p, g), "Kalker QP (periodic)")
 

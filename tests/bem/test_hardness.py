@@ -16,6 +16,7 @@ import pytest
 import bem
 from bem.gaps import Paraboloid
 from bem.kkt import kkt_residual
+from bem.periodic.qp_parts import ContactBrick
 
 
 def _rough(cell, seed=5, modes=4):
@@ -224,12 +225,17 @@ def test_a_small_half_space_region_agrees_with_an_independent_dense_solver():
     assert np.abs(q - res.p).max() <= 1e-10 * H
 
 
-def test_a_hardness_above_the_peak_pressure_gives_the_elastic_answer():
+def test_a_hardness_above_the_peak_pressure_gives_the_elastic_answer(monkeypatch):
     h = _rough(CELL)
-    elastic = bem.solve_periodic(h, step=CELL.step, E_star=1.0, mean_pressure=0.02)
+    with monkeypatch.context() as m:
+        # the elastic cell with the bounded step's update of C p at a change of the contact, an exact product (its
+        # default, the product of the move, differs by rounding: 8.5e-11 of p_max here;
+        # tests/bem/test_periodic_move_product.py)
+        m.setattr(ContactBrick, "moved", lambda self, *args: None)
+        elastic = bem.solve_periodic(h, step=CELL.step, E_star=1.0, mean_pressure=0.02)
     capped = bem.solve_periodic(h, step=CELL.step, E_star=1.0, mean_pressure=0.02, hardness=1.01 * elastic.p_max)
     assert capped.plastic_area == 0.0 and capped.status == "converged"
-    assert np.abs(capped.p - elastic.p).max() <= 1e-11 * elastic.p_max  # measured 1.4e-12 (the same iterations)
+    assert np.abs(capped.p - elastic.p).max() <= 1e-11 * elastic.p_max  # measured 7.2e-12 (the same iterations)
     assert capped.contact_area == elastic.contact_area
     sphere = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.3)
     big = bem.solve(Paraboloid(1.0), E_star=1.0, force=1.0, step=0.05, extent=1.3, hardness=1e6)

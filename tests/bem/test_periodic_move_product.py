@@ -1,0 +1,145 @@
+"""The update of ``u = (C + lam) p`` after a step of the periodic QP that changed the contact, in double precision:
+from the single-precision product of the step's own move (:meth:`bem.periodic.qp_parts.ContactBrick.moved`) instead
+of a double-precision product of ``p``. Against the QP that recomputes ``u`` at every change (the move's brick
+refused), the dense matrix and the KKT conditions; the brick's edits against their definition."""
+
+import math
+
+import numpy as np
+import pytest
+
+import bem.periodic.qp as qp
+from bem.backend import get_backend
+from bem.kkt import kkt_residual
+from bem.periodic import PeriodicCell, PeriodicOperator
+from bem.periodic.qp import solve_periodic_qp
+from bem.periodic.qp_parts import ContactBrick
+
+from .test_periodic_qp import _self_affine
+
+E_STAR = 1.0
+
+
+def _brick():
+    rng = np.random.default_rng(7)
+    brick = ContactBrick(get_backend("cpu"), (6, 8))
+    nodes = np.sort(rng.choice(48, 20, replace=False))
+    brick.write(nodes, rng.standard_normal(20))
+    return brick, nodes
+
+
+def test_the_move_writes_at_the_clipped_nodes_adds_at_the_entering_ones_and_is_undone():
+    brick, nodes = _brick()
+    before = brick.values.copy()
+    at = np.zeros(20, dtype=bool)
+    at[[2, 5, 11]] = True
+    off = np.setdiff1d(np.arange(48), nodes)[:4]
+    entering = np.sort(np.concatenate([off, nodes[[5]]]))  # one node both clipped and entering
+    values, extra = np.array([1.5, -2.0, 3.25]), np.array([0.5, -0.25, 4.0, 1.0, 2.0])
+    got = brick.moved(at, values, entering, extra)
+    assert got is brick.values
+    want = before.reshape(-1).copy()
+    want[nodes[at]] = values
+    want[entering] += extra
+    np.testing.assert_array_equal(got.reshape(-1), want.astype(np.float32))
+    brick.restore()
+    np.testing.assert_array_equal(brick.values, before)  # bit for bit, the last write's brick
+
+
+def test_a_move_beyond_single_precision_writes_nothing():
+    brick, nodes = _brick()
+    before = brick.values.copy()
+    at = np.zeros(20, dtype=bool)
+    at[3] = True
+    for values, extra in ((np.array([1e39]), None), (np.array([np.nan]), None), (np.array([1.0]), np.array([2e38]))):
+        entering = None if extra is None else np.setdiff1d(np.arange(48), nodes)[:1]
+        assert brick.moved(at, values, entering, extra) is None
+        np.testing.assert_array_equal(brick.values, before)
+
+
+def _spy(monkeypatch, op):
+    seen = []
+    spectrum = op.spectrum
+    monkeypatch.setattr(op, "spectrum", lambda v, out=None: seen.append(v.dtype) or spectrum(v, out=out))
+    return seen
+
+
+def _exact_path(monkeypatch):
+    monkeypatch.setattr(ContactBrick, "moved", lambda self, *a: None)
+
+
+@pytest.mark.parametrize("per_node", [False, True])
+def test_changes_in_double_precision_take_the_product_of_the_move(monkeypatch, per_node):
+    """Double precision from the start: every change of the contact after the first product updates ``u`` from the
+    move's product. The answer is that of the QP that recomputes ``u`` at every change, in about as many
+    iterations, with a fraction of its double-precision transforms; its displacement (confirmed) is exact."""
+    monkeypatch.setattr(qp, "SINGLE_START", math.inf)
+    cell = PeriodicCell(1.0 / 128, 128, 128)
+    h = _self_affine(cell)
+    force = 0.03 * cell.area
+    lam = E_STAR * 0.0 if not per_node else np.random.default_rng(2).uniform(0.2, 2.0, cell.shape) / 128
+    op = PeriodicOperator(cell, E_STAR)
+    seen = _spy(monkeypatch, op)
+    res = solve_periodic_qp(op, h, force=force, lam=lam, rtol=1e-10)
+    with monkeypatch.context() as m:
+        _exact_path(m)
+        ref_op = PeriodicOperator(cell, E_STAR)
+        ref_seen = _spy(m, ref_op)
+        ref = solve_periodic_qp(ref_op, h, force=force, lam=lam, rtol=1e-10)
+    assert res.converged and ref.converged
+    changes = sum(c > 0 for c in ref.history["changes"])
+    assert changes >= 15  # the contact moves in many iterations
+    assert ref_seen.count(np.float64) >= changes and seen.count(np.float64) <= 4
+    assert abs(res.iterations - ref.iterations) <= 2
+    # the same iterates to the rounding of u while the contact moves (a direction left with t' in it departs at once)
+    early = np.array(res.history["residual"][:15]) / np.array(ref.history["residual"][:15])
+    assert np.abs(early - 1).max() <= 1e-4
+    assert np.abs(res.p - ref.p).max() <= 1e-8 * ref.p.max()
+    u = PeriodicOperator(cell, E_STAR).matvec(res.p)
+    np.testing.assert_allclose(res.displacement, u, rtol=0, atol=1e-12 * np.abs(u).max())
+    g = (u + lam * res.p + h - res.approach).ravel()
+    kkt = kkt_residual(res.p.ravel(), g, displacement_scale=float(np.abs(u + lam * res.p).max()), force=force,
+                       node_area=cell.node_area)
+    assert kkt <= 1e-10
+
+
+@pytest.mark.parametrize("control", ["force", "approach"])
+def test_an_unconfirmed_solve_carries_the_moves_into_its_displacement(control):
+    """Newton's model QP (a compliance per node, the caller's start and a product rounded to single precision,
+    ``confirm=False``): ``u`` is made exact at the first change, then follows the moves, so the displacement it
+    returns is ``C p`` to the single-precision rounding of the steps, far below the tolerance."""
+    cell = PeriodicCell(1.0 / 128, 128, 128)
+    h = _self_affine(cell)
+    op = PeriodicOperator(cell, E_STAR)
+    D = np.random.default_rng(5).uniform(0.2, 2.0, cell.shape) * op.diagonal
+    kw = dict(force=0.03 * cell.area) if control == "force" else dict(approach=float(np.quantile(h, 0.25)))
+    x0 = solve_periodic_qp(op, h, rtol=1e-3, **kw).p
+    u0 = op.matvec(x0).astype(np.float32).astype(np.float64)  # as Newton's, after a step in single precision
+    res = solve_periodic_qp(op, h, lam=D, x0=x0, u0=u0, rtol=1e-10, confirm=False, **kw)
+    assert res.converged and sum(c > 0 for c in res.history["changes"]) >= 5
+    u = PeriodicOperator(cell, E_STAR).matvec(res.p)
+    assert np.abs(res.displacement - u).max() <= 1e-9 * np.abs(u).max()
+    g = (u + D * res.p + h - res.approach).ravel()
+    kkt = kkt_residual(res.p.ravel(), g, displacement_scale=float(np.abs(u + D * res.p).max()),
+                       force=kw.get("force"), node_area=cell.node_area)
+    assert kkt <= 1e-9
+
+
+@pytest.mark.parametrize("control", ["force", "approach"])
+def test_a_callers_product_is_recomputed_at_the_first_change_before_moves_follow_it(control):
+    """Started in double precision near the answer from a product rounded to single precision (a later Newton step),
+    the first change recomputes ``u``: the moves then carry an exact product, and the displacement of a solve that
+    ends before the periodic recomputation is ``C p`` far below the rounding of the caller's product."""
+    cell = PeriodicCell(1.0 / 128, 128, 128)
+    h = _self_affine(cell)
+    op = PeriodicOperator(cell, E_STAR)
+    D = np.random.default_rng(5).uniform(0.2, 2.0, cell.shape) * op.diagonal
+    kw = dict(force=0.03 * cell.area) if control == "force" else dict(approach=float(np.quantile(h, 0.25)))
+    x0 = solve_periodic_qp(op, h, lam=D, rtol=1e-3, **kw).p
+    u0 = op.matvec(x0).astype(np.float32).astype(np.float64)
+    res = solve_periodic_qp(op, h, lam=D, x0=x0, u0=u0, rtol=1e-7, confirm=False, **kw)
+    assert res.converged and res.iterations < qp.RECOMPUTE_EVERY - 1
+    assert res.history["residual"][0] < qp.SINGLE_START * qp.SINGLE_ABOVE and sum(c > 0 for c in res.history["changes"]) >= 2
+    u = PeriodicOperator(cell, E_STAR).matvec(res.p)
+    assert np.abs(u0 - op.matvec(x0)).max() > 1e-8 * np.abs(u).max()  # the caller's product is off
+    assert np.abs(res.displacement - u).max() <= 1e-9 * np.abs(u).max()
