@@ -9,6 +9,8 @@ contiguous parts run at once (:func:`bem.fft.in_parts`):
   instead of four;
 - ``subtract_scaled``: the update ``u = s (u - tau (C + lam) t)`` from the product in single precision (``s`` the
   rescaling to the force), one pass instead of three;
+- ``add_at``: ``x[idx] += values`` in ``x``'s precision (a compliance per node's terms of ``u``), one pass
+  instead of a gather, a sum and a scatter;
 - ``gather``: the preconditioned gap (single precision) at the contact's nodes, in double precision;
 - ``merge``: the next contact made from the step, its nodes that stayed and the entering ones merged in order, with
   their pressures, into given arrays (:class:`bem.periodic.qp_parts.ContactNodes`), in one pass (serial);
@@ -62,6 +64,13 @@ class _NumPyKernels:
             u *= u.dtype.type(s)  # in u's precision
 
     @staticmethod
+    def add_at(x, idx, values):
+        """``x[idx] += values`` at the distinct flat indices ``idx``, the sum rounded to ``x``'s precision; ``x``."""
+        flat = x.reshape(-1)
+        flat[idx] = (np.take(flat, idx) + values).astype(x.dtype, copy=False)
+        return x
+
+    @staticmethod
     def gather(x, idx):
         """``x`` (float32) at the flat indices ``idx``, in double precision."""
         return np.take(x.reshape(-1), idx).astype(np.float64)
@@ -87,6 +96,10 @@ class _NamespaceKernels:
         if s != 1.0:
             u *= s
 
+    def add_at(self, x, idx, values):
+        bk = self.bk
+        return bk.put(x, idx, bk.xp.astype(bk.take(x, idx) + values, x.dtype, copy=False))
+
     def gather(self, x, idx):
         return self.bk.xp.astype(self.bk.take(x, idx), self.bk.xp.float64)
 
@@ -110,7 +123,8 @@ def kernels(n_nodes, bk=None):
     Returns
     -------
     class or object
-        Methods ``gap(u, h, g)``, ``subtract_scaled(u, r, tau, s=1.0)``, ``gather(x, idx)`` (and, compiled,
+        Methods ``gap(u, h, g)``, ``subtract_scaled(u, r, tau, s=1.0)``, ``add_at(x, idx, values)`` (``x``; on NumPy
+        in place), ``gather(x, idx)`` (and, compiled,
         ``mix(spectrum, symbol, out, even, rows)`` and ``merge(idx, values, stayed, new, new_values, out_idx,
         out_values, at)``) and the flag ``compiled``.
     """
@@ -141,6 +155,7 @@ def load():
         for u in (x64, x32):  # the iterate's product in double or in single precision
             k.gap(u, x64, np.empty(4))
             k.subtract_scaled(u, x32.copy(), 1.0, 2.0)
+            k.add_at(u, idx, x64[:2])
         k.gather(x32, idx)
         at, flag = np.empty(1, dtype=np.intp), np.ones(2, dtype=bool)
         k.merge(idx, x64[:2], flag, idx[:1], x64[:1], np.empty(3, dtype=idx.dtype), np.empty(3), at)
@@ -178,6 +193,11 @@ def _compile():
     def _subtract_scaled(u, r, tau, s, lo, hi):  # s = 1: the same numbers as u -= r tau (x 1.0 is exact)
         for i in range(lo, hi):
             u[i] = (u[i] - r[i] * tau) * s
+
+    @njit(**opts)
+    def _add_at(x, idx, values, lo, hi):  # distinct indices: the parts write disjoint entries
+        for j in range(lo, hi):
+            x[idx[j]] = x[idx[j]] + values[j]
 
     @njit(**opts)
     def _gather(x, idx, out, lo, hi):
@@ -246,6 +266,14 @@ def _compile():
                 return _NumPyKernels.subtract_scaled(u, r, tau, s)
             u, r, tau, s = u.reshape(-1), r.reshape(-1), np.float32(tau), u.dtype.type(s)
             run(lambda lo, hi: _subtract_scaled(u, r, tau, s, lo, hi), u.size)
+
+        @staticmethod
+        def add_at(x, idx, values):
+            if not x.flags.c_contiguous:
+                return _NumPyKernels.add_at(x, idx, values)
+            xf = x.reshape(-1)
+            run(lambda lo, hi: _add_at(xf, idx, values, lo, hi), idx.size)
+            return x
 
         @staticmethod
         def mix(spectrum, symbol, out, even, rows):

@@ -177,9 +177,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
         return 1.0 / (diag + (bk.take(D, sel) if D_n is None else D_n))
 
-    def add_at(x, sel, values):  # x += values at the selected nodes, in x's precision
-        bk.put(x, sel, xp.astype(bk.take(x, sel) + values, x.dtype, copy=False))
-
     def add_into(x, y):  # x += y in x's precision (NumPy: in place)
         return np.add(x, y, out=x) if bk.is_numpy else xp.astype(x + y, x.dtype, copy=False)
 
@@ -359,9 +356,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         else:
             u, stale = product_u(), 0
             if per_node:  # u += D p, on the nodes where p > 0
-                add_at(u, idx, D_c * p_c)
+                passes.add_at(u, idx, D_c * p_c)
                 if entered:
-                    add_at(u, overlap, bk.take(D, overlap) * p_o)
+                    passes.add_at(u, overlap, bk.take(D, overlap) * p_o)
         nodes.stepped(p_c, entered, overlap, p_o)  # after the product: the next contact is not held through it
         return None
 
@@ -374,7 +371,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         r = op.brick(R, overwrite=True, out=work.brick32(second=False))
         passes.subtract_scaled(u, r, tau, 1.0 if terms else s)  # s: one pass
         for sel, values in terms:
-            add_at(u, sel, values)
+            passes.add_at(u, sel, values)
         if terms and s != 1.0:
             u *= s
         stale += 1

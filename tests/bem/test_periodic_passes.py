@@ -89,6 +89,28 @@ def test_the_compiled_passes_give_the_numpy_forms_numbers(two_threads, single):
     assert fast.gather(x, idx[:0]).shape == (0,)
 
 
+@pytest.mark.parametrize("single", [False, True])
+def test_the_compiled_scatter_add_gives_the_numpy_forms_numbers(two_threads, single):
+    """``add_at`` is NumPy's gather, sum and scatter in ``x``'s precision, bit for bit, over parts of the
+    indices on the threads; it leaves the indices and values as they were."""
+    rng = np.random.default_rng(11)
+    ref, fast = passes.numpy_kernels(), _compiled()
+    dtype = np.float32 if single else np.float64
+    u0 = rng.standard_normal(N).astype(dtype)
+    idx = np.flatnonzero(rng.random(N) < 0.6)  # over 2**17 indices: in parts
+    values = rng.standard_normal(idx.size) * 1e-3
+    expected, x = u0.copy(), u0.copy()
+    keep_idx, keep_values = idx.copy(), values.copy()
+    assert ref.add_at(expected, idx, values) is expected and fast.add_at(x, idx, values) is x
+    assert _identical(x, expected) and not _identical(x, u0)
+    flat = u0.copy()
+    flat[idx] = (u0[idx] + values).astype(dtype)
+    assert _identical(expected, flat)
+    assert _identical(idx, keep_idx) and _identical(values, keep_values)
+    y = u0.copy()
+    assert fast.add_at(y, idx[:0], values[:0]) is y and _identical(y, u0)
+
+
 def test_a_nan_propagates_as_in_numpy(two_threads):
     """A NaN in ``u`` makes every extreme NaN; a NaN in ``h`` only the gap's minimum (NumPy's extremes)."""
     ref, fast = passes.numpy_kernels(), _compiled()
@@ -135,7 +157,7 @@ def test_the_qp_with_the_compiled_passes_is_the_qp_without(monkeypatch, two_thre
     monkeypatch.setattr(spectra, "kernels", lambda n: passes.numpy_kernels())
     with_kernels = solve_periodic_qp(op, h, **kw)
     n_with = op.n_matvec
-    assert {"gap", "subtract_scaled", "gather", "merge"} <= set(calls)
+    assert {"gap", "subtract_scaled", "gather", "merge"} | ({"add_at"} if case == "per_node" else set()) <= set(calls)
     monkeypatch.setattr(passes, "MIN_NODES", 10**12)
     op.n_matvec = 0
     without = solve_periodic_qp(op, h, **kw)
