@@ -126,3 +126,53 @@ def test_the_entering_mask_is_made_in_the_first_half_beside_the_product_of_the_d
     other = StepArrays(get_backend(xp), shape)
     got = other.entering(xp.asarray(g), -0.2, xp.asarray(p))
     np.testing.assert_array_equal(np.asarray(got), mask)
+
+
+def _optional(name):
+    try:
+        return __import__(name)
+    except ImportError:
+        return None
+
+
+def test_the_direction_and_the_stepped_pressures_are_the_expressions_bit_for_bit():
+    """``direction`` is ``z + beta t_old`` and ``stepped_pressures`` is ``p_c0 - tau t_c`` with the negative entries
+    set to +0 (a -0.0 kept, a NaN kept), on NumPy and off it; neither writes its inputs."""
+    from bem.periodic.qp_parts import direction, stepped_pressures
+
+    rng = np.random.default_rng(8)
+    z = rng.standard_normal(1001)
+    t_old = rng.standard_normal(1001).astype(np.float32)
+    p_c0 = np.abs(rng.standard_normal(1001))
+    p_c0[[3, 5, 7]] = [0.25, -0.0, np.nan]
+    keep = [a.copy() for a in (z, t_old, p_c0)]
+    strict = _optional("array_api_strict")
+    for bk in [get_backend("cpu")] + ([get_backend(strict)] if strict is not None else []):
+        xp, host = bk.xp, bk.to_host
+        zz, tt, pp = (xp.asarray(a) for a in (z, t_old, p_c0))
+        for beta in (0.0, 0.3712345678) + ((np.float64(1.25),) if bk.is_numpy else ()):  # a NumPy scalar is not weak
+            t = host(direction(bk, zz, beta, tt))
+            assert np.array_equal(t, z + beta * t_old) and t.dtype == np.float64
+        t_c = z + 0.5 * t_old
+        t_c[[3, 5]] = [0.25 / 0.75, 0.0]  # p_c0 - tau t_c: about 0 at node 3, -0.0 (kept, not clipped) at node 5
+        for tau in (0.75, 1e-3):
+            p_c, clipped = (host(a) for a in stepped_pressures(bk, pp, tau, xp.asarray(t_c)))
+            raw = p_c0 - tau * t_c
+            want = np.where(raw < 0, 0.0, raw)
+            assert np.array_equal(clipped, raw < 0)
+            assert np.array_equal(p_c, want, equal_nan=True) and np.array_equal(np.signbit(p_c), np.signbit(want))
+    for a, b in zip((z, t_old, p_c0), keep):
+        assert np.array_equal(a, b, equal_nan=True)
+
+
+def test_a_held_array_is_reused_and_grows_by_an_eighth():
+    from bem.periodic.qp_parts import HeldArray
+
+    held = HeldArray()
+    a = held(800)
+    assert a.shape == (800,) and a.dtype == np.float64 and held.data.size == 900
+    b = held(900)
+    assert np.shares_memory(a, b) and b.shape == (900,)
+    c = held(901)
+    assert not np.shares_memory(b, c) and held.data.size == 901 + 112
+    assert np.shares_memory(held(5), c)
