@@ -70,8 +70,7 @@ from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bou
                         entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .passes import kernels
-from .qp_parts import (ContactBrick, ContactNodes, HeldArray, LastPreconditionedGap, StepArrays, direction,
-                       elastic_part, stepped_pressures, weighted_square)
+from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, StepArrays, elastic_part, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -159,7 +158,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     M, A32 = op.symbol(lam_pc, inverse=True, single=True), op.symbol(lam, single=True)
     brick = ContactBrick(bk, lat.shape)  # the gap on the contact, then the search direction t (float32)
     work = StepArrays(bk, lat.shape)  # the spectra and bricks of the products (NumPy: one array, reused)
-    held = HeldArray()  # the gap on the contact (NumPy)
 
     def product(v):  # (C + lam) v, a spectrum in work's bytes
         op.n_matvec += 1
@@ -241,7 +239,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         nonlocal idx, g_c, p_c0, delta, g_min
         idx, p_c0 = nodes.read(p)
         g_low = gap()  # the gap is g - delta: delta is subtracted on the contact only
-        g_c = np.take(g.reshape(-1), idx, out=held(idx.size), mode="clip") if bk.is_numpy else bk.take(g, idx)
+        g_c = bk.take(g, idx)
         if force is not None:
             delta = float(xp.mean(g_c)) if bk.count(idx) else math.nan
         g_c -= delta
@@ -300,7 +298,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         beta = 0.0 if k == 1 or gz_old == 0 or restart else max(  # gz_old = 0: one contact node under force control
             0.0, (gz - bk.dot(g_c, last_z.at(idx, nodes))) / gz_old)
         last_z.keep(idx, z)
-        t_c = direction(bk, z, beta, t_old)
+        t_c = z + beta * t_old
         if force is not None:  # nodes that left the contact broke the zero sum of t
             t_c -= m_one * (float(xp.sum(t_c)) / float(xp.sum(m_one))) if m_one is not None else xp.mean(t_c)
         gt = bk.dot(g_c, t_c)
@@ -321,7 +319,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             tau = gt / tt  # the minimum along t (gt = gz when the contact has not changed)
         if bounded:
             return bounded_step(tau, t_c, R, D_c if per_node else None)
-        p_c, clipped = stepped_pressures(bk, p_c0, tau, t_c)
+        p_c = p_c0 - tau * t_c
+        clipped = p_c < 0
+        p_c = xp.where(clipped, 0.0, p_c)
         changed = bool(xp.any(clipped))
         if not (positive := bool(xp.all(p_c > 0))):  # else p = 0 at the same nodes (p_c0 > 0): put once below
             bk.put(p, idx, p_c)  # p is 0 off idx

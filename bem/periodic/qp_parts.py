@@ -10,8 +10,7 @@ import numpy as np
 
 from ..cg_rules import is_per_node
 
-__all__ = ["ContactBrick", "ContactNodes", "HeldArray", "LastPreconditionedGap", "StepArrays", "direction",
-           "elastic_part", "stepped_pressures", "weighted_square"]
+__all__ = ["ContactBrick", "ContactNodes", "LastPreconditionedGap", "StepArrays", "elastic_part", "weighted_square"]
 
 
 def elastic_part(bk, u, lam, p, buffer):
@@ -23,45 +22,6 @@ def elastic_part(bk, u, lam, p, buffer):
     if bk.is_numpy:
         return np.subtract(u, np.multiply(lam, p, out=buffer), out=buffer)
     return u - lam * p
-
-
-def direction(bk, z, beta, t_old):
-    """The search direction ``z + beta t_old`` (``beta t_old`` in ``t_old``'s precision, then added in double
-    precision): on NumPy one new array, the same numbers."""
-    if not bk.is_numpy:
-        return z + beta * t_old
-    t = np.multiply(t_old, beta, out=np.empty(z.shape))
-    t += z
-    return t
-
-
-def stepped_pressures(bk, p_c0, tau, t_c):
-    """``(p_c, clipped)``: the contact's pressures after the step, ``p_c0 - tau t_c`` with the negative ones set to
-    ``+0``, and the boolean of those; on NumPy one new array of pressures, the same numbers."""
-    if not bk.is_numpy:
-        p_c = p_c0 - tau * t_c
-        clipped = p_c < 0
-        return bk.xp.where(clipped, 0.0, p_c), clipped
-    p_c = np.multiply(t_c, tau)
-    np.subtract(p_c0, p_c, out=p_c)
-    clipped = p_c < 0
-    p_c[clipped] = 0.0
-    return p_c, clipped
-
-
-class HeldArray:
-    """The first ``n`` entries of a float64 array held for a solve, made anew (an eighth longer) only where it is
-    too short: for an array of the contact's size that the step makes at every iteration and lets go at the next,
-    whose pages are then not mapped again (:class:`StepArrays`)."""
-
-    def __init__(self):
-        self.data = None
-
-    def __call__(self, n):
-        if self.data is None or self.data.size < n:
-            self.data = None  # let go before the longer one is made
-            self.data = np.empty(n + n // 8)
-        return self.data[:n]
 
 
 def weighted_square(bk, d, t):
