@@ -18,10 +18,11 @@ leaving, at a constant KKT residual: ``tests/bem/test_periodic_robustness.py``).
 
 - the iteration keeps ``u = (C + lam) p`` in double precision, updated after a step by the product of its move in
   single precision (rounded to a relative ``1e-7`` of the step, which falls with the residual): where the contact set
-  did not change ``tau (C + lam) t``, the search direction's product; where it changed (NumPy) that of ``t'``,
-  ``tau t' = p - p_new / s``: ``t`` but at the clipped and entering nodes. ``u`` is recomputed from ``p`` after
-  every 20 updates, and at a change while the products run in single precision (below), before ``u`` was once
-  recomputed in double precision (from the caller's ``u0``) or off NumPy;
+  did not change ``tau (C + lam) t``, the search direction's product; where it changed (NumPy, a confirmed stop)
+  that of ``t'``, ``tau t' = p - p_new / s``: ``t`` but at the clipped and entering nodes. ``u`` is recomputed
+  from ``p`` after every 20 updates, and at a change while the products run in single precision (below), before
+  ``u`` was once recomputed in double precision (from the caller's ``u0``), in an unconfirmed solve (whose caller
+  takes its ``u``) or off NumPy;
 - the curvature ``t.(C + lam) t`` is a sum over the spectrum of that product (Parseval, summed in double precision,
   block by block as the product is made: :func:`bem.periodic.spectra.mixed`);
 - the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
@@ -332,7 +333,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, jacobi_at(overlap) if per_node else jacobi,
                                 per_node, preconditioned=True) if entered else None
         moved = terms = None  # a change in double precision: u from the product of the move t' (module docstring)
-        if (changed or entered) and exact_base and not single and tau > 0 and stale < RECOMPUTE_EVERY and bk.is_numpy:
+        if (changed or entered) and confirm and exact_base and not single and tau > 0 and stale < RECOMPUTE_EVERY and (
+                bk.is_numpy):
             moved = brick.moved(clipped, p_c0[clipped] / tau, *((overlap, -p_o / tau) if entered else ()))
             terms = [(idx, D_c * (p_c - p_c0))] + ([(overlap, bk.take(D, overlap) * p_o)] if entered else []) if (
                 per_node) else []  # D (p_new / s - p), before the scaling by s

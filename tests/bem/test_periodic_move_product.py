@@ -103,43 +103,53 @@ def test_changes_in_double_precision_take_the_product_of_the_move(monkeypatch, p
     assert kkt <= 1e-10
 
 
+def _events(monkeypatch, op):
+    """The double-precision transforms of ``op`` and the moves' products, in their order."""
+    seen = []
+    spectrum, moved = op.spectrum, ContactBrick.moved
+    monkeypatch.setattr(op, "spectrum", lambda v, out=None: (v.dtype == np.float64 and seen.append("exact")) or
+                        spectrum(v, out=out))
+    monkeypatch.setattr(ContactBrick, "moved", lambda self, *a: seen.append("moved") or moved(self, *a))
+    return seen
+
+
 @pytest.mark.parametrize("control", ["force", "approach"])
-def test_an_unconfirmed_solve_carries_the_moves_into_its_displacement(control):
-    """Newton's model QP (a compliance per node, the caller's start and a product rounded to single precision,
-    ``confirm=False``): ``u`` is made exact at the first change, then follows the moves, so the displacement it
-    returns is ``C p`` to the single-precision rounding of the steps, far below the tolerance."""
+def test_an_unconfirmed_solve_recomputes_u_at_every_change(monkeypatch, control):
+    """Newton's model QP (a compliance per node, the caller's start and product, ``confirm=False``) hands its ``u`` to
+    the caller unconfirmed: it recomputes ``u`` at a change, never from a move, and its displacement is ``C p``."""
     cell = PeriodicCell(1.0 / 128, 128, 128)
     h = _self_affine(cell)
     op = PeriodicOperator(cell, E_STAR)
     D = np.random.default_rng(5).uniform(0.2, 2.0, cell.shape) * op.diagonal
     kw = dict(force=0.03 * cell.area) if control == "force" else dict(approach=float(np.quantile(h, 0.25)))
-    x0 = solve_periodic_qp(op, h, rtol=1e-3, **kw).p
-    u0 = op.matvec(x0).astype(np.float32).astype(np.float64)  # as Newton's, after a step in single precision
-    res = solve_periodic_qp(op, h, lam=D, x0=x0, u0=u0, rtol=1e-10, confirm=False, **kw)
-    assert res.converged and sum(c > 0 for c in res.history["changes"]) >= 5
+    x0 = solve_periodic_qp(op, h, lam=D, rtol=1e-3, **kw).p  # in double precision from the start
+    seen = _events(monkeypatch, op)
+    res = solve_periodic_qp(op, h, lam=D, x0=x0, u0=op.matvec(x0), rtol=1e-10, confirm=False, **kw)
+    changes = sum(c > 0 for c in res.history["changes"])
+    assert res.converged and changes >= 2 and res.history["residual"][0] < qp.SINGLE_START * qp.SINGLE_ABOVE
+    assert "moved" not in seen and seen.count("exact") >= changes
     u = PeriodicOperator(cell, E_STAR).matvec(res.p)
     assert np.abs(res.displacement - u).max() <= 1e-9 * np.abs(u).max()
-    g = (u + D * res.p + h - res.approach).ravel()
-    kkt = kkt_residual(res.p.ravel(), g, displacement_scale=float(np.abs(u + D * res.p).max()),
-                       force=kw.get("force"), node_area=cell.node_area)
-    assert kkt <= 1e-9
 
 
 @pytest.mark.parametrize("control", ["force", "approach"])
-def test_a_callers_product_is_recomputed_at_the_first_change_before_moves_follow_it(control):
-    """Started in double precision near the answer from a product rounded to single precision (a later Newton step),
-    the first change recomputes ``u``: the moves then carry an exact product, and the displacement of a solve that
-    ends before the periodic recomputation is ``C p`` far below the rounding of the caller's product."""
+def test_a_callers_product_is_recomputed_at_the_first_change_before_moves_follow_it(monkeypatch, control):
+    """Started in double precision near the answer from a product rounded to single precision, the first change
+    recomputes ``u`` before any move's product is taken: the moves carry an exact product, not the caller's error."""
     cell = PeriodicCell(1.0 / 128, 128, 128)
     h = _self_affine(cell)
     op = PeriodicOperator(cell, E_STAR)
     D = np.random.default_rng(5).uniform(0.2, 2.0, cell.shape) * op.diagonal
     kw = dict(force=0.03 * cell.area) if control == "force" else dict(approach=float(np.quantile(h, 0.25)))
     x0 = solve_periodic_qp(op, h, lam=D, rtol=1e-3, **kw).p
-    u0 = op.matvec(x0).astype(np.float32).astype(np.float64)
-    res = solve_periodic_qp(op, h, lam=D, x0=x0, u0=u0, rtol=1e-7, confirm=False, **kw)
-    assert res.converged and res.iterations < qp.RECOMPUTE_EVERY - 1
-    assert res.history["residual"][0] < qp.SINGLE_START * qp.SINGLE_ABOVE and sum(c > 0 for c in res.history["changes"]) >= 2
+    u0 = op.matvec(x0).astype(np.float32).astype(np.float64)  # as Newton's, after a step in single precision
+    seen = _events(monkeypatch, op)
+    res = solve_periodic_qp(op, h, lam=D, x0=x0, u0=u0, rtol=1e-10, **kw)
+    assert res.converged and res.history["residual"][0] < qp.SINGLE_START * qp.SINGLE_ABOVE
+    assert "moved" in seen and seen.index("exact") < seen.index("moved")
     u = PeriodicOperator(cell, E_STAR).matvec(res.p)
-    assert np.abs(u0 - op.matvec(x0)).max() > 1e-8 * np.abs(u).max()  # the caller's product is off
-    assert np.abs(res.displacement - u).max() <= 1e-9 * np.abs(u).max()
+    np.testing.assert_allclose(res.displacement, u, rtol=0, atol=1e-12 * np.abs(u).max())
+    g = (u + D * res.p + h - res.approach).ravel()
+    kkt = kkt_residual(res.p.ravel(), g, displacement_scale=float(np.abs(u + D * res.p).max()),
+                       force=kw.get("force"), node_area=cell.node_area)
+    assert kkt <= 1e-10
