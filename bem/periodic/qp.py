@@ -50,9 +50,9 @@ cell at 18 % of ``H``, ``tests/bem/test_hardness_units.py``), not where nodes en
 pressures at ``H = E* h'_rms``: 531 iterations, 695 when those restart too).
 
 A step costs four transforms of the cell in single precision while the contact set does not change (two for the
-preconditioner, one forward for the search direction, one inverse for its product), five where it changes (off
-NumPy two of them in double precision once the residual is below ``SINGLE_ABOVE``; the general loop: four or six in
-double precision, or up to eight with a compliance per node).
+preconditioner, one forward for the search direction, one inverse for its product), five where it changes (where
+``u`` is recomputed, two of them in double precision once the residual is below ``SINGLE_ABOVE``; the general loop:
+four or six in double precision, or up to eight with a compliance per node).
 
 The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any array API
 namespace with ``xp.fft``); the host receives its scalars (about 16 a step, more with a compliance per node or a
