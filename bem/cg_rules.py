@@ -23,8 +23,10 @@ import numpy as np
 from .backend import operator_backend
 from .plastic import carry_force, clipped_start, fill_force, leaving_pressure, plastic_approach, plastic_start
 
-__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual", "stopping_rule",
-           "entering_pressure", "is_per_node", "is_stiff", "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS", "RIGID_SHARE", "BoundedSets", "bounded_sets", "bounded_move"]
+__all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual",
+           "stopping_rule", "entering_pressure", "elastic_displacement", "is_per_node", "is_stiff",
+           "RECOMPUTE_EVERY", "ENTERING_FRACTION", "BACKTRACK_HALVINGS", "RIGID_SHARE", "BoundedSets",
+           "bounded_sets", "bounded_move"]
 
 log = logging.getLogger(__name__)
 
@@ -272,6 +274,16 @@ def is_stiff(D, diagonal, threshold):
 def is_per_node(lam):
     """Whether the compliance ``lam`` is given per node (an array) rather than uniform."""
     return getattr(lam, "ndim", 0) > 0
+
+
+def elastic_displacement(bk, u, lam, p, out=None):
+    """``C p = u - lam p`` (float64) from ``u = (C + lam) p``, ``lam`` per node or uniform [length/pressure]: ``u``
+    itself (float64) where ``lam`` is 0; ``out``: a float64 brick array for it on NumPy, not ``u``."""
+    if not is_per_node(lam) and not lam:
+        return bk.xp.astype(u, bk.xp.float64, copy=False)
+    if bk.is_numpy:
+        return np.subtract(u, np.multiply(lam, p, out=out), out=out)
+    return u - lam * p
 
 
 def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None, plastic_gap=None):

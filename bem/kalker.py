@@ -32,8 +32,8 @@ import math
 import numpy as np
 
 from .backend import operator_backend
-from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, entering_pressure,
-                       initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
+from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, elastic_displacement,
+                       entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
 from .plastic import carry_force, note_fully_plastic
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
@@ -339,8 +339,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     kkt = run_constrained_cg(CGStep(measure_bounded if bounded else measure, confirms, observe, advance, report),
                              record, maxiter, callback)
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not n_idx)
-    elastic = u - lam * p if per_node or lam else u  # C p: the layer's closure is not a displacement
-    return record.solution(p, delta, kkt, elastic, "Kalker QP")
+    return record.solution(p, delta, kkt, elastic_displacement(bk, u, lam, p), "Kalker QP")
 
 
 def _kept_at(bk, shape, kept, idx, changes):

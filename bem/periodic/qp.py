@@ -68,10 +68,11 @@ import numpy as np
 
 from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
-                        entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
+                        elastic_displacement, entering_pressure, initial_pressure, is_per_node, is_stiff,
+                        iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .passes import kernels
-from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, StepArrays, elastic_part, weighted_square
+from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, StepArrays, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -195,9 +196,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def exact_u():  # (C + lam) p, and D p per node
         return add_into(product_u(), times_p(D)) if per_node else product_u()
 
-    # the first product in double precision: it sets the scale of the KKT residual; exact_base: u was last made by a
-    # product in double precision (not the caller's u0, nor in single precision), updated since by steps' products
-    single, u, exact_base = False, None, False
+    # the first product in double precision (the KKT residual's scale); exact_base: u from a double-precision product
+    single, u, exact_base = False, None, False  # (not the caller's u0, nor single precision) and steps' updates since
     if u0 is None:
         u, stale = exact_u(), 0
     else:  # C x0 from the caller, confirmed like an incremental update
@@ -332,10 +332,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         entered = bool(bk.count(overlap))
         p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, jacobi_at(overlap) if per_node else jacobi,
                                 per_node, preconditioned=True) if entered else None
-        moved = terms = None  # a change in double precision: u from the product of the move t' (module docstring)
+        t_move = terms = None  # a change in double precision: u from the product of the move t' (module docstring)
         if (changed or entered) and confirm and exact_base and not single and tau > 0 and stale < RECOMPUTE_EVERY and (
                 bk.is_numpy):
-            moved = brick.moved(clipped, p_c0[clipped] / tau, *((overlap, -p_o / tau) if entered else ()))
+            t_move = brick.write_move(clipped, p_c0[clipped] / tau, *((overlap, -p_o / tau) if entered else ()))
             terms = [(idx, D_c * (p_c - p_c0))] + ([(overlap, bk.take(D, overlap) * p_o)] if entered else []) if (
                 per_node) else []  # D (p_new / s - p), before the scaling by s
         s = 1.0
@@ -352,9 +352,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             if s != 1.0:
                 p_o *= s
             bk.put(p, overlap, p_o)
-        if moved is not None or not (changed or entered or stale >= RECOMPUTE_EVERY):
-            # p = s (p - tau t) (t' where moved): u = s (u - tau (C + lam) t), plus D t per node
-            update_u(R, tau, s, terms if moved is not None else [(idx, -tau * (D_c * t_c))] if per_node else [], moved)
+        if t_move is not None:  # p = s (p - tau t'): u = s (u - tau (C + lam) t'), plus D's terms per node
+            update_u(R, tau, s, terms, t_move)
+        elif not (changed or entered or stale >= RECOMPUTE_EVERY):  # p = s (p - tau t) on the contact
+            update_u(R, tau, s, [(idx, -tau * (D_c * t_c))] if per_node else [])
         else:
             u, stale = product_u(), 0
             if per_node:  # u += D p, on the nodes where p > 0
@@ -364,11 +365,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         nodes.stepped(p_c, entered, overlap, p_o)  # after the product: the next contact is not held through it
         return None
 
-    def update_u(R, tau, s, terms, moved=None):  # s (u - tau (C + lam) t + terms): R the spectrum of (C + lam) t, or
-        nonlocal u, stale  # moved the brick of t' (made here); terms: D's, a list of (nodes, values)
-        if moved is not None:
+    def update_u(R, tau, s, terms, t_move=None):  # s (u - tau (C + lam) t + terms): R the spectrum of (C + lam) t, or
+        nonlocal u, stale  # t_move the brick of t' (its product made here); terms: D's, a list of (nodes, values)
+        if t_move is not None:
             op.n_matvec += 1
-            R = op.mix(op.spectrum(moved, out=work.spectrum(np.complex64, second=True)), A32, out=R)
+            R = op.mix(op.spectrum(t_move, out=work.spectrum(np.complex64, second=True)), A32, out=R)
             brick.restore()
         r = op.brick(R, overwrite=True, out=work.brick32(second=False))
         passes.subtract_scaled(u, r, tau, 1.0 if terms else s)  # s: one pass
@@ -394,6 +395,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         measure, confirms, observe, advance, lambda: bk.copy(p))
     kkt = run_constrained_cg(step, record, maxiter, callback)
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not bk.count(idx))
-    # C p: the layer's closure is not a displacement (on NumPy in the gap's buffer, free now; u may be float32)
-    return record.solution(p, delta, kkt, elastic_part(bk, u, D if per_node else lam, p, g), "Kalker QP (periodic)")
+    return record.solution(p, delta, kkt, elastic_displacement(bk, u, D if per_node else lam, p, out=g),
+                           "Kalker QP (periodic)")  # C p, in the gap's buffer (free now) on NumPy
 

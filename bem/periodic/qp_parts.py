@@ -8,20 +8,7 @@ import math
 
 import numpy as np
 
-from ..cg_rules import is_per_node
-
-__all__ = ["ContactBrick", "ContactNodes", "LastPreconditionedGap", "StepArrays", "elastic_part", "weighted_square"]
-
-
-def elastic_part(bk, u, lam, p, buffer):
-    """``C p = u - lam p`` in double precision from ``u = (C + lam) p`` (``u`` itself, or its float64 copy, where
-    ``lam`` is 0), ``lam`` a compliance per node (brick array) or uniform [length/pressure]; on NumPy in ``buffer``
-    (a float64 brick array, not ``u``)."""
-    if not is_per_node(lam) and not lam:
-        return bk.xp.astype(u, bk.xp.float64, copy=False)
-    if bk.is_numpy:
-        return np.subtract(u, np.multiply(lam, p, out=buffer), out=buffer)
-    return u - lam * p
+__all__ = ["ContactBrick", "ContactNodes", "LastPreconditionedGap", "StepArrays", "weighted_square"]
 
 
 def weighted_square(bk, d, t):
@@ -181,7 +168,7 @@ class ContactBrick:
         self.nodes = nodes
         return self.values
 
-    def moved(self, at, values, entering=None, entering_values=None):
+    def write_move(self, at, values, entering=None, entering_values=None):
         """The last write changed where a step's move differs from the direction (NumPy only): ``values`` at the
         last write's nodes where the boolean ``at`` (one entry a node) is true, then ``entering_values`` added at the
         node selection ``entering`` (nodes off the last write, or among ``at``), rounded to float32; the brick, or
@@ -194,12 +181,12 @@ class ContactBrick:
         flat[self.nodes[at]] = values.astype(np.float32)
         if entering is not None:
             flat[entering] += entering_values.astype(np.float32)
-        self._moved = at, entering
+        self._move = at, entering
         return self.values
 
     def restore(self):
-        """The brick as the last :meth:`write` left it, after :meth:`moved`."""
-        at, entering = self._moved
+        """The brick as the last :meth:`write` left it, after :meth:`write_move`."""
+        at, entering = self._move
         flat = self.values.reshape(-1)
         if entering is not None:
             flat[entering] = 0.0

@@ -1,7 +1,7 @@
 """The update of ``u = (C + lam) p`` after a step of the periodic QP that changed the contact, in double precision:
-from the single-precision product of the step's own move (:meth:`bem.periodic.qp_parts.ContactBrick.moved`) instead
-of a double-precision product of ``p``. Against the QP that recomputes ``u`` at every change (the move's brick
-refused), the dense matrix and the KKT conditions; the brick's edits against their definition."""
+from the single-precision product of the step's own move (:meth:`bem.periodic.qp_parts.ContactBrick.write_move`)
+instead of a double-precision product of ``p``. Against the QP that recomputes ``u`` at every change (the move's
+brick refused), the dense matrix and the KKT conditions; the brick's edits against their definition."""
 
 import math
 
@@ -36,7 +36,7 @@ def test_the_move_writes_at_the_clipped_nodes_adds_at_the_entering_ones_and_is_u
     off = np.setdiff1d(np.arange(48), nodes)[:4]
     entering = np.sort(np.concatenate([off, nodes[[5]]]))  # one node both clipped and entering
     values, extra = np.array([1.5, -2.0, 3.25]), np.array([0.5, -0.25, 4.0, 1.0, 2.0])
-    got = brick.moved(at, values, entering, extra)
+    got = brick.write_move(at, values, entering, extra)
     assert got is brick.values
     want = before.reshape(-1).copy()
     want[nodes[at]] = values
@@ -53,7 +53,7 @@ def test_a_move_beyond_single_precision_writes_nothing():
     at[3] = True
     for values, extra in ((np.array([1e39]), None), (np.array([np.nan]), None), (np.array([1.0]), np.array([2e38]))):
         entering = None if extra is None else np.setdiff1d(np.arange(48), nodes)[:1]
-        assert brick.moved(at, values, entering, extra) is None
+        assert brick.write_move(at, values, entering, extra) is None
         np.testing.assert_array_equal(brick.values, before)
 
 
@@ -65,7 +65,7 @@ def _spy(monkeypatch, op):
 
 
 def _exact_path(monkeypatch):
-    monkeypatch.setattr(ContactBrick, "moved", lambda self, *a: None)
+    monkeypatch.setattr(ContactBrick, "write_move", lambda self, *a: None)
 
 
 @pytest.mark.parametrize("per_node", [False, True])
@@ -106,10 +106,10 @@ def test_changes_in_double_precision_take_the_product_of_the_move(monkeypatch, p
 def _events(monkeypatch, op):
     """The double-precision transforms of ``op`` and the moves' products, in their order."""
     seen = []
-    spectrum, moved = op.spectrum, ContactBrick.moved
+    spectrum, write_move = op.spectrum, ContactBrick.write_move
     monkeypatch.setattr(op, "spectrum", lambda v, out=None: (v.dtype == np.float64 and seen.append("exact")) or
                         spectrum(v, out=out))
-    monkeypatch.setattr(ContactBrick, "moved", lambda self, *a: seen.append("moved") or moved(self, *a))
+    monkeypatch.setattr(ContactBrick, "write_move", lambda self, *a: seen.append("write_move") or write_move(self, *a))
     return seen
 
 
@@ -127,7 +127,7 @@ def test_an_unconfirmed_solve_recomputes_u_at_every_change(monkeypatch, control)
     res = solve_periodic_qp(op, h, lam=D, x0=x0, u0=op.matvec(x0), rtol=1e-10, confirm=False, **kw)
     changes = sum(c > 0 for c in res.history["changes"])
     assert res.converged and changes >= 2 and res.history["residual"][0] < qp.SINGLE_START * qp.SINGLE_ABOVE
-    assert "moved" not in seen and seen.count("exact") >= changes
+    assert "write_move" not in seen and seen.count("exact") >= changes
     u = PeriodicOperator(cell, E_STAR).matvec(res.p)
     assert np.abs(res.displacement - u).max() <= 1e-9 * np.abs(u).max()
 
@@ -146,7 +146,7 @@ def test_a_callers_product_is_recomputed_at_the_first_change_before_moves_follow
     seen = _events(monkeypatch, op)
     res = solve_periodic_qp(op, h, lam=D, x0=x0, u0=u0, rtol=1e-10, **kw)
     assert res.converged and res.history["residual"][0] < qp.SINGLE_START * qp.SINGLE_ABOVE
-    assert "moved" in seen and seen.index("exact") < seen.index("moved")
+    assert "write_move" in seen and seen.index("exact") < seen.index("write_move")
     u = PeriodicOperator(cell, E_STAR).matvec(res.p)
     np.testing.assert_allclose(res.displacement, u, rtol=0, atol=1e-12 * np.abs(u).max())
     g = (u + D * res.p + h - res.approach).ravel()
