@@ -34,7 +34,7 @@ import numpy as np
 from .backend import operator_backend
 from .cg_rules import (RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets, elastic_displacement,
                        entering_pressure, initial_pressure, is_per_node, is_stiff, iterate_residual, run_constrained_cg)
-from .plastic import carry_force, note_fully_plastic
+from .plastic import carry_force, in_place, note_fully_plastic
 
 __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
@@ -59,7 +59,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         Initial pressure (brick array); negative entries are clipped.
     overwrite_x0 : bool
         Whether a float64 NumPy ``x0`` may hold the iterate (clipped and masked in place, not copied: one array
-        of the lattice fewer). Without ``u0`` only.
+        of the lattice fewer; with ``u0``, masked only).
     rtol : float
         Tolerance on the KKT residual.
     maxiter : int, optional
@@ -128,7 +128,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 p = carry_force(xp, p, target, hardness, mask)
         u0 = None
     else:  # the caller's iterate and its product, as they are
-        p = xp.where(mask, x0, 0.0)
+        p = bk.put(x0, bk.select(~mask), 0.0) if overwrite_x0 and in_place(bk, x0) else xp.where(mask, x0, 0.0)
     off = bk.select(~mask)  # the few masked nodes (last node of the odd rows)
 
     def apply(v):

@@ -101,10 +101,19 @@ def _advance(bk, p, u, sub, t, force, node_area, hardness):
     return q, uq
 
 
-def _model_qp(op, b, D, contact, precondition, **kw):
-    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one):
-    the operator's own constrained-CG step (``op.qp``, :meth:`bem.operator.InfluenceOperator.qp`)."""
-    return op.qp(b, lam=D, precondition=precondition, contact=contact, **kw)
+def _model_qp(op, b, D, contact, precondition, p, **kw):
+    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one) from ``p`` by the
+    operator's constrained-CG step (``op.qp``); ``(solution, p)``. Where the QP can hold its iterate in ``p``
+    (:func:`bem.plastic.in_place`) it does, and ``p`` is kept meanwhile on its nodes of nonzero pressure only, and
+    returned as a new array (the same values; one array of the lattice fewer through the QP)."""
+    if not in_place(backend_of(p), p):
+        return op.qp(b, lam=D, precondition=precondition, contact=contact, x0=p, **kw), p
+    at = np.flatnonzero(p)
+    kept = p.reshape(-1)[at]
+    sub = op.qp(b, lam=D, precondition=precondition, contact=contact, x0=p, overwrite_x0=True, **kw)
+    p = np.zeros(p.shape)
+    p.reshape(-1)[at] = kept
+    return sub, p
 
 
 def _count_inner(hist, sub):
@@ -242,15 +251,12 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         b = h + wp - D * p
         wp = None  # made again where needed: not held through the model's solve
         # forcing term: _FORCING, or less where the last step reduced the residual (Eisenstat & Walker)
-        eta = _FORCING
-        if len(hist["residual"]) > 1:
-            eta = min(_FORCING, _GAMMA * (kkt / hist["residual"][-2]) ** _ALPHA)
+        eta = min(_FORCING, _GAMMA * (kkt / hist["residual"][-2]) ** _ALPHA) if len(hist["residual"]) > 1 else _FORCING
         inner = max(rtol / 3, min(1e-2, eta * kkt))
-        # the model starts at p with the product u Newton carries, and Newton checks every step on
-        # its own residual: no product to start or to confirm the inner solve (fewer products on
-        # the root-layer problem of benchmarks/side_by_side.py)
-        sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p, rtol=inner,
-                        maxiter=inner_maxiter, u0=u, confirm=False, **bound)
+        # the model starts at p with the product u Newton carries, and Newton checks every step on its own residual:
+        # no product to start or to confirm the inner solve (fewer products on benchmarks/side_by_side.py's root layer)
+        sub, p = _model_qp(op, b, D, contact, precondition, p, force=force, approach=approach, rtol=inner,
+                           maxiter=inner_maxiter, u0=u, confirm=False, **bound)
         b = None  # the model's gap: not held through the line search
         _count_inner(hist, sub)
         # the step d = q - p of the model's solution q (C d = uq - u) is formed where it is used, not held
@@ -262,9 +268,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             b = h + wp - D * p
             wp = None
             sub = None
-            sub = _model_qp(op, b, D, contact, precondition, force=force, approach=approach, x0=p,
-                            rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u, confirm=False,
-                            **bound)
+            sub, p = _model_qp(op, b, D, contact, precondition, p, force=force, approach=approach,
+                               rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u,
+                               confirm=False, **bound)
             b = None
             _count_inner(hist, sub)
             t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, mask)

@@ -5,13 +5,15 @@ With numba installed (the optional extra ``contactlab[fast]``) and a cell of at 
 periodic QP on NumPy makes these passes with the kernels of this module, each split into :func:`bem.fft.threads`
 contiguous parts run at once (:func:`bem.fft.in_parts`):
 
-- ``gap``: ``g = u + h`` with ``min g``, ``max u`` and ``min u`` (the KKT residual and its scale) in one pass
-  instead of four;
+- ``scan``: ``min (u + h)``, ``max u`` and ``min u`` (the KKT residual and its scale) and the mask
+  ``(u + h < delta) & (p == 0)`` of the nodes that may enter the contact, in one pass with no array of the gap
+  (``gap``: the extremes with the gap ``g = u + h`` written into an array, for the bounded QP of a hardness);
 - ``subtract_scaled``: the update ``u = s (u - tau (C + lam) t)`` from the product in single precision (``s`` the
   rescaling to the force), one pass instead of three;
 - ``add_at``: ``x[idx] += values`` in ``x``'s precision (a compliance per node's terms of ``u``), one pass
   instead of a gather, a sum and a scatter;
 - ``gather``: the preconditioned gap (single precision) at the contact's nodes, in double precision;
+- ``gap_at``: the gap ``u + h`` at the contact's nodes (or the entering ones), one gather instead of two and a sum;
 - ``merge``: the next contact made from the step, its nodes that stayed and the entering ones merged in order, with
   their pressures, into given arrays (:class:`bem.periodic.qp_parts.ContactNodes`), in one pass (serial);
 - ``mix``: the 2 x 2 block product of a spectrum (:func:`bem.periodic.spectra.mixed`, every product with ``C``
@@ -20,7 +22,7 @@ contiguous parts run at once (:func:`bem.fft.in_parts`):
 
 Without numba, or on a smaller cell, the same passes run as the NumPy forms (:func:`numpy_kernels`,
 :func:`bem.periodic.spectra.numpy_mixed`; the merge as ``numpy.insert`` in :class:`bem.periodic.qp_parts.ContactNodes`).
-The first three give NumPy's numbers bit for bit: each makes the same operations in the same precision at every
+The element-wise passes give NumPy's numbers bit for bit: each makes the same operations in the same precision at every
 node, and their reductions are minima and maxima, whose value does not depend on their order; a NaN propagates as in
 NumPy. The merge copies values. The block product rounds each operation as written (NumPy's
 loops may fuse a multiply and an add: the two can differ in the last bit) and sums each block of rows in the order
@@ -40,6 +42,7 @@ from .. import fft
 __all__ = ["MIN_NODES", "kernels", "load", "numpy_kernels"]
 
 MIN_NODES = 1 << 18  # below it a pass is too short for the threads' start
+CHUNK = 1 << 16  # nodes a part of the NumPy form of ``scan`` (a buffer of 512 kB)
 _COMPILED = []  # the compiled kernels, made at the first call of kernels()
 
 
@@ -53,6 +56,24 @@ class _NumPyKernels:
         """``(g, min g, max u, min u)`` for ``g = u + h``, made in ``g``'s buffer."""
         np.add(u, h, out=g)
         return g, float(g.min()), float(u.max()), float(u.min())
+
+    @staticmethod
+    def scan(u, h, delta, p, out):
+        """``(out, min (u + h), max u, min u)`` with ``out = (u + h < delta) & (p == 0)`` (boolean, the cell's
+        shape), the sum made a part of :data:`CHUNK` nodes at a time where every array is contiguous (no array of
+        the cell's size)."""
+        if not all(a.flags.c_contiguous for a in (u, h, p, out)):  # no flat view of each: the whole arrays
+            g = np.add(u, h)
+            return np.logical_and(g < delta, p == 0, out=out), float(g.min()), float(u.max()), float(u.min())
+        uf, hf, pf, of = u.reshape(-1), h.reshape(-1), p.reshape(-1), out.reshape(-1)
+        buf, zero, lows = np.empty(min(CHUNK, uf.size)), np.empty(min(CHUNK, uf.size), dtype=bool), []
+        for i in range(0, uf.size, CHUNK):
+            n = min(CHUNK, uf.size - i)
+            g = np.add(uf[i : i + n], hf[i : i + n], out=buf[:n])
+            lows.append(float(g.min()))
+            np.logical_and(np.less(g, delta, out=of[i : i + n]), np.equal(pf[i : i + n], 0, out=zero[:n]),
+                           out=of[i : i + n])
+        return out, float(np.min(lows)), float(u.max()), float(u.min())
 
     @staticmethod
     def subtract_scaled(u, r, tau, s=1.0):
@@ -75,6 +96,11 @@ class _NumPyKernels:
         """``x`` (float32) at the flat indices ``idx``, in double precision."""
         return np.take(x.reshape(-1), idx).astype(np.float64)
 
+    @staticmethod
+    def gap_at(u, h, idx):
+        """``u + h`` at the flat indices ``idx`` (float64)."""
+        return np.take(u.reshape(-1), idx) + np.take(h.reshape(-1), idx)
+
 
 class _NamespaceKernels:
     """The forms on another array namespace (:class:`bem.backend.Backend` ``bk``): new arrays where NumPy reuses
@@ -90,6 +116,10 @@ class _NamespaceKernels:
         g = u + h
         return g, float(xp.min(g)), float(xp.max(u)), float(xp.min(u))
 
+    def scan(self, u, h, delta, p, out):
+        g, *rest = self.gap(u, h, None)
+        return ((g < delta) & (p == 0), *rest)
+
     def subtract_scaled(self, u, r, tau, s=1.0):
         r *= tau
         u -= r
@@ -102,6 +132,9 @@ class _NamespaceKernels:
 
     def gather(self, x, idx):
         return self.bk.xp.astype(self.bk.take(x, idx), self.bk.xp.float64)
+
+    def gap_at(self, u, h, idx):
+        return self.bk.take(u, idx) + self.bk.take(h, idx)
 
 
 def numpy_kernels():
@@ -123,8 +156,9 @@ def kernels(n_nodes, bk=None):
     Returns
     -------
     class or object
-        Methods ``gap(u, h, g)``, ``subtract_scaled(u, r, tau, s=1.0)``, ``add_at(x, idx, values)`` (``x``; on NumPy
-        in place), ``gather(x, idx)`` (and, compiled,
+        Methods ``gap(u, h, g)``, ``scan(u, h, delta, p, out)`` (``out`` a boolean brick array, or None off NumPy),
+        ``subtract_scaled(u, r, tau, s=1.0)``, ``add_at(x, idx, values)`` (``x``; on NumPy
+        in place), ``gather(x, idx)``, ``gap_at(u, h, idx)`` (and, compiled,
         ``mix(spectrum, symbol, out, even, rows)`` and ``merge(idx, values, stayed, new, new_values, out_idx,
         out_values, at)``) and the flag ``compiled``.
     """
@@ -154,9 +188,12 @@ def load():
         x64, x32, idx = np.zeros(4), np.zeros(4, dtype=np.float32), np.arange(2)
         for u in (x64, x32):  # the iterate's product in double or in single precision
             k.gap(u, x64, np.empty(4))
+            k.scan(u, x64, 0.0, x64, np.empty(4, dtype=bool))
             k.subtract_scaled(u, x32.copy(), 1.0, 2.0)
             k.add_at(u, idx, x64[:2])
         k.gather(x32, idx)
+        for u in (x64, x32):
+            k.gap_at(u, x64, idx)
         at, flag = np.empty(1, dtype=np.intp), np.ones(2, dtype=bool)
         k.merge(idx, x64[:2], flag, idx[:1], x64[:1], np.empty(3, dtype=idx.dtype), np.empty(3), at)
         for real, cplx in ((np.float32, np.complex64), (np.float64, np.complex128)):  # the spectra's precisions
@@ -190,6 +227,20 @@ def _compile():
         return np.nan if g_nan else g_min, np.nan if u_nan else u_max, np.nan if u_nan else u_min
 
     @njit(**opts)
+    def _scan(u, h, delta, p, out):  # a part's slices
+        g_min, u_max, u_min, g_nan, u_nan = np.inf, -np.inf, np.inf, False, False
+        for i in range(out.size):
+            x = u[i]
+            y = x + h[i]
+            out[i] = (y < delta) & (p[i] == 0)
+            g_nan |= y != y
+            u_nan |= x != x
+            g_min = min(g_min, y)
+            u_max = max(u_max, x)
+            u_min = min(u_min, x)
+        return np.nan if g_nan else g_min, np.nan if u_nan else u_max, np.nan if u_nan else u_min
+
+    @njit(**opts)
     def _subtract_scaled(u, r, tau, s, lo, hi):  # s = 1: the same numbers as u -= r tau (x 1.0 is exact)
         for i in range(lo, hi):
             u[i] = (u[i] - r[i] * tau) * s
@@ -203,6 +254,11 @@ def _compile():
     def _gather(x, idx, out, lo, hi):
         for j in range(lo, hi):
             out[j] = x[idx[j]]
+
+    @njit(**opts)
+    def _gap_at(u, h, idx, out, lo, hi):
+        for j in range(lo, hi):
+            out[j] = u[idx[j]] + h[idx[j]]
 
     @njit(**opts)
     def _mix(x, d, b, out, rows, lo, hi, sums, even):  # blocks lo..hi of `rows` rows; sums: one a block, or empty
@@ -261,6 +317,14 @@ def _compile():
             return g, float(e[:, 0].min()), float(e[:, 1].max()), float(e[:, 2].min())
 
         @staticmethod
+        def scan(u, h, delta, p, out):
+            if not all(a.flags.c_contiguous for a in (u, h, p, out)):
+                return _NumPyKernels.scan(u, h, delta, p, out)
+            uf, hf, pf, of, d = u.reshape(-1), h.reshape(-1), p.reshape(-1), out.reshape(-1), float(delta)
+            e = np.array(run(lambda lo, hi: _scan(uf[lo:hi], hf[lo:hi], d, pf[lo:hi], of[lo:hi]), uf.size))
+            return out, float(e[:, 0].min()), float(e[:, 1].max()), float(e[:, 2].min())
+
+        @staticmethod
         def subtract_scaled(u, r, tau, s=1.0):
             if not (u.flags.c_contiguous and r.flags.c_contiguous):
                 return _NumPyKernels.subtract_scaled(u, r, tau, s)
@@ -292,6 +356,14 @@ def _compile():
         def gather(x, idx):
             x, out = x.reshape(-1), np.empty(idx.size)
             run(lambda lo, hi: _gather(x, idx, out, lo, hi), idx.size)
+            return out
+
+        @staticmethod
+        def gap_at(u, h, idx):
+            if not (u.flags.c_contiguous and h.flags.c_contiguous):
+                return _NumPyKernels.gap_at(u, h, idx)
+            uf, hf, out = u.reshape(-1), h.reshape(-1), np.empty(idx.size)
+            run(lambda lo, hi: _gap_at(uf, hf, idx, out, lo, hi), idx.size)
             return out
 
     return Compiled

@@ -182,10 +182,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def add_into(x, y):  # x += y in x's precision (NumPy: in place)
         return np.add(x, y, out=x) if bk.is_numpy else xp.astype(x + y, x.dtype, copy=False)
 
-    g = np.empty(lat.shape) if bk.is_numpy else None  # u + h (NumPy: a buffer; holds D p where no gap is needed)
-
-    def times_p(c):  # c p for a compliance c (per node or uniform), in g's buffer on NumPy
-        return np.multiply(c, p, out=g) if bk.is_numpy else c * p
+    def times_p(c):  # c p for a compliance c (per node or uniform), in work's bytes on NumPy (no spectrum held there)
+        return np.multiply(c, p, out=work.brick64()) if bk.is_numpy else c * p
 
     def product_u():  # u = (C + lam) p; on NumPy in the last u where it has the product's precision (else let go first)
         nonlocal u, exact_base
@@ -212,24 +210,21 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     bounded, sets = hardness is not None, None
     restart = False  # with a hardness: the last step was shortened to carry the force, the direction restarts
     was_on, was_plastic = (nodes.was_on, p >= hardness) if bounded else (None, None)  # the bound's own counts
-
-    def gap():  # u + h (NumPy: in one buffer); its minimum, and the extremes of u for the residual's scale
-        nonlocal g, u_range
-        g, g_low, *u_range = passes.gap(u, h, g)
-        return g_low
+    g = np.empty(lat.shape) if bounded and bk.is_numpy else None  # the gap u + h, an array in the bounded QP only
+    enter = np.empty(lat.shape, dtype=bool) if bk.is_numpy and not bounded else None  # nodes that may enter
 
     def residual(k, contact_gap, force_error, plastic_gap=None):
         nonlocal single
         scale = max(u_range[0], -u_range[1]) if fixed_scale is None else fixed_scale
-        kkt = iterate_residual(contact_gap, g_min, scale, lambda: float(xp.max(xp.abs(g - delta))), force_error,
+        kkt = iterate_residual(contact_gap, g_min, scale, lambda: float(xp.max(xp.abs(u + h - delta))), force_error,
                                plastic_gap=plastic_gap)
         if k == 1:  # single precision pays for its closing product only well above SINGLE_ABOVE
             single = kkt > SINGLE_START * SINGLE_ABOVE or (kkt > SINGLE_ABOVE and rtol >= SINGLE_ABOVE)
         return kkt
 
     def measure_bounded(k):  # measure() with the bound: the CG lives on the elastic contact 0 < p < H
-        nonlocal idx, g_c, p_c0, delta, g_min, sets
-        gap()  # the gap is g - delta
+        nonlocal idx, g_c, p_c0, delta, g_min, sets, g, u_range
+        g, _, *u_range = passes.gap(u, h, g)  # the gap is g - delta; the extremes of u, the residual's scale
         sets = bounded_sets(bk, p, g, hardness, delta, force)
         idx, delta, g_min = sets.idx, sets.delta, sets.gap_min
         g_c, p_c0 = bk.take(g, idx) - delta, bk.take(p, idx)
@@ -237,12 +232,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                         sets.plastic_gap)
 
     def measure(k):  # the gap, the approach under force control and the KKT residual of the iterate
-        nonlocal idx, g_c, p_c0, delta, g_min
+        nonlocal idx, g_c, p_c0, delta, g_min, enter, u_range
         idx, p_c0 = nodes.read(p)
-        g_low = gap()  # the gap is g - delta: delta is subtracted on the contact only
-        g_c = bk.take(g, idx)
+        g_c = passes.gap_at(u, h, idx)  # the gap is u + h - delta: delta is subtracted on the contact only
         if force is not None:
             delta = float(xp.mean(g_c)) if bk.count(idx) else math.nan
+        enter, g_low, *u_range = passes.scan(u, h, delta, p, enter)  # with the mask of the entering test
         g_c -= delta
         g_min = g_low - delta
         return residual(k, bk.max0(xp.abs(g_c)), None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
@@ -328,10 +323,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             bk.put(p, idx, p_c)  # p is 0 off idx
         # re-entering nodes (p = 0, g < 0): the step tau of the preconditioned direction with the Jacobi
         # estimate of M there, -f min(tau, 1) g / (C_nn + lam) (module docstring: entering nodes)
-        overlap = bk.select(work.entering(g, delta, p))
+        if bk.is_numpy:  # g < 0 and p = 0 from measure (the same u and delta), and at the nodes clipped to 0 here
+            enter.reshape(-1)[idx[clipped]] = g_c[clipped] < 0
+        overlap = bk.select(enter if bk.is_numpy else (u + h < delta) & (p == 0))
         entered = bool(bk.count(overlap))
-        p_o = entering_pressure(xp, bk.take(g, overlap) - delta, tau, jacobi_at(overlap) if per_node else jacobi,
-                                per_node, preconditioned=True) if entered else None
+        p_o = entering_pressure(xp, passes.gap_at(u, h, overlap) - delta, tau, jacobi_at(overlap) if (
+            per_node) else jacobi, per_node, preconditioned=True) if entered else None
         t_move = terms = None  # a change in double precision: u from the product of the move t' (module docstring)
         if (changed or entered) and confirm and exact_base and not single and tau > 0 and stale < RECOMPUTE_EVERY and (
                 bk.is_numpy):
@@ -395,6 +392,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         measure, confirms, observe, advance, lambda: bk.copy(p))
     kkt = run_constrained_cg(step, record, maxiter, callback)
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not bk.count(idx))
-    return record.solution(p, delta, kkt, elastic_displacement(bk, u, D if per_node else lam, p, out=g),
-                           "Kalker QP (periodic)")  # C p, in the gap's buffer (free now) on NumPy
+    return record.solution(p, delta, kkt, elastic_displacement(bk, u, D if per_node else lam, p, out=work.brick64()),
+                           "Kalker QP (periodic)")  # C p, in work's bytes (free now) on NumPy
 

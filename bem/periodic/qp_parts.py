@@ -253,11 +253,11 @@ class LastPreconditionedGap:
 
 class StepArrays:
     """The bytes of a complex128 spectrum of the cell that the products of every step write into, on NumPy: a
-    complex128 spectrum, or in each half of the bytes a complex64 spectrum or a float32 brick array (which fits
-    there). One array for the solve instead of new arrays at every product: the pages of a new array above the
-    allocator's mapping threshold (32 MB by default in glibc) are mapped and zeroed by the kernel at each allocation,
-    a cost of the order of the transforms on large cells (``docs/performance.md``, "The arrays the cell's step
-    reuses"). Off NumPy every method gives ``None`` (new arrays).
+    complex128 spectrum or a float64 brick array (which fits there), or in each half of the bytes a complex64
+    spectrum or a float32 brick array. One array for the solve instead of new arrays at every product: the pages of
+    a new array above the allocator's mapping threshold (32 MB by default in glibc) are mapped and zeroed by the
+    kernel at each allocation, a cost of the order of the transforms on large cells (``docs/performance.md``, "The
+    arrays the cell's step reuses"). Off NumPy every method gives ``None`` (new arrays).
 
     Parameters
     ----------
@@ -291,15 +291,12 @@ class StepArrays:
             return None
         return self._half(second)[: 4 * math.prod(self.shape)].view(np.float32).reshape(self.shape)
 
-    def entering(self, g, delta, p):
-        """The mask of the nodes that may enter the contact, ``(g < delta) & (p == 0)`` (NumPy: in the first half of
-        the bytes, free between the product of a step's direction and the update of ``u``)."""
+    def brick64(self):
+        """A float64 brick array in all the bytes (where no spectrum is held: ``D p`` and the final ``C p``), or
+        None off NumPy."""
         if self.bytes is None:
-            return (g < delta) & (p == 0)
-        n = math.prod(self.shape)
-        mask, zero = (self.bytes[i * n : (i + 1) * n].view(np.bool_).reshape(self.shape) for i in (0, 1))
-        np.less(g, delta, out=mask)
-        return np.logical_and(mask, np.equal(p, 0, out=zero), out=mask)
+            return None
+        return self.bytes[: 8 * math.prod(self.shape)].view(np.float64).reshape(self.shape)
 
     def single(self, v):
         """``v`` rounded to float32 (in :meth:`brick32` on NumPy)."""

@@ -36,9 +36,9 @@ def _newton_model(h, step=3):
     models = []
     model_qp = bem.newton._model_qp
 
-    def spy(op, b, D, contact, precondition, **kw):
-        models.append((b.copy(), D.copy(), kw["x0"].copy()))
-        return model_qp(op, b, D, contact, precondition, **kw)
+    def spy(op, b, D, contact, precondition, p, **kw):
+        models.append((b.copy(), D.copy(), p.copy()))
+        return model_qp(op, b, D, contact, precondition, p, **kw)
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(bem.newton, "_model_qp", spy)

@@ -73,3 +73,47 @@ def test_newton_leaves_a_start_it_may_not_hold_its_iterate_in(start):
     res = _newton(x0, overwrite_x0=start != "no overwrite")
     assert res.converged and res.p is not x0
     np.testing.assert_array_equal(x0, keep)
+
+
+def _half_space_case():
+    """A sphere on a half-space region with a root layer: ``(op, h, force)``."""
+    region = bem.HalfSpaceRegion(step=0.02, extent=0.3)
+    lat = region.lattice()
+    return bem.InfluenceOperator(lat, 1.0), region.nodal_gap(bem.gaps.Paraboloid(1.0), lat), 0.01
+
+
+@pytest.mark.parametrize("domain", ["cell", "half-space"])
+def test_the_model_qp_iterates_in_newtons_pressure_which_keeps_its_values(monkeypatch, domain):
+    """Each model QP holds its iterate in the array of Newton's pressure (no copy of it through the QP), and Newton
+    gets its pressure back with the same values: the solve is the one with the QP's own copy, bit for bit."""
+    if domain == "cell":
+        op, h, force = PeriodicOperator(CELL, 1.0), waves(CELL), 0.02
+    else:
+        op, h, force = _half_space_case()
+    real, seen = op.qp, []
+
+    def qp(b, *, x0, **kw):
+        before = x0.copy()
+        sub = real(b, x0=x0, **kw)
+        seen.append((sub.p is x0, kw.get("overwrite_x0", False), before))
+        return sub
+
+    monkeypatch.setattr(op, "qp", qp)
+    checks = []
+    original = newton._model_qp
+
+    def model_qp(op_, b, D, contact, precondition, p, **kw):
+        sub, back = original(op_, b, D, contact, precondition, p, **kw)
+        checks.append(np.array_equal(back, seen[-1][2]) and back is not sub.p)
+        return sub, back
+
+    monkeypatch.setattr(newton, "_model_qp", model_qp)
+    held = newton.solve_newton(op, h, layer=LAYER, force=force)
+    assert held.converged and held.iterations >= 2 and len(seen) == held.iterations
+    assert all(in_buffer and overwrite for in_buffer, overwrite, _ in seen) and all(checks)
+    monkeypatch.setattr(newton, "in_place", lambda bk, x: False)  # the QP's own copy of the pressure
+    seen.clear()
+    copied = newton.solve_newton(op, h, layer=LAYER, force=force)
+    assert not any(in_buffer for in_buffer, _, _ in seen)
+    assert copied.iterations == held.iterations and np.array_equal(copied.p, held.p)
+    assert np.array_equal(copied.displacement, held.displacement)

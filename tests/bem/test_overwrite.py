@@ -101,3 +101,23 @@ def test_the_half_space_qp_meets_its_kkt_conditions_with_a_compliance(lam):
     assert np.abs(g[contact]).max() <= 1e-9 * scale  # closed where it presses
     assert g[m & ~contact].min() >= -1e-9 * scale  # open elsewhere
     assert p.min() >= 0 and abs(lat.node_area * p.sum() - force) <= 1e-12 * force
+
+
+def test_the_half_space_qp_from_a_product_holds_its_iterate_in_the_start_it_may_overwrite():
+    """With the caller's product ``u0 = C x0`` and ``overwrite_x0`` the QP iterates in ``x0``, masked in place (0 at
+    the nodes off the candidates), and gives the answer of the QP on its own copy bit for bit."""
+    from bem.kalker import solve_qp
+
+    lat = Lattice.from_extent(0.04, (1.0, 1.0))
+    op = InfluenceOperator(lat, 1.0)
+    x, y = lat.x - 0.5, lat.y - 0.5
+    h = (x * x + y * y) / 2
+    x0 = np.where(x * x + y * y < 0.01, 0.05, 0.0)
+    x0[~lat.mask] = 0.05  # written off the candidates: not part of the iterate
+    u0 = op.matvec(np.where(lat.mask, x0, 0.0))
+    kw = dict(force=2e-3, rtol=1e-10, preconditioner=op.preconditioner(), u0=u0)
+    own = solve_qp(op, h, x0=x0.copy(), **kw)
+    held = solve_qp(op, h, x0=x0, overwrite_x0=True, **kw)
+    assert own.converged and held.converged and held.p is x0 and own.p is not x0
+    assert np.all(x0[~lat.mask] == 0)
+    assert held.iterations == own.iterations and np.array_equal(held.p, own.p)

@@ -90,6 +90,39 @@ def test_the_compiled_passes_give_the_numpy_forms_numbers(two_threads, single):
 
 
 @pytest.mark.parametrize("single", [False, True])
+def test_the_compiled_passes_of_the_gap_give_the_numpy_forms_numbers(two_threads, single):
+    """``scan`` and ``gap_at`` (the gap ``u + h`` read without an array of it) give bit for bit the numbers of the
+    NumPy forms, in parts, on contiguous and strided arrays, and leave their inputs as they were."""
+    rng = np.random.default_rng(11)
+    ref, fast = passes.numpy_kernels(), _compiled()
+    u = rng.standard_normal(N).astype(np.float32 if single else np.float64)
+    h, p = rng.standard_normal(N) * 1e-3, np.where(rng.random(N) < 0.6, 0.0, rng.random(N))
+    u[N - 1], h[3] = 10.0, -20.0
+    keep = [x.copy() for x in (u, h, p)]
+    mask, expected = np.ones(N, dtype=bool), np.zeros(N, dtype=bool)
+    got, want = fast.scan(u, h, -0.3, p, mask), ref.scan(u, h, -0.3, p, expected)
+    assert got[0] is mask and got[1:] == want[1:]
+    assert _identical(mask, expected) and mask.any() and not mask.all()
+    below = -np.abs(u)
+    assert fast.scan(below, -h, 0.0, p, mask)[1:] == ref.scan(below, -h, 0.0, p, expected)[1:]
+    idx = np.flatnonzero(rng.random(N) < 0.3)
+    assert _identical(fast.gap_at(u, h, idx), ref.gap_at(u, h, idx))
+    assert fast.gap_at(u, h, idx[:0]).shape == (0,)
+    for x, y in zip((u, h, p), keep):
+        assert _identical(x, y)
+    shape = (400, 320)  # strided 2-D views (no flat view): the NumPy forms' numbers all the same
+    n = 400 * 320
+    wide = np.zeros((400, 640), dtype=u.dtype)
+    view = wide[:, :320]
+    view[...] = u[:n].reshape(shape)
+    h2, p2 = h[:n].reshape(shape), p[:n].reshape(shape)
+    out = np.zeros((400, 640), dtype=bool)[:, 320:]
+    assert fast.scan(view, h2, -0.3, p2, out)[1:] == ref.scan(view.copy(), h2, -0.3, p2, np.empty(shape, bool))[1:]
+    assert _identical(out, (view + h2 < -0.3) & (p2 == 0))
+    assert _identical(fast.gap_at(view, h2, idx[idx < n]), (view + h2).reshape(-1)[idx[idx < n]])
+
+
+@pytest.mark.parametrize("single", [False, True])
 def test_the_compiled_scatter_add_gives_the_numpy_forms_numbers(two_threads, single):
     """``add_at`` is NumPy's gather, sum and scatter in ``x``'s precision, bit for bit, over parts of the
     indices on the threads; it leaves the indices and values as they were."""
@@ -120,6 +153,7 @@ def test_a_nan_propagates_as_in_numpy(two_threads):
         a, b = ref.gap(u, h, np.empty(N))[1:], fast.gap(u, h, np.empty(N))[1:]
         assert _identical(np.array(a), np.array(b))
         assert np.isnan(a[0]) and np.isnan(a[1]) == (where == "u")
+        assert _identical(np.array(fast.scan(u, h, 0.0, u, np.empty(N, dtype=bool))[1:]), np.array(a))
 
 
 def test_small_cells_and_no_numba_take_the_numpy_forms(monkeypatch):
@@ -157,7 +191,8 @@ def test_the_qp_with_the_compiled_passes_is_the_qp_without(monkeypatch, two_thre
     monkeypatch.setattr(spectra, "kernels", lambda n: passes.numpy_kernels())
     with_kernels = solve_periodic_qp(op, h, **kw)
     n_with = op.n_matvec
-    assert {"gap", "subtract_scaled", "gather", "merge"} | ({"add_at"} if case == "per_node" else set()) <= set(calls)
+    gap = {"gap"} if case == "hardness" else {"scan", "gap_at"}  # an array of the gap with the bound
+    assert gap | {"subtract_scaled", "gather", "merge"} | ({"add_at"} if case == "per_node" else set()) <= set(calls)
     monkeypatch.setattr(passes, "MIN_NODES", 10**12)
     op.n_matvec = 0
     without = solve_periodic_qp(op, h, **kw)

@@ -105,24 +105,13 @@ def test_a_periodic_qp_makes_its_products_in_its_step_arrays(per_node, monkeypat
 
 
 @pytest.mark.parametrize("shape", [(16, 12), (16, 13), (2, 5)])
-def test_the_entering_mask_is_made_in_the_first_half_beside_the_product_of_the_direction(shape):
-    """``(g < delta) & (p == 0)`` in the half of the bytes that the step's product of its direction does not use (it
-    is read after the mask, to update ``u``)."""
+def test_a_float64_brick_fits_in_the_bytes_of_a_complex128_spectrum(shape):
+    """``D p`` and the final ``C p`` of the QP go into the step's bytes where no spectrum is held: a float64 brick
+    array of the cell's shape over them (the bytes of a complex128 spectrum hold at least the cell's nodes)."""
     work = StepArrays(get_backend("cpu"), shape)
-    rng = np.random.default_rng(5)
-    product = work.spectrum(np.complex64, second=True)
-    product[...] = rng.standard_normal(product.shape) + 1j * rng.standard_normal(product.shape)
-    keep = product.copy()
-    g, p = rng.standard_normal(shape), np.where(rng.random(shape) < 0.5, 0.0, rng.random(shape))
-    g_in, p_in = g.copy(), p.copy()
-    mask = work.entering(g, -0.2, p)
-    np.testing.assert_array_equal(mask, (g < -0.2) & (p == 0))
-    assert mask.any() and not mask.all()
-    assert np.shares_memory(mask, work.spectrum(np.complex64)) and not np.shares_memory(mask, product)
-    np.testing.assert_array_equal(product, keep)
-    np.testing.assert_array_equal(g, g_in)
-    np.testing.assert_array_equal(p, p_in)
-    xp = pytest.importorskip("array_api_strict")
-    other = StepArrays(get_backend(xp), shape)
-    got = other.entering(xp.asarray(g), -0.2, xp.asarray(p))
-    np.testing.assert_array_equal(np.asarray(got), mask)
+    brick = work.brick64()
+    assert brick.shape == shape and brick.dtype == np.float64 and brick.flags.c_contiguous
+    assert np.shares_memory(brick, work.bytes) and brick.nbytes <= work.bytes.nbytes
+    brick[...] = np.arange(np.prod(shape)).reshape(shape)
+    np.testing.assert_array_equal(work.bytes[: brick.nbytes].view(np.float64), np.arange(np.prod(shape)))
+    assert StepArrays(get_backend(pytest.importorskip("array_api_strict")), shape).brick64() is None
