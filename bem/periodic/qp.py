@@ -149,14 +149,15 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         p = x0 if overwrite_x0 and in_place(bk, x0) else bk.copy(bk.asarray(x0))  # updated in place below
     A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
     passes = kernels(lat.n_nodes, bk)  # the passes over the whole cell (bem.periodic.passes)
-    soft = stiff = None
+    soft, stiff = False, None  # soft: some node's compliance dominates (Jacobi there); stiff: for M 1 then
     lam_pc, jacobi = lam, 1.0 / (diag + lam)
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
         stiff = is_stiff(D, diag, threshold)
         sel = stiff & (p > 0)
         lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
         jacobi = 1.0 / (diag + D) if hardness is not None else None  # 1 / (C_nn + D), for bounded_move
-        soft = None if bool(xp.all(stiff)) else ~stiff
+        soft = not bool(xp.all(stiff))
+        sel, stiff = None, stiff if soft else None  # not held through the solve (stiff: until M 1 is made)
     M, A32 = op.symbol(lam_pc, inverse=True, single=True), op.symbol(lam, single=True)
     brick = ContactBrick(bk, lat.shape)  # the gap on the contact, then the search direction t (float32)
     work = StepArrays(bk, lat.shape)  # the spectra and bricks of the products (NumPy: one array, reused)
@@ -262,7 +263,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return bk.max0(p_c0), n, changes, n == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, m_at, gz_old, u, stale
+        nonlocal m_full, m_one, m_at, gz_old, u, stale, stiff
         if bounded and not bk.count(idx):  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
         steady = nodes.steady  # the last direction on the contact (float32) as written, D and what follows there
@@ -271,17 +272,17 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         else:  # gathers, at the entering nodes only where the contact was made from the step (ContactNodes.over)
             t_old = nodes.over(idx, lambda n: bk.take(brick.values, n), brick.last)
             D_c = nodes.over(idx, lambda n: bk.take(D, n), nodes.kept[0]) if per_node else None
-            soft_c, jac_c = (None, None) if soft is None else (~is_stiff(D_c, diag, threshold), jacobi_at(idx, D_c))
+            soft_c, jac_c = (None, None) if not soft else (~is_stiff(D_c, diag, threshold), jacobi_at(idx, D_c))
             nodes.kept = D_c, soft_c, jac_c
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        z = precondition(brick.write(idx, g_c if soft is None else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
-        if force is not None and soft is None:
+        z = precondition(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
+        if force is not None and not soft:
             z -= xp.mean(z)
         elif force is not None:
             # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
             if m_full is None:  # M (contact & stiff), single precision, kept so
-                m_full = apply_m(xp.astype((p > 0) & stiff, xp.float32))
+                m_full, stiff = apply_m(xp.astype((p > 0) & stiff, xp.float32)), None
             # and the Jacobi estimate at the soft nodes
             if not steady:  # m_at: M 1 at the contact's nodes
                 m_at = nodes.over(idx, lambda n: xp.astype(bk.take(m_full, n), xp.float64), m_at)
