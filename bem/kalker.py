@@ -116,6 +116,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     if maxiter is None:
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
     target = None if force is None else force / a
+    off = bk.select(~mask)  # the few masked nodes (last node of the odd rows)
     if u0 is None or x0 is None:
         p = initial_pressure(op, h, lam, force, approach, x0, hardness, overwrite_x0)
         if p is not x0:  # x0 itself where overwrite_x0 allows: clipped and masked in place
@@ -128,8 +129,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
                 p = carry_force(xp, p, target, hardness, mask)
         u0 = None
     else:  # the caller's iterate and its product, as they are
-        p = bk.put(x0, bk.select(~mask), 0.0) if overwrite_x0 and in_place(bk, x0) else xp.where(mask, x0, 0.0)
-    off = bk.select(~mask)  # the few masked nodes (last node of the odd rows)
+        p = bk.put(x0, off, 0.0) if overwrite_x0 and in_place(bk, x0) else xp.where(mask, x0, 0.0)
 
     def apply(v):
         out = op.matvec(v)
