@@ -183,6 +183,10 @@ class Backend:
             x[sel] = values
         return x
 
+    def add_at(self, x, sel, values):
+        """``x[sel] += values`` in place (each node once), rounded to ``x``'s precision; returns ``x``."""
+        return self.put(x, sel, self.xp.astype(self.take(x, sel) + values, x.dtype))
+
     def spread(self, shape, sel, values):
         """A brick array of ``shape`` holding ``values`` at the selected nodes, 0 elsewhere."""
         return self.put(self.xp.zeros(shape, dtype=self.float64), sel, values)

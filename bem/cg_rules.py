@@ -276,14 +276,15 @@ def is_per_node(lam):
     return getattr(lam, "ndim", 0) > 0
 
 
-def elastic_displacement(bk, u, lam, p, out=None):
-    """``C p = u - lam p`` (float64) from ``u = (C + lam) p``, ``lam`` per node or uniform [length/pressure]: ``u``
-    itself (float64) where ``lam`` is 0; ``out``: a float64 brick array for it on NumPy, not ``u``."""
+def elastic_displacement(bk, u, lam, p, out=None, offset=None):
+    """``C p = u - lam p - offset`` (float64) from ``u = (C + lam) p + offset``, ``lam`` per node or uniform
+    [length/pressure], ``offset`` None or ``(nodes, values)`` (a QP's, 0 elsewhere): ``u`` itself (float64) where
+    both are 0; ``out``: a float64 brick array for it on NumPy, not ``u``."""
     if not is_per_node(lam) and not lam:
-        return bk.xp.astype(u, bk.xp.float64, copy=False)
-    if bk.is_numpy:
-        return np.subtract(u, np.multiply(lam, p, out=out), out=out)
-    return u - lam * p
+        v = bk.xp.astype(u, bk.xp.float64, copy=False)
+    else:
+        v = np.subtract(u, np.multiply(lam, p, out=out), out=out) if bk.is_numpy else u - lam * p
+    return v if offset is None else bk.add_at(v, offset[0], -offset[1])
 
 
 def iterate_residual(contact_gap, gap_min, scale, gap_max, force_error=None, plastic_gap=None):

@@ -41,7 +41,7 @@ __all__ = ["solve_qp", "constrained_cg", "compliance_preconditioner"]
 
 def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
              maxiter=None, preconditioner=None, callback=None, scale=None, u0=None, confirm=True, hardness=None,
-             overwrite_x0=False):
+             overwrite_x0=False, offset=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` (``0 <= p <= H`` with a hardness).
 
     Parameters
@@ -53,8 +53,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     force, approach : float
         Exactly one: total force ``P`` [force] or approach ``delta`` [length].
     lam : float or ndarray
-        Linear layer compliance ``lam`` [length/pressure], scalar or per node
-        (the variable-compliance method of eq. 22 passes an array).
+        Linear layer compliance ``lam`` [length/pressure], scalar or per node (eq. 22's method, Newton's models).
     x0 : ndarray, optional
         Initial pressure (brick array); negative entries are clipped.
     overwrite_x0 : bool
@@ -80,10 +79,12 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         control it must carry the force), and the stopping check is then confirmed on an
         exact product as after any incremental update.
     confirm : bool
-        Confirm the stopping check on an exactly recomputed ``C p`` (default). A caller
-        that re-checks the solution itself (Newton's inner solves) passes False and gets
-        the solution of the incrementally updated products, which differ from the exact
-        ones by round-off only.
+        Confirm the stopping check on an exactly recomputed ``C p`` (default). A caller that re-checks the solution
+        itself (Newton's inner solves) passes False and gets the solution of the incrementally updated products,
+        which differ from the exact ones by round-off only.
+    offset : tuple, optional
+        ``(nodes, values)``: a part of the gap at some nodes (a backend's selection), added to ``h`` there with no
+        array of the sum (Newton's model gap ``h + w(p) - D p``, whose second part lives where ``p > 0``).
     hardness : float, optional
         The bound ``H`` of the pressure [pressure] (:mod:`bem.plastic`): the nodes at ``p = H`` are
         plastic, held at ``H`` and left out of the search direction like the open nodes; the step
@@ -101,17 +102,14 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
 
     ``max( max_{p>0} |g| , max_{p=0} (-g)_+ ) <= rtol * max |C p + lam p|``
 
-    with ``g = C p + lam p + h - delta`` (and ``|a sum p - P| <= rtol P`` under
-    force control, which the rescaling keeps to round-off), i.e.
-    :func:`bem.kkt.kkt_residual` ``<= rtol``; the check uses an exactly
-    recomputed ``C p`` unless ``confirm`` is False.
+    with ``g = C p + lam p + h - delta`` (and ``|a sum p - P| <= rtol P`` under force control, which the rescaling
+    keeps to round-off), i.e. :func:`bem.kkt.kkt_residual` ``<= rtol``; the check uses an exactly recomputed ``C p``
+    unless ``confirm`` is False.
     """
-    lat = op.lattice
-    bk, mask = operator_backend(op)
-    xp = bk.xp
-    a = lat.node_area
+    lat, (bk, mask) = op.lattice, operator_backend(op)
+    xp, a = bk.xp, lat.node_area
     per_node = is_per_node(lam)
-    lam = xp.where(mask, lam, 0.0) if per_node else float(lam)
+    lam = xp.astype(xp.where(mask, lam, 0.0), xp.float64) if per_node else float(lam)  # (a model's D: float32)
     h = _masked_gap(bk, mask, h)
     if maxiter is None:
         maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
@@ -131,17 +129,18 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     else:  # the caller's iterate and its product, as they are
         p = bk.put(x0, off, 0.0) if overwrite_x0 and in_place(bk, x0) else xp.where(mask, x0, 0.0)
 
-    def apply(v):
+    def apply(v):  # u of the iterate v: (C + lam) v and the gap's offset
         out = op.matvec(v)
         if per_node or lam:
             out += lam * v
-        return out
+        return out if offset is None else bk.add_at(out, *offset)
 
     if u0 is None:
         u, stale = apply(p), 0
     else:  # from the caller: C x0 (+ lam x0), to be confirmed like an incremental update
         u, stale = xp.where(mask, u0, 0.0), 1
         u += lam * p
+        u = u if offset is None else bk.add_at(u, *offset)
     t_kept = None  # (nodes, values): the last search direction on its contact (kept compact, as last_z)
     gz_old, restart = 1.0, False  # restart the direction (the rules in advance)
     last_z = None  # (nodes, z): the last preconditioned gap on its contact, for the Polak-Ribiere+ coefficient
@@ -311,8 +310,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         else:
             r *= tau
             u -= r
-            if s != 1.0:
+            if s != 1.0:  # the offset is not scaled with p
                 u *= s
+                u = u if offset is None else bk.add_at(u, offset[0], (1.0 - s) * offset[1])
             stale += 1
         return None
 
@@ -330,8 +330,9 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
         else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
             r *= tau
             u -= r
-            if s != 1.0:
+            if s != 1.0:  # the offset is not scaled with p
                 u *= s
+                u = u if offset is None else bk.add_at(u, offset[0], (1.0 - s) * offset[1])
             stale += 1
         return None
 
@@ -339,7 +340,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
     kkt = run_constrained_cg(CGStep(measure_bounded if bounded else measure, confirms, observe, advance, report),
                              record, maxiter, callback)
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not n_idx)
-    return record.solution(p, delta, kkt, elastic_displacement(bk, u, lam, p), "Kalker QP")
+    return record.solution(p, delta, kkt, elastic_displacement(bk, u, lam, p, offset=offset), "Kalker QP")
 
 
 def _kept_at(bk, shape, kept, idx, changes):

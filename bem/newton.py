@@ -50,6 +50,7 @@ log = logging.getLogger(__name__)
 # 6 Newton steps and 55 inner iterations on the finest level, against 9 and 57 with eta_k = r_k / r_(k-1).
 _FORCING = 0.3
 _GAMMA, _ALPHA = 0.9, (1 + math.sqrt(5)) / 2
+_SINGLE_MAX = float(np.finfo(np.float32).max)  # the model's D in single precision below it
 
 
 # Dot products go through Backend.dot: on NumPy np.einsum, because np.dot and np.vdot call the
@@ -101,19 +102,21 @@ def _advance(bk, p, u, sub, t, force, node_area, hardness):
     return q, uq
 
 
-def _model_qp(op, b, D, contact, precondition, p, **kw):
+def _model_qp(op, h, layer, D, contact, precondition, p, **kw):
     """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one) from ``p`` by the
-    operator's constrained-CG step (``op.qp``); ``(solution, p)``. Where the QP can hold its iterate in ``p``
-    (:func:`bem.plastic.in_place`) it does, and ``p`` is kept meanwhile on its nodes of nonzero pressure only, and
-    returned as a new array (the same values; one array of the lattice fewer through the QP)."""
-    if not in_place(backend_of(p), p):
-        return op.qp(b, lam=D, precondition=precondition, contact=contact, x0=p, **kw), p
-    at = np.flatnonzero(p)
-    kept = p.reshape(-1)[at]
-    sub = op.qp(b, lam=D, precondition=precondition, contact=contact, x0=p, overwrite_x0=True, **kw)
-    p = np.zeros(p.shape)
-    p.reshape(-1)[at] = kept
-    return sub, p
+    operator's constrained-CG step (``op.qp``); ``(solution, p)``. Its gap ``h + w(p) - D p`` goes as ``h`` and the
+    offset ``w(p) - D p`` on the nodes of nonzero pressure (``w(0) = 0``, :mod:`bem.layers.base`): no array of it.
+    Where the QP can hold its iterate in ``p`` (:func:`bem.plastic.in_place`) it does, and ``p`` is kept meanwhile on
+    those nodes only, and returned as a new array (the same values; one array of the lattice fewer through the QP)."""
+    bk = backend_of(p)
+    at = bk.select(p > 0)
+    kept = bk.take(p, at)
+    offset = (at, bk.asarray(layer.w(kept)) - bk.take(D, at) * kept)
+    kw.update(lam=D, precondition=precondition, contact=contact, x0=p, offset=offset)
+    if not in_place(bk, p):
+        return op.qp(h, **kw), p
+    sub = op.qp(h, overwrite_x0=True, **kw)
+    return sub, bk.spread(p.shape, at, kept)
 
 
 def _count_inner(hist, sub):
@@ -247,17 +250,16 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             break
         p_ref = float(xp.mean(p[contact])) if bool(xp.any(contact)) else 1.0
         D = masked(tangent(bk, layer, p, gap, p_ref))
+        D = xp.astype(D, xp.float32) if float(xp.max(D)) < _SINGLE_MAX else D  # a model's: single precision will do
         gap = None  # recomputed at the next step; not held through the model's solve
-        b = h + wp - D * p
         wp = None  # made again where needed: not held through the model's solve
         # forcing term: _FORCING, or less where the last step reduced the residual (Eisenstat & Walker)
         eta = min(_FORCING, _GAMMA * (kkt / hist["residual"][-2]) ** _ALPHA) if len(hist["residual"]) > 1 else _FORCING
         inner = max(rtol / 3, min(1e-2, eta * kkt))
         # the model starts at p with the product u Newton carries, and Newton checks every step on its own residual:
         # no product to start or to confirm the inner solve (fewer products on benchmarks/side_by_side.py's root layer)
-        sub, p = _model_qp(op, b, D, contact, precondition, p, force=force, approach=approach, rtol=inner,
+        sub, p = _model_qp(op, h, layer, D, contact, precondition, p, force=force, approach=approach, rtol=inner,
                            maxiter=inner_maxiter, u0=u, confirm=False, **bound)
-        b = None  # the model's gap: not held through the line search
         _count_inner(hist, sub)
         # the step d = q - p of the model's solution q (C d = uq - u) is formed where it is used, not held
         t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, mask)
@@ -265,13 +267,10 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             wp = closure(p)
             scale = float(xp.max(xp.abs(u + wp)))
             D = majorant(op, layer, p, sub.p, D, mask)
-            b = h + wp - D * p
-            wp = None
-            sub = None
-            sub, p = _model_qp(op, b, D, contact, precondition, p, force=force, approach=approach,
+            wp = sub = None
+            sub, p = _model_qp(op, h, layer, D, contact, precondition, p, force=force, approach=approach,
                                rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u,
                                confirm=False, **bound)
-            b = None
             _count_inner(hist, sub)
             t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, mask)
         # the model's closure at the step, for the closure move (not for linear laws, where it is the step itself)

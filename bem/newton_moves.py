@@ -120,9 +120,9 @@ def settle_plastic(op, layer, h, p, u, at_bound, delta, *, force, hardness):
 
 def model_closure(bk, layer, p, q, D, t):
     """``w(p) + t D (q - p)`` [length]: the closure of a Newton step's model (compliance ``D`` per node) at
-    ``p + t (q - p)``. On NumPy in the buffer of ``D``, which it consumes."""
-    if not in_place(bk, D):
-        return bk.asarray(layer.w(p)) + t * D * (q - p)
+    ``p + t (q - p)``, in double precision. On NumPy in the buffer of a float64 ``D``, which it consumes."""
+    if not in_place(bk, D):  # (a float32 D: the sum in double precision)
+        return bk.asarray(layer.w(p)) + D * (t * (q - p))
     D *= t
     D *= np.subtract(q, p)
     D += layer.w(p)

@@ -30,6 +30,7 @@ from ..operator import diagonal_coefficient
 from .coated import coated_template
 from .kernel import periodic_template
 from .spectra import mixed, weighted_dot
+from .symbol import Symbol
 
 __all__ = ["PeriodicOperator"]
 
@@ -68,13 +69,17 @@ def _spectra(w):
 
 
 def _packed(spectra):
-    """The packed symbol of :meth:`PeriodicOperator.mix` from :func:`_spectra` (the spectra themselves are not kept)."""
-    return PeriodicOperator._pack(spectra[0].real, spectra[2], spectra[1])
+    """The packed symbol ``(S_00, S_01)`` of :class:`bem.periodic.symbol.Symbol` from :func:`_spectra` (new arrays:
+    the spectra themselves are not kept)."""
+    d = np.empty((spectra.shape[1], 1, spectra.shape[2]))
+    b = np.empty(d.shape, dtype=np.complex128)
+    d[:, 0], b[:, 0] = spectra[0].real, spectra[2]
+    return d, b
 
 
 @lru_cache(maxsize=8)  # the levels of nested iteration of one or two cells
 def _homogeneous_symbol(n_rows, n_cols, scale):
-    """The packed symbol of the homogeneous operator of a cell, ``scale = c / (pi E*)``, read-only."""
+    """The packed symbol of the homogeneous operator of a cell, ``scale = c / (pi E*)``, read-only (:func:`_packed`)."""
     d, b = _packed(_spectra(periodic_template(n_rows, n_cols, cache=False) * scale))
     d.setflags(write=False)
     b.setflags(write=False)
@@ -131,7 +136,7 @@ class PeriodicOperator:
         if bk.is_numpy:
             self._symbol = _packed(spectra)
         else:
-            self._s00, self._s10, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra)
+            self._s00, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra[::2])  # S_10 = conj(S_01)
 
     def _template(self):
         """The dimensionless template of the cell: periodic, or of the coated bodies."""
@@ -191,18 +196,17 @@ class PeriodicOperator:
 
     @staticmethod
     def mix(spectrum, symbol, out=None):
-        """``out_a = sum_b S_ab X_b`` on a spectrum ``X`` of :meth:`spectrum`'s layout.
+        """``out_a = sum_b S_ab X_b`` on a spectrum ``X`` of :meth:`spectrum`'s layout, by a :meth:`symbol`.
 
-        ``symbol = (D, B)`` in the same layout: ``D[:, a] = S_aa`` (real; ``D`` of shape
-        ``(n_rows/2, 1, n_cols/2 + 1)`` where the two blocks are equal, as :meth:`symbol` gives
-        it) and ``B[:, a] = S_a(1-a)``, so that ``out = D X + B X'`` with ``X'`` the spectrum with
-        its parities swapped: three passes over blocks of :data:`bem.fft.BLOCK` entries (the product
-        ``B X'`` in a buffer of one block), on :func:`bem.fft.in_parts` threads. ``out`` (default: a new
-        array; C-contiguous, of the spectrum's shape and dtype) may be ``spectrum`` itself. Off NumPy,
-        ``D X + B X'`` in the spectrum's namespace (a new array; ``out`` is not used).
+        With ``(D, B)`` the symbol's arrays (:meth:`bem.periodic.symbol.Symbol.rows`: ``D[:, 0] = S_00 = S_11``,
+        ``B[:, a] = S_a(1-a)``) ``out = D X + B X'``, ``X'`` the spectrum with its parities swapped: on NumPy over
+        blocks of :data:`bem.fft.BLOCK` entries on :func:`bem.fft.in_parts` threads, the symbol's blocks made as
+        they are used (:func:`bem.periodic.spectra.mixed`). ``out`` (default: a new array; C-contiguous, of the
+        spectrum's shape and dtype) may be ``spectrum`` itself. Off NumPy, ``D X + B X'`` in the spectrum's
+        namespace (a new array; ``out`` is not used).
         """
-        d, b = symbol
-        if not isinstance(spectrum, np.ndarray):
+        if not isinstance(symbol, Symbol):  # a device's arrays
+            d, b = symbol
             return d * spectrum + b * backend_of(spectrum).xp.flip(spectrum, axis=1)
         return mixed(spectrum, symbol, _checked_out(out, spectrum.shape, spectrum.dtype), None)[0]
 
@@ -213,7 +217,7 @@ class PeriodicOperator:
         spectra), in double precision; ``out`` (as for :meth:`mix`) must not be ``spectrum``.
         """
         n_rows, n_cols = self.lattice.shape
-        if not isinstance(spectrum, np.ndarray):
+        if not isinstance(symbol, Symbol):  # a device's arrays
             out = self.mix(spectrum, symbol)
             return out, self.inner(spectrum, out)
         if out is spectrum:
@@ -235,16 +239,21 @@ class PeriodicOperator:
     def symbol(self, lam=0.0, inverse=False, single=False):
         """The 2 x 2 block symbol of ``C + lam I``, or of :meth:`preconditioner` (``inverse``), for :meth:`mix`.
 
-        ``(D, B)``, in the namespace of the operator's device: the diagonal blocks are real and equal
-        (the kernel of a parity on itself is even, and the same for both parities), ``D`` holds their real part once, shape
-        ``(n_rows/2, 1, n_cols/2 + 1)``, ``B`` the off-diagonal blocks, shape ``(n_rows/2, 2,
-        n_cols/2 + 1)``. ``single``: in single precision (float32, complex64), rounded from the
+        On NumPy a :class:`bem.periodic.symbol.Symbol` over the operator's packed symbol (its blocks made as a
+        product uses them: no array of their own). On a device ``(D, B)``, arrays in its namespace: the diagonal
+        blocks are real and equal (the kernel of a parity on itself is even, and the same for both parities), ``D``
+        holds their real part once, shape ``(n_rows/2, 1, n_cols/2 + 1)``, ``B`` the off-diagonal blocks, shape
+        ``(n_rows/2, 2, n_cols/2 + 1)``. ``single``: in single precision (float32, complex64), rounded from the
         double-precision blocks.
         """
+        shift = 0.5 * float(self.diagonal)  # the constant mode (1, 1) / sqrt 2 of frequency 0: eigenvalue C_nn + lam
+        if self.backend.is_numpy:
+            return Symbol(*self._symbol, lam=float(lam), inverse=inverse, shift=shift if inverse else 0.0,
+                          single=single)
         if inverse:
-            return self._pack(*self._inverse_blocks(lam), None, single=single)
-        if self._symbol is None:  # a device: packed from its spectra once
-            self._symbol = self._pack(self.backend.xp.real(self._s00), self._s01, self._s10)
+            return self._pack(*self._inverse_blocks(lam, shift), single=single)
+        if self._symbol is None:  # packed from its spectra once
+            self._symbol = self._pack(self.backend.xp.real(self._s00), self._s01)
         d, b = self._symbol
         if single and not lam:  # the symbol of C alone, rounded once per operator
             if self._symbol32 is None:
@@ -254,29 +263,18 @@ class PeriodicOperator:
         return self._rounded(d, b) if single else (d, b)
 
     def _rounded(self, d, b):
-        """``(D, B)`` of :meth:`symbol` rounded to single precision."""
-        if self.backend.is_numpy:
-            return d.astype(np.float32), b.astype(np.complex64)
+        """``(D, B)`` of :meth:`symbol` on a device rounded to single precision."""
         xp = self.backend.xp
         return xp.astype(d, xp.float32), xp.astype(b, xp.complex64)
 
     @staticmethod
-    def _pack(d00, s01, s10, single=False):
-        """``(D, B)`` of :meth:`symbol` from the real diagonal block ``d00`` and the off-diagonal ones
-        (``s10`` None: its conjugate ``conj(s01)``), in their namespace."""
-        if not isinstance(d00, np.ndarray):
-            xp = backend_of(d00).xp
-            d = xp.reshape(d00, (d00.shape[0], 1, d00.shape[1]))
-            b = xp.stack([s01, xp.conj(s01) if s10 is None else s10], axis=1)
-            return (xp.astype(d, xp.float32), xp.astype(b, xp.complex64)) if single else (d, b)
-        d = np.empty((d00.shape[0], 1, d00.shape[1]), dtype=np.float32 if single else np.float64)
-        b = np.empty((d00.shape[0], 2, d00.shape[1]), dtype=np.complex64 if single else np.complex128)
-        d[:, 0], b[:, 0] = d00, s01
-        if s10 is None:
-            np.conjugate(s01, out=b[:, 1], casting="same_kind")
-        else:
-            b[:, 1] = s10
-        return d, b
+    def _pack(d00, s01, single=False):
+        """``(D, B)`` of :meth:`symbol` on a device from the real diagonal block ``d00`` and ``S_01`` (``S_10`` its
+        conjugate), in their namespace."""
+        xp = backend_of(d00).xp
+        d = xp.reshape(d00, (d00.shape[0], 1, d00.shape[1]))
+        b = xp.stack([s01, xp.conj(s01)], axis=1)
+        return (xp.astype(d, xp.float32), xp.astype(b, xp.complex64)) if single else (d, b)
 
     def _apply(self, v, s00, s01, s10, s11, single=False):
         """``out_a = sum_b S_ab v_b`` by the spectra ``S`` of a 2 x 2 block symbol (NumPy: ``s00`` is ``(D, B)``;
@@ -304,7 +302,7 @@ class PeriodicOperator:
         self.n_matvec += 1
         if self.backend.is_numpy:
             return self._apply(p, self.symbol(), None, None, None)
-        return self._apply(p, self._s00, self._s01, self._s10, self._s00)
+        return self._apply(p, self._s00, self._s01, self.backend.xp.conj(self._s01), self._s00)
 
     __call__ = matvec
 
@@ -347,7 +345,7 @@ class PeriodicOperator:
         if self.backend.is_numpy:
             i00, i01, i10, i11 = self.symbol(lam, inverse=True, single=single), None, None, None
         else:
-            a, b = self._inverse_blocks(lam)
+            a, b = self._inverse_blocks(lam, 0.5 * float(self.diagonal))
             i00, i01, i10, i11 = a, b, self.backend.xp.conj(b), a
 
         def apply(r):
@@ -355,27 +353,21 @@ class PeriodicOperator:
 
         return apply
 
-    def _inverse_blocks(self, lam):
-        """The blocks ``(I00, I01)`` of the symbol of :meth:`preconditioner` (``I11 = I00``, ``I10 = conj(I01)``).
+    def _inverse_blocks(self, lam, shift):
+        """The blocks ``(I00, I01)`` of the symbol of :meth:`preconditioner` on a device (``I11 = I00``, ``I10 =
+        conj(I01)``), as :meth:`bem.periodic.symbol.Symbol.rows` makes them on NumPy.
 
         ``C`` is symmetric, so its symbol is Hermitian: ``S_11 = S_00`` is real and
         ``S_10 = conj(S_01)``. The determinant ``S_00^2 - |S_01|^2`` is then real, ``I00 = I11``
         is real and ``I10 = conj(I01)``.
         """
         xp = self.backend.xp
-        if self.backend.is_numpy:  # the blocks of the packed symbol: the same numbers as the spectra
-            d, s01 = self._symbol[0][:, 0], self._symbol[1][:, 0]
-            a, b = d + lam, s01.copy()
-        else:
-            a = xp.real(self._s00) + lam
-            b = self.backend.copy(self._s01)
-        shift = 0.5 * float(self.diagonal)  # the constant mode (1, 1) / sqrt 2 of frequency 0 gets eigenvalue C_nn + lam
+        a = xp.real(self._s00) + lam
+        b = self.backend.copy(self._s01)
         a[0, 0] += shift
         b[0, 0] += shift
-        det = a * a - (xp.real(b) ** 2 + xp.imag(b) ** 2)
-        b /= -det
-        a /= det
-        return a, b
+        det = a * a - (xp.real(b) * xp.real(b) + xp.imag(b) * xp.imag(b))
+        return a / det, b * (-1.0 / det)
 
     def dense(self):
         """The dense matrix ``C`` over the flattened nodes (small cells only), from :attr:`kernel` by offsets."""

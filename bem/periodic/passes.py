@@ -12,7 +12,8 @@ contiguous parts run at once (:func:`bem.fft.in_parts`):
   rescaling to the force), one pass instead of three;
 - ``add_at``: ``x[idx] += values`` in ``x``'s precision (a compliance per node's terms of ``u``), one pass
   instead of a gather, a sum and a scatter;
-- ``gather``: the preconditioned gap (single precision) at the contact's nodes, in double precision;
+- ``gather``: the preconditioned gap (single precision) or a compliance per node at the contact's nodes, in double
+  precision;
 - ``gap_at``: the gap ``u + h`` at the contact's nodes (or the entering ones), one gather instead of two and a sum;
 - ``merge``: the next contact made from the step, its nodes that stayed and the entering ones merged in order, with
   their pressures, into given arrays (:class:`bem.periodic.qp_parts.ContactNodes`), in one pass (serial);
@@ -93,7 +94,7 @@ class _NumPyKernels:
 
     @staticmethod
     def gather(x, idx):
-        """``x`` (float32) at the flat indices ``idx``, in double precision."""
+        """``x`` (float32 or float64) at the flat indices ``idx``, in double precision."""
         return np.take(x.reshape(-1), idx).astype(np.float64)
 
     @staticmethod
@@ -183,6 +184,8 @@ def load():
     bool
         Whether the compiled kernels are in use on large cells.
     """
+    from .symbol import Symbol
+
     k = kernels(MIN_NODES)
     if k.compiled:
         x64, x32, idx = np.zeros(4), np.zeros(4, dtype=np.float32), np.arange(2)
@@ -191,14 +194,15 @@ def load():
             k.scan(u, x64, 0.0, x64, np.empty(4, dtype=bool))
             k.subtract_scaled(u, x32.copy(), 1.0, 2.0)
             k.add_at(u, idx, x64[:2])
-        k.gather(x32, idx)
         for u in (x64, x32):
             k.gap_at(u, x64, idx)
+            k.gather(u, idx)
         at, flag = np.empty(1, dtype=np.intp), np.ones(2, dtype=bool)
         k.merge(idx, x64[:2], flag, idx[:1], x64[:1], np.empty(3, dtype=idx.dtype), np.empty(3), at)
-        for real, cplx in ((np.float32, np.complex64), (np.float64, np.complex128)):  # the spectra's precisions
+        symbol = Symbol(np.ones((2, 1, 3)), np.zeros((2, 1, 3), dtype=complex), inverse=True, shift=1.0)
+        for cplx in (np.complex64, np.complex128):  # the spectra's precisions
             x = np.zeros((2, 2, 3), dtype=cplx)
-            k.mix(x, (np.zeros((2, 1, 3), dtype=real), x.copy()), x, True, 1)
+            k.mix(x, symbol, x, True, 1)
     return k.compiled
 
 
@@ -260,21 +264,27 @@ def _compile():
         for j in range(lo, hi):
             out[j] = u[idx[j]] + h[idx[j]]
 
-    @njit(**opts)
-    def _mix(x, d, b, out, rows, lo, hi, sums, even):  # blocks lo..hi of `rows` rows; sums: one a block, or empty
-        n_rows, n_cols = x.shape[0], x.shape[2]
-        shared = d.shape[1] == 1
+    @njit(error_model="numpy", **opts)
+    def _mix(x, d, b, lam, inverse, shift, cast, out, rows, lo, hi, sums, even):  # blocks lo..hi of `rows` rows
+        n_rows, n_cols = x.shape[0], x.shape[2]  # the symbol per entry as Symbol.rows makes it; cast: x's real type
         for k in range(lo, hi):
             total = 0.0
             for r in range(k * rows, min((k + 1) * rows, n_rows)):
                 for c in range(n_cols):
-                    x0, x1, b0, b1 = x[r, 0, c], x[r, 1, c], b[r, 0, c], b[r, 1, c]
-                    d0 = d[r, 0, c]
-                    d1 = d0 if shared else d[r, 1, c]
-                    y0r = d0 * x0.real + (b0.real * x1.real - b0.imag * x1.imag)
-                    y0i = d0 * x0.imag + (b0.real * x1.imag + b0.imag * x1.real)
-                    y1r = d1 * x1.real + (b1.real * x0.real - b1.imag * x0.imag)
-                    y1i = d1 * x1.imag + (b1.real * x0.imag + b1.imag * x0.real)
+                    a, br, bi = d[r, 0, c] + lam, b[r, 0, c].real, b[r, 0, c].imag
+                    if inverse:
+                        if r == 0 and c == 0:  # the constant mode
+                            a, br = a + shift, br + shift
+                        det = a * a - (br * br + bi * bi)
+                        s = -1.0 / det
+                        a, br, bi = a / det, br * s, bi * s
+                    d0, b0r, b0i = cast(a), cast(br), cast(bi)
+                    b1r, b1i = b0r, -b0i  # S_10 = conj(S_01)
+                    x0, x1 = x[r, 0, c], x[r, 1, c]
+                    y0r = d0 * x0.real + (b0r * x1.real - b0i * x1.imag)
+                    y0i = d0 * x0.imag + (b0r * x1.imag + b0i * x1.real)
+                    y1r = d0 * x1.real + (b1r * x0.real - b1i * x0.imag)
+                    y1i = d0 * x1.imag + (b1r * x0.imag + b1i * x0.real)
                     out[r, 0, c] = complex(y0r, y0i)
                     out[r, 1, c] = complex(y1r, y1i)
                     if sums.size:
@@ -341,11 +351,11 @@ def _compile():
 
         @staticmethod
         def mix(spectrum, symbol, out, even, rows):
-            d, b = symbol
             blocks = -(-spectrum.shape[0] // rows)
             sums = np.zeros(blocks if even is not None else 0)
-            fft.in_parts(lambda part: _mix(spectrum, d, b, out, rows, part.start, part.stop, sums, bool(even)),
-                         blocks, spectrum.size)
+            s, cast = symbol, spectrum.real.dtype.type
+            fft.in_parts(lambda part: _mix(spectrum, s.d, s.b, float(s.lam), bool(s.inverse), float(s.shift), cast, out,
+                                           rows, part.start, part.stop, sums, bool(even)), blocks, spectrum.size)
             return out, sums
 
         @staticmethod

@@ -39,7 +39,7 @@ leaving, at a constant KKT residual: ``tests/bem/test_periodic_robustness.py``).
   threads (:mod:`bem.periodic.passes`).
 
 With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are those of ``C`` alone,
-``u = C p + D p`` and the curvature adds ``sum D t^2``; the preconditioner is that of
+``u = C p + D p`` (plus the gap's ``offset``) and the curvature adds ``sum D t^2``; the preconditioner is that of
 :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique projection under force control (by
 ``M 1`` of the starting contact).
 
@@ -82,7 +82,7 @@ SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_AB
 
 def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
                       callback=None, scale=None, u0=None, confirm=True, threshold=4.0, hardness=None,
-                      overwrite_x0=False):
+                      overwrite_x0=False, offset=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell.
 
     Parameters
@@ -108,10 +108,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         Iteration limit (default ``max(200, 10 * sqrt(N))``).
     callback : callable, optional
         ``callback(k, p)`` after every iteration.
-    scale, u0, confirm
+    scale, u0, confirm, offset
         As for :func:`bem.kalker.solve_qp`: the displacement scale of the KKT residual [length], ``C x0`` where the
-        caller has it (the iterate then starts from ``x0`` as given), and whether to confirm the stopping check on
-        an exact product. Unconfirmed, a stop at ``rtol >= SINGLE_ABOVE`` returns ``C p`` in single precision.
+        caller has it (the iterate then starts from ``x0`` as given), whether to confirm the stopping check on
+        an exact product (unconfirmed, a stop at ``rtol >= SINGLE_ABOVE`` returns ``C p`` in single precision), and
+        the gap's part at some nodes, ``(nodes, values)``, added to ``h`` there (no array of the sum).
     threshold : float
         With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner (as in
         :func:`bem.kalker.compliance_preconditioner`).
@@ -125,16 +126,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         As :func:`bem.kalker.solve_qp` with its FFT preconditioner; ``op.n_matvec`` counts the
         products ``(C + lam) v`` (spectral multiplications, in single or double precision).
     """
-    lat = op.lattice
-    a = lat.node_area
-    bk = operator_backend(op)[0]
-    xp = bk.xp
+    lat, bk = op.lattice, operator_backend(op)[0]
+    a, xp = lat.node_area, bk.xp
     per_node = is_per_node(lam)
-    D = bk.asarray(lam) if per_node else None
+    D = bk.asarray(lam, xp.float32 if getattr(lam, "dtype", None) == xp.float32 else None) if per_node else None
     lam = 0.0 if per_node else float(lam)
     h = bk.asarray(h)
-    if maxiter is None:
-        maxiter = max(200, int(10 * math.sqrt(lat.n_nodes)))
+    maxiter = max(200, int(10 * math.sqrt(lat.n_nodes))) if maxiter is None else maxiter
     target = None if force is None else force / a
     if u0 is None or x0 is None:  # a new array, or x0 itself with overwrite_x0
         p = initial_pressure(op, h, D if per_node else lam, force, approach, x0, hardness, overwrite_x0)
@@ -155,7 +153,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         stiff = is_stiff(D, diag, threshold)
         sel = stiff & (p > 0)
         lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
-        jacobi = 1.0 / (diag + D) if hardness is not None else None  # 1 / (C_nn + D), for bounded_move
+        jacobi = 1.0 / (diag + xp.astype(D, xp.float64)) if hardness is not None else None  # for bounded_move
         soft = not bool(xp.all(stiff))
         sel, stiff = None, stiff if soft else None  # not held through the solve (stiff: until M 1 is made)
     M, A32 = op.symbol(lam_pc, inverse=True, single=True), op.symbol(lam, single=True)
@@ -172,13 +170,12 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return op.brick(op.mix(x, M, out=x), overwrite=True, out=out)
 
     def precondition(r32, sel, r_c, soft_c, jac_c):
-        # M r at the selected nodes: r_c = r there, r32 = r (float32) at the stiff nodes; soft_c, jac_c: the soft
-        # nodes and 1 / (C_nn + D) there (None: no soft node)
+        # M r at the nodes sel (r_c: r there, r32: r at the stiff nodes; soft_c, jac_c: soft nodes, 1 / (C_nn + D))
         z = passes.gather(apply_m(r32, work.brick32()), sel)
         return z if soft_c is None else xp.where(soft_c, jac_c * r_c, z)
 
     def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
-        return 1.0 / (diag + (bk.take(D, sel) if D_n is None else D_n))
+        return 1.0 / (diag + (passes.gather(D, sel) if D_n is None else D_n))
 
     def add_into(x, y):  # x += y in x's precision (NumPy: in place)
         return np.add(x, y, out=x) if bk.is_numpy else xp.astype(x + y, x.dtype, copy=False)
@@ -192,8 +189,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         u, exact_base = op.brick(product(p), overwrite=True, out=u), not single
         return u
 
-    def exact_u():  # (C + lam) p, and D p per node
-        return add_into(product_u(), times_p(D)) if per_node else product_u()
+    def offset_added(v, times=1.0):  # v plus times the gap's offset (NumPy: in place)
+        return v if offset is None or not times else passes.add_at(v, offset[0], times * offset[1])
+
+    def exact_u():  # (C + lam) p, D p per node, and the gap's offset
+        return offset_added(add_into(product_u(), times_p(D)) if per_node else product_u())
 
     # the first product in double precision (the KKT residual's scale); exact_base: u from a double-precision product
     single, u, exact_base = False, None, False  # (not the caller's u0, nor single precision) and steps' updates since
@@ -201,6 +201,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         u, stale = exact_u(), 0
     else:  # C x0 from the caller, confirmed like an incremental update
         u, stale = add_into(bk.copy(bk.asarray(u0)), times_p(D)) if per_node else bk.copy(bk.asarray(u0)), 1
+        u = offset_added(u)
     last_z = LastPreconditionedGap(bk, lat.shape)  # the last preconditioned gap, on its contact only
     gz_old, m_one, m_full, m_at = 1.0, None, None, None
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
@@ -271,7 +272,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             t_old, (D_c, soft_c, jac_c) = brick.last, nodes.kept
         else:  # gathers, at the entering nodes only where the contact was made from the step (ContactNodes.over)
             t_old = nodes.over(idx, lambda n: bk.take(brick.values, n), brick.last)
-            D_c = nodes.over(idx, lambda n: bk.take(D, n), nodes.kept[0]) if per_node else None
+            D_c = nodes.over(idx, lambda n: passes.gather(D, n), nodes.kept[0]) if per_node else None
             soft_c, jac_c = (None, None) if not soft else (~is_stiff(D_c, diag, threshold), jacobi_at(idx, D_c))
             nodes.kept = D_c, soft_c, jac_c
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
@@ -334,7 +335,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if (changed or entered) and confirm and exact_base and not single and tau > 0 and stale < RECOMPUTE_EVERY and (
                 bk.is_numpy):
             t_move = brick.write_move(clipped, p_c0[clipped] / tau, *((overlap, -p_o / tau) if entered else ()))
-            terms = [(idx, D_c * (p_c - p_c0))] + ([(overlap, bk.take(D, overlap) * p_o)] if entered else []) if (
+            terms = [(idx, D_c * (p_c - p_c0))] + ([(overlap, passes.gather(D, overlap) * p_o)] if entered else []) if (
                 per_node) else []  # D (p_new / s - p), before the scaling by s
         s = 1.0
         if target is not None:
@@ -355,11 +356,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         elif not (changed or entered or stale >= RECOMPUTE_EVERY):  # p = s (p - tau t) on the contact
             update_u(R, tau, s, [(idx, -tau * (D_c * t_c))] if per_node else [])
         else:
-            u, stale = product_u(), 0
+            u, stale = offset_added(product_u()), 0
             if per_node:  # u += D p, on the nodes where p > 0
                 passes.add_at(u, idx, D_c * p_c)
                 if entered:
-                    passes.add_at(u, overlap, bk.take(D, overlap) * p_o)
+                    passes.add_at(u, overlap, passes.gather(D, overlap) * p_o)
         nodes.stepped(p_c, entered, overlap, p_o)  # after the product: the next contact is not held through it
         return None
 
@@ -375,6 +376,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             passes.add_at(u, sel, values)
         if terms and s != 1.0:
             u *= s
+        u = offset_added(u, 1.0 - s)  # the offset is not scaled with p
         stale += 1
 
     def bounded_step(tau, t_c, R, D_c):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
@@ -393,6 +395,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         measure, confirms, observe, advance, lambda: bk.copy(p))
     kkt = run_constrained_cg(step, record, maxiter, callback)
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not bk.count(idx))
-    return record.solution(p, delta, kkt, elastic_displacement(bk, u, D if per_node else lam, p, out=work.brick64()),
-                           "Kalker QP (periodic)")  # C p, in work's bytes (free now) on NumPy
+    c_p = elastic_displacement(bk, u, D if per_node else lam, p, out=work.brick64(), offset=offset)  # in work's bytes
+    return record.solution(p, delta, kkt, c_p, "Kalker QP (periodic)")
 

@@ -1,5 +1,6 @@
 """Products of the periodic cell's spectra on NumPy: the 2 x 2 block product of
-:meth:`bem.periodic.PeriodicOperator.mix` and the inner product of two brick arrays from their half spectra.
+:meth:`bem.periodic.PeriodicOperator.mix` by a :class:`bem.periodic.symbol.Symbol` and the inner product of two brick
+arrays from their half spectra.
 
 A spectrum has the layout of :meth:`bem.periodic.PeriodicOperator.spectrum`: ``(n_rows/2, 2, n_cols/2 + 1)``,
 the real FFT along the rows of each row parity, then the FFT along the columns.
@@ -35,7 +36,8 @@ def weighted_dot(x, y, even):
 
 
 def mixed(spectrum, symbol, out, even):
-    """:meth:`bem.periodic.PeriodicOperator.mix` of ``spectrum`` into ``out``, block by block on threads; with
+    """:meth:`bem.periodic.PeriodicOperator.mix` of ``spectrum`` by a :class:`bem.periodic.symbol.Symbol` into
+    ``out``, block by block on threads (the symbol's blocks made as they are used, in the spectrum's precision); with
     ``even`` not None also the :func:`weighted_dot` of ``spectrum`` and ``out`` of each block of rows as it is made
     (``out`` must then not be ``spectrum``). Returns ``(out, sums)``, ``sums`` the blocks' sums in the order of the
     blocks (empty with ``even`` None).
@@ -51,9 +53,9 @@ def mixed(spectrum, symbol, out, even):
 
 
 def numpy_mixed(spectrum, symbol, out, even, rows):
-    """:func:`mixed` in NumPy, over blocks of ``rows`` rows: three passes over each block (the product ``B X'`` in a
-    buffer of one block), the sum by :func:`weighted_dot`."""
-    d, b = symbol
+    """:func:`mixed` in NumPy, over blocks of ``rows`` rows: the block's symbol
+    (:meth:`bem.periodic.symbol.Symbol.rows`), then three passes over the block (the product ``B X'`` in a buffer of
+    one block), the sum by :func:`weighted_dot`."""
     sums = {}
 
     def part(s):  # rows s of every array: the parity swap stays inside a row
@@ -61,8 +63,9 @@ def numpy_mixed(spectrum, symbol, out, even, rows):
         for lo in range(s.start, s.stop, rows):
             r = slice(lo, min(lo + rows, s.stop))
             w = work[:r.stop - lo]
-            np.multiply(b[r], spectrum[r, ::-1, :], out=w)
-            np.multiply(d[r], spectrum[r], out=out[r])
+            d, b = symbol.rows(r.start, r.stop)
+            np.multiply(b, spectrum[r, ::-1, :], out=w)
+            np.multiply(d, spectrum[r], out=out[r])
             np.add(out[r], w, out=out[r])
             if even is not None:
                 sums[lo] = weighted_dot(spectrum[r], out[r], even)

@@ -31,14 +31,16 @@ def rough(cell, seed=7):
 
 
 def _newton_model(h, step=3):
-    """``(b, D, x0)`` of the model QP of Newton step ``step`` of the root layer on :data:`CELL` (NumPy): a
-    compliance per node ``D``, stiff on the contact and soft (``D > 4 C_nn``) at the open nodes."""
+    """``(b, D, x0)`` of the model QP of Newton step ``step`` of the root layer on :data:`CELL` (NumPy): its gap
+    ``b = h + w(p) - D p`` as an array, a compliance per node ``D`` (float32, as Newton makes it), stiff on the
+    contact and soft (``D > 4 C_nn``) at the open nodes."""
     models = []
     model_qp = bem.newton._model_qp
 
-    def spy(op, b, D, contact, precondition, p, **kw):
-        models.append((b.copy(), D.copy(), p.copy()))
-        return model_qp(op, b, D, contact, precondition, p, **kw)
+    def spy(op, h, layer, D, contact, precondition, p, **kw):
+        b = h + layer.w(p) - D * p
+        models.append((b, D.copy(), p.copy()))
+        return model_qp(op, h, layer, D, contact, precondition, p, **kw)
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(bem.newton, "_model_qp", spy)

@@ -65,18 +65,19 @@ def test_in_parts_gives_the_numbers_of_one_thread(monkeypatch):
     op = PeriodicOperator(cell, 1.0)
     X = op.spectrum(np.random.default_rng(1).standard_normal(cell.shape))
     before = X.copy()
-    d, b = op.symbol(0.3 * op.diagonal)
+    symbol = op.symbol(0.3 * op.diagonal)
+    d, b = symbol.arrays()
     monkeypatch.setattr(fft, "_override", 2)
-    two = op.mix(X, (d, b))
+    two = op.mix(X, symbol)
     monkeypatch.setattr(fft, "_override", 1)
-    one = op.mix(X, (d, b))
+    one = op.mix(X, symbol)
     np.testing.assert_array_equal(X, before)  # the input is not modified
     np.testing.assert_array_equal(two, one)
     direct = d * X + b * X[:, ::-1, :]
     np.testing.assert_allclose(two, direct, rtol=1e-15, atol=1e-15 * np.abs(direct).max())
     monkeypatch.setattr(fft, "_override", 2)
     Y = X.copy()
-    assert op.mix(Y, (d, b), out=Y) is Y  # in place, as the solvers call it
+    assert op.mix(Y, symbol, out=Y) is Y  # in place, as the solvers call it
     np.testing.assert_array_equal(Y, one)
 
 

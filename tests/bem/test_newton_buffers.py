@@ -92,9 +92,9 @@ def test_the_model_qp_iterates_in_newtons_pressure_which_keeps_its_values(monkey
         op, h, force = _half_space_case()
     real, seen = op.qp, []
 
-    def qp(b, *, x0, **kw):
+    def qp(h_, *, x0, **kw):
         before = x0.copy()
-        sub = real(b, x0=x0, **kw)
+        sub = real(h_, x0=x0, **kw)
         seen.append((sub.p is x0, kw.get("overwrite_x0", False), before))
         return sub
 
@@ -102,8 +102,8 @@ def test_the_model_qp_iterates_in_newtons_pressure_which_keeps_its_values(monkey
     checks = []
     original = newton._model_qp
 
-    def model_qp(op_, b, D, contact, precondition, p, **kw):
-        sub, back = original(op_, b, D, contact, precondition, p, **kw)
+    def model_qp(op_, h_, layer, D, contact, precondition, p, **kw):
+        sub, back = original(op_, h_, layer, D, contact, precondition, p, **kw)
         checks.append(np.array_equal(back, seen[-1][2]) and back is not sub.p)
         return sub, back
 

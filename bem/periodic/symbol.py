@@ -1,0 +1,73 @@
+"""The 2 x 2 block symbol of the periodic cell's operator (:class:`bem.periodic.PeriodicOperator`), or of its
+inverse, made from the packed symbol of ``C`` a block of rows at a time as a product uses it.
+
+A spectrum of the cell has the layout of :meth:`bem.periodic.PeriodicOperator.spectrum`, ``(n_rows/2, 2, n_cols/2 +
+1)``: per frequency the two row parities, which ``C`` couples by a 2 x 2 block. ``C`` is symmetric, so the block is
+Hermitian: its diagonal entries are real and equal (the kernel of a parity on itself is even, and the same for both
+parities), ``S_00 = S_11``, and ``S_10 = conj(S_01)``. The operator keeps ``S_00`` and ``S_01`` once, in double
+precision (6 bytes a node); the symbols of ``C + lam I``, of its inverse (the preconditioner) and their single
+precision forms are made from them where a product needs them (:func:`bem.periodic.spectra.mixed`, and compiled in
+:mod:`bem.periodic.passes`), not held.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Symbol"]
+
+
+@dataclass(frozen=True)
+class Symbol:
+    """The 2 x 2 block symbol of ``C + lam I``, or of its inverse, over the packed symbol ``(S_00, S_01)`` of ``C``.
+
+    Attributes
+    ----------
+    d : ndarray
+        ``S_00`` of ``C``, float64, shape ``(n_rows/2, 1, n_cols/2 + 1)`` (read, never written).
+    b : ndarray
+        ``S_01`` of ``C``, complex128, the same shape.
+    lam : float
+        Uniform compliance added on the diagonal [length/pressure].
+    inverse : bool
+        The symbol of ``(C + lam I)^-1``: ``a / det`` and ``-b / det`` with ``a = S_00 + lam``, ``det = a^2 - |b|^2``,
+        where at frequency 0 ``shift`` is added to ``a`` and to ``b`` first (``b`` times ``-1 / det``, as a product
+        with the reciprocal).
+    shift : float
+        See ``inverse``: half the eigenvalue the constant mode takes (where ``C`` vanishes).
+    single : bool
+        The blocks rounded to single precision (after they are made in double precision), for float32 products.
+    """
+
+    d: np.ndarray
+    b: np.ndarray
+    lam: float = 0.0
+    inverse: bool = False
+    shift: float = 0.0
+    single: bool = False
+
+    def rows(self, lo=0, hi=None):
+        """``(D, B)`` of the rows ``lo:hi`` of the spectrum: ``D`` real, shape ``(rows, 1, n_cols/2 + 1)``, ``B``
+        complex, ``(rows, 2, n_cols/2 + 1)``, ``B[:, 0] = S_01``, ``B[:, 1] = S_10``; in single precision with
+        ``single``. New arrays: the form of reference for the compiled product (:mod:`bem.periodic.passes`)."""
+        a, b = self.d[lo:hi] + self.lam, self.b[lo:hi]
+        if self.inverse:
+            if lo == 0 and a.size:  # frequency 0: the constant mode
+                b = b.copy()
+                a[0, 0, 0] += self.shift
+                b[0, 0, 0] += self.shift
+            det = b.real * b.real
+            det += b.imag * b.imag
+            np.subtract(a * a, det, out=det)  # a^2 - |b|^2
+            a /= det
+            b = b * np.divide(-1.0, det, out=det)
+        out = np.empty((a.shape[0], 2) + a.shape[2:], dtype=np.complex64 if self.single else np.complex128)
+        out[:, :1] = b
+        np.conjugate(out[:, :1], out=out[:, 1:])
+        return (a.astype(np.float32) if self.single else a), out
+
+    def arrays(self):
+        """``(D, B)`` of every row (:meth:`rows`): the symbol as arrays."""
+        return self.rows()
