@@ -10,7 +10,8 @@ contiguous parts run at once (:func:`bem.fft.in_parts`):
   (``gap``: the extremes with the gap ``g = u + h`` written into an array, for the bounded QP of a hardness);
 - ``subtract_scaled``: the update ``u = s (u - tau (C + lam) t)`` from the product in single precision (``s`` the
   rescaling to the force), one pass instead of three;
-- ``add_at``: ``x[idx] += values`` in ``x``'s precision (a compliance per node's terms of ``u``), one pass
+- ``add_at``: ``x[idx] += times * values`` in ``x``'s precision (a compliance per node's terms of ``u``, a gap's
+  offset), one pass
   instead of a gather, a sum and a scatter;
 - ``gather``: the preconditioned gap (single precision) or a compliance per node at the contact's nodes, in double
   precision;
@@ -86,10 +87,11 @@ class _NumPyKernels:
             u *= u.dtype.type(s)  # in u's precision
 
     @staticmethod
-    def add_at(x, idx, values):
-        """``x[idx] += values`` at the distinct flat indices ``idx``, the sum rounded to ``x``'s precision; ``x``."""
+    def add_at(x, idx, values, times=1.0):
+        """``x[idx] += times * values`` at the distinct flat indices ``idx``, the sum rounded to ``x``'s precision;
+        ``x``."""
         flat = x.reshape(-1)
-        flat[idx] = (np.take(flat, idx) + values).astype(x.dtype, copy=False)
+        flat[idx] = (np.take(flat, idx) + times * values).astype(x.dtype, copy=False)
         return x
 
     @staticmethod
@@ -127,9 +129,9 @@ class _NamespaceKernels:
         if s != 1.0:
             u *= s
 
-    def add_at(self, x, idx, values):
+    def add_at(self, x, idx, values, times=1.0):
         bk = self.bk
-        return bk.put(x, idx, bk.xp.astype(bk.take(x, idx) + values, x.dtype, copy=False))
+        return bk.put(x, idx, bk.xp.astype(bk.take(x, idx) + times * values, x.dtype, copy=False))
 
     def gather(self, x, idx):
         return self.bk.xp.astype(self.bk.take(x, idx), self.bk.xp.float64)
@@ -158,7 +160,7 @@ def kernels(n_nodes, bk=None):
     -------
     class or object
         Methods ``gap(u, h, g)``, ``scan(u, h, delta, p, out)`` (``out`` a boolean brick array, or None off NumPy),
-        ``subtract_scaled(u, r, tau, s=1.0)``, ``add_at(x, idx, values)`` (``x``; on NumPy
+        ``subtract_scaled(u, r, tau, s=1.0)``, ``add_at(x, idx, values, times=1.0)`` (``x``; on NumPy
         in place), ``gather(x, idx)``, ``gap_at(u, h, idx)`` (and, compiled,
         ``mix(spectrum, symbol, out, even, rows)`` and ``merge(idx, values, stayed, new, new_values, out_idx,
         out_values, at)``) and the flag ``compiled``.
@@ -250,9 +252,9 @@ def _compile():
             u[i] = (u[i] - r[i] * tau) * s
 
     @njit(**opts)
-    def _add_at(x, idx, values, lo, hi):  # distinct indices: the parts write disjoint entries
+    def _add_at(x, idx, values, times, lo, hi):  # distinct indices: the parts write disjoint entries
         for j in range(lo, hi):
-            x[idx[j]] = x[idx[j]] + values[j]
+            x[idx[j]] = x[idx[j]] + times * values[j]
 
     @njit(**opts)
     def _gather(x, idx, out, lo, hi):
@@ -342,11 +344,11 @@ def _compile():
             run(lambda lo, hi: _subtract_scaled(u, r, tau, s, lo, hi), u.size)
 
         @staticmethod
-        def add_at(x, idx, values):
+        def add_at(x, idx, values, times=1.0):
             if not x.flags.c_contiguous:
-                return _NumPyKernels.add_at(x, idx, values)
+                return _NumPyKernels.add_at(x, idx, values, times)
             xf = x.reshape(-1)
-            run(lambda lo, hi: _add_at(xf, idx, values, lo, hi), idx.size)
+            run(lambda lo, hi: _add_at(xf, idx, values, float(times), lo, hi), idx.size)
             return x
 
         @staticmethod

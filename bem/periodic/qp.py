@@ -190,7 +190,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return u
 
     def offset_added(v, times=1.0):  # v plus times the gap's offset (NumPy: in place)
-        return v if offset is None or not times else passes.add_at(v, offset[0], times * offset[1])
+        return v if offset is None or not times else passes.add_at(v, *offset, times)
 
     def exact_u():  # (C + lam) p, D p per node, and the gap's offset
         return offset_added(add_into(product_u(), times_p(D)) if per_node else product_u())
@@ -354,7 +354,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if t_move is not None:  # p = s (p - tau t'): u = s (u - tau (C + lam) t'), plus D's terms per node
             update_u(R, tau, s, terms, t_move)
         elif not (changed or entered or stale >= RECOMPUTE_EVERY):  # p = s (p - tau t) on the contact
-            update_u(R, tau, s, [(idx, -tau * (D_c * t_c))] if per_node else [])
+            update_u(R, tau, s, [(idx, D_c * t_c, -tau)] if per_node else [])
         else:
             u, stale = offset_added(product_u()), 0
             if per_node:  # u += D p, on the nodes where p > 0
@@ -365,15 +365,15 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return None
 
     def update_u(R, tau, s, terms, t_move=None):  # s (u - tau (C + lam) t + terms): R the spectrum of (C + lam) t, or
-        nonlocal u, stale  # t_move the brick of t' (its product made here); terms: D's, a list of (nodes, values)
+        nonlocal u, stale  # t_move the brick of t' (its product made here); terms: D's, (nodes, values[, times])
         if t_move is not None:
             op.n_matvec += 1
             R = op.mix(op.spectrum(t_move, out=work.spectrum(np.complex64, second=True)), A32, out=R)
             brick.restore()
         r = op.brick(R, overwrite=True, out=work.brick32(second=False))
         passes.subtract_scaled(u, r, tau, 1.0 if terms else s)  # s: one pass
-        for sel, values in terms:
-            passes.add_at(u, sel, values)
+        for sel, values, *times in terms:  # (nodes, values[, times]): one array of the nodes' size at a time
+            passes.add_at(u, sel, values, *times)
         if terms and s != 1.0:
             u *= s
         u = offset_added(u, 1.0 - s)  # the offset is not scaled with p
@@ -388,7 +388,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if changed or R is None or stale >= RECOMPUTE_EVERY:
             u, stale = exact_u(), 0
         else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
-            update_u(R, tau, s, [] if D_c is None else [(idx, -tau * (D_c * t_c))])
+            update_u(R, tau, s, [] if D_c is None else [(idx, D_c * t_c, -tau)])
         return None
 
     step = CGStep(measure_bounded, confirms, observe_bounded, advance, lambda: bk.copy(p)) if bounded else CGStep(

@@ -142,6 +142,13 @@ def test_the_compiled_scatter_add_gives_the_numpy_forms_numbers(two_threads, sin
     assert _identical(idx, keep_idx) and _identical(values, keep_values)
     y = u0.copy()
     assert fast.add_at(y, idx[:0], values[:0]) is y and _identical(y, u0)
+    # a multiple of the values (a gap's offset after a rescaling), made per node in the same roundings
+    times = -3.7e-3
+    expected, x = u0.copy(), u0.copy()
+    assert ref.add_at(expected, idx, values, times) is expected and fast.add_at(x, idx, values, times) is x
+    flat = u0.copy()
+    flat[idx] = (u0[idx] + times * values).astype(dtype)
+    assert _identical(x, expected) and _identical(expected, flat) and _identical(values, keep_values)
 
 
 def test_a_nan_propagates_as_in_numpy(two_threads):
