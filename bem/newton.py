@@ -266,7 +266,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
             wp = closure(p)
             scale = float(xp.max(xp.abs(u + wp)))
-            D = majorant(op, layer, p, sub.p, D, mask)
+            D = majorant(op, layer, p, sub.p, xp.astype(D, xp.float64), mask)  # (raised past single precision's range)
             wp = sub = None
             sub, p = _model_qp(op, h, layer, D, contact, precondition, p, force=force, approach=approach,
                                rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u,
