@@ -19,8 +19,8 @@ contiguous parts run at once (:func:`bem.fft.in_parts`):
 - ``merge``: the next contact made from the step, its nodes that stayed and the entering ones merged in order, with
   their pressures, into given arrays (:class:`bem.periodic.qp_parts.ContactNodes`), in one pass (serial);
 - ``mix``: the 2 x 2 block product of a spectrum (:func:`bem.periodic.spectra.mixed`, every product with ``C``
-  or its inverse) and, for the curvature of the step, its weighted sum with the spectrum, one pass instead of
-  four.
+  or its inverse), the blocks of the :class:`bem.periodic.symbol.Symbol` made per entry in the spectrum's
+  precision, and, for the curvature of the step, its weighted sum with the spectrum, one pass instead of four.
 
 Without numba, or on a smaller cell, the same passes run as the NumPy forms (:func:`numpy_kernels`,
 :func:`bem.periodic.spectra.numpy_mixed`; the merge as ``numpy.insert`` in :class:`bem.periodic.qp_parts.ContactNodes`).
