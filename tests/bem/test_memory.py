@@ -152,8 +152,8 @@ def _traced_peak_per_node(solve):
 # and 144 bytes, the cells with the compiled passes 54 and 78; the cell's QP holding an array of the gap u + h
 # through its steps traced 70 and 110 (before the symbols below), the model QP on its own copy of Newton's pressure
 # 107 (and holding its masks of the stiff and the soft nodes 105); with the compiled passes, the single-precision
-# symbols of C and of the preconditioner held 59 and 83, Newton's model gap as an array 86, its compliance D in
-# double precision 82. Measured
+# symbols of every QP kept by the operator 64 and 123, Newton's model gap as an array 84.5, its compliance D in
+# double precision 80.5. Measured
 # before the warm-up solve (after the other problems in the process): a solve that holds its coarser levels, the
 # spectra its symbols are made of and its copies of the iterates traced 176, 275, 180 and 343; Newton holding its
 # step and the model's gap through the line search, and its iterate beside its start, 132 with the root layer; a
