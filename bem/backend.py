@@ -185,7 +185,7 @@ class Backend:
 
     def add_at(self, x, sel, values):
         """``x[sel] += values`` in place (each node once), rounded to ``x``'s precision; returns ``x``."""
-        return self.put(x, sel, self.xp.astype(self.take(x, sel) + values, x.dtype))
+        return self.put(x, sel, self.xp.astype(self.take(x, sel) + values, x.dtype, copy=False))
 
     def spread(self, shape, sel, values):
         """A brick array of ``shape`` holding ``values`` at the selected nodes, 0 elsewhere."""

@@ -135,6 +135,15 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             out += lam * v
         return out if offset is None else bk.add_at(out, *offset)
 
+    def moved(r, tau, s):  # u after a step p = s (p - tau t), r = (C + lam) t (consumed); the offset not scaled
+        nonlocal u, stale
+        r *= tau
+        u -= r
+        if s != 1.0:
+            u *= s
+            u = u if offset is None else bk.add_at(u, offset[0], (1.0 - s) * offset[1])
+        stale += 1
+
     if u0 is None:
         u, stale = apply(p), 0
     else:  # from the caller: C x0 (+ lam x0), to be confirmed like an incremental update
@@ -308,12 +317,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             u = r = None
             u, stale = apply(p), 0
         else:
-            r *= tau
-            u -= r
-            if s != 1.0:  # the offset is not scaled with p
-                u *= s
-                u = u if offset is None else bk.add_at(u, offset[0], (1.0 - s) * offset[1])
-            stale += 1
+            moved(r, tau, s)
         return None
 
     def bounded_step(tau, t_c, r):  # the step of the bounded QP (bem.cg_rules.bounded_move) and its product
@@ -328,12 +332,7 @@ def solve_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10,
             u = r = None
             u, stale = apply(p), 0
         else:  # the elastic nodes moved along t and were scaled by s (the plastic ones by s - 1 of round-off)
-            r *= tau
-            u -= r
-            if s != 1.0:  # the offset is not scaled with p
-                u *= s
-                u = u if offset is None else bk.add_at(u, offset[0], (1.0 - s) * offset[1])
-            stale += 1
+            moved(r, tau, s)
         return None
 
     report = (lambda: bk.copy(p)) if bounded else (lambda: p)  # the bounded step updates p in place

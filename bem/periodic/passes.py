@@ -11,8 +11,7 @@ contiguous parts run at once (:func:`bem.fft.in_parts`):
 - ``subtract_scaled``: the update ``u = s (u - tau (C + lam) t)`` from the product in single precision (``s`` the
   rescaling to the force), one pass instead of three;
 - ``add_at``: ``x[idx] += times * values`` in ``x``'s precision (a compliance per node's terms of ``u``, a gap's
-  offset), one pass
-  instead of a gather, a sum and a scatter;
+  offset), one pass instead of a gather, a sum and a scatter;
 - ``gather``: the preconditioned gap (single precision) or a compliance per node at the contact's nodes, in double
   precision;
 - ``gap_at``: the gap ``u + h`` at the contact's nodes (or the entering ones), one gather instead of two and a sum;
@@ -130,8 +129,7 @@ class _NamespaceKernels:
             u *= s
 
     def add_at(self, x, idx, values, times=1.0):
-        bk = self.bk
-        return bk.put(x, idx, bk.xp.astype(bk.take(x, idx) + times * values, x.dtype, copy=False))
+        return self.bk.add_at(x, idx, times * values)
 
     def gather(self, x, idx):
         return self.bk.xp.astype(self.bk.take(x, idx), self.bk.xp.float64)

@@ -19,7 +19,7 @@ import numpy as np
 __all__ = ["Symbol"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: compared by identity
 class Symbol:
     """The 2 x 2 block symbol of ``C + lam I``, or of its inverse, over the packed symbol ``(S_00, S_01)`` of ``C``.
 
