@@ -8,14 +8,19 @@ side by side, interleaved, median of ``--repeat``:
 * pyFFTW, if installed, with ``FFTW_ESTIMATE`` plans and with ``FFTW_MEASURE``
   plans (planning time reported separately; plans and aligned buffers cached).
 
-Then, on the problem of ``benchmarks/side_by_side.py`` (Hertz, KKT 1e-10), our
-cost per conjugate-gradient iteration on the finest lattice (median interval
-between ``callback`` calls) and the cost of one ``C p`` and one preconditioner
-application on the converged contact, each divided by the floor. With
-``--threads 1 2`` the solve is repeated at each thread count
-(:func:`bem.fft.set_threads`), interleaved: the core-scaling figure.
+Then, on a half-space problem (KKT 1e-10), our cost per conjugate-gradient iteration on the
+finest lattice (median interval between ``callback`` calls) and the cost of the products of an
+iteration on the converged contact, each divided by the floor: one ``C p`` (double precision), one
+preconditioner application ``M r`` as the QP makes it (single precision, over the box of the
+contact) and one quadratic form ``t.C t`` (:meth:`bem.InfluenceOperator.quadratic`, the curvature of
+an iteration whose contact changes), on the operator the finest level solves on (its candidate
+window, :mod:`bem.windows`). ``--problem hertz``: the sphere of ``benchmarks/side_by_side.py``
+(contact 3 % of the region); ``--problem rough-sphere``: the rough sphere of :mod:`cases` (contact
+28 %, its gap a callable), the problem of ``peers.py``. With ``--threads 1 2`` the solve is
+repeated at each thread count (:func:`bem.fft.set_threads`), interleaved: the core-scaling figure.
 
-Run: ``python benchmarks/fft_floor.py [--sizes 256 512 1024] [--repeat 5] [--threads 1 2]``
+Run: ``python benchmarks/fft_floor.py [--sizes 256 512 1024] [--repeat 5] [--problem hertz|rough-sphere]
+[--threads 1 2]``
 """
 
 from __future__ import annotations
@@ -82,22 +87,44 @@ def floor_candidates(n):
     return cands, planning
 
 
-def solve_kw(n):
-    step = np.sqrt(2 / np.sqrt(3)) * SIDE / n
-    return dict(E_star=E_STAR, force=FORCE, step=step, extent=SIDE / 2, rtol=1e-10)
+def problem(name, n):
+    """``(gap, keywords of bem.solve)`` of ``name`` with the node density of an ``n x n`` grid."""
+    if name == "hertz":
+        step = np.sqrt(2 / np.sqrt(3)) * SIDE / n
+        return Paraboloid(RADIUS), dict(E_star=E_STAR, force=FORCE, step=step, extent=SIDE / 2, rtol=1e-10)
+    import cases
+
+    step = np.sqrt(2 / np.sqrt(3)) * cases.SIDE / n
+    return cases.RoughSphere(), dict(E_star=1.0, force=cases.hertz_force(cases.A_ROUGH), step=step,
+                                     extent=cases.SIDE / 2, rtol=cases.RTOL)
 
 
-def per_iteration(n):
+def per_iteration(gap, kw):
     """Median time between iterations on the finest lattice, and the solution."""
     stamps = []
-    res = bem.solve(Paraboloid(RADIUS), **solve_kw(n), callback=lambda k, p: stamps.append(time.perf_counter()))
+    res = bem.solve(gap, **kw, callback=lambda k, p: stamps.append(time.perf_counter()))
     return statistics.median(np.diff(stamps)), res
+
+
+def finest_operator(gap, res):
+    """``(op, p)``: the operator of the finest level's candidate window (the whole lattice without one) and the
+    solution on it (a brick array)."""
+    from bem.windows import candidate_window
+
+    lat = res.lattice
+    h = np.where(lat.mask, gap(lat.x, lat.y), 0.0)
+    window = candidate_window(lat, h, res.approach)
+    p = res.grid()
+    if window is None:
+        return InfluenceOperator(lat, res.E_star), p
+    return InfluenceOperator(window, res.E_star), np.ascontiguousarray(p[window.index])
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[256, 512, 1024])
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--problem", choices=("hertz", "rough-sphere"), default="hertz")
     parser.add_argument("--threads", type=int, nargs="*", default=[], help="core scaling: thread counts to compare")
     args = parser.parse_args(argv)
     print(f"# threads {bfft.threads()} (affinity), load at start {os.getloadavg()[0]:.2f}, median of {args.repeat}")
@@ -115,30 +142,36 @@ def main(argv=None):
             plan = planning.get("FFTW_" + k.split()[-1].upper(), 0.0) if k != "scipy" else 0.0
             print(f"| {n} | {2 * n}^2 | {k} | {1e3 * t:.1f} | {plan:.2f} | {os.getloadavg()[0]:.1f} |", flush=True)
         floors[n] = min(statistics.median(v) for v in times.values())
-    print("\n| N | floor [ms] | per iteration [ms] | / floor | C p [ms] | / floor | M r [ms] | / floor | load |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print(f"\n{args.problem}: the finest lattice's iteration and products, each also over the floor")
+    print("| N | floor [ms] | iterations (finest) | per iteration [ms] | / floor | C p [ms] | / floor "
+          "| M r [ms] | / floor | t.C t [ms] | / floor | load |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for n in args.sizes:
-        bem.solve(Paraboloid(RADIUS), **solve_kw(n))  # warm-up
-        its = [per_iteration(n) for _ in range(args.repeat)]
+        gap, kw = problem(args.problem, n)
+        bem.solve(gap, **kw)  # warm-up
+        its = [per_iteration(gap, kw) for _ in range(args.repeat)]
         it_time, res = statistics.median(t for t, _ in its), its[-1][1]
-        op = InfluenceOperator(res.lattice, E_STAR)
-        p = res.grid()
-        M = op.preconditioner()
-        t_mv = _median(lambda: op.matvec(p), args.repeat)
-        t_m = _median(lambda: M(p), args.repeat)
+        op, p = finest_operator(gap, res)
+        M = op.preconditioner(single=True)  # as the QP makes it
+        r = np.where(p > 0, np.random.default_rng(0).standard_normal(p.shape), 0.0)  # a gap on the contact
         f = floors[n]
-        print(f"| {n} | {1e3 * f:.1f} | {1e3 * it_time:.1f} | {it_time / f:.2f} | {1e3 * t_mv:.1f} | {t_mv / f:.2f} | "
-              f"{1e3 * t_m:.1f} | {t_m / f:.2f} | {os.getloadavg()[0]:.1f} |", flush=True)
+        cells = []
+        for fn in (lambda: op.matvec(p), lambda: M(r), lambda: op.quadratic(r)):
+            t = _median(fn, args.repeat)
+            cells.append(f"{1e3 * t:.1f} | {t / f:.2f}")
+        print(f"| {n} | {1e3 * f:.1f} | {res.iterations} | {1e3 * it_time:.1f} | {it_time / f:.2f} | "
+              + " | ".join(cells) + f" | {os.getloadavg()[0]:.1f} |", flush=True)
     if args.threads:
-        print("\n| N | threads | Hertz solve [s] | load |")
+        print(f"\n| N | threads | {args.problem} solve [s] | load |")
         print("|---|---|---|---|")
         for n in args.sizes:
+            gap, kw = problem(args.problem, n)
             times = {k: [] for k in args.threads}
             for _ in range(args.repeat):
                 for k in args.threads:
                     previous = bfft.set_threads(k)
                     t0 = time.perf_counter()
-                    bem.solve(Paraboloid(RADIUS), **solve_kw(n))
+                    bem.solve(gap, **kw)
                     times[k].append(time.perf_counter() - t0)
                     bfft.set_threads(previous)
             for k in args.threads:
