@@ -108,7 +108,8 @@ def per_iteration(gap, kw):
 
 def finest_operator(gap, res):
     """``(op, p)``: the operator of the finest level's candidate window (the whole lattice without one) and the
-    solution on it (a brick array)."""
+    solution on it (a brick array). The window is made with the solution's approach; the solve made it with the
+    coarser level's, so the two may differ by a few rows or columns."""
     from bem.windows import candidate_window
 
     lat = res.lattice
