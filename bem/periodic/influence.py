@@ -30,7 +30,7 @@ from ..operator import diagonal_coefficient
 from .coated import coated_template
 from .kernel import periodic_template
 from .spectra import mixed, weighted_dot
-from .symbol import Symbol
+from .symbol import Symbol, inverse_blocks
 
 __all__ = ["PeriodicOperator"]
 
@@ -355,19 +355,15 @@ class PeriodicOperator:
 
     def _inverse_blocks(self, lam, shift):
         """The blocks ``(I00, I01)`` of the symbol of :meth:`preconditioner` on a device (``I11 = I00``, ``I10 =
-        conj(I01)``), as :meth:`bem.periodic.symbol.Symbol.rows` makes them on NumPy.
+        conj(I01)``), by :func:`bem.periodic.symbol.inverse_blocks` as :meth:`bem.periodic.symbol.Symbol.rows` makes
+        them on NumPy.
 
         ``C`` is symmetric, so its symbol is Hermitian: ``S_11 = S_00`` is real and
         ``S_10 = conj(S_01)``. The determinant ``S_00^2 - |S_01|^2`` is then real, ``I00 = I11``
         is real and ``I10 = conj(I01)``.
         """
         xp = self.backend.xp
-        a = xp.real(self._s00) + lam
-        b = self.backend.copy(self._s01)
-        a[0, 0] += shift
-        b[0, 0] += shift
-        det = a * a - (xp.real(b) * xp.real(b) + xp.imag(b) * xp.imag(b))
-        return a / det, b * (-1.0 / det)
+        return inverse_blocks(xp, xp.real(self._s00) + lam, self.backend.copy(self._s01), shift)
 
     def dense(self):
         """The dense matrix ``C`` over the flattened nodes (small cells only), from :attr:`kernel` by offsets."""

@@ -16,7 +16,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Symbol"]
+__all__ = ["Symbol", "inverse_blocks"]
+
+
+def inverse_blocks(xp, a, b, shift=None):
+    """The blocks ``(a / det, b * (-1 / det))``, ``det = a^2 - |b|^2``, of ``(C + lam I)^-1`` from those of ``C + lam I``
+    (``a = S_00 + lam``, real, ``b = S_01``), in the arrays' namespace ``xp``: the one formula of the inverse symbol, for
+    :meth:`Symbol.rows` and for a device's operator. ``shift`` (where the arrays start at frequency 0) is added first to
+    their first entries, the constant mode's (``a`` and ``b`` are then written there: arrays of the caller's own)."""
+    if shift is not None:
+        a[(0,) * a.ndim] += shift
+        b[(0,) * b.ndim] += shift
+    det = a * a - (xp.real(b) * xp.real(b) + xp.imag(b) * xp.imag(b))
+    return a / det, b * (-1.0 / det)
 
 
 @dataclass(frozen=True, eq=False)  # arrays: compared by identity
@@ -54,15 +66,8 @@ class Symbol:
         ``single``. New arrays: the form of reference for the compiled product (:mod:`bem.periodic.passes`)."""
         a, b = self.d[lo:hi] + self.lam, self.b[lo:hi]
         if self.inverse:
-            if lo == 0 and a.size:  # frequency 0: the constant mode
-                b = b.copy()
-                a[0, 0, 0] += self.shift
-                b[0, 0, 0] += self.shift
-            det = b.real * b.real
-            det += b.imag * b.imag
-            np.subtract(a * a, det, out=det)  # a^2 - |b|^2
-            a /= det
-            b = b * np.divide(-1.0, det, out=det)
+            first = lo == 0 and a.size  # frequency 0, the constant mode, in these rows
+            a, b = inverse_blocks(np, a, b.copy() if first else b, self.shift if first else None)
         out = np.empty((a.shape[0], 2) + a.shape[2:], dtype=np.complex64 if self.single else np.complex128)
         out[:, :1] = b
         np.conjugate(out[:, :1], out=out[:, 1:])
