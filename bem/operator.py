@@ -37,10 +37,12 @@ from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel
 from .checks import check_positive
 from .column_bands import BANDS_ABOVE, PairedSymbol, convolve_by_bands, paired_spectra
 from .matrix_views import dense, linear_operator
-from .template import template
+from .template import diagonal_coefficient, lattice_table
 
 __all__ = ["InfluenceOperator", "diagonal_coefficient"]
 
+#: nodes of a lattice up to which :class:`InfluenceOperator` holds its coefficient table
+TABLE_HELD_UP_TO = 1 << 20
 _WINDOWS_KEPT = 3  # kernel spectra cached per operator (matvec windows, preconditioner boxes)
 #: Spectrum entries of one row parity above which a product's inverse transform runs one parity at a
 #: time (half its output held at once); below, both in one call (fewer, larger transforms)
@@ -54,15 +56,6 @@ _REUSE_UP_TO = 2.0
 # (four blocks below BANDS_ABOVE, paired above; measured in docs/performance.md); a cached paired window is reused
 # up to this size ratio (the four blocks up to _REUSE_UP_TO)
 _FULL_ABOVE, _NUMPY_FULL_ABOVE, _PAIRED_REUSE_UP_TO = 0.7, 0.85, 1.25
-
-
-def diagonal_coefficient(step, E_star):
-    """Diagonal influence coefficient ``C_nn = c / (pi E*) w_t(0, 0)`` [length/pressure] (eq. 6).
-
-    The closure of a node under its own unit pyramid; the paper states layer
-    compliances in units of it (``lam = 10 C_nn``, Fig. 5).
-    """
-    return check_positive("step", step) / (math.pi * check_positive("E_star", E_star)) * float(template(0.0, 0.0))
 
 
 def _contains(outer, inner):
@@ -122,21 +115,29 @@ class InfluenceOperator:
         self._n = tuple(len(range(s, n_rows, 2)) for s in self._start)  # rows of parity a
         # the last node of the odd rows lies outside the region (a window off the right edge has none)
         self._masked_last = not bool(lattice.mask[:, -1].all())
-        # w_t at every offset (m/2, n sqrt3/2), m = n mod 2 (lattice units), times c / (pi E*)
-        n = np.arange(n_rows)[:, None]
-        t = np.arange(n_cols + 1)[None, :]
         self.bodies = bodies if bodies is not None and bodies.is_coated else None
+        self._held = None  # the coefficient table where it is held (see _table)
         if self.bodies is not None:  # coated bodies: the coefficients of bem.coated_kernel (cached)
             from .coated_kernel import coated_table
 
-            self._table = coated_table(lattice.step, (n_rows, n_cols), self.bodies)
-            self.diagonal = float(self._table[0, 0])
+            self._held = coated_table(lattice.step, (n_rows, n_cols), self.bodies)
+            self.diagonal = float(self._held[0, 0])
         else:
-            self._table = template((2 * t + n % 2) / 2.0, n * (math.sqrt(3.0) / 2))
-            self._table *= lattice.step / (math.pi * self.E_star)
             self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
         self._spectra = OrderedDict()
         self._quad = None
+
+    @property
+    def _table(self):
+        """``C`` at every lattice offset (:func:`bem.template.lattice_table`, or a coated body's table): held on
+        lattices of at most :data:`TABLE_HELD_UP_TO` nodes, made anew where a symbol is built on larger ones (an array
+        of the lattice not held through the solve; the template costs little against the symbol's transforms)."""
+        if self._held is not None:
+            return self._held
+        table = lattice_table(self.lattice.shape, self.lattice.step, self.E_star)
+        if math.prod(self.lattice.shape) <= TABLE_HELD_UP_TO:
+            self._held = table
+        return table
 
     # -- geometry of the 2 x 2 block convolution -------------------------------------------------
 

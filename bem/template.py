@@ -63,9 +63,9 @@ from fractions import Fraction
 
 import numpy as np
 
-from .checks import InputError, check_finite_array
+from .checks import InputError, check_finite_array, check_positive
 
-__all__ = ["template", "R_SWITCH"]
+__all__ = ["template", "diagonal_coefficient", "lattice_table", "R_SWITCH"]
 
 R_SWITCH = 8.0
 """Offset radius [lattice steps] beyond which the multipole expansion is used."""
@@ -227,3 +227,26 @@ def template(x, y):
         block = slice(k, k + _CHUNK)
         out[block] = _block(xf[block], yf[block])
     return out.reshape(shape)[()]
+
+
+def diagonal_coefficient(step, E_star):
+    """Diagonal influence coefficient ``C_nn = c / (pi E*) w_t(0, 0)`` [length/pressure] (eq. 6).
+
+    The closure of a node under its own unit pyramid; the paper states layer
+    compliances in units of it (``lam = 10 C_nn``, Fig. 5).
+    """
+    return check_positive("step", step) / (math.pi * check_positive("E_star", E_star)) * float(template(0.0, 0.0))
+
+
+def lattice_table(shape, step, E_star):
+    """The influence coefficients of eq. 6 at every lattice offset of a brick array of ``shape`` [length/pressure].
+
+    Entry ``[n, t]`` is ``c / (pi E*) w_t(m / 2, n sqrt3 / 2)``, ``m = 2 t + n mod 2`` (lattice units: ``n`` rows
+    and ``m`` half steps apart), shape ``(n_rows, n_cols + 1)``; ``step`` is ``c`` [length], ``E_star`` ``E*``
+    [pressure]. The table of :class:`bem.InfluenceOperator`.
+    """
+    n_rows, n_cols = shape
+    n, t = np.arange(n_rows)[:, None], np.arange(n_cols + 1)[None, :]
+    table = template((2 * t + n % 2) / 2.0, n * (math.sqrt(3.0) / 2))
+    table *= step / (math.pi * E_star)
+    return table

@@ -178,3 +178,26 @@ def test_the_product_over_the_whole_region_keeps_the_compact_spectra():
     shape, K = op._kernel_spectra(box, box)  # the four blocks, through the same convolution
     op._convolve(K, shape, p, box, box, out)
     assert np.abs(u - out).max() <= 1e-15 * np.abs(u).max()
+
+
+@pytest.mark.parametrize("bands", [False, True])
+def test_an_operator_that_makes_its_table_anew_gives_the_products_of_one_that_holds_it(monkeypatch, bands):
+    # above bem.operator.TABLE_HELD_UP_TO nodes the coefficient table is made where a symbol is built, not held:
+    # the same products bit for bit (matvec windows, the preconditioner's box, the quadratic form), and no table kept
+    if bands:  # the paired symbols of the larger regions
+        monkeypatch.setattr("bem.operator.BANDS_ABOVE", 0)
+    lat = Lattice.from_extent(0.02, 1.0)
+    rng = np.random.default_rng(3)
+    p = np.where(lat.mask & (rng.random(lat.shape) < 0.3), rng.random(lat.shape), 0.0)
+    p[: lat.shape[0] // 3] = 0.0  # a support smaller than the region: a window of its own
+
+    def products(op):
+        return op.matvec(p), op.matvec(np.where(lat.mask, 1.0, 0.0)), op.preconditioner(single=True)(p), op.quadratic(p)
+
+    held = InfluenceOperator(lat, 2.0)
+    expected = products(held)
+    monkeypatch.setattr("bem.operator.TABLE_HELD_UP_TO", 0)
+    anew = InfluenceOperator(lat, 2.0)
+    for a, b in zip(expected, products(anew)):
+        assert np.array_equal(a, b)
+    assert held._held is not None and anew._held is None
