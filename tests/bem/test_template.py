@@ -259,3 +259,20 @@ def test_huge_offsets_give_one_over_r():
 def test_bad_input_raises(x, y):
     with pytest.raises(InputError):
         template(x, y)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_the_lattice_table_is_the_template_at_every_offset(threads):
+    # bem.template.lattice_table makes the table of bem.InfluenceOperator by blocks of rows on threads: the
+    # template at the offsets (m / 2, n sqrt3 / 2), m = 2 t + n mod 2, times c / (pi E*), bit for bit
+    from bem import fft
+    from bem.template import lattice_table
+
+    previous = fft.set_threads(threads)
+    try:
+        for shape in [(7, 5), (301, 440)]:  # the larger one above the size bem.fft.in_parts splits
+            n, t = np.arange(shape[0])[:, None], np.arange(shape[1] + 1)[None, :]
+            expected = template((2 * t + n % 2) / 2.0, n * (math.sqrt(3.0) / 2)) * (0.03 / (math.pi * 2.5))
+            assert np.array_equal(lattice_table(shape, 0.03, 2.5), expected)
+    finally:
+        fft.set_threads(previous)
