@@ -243,21 +243,10 @@ def lattice_table(shape, step, E_star):
 
     Entry ``[n, t]`` is ``c / (pi E*) w_t(m / 2, n sqrt3 / 2)``, ``m = 2 t + n mod 2`` (lattice units: ``n`` rows
     and ``m`` half steps apart), shape ``(n_rows, n_cols + 1)``; ``step`` is ``c`` [length], ``E_star`` ``E*``
-    [pressure]. The table of :class:`bem.InfluenceOperator`, made by blocks of rows (temporaries of a block) on the
-    threads of :func:`bem.fft.in_parts`.
+    [pressure]. The table of :class:`bem.InfluenceOperator`.
     """
-    from .fft import in_parts
-
     n_rows, n_cols = shape
-    table = np.empty((n_rows, n_cols + 1))
-    twice = 2.0 * np.arange(n_cols + 1)  # 2 t
-    block = max(1, 8 * _CHUNK // (n_cols + 1))  # rows of a block
-
-    def part(rows):
-        for lo in range(rows.start, rows.stop, block):
-            n = np.arange(lo, min(lo + block, rows.stop))[:, None]
-            table[lo : lo + n.shape[0]] = template((twice + n % 2) / 2.0, n * (math.sqrt(3.0) / 2))
-
-    in_parts(part, n_rows, table.size)
+    n, t = np.arange(n_rows)[:, None], np.arange(n_cols + 1)[None, :]
+    table = template((2 * t + n % 2) / 2.0, n * (math.sqrt(3.0) / 2))
     table *= step / (math.pi * E_star)
     return table

@@ -261,18 +261,14 @@ def test_bad_input_raises(x, y):
         template(x, y)
 
 
-@pytest.mark.parametrize("threads", [1, 2])
-def test_the_lattice_table_is_the_template_at_every_offset(threads):
-    # bem.template.lattice_table makes the table of bem.InfluenceOperator by blocks of rows on threads: the
-    # template at the offsets (m / 2, n sqrt3 / 2), m = 2 t + n mod 2, times c / (pi E*), bit for bit
-    from bem import fft
+def test_the_lattice_table_is_the_template_at_every_offset():
+    # bem.template.lattice_table, the table of bem.InfluenceOperator: the template at the offsets (m / 2, n sqrt3 / 2),
+    # m = 2 t + n mod 2, times c / (pi E*); its entries against the template at points made here one by one
     from bem.template import lattice_table
 
-    previous = fft.set_threads(threads)
-    try:
-        for shape in [(7, 5), (301, 440)]:  # the larger one above the size bem.fft.in_parts splits
-            n, t = np.arange(shape[0])[:, None], np.arange(shape[1] + 1)[None, :]
-            expected = template((2 * t + n % 2) / 2.0, n * (math.sqrt(3.0) / 2)) * (0.03 / (math.pi * 2.5))
-            assert np.array_equal(lattice_table(shape, 0.03, 2.5), expected)
-    finally:
-        fft.set_threads(previous)
+    table = lattice_table((7, 5), 0.03, 2.5)
+    assert table.shape == (7, 6)
+    for n in range(7):
+        for t in range(6):
+            x, y = t + (n % 2) / 2.0, n * math.sqrt(3.0) / 2
+            assert table[n, t] == pytest.approx(0.03 / (math.pi * 2.5) * float(template(x, y)), rel=1e-15)
