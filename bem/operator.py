@@ -42,7 +42,7 @@ from .template import diagonal_coefficient, lattice_table
 __all__ = ["InfluenceOperator", "diagonal_coefficient"]
 
 #: nodes of a lattice up to which :class:`InfluenceOperator` holds its coefficient table
-TABLE_HELD_UP_TO = 1 << 22
+TABLE_HELD_UP_TO = 1 << 20
 _WINDOWS_KEPT = 3  # kernel spectra cached per operator (matvec windows, preconditioner boxes)
 #: Spectrum entries of one row parity above which a product's inverse transform runs one parity at a
 #: time (half its output held at once); below, both in one call (fewer, larger transforms)
