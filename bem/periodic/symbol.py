@@ -20,10 +20,11 @@ __all__ = ["Symbol", "inverse_blocks"]
 
 
 def inverse_blocks(xp, a, b, shift=None):
-    """The blocks ``(a / det, b * (-1 / det))``, ``det = a^2 - |b|^2``, of ``(C + lam I)^-1`` from those of ``C + lam I``
-    (``a = S_00 + lam``, real, ``b = S_01``), in the arrays' namespace ``xp``: the one formula of the inverse symbol, for
-    :meth:`Symbol.rows` and for a device's operator. ``shift`` (where the arrays start at frequency 0) is added first to
-    their first entries, the constant mode's (``a`` and ``b`` are then written there: arrays of the caller's own)."""
+    """The blocks ``(a / det, b * (-1 / det))``, ``det = a^2 - |b|^2``, of ``(C + lam I)^-1`` from those of
+    ``C + lam I`` (``a = S_00 + lam``, real, ``b = S_01``), in the arrays' namespace ``xp``: the one formula of the
+    inverse symbol, for :meth:`Symbol.rows` and for a device's operator. ``shift`` (where the arrays start at frequency
+    0) is added first to their first entries, the constant mode's (``a`` and ``b`` are then written there: arrays of the
+    caller's own)."""
     if shift is not None:
         a[(0,) * a.ndim] += shift
         b[(0,) * b.ndim] += shift
