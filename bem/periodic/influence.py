@@ -246,12 +246,10 @@ class PeriodicOperator:
         ``(n_rows/2, 2, n_cols/2 + 1)``. ``single``: in single precision (float32, complex64), rounded from the
         double-precision blocks.
         """
-        shift = 0.5 * float(self.diagonal)  # the constant mode (1, 1) / sqrt 2 of frequency 0: eigenvalue C_nn + lam
         if self.backend.is_numpy:
-            return Symbol(*self._symbol, lam=float(lam), inverse=inverse, shift=shift if inverse else 0.0,
-                          single=single)
+            return Symbol(*self._symbol, lam=float(lam), inverse=inverse, shift=self._shift, single=single)
         if inverse:
-            return self._pack(*self._inverse_blocks(lam, shift), single=single)
+            return self._pack(*self._inverse_blocks(lam), single=single)
         if self._symbol is None:  # packed from its spectra once
             self._symbol = self._pack(self.backend.xp.real(self._s00), self._s01)
         d, b = self._symbol
@@ -345,7 +343,7 @@ class PeriodicOperator:
         if self.backend.is_numpy:
             i00, i01, i10, i11 = self.symbol(lam, inverse=True, single=single), None, None, None
         else:
-            a, b = self._inverse_blocks(lam, 0.5 * float(self.diagonal))
+            a, b = self._inverse_blocks(lam)
             i00, i01, i10, i11 = a, b, self.backend.xp.conj(b), a
 
         def apply(r):
@@ -353,7 +351,13 @@ class PeriodicOperator:
 
         return apply
 
-    def _inverse_blocks(self, lam, shift):
+    @property
+    def _shift(self):
+        """What the inverse symbol adds at frequency 0 (:func:`bem.periodic.symbol.inverse_blocks`): the constant mode
+        ``(1, 1) / sqrt 2``, where ``C`` vanishes, takes the eigenvalue ``C_nn + lam``."""
+        return 0.5 * float(self.diagonal)
+
+    def _inverse_blocks(self, lam):
         """The blocks ``(I00, I01)`` of the symbol of :meth:`preconditioner` on a device (``I11 = I00``, ``I10 =
         conj(I01)``), by :func:`bem.periodic.symbol.inverse_blocks` as :meth:`bem.periodic.symbol.Symbol.rows` makes
         them on NumPy.
@@ -363,7 +367,7 @@ class PeriodicOperator:
         is real and ``I10 = conj(I01)``.
         """
         xp = self.backend.xp
-        return inverse_blocks(xp, xp.real(self._s00) + lam, self.backend.copy(self._s01), shift)
+        return inverse_blocks(xp, xp.real(self._s00) + lam, self.backend.copy(self._s01), self._shift)
 
     def dense(self):
         """The dense matrix ``C`` over the flattened nodes (small cells only), from :attr:`kernel` by offsets."""

@@ -73,7 +73,3 @@ class Symbol:
         out[:, :1] = b
         np.conjugate(out[:, :1], out=out[:, 1:])
         return (a.astype(np.float32) if self.single else a), out
-
-    def arrays(self):
-        """``(D, B)`` of every row (:meth:`rows`): the symbol as arrays."""
-        return self.rows()

@@ -66,7 +66,7 @@ def test_in_parts_gives_the_numbers_of_one_thread(monkeypatch):
     X = op.spectrum(np.random.default_rng(1).standard_normal(cell.shape))
     before = X.copy()
     symbol = op.symbol(0.3 * op.diagonal)
-    d, b = symbol.arrays()
+    d, b = symbol.rows()
     monkeypatch.setattr(fft, "_override", 2)
     two = op.mix(X, symbol)
     monkeypatch.setattr(fft, "_override", 1)

@@ -67,7 +67,7 @@ def test_the_periodic_operator_keeps_its_packed_symbol_only():
     symbol = op.symbol()
     assert symbol.d.shape == (16, 1, 33) and symbol.b.shape == (16, 1, 33)  # S_00 = S_11 and S_01 (S_10 = conj S_01)
     assert symbol.d.dtype == np.float64 and symbol.b.dtype == np.complex128
-    d, b = symbol.arrays()
+    d, b = symbol.rows()
     assert d.shape == (16, 1, 33) and b.shape == (16, 2, 33) and np.array_equal(b[:, 1], np.conj(b[:, 0]))
     # the kernel it no longer stores is made on request, the same numbers as the template scaled
     w = bem.periodic.periodic_template(32, 64) * (0.1 / (math.pi * 2.0))
@@ -84,7 +84,7 @@ def test_the_block_products_equal_the_whole_array_formulas_bit_for_bit(monkeypat
     op = PeriodicOperator(cell, 1.0)
     x = op.spectrum(rng.standard_normal(cell.shape))
     symbol = op.symbol(0.3 * op.diagonal)
-    d, b = symbol.arrays()
+    d, b = symbol.rows()
     expected = d * x + b * x[:, ::-1, :]
     assert np.array_equal(op.mix(x, symbol), expected)
     y = x.copy()

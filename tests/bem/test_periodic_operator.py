@@ -87,7 +87,7 @@ def test_single_precision_preconditioner_symbol_applies_the_preconditioner_to_si
     r = np.random.default_rng(7).standard_normal(op.lattice.shape)
     for lam in (0.0, 0.4):
         single = op.symbol(lam, inverse=True, single=True)
-        assert [a.dtype for a in single.arrays()] == [np.float32, np.complex64]
+        assert [a.dtype for a in single.rows()] == [np.float32, np.complex64]
         x = op.spectrum(r.astype(np.float32))
         z = op.brick(op.mix(x, single, out=x))
         exact = op.preconditioner(lam)(r)

@@ -33,15 +33,15 @@ def test_the_packed_symbol_is_the_spectra_of_the_kernels_blocks(cell):
     scale = np.abs(s00).max()
     assert np.abs(symbol.d[:, 0] - s00.real).max() <= 1e-14 * scale and np.abs(s00.imag).max() <= 1e-14 * scale
     assert np.abs(symbol.b[:, 0] - s01).max() <= 1e-14 * scale
-    d, b = symbol.arrays()
+    d, b = symbol.rows()
     assert np.array_equal(b[:, 1], np.conj(b[:, 0])) and np.abs(b[:, 1] - s10).max() <= 1e-13 * scale
 
 
 @pytest.mark.parametrize("lam", [0.0, 0.4])
 def test_the_inverse_symbol_inverts_each_block_and_gives_the_constant_mode_its_eigenvalue(lam):
     op = PeriodicOperator(CELL, 2.0)
-    S = _matrices(*op.symbol(lam).arrays())
-    inv = _matrices(*op.symbol(lam, inverse=True).arrays())
+    S = _matrices(*op.symbol(lam).rows())
+    inv = _matrices(*op.symbol(lam, inverse=True).rows())
     eye = np.broadcast_to(np.eye(2), S.shape)
     zero = np.zeros(S.shape[:2], dtype=bool)
     zero[0, 0] = True
@@ -57,8 +57,8 @@ def test_the_inverse_symbol_inverts_each_block_and_gives_the_constant_mode_its_e
 @pytest.mark.parametrize("inverse", [False, True])
 def test_single_precision_is_the_double_symbol_rounded_and_rows_are_the_whole(inverse):
     op = PeriodicOperator(CELL, 2.0)
-    d, b = op.symbol(0.3, inverse=inverse).arrays()
-    d32, b32 = op.symbol(0.3, inverse=inverse, single=True).arrays()
+    d, b = op.symbol(0.3, inverse=inverse).rows()
+    d32, b32 = op.symbol(0.3, inverse=inverse, single=True).rows()
     assert d32.dtype == np.float32 and b32.dtype == np.complex64
     assert np.array_equal(d32, d.astype(np.float32)) and np.array_equal(b32, b.astype(np.complex64))
     symbol = op.symbol(0.3, inverse=inverse)
@@ -74,7 +74,7 @@ def test_a_symbol_holds_no_array_of_its_own_and_leaves_the_packed_one_as_it_was(
     for kw in ({"lam": 0.3}, {"inverse": True}, {"lam": 0.3, "inverse": True, "single": True}):
         symbol = op.symbol(**kw)
         assert isinstance(symbol, Symbol) and symbol.d is base.d and symbol.b is base.b
-        symbol.arrays()
+        symbol.rows()
         x = op.spectrum(np.random.default_rng(0).standard_normal(CELL.shape))
         op.mix(x, symbol, out=x)
     assert np.array_equal(base.d, keep[0]) and np.array_equal(base.b, keep[1])

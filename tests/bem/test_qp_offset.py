@@ -33,14 +33,15 @@ def _offset(op, h, force):
     return start.p, at, values
 
 
-@pytest.mark.parametrize("domain", ["cell", "half-space"])
+@pytest.mark.parametrize("domain, start", [("cell", "u0"), ("cell", "cold"), ("cell", "double"), ("half-space", "u0"),
+                                           ("half-space", "cold")])
 @pytest.mark.parametrize("control", ["force", "approach"])
 @pytest.mark.parametrize("precision", [np.float64, np.float32])
-@pytest.mark.parametrize("start", ["u0", "cold", "double"])
 def test_a_qp_with_an_offset_solves_the_gap_with_it_added(monkeypatch, domain, control, precision, start):
-    """``double``: the cell's products in double precision from the first iteration, so that its steps that change
-    the contact update ``u`` by the product of their move and rescale it to the force by up to 70 %, which must
-    leave the offset as it is (:data:`bem.periodic.qp.SINGLE_ABOVE` raised)."""
+    """``double`` (the cell's rule; the half-space QP has no single-precision products): the cell's products in double
+    precision from the first iteration, so that its steps that change the contact update ``u`` by the product of their
+    move and rescale it to the force by up to 70 %, which must leave the offset as it is
+    (:data:`bem.periodic.qp.SINGLE_ABOVE` raised)."""
     if start == "double":
         monkeypatch.setattr("bem.periodic.qp.SINGLE_ABOVE", 1e3)
     op, h, lam, force = _case(domain)
