@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import fft as _cpu_fft
+from . import pruned_fft as _pruned
 
 __all__ = ["Backend", "get_backend", "backend_of", "operator_backend", "to_host"]
 
@@ -80,16 +81,16 @@ class Backend:
     # -- FFTs ---------------------------------------------------------------------------------------
 
     def forward(self, x, shape):
-        """Spectrum of a batch of real arrays zero-padded to ``shape`` (:func:`bem.fft.forward`)."""
+        """Spectrum of a batch of real arrays zero-padded to ``shape`` (:func:`bem.pruned_fft.forward`)."""
         if self.is_numpy:
-            return _cpu_fft.forward(x, shape)
+            return _pruned.forward(x, shape)
         f = self.xp.fft
         return f.fft(f.rfft(x, n=shape[1], axis=-1), n=shape[0], axis=-2)
 
     def inverse(self, spectrum, shape, keep):
-        """Inverse of :meth:`forward` without the ``1 / (Lk Lq)``, cropped (:func:`bem.fft.inverse`)."""
+        """Inverse of :meth:`forward` without the ``1 / (Lk Lq)``, cropped (:func:`bem.pruned_fft.inverse`)."""
         if self.is_numpy:
-            return _cpu_fft.inverse(spectrum, shape, keep)
+            return _pruned.inverse(spectrum, shape, keep)
         f = self.xp.fft
         cols = f.ifft(spectrum, axis=-2, norm="forward")
         return f.irfft(cols[..., : keep[0], :], n=shape[1], axis=-1, norm="forward")[..., : keep[1]]

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import fft
+from . import fft, pruned_fft
 
 __all__ = ["block_product", "block_quadratic", "inverse_symbol", "kernel_spectra", "padded_kernel", "padded_shape",
            "single_symbol"]
@@ -71,7 +71,7 @@ def block_product(S, V):
 def block_quadratic(S, V, n_cols, xp=np):
     """``sum_q sum_ab conj(V_a) S_ab V_b`` over the whole spectrum of a pair of real arrays [the units of ``S``
     times those of ``V`` squared], from their half spectra ``V`` (shape ``(2, rows, n_cols // 2 + 1)``, of
-    :func:`bem.fft.forward`) and a Hermitian symbol ``S`` of :func:`kernel_spectra` (``S_10`` not stored).
+    :func:`bem.pruned_fft.forward`) and a Hermitian symbol ``S`` of :func:`kernel_spectra` (``S_10`` not stored).
 
     With ``S`` the spectra of ``C`` over a box onto itself and ``V`` the padded spectra of ``v`` on that box, the
     quadratic form ``v.C v``. The columns of the half spectrum weigh as :func:`bem.fft.half_spectrum_weights`.
@@ -231,15 +231,38 @@ def padded_shape(out_box, in_box):
     return lk, fft.fast_length(out_box[1][1] + in_box[1][1] - 1, real=True)
 
 
+def _offsets(start, a, b, rows, cols, shift):
+    """The brick-row offsets ``dr`` and table columns ``t`` of :func:`padded_kernel`'s rows and columns."""
+    e, f = np.r_[0 : rows[0], -rows[1] : 0], np.r_[0 : cols[0], -cols[1] : 0]
+    dr = start[a] - start[b] + 2 * (e + shift[0])  # brick row offset
+    t = (np.abs(2 * (f + shift[1]) + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
+    return dr, t
+
+
+def _block_args(out_box, in_box, a, b):
+    """``(rows, cols, shift)`` of :func:`padded_kernel` for the block from parity ``b`` of ``in_box`` to ``a``."""
+    (o_rows, (oq, nq)), (i_rows, (iq, bq)) = out_box, in_box
+    (oa, na), (ib, nb) = o_rows[a], i_rows[b]
+    return (na, nb - 1), (nq, bq - 1), (oa - ib, oq - iq)
+
+
+def table_extent(start, out_box, in_box):
+    """``(rows, cols)``: the smallest lattice shape whose coefficient table (:func:`bem.template.lattice_table`,
+    ``rows x (cols + 1)`` offsets) holds every offset that :func:`kernel_spectra` of these boxes meets."""
+    rows = cols = 0
+    for a, b in ((0, 0), (0, 1), (1, 0), (1, 1)):
+        dr, t = _offsets(start, a, b, *_block_args(out_box, in_box, a, b))
+        rows, cols = max(rows, int(np.abs(dr).max(initial=-1)) + 1), max(cols, int(t.max(initial=0)))
+    return rows, cols
+
+
 def padded_kernel(table, start, a, b, rows, cols, shift, shape, out=None, clip=False):
     """The kernel from the rows of parity ``b`` to those of parity ``a`` in a zero-padded array of ``shape`` (``out``
     where given): at the parity-row offsets ``e = 0 .. rows[0] - 1`` from its first row and ``-rows[1] .. -1`` in its
     last rows, the column offsets ``f`` from ``cols`` alike, the coefficient of ``table`` at the brick-row offset
     ``start[a] - start[b] + 2 (e + shift[0])`` and the half-step column offset ``2 (f + shift[1]) + a - b``.
     ``clip``: offsets beyond the table take its last entries (offsets that no product meets)."""
-    e, f = np.r_[0 : rows[0], -rows[1] : 0], np.r_[0 : cols[0], -cols[1] : 0]
-    dr = start[a] - start[b] + 2 * (e + shift[0])  # brick row offset
-    t = (np.abs(2 * (f + shift[1]) + (a - b)) - (a != b)) // 2  # table column (x offset in half steps)
+    dr, t = _offsets(start, a, b, rows, cols, shift)
     mode = "clip" if clip else "raise"
     block = table.take(np.abs(dr), axis=0, mode=mode).take(t, axis=1, mode=mode)  # rows e, columns f
     kernel = np.zeros(shape) if out is None else out
@@ -269,23 +292,22 @@ def kernel_spectra(backend, table, start, out_box, in_box, hermitian=False):
     """
     if hermitian and out_box != in_box:
         raise ValueError(f"hermitian = True needs out_box == in_box, got {out_box!r} and {in_box!r}")
-    (o_rows, (oq, nq)), (i_rows, (iq, bq)) = out_box, in_box
     lk, lq = padded_shape(out_box, in_box)
     # on NumPy one block at a time into the spectra (the same numbers as the batch: each line is
     # transformed alone), so that the padded kernels are never all held at once
     numpy = backend.is_numpy
-    blocks = ((0, 0), (0, 1), (1, 1)) if hermitian else ((0, 0), (0, 1), (1, 0), (1, 1))
+    # the complex block last: two real diagonal blocks held while it is made (not a complex and a real one)
+    blocks = ((0, 0), (1, 1), (0, 1)) if hermitian else ((0, 0), (0, 1), (1, 0), (1, 1))
     if numpy and hermitian:
         out = {}
     else:
         out = np.empty((2, 2, lk, lq // 2 + 1), dtype=complex) if numpy else np.zeros((2, 2, lk, lq))
     for a, b in blocks:
-        (oa, na), (ib, nb) = o_rows[a], i_rows[b]
-        kernel = padded_kernel(table, start, a, b, (na, nb - 1), (nq, bq - 1), (oa - ib, oq - iq), (lk, lq),
+        kernel = padded_kernel(table, start, a, b, *_block_args(out_box, in_box, a, b), (lk, lq),
                                None if numpy else out[a, b])
         if numpy:
             kernel /= lk * lq
-            spectrum = fft.forward(kernel, (lk, lq))
+            spectrum = pruned_fft.forward(kernel, (lk, lq))
             del kernel
             out[a, b] = spectrum.real.copy() if hermitian and a == b else spectrum
             del spectrum

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import fft
+from . import fft, pruned_fft
 from .block_symbol import padded_kernel
 
 __all__ = ["BANDS_ABOVE", "PairedSymbol", "band_columns", "convolve_by_bands", "paired_spectra"]
@@ -92,7 +92,7 @@ def paired_spectra(table, start, n_rows, n_cols, box):
     for a, b in ((0, 0), (0, 1)):
         kernel = padded_kernel(table, start, a, b, rows, cols, (-ib, -iq), (lk, lq), clip=True)
         kernel /= lk * lq
-        blocks.append(fft.forward(kernel, (lk, lq)))
+        blocks.append(pruned_fft.forward(kernel, (lk, lq)))
         del kernel
     k, q = np.arange(lk), np.arange(lq // 2 + 1)
     row_phase = np.exp(2j * np.pi * (k * sigma % lk) / lk)
@@ -130,7 +130,7 @@ def convolve_by_bands(S, shape, parts, dests, dtype=np.float64):
     cdtype = np.result_type(dtype, np.complex64)
     half = np.empty((2, max(rows_in + rows_out), n_half), dtype=cdtype)  # the row spectra, then the products
     for b, x in enumerate(parts):
-        fft.rfft_rows(x, half[b, : rows_in[b]], lq, dtype)
+        pruned_fft.rfft_rows(x, half[b, : rows_in[b]], lq, dtype)
     width = band_columns(lk, np.dtype(cdtype).itemsize)
 
     def bands(part):  # the bands of columns of a part, on the threads of bem.fft.in_parts
@@ -166,4 +166,4 @@ def convolve_by_bands(S, shape, parts, dests, dtype=np.float64):
 
     fft.in_parts(bands, -(-n_half // width), half.size)
     for a, dest in enumerate(dests):
-        fft.irfft_rows(half[a, : rows_out[a]], dest, lq)
+        pruned_fft.irfft_rows(half[a, : rows_out[a]], dest, lq)

@@ -1,4 +1,4 @@
-"""FFT back end of the influence operator: thread count, fast sizes, pruned padded transforms.
+"""FFT back end of the influence operators: thread count, fast sizes, transforms in place and in parts.
 
 Thread count
     :func:`threads` is the number of CPUs this process may run on, ``len(os.sched_getaffinity(0))``
@@ -18,21 +18,12 @@ Parts on threads
     numba's ``nogil`` kernels and pocketfft release the GIL): the calling thread takes the last part itself and a
     pool of ``threads() - 1`` threads the others; arrays below ``2**17`` entries stay in the calling thread. The
     transforms of the solvers' iterations run so too (:func:`rfft_into`, :func:`cfft_in_place`,
-    :func:`irfft_into`, and the pruned transforms below), one single-threaded pocketfft call per part, rather
-    than with pocketfft's ``workers``, whose calling thread sleeps while its pool works and whose pool threads the
-    scheduler may wake on one core, where they take turns (measured in ``docs/performance.md``, "Threads that
-    share a core"). The numbers are the same either way.
+    :func:`irfft_into`, and the pruned transforms of :mod:`bem.pruned_fft`), one single-threaded pocketfft call
+    per part, rather than with pocketfft's ``workers``, whose calling thread sleeps while its pool works and whose
+    pool threads the scheduler may wake on one core, where they take turns (measured in ``docs/performance.md``,
+    "Threads that share a core"). The numbers are the same either way.
 
-Pruned transforms
-    :func:`forward` and :func:`inverse` are the two halves of a zero-padded (non-periodic) convolution of a batch
-    of real 2-D arrays. The real FFT along the last axis runs only over the rows that hold data (forward) or are
-    kept (inverse); the complex FFT along the first data axis does the zero padding. Against a plain
-    ``rfft2``/``irfft2`` pair of the padded size this skips the transforms of the zero rows (about 25 % of the
-    work when the data fill half the padded rows). The real transforms run in bands of rows (:data:`_BAND`
-    entries), written into the padded spectrum or the output as they are made, so that no whole unpadded spectrum
-    or padded input is held beside them; :func:`forward_parts` and :func:`inverse_into` take the batch as its
-    entries (strided views of a brick array's row parities) and write the product where it goes (no gathered
-    copy). Banded or not, the numbers are the same (``tests/bem/test_fft.py``).
+The pruned padded transforms of the half-space's convolutions are :mod:`bem.pruned_fft`.
 """
 
 from __future__ import annotations
@@ -62,8 +53,8 @@ def _entry_points():
 
 _pocketfft = _entry_points()
 
-__all__ = ["threads", "set_threads", "fast_length", "forward", "inverse", "forward_parts", "inverse_into", "in_parts",
-           "rfft_into", "cfft_in_place", "irfft_into", "rfft_rows", "irfft_rows", "half_spectrum_weights", "BLOCK"]
+__all__ = ["threads", "set_threads", "fast_length", "in_parts", "rfft_into", "cfft_in_place", "irfft_into",
+           "half_spectrum_weights", "BLOCK"]
 
 _ENV = "CONTACTLAB_THREADS"
 _override = None
@@ -71,8 +62,6 @@ _override = None
 #: block, not a spectrum)
 BLOCK = 1 << 15
 _PARTS_MIN = 1 << 17  # entries below which in_parts runs in the calling thread
-_BAND = 1 << 19  # entries of the bands of rows :func:`forward` and :func:`inverse` transform one after the other:
-# their temporaries are a band's, not the whole array's (bands of fewer entries cost more calls than they save)
 _pool, _pool_size = None, 0
 
 
@@ -168,11 +157,6 @@ def _by_parts(call, shape, split, size):
         return call((Ellipsis,))
     lead = (slice(None),) * split
     in_parts(lambda part: call(lead + (part,)), shape[split], size)
-
-
-def _rows_by_parts(transform, src, dest):
-    """``dest[i] = transform(src[i])`` for contiguous parts ``i`` of the rows (:func:`in_parts`)."""
-    _by_parts(lambda i: dest.__setitem__(i, transform(src[i])), dest.shape, 0, dest.size)
 
 
 def _transform_parts(fast, fallback, shape, split, size):
@@ -283,115 +267,3 @@ def fast_length(n, real):
         transforms take 2-3-5 factors), ``False`` for a complex one (up to 11).
     """
     return _sfft.next_fast_len(int(n), real=real)
-
-
-def forward(x, shape):
-    """Spectrum of a batch of real arrays zero-padded to ``shape``.
-
-    Parameters
-    ----------
-    x : ndarray, shape ``(..., rows, cols)``, float64
-        Data; ``rows <= shape[0]``, ``cols <= shape[1]``. Not modified.
-    shape : (int, int)
-        Padded size ``(Lk, Lq)``.
-
-    Returns
-    -------
-    ndarray, shape ``(..., Lk, Lq // 2 + 1)``, complex128
-        Unnormalised 2-D DFT of the padded arrays.
-    """
-    lead = x.shape[:-2]
-    spectra = forward_parts(x.reshape((-1,) + x.shape[-2:]), shape, x.dtype)
-    return spectra.reshape(lead + spectra.shape[1:])
-
-
-def _band(rows, size):
-    """Rows of an array of ``size`` entries that a banded transform takes at once: all of them up to twice
-    :data:`_BAND` entries, else bands of about :data:`_BAND` entries."""
-    return rows if size <= 2 * _BAND else max(1, rows * _BAND // size)
-
-
-def forward_parts(parts, shape, dtype=np.float64, scale=None):
-    """:func:`forward` of a batch given as its entries: 2-D real arrays (views allowed, not modified), each
-    zero-padded to ``shape`` and rounded to ``dtype`` band by band (no gathered copy of the batch).
-
-    Parameters
-    ----------
-    parts : sequence of ndarray, shapes ``(rows_b, cols_b)``
-        ``rows_b <= Lk``, ``cols_b <= Lq``.
-    shape : (int, int)
-        Padded size ``(Lk, Lq)``.
-    dtype : numpy dtype
-        ``float64``, or ``float32`` for a single-precision spectrum.
-    scale : float, optional
-        A factor applied to the data before it is rounded to ``dtype`` (band by band: no scaled copy of a part).
-
-    Returns
-    -------
-    ndarray, shape ``(len(parts), Lk, Lq // 2 + 1)``
-        The spectra, complex128 (complex64 for ``float32``).
-    """
-    lk, lq = shape
-    out = np.empty((len(parts), lk, lq // 2 + 1), dtype=np.result_type(dtype, np.complex64))
-    for b, x in enumerate(parts):
-        out[b, x.shape[0] :, :] = 0.0  # the padding rows
-        rfft_rows(x, out[b, : x.shape[0]], lq, dtype, scale, size=out[b].size)
-    return cfft_in_place(out, 1, 2)
-
-
-def rfft_rows(x, dest, n, dtype=np.float64, scale=None, size=None):
-    """``dest`` = the real FFT of the rows of ``x`` (times ``scale``, rounded to ``dtype``) zero-padded to ``n``
-    points, a band of rows after another (:func:`_band` of ``size`` entries, default ``dest.size``), each in parts."""
-    _rows_by_bands(lambda y: _sfft.rfft((y if scale is None else y * scale).astype(dtype, copy=False), n=n, axis=-1,
-                                        workers=1), x, dest, size)
-
-
-def irfft_rows(x, dest, n):
-    """``dest`` = the first ``dest.shape[1]`` points of the unnormalised inverse real FFT (``n`` points) of the rows
-    of the half spectra ``x``, a band of rows after another, each in parts."""
-    _rows_by_bands(lambda y: _sfft.irfft(y, n=n, axis=-1, norm="forward", workers=1)[:, : dest.shape[1]], x, dest)
-
-
-def _rows_by_bands(transform, src, dest, size=None):
-    band = _band(dest.shape[0], dest.size if size is None else size)
-    for lo in range(0, dest.shape[0], band):
-        _rows_by_parts(transform, src[lo : lo + band], dest[lo : lo + band])
-
-
-def inverse_into(spectrum, shape, dest):
-    """:func:`inverse` of one spectrum written into ``dest`` (a view allowed; values cast to its dtype).
-
-    Parameters
-    ----------
-    spectrum : ndarray, shape ``(Lk, Lq // 2 + 1)``
-        Overwritten.
-    shape : (int, int)
-        Padded size ``(Lk, Lq)``.
-    dest : ndarray, shape ``(rows, cols)``
-        Receives the rows and columns kept from the origin, without the ``1 / (Lk Lq)`` factor.
-    """
-    cols = cfft_in_place(spectrum, 0, 1, inverse=True, normalise=False)
-    irfft_rows(cols[: dest.shape[0]], dest, shape[1])
-
-
-def inverse(spectrum, shape, keep):
-    """Inverse of :func:`forward`, without the ``1 / (Lk Lq)`` factor, cropped.
-
-    Parameters
-    ----------
-    spectrum : ndarray, shape ``(..., Lk, Lq // 2 + 1)``, complex128
-        Overwritten.
-    shape : (int, int)
-        Padded size ``(Lk, Lq)``.
-    keep : (int, int)
-        Rows and columns kept from the origin.
-
-    Returns
-    -------
-    ndarray, shape ``(..., keep[0], keep[1])``
-        A fresh array; the caller scales it.
-    """
-    out = np.empty(spectrum.shape[:-2] + tuple(keep), dtype=spectrum.real.dtype)
-    for entry, dest in zip(spectrum.reshape((-1,) + spectrum.shape[-2:]), out.reshape((-1,) + tuple(keep))):
-        inverse_into(entry, shape, dest)
-    return out

@@ -7,7 +7,7 @@ convolution. In the brick storage of :class:`bem.lattice.Lattice` the offset
 also depends on the parities of the two rows, so the rows are split into their
 even and odd classes (strided views, no copy) and ``u`` is a 2 x 2 block
 convolution ``u_a = sum_b K_ab * p_b`` on the half-height arrays, evaluated
-exactly with pruned real FFTs (:mod:`bem.fft`): cost ``O(N log N)``, memory
+exactly with pruned real FFTs (:mod:`bem.pruned_fft`): cost ``O(N log N)``, memory
 ``O(N)``, no dense ``N x N`` matrix.
 
 Support windows
@@ -31,9 +31,10 @@ from collections import OrderedDict
 
 import numpy as np
 
-from . import fft
+from . import fft, pruned_fft
 from .backend import get_backend
-from .block_symbol import block_product, block_quadratic, inverse_symbol, kernel_spectra, padded_shape, single_symbol
+from .block_symbol import (block_product, block_quadratic, inverse_symbol, kernel_spectra, padded_shape, single_symbol,
+                           table_extent)
 from .checks import check_positive
 from .column_bands import BANDS_ABOVE, PairedSymbol, convolve_by_bands, paired_spectra
 from .matrix_views import dense, linear_operator
@@ -127,17 +128,16 @@ class InfluenceOperator:
         self._spectra = OrderedDict()
         self._quad = None
 
-    @property
-    def _table(self):
-        """``C`` at every lattice offset (:func:`bem.template.lattice_table`, or a coated body's table): held on
-        lattices of at most :data:`TABLE_HELD_UP_TO` nodes, made anew where a symbol is built on larger ones (an array
-        of the lattice not held through the solve; the template costs little against the symbol's transforms)."""
-        if self._held is not None:
-            return self._held
-        table = lattice_table(self.lattice.shape, self.lattice.step, self.E_star)
-        if math.prod(self.lattice.shape) <= TABLE_HELD_UP_TO:
-            self._held = table
-        return table
+    def _table_within(self, shape):
+        """``C`` at the offsets of a lattice of ``shape`` or more (:func:`bem.template.lattice_table`, or a coated
+        body's table): held over the whole lattice where it has at most :data:`TABLE_HELD_UP_TO` nodes, made anew
+        over ``shape`` where a symbol is built on larger ones (not held through the solve; the template costs little
+        against the symbol's transforms)."""
+        if self._held is None and math.prod(self.lattice.shape) <= TABLE_HELD_UP_TO:
+            self._held = lattice_table(self.lattice.shape, self.lattice.step, self.E_star)
+        return self._held if self._held is not None else lattice_table(shape, self.lattice.step, self.E_star)
+
+    _table = property(lambda self: self._table_within(self.lattice.shape), doc="``C`` at every lattice offset.")
 
     # -- geometry of the 2 x 2 block convolution -------------------------------------------------
 
@@ -174,8 +174,9 @@ class InfluenceOperator:
         return tuple((0, n) for n in self._n), (0, self.lattice.shape[1])
 
     def _kernel_spectra(self, out_box, in_box, hermitian=False):
-        """:func:`bem.block_symbol.kernel_spectra` of this operator's coefficient table."""
-        return kernel_spectra(self.backend, self._table, self._start, out_box, in_box, hermitian)
+        """:func:`bem.block_symbol.kernel_spectra` of this operator's coefficients at the offsets the boxes meet."""
+        table = self._table_within(table_extent(self._start, out_box, in_box))
+        return kernel_spectra(self.backend, table, self._start, out_box, in_box, hermitian)
 
     def _cached(self, key, build):
         if key in self._spectra:
@@ -219,7 +220,7 @@ class InfluenceOperator:
         return box, self._cached(("C", box), lambda: self._kernel_spectra(full, box, hermitian=box == full))
 
     def _parts(self, v, box):
-        """The rows of each parity of ``v`` in ``box`` (views), for :func:`bem.fft.forward_parts`."""
+        """The rows of each parity of ``v`` in ``box`` (views), for :func:`bem.pruned_fft.forward_parts`."""
         i_rows, (iq, bq) = box
         return [v[_rows(s, k0, nb, v.shape[0]), iq : iq + bq] for s, (k0, nb) in zip(self._start, i_rows)]
 
@@ -241,10 +242,10 @@ class InfluenceOperator:
             convolve_by_bands(spectra, shape, self._parts(v, in_box), dests, np.float32 if single else np.float64)
         elif bk.is_numpy:  # the parities' rows transformed where they are, the products written where they go
             dtype = np.float32 if single else np.float64
-            V = block_product(spectra, fft.forward_parts(self._parts(v, in_box), shape, dtype))
+            V = block_product(spectra, pruned_fft.forward_parts(self._parts(v, in_box), shape, dtype))
             for a, s in enumerate(self._start):
                 k0, na = o_rows[a]
-                fft.inverse_into(V[a], shape, out[_rows(s, k0, na, out.shape[0]), oq : oq + nq])
+                pruned_fft.inverse_into(V[a], shape, out[_rows(s, k0, na, out.shape[0]), oq : oq + nq])
         else:
             self._convolve_device(spectra, shape, v, in_box, out_box, out, single)
         if self._masked_last:
@@ -268,8 +269,7 @@ class InfluenceOperator:
         padded box of the support of ``v`` onto itself (:func:`bem.block_symbol.block_quadratic`), one forward
         transform of ``v / max |v|`` in single precision, the box's symbol rounded to single precision (kept for the
         next call on that box), the sum in double precision; relative error about ``1e-7``."""
-        bk = self.backend
-        xp = bk.xp
+        bk, xp = self.backend, self.backend.xp
         v = bk.asarray(v)
         box = self._box(v)
         if box is None:
@@ -283,7 +283,7 @@ class InfluenceOperator:
         if not math.isfinite(s):
             return math.nan
         if bk.is_numpy:
-            V = fft.forward_parts(self._parts(v, box), shape, np.float32, scale=1.0 / s)
+            V = pruned_fft.forward_parts(self._parts(v, box), shape, np.float32, scale=1.0 / s)
         else:
             V = bk.forward(self._batch(v, box, xp.float32, 1.0 / s), shape)
         return block_quadratic(symbol, V, shape[1], xp) * s * s

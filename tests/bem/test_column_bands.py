@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import bem.column_bands as column_bands
-from bem import fft
+from bem import fft, pruned_fft
 from bem.block_symbol import block_product
 from bem.lattice import Lattice
 from bem.operator import InfluenceOperator
@@ -13,11 +13,11 @@ from bem.operator import InfluenceOperator
 def _whole(op, spectra, shape, v, in_box, out_box, dtype):
     """The whole-array path written out: every row of the padded pair transformed, multiplied, inverted."""
     out = np.zeros(op.lattice.shape)
-    V = block_product(spectra, fft.forward_parts(op._parts(v, in_box), shape, dtype))
+    V = block_product(spectra, pruned_fft.forward_parts(op._parts(v, in_box), shape, dtype))
     o_rows, (oq, nq) = out_box
     for a, s in enumerate(op._start):
         k0, na = o_rows[a]
-        fft.inverse_into(V[a], shape, out[s + 2 * k0 : s + 2 * (k0 + na) : 2, oq : oq + nq])
+        pruned_fft.inverse_into(V[a], shape, out[s + 2 * k0 : s + 2 * (k0 + na) : 2, oq : oq + nq])
     return out
 
 

@@ -31,14 +31,6 @@ def test_set_threads_refuses_bad_values(bad):
         fft.set_threads(bad)
 
 
-def test_forward_inverse_is_a_zero_padded_circular_pair():
-    rng = np.random.default_rng(0)
-    x = rng.random((2, 5, 7))
-    shape = (fft.fast_length(11, real=False), fft.fast_length(15, real=True))
-    back = fft.inverse(fft.forward(x, shape), shape, (5, 7)) / (shape[0] * shape[1])
-    np.testing.assert_allclose(back, x, rtol=0, atol=1e-14)
-
-
 @pytest.mark.parametrize("n_threads, size, parts", [(2, 1 << 17, 2), (3, 1 << 20, 3), (1, 1 << 20, 1), (2, 1000, 1)])
 def test_in_parts_covers_the_axis_once_in_contiguous_parts(monkeypatch, n_threads, size, parts):
     monkeypatch.setattr(fft, "_override", n_threads)
@@ -79,52 +71,6 @@ def test_in_parts_gives_the_numbers_of_one_thread(monkeypatch):
     Y = X.copy()
     assert op.mix(Y, symbol, out=Y) is Y  # in place, as the solvers call it
     np.testing.assert_array_equal(Y, one)
-
-
-def _gathered_forward(parts, shape, dtype):
-    """The batch gathered into one zero-filled array, then the plain padded transform pair of SciPy."""
-    import scipy.fft as sfft
-
-    data = np.zeros((len(parts), max(p.shape[0] for p in parts), max(p.shape[1] for p in parts)), dtype=dtype)
-    for b, p in enumerate(parts):
-        data[b, : p.shape[0], : p.shape[1]] = p.astype(dtype)
-    rows = sfft.rfft(data, n=shape[1], axis=-1)
-    return sfft.fft(rows, n=shape[0], axis=-2)
-
-
-@pytest.mark.parametrize("band", [None, 3])  # None: the default bands (one here); 3: bands of a few rows
-@pytest.mark.parametrize("dtype", [np.float64, np.float32])
-def test_forward_parts_of_strided_rows_is_the_gathered_transform_bit_for_bit(monkeypatch, band, dtype):
-    if band is not None:
-        monkeypatch.setattr(fft, "_BAND", band)
-    v = np.random.default_rng(1).standard_normal((23, 17))
-    parts = [v[0::2, 2:13], v[1::2, 2:13]]  # 12 and 11 rows, views with a row stride
-    keep = v.copy()
-    shape = (fft.fast_length(24, real=False), fft.fast_length(21, real=True))
-    got = fft.forward_parts(parts, shape, dtype)
-    want = _gathered_forward(parts, shape, dtype)
-    np.testing.assert_array_equal(v, keep)
-    assert got.dtype == want.dtype and np.array_equal(got, want)
-
-
-@pytest.mark.parametrize("band", [None, 3])
-def test_banded_forward_and_inverse_are_the_plain_pair_bit_for_bit(monkeypatch, band):
-    import scipy.fft as sfft
-
-    if band is not None:
-        monkeypatch.setattr(fft, "_BAND", band)
-    x = np.random.default_rng(2).random((2, 9, 7))
-    shape = (fft.fast_length(17, real=False), fft.fast_length(13, real=True))
-    spectrum = fft.forward(x, shape)
-    assert np.array_equal(spectrum, _gathered_forward(list(x), shape, np.float64))
-    plain = sfft.irfft(sfft.ifft(spectrum, axis=-2, norm="forward")[..., :9, :], n=shape[1], axis=-1,
-                       norm="forward")[..., :7]
-    back = fft.inverse(spectrum.copy(), shape, (9, 7))
-    assert back.shape == (2, 9, 7) and np.array_equal(back, plain)
-    out = np.full((18, 11), -1.0)
-    fft.inverse_into(spectrum[1].copy(), shape, out[1::2, 3:10])  # a strided destination, the rest untouched
-    assert np.array_equal(out[1::2, 3:10], plain[1])
-    assert np.all(out[0::2] == -1.0) and np.all(out[:, :3] == -1.0) and np.all(out[:, 10:] == -1.0)
 
 
 def test_in_parts_runs_a_part_in_the_calling_thread_and_waits_for_the_others(monkeypatch):
@@ -187,25 +133,6 @@ def test_transforms_in_parts_equal_scipy_fft(monkeypatch, entry_points, dtype):
     np.testing.assert_allclose(out, x, rtol=0, atol=(1e-5 if dtype == np.float32 else 1e-13) * np.abs(x).max())
     raw = fft.irfft_into(back, np.empty(x.shape, dtype), 512, 2, normalise=False)
     np.testing.assert_array_equal(raw, sfft.irfft(kept, n=512, axis=2, norm="forward"))
-
-
-def test_padded_transforms_on_threads_equal_one_thread(monkeypatch):
-    """forward_parts and inverse_into (the half-space's pruned pair) in parts on two threads give the numbers of
-    one thread, bit for bit, banded or not."""
-    x = np.random.default_rng(4).standard_normal((2, 300, 500))
-    shape = (fft.fast_length(599, real=False), fft.fast_length(999, real=True))
-    results = []
-    for n_threads, band in ((1, 1 << 19), (2, 1 << 19), (2, 1 << 16)):
-        monkeypatch.setattr(fft, "_override", n_threads)
-        monkeypatch.setattr(fft, "_BAND", band)
-        spectra = fft.forward_parts(list(x), shape)
-        dest = np.empty((300, 500))
-        fft.inverse_into(spectra[1].copy(), shape, dest)
-        results.append((spectra, dest))
-    for spectra, dest in results[1:]:
-        np.testing.assert_array_equal(spectra, results[0][0])
-        np.testing.assert_array_equal(dest, results[0][1])
-    np.testing.assert_allclose(results[0][1] / (shape[0] * shape[1]), x[1], rtol=0, atol=1e-13)
 
 
 def test_pocketfft_entry_points_are_used_only_where_they_check_out(monkeypatch):

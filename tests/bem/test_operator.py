@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import bem
+from bem.block_symbol import table_extent
 from bem.lattice import Lattice
 from bem.operator import InfluenceOperator
 from bem.template import template
@@ -201,3 +202,5 @@ def test_an_operator_that_makes_its_table_anew_gives_the_products_of_one_that_ho
     for a, b in zip(expected, products(anew)):
         assert np.array_equal(a, b)
     assert held._held is not None and anew._held is None
+    box = anew._box(p)  # the box's symbol met the offsets of its box only: a table smaller than the lattice's
+    assert all(e < n for e, n in zip(table_extent(anew._start, box, box), lat.shape))
