@@ -18,7 +18,7 @@ import numpy as np
 from . import fft, pruned_fft
 
 __all__ = ["block_product", "block_quadratic", "inverse_symbol", "kernel_spectra", "padded_kernel", "padded_shape",
-           "single_symbol"]
+           "single_symbol", "table_extent"]
 
 
 def _conj(x):
