@@ -18,7 +18,9 @@ run again unless ``--force``. ``scaling.md`` (the table; cases not yet measured 
 rewritten after every case.
 
 Run: ``python benchmarks/scaling.py --out results/scaling [--problems periodic periodic-root hertz rough-sphere]
-[--sizes 1024 2048] [--force]``
+[--sizes 1024 2048] [--force]``. The C library's allocator settings in the environment (``MALLOC_*``, such as
+``MALLOC_MMAP_THRESHOLD_=4194304``, and ``GLIBC_TUNABLES``) reach the cases' processes and are recorded with
+their rows (``docs/performance.md``, "Memory per node and the node guard").
 """
 
 from __future__ import annotations
@@ -65,11 +67,23 @@ def markdown(data):
             elif "error" in r:
                 lines.append(f"| {LABELS[problem]} | {n}^2 | - | failed: {r['error']} | | | | | | | |")
             else:
-                lines.append(f"| {LABELS[problem]} | {n}^2 | {r['nodes']:,} | {r['iterations']} | {r['wall_s']:.2f} | "
-                             f"{r['cpu_s']:.2f} | {r['cpu_us_per_node']:.2f} | {r['peak_mb'] / 1e3:.2f} | "
-                             f"{r['bytes_per_node']:.0f} | {r['solve_bytes_per_node']:.0f} | "
+                mark = " (a)" if r.get("allocator") else ""
+                lines.append(f"| {LABELS[problem]} | {n}^2{mark} | {r['nodes']:,} | {r['iterations']} | "
+                             f"{r['wall_s']:.2f} | {r['cpu_s']:.2f} | {r['cpu_us_per_node']:.2f} | "
+                             f"{r['peak_mb'] / 1e3:.2f} | {r['bytes_per_node']:.0f} | "
+                             f"{r['solve_bytes_per_node']:.0f} | "
                              f"{r['load_before'][0]:.1f} / {r['load_after'][0]:.1f} |")
+    settings = sorted({f"{k}={v}" for r in data["rows"] for k, v in r.get("allocator", {}).items()})
+    if settings:
+        lines += ["", f"(a): run with the C library's allocator set by the environment: {', '.join(settings)} "
+                  "(the other rows with its defaults)."]
     return "\n".join(lines) + "\n"
+
+
+def allocator_settings():
+    """The environment variables that set glibc's allocator (``MALLOC_*``, ``GLIBC_TUNABLES``), which the fresh
+    processes of the cases inherit: a row's memory and time depend on them."""
+    return {k: v for k, v in sorted(os.environ.items()) if k.startswith("MALLOC_") or k == "GLIBC_TUNABLES"}
 
 
 def plot(data, path):
@@ -130,6 +144,8 @@ def main(argv=None):
                 print(f"# {problem} {n}^2: in {path}, not run again (--force runs it)", flush=True)
                 continue
             row = fresh(problem, n)
+            if allocator_settings():
+                row["allocator"] = allocator_settings()
             print(json.dumps(row), flush=True)
             data["rows"] = [r for r in data["rows"] if not (r["problem"] == problem and r["n"] == n)] + [row]
             cases.write_whole(path, json.dumps(data, indent=1))
