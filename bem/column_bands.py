@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import fft, pruned_fft
+from . import fft, heap, pruned_fft
 from .block_symbol import padded_kernel
 
 __all__ = ["BANDS_ABOVE", "PairedSymbol", "band_columns", "convolve_by_bands", "paired_spectra"]
@@ -128,7 +128,9 @@ def convolve_by_bands(S, shape, parts, dests, dtype=np.float64):
     rows_in = [x.shape[0] for x in parts]
     rows_out = [d.shape[0] for d in dests]
     cdtype = np.result_type(dtype, np.complex64)
-    half = np.empty((2, max(rows_in + rows_out), n_half), dtype=cdtype)  # the row spectra, then the products
+    shape_half = (2, max(rows_in + rows_out), n_half)
+    heap.release(np.dtype(cdtype).itemsize * shape_half[0] * shape_half[1] * n_half)  # no freed blocks beside it
+    half = np.empty(shape_half, dtype=cdtype)  # the row spectra, then the products
     for b, x in enumerate(parts):
         pruned_fft.rfft_rows(x, half[b, : rows_in[b]], lq, dtype)
     width = band_columns(lk, np.dtype(cdtype).itemsize)
