@@ -129,7 +129,7 @@ def convolve_by_bands(S, shape, parts, dests, dtype=np.float64):
     rows_out = [d.shape[0] for d in dests]
     cdtype = np.result_type(dtype, np.complex64)
     shape_half = (2, max(rows_in + rows_out), n_half)
-    heap.release(np.dtype(cdtype).itemsize * shape_half[0] * shape_half[1] * n_half)  # no freed blocks beside it
+    heap.release(np.dtype(cdtype).itemsize * int(np.prod(shape_half)))  # no freed blocks of the heap beside it
     half = np.empty(shape_half, dtype=cdtype)  # the row spectra, then the products
     for b, x in enumerate(parts):
         pruned_fft.rfft_rows(x, half[b, : rows_in[b]], lq, dtype)

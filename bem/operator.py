@@ -31,7 +31,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from . import fft, pruned_fft
+from . import pruned_fft
 from .backend import get_backend
 from .block_symbol import (block_product, block_quadratic, inverse_symbol, kernel_spectra, padded_shape, single_symbol,
                            table_extent)

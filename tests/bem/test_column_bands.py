@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import bem.column_bands as column_bands
-from bem import fft, pruned_fft
+from bem import pruned_fft
 from bem.block_symbol import block_product
 from bem.lattice import Lattice
 from bem.operator import InfluenceOperator
