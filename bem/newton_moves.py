@@ -106,7 +106,6 @@ def settle_plastic(op, layer, h, p, u, at_bound, delta, *, force, hardness):
     filled by :func:`bem.plastic.fill_force`) costs one product with ``C``. Returns ``(p, u)``.
     """
     bk, mask = operator_backend(op)
-    xp = bk.xp
     up = bk.select(mask & at_bound & (p < hardness))
     if not bk.count(up):
         return p, u

@@ -1,14 +1,12 @@
 """Nonlinear layers: the three methods against each other, against KKT, and the paper's findings."""
 
-import math
-
 import numpy as np
 import pytest
 
 import bem
 from bem import layers
 
-from .conftest import A_HERTZ, C_NN, E_STAR, EXTENT, FORCE, P0_HERTZ, R, STEP, paper_laws
+from .conftest import E_STAR, FORCE, R, paper_laws
 
 METHODS = ("newton", "augmented_gap", "variable_compliance")
 

@@ -1,8 +1,6 @@
 """A coating meshed as its own material, bonded to its substrate: the mesh, an exact state, and the
 surface displacement against the Hankel transform of the coated half-space's compliance."""
 
-import math
-
 import numpy as np
 import pytest
 from scipy.special import j0, jv

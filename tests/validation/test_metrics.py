@@ -10,7 +10,7 @@ import pytest
 
 import bem
 from bem.checks import InputError
-from bem.gaps import EllipticParaboloid, Paraboloid
+from bem.gaps import Paraboloid
 from fem_reference.result import FemResult
 from bem.reference import hertz_elliptic, hertz_sphere
 from validation.compare import PAIR_KEYS, RADIUS_KEYS, compare, pair_metrics, relative_l2, ring_weights
