@@ -95,7 +95,7 @@ def rfft_rows(x, dest, n, dtype=np.float64, scale=None, size=None):
             np.multiply(x[lo:hi], scale, out=buf[:, :cols], casting="unsafe")
         rfft_into(buf, dest[lo:hi], 1, split=None)
 
-    _in_bands(band, dest.shape[0], dest.size if size is None else size, (n, dtype, np.zeros))
+    _in_bands(band, dest.shape[0], dest.size if size is None else size, n, dtype, zeroed=True)
 
 
 def irfft_rows(x, dest, n):
@@ -106,15 +106,15 @@ def irfft_rows(x, dest, n):
         irfft_into(x[lo:hi], buf, n, 1, split=None, normalise=False)
         dest[lo:hi] = buf[:, : dest.shape[1]]
 
-    _in_bands(band, dest.shape[0], dest.size, (n, x.real.dtype, np.empty))
+    _in_bands(band, dest.shape[0], dest.size, n, x.real.dtype)
 
 
-def _in_bands(band, rows, size, buffer):
+def _in_bands(band, rows, size, columns, dtype, zeroed=False):
     """``band(buf, lo, hi)`` on the bands ``lo:hi`` of :func:`_band` rows of an array of ``rows`` rows and ``size``
     entries: in parts of the rows (:func:`in_parts`), each part a band after another into one buffer ``buf`` of its
-    own, ``buffer = (columns, dtype, make)`` (``make``: ``np.zeros`` or ``np.empty``), made once."""
+    own, ``columns`` wide, of ``dtype`` (``zeroed``: made of zeros), made once."""
     step = _band(rows, size)
-    columns, dtype, make = buffer
+    make = np.zeros if zeroed else np.empty
 
     def part(rows_part):
         buf = make((min(step, rows_part.stop - rows_part.start), columns), dtype=dtype)

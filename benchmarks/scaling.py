@@ -144,8 +144,8 @@ def main(argv=None):
                 print(f"# {problem} {n}^2: in {path}, not run again (--force runs it)", flush=True)
                 continue
             row = fresh(problem, n)
-            if allocator_settings():
-                row["allocator"] = allocator_settings()
+            if settings := allocator_settings():
+                row["allocator"] = settings
             print(json.dumps(row), flush=True)
             data["rows"] = [r for r in data["rows"] if not (r["problem"] == problem and r["n"] == n)] + [row]
             cases.write_whole(path, json.dumps(data, indent=1))

@@ -26,7 +26,7 @@ import scipy.fft as sfft
 from .. import fft
 from ..backend import backend_of, get_backend
 from ..checks import check_positive, fail
-from ..operator import diagonal_coefficient
+from ..template import diagonal_coefficient
 from .coated import coated_template
 from .kernel import periodic_template
 from .spectra import mixed, weighted_dot
