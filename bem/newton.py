@@ -59,17 +59,18 @@ _SINGLE_MAX = float(np.finfo(np.float32).max)  # the model's D in single precisi
 
 
 def _line_search(bk, layer, p, q, u, uq, h, delta, mask):
-    """Exact minimiser of ``Phi(p + t d)``, ``d = q - p``, on ``(0, 1]``: root of ``d.grad Phi(p + t d)``
-    (``u = C p``, ``uq = C q``; ``d`` and ``C d`` are formed on the nodes that move only).
-
-    Under force control ``sum d = 0``, so ``delta`` drops out of the derivative.
-    """
-    sel = bk.select(mask & (q != p))
-    ps, us, hs = (bk.take(x, sel) for x in (p, u, h))
-    ds, cds = bk.take(q, sel) - ps, bk.take(uq, sel) - us
+    """Exact minimiser of ``Phi(p + t d)``, ``d = q - p``, on ``(0, 1]``: root of the slope ``d.grad Phi(p + t d) =
+    a + t b + d.w(p + t d)``, ``a = d.(u + h - delta)`` and ``b = d.C d`` summed once (``u = C p``, ``uq = C q``; on
+    the nodes that move only; ``mask`` None: every node). Under force control ``sum d = 0``: ``delta`` drops out."""
+    xp = bk.xp
+    sel = bk.select(q != p if mask is None else mask & (q != p))
+    ps, us = bk.take(p, sel), bk.take(u, sel)
+    ds = bk.take(q, sel) - ps
+    a = bk.dot(ds, us + bk.take(h, sel) - delta)
+    b = bk.dot(ds, bk.take(uq, sel) - us)
 
     def slope(t):
-        return bk.dot(ds, us + t * cds + layer.w(bk.xp.maximum(ps + t * ds, 0.0)) + hs - delta)
+        return a + t * b + bk.dot(ds, layer.w(xp.maximum(ps + t * ds, 0.0)))
 
     s0, s1 = slope(0.0), slope(1.0)
     if s0 >= 0:
@@ -262,7 +263,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
                            maxiter=inner_maxiter, u0=u, confirm=False, **bound)
         _count_inner(hist, sub)
         # the step d = q - p of the model's solution q (C d = uq - u) is formed where it is used, not held
-        t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, mask)
+        t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, None if full else mask)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
             wp = closure(p)
             scale = float(xp.max(xp.abs(u + wp)))
@@ -272,7 +273,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
                                rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u,
                                confirm=False, **bound)
             _count_inner(hist, sub)
-            t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, mask)
+            t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, None if full else mask)
         # the model's closure at the step, for the closure move (not for linear laws, where it is the step itself)
         moves = t > 0.0 and hardness is None and not layer.is_linear
         w_model = model_closure(bk, layer, p, sub.p, D, t) if moves else None
