@@ -66,3 +66,20 @@ def test_the_full_step_where_the_functional_falls_all_the_way_and_none_where_it_
     # the direction reversed: no descent
     back = np.maximum(p - d, 0.0)
     assert newton._line_search(bk, layer, p, back, op.matvec(p), op.matvec(back), h, delta, None) == 0.0
+
+
+def test_a_mask_leaves_the_nodes_off_it_out_of_the_slope():
+    # the nodes off the mask move too here; the step is the minimiser along d restricted to the mask
+    op, layer, h, p, q, delta = _case(1, overshoot=3.0)
+    mask = np.ones(CELL.shape, dtype=bool)
+    mask[: CELL.shape[0] // 2] = False
+    bk = get_backend("cpu")
+    u, uq = op.matvec(p), op.matvec(q)
+    t = newton._line_search(bk, layer, p, q, u, uq, h, delta, mask)
+    d = np.where(mask, q - p, 0.0)  # the slope on the mask: d.(C p + t C (q - p) + w(p + t d) + h - delta) there
+
+    def slope(s):
+        return float(np.sum(d * (u + s * (uq - u) + layer.w(p + s * d) + h - delta)))
+
+    assert 0.0 < t < 1.0 and t != newton._line_search(bk, layer, p, q, u, uq, h, delta, None)
+    assert slope(t - 1e-9) < 0 < slope(t + 1e-9)
