@@ -1,13 +1,27 @@
-"""A periodic gap of a few seeded waves and its cell, for the tests of Newton's method on a cell
-(tests/bem/test_newton_buffers.py, tests/bem/test_newton_closure_move.py)."""
+"""A periodic gap of a few seeded waves and its cell, a root law and the functional, for the tests of Newton's method
+on a cell (tests/bem/test_newton_buffers.py, test_newton_closure_move.py, test_newton_line_search.py)."""
 
 import math
 
 import numpy as np
 
+import bem
+from bem import layers
 from bem.periodic import PeriodicCell
 
 CELL = PeriodicCell(1.0 / 48, 48, 48)
+FORCE = 0.02
+
+
+def root_law(scale):
+    """A root law whose closure at the mean pressure ``FORCE / CELL.area`` is ``scale`` times the elastic ``C_nn``
+    times it."""
+    return layers.Root(scale * bem.diagonal_coefficient(CELL.step, 1.0) * math.sqrt(FORCE / CELL.area))
+
+
+def phi(op, layer, h, p, delta):
+    """``Phi / a`` of eq. 15 by its definition."""
+    return 0.5 * float(np.sum(p * op.matvec(p))) + float(np.sum(p * (h - delta))) + float(np.sum(layer.energy(p)))
 
 
 def waves(cell, seed=5, modes=8):

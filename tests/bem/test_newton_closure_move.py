@@ -1,8 +1,6 @@
 """The closure move of a Newton step (:func:`bem.newton_moves.closure_move`): the pressure whose closure is the
 model's, kept where it lowers the functional, and Newton's method with it and without it."""
 
-import math
-
 import numpy as np
 import pytest
 
@@ -12,19 +10,7 @@ from bem.backend import get_backend
 from bem.newton_moves import closure_move, model_closure
 from bem.periodic import PeriodicOperator
 
-from .newton_cases import CELL, waves
-
-FORCE = 0.02
-
-
-def _root(scale):
-    """A root law whose closure at the mean pressure is ``scale`` times the elastic ``C_nn`` times it."""
-    return layers.Root(scale * bem.diagonal_coefficient(CELL.step, 1.0) * math.sqrt(FORCE / CELL.area))
-
-
-def _phi(op, layer, h, p, delta):
-    """``Phi / a`` of eq. 15 by its definition."""
-    return 0.5 * float(np.sum(p * op.matvec(p))) + float(np.sum(p * (h - delta))) + float(np.sum(layer.energy(p)))
+from .newton_cases import CELL, FORCE, phi, root_law, waves
 
 
 def _solve(layer, **kw):
@@ -39,7 +25,7 @@ def _without_move(monkeypatch):
 @pytest.mark.parametrize("scale", [0.3, 1.0, 3.0, 30.0])
 def test_newton_with_the_move_takes_fewer_steps_to_the_same_answer(monkeypatch, scale):
     # from an elastic-dominated (0.3: the move gains little there) to a layer-dominated root layer
-    layer = _root(scale)
+    layer = root_law(scale)
     moved = _solve(layer)
     _without_move(monkeypatch)
     plain = _solve(layer)
@@ -53,7 +39,7 @@ def test_newton_with_the_move_takes_fewer_steps_to_the_same_answer(monkeypatch, 
 def test_with_the_layer_alone_carrying_the_load_newton_converges_in_a_few_steps(monkeypatch):
     # w' far above C_nn at every contact pressure: the closure move is Newton's method in the closure, where the
     # law is linear; the step along d alone converges linearly from a start decades below the answer
-    layer = _root(1e4)
+    layer = root_law(1e4)
     x0 = np.random.default_rng(1).uniform(1e-4, 1.0, CELL.shape) ** 3
     moved = _solve(layer, x0=x0.copy())
     _without_move(monkeypatch)
@@ -70,23 +56,23 @@ def _state(layer, x0):
 
 
 def test_the_move_to_the_answers_closure_lands_on_the_answer_and_lowers_phi():
-    layer = _root(3.0)
+    layer = root_law(3.0)
     answer = _solve(layer)
     start = np.random.default_rng(2).uniform(0.5, 1.5, CELL.shape)
     op, h, p, u = _state(layer, start)
     delta = answer.approach
-    before = _phi(op, layer, h, p, delta)
+    before = phi(op, layer, h, p, delta)
     closure = layer.w(answer.p)
     new_p, new_u, moved = closure_move(op, layer, h, p.copy(), u.copy(), closure, answer.p > 0, delta, force=FORCE)
     assert moved
     np.testing.assert_allclose(new_p, answer.p, rtol=0, atol=1e-12 * answer.p.max())
     np.testing.assert_allclose(new_u, op.matvec(new_p), rtol=0, atol=1e-12 * np.abs(new_u).max())
-    assert _phi(op, layer, h, new_p, delta) < before
+    assert phi(op, layer, h, new_p, delta) < before
     assert CELL.node_area * new_p.sum() == pytest.approx(FORCE, rel=1e-13)
 
 
 def test_a_move_that_raises_phi_is_not_taken_and_leaves_the_state():
-    layer = _root(3.0)
+    layer = root_law(3.0)
     answer = _solve(layer)
     op, h, p, u = _state(layer, answer.p.copy())
     keep = p.copy(), u.copy()
@@ -112,7 +98,7 @@ def test_released_nodes_go_to_zero_and_a_rigid_branch_keeps_its_pressure():
     # the move by its definition, and the functional's change by the definition of Phi
     want = np.where(released, 0.0, np.where(rigid, p, layer.inverse(layer.w(answer.p))))
     want *= FORCE / CELL.node_area / want.sum()
-    assert _phi(op, layer, h, want, 0.0) < _phi(op, layer, h, p, 0.0)
+    assert phi(op, layer, h, want, 0.0) < phi(op, layer, h, p, 0.0)
     new_p, new_u, moved = closure_move(op, layer, h, p.copy(), u.copy(), closure, ~released, 0.0, force=FORCE)
     assert moved
     np.testing.assert_allclose(new_p, want, rtol=1e-13, atol=1e-15 * want.max())
@@ -121,7 +107,7 @@ def test_released_nodes_go_to_zero_and_a_rigid_branch_keeps_its_pressure():
 
 @pytest.mark.parametrize("writeable", [True, False])
 def test_the_models_closure_is_its_formula_in_the_buffer_of_d(writeable):
-    layer = _root(3.0)
+    layer = root_law(3.0)
     rng = np.random.default_rng(6)
     p, q, D = (rng.uniform(0.0, 2.0, (9, 11)) for _ in range(3))
     want = layer.w(p) + 0.7 * D * (q - p)

@@ -1,22 +1,15 @@
 """The line search of a Newton step (``bem.newton._line_search``): the step ``t`` that minimises the functional along
 ``d = q - p``, checked against the slope and the functional made by their definitions with whole products."""
 
-import math
-
 import numpy as np
 import pytest
 
 import bem
-from bem import layers, newton
+from bem import newton
 from bem.backend import get_backend
 from bem.periodic import PeriodicOperator
 
-from .newton_cases import CELL, waves
-
-
-def _phi(op, layer, h, p, delta):
-    """``Phi / a`` of eq. 15 by its definition."""
-    return 0.5 * float(np.sum(p * op.matvec(p))) + float(np.sum(p * (h - delta))) + float(np.sum(layer.energy(p)))
+from .newton_cases import CELL, FORCE, phi, root_law, waves
 
 
 def _slope(op, layer, h, p, d, delta):
@@ -29,8 +22,8 @@ def _case(seed, overshoot):
     with ``q`` ``overshoot`` times a descent step from ``p``, so that the minimum along ``d`` lies inside (0, 1)."""
     rng = np.random.default_rng(seed)
     op, h = PeriodicOperator(CELL, 1.0), waves(CELL)
-    layer = layers.Root(3 * bem.diagonal_coefficient(CELL.step, 1.0) * math.sqrt(0.02 / CELL.area))
-    p = np.where(h < np.quantile(h, 0.3), rng.uniform(0.5, 1.5, CELL.shape), 0.0) * 0.02 / CELL.area
+    layer = root_law(3.0)
+    p = np.where(h < np.quantile(h, 0.3), rng.uniform(0.5, 1.5, CELL.shape), 0.0) * FORCE / CELL.area
     delta = float(np.mean((op.matvec(p) + layer.w(p) + h)[p > 0]))
     grad = op.matvec(p) + layer.w(p) + h - delta
     q = np.maximum(p - overshoot * grad / bem.diagonal_coefficient(CELL.step, 1.0), 0.0)
@@ -49,8 +42,8 @@ def test_the_step_is_the_minimiser_of_the_functional_along_the_direction(seed):
     # the slope by its definition changes sign at t, and t is within 1e-9 of its root
     assert _slope(op, layer, h, p + (t - 1e-9) * d, d, delta) < 0 < _slope(op, layer, h, p + (t + 1e-9) * d, d, delta)
     assert abs(_slope(op, layer, h, p + t * d, d, delta)) <= 1e-7 * abs(_slope(op, layer, h, p, d, delta))
-    phi = _phi(op, layer, h, p + t * d, delta)
-    assert phi <= min(_phi(op, layer, h, p + (t + s) * d, delta) for s in (-1e-3, 1e-3, -t, 1 - t))
+    at_t = phi(op, layer, h, p + t * d, delta)
+    assert at_t <= min(phi(op, layer, h, p + (t + s) * d, delta) for s in (-1e-3, 1e-3, -t, 1 - t))
     # the inputs are not modified; a mask of every node gives the same step
     for a, b in zip((p, q, h), before):
         np.testing.assert_array_equal(a, b)
