@@ -9,12 +9,12 @@ directions: ``t = z + beta t_old`` on the current contact, ``beta = max(0, g.(z 
 (Polak-Ribiere+), the step the minimum along ``t``, ``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the contact
 does not change), and ``t = z`` where ``g.t <= 0``. On a rough surface, whose contact set changes at most iterations
 until it settles, a loop that restarts at every entering node degrades to preconditioned steepest descent
-(``tests/bem/test_periodic_qp.py``: 82 iterations against 57 on a 256 x 256 self-affine cell). An entering node
-(``p = 0``, ``g < 0``) takes the step with a share of the Jacobi estimate of the preconditioner there,
-``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`): ``tau`` is dimensionless
-here (``t`` is ``M g``), and ``-tau g`` would give it ``tau C_nn`` of its Jacobi pressure, a fraction that falls with
-the step (on a 672 x 776 rough cell at 1e-4 of the mean contact pressure, nodes entering with almost no pressure and
-leaving, at a constant KKT residual: ``tests/bem/test_periodic_robustness.py``). Further:
+(``tests/bem/test_periodic_qp.py``: 82 iterations against 57, 52 with :mod:`bem.periodic.edge`, on a 256^2
+self-affine cell). An entering node (``p = 0``, ``g < 0``) takes the step with a share of the Jacobi estimate of the
+preconditioner there, ``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`): ``tau``
+is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give it ``tau C_nn`` of its Jacobi pressure, a fraction
+that falls with the step (on a 672 x 776 rough cell at 1e-4 of the mean contact pressure, nodes entering with almost no
+pressure and leaving, at a constant KKT residual: ``tests/bem/test_periodic_robustness.py``). Further:
 
 - the iteration keeps ``u = (C + lam) p`` in double precision, updated after a step by the product of its move in
   single precision (rounded to a relative ``1e-7`` of the step, which falls with the residual): where the contact set
@@ -25,7 +25,8 @@ leaving, at a constant KKT residual: ``tests/bem/test_periodic_robustness.py``).
   takes its ``u``) or off NumPy;
 - the curvature ``t.(C + lam) t`` is a sum over the spectrum of that product (Parseval, summed in double precision,
   block by block as the product is made: :func:`bem.periodic.spectra.mixed`);
-- the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``;
+- the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``; without a compliance per
+  node or a hardness it is corrected at the edges of the contact once the contact settles (:mod:`bem.periodic.edge`);
 - so does the recomputed ``u`` while the KKT residual is above ``1e-4`` (:data:`SINGLE_ABOVE`), in a solve that
   starts above ``1e-2`` (:data:`SINGLE_START` times that) or stops above ``1e-4`` (``rtol >= SINGLE_ABOVE``, a
   Newton step's model far from the answer), where the rounding of single precision (a relative ``1e-7`` of ``C p``)
@@ -71,6 +72,7 @@ from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bou
                         elastic_displacement, entering_pressure, initial_pressure, is_per_node, is_stiff,
                         iterate_residual, run_constrained_cg)
 from ..plastic import carry_force, in_place, note_fully_plastic
+from .edge import EdgeCorrection
 from .passes import kernels
 from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, StepArrays, weighted_square
 
@@ -127,11 +129,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         products ``(C + lam) v`` (spectral multiplications, in single or double precision).
     """
     lat, bk = op.lattice, operator_backend(op)[0]
-    a, xp = lat.node_area, bk.xp
-    per_node = is_per_node(lam)
+    a, xp, per_node = lat.node_area, bk.xp, is_per_node(lam)
     D = bk.asarray(lam, xp.float32 if getattr(lam, "dtype", None) == xp.float32 else None) if per_node else None
-    lam = 0.0 if per_node else float(lam)
-    h = bk.asarray(h)
+    lam, h = 0.0 if per_node else float(lam), bk.asarray(h)
     maxiter = max(200, int(10 * math.sqrt(lat.n_nodes))) if maxiter is None else maxiter
     target = None if force is None else force / a
     if u0 is None or x0 is None:  # a new array, or x0 itself with overwrite_x0
@@ -203,14 +203,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         u, stale = add_into(bk.copy(bk.asarray(u0)), times_p(D)) if per_node else bk.copy(bk.asarray(u0)), 1
         u = offset_added(u)
     last_z = LastPreconditionedGap(bk, lat.shape)  # the last preconditioned gap, on its contact only
-    gz_old, m_one, m_full, m_at = 1.0, None, None, None
+    gz_old, m_one, m_full, m_at, fixed_scale = 1.0, None, None, None, scale
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     nodes = ContactNodes(bk, p, getattr(passes, "merge", None))  # the iterate's contact (steady: the last step's)
-    fixed_scale = scale
     idx = g_c = p_c0 = g_min = u_range = None  # u_range: max u, min u
 
-    bounded, sets = hardness is not None, None
-    restart = False  # with a hardness: the last step was shortened to carry the force, the direction restarts
+    bounded, sets, restart = hardness is not None, None, False  # restart: a bounded step shortened to carry the force
+    edge = None if per_node or bounded else EdgeCorrection(bk, apply_m, lat.shape, diag + lam)  # M at the edges
     was_on, was_plastic = (nodes.was_on, p >= hardness) if bounded else (None, None)  # the bound's own counts
     g = np.empty(lat.shape) if bounded and bk.is_numpy else None  # the gap u + h, an array in the bounded QP only
     enter = np.empty(lat.shape, dtype=bool) if bk.is_numpy and not bounded else None  # nodes that may enter
@@ -277,6 +276,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             nodes.kept = D_c, soft_c, jac_c
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         z = precondition(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
+        z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"])
         if force is not None and not soft:
             z -= xp.mean(z)
         elif force is not None:

@@ -1,0 +1,119 @@
+"""The cell's preconditioner corrected at the edges of the contact (its regional form on the contact).
+
+The constrained CG of :mod:`bem.periodic.qp` preconditions the gap ``r`` on the contact ``A`` by ``M_AA r``:
+``M``, the inverse of the whole cell's operator, restricted to ``A`` (one transform pair). ``M_AA`` exceeds the
+exact ``C_AA^-1`` by ``M_AI M_II^-1 M_IA`` (``I`` the nodes off the contact), a term that lives on the edges of
+the contact spots and grows with the lattice: the condition number of the preconditioned contact rises with
+``log N`` (``docs/performance.md``, "The rate of the finest cell").
+
+``M``'s off-diagonal entries are negative but for two small shells (the six nearest nodes ``-0.155 M_nn``, the
+next two shells ``+0.009`` and ``+0.005 M_nn``, the rest negative and falling as the distance cubed), so its
+quadratic form on a pressure ``x`` on ``A`` (0 elsewhere) is about ``x.M x = 1/2 sum_{a, b in A} -M_ab (x_a -
+x_b)^2 + sum_{a in A} (M 1)_a x_a^2 - sum_{a in A} (M 1_I)_a x_a^2``: the last sum, each contact node's coupling
+to the nodes off the contact, ``(M 1_I)_a = sum_{i in I} M_ai`` (negative), weighs the pressure's jump to 0 across
+the edge. Without it the form is the regional one, pairs of contact nodes only: the intrinsic ``H^1/2(A)`` form,
+the space of the gap on the contact, against the form of the pressure extended by zero. The correction takes
+``theta`` (:data:`THETA`) of that sum away, and keeps every diagonal entry at least ``beta / C_nn``
+(:data:`FLOOR`; ``1 / C_nn`` is the exact inverse at a node alone in contact):
+
+    z = M_AA r + c r,    c_a = max(theta (M (1_I - f))_a, beta / C_nn - M_nn),
+
+``f`` the share of the cell's nodes off the contact (the mean taken away, so that ``M``'s value at frequency 0
+does not enter), ``M_nn`` its diagonal. On the contact of the cell of ``benchmarks/periodic_spectrum.py``, held
+fixed, the condition number is 9.2, 9.5, 9.8 and 10.3 at 65k, 262k, 1M and 4.2M nodes against 12.2, 14.4, 16.8
+and 19.3 with ``M_AA`` alone. ``theta = 0.9`` conditions these self-affine contacts a little better and the contacts
+of smooth surfaces worse than ``M_AA`` alone; ``0.7`` conditions both better (the dense spectra of
+``tests/bem/test_periodic_edge.py``; the iterations in ``docs/performance.md``).
+
+While the contact set moves, the correction's longer steps at the edges move it more (more iterations), so the
+correction is made from the first step that changes at most :data:`SETTLED` of the contact's nodes, and made again
+once the nodes changed since exceed :data:`REMAKE` of them; between, it is read at the present contact's nodes (a
+node that entered since reads its value off the contact, about 0 or positive: ``M``'s own diagonal or more).
+Making it takes a transform pair in single precision, ``M (1_A - |A| / N)``, and once a solve a second for
+``M_nn``. A step whose corrected ``z`` is not a descent direction (``r.z <= 0``) takes the uncorrected one.
+"""
+
+from __future__ import annotations
+
+__all__ = ["FLOOR", "REMAKE", "SETTLED", "THETA", "EdgeCorrection"]
+
+#: share of each contact node's coupling to the nodes off the contact taken out of ``M``'s diagonal
+THETA = 0.7
+#: the corrected diagonal is at least ``FLOOR / C_nn``
+FLOOR = 0.85
+#: the correction starts at the first step that changes at most this share of the contact's nodes
+SETTLED = 3e-3
+#: and is made again once the nodes changed since exceed this share of the contact's nodes
+REMAKE = 2e-3
+
+
+class EdgeCorrection:
+    """The correction ``c r`` of the module docstring for one solve of the cell's QP.
+
+    Parameters
+    ----------
+    bk : bem.backend.Backend
+        The backend of the iteration.
+    apply_m : callable
+        ``apply_m(r32, out)``: ``M r`` of a float32 brick array into the float32 brick array ``out`` (which may be
+        ``r32``), returned (the QP's preconditioner; off NumPy a new array).
+    shape : tuple of int
+        The shape of the cell's brick arrays.
+    diagonal : float
+        ``C_nn`` of the operator the preconditioner inverts (with any uniform compliance added) [length/pressure].
+    """
+
+    def __init__(self, bk, apply_m, shape, diagonal):
+        self.bk, self.apply_m, self.shape, self.diagonal = bk, apply_m, tuple(shape), float(diagonal)
+        self.values = None  # theta M (1_I - f), float32 brick array, where made
+        self.floor = None  # FLOOR / C_nn - M_nn
+        self.changed = 0  # nodes changed since the correction was made
+        self.n_made = 0  # times it was made (a transform pair each, and one more the first time for M_nn)
+
+    def _make(self, idx):
+        bk, xp = self.bk, self.bk.xp
+        if self.floor is None:  # M_nn: M of a unit pressure at the first node, there
+            origin = xp.zeros(self.shape, dtype=xp.bool)
+            origin[0, 0] = True
+            origin = bk.select(origin)
+            unit = bk.put(xp.zeros(self.shape, dtype=xp.float32), origin, xp.ones(1, dtype=xp.float32))
+            self.floor = FLOOR / self.diagonal - float(bk.take(self.apply_m(unit, unit), origin)[0])
+        self.values = None  # let go before the next is made
+        share = bk.count(idx) / (self.shape[0] * self.shape[1])
+        v = xp.full(self.shape, -share, dtype=xp.float32)  # 1_A - |A| / N
+        v = bk.put(v, idx, xp.full(bk.count(idx), 1.0 - share, dtype=xp.float32))
+        self.values = self.apply_m(v, v)  # M (1_A - f_A) = -M (1_I - f): theta M (1_I - f) is -theta times it
+        self.values *= -THETA
+        self.changed, self.n_made = 0, self.n_made + 1
+
+    def applied(self, z, r, idx, changes):
+        """``z + c r`` at the contact's nodes ``idx`` where the correction is on; the uncorrected ``z`` before it
+        starts and where ``r.(z + c r)`` is not positive.
+
+        Parameters
+        ----------
+        z, r : array
+            ``M_AA r`` and the gap ``r`` at the contact's nodes (1-D, float64).
+        idx : node selection
+            The contact's nodes.
+        changes : list of int
+            The nodes that entered or left the contact at each step of the solve so far (the first entry counts
+            from no earlier contact).
+
+        Returns
+        -------
+        array
+            The preconditioned gap (a new array where corrected; ``z`` itself otherwise).
+        """
+        bk, xp = self.bk, self.bk.xp
+        n = bk.count(idx)
+        if self.values is None:
+            if len(changes) < 2 or changes[-1] > SETTLED * n:
+                return z
+        else:
+            self.changed += changes[-1]
+        if self.values is None or self.changed > REMAKE * n:
+            self._make(idx)
+        corrected = xp.maximum(bk.take(self.values, idx), self.floor) * r  # c (float32) times r: float64
+        corrected += z
+        return corrected if bk.dot(r, corrected) > 0 else z

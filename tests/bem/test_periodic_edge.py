@@ -1,0 +1,199 @@
+"""The cell's preconditioner corrected at the edges of the contact (bem.periodic.edge): the correction against its
+definition by the dense inverse of the cell's operator, the spectrum of the corrected preconditioner on a fixed
+contact against the plain one's (dense), its rules, and the QP's answer with it against the answer without."""
+
+import math
+
+import numpy as np
+import pytest
+
+import bem.periodic.edge as edge
+import bem.periodic.qp as periodic_qp
+from bem.backend import operator_backend
+from bem.kkt import kkt_residual
+from bem.periodic import PeriodicCell, PeriodicOperator
+from bem.periodic.edge import EdgeCorrection
+from bem.periodic.qp import solve_periodic_qp
+
+from .test_periodic_qp import _rough
+
+
+def _self_affine(cell, seed=3, hurst=0.8):
+    """A random surface with a power spectrum ``|q|^-2(1 + H)`` over the cell's brick array [length]: many small
+    contact spots at a few per cent of full contact."""
+    n_rows, n_cols = cell.shape
+    rng = np.random.default_rng(seed)
+    q2 = np.fft.fftfreq(n_cols)[None, :] ** 2 + np.fft.fftfreq(n_rows)[:, None] ** 2
+    amp = np.where(q2 > 0, (q2 + 1e-4) ** (-(1 + hurst) / 2), 0.0)
+    z = np.real(np.fft.ifft2(amp * np.exp(2j * math.pi * rng.random(cell.shape))))
+    return 0.02 * (z - z.min()) / np.ptp(z)
+
+
+def _contact(cell, h, load):
+    """The contact of the cell's QP under ``h`` at the mean pressure ``load`` (``E* = 1``)."""
+    op = PeriodicOperator(cell, 1.0)
+    res = solve_periodic_qp(op, h, force=load * cell.area, rtol=1e-11)
+    assert res.converged
+    return op, res.p > 0
+
+
+def _dense_inverse(op):
+    """``M = (C + C_nn 1 1' / N)^-1`` from the dense ``C`` (the cell's preconditioner, made independently)."""
+    C = op.dense()
+    n = C.shape[0]
+    return C, np.linalg.inv(C + op.diagonal * np.ones((n, n)) / n)
+
+
+def _apply_m(op):
+    """The preconditioner as the QP hands it to :class:`EdgeCorrection`: float32 in, float32 into ``out``."""
+    M = op.preconditioner()
+
+    def apply_m(r32, out=None):
+        values = M(np.asarray(r32, dtype=np.float64)).astype(np.float32)
+        if out is None:
+            return values
+        out[...] = values
+        return out
+
+    return apply_m
+
+
+def _correction(op, contact):
+    """An :class:`EdgeCorrection` of the cell and the contact's flat node indices."""
+    return EdgeCorrection(operator_backend(op)[0], _apply_m(op), contact.shape, op.diagonal), np.flatnonzero(contact)
+
+
+def _preconditioned(op, contact, r):
+    """``M_AA r`` (double precision) of a gap ``r`` at the contact's nodes."""
+    v = np.zeros(contact.shape)
+    v[contact] = r
+    return op.preconditioner()(v)[contact]
+
+
+def test_the_correction_is_its_definition_by_the_dense_inverse():
+    cell = PeriodicCell(1.0 / 48, 48, 48)
+    op, contact = _contact(cell, _self_affine(cell), 0.01)
+    fix, idx = _correction(op, contact)
+    _, M = _dense_inverse(op)
+    off = (~contact).ravel().astype(float)
+    c = np.maximum(edge.THETA * (M @ (off - off.mean()))[idx], edge.FLOOR / op.diagonal - M[0, 0])
+    floored = c == edge.FLOOR / op.diagonal - M[0, 0]
+    assert 0 < np.count_nonzero(floored) < idx.size  # both branches of the definition are met
+    assert np.count_nonzero(c < 0) > idx.size / 2  # most contact nodes' diagonal lowered
+    rng = np.random.default_rng(1)
+    r = rng.standard_normal(idx.size)
+    z = _preconditioned(op, contact, r)
+    z_in, r_in = z.copy(), r.copy()
+    got = fix.applied(z, r, idx, [idx.size, 0])
+    assert np.array_equal(z, z_in) and np.array_equal(r, r_in)  # the inputs untouched
+    assert fix.n_made == 1
+    want = z + c * r
+    assert np.abs(got - want).max() <= 1e-5 * np.abs(c * r).max()  # the float32 products' rounding
+
+
+@pytest.mark.parametrize("surface, load, at_most", [("smooth", 0.03, 0.75), ("smooth", 0.003, 0.85),
+                                                     ("self-affine", 0.01, 0.9), ("self-affine", 0.03, 0.8)])
+def test_the_corrected_preconditioner_conditions_a_fixed_contact_better(surface, load, at_most):
+    """The spectrum of the preconditioned contact ``P C_AA`` on the zero-sum pressures of a fixed contact (the
+    force's constraint), dense: ``P`` positive definite, and its condition number below ``at_most`` of that of
+    ``M_AA`` alone (measured at 48 x 48: 2.52 -> 1.76 and 2.21 -> 1.76 on the smooth surface, 4.52 -> 3.84 and
+    5.22 -> 3.93 on the self-affine one)."""
+    cell = PeriodicCell(1.0 / 48, 48, 48)
+    op, contact = _contact(cell, _rough(cell) if surface == "smooth" else _self_affine(cell), load)
+    C, M = _dense_inverse(op)
+    on = contact.ravel()
+    m = int(np.count_nonzero(on))
+    C_AA, M_AA = C[np.ix_(on, on)], M[np.ix_(on, on)]
+    off = (~on).astype(float)
+    c = np.maximum(edge.THETA * (M @ (off - off.mean()))[on], edge.FLOOR / op.diagonal - M[0, 0])
+    Q = np.linalg.qr(np.eye(m) - 1.0 / m)[0][:, : m - 1]  # an orthonormal basis of the zero-sum pressures
+
+    def spectrum(P):
+        L = np.linalg.cholesky(Q.T @ P @ Q)  # raises where P is not positive definite there
+        ev = np.linalg.eigvalsh(L.T @ (Q.T @ C_AA @ Q) @ L)
+        return ev[0], ev[-1] / ev[0]
+
+    low, kappa = spectrum(M_AA + np.diag(c))
+    low_plain, kappa_plain = spectrum(M_AA)
+    assert low > 0 and low_plain == pytest.approx(1.0, abs=1e-6)  # M_AA - C_AA^-1 >= 0: lambda_min of M alone is 1
+    assert kappa < at_most * kappa_plain
+
+
+def test_the_correction_starts_when_the_contact_settles_and_is_made_again_after_enough_changes(monkeypatch):
+    monkeypatch.setattr(edge, "REMAKE", 0.03)  # changes of a few nodes to count on this small contact
+    cell = PeriodicCell(1.0 / 48, 48, 48)
+    op, contact = _contact(cell, _self_affine(cell), 0.01)
+    fix, idx = _correction(op, contact)
+    n = idx.size
+    r = np.random.default_rng(2).standard_normal(n)
+    z = _preconditioned(op, contact, r)
+    many = int(edge.SETTLED * n) + 1
+    assert fix.applied(z, r, idx, [n]) is z  # the first step: no earlier contact to count changes from
+    assert fix.applied(z, r, idx, [n, many]) is z and fix.n_made == 0  # the contact still moves
+    few = int(edge.SETTLED * n)
+    assert fix.applied(z, r, idx, [n, many, few]) is not z and fix.n_made == 1
+    each = int(edge.REMAKE * n / 3)
+    assert each > 0
+    for k in range(3):  # the changes since add up to REMAKE * n at most: not made again
+        fix.applied(z, r, idx, [n, many, few] + [each] * (k + 1))
+    assert fix.n_made == 1
+    fix.applied(z, r, idx, [n, many, few, each, each, each, n])
+    assert fix.n_made == 2
+
+
+def test_a_corrected_gap_that_is_no_descent_direction_is_not_taken():
+    cell = PeriodicCell(1.0 / 48, 48, 48)
+    op, contact = _contact(cell, _self_affine(cell), 0.01)
+    fix, idx = _correction(op, contact)
+    r = np.ones(idx.size)
+    z = np.zeros(idx.size)  # r.(z + c r) = sum c, negative: most of the diagonal is lowered
+    assert fix.applied(z, r, idx, [idx.size, 0]) is z
+    z = _preconditioned(op, contact, r)  # M_AA r: r.(z + c r) = r.P r > 0
+    assert fix.applied(z, r, idx, [idx.size, 0]) is not z
+
+
+@pytest.mark.parametrize("surface, load", [("smooth", 0.03), ("self-affine", 0.01)])
+def test_the_qp_with_the_correction_gives_the_answer_without_it_in_fewer_iterations(surface, load, monkeypatch):
+    cell = PeriodicCell(1.0 / 128, 128, 128)
+    h = _rough(cell) if surface == "smooth" else _self_affine(cell)
+    op = PeriodicOperator(cell, 1.0)
+    made = []
+    original = EdgeCorrection._make
+    monkeypatch.setattr(EdgeCorrection, "_make", lambda self, idx: made.append(idx.size) or original(self, idx))
+    fixed = solve_periodic_qp(op, h, force=load * cell.area, rtol=1e-10)
+    monkeypatch.setattr(edge, "THETA", 0.0)
+    plain = solve_periodic_qp(op, h, force=load * cell.area, rtol=1e-10)
+    assert fixed.converged and plain.converged and made
+    assert fixed.iterations < plain.iterations
+    assert np.abs(fixed.p - plain.p).max() <= 1e-8 * plain.p.max()
+    u = op.matvec(fixed.p)  # the KKT conditions on a product made here
+    gap = u + h - fixed.approach
+    assert kkt_residual(fixed.p, gap, displacement_scale=float(np.abs(u).max()), force=load * cell.area,
+                        node_area=cell.node_area) <= 1e-10
+
+
+@pytest.mark.parametrize("case", ["uniform compliance", "per node", "hardness"])
+def test_the_correction_serves_the_qp_without_a_compliance_per_node_or_a_hardness(case, monkeypatch):
+    cell = PeriodicCell(1.0 / 32, 32, 32)
+    h = _rough(cell)
+    op = PeriodicOperator(cell, 1.0)
+    made = []
+
+    class Spy(EdgeCorrection):
+        def __init__(self, *args):
+            made.append(args[-1])
+            super().__init__(*args)
+
+    monkeypatch.setattr(periodic_qp, "EdgeCorrection", Spy)
+    kw = dict(force=0.03 * cell.area, rtol=1e-10)
+    if case == "uniform compliance":
+        kw["lam"] = 0.5 * op.diagonal
+    elif case == "per node":
+        kw["lam"] = np.full(cell.shape, 0.5 * op.diagonal)
+    else:
+        kw["hardness"] = 0.05
+    assert solve_periodic_qp(op, h, **kw).converged
+    if case == "uniform compliance":  # the diagonal of the operator it inverts: C_nn + lam
+        assert made == [pytest.approx(1.5 * op.diagonal)]
+    else:
+        assert made == []
