@@ -27,10 +27,10 @@ of smooth surfaces worse than ``M_AA`` alone; ``0.7`` conditions both better (th
 
 While the contact set moves, the correction's longer steps at the edges move it more (more iterations), so the
 correction is made from the first step that changes at most :data:`SETTLED` of the contact's nodes, and made again
-once the nodes changed since exceed :data:`REMAKE` of them; between, it is read at the present contact's nodes (a
-node that entered since reads its value off the contact, about 0 or positive: ``M``'s own diagonal or more).
-Making it takes a transform pair in single precision, ``M (1_A - |A| / N)``, and once a solve a second for
-``M_nn``. A step whose corrected ``z`` is not a descent direction (``r.z <= 0``) takes the uncorrected one.
+once the nodes changed since exceed :data:`REMAKE` of them; between, the nodes that stay in contact keep their ``c``
+and a node that entered takes 0 (``M_AA``'s own diagonal). Making it takes a transform pair in single precision,
+``M (1_A - |A| / N)``, and once a solve a second for ``M_nn``; ``c`` is held at the contact's nodes only (float32).
+A step whose corrected ``z`` is not a descent direction (``r.z <= 0``) takes the uncorrected one.
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ class EdgeCorrection:
 
     def __init__(self, bk, apply_m, shape, diagonal):
         self.bk, self.apply_m, self.shape, self.diagonal = bk, apply_m, tuple(shape), float(diagonal)
-        self.values = None  # theta M (1_I - f), float32 brick array, where made
+        self.values = self.nodes = None  # c at the nodes of the contact of the last step (float32), and those nodes
         self.floor = None  # FLOOR / C_nn - M_nn
         self.changed = 0  # nodes changed since the correction was made
         self.n_made = 0  # times it was made (a transform pair each, and one more the first time for M_nn)
@@ -82,11 +82,25 @@ class EdgeCorrection:
         share = bk.count(idx) / (self.shape[0] * self.shape[1])
         v = xp.full(self.shape, -share, dtype=xp.float32)  # 1_A - |A| / N
         v = bk.put(v, idx, xp.full(bk.count(idx), 1.0 - share, dtype=xp.float32))
-        self.values = self.apply_m(v, v)  # M (1_A - f_A) = -M (1_I - f): theta M (1_I - f) is -theta times it
-        self.values *= -THETA
+        c = bk.take(self.apply_m(v, v), idx)  # M (1_A - f_A) = -M (1_I - f) at the contact: -1 / theta times c
+        c *= -THETA
+        self.values, self.nodes = xp.maximum(c, xp.asarray(self.floor, dtype=xp.float32)), idx
         self.changed, self.n_made = 0, self.n_made + 1
 
-    def applied(self, z, r, idx, changes):
+    def _at(self, idx, contact):
+        """``c`` at the contact's nodes ``idx``: the nodes of the last step's contact keep theirs, an entering node
+        takes 0 (``M_AA``'s own diagonal) until the correction is made again; ``contact`` the
+        :class:`bem.periodic.qp_parts.ContactNodes` of ``idx`` (on NumPy its step's merge, without a brick array)."""
+        bk, xp = self.bk, self.bk.xp
+        if idx is not self.nodes:
+            if contact is not None and contact.from_step is not None:
+                values = contact.over(idx, lambda n: xp.zeros(bk.count(n), dtype=xp.float32), self.values)
+            else:  # through a brick array that holds them for this read only
+                values = bk.take(bk.put(xp.zeros(self.shape, dtype=xp.float32), self.nodes, self.values), idx)
+            self.values, self.nodes = values, idx
+        return self.values
+
+    def applied(self, z, r, idx, changes, contact=None):
         """``z + c r`` at the contact's nodes ``idx`` where the correction is on; the uncorrected ``z`` before it
         starts and where ``r.(z + c r)`` is not positive.
 
@@ -99,13 +113,15 @@ class EdgeCorrection:
         changes : list of int
             The nodes that entered or left the contact at each step of the solve so far (the first entry counts
             from no earlier contact).
+        contact : bem.periodic.qp_parts.ContactNodes, optional
+            The QP's contact (``idx`` its last read), whose step maps the last values onto ``idx`` on NumPy.
 
         Returns
         -------
         array
             The preconditioned gap (a new array where corrected; ``z`` itself otherwise).
         """
-        bk, xp = self.bk, self.bk.xp
+        bk = self.bk
         n = bk.count(idx)
         if self.values is None:
             if len(changes) < 2 or changes[-1] > SETTLED * n:
@@ -114,6 +130,6 @@ class EdgeCorrection:
             self.changed += changes[-1]
         if self.values is None or self.changed > REMAKE * n:
             self._make(idx)
-        corrected = xp.maximum(bk.take(self.values, idx), self.floor) * r  # c (float32) times r: float64
+        corrected = self._at(idx, contact) * r  # c (float32) times r: float64
         corrected += z
         return corrected if bk.dot(r, corrected) > 0 else z

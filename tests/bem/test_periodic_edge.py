@@ -14,6 +14,7 @@ from bem.kkt import kkt_residual
 from bem.periodic import PeriodicCell, PeriodicOperator
 from bem.periodic.edge import EdgeCorrection
 from bem.periodic.qp import solve_periodic_qp
+from bem.periodic.qp_parts import ContactNodes
 
 from .test_periodic_qp import _rough
 
@@ -139,6 +140,35 @@ def test_the_correction_starts_when_the_contact_settles_and_is_made_again_after_
     assert fix.n_made == 1
     fix.applied(z, r, idx, [n, many, few, each, each, each, n])
     assert fix.n_made == 2
+
+
+def test_the_correction_follows_the_contact_through_a_step():
+    """The nodes that stay keep their correction and an entering node takes 0, the same through the step's merge
+    (ContactNodes.over) and through a brick array."""
+    cell = PeriodicCell(1.0 / 48, 48, 48)
+    op, contact = _contact(cell, _self_affine(cell), 0.01)
+    fix, idx = _correction(op, contact)
+    r = np.random.default_rng(4).standard_normal(idx.size)
+    fix.applied(_preconditioned(op, contact, r), r, idx, [idx.size, 0])
+    made, made_at = fix.values.copy(), fix.nodes
+    assert np.count_nonzero(made) == idx.size  # c != 0 at every node of the contact it was made on
+    p = np.where(contact, 1.0, 0.0)
+    nodes = ContactNodes(operator_backend(op)[0], p)
+    _, p_c = nodes.read(p)
+    p_c = p_c.copy()
+    p_c[: idx.size // 10] = 0.0  # a tenth of the contact leaves, twenty nodes off it enter
+    entering = np.flatnonzero(~contact)[::7][:20]
+    nodes.stepped(p_c, True, entering, np.ones(entering.size))
+    after, _ = nodes.read(p)
+    assert nodes.from_step is not None
+    through_step = fix._at(after, nodes).copy()
+    fix.values, fix.nodes = made, made_at
+    through_brick = fix._at(after, None)
+    want = np.zeros(after.size, dtype=np.float32)
+    stayed = np.isin(after, idx)
+    want[stayed] = made[np.searchsorted(idx, after[stayed])]
+    assert np.array_equal(through_step, want) and np.array_equal(through_brick, want)
+    assert np.count_nonzero(~stayed) == entering.size and not np.any(through_step[~stayed])
 
 
 def test_a_corrected_gap_that_is_no_descent_direction_is_not_taken():
