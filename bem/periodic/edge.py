@@ -87,20 +87,17 @@ class EdgeCorrection:
         self.values, self.nodes = xp.maximum(c, xp.asarray(self.floor, dtype=xp.float32)), idx
         self.changed, self.n_made = 0, self.n_made + 1
 
-    def _at(self, idx, contact):
+    def _at(self, idx):
         """``c`` at the contact's nodes ``idx``: the nodes of the last step's contact keep theirs, an entering node
-        takes 0 (``M_AA``'s own diagonal) until the correction is made again; ``contact`` the
-        :class:`bem.periodic.qp_parts.ContactNodes` of ``idx`` (on NumPy its step's merge, without a brick array)."""
+        takes 0 (``M_AA``'s own diagonal) until the correction is made again (through a brick array that holds them
+        for this read only)."""
         bk, xp = self.bk, self.bk.xp
         if idx is not self.nodes:
-            if contact is not None and contact.from_step is not None:
-                values = contact.over(idx, lambda n: xp.zeros(bk.count(n), dtype=xp.float32), self.values)
-            else:  # through a brick array that holds them for this read only
-                values = bk.take(bk.put(xp.zeros(self.shape, dtype=xp.float32), self.nodes, self.values), idx)
-            self.values, self.nodes = values, idx
+            self.values = bk.take(bk.put(xp.zeros(self.shape, dtype=xp.float32), self.nodes, self.values), idx)
+            self.nodes = idx
         return self.values
 
-    def applied(self, z, r, idx, changes, contact=None):
+    def applied(self, z, r, idx, changes):
         """``z + c r`` at the contact's nodes ``idx`` where the correction is on; the uncorrected ``z`` before it
         starts and where ``r.(z + c r)`` is not positive.
 
@@ -113,8 +110,6 @@ class EdgeCorrection:
         changes : list of int
             The nodes that entered or left the contact at each step of the solve so far (the first entry counts
             from no earlier contact).
-        contact : bem.periodic.qp_parts.ContactNodes, optional
-            The QP's contact (``idx`` its last read), whose step maps the last values onto ``idx`` on NumPy.
 
         Returns
         -------
@@ -130,6 +125,6 @@ class EdgeCorrection:
             self.changed += changes[-1]
         if self.values is None or self.changed > REMAKE * n:
             self._make(idx)
-        corrected = self._at(idx, contact) * r  # c (float32) times r: float64
+        corrected = self._at(idx) * r  # c (float32) times r: float64
         corrected += z
         return corrected if bk.dot(r, corrected) > 0 else z

@@ -276,7 +276,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             nodes.kept = D_c, soft_c, jac_c
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         z = precondition(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
-        z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"], nodes)
+        z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"])
         if force is not None and not soft:
             z -= xp.mean(z)
         elif force is not None:

@@ -143,32 +143,30 @@ def test_the_correction_starts_when_the_contact_settles_and_is_made_again_after_
 
 
 def test_the_correction_follows_the_contact_through_a_step():
-    """The nodes that stay keep their correction and an entering node takes 0, the same through the step's merge
-    (ContactNodes.over) and through a brick array."""
+    """The nodes in both contacts keep their correction, a node that left and entered again among them, and an
+    entering node takes 0."""
     cell = PeriodicCell(1.0 / 48, 48, 48)
     op, contact = _contact(cell, _self_affine(cell), 0.01)
     fix, idx = _correction(op, contact)
     r = np.random.default_rng(4).standard_normal(idx.size)
     fix.applied(_preconditioned(op, contact, r), r, idx, [idx.size, 0])
-    made, made_at = fix.values.copy(), fix.nodes
+    made = fix.values.copy()
     assert np.count_nonzero(made) == idx.size  # c != 0 at every node of the contact it was made on
     p = np.where(contact, 1.0, 0.0)
     nodes = ContactNodes(operator_backend(op)[0], p)
     _, p_c = nodes.read(p)
     p_c = p_c.copy()
-    p_c[: idx.size // 10] = 0.0  # a tenth of the contact leaves, twenty nodes off it enter
-    entering = np.flatnonzero(~contact)[::7][:20]
+    p_c[: idx.size // 10] = 0.0  # a tenth of the contact leaves, twenty nodes off it and one of those enter
+    entering = np.union1d(np.flatnonzero(~contact)[::7][:20], idx[:1])
     nodes.stepped(p_c, True, entering, np.ones(entering.size))
     after, _ = nodes.read(p)
-    assert nodes.from_step is not None
-    through_step = fix._at(after, nodes).copy()
-    fix.values, fix.nodes = made, made_at
-    through_brick = fix._at(after, None)
+    got = fix._at(after)
     want = np.zeros(after.size, dtype=np.float32)
     stayed = np.isin(after, idx)
     want[stayed] = made[np.searchsorted(idx, after[stayed])]
-    assert np.array_equal(through_step, want) and np.array_equal(through_brick, want)
-    assert np.count_nonzero(~stayed) == entering.size and not np.any(through_step[~stayed])
+    assert np.array_equal(got, want)
+    k = int(np.searchsorted(after, idx[0]))  # the node that left and entered again keeps its own
+    assert np.count_nonzero(~stayed) == 20 and not np.any(got[~stayed]) and after[k] == idx[0] and got[k] == made[0]
 
 
 def test_a_corrected_gap_that_is_no_descent_direction_is_not_taken():
