@@ -35,6 +35,8 @@ A step whose corrected ``z`` is not a descent direction (``r.z <= 0``) takes the
 
 from __future__ import annotations
 
+from .qp_parts import KeptOnContact
+
 __all__ = ["FLOOR", "REMAKE", "SETTLED", "THETA", "EdgeCorrection"]
 
 #: share of each contact node's coupling to the nodes off the contact taken out of ``M``'s diagonal
@@ -65,39 +67,35 @@ class EdgeCorrection:
 
     def __init__(self, bk, apply_m, shape, diagonal):
         self.bk, self.apply_m, self.shape, self.diagonal = bk, apply_m, tuple(shape), float(diagonal)
-        self.values = self.nodes = None  # c at the nodes of the contact of the last step (float32), and those nodes
+        self.kept = KeptOnContact(bk, shape, hold=False)  # c at the nodes of the contact of the last step
+        self.on = False  # made
         self.floor = None  # FLOOR / C_nn - M_nn
         self.changed = 0  # nodes changed since the correction was made
-        self.n_made = 0  # times it was made (a transform pair each, and one more the first time for M_nn)
 
     def _make(self, idx):
         bk, xp = self.bk, self.bk.xp
         if self.floor is None:  # M_nn: M of a unit pressure at the first node, there
-            origin = xp.zeros(self.shape, dtype=xp.bool)
-            origin[0, 0] = True
-            origin = bk.select(origin)
-            unit = bk.put(xp.zeros(self.shape, dtype=xp.float32), origin, xp.ones(1, dtype=xp.float32))
-            self.floor = FLOOR / self.diagonal - float(bk.take(self.apply_m(unit, unit), origin)[0])
-        self.values = None  # let go before the next is made
+            unit = xp.zeros(self.shape, dtype=xp.float32)
+            unit[0, 0] = 1.0
+            self.floor = FLOOR / self.diagonal - float(self.apply_m(unit, unit)[0, 0])
         share = bk.count(idx) / (self.shape[0] * self.shape[1])
         v = xp.full(self.shape, -share, dtype=xp.float32)  # 1_A - |A| / N
         v = bk.put(v, idx, xp.full(bk.count(idx), 1.0 - share, dtype=xp.float32))
         c = bk.take(self.apply_m(v, v), idx)  # M (1_A - f_A) = -M (1_I - f) at the contact: -1 / theta times c
         c *= -THETA
-        self.values, self.nodes = xp.maximum(c, xp.asarray(self.floor, dtype=xp.float32)), idx
-        self.changed, self.n_made = 0, self.n_made + 1
+        self.kept.keep(idx, xp.maximum(c, xp.asarray(self.floor, dtype=xp.float32)))
+        self.on, self.changed = True, 0
 
-    def _at(self, idx):
-        """``c`` at the contact's nodes ``idx``: the nodes of the last step's contact keep theirs, an entering node
-        takes 0 (``M_AA``'s own diagonal) until the correction is made again (through a brick array that holds them
-        for this read only)."""
-        bk, xp = self.bk, self.bk.xp
-        if idx is not self.nodes:
-            self.values = bk.take(bk.put(xp.zeros(self.shape, dtype=xp.float32), self.nodes, self.values), idx)
-            self.nodes = idx
-        return self.values
+    def _at(self, idx, contact):
+        """``c`` at the contact's nodes ``idx`` (float64): the nodes of the last step's contact keep theirs, an
+        entering node takes 0 (``M_AA``'s own diagonal) until the correction is made again; kept again at ``idx``,
+        so that the next step's contact maps from this one."""
+        c = self.kept.at(idx, contact)
+        if idx is not self.kept.nodes:
+            self.kept.keep(idx, c)
+        return c
 
-    def applied(self, z, r, idx, changes):
+    def applied(self, z, r, idx, changes, contact=None):
         """``z + c r`` at the contact's nodes ``idx`` where the correction is on; the uncorrected ``z`` before it
         starts and where ``r.(z + c r)`` is not positive.
 
@@ -110,6 +108,8 @@ class EdgeCorrection:
         changes : list of int
             The nodes that entered or left the contact at each step of the solve so far (the first entry counts
             from no earlier contact).
+        contact : bem.periodic.qp_parts.ContactNodes, optional
+            The QP's contact, ``idx`` its last read (on NumPy its step maps the correction onto ``idx``).
 
         Returns
         -------
@@ -118,13 +118,13 @@ class EdgeCorrection:
         """
         bk = self.bk
         n = bk.count(idx)
-        if self.values is None:
+        if not self.on:
             if len(changes) < 2 or changes[-1] > SETTLED * n:
                 return z
         else:
             self.changed += changes[-1]
-        if self.values is None or self.changed > REMAKE * n:
+        if not self.on or self.changed > REMAKE * n:
             self._make(idx)
-        corrected = self._at(idx) * r  # c (float32) times r: float64
+        corrected = self._at(idx, contact) * r
         corrected += z
         return corrected if bk.dot(r, corrected) > 0 else z

@@ -74,7 +74,7 @@ from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bou
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .edge import EdgeCorrection
 from .passes import kernels
-from .qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, StepArrays, weighted_square
+from .qp_parts import ContactBrick, ContactNodes, KeptOnContact, StepArrays, weighted_square
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -202,7 +202,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     else:  # C x0 from the caller, confirmed like an incremental update
         u, stale = add_into(bk.copy(bk.asarray(u0)), times_p(D)) if per_node else bk.copy(bk.asarray(u0)), 1
         u = offset_added(u)
-    last_z = LastPreconditionedGap(bk, lat.shape)  # the last preconditioned gap, on its contact only
+    last_z = KeptOnContact(bk, lat.shape)  # the last preconditioned gap, on its contact only
     gz_old, m_one, m_full, m_at, fixed_scale = 1.0, None, None, None, scale
     record, kkt, delta = Record(rtol, maxiter), np.inf, approach
     nodes = ContactNodes(bk, p, getattr(passes, "merge", None))  # the iterate's contact (steady: the last step's)
@@ -276,7 +276,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             nodes.kept = D_c, soft_c, jac_c
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         z = precondition(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
-        z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"])
+        z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"], nodes)
         if force is not None and not soft:
             z -= xp.mean(z)
         elif force is not None:

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-__all__ = ["ContactBrick", "ContactNodes", "LastPreconditionedGap", "StepArrays", "weighted_square"]
+__all__ = ["ContactBrick", "ContactNodes", "KeptOnContact", "StepArrays", "weighted_square"]
 
 
 def weighted_square(bk, d, t):
@@ -145,7 +145,7 @@ class ContactBrick:
     ----------
     bk, shape
         The backend of the iteration and the shape of the cell's brick arrays (as for
-        :class:`LastPreconditionedGap`).
+        :class:`KeptOnContact`).
     """
 
     def __init__(self, bk, shape):
@@ -193,16 +193,18 @@ class ContactBrick:
         flat[self.nodes[at]] = self.last[at]
 
 
-class LastPreconditionedGap:
-    """The last preconditioned gap ``z`` of the iteration on its contact, read at the nodes of the next contact
-    (0 at the nodes that were off it): the ``z_old`` of the Polak-Ribiere+ coefficient.
+class KeptOnContact:
+    """Values kept at the nodes of a contact, read at the nodes of a later contact (0 at the nodes that were off it):
+    the last preconditioned gap ``z_old`` of the Polak-Ribiere+ coefficient, the correction of
+    :class:`bem.periodic.edge.EdgeCorrection`.
 
     On NumPy in single precision: at the kept node selection itself (the same object: the contact did not
     change) the kept values; at a contact made from the step (:meth:`ContactNodes.over`) the kept values at the
     nodes that stayed and a lookup at the entering ones; at other nodes a gather from a brick array that holds
     them, 0 off their nodes (faster than looking the new contact's nodes up among the last one's, for 4 bytes a
-    node), filled at the first such read after a keep. On other namespaces in double precision, a brick array at
-    every keep (a node selection of :class:`bem.backend.Backend` may be a boolean array there).
+    node), filled at the first such read after a keep (``hold``: held to the next, else made for that read only). On
+    other namespaces in double precision, a brick array at every keep (a node selection of
+    :class:`bem.backend.Backend` may be a boolean array there).
 
     Parameters
     ----------
@@ -210,15 +212,17 @@ class LastPreconditionedGap:
         The backend of the iteration.
     shape : tuple of int
         The shape of the cell's brick arrays.
+    hold : bool
+        Whether the NumPy form holds its brick array between reads.
     """
 
-    def __init__(self, bk, shape):
-        self.bk, self.shape = bk, shape
+    def __init__(self, bk, shape, hold=True):
+        self.bk, self.shape, self.hold = bk, shape, hold
         self.values = self.nodes = self.z = None
         self.filled = False
 
     def keep(self, nodes, z):
-        """Keep ``z`` (1-D), the values at the node selection ``nodes``."""
+        """Keep ``z`` (1-D), the values at the node selection ``nodes`` (copied)."""
         bk = self.bk
         if not bk.is_numpy:
             self.values = bk.spread(self.shape, nodes, z)
@@ -226,7 +230,7 @@ class LastPreconditionedGap:
         self.nodes, self.z, self.filled = nodes, z.astype(np.float32), False
 
     def at(self, nodes, contact=None):
-        """The kept ``z`` at the node selection ``nodes`` (1-D, float64), 0 where it was not kept; ``contact`` the
+        """The kept values at the node selection ``nodes`` (1-D, float64), 0 where not kept; ``contact`` the
         :class:`ContactNodes` of ``nodes``, whose selection at the last keep was the contact before its last step."""
         bk = self.bk
         if not bk.is_numpy:
@@ -244,9 +248,12 @@ class LastPreconditionedGap:
             self.values.fill(0.0)
             self.values.reshape(-1)[self.nodes] = self.z
             self.filled = True
-        return bk.take(self.values, nodes).astype(np.float64)
+        out = bk.take(self.values, nodes).astype(np.float64)
+        if not self.hold:
+            self.values, self.filled = None, False
+        return out
 
-    def _lookup(self, nodes):  # the kept z at a few sorted nodes, 0 where it was not kept
+    def _lookup(self, nodes):  # the kept values at a few sorted nodes, 0 where not kept
         at = np.minimum(np.searchsorted(self.nodes, nodes), self.nodes.size - 1)
         return np.where(self.nodes[at] == nodes, self.z[at], np.float32(0))
 

@@ -8,18 +8,19 @@ import bem.periodic.qp_parts as qp_parts
 from bem.backend import get_backend
 from bem.periodic import PeriodicCell, PeriodicOperator
 from bem.periodic.qp import solve_periodic_qp
-from bem.periodic.qp_parts import ContactBrick, ContactNodes, LastPreconditionedGap, weighted_square
+from bem.periodic.qp_parts import ContactBrick, ContactNodes, KeptOnContact, weighted_square
 
 from .fourier_qp_cases import assert_same_bits, cell_qp
 
 
-def test_last_preconditioned_gap_reads_the_kept_values_at_new_nodes():
+@pytest.mark.parametrize("hold", [True, False])
+def test_kept_on_contact_reads_the_kept_values_at_new_nodes(hold):
     """``at`` gives the last kept ``z`` at nodes of the last selection (to single precision) and 0 elsewhere,
-    whatever selections came before; ``keep`` copies."""
+    whatever selections came before; ``keep`` copies; the brick array of the reads held or not (``hold``)."""
     shape = (12, 10)
     bk = get_backend("cpu")
     rng = np.random.default_rng(3)
-    last = LastPreconditionedGap(bk, shape)
+    last = KeptOnContact(bk, shape, hold=hold)
     assert np.array_equal(last.at(np.array([0, 5, 7])), np.zeros(3))
     for _ in range(4):
         nodes = np.flatnonzero(rng.random(shape) < 0.4)
@@ -32,6 +33,7 @@ def test_last_preconditioned_gap_reads_the_kept_values_at_new_nodes():
         where = np.isin(new, nodes)
         expected[where] = kept[np.searchsorted(nodes, new[where])]
         got = last.at(new)
+        assert (last.values is not None) == hold  # the brick array of the read
         assert got.dtype == np.float64
         np.testing.assert_allclose(got, expected, rtol=1e-7, atol=0)
         assert np.all(got[~where] == 0)
@@ -99,7 +101,7 @@ def test_contact_nodes_read_the_contact_and_count_its_changes():
     p_o = np.full(entering.size, 0.25)
     q.reshape(-1)[idx_r] = step
     q.reshape(-1)[entering] = p_o
-    last = LastPreconditionedGap(bk, shape)
+    last = KeptOnContact(bk, shape)
     z = rng.standard_normal(idx_r.size)
     last.keep(idx_r, z)  # the last preconditioned gap on the contact before the step
     nodes.stepped(step, True, entering, p_o)
