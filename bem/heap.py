@@ -15,7 +15,7 @@ import ctypes
 import functools
 import sys
 
-__all__ = ["RELEASE_ABOVE", "release"]
+__all__ = ["RELEASE_ABOVE", "above", "release"]
 
 #: bytes of a product's work array above which :func:`release` is asked for before it is made
 RELEASE_ABOVE = 128 << 20
@@ -34,6 +34,13 @@ def _malloc_trim():
     return trim
 
 
+def above(nbytes):
+    """Whether ``nbytes`` bytes [bytes] are above :data:`RELEASE_ABOVE`: arrays at which the solvers give memory the
+    precedence over time (this module's release; :mod:`bem.newton`'s product held by a cell's model QP; the coarser
+    cells' symbols let go in nested iteration, :meth:`bem.periodic.PeriodicCell.refine`)."""
+    return nbytes > RELEASE_ABOVE
+
+
 def release(nbytes):
     """Return the free heap memory of the C library to the system where an array of ``nbytes`` bytes is about to be
     made and ``nbytes`` is above :data:`RELEASE_ABOVE`.
@@ -48,7 +55,7 @@ def release(nbytes):
     bool
         Whether the C library was asked (glibc's ``malloc_trim(0)``).
     """
-    trim = _malloc_trim() if nbytes > RELEASE_ABOVE else None
+    trim = _malloc_trim() if above(nbytes) else None
     if trim is None:
         return False
     trim(0)

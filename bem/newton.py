@@ -37,6 +37,7 @@ from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 from .newton_moves import closure_move, model_closure, release, scaled, settle_plastic
+from . import heap
 from .plastic import carry_force, clip, clipped_start, fully_plastic_note, in_place
 
 __all__ = ["solve_newton"]
@@ -103,21 +104,25 @@ def _advance(bk, p, u, sub, t, force, node_area, hardness):
     return q, uq
 
 
-def _model_qp(op, h, layer, D, contact, precondition, p, **kw):
-    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one) from ``p`` by the
-    operator's constrained-CG step (``op.qp``); ``(solution, p)``. Its gap ``h + w(p) - D p`` goes as ``h`` and the
-    offset ``w(p) - D p`` on the nodes of nonzero pressure (``w(0) = 0``, :mod:`bem.layers.base`): no array of it.
-    Where the QP can hold its iterate in ``p`` (:func:`bem.plastic.in_place`) it does, and ``p`` is kept meanwhile on
-    those nodes only, and returned as a new array (the same values; one array of the lattice fewer through the QP)."""
+def _model_qp(op, h, layer, D, contact, precondition, p, u, cell, **kw):
+    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one) from ``p`` and ``u = C
+    p`` by the operator's constrained-CG step (``op.qp``); ``(solution, p, u)``. Its gap ``h + w(p) - D p`` goes as
+    ``h`` and the offset ``w(p) - D p`` on the nodes of nonzero pressure (``w(0) = 0``, :mod:`bem.layers.base`): no
+    array of it. Where it can (:func:`bem.plastic.in_place`) the QP holds its iterate in ``p``, kept meanwhile on those
+    nodes only and returned as a new array (the same values), and on a periodic ``cell`` whose product ``C p`` (spectrum
+    and ``u``) takes more than :data:`bem.heap.RELEASE_ABOVE` bytes its product in ``u`` (``overwrite_u0``), made again
+    after (one product a step): an array of the lattice fewer through the QP each (a region's QP makes new ones)."""
     bk = backend_of(p)
     at = bk.select(p > 0)
     kept = bk.take(p, at)
     offset = (at, bk.asarray(layer.w(kept)) - bk.take(D, at) * kept)
-    kw.update(lam=D, precondition=precondition, contact=contact, x0=p, offset=offset)
-    if not in_place(bk, p):
-        return op.qp(h, **kw), p
-    sub = op.qp(h, overwrite_x0=True, **kw)
-    return sub, bk.spread(p.shape, at, kept)
+    own, hand = in_place(bk, p), cell and in_place(bk, u) and heap.above(2 * u.nbytes)
+    kw = dict(kw, overwrite_u0=True) if hand else kw  # (the region's QP takes no overwrite_u0)
+    sub = op.qp(h, lam=D, precondition=precondition, contact=contact, x0=p, offset=offset, u0=u, overwrite_x0=own, **kw)
+    p = bk.spread(p.shape, at, kept) if own else p
+    if hand:  # the QP's arrays, freed, returned to the system before the product's spectrum and output are made
+        heap.release(2 * u.nbytes)
+    return sub, p, op.matvec(p) if hand else u
 
 
 def _count_inner(hist, sub):
@@ -170,18 +175,16 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
 
     Notes
     -----
-    Stopping rule: ``r = kkt_residual(p, C p + w(p) + h - delta) <= rtol`` on an exactly
-    recomputed ``C p``. Where the line search finds no measurable decrease of ``Phi`` (its
-    change is below round-off near the solution) the full step is taken if it lowers ``r``;
-    otherwise the iteration stops, not converged. After each step of a nonlinear law without a
-    hardness, the pressure whose closure is the model's, ``w^-1(w(p) + t D (q - p))`` where
-    ``q_n > 0``, replaces the step's when that lowers ``Phi`` (``history["closure_moves"]`` counts
-    them); then nodes that the model solution releases (``q_n = 0``) are set to 0 when that lowers
-    ``Phi`` (and with a hardness, those it puts at ``H`` are set to ``H``; :mod:`bem.newton_moves`).
-    The inner QP of step ``k`` is solved to ``min(1e-2, eta_k r_k)``, never below ``rtol / 3``
-    (``r_k`` the current KKT residual): an inexact Newton method with the forcing term
-    ``eta_k = min(0.3, 0.9 (r_k / r_(k-1))^1.618)`` (Eisenstat & Walker's second choice), which
-    follows the convergence of the outer iteration.
+    Stopping rule: ``r = kkt_residual(p, C p + w(p) + h - delta) <= rtol`` on an exactly recomputed ``C p``. Where the
+    line search finds no measurable decrease of ``Phi`` (its change is below round-off near the solution) the full step
+    is taken if it lowers ``r``; otherwise the iteration stops, not converged. After each step of a nonlinear law
+    without a hardness, the pressure whose closure is the model's, ``w^-1(w(p) + t D (q - p))`` where ``q_n > 0``,
+    replaces the step's when that lowers ``Phi`` (``history["closure_moves"]`` counts them); then nodes that the model
+    solution releases (``q_n = 0``) are set to 0 when that lowers ``Phi`` (and with a hardness, those it puts at ``H``
+    are set to ``H``; :mod:`bem.newton_moves`). The inner QP of step ``k`` is solved to ``min(1e-2, eta_k r_k)``, never
+    below ``rtol / 3`` (``r_k`` the current KKT residual): an inexact Newton method with the forcing term ``eta_k =
+    min(0.3, 0.9 (r_k / r_(k-1))^1.618)`` (Eisenstat & Walker's second choice), which follows the convergence of the
+    outer iteration.
     """
     bk, mask = operator_backend(op)
     xp = bk.xp
@@ -190,8 +193,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     if not bool(xp.all(mask)):  # a periodic cell's gap is used as it is (never written)
         h = xp.where(mask, h, 0.0)
     if x0 is None:
-        # smooth-body solution, then one secant (variable compliance) step: a start
-        # that is fair for stiff and for layer-dominated problems alike
+        # the smooth-body solution, then one secant (variable compliance) step: fair for stiff and soft layers alike
         start = solve_qp(op, h, force=force, approach=approach, rtol=1e-3,
                          preconditioner=op.preconditioner() if precondition else None, hardness=hardness)
         contact = start.p > 0
@@ -210,9 +212,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     x0 = None
     u = op.matvec(p)
     hist = {"residual": [], "p_max": [], "n_contact": [], "changes": [], "step": [], "inner_iterations": [],
-            "inner_missed": 0, "inner_worst": 0.0, "closure_moves": 0}
-    if record:
-        hist["p"] = []
+            "inner_missed": 0, "inner_worst": 0.0, "closure_moves": 0, **({"p": []} if record else {})}
     converged, message, status, exact = False, "", "maxiter", True
     bound = {} if hardness is None else {"hardness": hardness}  # the elastic inner solves take no bound
     prev = p > 0
@@ -225,6 +225,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         return masked(bk.asarray(layer.w(p)))
 
     for k in range(maxiter + 1):
+        heap.release(24 * math.prod(p.shape))  # the free heap (the last QP's arrays) before the closure, C p + w, gap
         wp = closure(p)
         gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp,
                                          hardness=hardness)
@@ -252,15 +253,14 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         p_ref = float(xp.mean(p[contact])) if bool(xp.any(contact)) else 1.0
         D = masked(tangent(bk, layer, p, gap, p_ref))
         D = xp.astype(D, xp.float32) if float(xp.max(D)) < _SINGLE_MAX else D  # a model's: single precision will do
-        gap = None  # recomputed at the next step; not held through the model's solve
-        wp = None  # made again where needed: not held through the model's solve
+        gap = wp = None  # made again at the next step or where needed: not held through the model's solve
         # forcing term: _FORCING, or less where the last step reduced the residual (Eisenstat & Walker)
         eta = min(_FORCING, _GAMMA * (kkt / hist["residual"][-2]) ** _ALPHA) if len(hist["residual"]) > 1 else _FORCING
         inner = max(rtol / 3, min(1e-2, eta * kkt))
-        # the model starts at p with the product u Newton carries, and Newton checks every step on its own residual:
-        # no product to start or to confirm the inner solve (fewer products on benchmarks/side_by_side.py's root layer)
-        sub, p = _model_qp(op, h, layer, D, contact, precondition, p, force=force, approach=approach, rtol=inner,
-                           maxiter=inner_maxiter, u0=u, confirm=False, **bound)
+        # the model starts at p with Newton's u and Newton checks each step on its own residual: no product to start
+        # or to confirm the inner solve (fewer products on benchmarks/side_by_side.py's root layer)
+        sub, p, u = _model_qp(op, h, layer, D, contact, precondition, p, u, full, force=force, approach=approach,
+                              rtol=inner, maxiter=inner_maxiter, confirm=False, **bound)
         _count_inner(hist, sub)
         # the step d = q - p of the model's solution q (C d = uq - u) is formed where it is used, not held
         t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, None if full else mask)
@@ -269,9 +269,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             scale = float(xp.max(xp.abs(u + wp)))
             D = majorant(op, layer, p, sub.p, xp.astype(D, xp.float64), mask)  # (raised past single precision's range)
             wp = sub = None
-            sub, p = _model_qp(op, h, layer, D, contact, precondition, p, force=force, approach=approach,
-                               rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter, scale=scale, u0=u,
-                               confirm=False, **bound)
+            sub, p, u = _model_qp(op, h, layer, D, contact, precondition, p, u, full, force=force,
+                                  approach=approach, rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter,
+                                  scale=scale, confirm=False, **bound)
             _count_inner(hist, sub)
             t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, None if full else mask)
         # the model's closure at the step, for the closure move (not for linear laws, where it is the step itself)

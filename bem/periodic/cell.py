@@ -21,9 +21,10 @@ from functools import cached_property
 
 import numpy as np
 
+from .. import heap
 from ..checks import check_int, check_node_count, check_positive, fail
 from .gap import cell_gap, check_cell_gap, coarse_gap
-from .influence import PeriodicOperator
+from .influence import PeriodicOperator, forget_symbols
 from .result import PeriodicContactResult
 
 __all__ = ["PeriodicCell"]
@@ -138,7 +139,10 @@ class PeriodicCell:
         return run(op, h, kw), [op]
 
     def refine(self, coarse, p, fine):
-        """The coarse solution interpolated onto the next finer cell."""
+        """The coarse solution interpolated onto the next finer cell; where a product on it (16 bytes a node) is
+        above :data:`bem.heap.RELEASE_ABOVE`, the kept symbols of the coarser cells are let go first."""
+        if heap.above(16 * fine.n_nodes):
+            forget_symbols(below=fine.n_nodes)
         return fine.prolong(p)
 
     def check_solution(self, cell, p):

@@ -18,7 +18,6 @@ and :mod:`bem.fixed_point` run on it unchanged.
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 
 import numpy as np
 import scipy.fft as sfft
@@ -77,13 +76,28 @@ def _packed(spectra):
     return d, b
 
 
-@lru_cache(maxsize=8)  # the levels of nested iteration of one or two cells
+_SYMBOLS = {}  # (n_rows, n_cols, scale): the packed symbols of the last cells, the last used last
+_SYMBOLS_KEPT = 8  # the levels of nested iteration of one or two cells
+
+
 def _homogeneous_symbol(n_rows, n_cols, scale):
-    """The packed symbol of the homogeneous operator of a cell, ``scale = c / (pi E*)``, read-only (:func:`_packed`)."""
-    d, b = _packed(_spectra(periodic_template(n_rows, n_cols, cache=False) * scale))
-    d.setflags(write=False)
-    b.setflags(write=False)
-    return d, b
+    """The packed symbol of the homogeneous operator of a cell, ``scale = c / (pi E*)``, read-only (:func:`_packed`);
+    the last :data:`_SYMBOLS_KEPT` are kept."""
+    key = (n_rows, n_cols, scale)
+    if (symbol := _SYMBOLS.pop(key, None)) is None:
+        symbol = _packed(_spectra(periodic_template(n_rows, n_cols, cache=False) * scale))
+        for part in symbol:
+            part.setflags(write=False)
+    _SYMBOLS[key] = symbol
+    while len(_SYMBOLS) > _SYMBOLS_KEPT:
+        del _SYMBOLS[next(iter(_SYMBOLS))]
+    return symbol
+
+
+def forget_symbols(below):
+    """Let go of the kept symbols of cells of fewer than ``below`` nodes (the coarser levels of a cell)."""
+    for key in [key for key in _SYMBOLS if key[0] * key[1] < below]:
+        del _SYMBOLS[key]
 
 
 class PeriodicOperator:

@@ -42,7 +42,7 @@ pressure and leaving, at a constant KKT residual: ``tests/bem/test_periodic_robu
 With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are those of ``C`` alone,
 ``u = C p + D p`` (plus the gap's ``offset``) and the curvature adds ``sum D t^2``; the preconditioner is that of
 :func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique projection under force control (by
-``M 1`` of the starting contact).
+``M 1`` of the starting contact, kept in half precision on NumPy: a direction, whose sum only has to be nonzero).
 
 With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H`` and the step is
 :func:`bem.cg_rules.bounded_move`; the directions restart (``beta = 0``) after a step shortened or capped at ``H`` to
@@ -74,7 +74,8 @@ from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bou
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .edge import EdgeCorrection
 from .passes import kernels
-from .qp_parts import ContactBrick, ContactNodes, KeptOnContact, StepArrays, weighted_square
+from .qp_parts import (ContactBrick, ContactNodes, KeptOnContact, StepArrays, added_into, multiplied_into,
+                       product_array, weighted_square)
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -84,7 +85,7 @@ SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_AB
 
 def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
                       callback=None, scale=None, u0=None, confirm=True, threshold=4.0, hardness=None,
-                      overwrite_x0=False, offset=None):
+                      overwrite_x0=False, offset=None, overwrite_u0=False):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell.
 
     Parameters
@@ -115,6 +116,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         caller has it (the iterate then starts from ``x0`` as given), whether to confirm the stopping check on
         an exact product (unconfirmed, a stop at ``rtol >= SINGLE_ABOVE`` returns ``C p`` in single precision), and
         the gap's part at some nodes, ``(nodes, values)``, added to ``h`` there (no array of the sum).
+    overwrite_u0 : bool
+        Whether a float64 NumPy ``u0`` may hold the iteration's ``(C + lam) p``, in either precision (not copied: one
+        array of the cell fewer; ``u0`` is then no longer ``C x0``).
     threshold : float
         With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner (as in
         :func:`bem.kalker.compliance_preconditioner`).
@@ -169,23 +173,19 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         x = op.spectrum(r32, out=work.spectrum(np.complex64))
         return op.brick(op.mix(x, M, out=x), overwrite=True, out=out)
 
-    def precondition(r32, sel, r_c, soft_c, jac_c):
-        # M r at the nodes sel (r_c: r there, r32: r at the stiff nodes; soft_c, jac_c: soft nodes, 1 / (C_nn + D))
+    def precondition(r32, sel, r_c, soft_c, D_c):  # M r at sel (r32: r at its stiff nodes, r_c: r; Jacobi at soft_c)
         z = passes.gather(apply_m(r32, work.brick32()), sel)
-        return z if soft_c is None else xp.where(soft_c, jac_c * r_c, z)
+        return z if soft_c is None else xp.where(soft_c, jacobi_at(sel, D_c) * r_c, z)
 
     def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
         return 1.0 / (diag + (passes.gather(D, sel) if D_n is None else D_n))
 
-    def add_into(x, y):  # x += y in x's precision (NumPy: in place)
-        return np.add(x, y, out=x) if bk.is_numpy else xp.astype(x + y, x.dtype, copy=False)
-
     def times_p(c):  # c p for a compliance c (per node or uniform), in work's bytes on NumPy (no spectrum held there)
         return np.multiply(c, p, out=work.brick64()) if bk.is_numpy else c * p
 
-    def product_u():  # u = (C + lam) p; on NumPy in the last u where it has the product's precision (else let go first)
+    def product_u():  # u = (C + lam) p; on NumPy in the last u or in u0's bytes (qp_parts.product_array)
         nonlocal u, exact_base
-        u = u if bk.is_numpy and u is not None and u.dtype == (np.float32 if single else np.float64) else None
+        u = product_array(u, np.float32 if single else np.float64, home) if bk.is_numpy else None
         u, exact_base = op.brick(product(p), overwrite=True, out=u), not single
         return u
 
@@ -193,18 +193,18 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return v if offset is None or not times else passes.add_at(v, *offset, times)
 
     def exact_u():  # (C + lam) p, D p per node, and the gap's offset
-        return offset_added(add_into(product_u(), times_p(D)) if per_node else product_u())
+        return offset_added(added_into(bk, product_u(), times_p(D)) if per_node else product_u())
 
     # the first product in double precision (the KKT residual's scale); exact_base: u from a double-precision product
-    single, u, exact_base = False, None, False  # (not the caller's u0, nor single precision) and steps' updates since
+    single, u, exact_base, home = False, None, False, None  # (not the caller's u0 nor single); stale: updates since
     if u0 is None:
         u, stale = exact_u(), 0
-    else:  # C x0 from the caller, confirmed like an incremental update
-        u, stale = add_into(bk.copy(bk.asarray(u0)), times_p(D)) if per_node else bk.copy(bk.asarray(u0)), 1
-        u = offset_added(u)
-    last_z = KeptOnContact(bk, lat.shape)  # the last preconditioned gap, on its contact only
-    gz_old, m_one, m_full, m_at, fixed_scale = 1.0, None, None, None, scale
-    record, kkt, delta = Record(rtol, maxiter), np.inf, approach
+    else:  # C x0 from the caller, confirmed like an incremental update; home: u0 holding u, in either precision
+        home = u0 if overwrite_u0 and in_place(bk, u0) else None
+        u = bk.copy(bk.asarray(u0)) if home is None else u0
+        u, stale = offset_added(added_into(bk, u, times_p(D)) if per_node else u), 1
+    last_z, record = KeptOnContact(bk, lat.shape), Record(rtol, maxiter)  # last_z: the last preconditioned gap
+    gz_old, m_one, m_full, m_at, m_scale, fixed_scale, delta = 1.0, None, None, None, 1.0, scale, approach
     nodes = ContactNodes(bk, p, getattr(passes, "merge", None))  # the iterate's contact (steady: the last step's)
     idx = g_c = p_c0 = g_min = u_range = None  # u_range: max u, min u
 
@@ -263,31 +263,31 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return bk.max0(p_c0), n, changes, n == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, m_at, gz_old, u, stale, stiff
+        nonlocal m_full, m_one, m_at, m_scale, gz_old, u, stale, stiff, g_c
         if bounded and not bk.count(idx):  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
         steady = nodes.steady  # the last direction on the contact (float32) as written, D and what follows there
         if steady:
-            t_old, (D_c, soft_c, jac_c) = brick.last, nodes.kept
+            t_old, (D_c, soft_c) = brick.last, nodes.kept
         else:  # gathers, at the entering nodes only where the contact was made from the step (ContactNodes.over)
             t_old = nodes.over(idx, lambda n: bk.take(brick.values, n), brick.last)
             D_c = nodes.over(idx, lambda n: passes.gather(D, n), nodes.kept[0]) if per_node else None
-            soft_c, jac_c = (None, None) if not soft else (~is_stiff(D_c, diag, threshold), jacobi_at(idx, D_c))
-            nodes.kept = D_c, soft_c, jac_c
+            nodes.kept = D_c, (soft_c := None if not soft else ~is_stiff(D_c, diag, threshold))
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        z = precondition(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, jac_c)
+        z = precondition(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, D_c)
         z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"], nodes)
         if force is not None and not soft:
             z -= xp.mean(z)
         elif force is not None:
             # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
             # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
-            if m_full is None:  # M (contact & stiff), single precision, kept so
+            if m_full is None:  # M (contact & stiff), kept in half precision over its largest magnitude m_scale
                 m_full, stiff = apply_m(xp.astype((p > 0) & stiff, xp.float32)), None
-            # and the Jacobi estimate at the soft nodes
-            if not steady:  # m_at: M 1 at the contact's nodes
-                m_at = nodes.over(idx, lambda n: xp.astype(bk.take(m_full, n), xp.float64), m_at)
-                m_one = xp.where(soft_c, jac_c, m_at)
+                m_scale = float(xp.max(xp.abs(m_full))) or 1.0
+                m_full = xp.astype(m_full * (1.0 / m_scale), np.float16 if bk.is_numpy else xp.float32)  # (no float16)
+            if not steady:  # m_at: M 1 at the contact's nodes, the Jacobi estimate at the soft ones (they stay soft)
+                m_at = nodes.over(idx, lambda n: xp.astype(bk.take(m_full, n), xp.float64) * m_scale, m_at)
+                m_one = m_at = xp.where(soft_c, jacobi_at(idx, D_c), m_at)
                 if not float(xp.sum(m_one)) > 0:  # a contact far from the starting one: the mean instead
                     m_one = xp.ones(bk.count(idx), dtype=xp.float64)
             z -= m_one * (float(xp.sum(z)) / float(xp.sum(m_one)))
@@ -302,7 +302,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         gt = bk.dot(g_c, t_c)
         if not gt > 0:  # no descent along t after a change of the contact: steepest descent
             t_c, gt = z, gz
-        gz_old = gz
+        gz_old, z = gz, None  # z not held past the direction
         T = op.spectrum(brick.write(idx, t_c), out=work.spectrum(np.complex64))
         op.n_matvec += 1
         # (C + lam) t, single precision, and t.(C + lam) t; t has zero sum on the contact under force control
@@ -328,7 +328,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if bk.is_numpy:  # g < 0 and p = 0 from measure (the same u and delta), and at the nodes clipped to 0 here
             enter.reshape(-1)[idx[clipped]] = g_c[clipped] < 0
         overlap = bk.select(enter if bk.is_numpy else (u + h < delta) & (p == 0))
-        entered = bool(bk.count(overlap))
+        entered, g_c = bool(bk.count(overlap)), None  # the gap not held past the entering test
         p_o = entering_pressure(xp, passes.gap_at(u, h, overlap) - delta, tau, jacobi_at(overlap) if (
             per_node) else jacobi, per_node, preconditioned=True) if entered else None
         t_move = terms = None  # a change in double precision: u from the product of the move t' (module docstring)
@@ -348,17 +348,17 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if target is not None or positive:
             bk.put(p, idx, p_c)
         if entered:
-            if s != 1.0:
-                p_o *= s
+            p_o *= s
             bk.put(p, overlap, p_o)
         if t_move is not None:  # p = s (p - tau t'): u = s (u - tau (C + lam) t'), plus D's terms per node
             update_u(R, tau, s, terms, t_move)
         elif not (changed or entered or stale >= RECOMPUTE_EVERY):  # p = s (p - tau t) on the contact
-            update_u(R, tau, s, [(idx, D_c * t_c, -tau)] if per_node else [])
-        else:
+            update_u(R, tau, s, [(idx, multiplied_into(bk, t_c, D_c), -tau)] if per_node else [])  # D t in t
+        else:  # t not held through the product; D p on the contact made before it
+            t_c, dp = None, D_c * p_c if per_node else None
             u, stale = offset_added(product_u()), 0
             if per_node:  # u += D p, on the nodes where p > 0
-                passes.add_at(u, idx, D_c * p_c)
+                passes.add_at(u, idx, dp)
                 if entered:
                     passes.add_at(u, overlap, passes.gather(D, overlap) * p_o)
         nodes.stepped(p_c, entered, overlap, p_o)  # after the product: the next contact is not held through it
@@ -391,8 +391,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             update_u(R, tau, s, [] if D_c is None else [(idx, D_c * t_c, -tau)])
         return None
 
-    step = CGStep(measure_bounded, confirms, observe_bounded, advance, lambda: bk.copy(p)) if bounded else CGStep(
-        measure, confirms, observe, advance, lambda: bk.copy(p))
+    step = CGStep(measure_bounded if bounded else measure, confirms, observe_bounded if bounded else observe, advance,
+                  lambda: bk.copy(p))
     kkt = run_constrained_cg(step, record, maxiter, callback)
     note_fully_plastic(record, sets.bracket if bounded else None, bounded and not bk.count(idx))
     c_p = elastic_displacement(bk, u, D if per_node else lam, p, out=work.brick64(), offset=offset)  # in work's bytes

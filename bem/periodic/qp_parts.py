@@ -55,7 +55,7 @@ class ContactNodes:
         self._pairs = [None, None]  # the arrays of the contacts made from the step (with merge)
         self.was_on = p > 0  # the contact of the last count of changes
         self.n_was = int(bk.xp.count_nonzero(self.was_on))
-        self.steady, self.idx, self.on, self.p_c, self.kept = False, None, None, None, (None, None, None)
+        self.steady, self.idx, self.on, self.p_c, self.kept = False, None, None, None, (None, None)
         self.next = self.moved = None  # the contact made from the last step; its nodes that left and entered
         self.from_step = None  # (stayed, at, entering) where the contact of the last read was made from the step
 
@@ -312,3 +312,22 @@ class StepArrays:
         out = self.brick32()
         out[...] = v
         return out
+
+
+def added_into(bk, x, y):
+    """``x + y`` in ``x``'s precision (NumPy: into ``x``)."""
+    return np.add(x, y, out=x) if bk.is_numpy else bk.xp.astype(x + y, x.dtype, copy=False)
+
+
+def multiplied_into(bk, x, y):
+    """``x y`` in ``x``'s precision (NumPy: into ``x``)."""
+    return np.multiply(x, y, out=x) if bk.is_numpy else bk.xp.astype(x * y, x.dtype, copy=False)
+
+
+def product_array(u, dtype, home=None):
+    """The array a product of the whole cell goes into on NumPy: ``u`` where it has ``dtype``; else the bytes of
+    ``home`` (the caller's float64 ``u0``, held with ``overwrite_u0``) as a ``dtype`` array of its shape; else None
+    (a new array, the last ``u`` let go first)."""
+    if u is not None and u.dtype == dtype:
+        return u
+    return None if home is None else home.reshape(-1).view(dtype)[: home.size].reshape(home.shape)

@@ -76,3 +76,32 @@ def test_a_callers_start_on_a_half_space_region_is_not_modified(method, layer):
     assert res.converged
     np.testing.assert_array_equal(x0, before)
     assert not np.shares_memory(res.p, x0)
+
+
+@pytest.mark.parametrize("per_node", [False, True])
+def test_the_cells_qp_holds_its_product_in_a_u0_it_may_overwrite_with_the_numbers_of_its_copy(per_node):
+    """``overwrite_u0``: the cell's QP iterates in the caller's ``C x0`` (no copy of it) and gives the solution of the
+    QP that copies it, bit for bit; without it, or where ``u0`` cannot hold it (float32, F order), ``u0`` is not
+    written."""
+    from bem.periodic import PeriodicCell, PeriodicOperator
+
+    cell = PeriodicCell(1.0 / 32, 32, 32)
+    op = PeriodicOperator(cell, 1.0)
+    h = 0.02 * (1 - np.cos(2 * np.pi * cell.x) * np.cos(2 * np.pi * cell.y))
+    rng = np.random.default_rng(3)
+    x0 = 1e-3 * rng.random(cell.shape)
+    x0 *= 0.004 / (cell.node_area * x0.sum())
+    lam = 0.02 + 0.01 * rng.random(cell.shape) if per_node else 0.0
+    kw = dict(force=0.004, lam=lam, rtol=1e-9)
+    u0 = op.matvec(x0)
+    before = u0.copy()
+    copied = op.qp(h, x0=x0.copy(), u0=u0, **kw)
+    np.testing.assert_array_equal(u0, before)
+    for other in (u0.astype(np.float32), np.asfortranarray(u0)):
+        kept = other.copy()
+        op.qp(h, x0=x0.copy(), u0=other, overwrite_u0=True, **kw)
+        np.testing.assert_array_equal(other, kept)
+    held = op.qp(h, x0=x0.copy(), u0=u0, overwrite_u0=True, **kw)
+    assert copied.converged and held.converged and held.iterations == copied.iterations
+    assert np.array_equal(held.p, copied.p) and np.array_equal(held.displacement, copied.displacement)
+    assert not np.array_equal(u0, before)  # the QP's own product was held in it

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import bem.column_bands as column_bands
+from bem import diagonal_coefficient
 import bem.heap as heap
 from bem.lattice import Lattice
 from bem.operator import InfluenceOperator
@@ -47,3 +48,35 @@ def test_glibc_trims_and_the_products_by_bands_keep_their_numbers(monkeypatch):
     monkeypatch.setattr(heap, "_malloc_trim", lambda: lambda pad: calls.append(pad) or real(pad))
     assert np.array_equal(InfluenceOperator(lat, 1.0).matvec(p), expected)
     assert calls and set(calls) == {0}
+
+
+@pytest.mark.parametrize("domain", ["cell", "half-space"])
+def test_newton_asks_for_the_free_heap_at_each_step_and_before_its_product_after_a_cells_model_qp(monkeypatch, domain):
+    """Newton asks :func:`bem.heap.release` at the start of each step with the bytes of three arrays of the lattice
+    (the closure, ``C p + w`` and the gap made there) and, on a cell whose model QP held ``C p``, before it makes the
+    product again (its spectrum and output); the release changes no number."""
+    from bem import layers, newton
+    from bem.periodic import PeriodicCell, PeriodicOperator
+
+    monkeypatch.setattr(heap, "RELEASE_ABOVE", 0)  # every size: the cell's model QPs hold C p, the C library asked
+    if domain == "cell":
+        cell = PeriodicCell(1.0 / 32, 32, 32)
+        make = lambda: PeriodicOperator(cell, 1.0)  # noqa: E731
+        h, force = 0.02 * (1 - np.cos(2 * np.pi * cell.x) * np.cos(2 * np.pi * cell.y)), 0.02
+    else:
+        lat = Lattice.from_extent(0.02, 0.3)
+        make = lambda: InfluenceOperator(lat, 1.0)  # noqa: E731
+        h, force = np.where(lat.mask, (lat.x**2 + lat.y**2) / 2, 0.0), 0.01
+    layer = layers.Root(0.3 * diagonal_coefficient(0.02 if domain == "half-space" else 1.0 / 32, 1.0))
+    asked, trims, real = [], [], heap.release
+    monkeypatch.setattr(heap, "release", lambda nbytes: asked.append(nbytes))  # not trimmed
+    kept = newton.solve_newton(make(), h, layer=layer, force=force)
+    monkeypatch.setattr(heap, "release", lambda nbytes: asked.append(nbytes) or real(nbytes))
+    monkeypatch.setattr(heap, "_malloc_trim", lambda: trims.append)
+    trimmed = newton.solve_newton(make(), h, layer=layer, force=force)
+    assert kept.converged and trimmed.converged and trimmed.iterations == kept.iterations >= 2
+    assert np.array_equal(trimmed.p, kept.p) and np.array_equal(trimmed.displacement, kept.displacement)
+    n_lattice = 8 * h.size
+    steps = kept.iterations + 1  # the steps' starts, the last one's included
+    expected = [3 * n_lattice] * steps + ([2 * n_lattice] * kept.iterations if domain == "cell" else [])
+    assert sorted(asked) == sorted(expected * 2) and len(trims) == len(expected) and set(trims) == {0}

@@ -102,10 +102,10 @@ def test_the_model_qp_iterates_in_newtons_pressure_which_keeps_its_values(monkey
     checks = []
     original = newton._model_qp
 
-    def model_qp(op_, h_, layer, D, contact, precondition, p, **kw):
-        sub, back = original(op_, h_, layer, D, contact, precondition, p, **kw)
+    def model_qp(op_, h_, layer, D, contact, precondition, p, u, cell, **kw):
+        sub, back, u = original(op_, h_, layer, D, contact, precondition, p, u, cell, **kw)
         checks.append(np.array_equal(back, seen[-1][2]) and back is not sub.p)
-        return sub, back
+        return sub, back, u
 
     monkeypatch.setattr(newton, "_model_qp", model_qp)
     held = newton.solve_newton(op, h, layer=LAYER, force=force)
@@ -117,3 +117,46 @@ def test_the_model_qp_iterates_in_newtons_pressure_which_keeps_its_values(monkey
     assert not any(in_buffer for in_buffer, _, _ in seen)
     assert copied.iterations == held.iterations and np.array_equal(copied.p, held.p)
     assert np.array_equal(copied.displacement, held.displacement)
+
+
+@pytest.mark.parametrize("domain", ["cell", "half-space"])
+def test_above_its_size_the_cells_model_qp_holds_its_product_in_newtons_and_newton_makes_it_again(monkeypatch, domain):
+    """Where Newton's product ``C p`` on a periodic cell takes more than ``bem.heap.RELEASE_ABOVE`` bytes (here every
+    size), each model QP gets ``u`` with ``overwrite_u0`` and iterates in it (no copy of it), and Newton makes ``C p``
+    again after, exactly: one product more a step, and the answer of the solve that holds ``u`` to its tolerance (its
+    path may differ: its ``u`` is exact at each step, the held one updated). A region's QP, which makes its products
+    in new arrays, gets Newton's ``u`` to copy as before: the same solve bit for bit."""
+    make = (lambda: (PeriodicOperator(CELL, 1.0), waves(CELL), 0.02)) if domain == "cell" else _half_space_case
+    op, h, force = make()
+    held = newton.solve_newton(op, h, layer=LAYER, force=force)
+    n_held = op.n_matvec
+    op, h, force = make()
+    reference = make()[0]
+    real_qp, real_matvec, given, exact = op.qp, op.matvec, [], []
+
+    def qp(h_, *, u0, **kw):
+        before = u0.copy()
+        sub = real_qp(h_, u0=u0, **kw)
+        given.append((kw.get("overwrite_u0", False), not np.array_equal(u0, before)))
+        return sub
+
+    def matvec(p, **kw):
+        out = real_matvec(p, **kw)
+        if not kw and given and len(exact) < len(given):  # Newton's product after the model's solve
+            want = reference.matvec(p)
+            exact.append(float(np.max(np.abs(out - want))) / float(np.max(np.abs(want))))
+        return out
+
+    monkeypatch.setattr(op, "qp", qp)
+    monkeypatch.setattr(op, "matvec", matvec)
+    monkeypatch.setattr(newton.heap, "RELEASE_ABOVE", 0)
+    handed = newton.solve_newton(op, h, layer=LAYER, force=force)
+    assert held.converged and handed.converged and min(handed.iterations, held.iterations) >= 2 and given
+    if domain == "half-space":
+        assert not any(overwrite or written for overwrite, written in given) and op.n_matvec == n_held
+        assert handed.iterations == held.iterations and np.array_equal(handed.p, held.p)
+        return
+    assert all(overwrite and written for overwrite, written in given)
+    assert len(exact) == len(given) and max(exact) == 0.0
+    np.testing.assert_allclose(handed.p, held.p, rtol=0, atol=1e-8 * float(np.max(held.p)))
+    assert handed.kkt_residual <= 1e-10

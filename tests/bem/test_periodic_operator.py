@@ -145,3 +145,32 @@ def test_periodic_cell_from_size_takes_the_nearest_cell_with_an_even_number_of_r
     assert (cell.n_cols, cell.n_rows) == (10, 10)  # 0.9 / (0.1 sqrt3/2) = 10.4 rows
     assert cell.size == pytest.approx((1.0, 10 * 0.1 * SQRT3 / 2))
     assert cell.area == pytest.approx(cell.n_nodes * cell.node_area)
+
+
+def test_the_operators_keep_the_last_symbols_and_a_large_cell_lets_the_coarser_ones_go(monkeypatch):
+    """The packed symbols of the last cells are kept (the same arrays for a second operator of a cell, the oldest let
+    go beyond the limit); nested iteration onto a cell whose product is above ``bem.heap.RELEASE_ABOVE`` lets the
+    coarser cells' symbols go before the finer level (here at every size), with the same solution bit for bit."""
+    import bem.periodic.influence as influence
+
+    monkeypatch.setattr(influence, "_SYMBOLS", {})
+    monkeypatch.setattr(influence, "_SYMBOLS_KEPT", 3)
+    cells = [PeriodicCell(1.0 / n, n, n) for n in (8, 16, 32, 64)]
+    ops = [PeriodicOperator(cell, 1.0) for cell in cells[:3]]
+    assert all(a is b for a, b in zip(PeriodicOperator(cells[0], 1.0)._symbol, ops[0]._symbol))
+    PeriodicOperator(cells[3], 1.0)  # the fourth: the least recently used (16 x 16) goes
+    assert {key[0] for key in influence._SYMBOLS} == {8, 32, 64}
+    influence.forget_symbols(below=32 * 32)
+    assert {key[0] for key in influence._SYMBOLS} == {32, 64}
+
+    cell = PeriodicCell(1.0 / 256, 256, 256)
+    h = 0.01 * (1 - np.cos(2 * np.pi * cell.x) * np.cos(2 * np.pi * cell.y))
+    influence._SYMBOLS.clear()
+    monkeypatch.setattr(influence, "_SYMBOLS_KEPT", 8)
+    kept = bem.solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=0.005)
+    all_levels = {key[0] for key in influence._SYMBOLS}
+    influence._SYMBOLS.clear()
+    monkeypatch.setattr("bem.heap.RELEASE_ABOVE", 0)
+    forgot = bem.solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=0.005)
+    assert len(all_levels) >= 3 and {key[0] for key in influence._SYMBOLS} == {256}
+    assert kept.converged and forgot.converged and np.array_equal(kept.p, forgot.p)
