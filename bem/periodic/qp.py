@@ -1,20 +1,20 @@
 """Kalker's QP on a periodic cell: the conjugate gradients of :func:`bem.kalker.solve_qp` in the Fourier basis.
 
 The step of :meth:`bem.periodic.PeriodicOperator.qp` in the one loop :func:`bem.cg_rules.run_constrained_cg`: the
-iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active set, Polonsky & Keer 1999,
-with the FFT preconditioner, the same entering rule, Jacobi cap and stopping rule) on
-:class:`bem.periodic.PeriodicOperator`, whose ``C`` is diagonal in the Fourier basis of the cell (a 2 x 2 block per
-frequency, one block row per row parity); every node is a candidate. Nodes entering the contact do not restart the
-directions: ``t = z + beta t_old`` on the current contact, ``beta = max(0, g.(z - z_old) / g_old.z_old)``
-(Polak-Ribiere+), the step the minimum along ``t``, ``tau = g.t / t.(C + lam) t`` (``g.t = g.z`` while the contact
-does not change), and ``t = z`` where ``g.t <= 0``. On a rough surface, whose contact set changes at most iterations
-until it settles, a loop that restarts at every entering node degrades to preconditioned steepest descent
-(``tests/bem/test_periodic_qp.py``: 82 iterations against 57, 52 with :mod:`bem.periodic.edge`, on a 256^2
-self-affine cell). An entering node (``p = 0``, ``g < 0``) takes the step with a share of the Jacobi estimate of the
-preconditioner there, ``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`): ``tau``
-is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give it ``tau C_nn`` of its Jacobi pressure, a fraction
-that falls with the step (on a 672 x 776 rough cell at 1e-4 of the mean contact pressure, nodes entering with almost no
-pressure and leaving, at a constant KKT residual: ``tests/bem/test_periodic_robustness.py``). Further:
+iteration of :func:`bem.kalker.solve_qp` (constrained conjugate gradients on the active set, Polonsky & Keer 1999; its
+FFT preconditioner, entering rule, Jacobi cap and stopping rule) on :class:`bem.periodic.PeriodicOperator`, whose ``C``
+is diagonal in the Fourier basis of the cell (a 2 x 2 block per frequency, one block row per row parity); every node is
+a candidate. Nodes entering the contact do not restart the directions: ``t = z + beta t_old`` on the current contact,
+``beta = max(0, g.(z - z_old) / g_old.z_old)`` (Polak-Ribiere+), the step the minimum along ``t``, ``tau = g.t / t.(C +
+lam) t`` (``g.t = g.z`` while the contact does not change), and ``t = z`` where ``g.t <= 0``. On a rough surface, whose
+contact set changes at most iterations until it settles, a loop that restarts at every entering node degrades to
+preconditioned steepest descent (``tests/bem/test_periodic_qp.py``: 82 iterations against 57, 52 with
+:mod:`bem.periodic.edge`, on a 256^2 self-affine cell). An entering node (``p = 0``, ``g < 0``) takes the step with a
+share of the Jacobi estimate of the preconditioner there, ``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` =
+:data:`bem.cg_rules.ENTERING_FRACTION`): ``tau`` is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give it
+``tau C_nn`` of its Jacobi pressure, a fraction that falls with the step (nodes entering with almost no pressure and
+leaving, at a constant KKT residual, on a 672 x 776 rough cell at 1e-4 of the mean contact pressure:
+``tests/bem/test_periodic_robustness.py``). Further:
 
 - the iteration keeps ``u = (C + lam) p`` in double precision, updated after a step by the product of its move in
   single precision (rounded to a relative ``1e-7`` of the step, which falls with the residual): where the contact set
@@ -71,6 +71,7 @@ from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
                         elastic_displacement, entering_pressure, initial_pressure, is_per_node, is_stiff,
                         iterate_residual, run_constrained_cg)
+from .. import heap
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .edge import EdgeCorrection
 from .passes import kernels
@@ -186,6 +187,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     def product_u():  # u = (C + lam) p; on NumPy in the last u or in u0's bytes (qp_parts.product_array)
         nonlocal u, exact_base
         u = product_array(u, np.float32 if single else np.float64, home) if bk.is_numpy else None
+        heap.release(16 * math.prod(work.spectrum_shape))  # the C library's free heap before a product of the cell
         u, exact_base = op.brick(product(p), overwrite=True, out=u), not single
         return u
 
@@ -236,8 +238,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         nonlocal idx, g_c, p_c0, delta, g_min, enter, u_range
         idx, p_c0 = nodes.read(p)
         g_c = passes.gap_at(u, h, idx)  # the gap is u + h - delta: delta is subtracted on the contact only
-        if force is not None:
-            delta = float(xp.mean(g_c)) if bk.count(idx) else math.nan
+        delta = (float(xp.mean(g_c)) if bk.count(idx) else math.nan) if force is not None else delta
         enter, g_low, *u_range = passes.scan(u, h, delta, p, enter)  # with the mask of the entering test
         g_c -= delta
         g_min = g_low - delta
@@ -348,8 +349,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if target is not None or positive:
             bk.put(p, idx, p_c)
         if entered:
-            p_o *= s
-            bk.put(p, overlap, p_o)
+            bk.put(p, overlap, (p_o := multiplied_into(bk, p_o, s)))
         if t_move is not None:  # p = s (p - tau t'): u = s (u - tau (C + lam) t'), plus D's terms per node
             update_u(R, tau, s, terms, t_move)
         elif not (changed or entered or stale >= RECOMPUTE_EVERY):  # p = s (p - tau t) on the contact
