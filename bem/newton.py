@@ -104,19 +104,19 @@ def _advance(bk, p, u, sub, t, force, node_area, hardness):
     return q, uq
 
 
-def _model_qp(op, h, layer, D, contact, precondition, p, u, cell, **kw):
+def _model_qp(op, h, layer, D, contact, precondition, p, u, periodic, **kw):
     """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one) from ``p`` and ``u = C
     p`` by the operator's constrained-CG step (``op.qp``); ``(solution, p, u)``. Its gap ``h + w(p) - D p`` goes as
     ``h`` and the offset ``w(p) - D p`` on the nodes of nonzero pressure (``w(0) = 0``, :mod:`bem.layers.base`): no
     array of it. Where it can (:func:`bem.plastic.in_place`) the QP holds its iterate in ``p``, kept meanwhile on those
-    nodes only and returned as a new array (the same values), and on a periodic ``cell`` whose product ``C p`` (spectrum
+    nodes only and returned as a new array (the same values), and on a ``periodic`` cell whose product ``C p`` (spectrum
     and ``u``) takes more than :data:`bem.heap.RELEASE_ABOVE` bytes its product in ``u`` (``overwrite_u0``), made again
     after (one product a step): an array of the lattice fewer through the QP each (a region's QP makes new ones)."""
     bk = backend_of(p)
     at = bk.select(p > 0)
     kept = bk.take(p, at)
     offset = (at, bk.asarray(layer.w(kept)) - bk.take(D, at) * kept)
-    own, hand = in_place(bk, p), cell and in_place(bk, u) and heap.above(2 * u.nbytes)
+    own, hand = in_place(bk, p), periodic and in_place(bk, u) and heap.above(2 * u.nbytes)
     kw = dict(kw, overwrite_u0=True) if hand else kw  # (the region's QP takes no overwrite_u0)
     sub = op.qp(h, lam=D, precondition=precondition, contact=contact, x0=p, offset=offset, u0=u, overwrite_x0=own, **kw)
     p = bk.spread(p.shape, at, kept) if own else p
