@@ -11,7 +11,10 @@ Back end
     ``scipy.fft`` (pocketfft), chosen by measurement against pyFFTW (``benchmarks/fft_floor.py``; the table is in
     ``docs/performance.md``). pyFFTW wins only with ``FFTW_MEASURE`` plans, whose planning takes longer than a
     whole solve, per shape (every support window has its own); with ``FFTW_ESTIMATE`` it is slower than
-    pocketfft, which plans in microseconds and caches its plans.
+    pocketfft, which plans in microseconds and caches its plans. Where ducc0 is installed (``contactlab[fast]``),
+    its transforms replace pocketfft's in double precision and the complex ones in single precision, where they
+    are faster; pocketfft keeps the single-precision real transforms, where ducc0's are slower (:func:`_library`;
+    measured by ``benchmarks/fft_floor.py --primitives``). The numbers then differ from pocketfft's by rounding.
 
 Parts on threads
     :func:`in_parts` runs a kernel on :func:`threads` contiguous parts of an array at once (NumPy's ufuncs,
@@ -21,7 +24,8 @@ Parts on threads
     :func:`irfft_into`, and the pruned transforms of :mod:`bem.pruned_fft`), one single-threaded pocketfft call
     per part, rather than with pocketfft's ``workers``, whose calling thread sleeps while its pool works and whose
     pool threads the scheduler may wake on one core, where they take turns (measured in ``docs/performance.md``,
-    "Threads that share a core"). The numbers are the same either way.
+    "Threads that share a core"). The numbers are the same either way, and on any number of threads: the parts of a
+    transform begin at multiples of :data:`LINES` lines.
 
 The pruned padded transforms of the half-space's convolutions are :mod:`bem.pruned_fft`.
 """
@@ -35,26 +39,53 @@ import numpy as np
 import scipy.fft as _sfft
 
 
+def _checks_out(lib):
+    """Whether ``lib``'s ``r2c``, ``c2c`` and ``c2r`` take the positional signatures used here, write into a given
+    array and give NumPy's numbers on a small array."""
+    try:
+        x = np.arange(8.0).reshape(2, 4)
+        s = lib.c2c(lib.r2c(x, (1,), True, 0, np.empty((2, 3), dtype=complex), 1), (0,), True, 0, None, 1)
+        back = lib.c2r(lib.c2c(s, (0,), False, 2, None, 1), (1,), 4, False, 2, np.empty((2, 4)), 1)
+        return bool(np.allclose(s, np.fft.rfft2(x), rtol=0, atol=1e-12) and np.allclose(back, x, rtol=0, atol=1e-12))
+    except Exception:  # a changed signature or module falls back  # noqa: BLE001
+        return False
+
+
 def _entry_points():
     """pocketfft's own entry points in SciPy, which write into a given array (``scipy.fft``'s allocate their
     output), where they exist with the signatures used here and give NumPy's numbers on a small array; else
     ``None`` (the transforms then call ``scipy.fft``, one copy of each part more)."""
     try:
         from scipy.fft._pocketfft import pypocketfft as pp
-
-        x = np.arange(8.0).reshape(2, 4)
-        s = pp.c2c(pp.r2c(x, (1,), True, 0, np.empty((2, 3), dtype=complex), 1), (0,), True, 0, None, 1)
-        back = pp.c2r(pp.c2c(s, (0,), False, 2, None, 1), (1,), 4, False, 2, np.empty((2, 4)), 1)
-        ok = np.allclose(s, np.fft.rfft2(x), rtol=0, atol=1e-12) and np.allclose(back, x, rtol=0, atol=1e-12)
-    except Exception:  # a private module: any SciPy that lacks or changed it falls back  # noqa: BLE001
+    except ImportError:  # a private module: any SciPy that lacks it falls back
         return None
-    return pp if ok else None
+    return pp if _checks_out(pp) else None
+
+
+def _ducc_entry_points():
+    """``ducc0.fft`` (the same entry points as pocketfft's, :func:`_entry_points`), where installed and checking out
+    as those do; else ``None``."""
+    try:
+        from ducc0 import fft as ducc
+    except ImportError:
+        return None
+    return ducc if _checks_out(ducc) else None
 
 
 _pocketfft = _entry_points()
+_ducc0 = _ducc_entry_points()
+
+
+def _library(kind, dtype):
+    """The entry points of a transform (``kind``: ``"r2c"``, ``"c2c"`` or ``"c2r"``) of data of ``dtype``: ducc0's
+    where installed, but for the real transforms in single precision (``r2c`` of float32, ``c2r`` of complex64),
+    whose pocketfft forms are faster; else pocketfft's (``None``: through ``scipy.fft``)."""
+    if _ducc0 is not None and (kind == "c2c" or np.dtype(dtype).char not in "fF"):
+        return _ducc0
+    return _pocketfft
 
 __all__ = ["threads", "set_threads", "fast_length", "in_parts", "rfft_into", "cfft_in_place", "irfft_into",
-           "half_spectrum_weights", "BLOCK"]
+           "half_spectrum_weights", "back_end", "BLOCK", "LINES"]
 
 _ENV = "CONTACTLAB_THREADS"
 _override = None
@@ -62,6 +93,10 @@ _override = None
 #: block, not a spectrum)
 BLOCK = 1 << 15
 _PARTS_MIN = 1 << 17  # entries below which in_parts runs in the calling thread
+#: lines of a transform at which its parts begin (:func:`in_parts`' ``align``): ducc0 transforms the lines of a call
+#: in groups of its vector length and the last few apart, rounded otherwise, so that parts beginning at multiples of
+#: the group give the numbers of one call on the whole array
+LINES = 64
 _pool, _pool_size = None, 0
 
 
@@ -118,7 +153,7 @@ def set_threads(n):
     return previous
 
 
-def in_parts(kernel, n, size):
+def in_parts(kernel, n, size, align=1):
     """Call ``kernel(part)`` on contiguous slices ``part`` of ``range(n)``, on :func:`threads` threads.
 
     The calling thread runs the last part, a pool of ``threads() - 1`` threads the others.
@@ -133,15 +168,18 @@ def in_parts(kernel, n, size):
     size : int
         Entries of the caller's arrays: below ``2**17``, or with one thread, ``kernel``
         runs once on the whole axis in the calling thread.
+    align : int
+        The parts begin at multiples of ``align`` (fewer parts where ``n`` is short of them).
     """
     global _pool, _pool_size
     k = min(threads(), n)
+    bounds = sorted({0, n} | {n * i // k // align * align for i in range(1, k)}) if k > 1 else [0, n]
+    k = len(bounds) - 1
     if k < 2 or size < _PARTS_MIN:
         kernel(slice(0, n))
         return
     if _pool_size < k - 1:
         _pool, _pool_size = ThreadPoolExecutor(max_workers=k - 1, thread_name_prefix="contactlab"), k - 1
-    bounds = [n * i // k for i in range(k + 1)]
     others = [_pool.submit(kernel, slice(lo, hi)) for lo, hi in zip(bounds[:-2], bounds[1:-1])]
     try:
         kernel(slice(bounds[-2], bounds[-1]))
@@ -156,13 +194,33 @@ def _by_parts(call, shape, split, size):
     if split is None:
         return call((Ellipsis,))
     lead = (slice(None),) * split
-    in_parts(lambda part: call(lead + (part,)), shape[split], size)
+    in_parts(lambda part: call(lead + (part,)), shape[split], size, align=LINES)
 
 
-def _transform_parts(fast, fallback, shape, split, size):
-    """``fast(index)`` (pocketfft's own entry points, :func:`_entry_points`) or, where SciPy lacks them,
+def back_end():
+    """The libraries of the transforms (:func:`_library`), as a benchmark records them.
+
+    Returns
+    -------
+    str
+        ``"pocketfft (SciPy <version>)"``, ``"scipy.fft (SciPy <version>)"`` where its entry points do not check
+        out, or with ducc0 ``"ducc0 <version>; <that> for single-precision real transforms"``.
+    """
+    import scipy
+
+    base = f"{'pocketfft' if _pocketfft is not None else 'scipy.fft'} (SciPy {scipy.__version__})"
+    if _ducc0 is None:
+        return base
+    import ducc0
+
+    return f"ducc0 {ducc0.__version__}; {base} for single-precision real transforms"
+
+
+def _transform_parts(kind, dtype, fast, fallback, shape, split, size):
+    """``fast(lib, index)`` with the entry points ``lib`` of :func:`_library` or, where there are none,
     ``fallback(index)`` (``scipy.fft``) on the parts of the axis ``split`` (:func:`_by_parts`)."""
-    _by_parts(fallback if _pocketfft is None else fast, shape, split, size)
+    lib = _library(kind, dtype)
+    _by_parts(fallback if lib is None else (lambda i: fast(lib, i)), shape, split, size)
 
 
 def rfft_into(x, out, axis, split=0):
@@ -183,7 +241,7 @@ def rfft_into(x, out, axis, split=0):
     ndarray
         ``out``.
     """
-    _transform_parts(lambda i: _pocketfft.r2c(x[i], (axis,), True, 0, out[i], 1),
+    _transform_parts("r2c", x.dtype, lambda lib, i: lib.r2c(x[i], (axis,), True, 0, out[i], 1),
                      lambda i: out.__setitem__(i, _sfft.rfft(x[i], axis=axis, workers=1)), x.shape, split, x.size)
     return out
 
@@ -210,7 +268,8 @@ def cfft_in_place(x, axis, split, inverse=False, normalise=True):
     """
     norm = "forward" if inverse and not normalise else "backward"
     fallback = _sfft.ifft if inverse else _sfft.fft
-    _transform_parts(lambda i: _pocketfft.c2c(x[i], (axis,), not inverse, 2 if inverse and normalise else 0, x[i], 1),
+    _transform_parts("c2c", x.dtype,
+                     lambda lib, i: lib.c2c(x[i], (axis,), not inverse, 2 if inverse and normalise else 0, x[i], 1),
                      lambda i: x.__setitem__(i, fallback(x[i], axis=axis, norm=norm, overwrite_x=True, workers=1)),
                      x.shape, split, x.size)
     return x
@@ -238,7 +297,7 @@ def irfft_into(x, out, n, axis, split=0, normalise=True):
         ``out``.
     """
     norm = "backward" if normalise else "forward"
-    _transform_parts(lambda i: _pocketfft.c2r(x[i], (axis,), n, False, 2 if normalise else 0, out[i], 1),
+    _transform_parts("c2r", x.dtype, lambda lib, i: lib.c2r(x[i], (axis,), n, False, 2 if normalise else 0, out[i], 1),
                      lambda i: out.__setitem__(i, _sfft.irfft(x[i], n=n, axis=axis, norm=norm, workers=1)),
                      out.shape, split, out.size)
     return out

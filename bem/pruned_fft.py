@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .fft import cfft_in_place, in_parts, irfft_into, rfft_into
+from .fft import LINES, cfft_in_place, in_parts, irfft_into, rfft_into
 
 __all__ = ["forward", "forward_parts", "inverse", "inverse_into", "rfft_rows", "irfft_rows"]
 
@@ -51,8 +51,12 @@ def forward(x, shape):
 
 def _band(rows, size):
     """Rows of an array of ``size`` entries that a banded transform takes at once: all of them up to twice
-    :data:`_BAND` entries, else bands of about :data:`_BAND` entries."""
-    return rows if size <= 2 * _BAND else max(1, rows * _BAND // size)
+    :data:`_BAND` entries, else bands of about :data:`_BAND` entries (a multiple of :data:`bem.fft.LINES` rows, where
+    there are so many)."""
+    if size <= 2 * _BAND:
+        return rows
+    step = max(1, rows * _BAND // size)
+    return step // LINES * LINES if step >= LINES else step
 
 
 def forward_parts(parts, shape, dtype=np.float64, scale=None):
@@ -122,7 +126,7 @@ def _in_bands(band, rows, size, columns, dtype, zeroed=False):
             hi = min(lo + step, rows_part.stop)
             band(buf[: hi - lo], lo, hi)
 
-    in_parts(part, rows, size)
+    in_parts(part, rows, size, align=LINES)
 
 
 def inverse_into(spectrum, shape, dest):

@@ -90,7 +90,10 @@ def loadavg():
 
 
 def machine():
-    """CPU model, cores, the CPUs this process may use, memory [GB] and the platform."""
+    """CPU model, cores, the CPUs this process may use, memory [GB], the platform and the FFT libraries
+    (:func:`bem.fft.back_end`)."""
+    from bem.fft import back_end
+
     model = platform.processor() or "unknown"
     try:
         with open("/proc/cpuinfo") as f:
@@ -100,7 +103,7 @@ def machine():
     memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     return dict(cpu=model, cores=os.cpu_count(), affinity=len(os.sched_getaffinity(0)),
                 memory_gb=round(memory / 1e9, 1), platform=platform.platform(), python=platform.python_version(),
-                numpy=np.__version__)
+                numpy=np.__version__, fft=back_end())
 
 
 # -- the surfaces ------------------------------------------------------------------------------

@@ -19,8 +19,13 @@ window, :mod:`bem.windows`). ``--problem hertz``: the sphere of ``benchmarks/sid
 28 %, its gap a callable), the problem of ``peers.py``. With ``--threads 1 2`` the solve is
 repeated at each thread count (:func:`bem.fft.set_threads`), interleaved: the core-scaling figure.
 
+``--primitives``: instead, the three transforms of :mod:`bem.fft` (the real FFT along the rows, the complex FFT
+along the columns, forward and inverse, and the inverse real FFT) of an ``N x N`` cell in the layout of
+:meth:`bem.periodic.PeriodicOperator.spectrum`, in single and double precision, one thread, by pocketfft and by
+ducc0 where installed (the measurement behind :func:`bem.fft._library`).
+
 Run: ``python benchmarks/fft_floor.py [--sizes 256 512 1024] [--repeat 5] [--problem hertz|rough-sphere]
-[--threads 1 2]``
+[--threads 1 2] [--primitives]``
 """
 
 from __future__ import annotations
@@ -121,13 +126,42 @@ def finest_operator(gap, res):
     return InfluenceOperator(window, res.E_star), np.ascontiguousarray(p[window.index])
 
 
+def primitives(sizes, repeat):
+    """The table of ``--primitives`` (module docstring): medians of ``repeat`` interleaved calls [ms]."""
+    libraries = {"pocketfft": bfft._pocketfft}
+    if bfft._ducc0 is not None:
+        libraries["ducc0"] = bfft._ducc0
+    print(f"| N | precision | transform | {' | '.join(f'{k} [ms]' for k in libraries)} | load |")
+    print("|---|---|---|" + "---|" * len(libraries) + "---|")
+    for n in sizes:
+        for real, cplx in ((np.float32, np.complex64), (np.float64, np.complex128)):
+            x = np.random.default_rng(0).random((n // 2, 2, n)).astype(real)
+            spectrum, back = np.empty((n // 2, 2, n // 2 + 1), cplx), np.empty_like(x)
+            calls = {"r2c rows": lambda lib: lib.r2c(x, (2,), True, 0, spectrum, 1),
+                     "c2c columns": lambda lib: lib.c2c(spectrum, (0,), True, 0, spectrum, 1),
+                     "c2c columns, inverse": lambda lib: lib.c2c(spectrum, (0,), False, 2, spectrum, 1),
+                     "c2r rows": lambda lib: lib.c2r(spectrum, (2,), n, False, 2, back, 1)}
+            for name, call in calls.items():
+                times = {k: [] for k in libraries}
+                for _ in range(repeat):
+                    for k, lib in libraries.items():
+                        times[k].append(_median(lambda: call(lib), 1))
+                cells = " | ".join(f"{1e3 * statistics.median(times[k]):.2f}" for k in libraries)
+                print(f"| {n}^2 | {np.dtype(real).name} | {name} | {cells} | {os.getloadavg()[0]:.1f} |", flush=True)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[256, 512, 1024])
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--problem", choices=("hertz", "rough-sphere"), default="hertz")
     parser.add_argument("--threads", type=int, nargs="*", default=[], help="core scaling: thread counts to compare")
+    parser.add_argument("--primitives", action="store_true", help="the transforms of bem.fft by library, then stop")
     args = parser.parse_args(argv)
+    if args.primitives:
+        print(f"# {bfft.back_end()}; one thread, load at start {os.getloadavg()[0]:.2f}, median of {args.repeat}")
+        primitives(args.sizes, args.repeat)
+        return
     print(f"# threads {bfft.threads()} (affinity), load at start {os.getloadavg()[0]:.2f}, median of {args.repeat}")
     print("| N | padded | back end | pair [ms] | planning [s] | load |")
     print("|---|---|---|---|---|---|")

@@ -8,6 +8,8 @@ import pytest
 from bem import fft
 from bem.checks import InputError
 
+from .fft_cases import use_library
+
 
 def test_threads_follow_affinity_then_env_then_setter(monkeypatch):
     monkeypatch.delenv("CONTACTLAB_THREADS", raising=False)
@@ -108,8 +110,7 @@ def test_transforms_in_parts_equal_scipy_fft(monkeypatch, entry_points, dtype):
     they were."""
     import scipy.fft as sfft
 
-    if not entry_points:
-        monkeypatch.setattr(fft, "_pocketfft", None)
+    use_library(monkeypatch, "pocketfft" if entry_points else "scipy.fft")
     monkeypatch.setattr(fft, "_override", 2)
     x = np.random.default_rng(3).standard_normal((256, 2, 512)).astype(dtype)  # 2**18 entries: in two parts
     x0 = x.copy()
@@ -135,6 +136,84 @@ def test_transforms_in_parts_equal_scipy_fft(monkeypatch, entry_points, dtype):
     np.testing.assert_array_equal(raw, sfft.irfft(kept, n=512, axis=2, norm="forward"))
 
 
+def _transforms(x):
+    """The forward and inverse transforms of ``bem.fft`` of ``x`` (``(256, 2, 512)``), as
+    ``test_transforms_in_parts_equal_scipy_fft`` makes them, with scipy.fft's of the same data."""
+    import scipy.fft as sfft
+
+    spectrum = fft.rfft_into(x, np.empty((256, 2, 257), np.result_type(x.dtype, np.complex64)), 2)
+    ours = [spectrum.copy(), fft.cfft_in_place(spectrum, 0, 2).copy()]
+    theirs = [sfft.rfft(x, axis=2), sfft.fft(ours[0], axis=0)]
+    back = spectrum.copy()
+    ours.append(fft.cfft_in_place(back, 0, 2, inverse=True).copy())
+    theirs.append(sfft.ifft(spectrum, axis=0))
+    unscaled = fft.cfft_in_place(spectrum.copy(), 0, 1, inverse=True, normalise=False)
+    ours.append(unscaled)
+    theirs.append(sfft.ifft(spectrum, axis=0, norm="forward"))
+    ours.append(fft.irfft_into(back, np.empty(x.shape, x.dtype), 512, 2))
+    theirs.append(sfft.irfft(ours[2], n=512, axis=2))
+    ours.append(fft.irfft_into(back, np.empty(x.shape, x.dtype), 512, 2, normalise=False))
+    theirs.append(sfft.irfft(ours[2], n=512, axis=2, norm="forward"))
+    return ours, theirs
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_transforms_through_ducc0_agree_with_scipy_fft_and_split_into_parts_bit_for_bit(monkeypatch, dtype):
+    """With ducc0 the transforms give scipy.fft's numbers to rounding (each of the six forms, so a wrong axis,
+    direction or scale fails), the same numbers on two threads as on one, bit for bit, and the input back from the
+    forward and inverse pair."""
+    use_library(monkeypatch, "ducc0")
+    x = np.random.default_rng(3).standard_normal((256, 2, 512)).astype(dtype)  # 2**18 entries: in two parts
+    x0 = x.copy()
+    monkeypatch.setattr(fft, "_override", 2)
+    two, theirs = _transforms(x)
+    np.testing.assert_array_equal(x, x0)
+    monkeypatch.setattr(fft, "_override", 1)
+    one, _ = _transforms(x)
+    eps = np.finfo(dtype).eps
+    for a, b, c in zip(two, one, theirs):
+        assert a.dtype == c.dtype
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_allclose(a, c, rtol=0, atol=64 * eps * np.abs(c).max())
+    np.testing.assert_allclose(two[4], x, rtol=0, atol=64 * eps * np.abs(x).max())
+
+
+def test_library_takes_ducc0_but_for_single_precision_real_transforms(monkeypatch):
+    """The rule of the back end: ducc0 for every double-precision transform and the single-precision complex ones,
+    pocketfft for the single-precision real ones; pocketfft for all without ducc0."""
+    import types
+
+    ducc = types.SimpleNamespace(name="ducc0")
+    monkeypatch.setattr(fft, "_ducc0", ducc)
+    for kind, dtype in [("r2c", np.float64), ("c2r", np.complex128), ("c2c", np.complex128), ("c2c", np.complex64)]:
+        assert fft._library(kind, dtype) is ducc, (kind, dtype)
+    for kind, dtype in [("r2c", np.float32), ("c2r", np.complex64)]:
+        assert fft._library(kind, dtype) is fft._pocketfft, (kind, dtype)
+    monkeypatch.setattr(fft, "_ducc0", None)
+    assert all(fft._library(k, d) is fft._pocketfft for k in ("r2c", "c2c", "c2r") for d in (np.float64, np.float32))
+
+
+def test_ducc0_is_used_only_where_it_is_installed_and_checks_out(monkeypatch):
+    """Without the module, with a changed signature or with wrong numbers, ducc0 is not taken."""
+    import sys
+
+    ducc0 = pytest.importorskip("ducc0")
+    assert fft._ducc_entry_points() is ducc0.fft
+    monkeypatch.setitem(sys.modules, "ducc0", None)  # import ducc0 raises ImportError
+    assert fft._ducc_entry_points() is None
+    monkeypatch.undo()
+
+    def changed(*args, **kwargs):
+        raise TypeError("c2c() takes a new signature")
+
+    monkeypatch.setattr(ducc0.fft, "c2c", changed)
+    assert fft._ducc_entry_points() is None
+    monkeypatch.undo()
+    real = ducc0.fft.r2c
+    monkeypatch.setattr(ducc0.fft, "r2c", lambda *a: 2 * real(*a))
+    assert fft._ducc_entry_points() is None
+
+
 def test_pocketfft_entry_points_are_used_only_where_they_check_out(monkeypatch):
     """The private entry points are taken only if they exist with the signatures used and give NumPy's numbers:
     a changed signature or wrong numbers fall back to scipy.fft (whose path the test above checks)."""
@@ -151,3 +230,42 @@ def test_pocketfft_entry_points_are_used_only_where_they_check_out(monkeypatch):
     real = pypocketfft.c2r
     monkeypatch.setattr(pypocketfft, "c2r", lambda *a: 2 * real(*a))
     assert fft._entry_points() is None
+
+
+@pytest.mark.parametrize("library", ["pocketfft", "ducc0"])
+def test_solves_give_the_same_numbers_on_one_two_and_three_threads(monkeypatch, library):
+    """The transforms' parts begin at multiples of LINES lines, so that a cell and a half-space region (whose arrays
+    are split into parts) give the same pressures bit for bit on 1, 2 and 3 threads through either library. With
+    parts anywhere ducc0's do not (its last lines of a call are rounded otherwise): a 3-thread cell differs."""
+    import math
+
+    import bem
+    from bem import pruned_fft
+    from bem.periodic import PeriodicCell
+
+    from .newton_cases import waves
+
+    use_library(monkeypatch, library)
+    cell = PeriodicCell(1.0 / 512, 512, 512)  # 262144 nodes: its transforms in parts
+    h = waves(cell, seed=3, modes=40)
+
+    def bump(x, y):  # a sphere with ripples on a region of 416,147 nodes
+        return (x * x + y * y) / 2.0 - 2e-3 * np.cos(40 * x) * np.cos(37 * y)
+
+    def solves():
+        cell_p = bem.solve_periodic(h, step=cell.step, E_star=1.0, mean_pressure=0.01).p
+        region = bem.solve(bump, E_star=1.0, step=2 * math.sqrt(0.3) / 600, extent=math.sqrt(0.3), force=0.02)
+        return np.asarray(cell_p), np.asarray(region.p)
+
+    results = []
+    for n in (1, 2, 3):
+        monkeypatch.setattr(fft, "_override", n)
+        results.append(solves())
+    for cell_p, region_p in results[1:]:
+        np.testing.assert_array_equal(cell_p, results[0][0])
+        np.testing.assert_array_equal(region_p, results[0][1])
+    if library == "ducc0":  # the planted fault: parts anywhere
+        monkeypatch.setattr(fft, "LINES", 1)
+        monkeypatch.setattr(pruned_fft, "LINES", 1)
+        monkeypatch.setattr(fft, "_override", 3)
+        assert not np.array_equal(solves()[0], results[0][0])

@@ -5,6 +5,8 @@ import pytest
 
 from bem import fft, pruned_fft
 
+from .fft_cases import use_library
+
 
 def test_forward_inverse_is_a_zero_padded_circular_pair():
     rng = np.random.default_rng(0)
@@ -28,6 +30,7 @@ def _gathered_forward(parts, shape, dtype):
 @pytest.mark.parametrize("band", [None, 3])  # None: the default bands (one here); 3: bands of a few rows
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_forward_parts_of_strided_rows_is_the_gathered_transform_bit_for_bit(monkeypatch, band, dtype):
+    use_library(monkeypatch, "pocketfft")  # the gathered transform is SciPy's
     if band is not None:
         monkeypatch.setattr(pruned_fft, "_BAND", band)
     v = np.random.default_rng(1).standard_normal((23, 17))
@@ -44,6 +47,7 @@ def test_forward_parts_of_strided_rows_is_the_gathered_transform_bit_for_bit(mon
 def test_banded_forward_and_inverse_are_the_plain_pair_bit_for_bit(monkeypatch, band):
     import scipy.fft as sfft
 
+    use_library(monkeypatch, "pocketfft")  # the plain pair is SciPy's
     if band is not None:
         monkeypatch.setattr(pruned_fft, "_BAND", band)
     x = np.random.default_rng(2).random((2, 9, 7))
@@ -60,9 +64,11 @@ def test_banded_forward_and_inverse_are_the_plain_pair_bit_for_bit(monkeypatch, 
     assert np.all(out[0::2] == -1.0) and np.all(out[:, :3] == -1.0) and np.all(out[:, 10:] == -1.0)
 
 
-def test_padded_transforms_on_threads_equal_one_thread(monkeypatch):
+@pytest.mark.parametrize("library", ["pocketfft", "ducc0"])
+def test_padded_transforms_on_threads_equal_one_thread(monkeypatch, library):
     """forward_parts and inverse_into (the half-space's pruned pair) in parts on two threads give the numbers of
-    one thread, bit for bit, banded or not."""
+    one thread, bit for bit, banded or not, through either library, and the data back."""
+    use_library(monkeypatch, library)
     x = np.random.default_rng(4).standard_normal((2, 300, 500))
     shape = (fft.fast_length(599, real=False), fft.fast_length(999, real=True))
     results = []
@@ -87,8 +93,7 @@ def test_row_transforms_are_scipy_fft_of_the_padded_rows_bit_for_bit(monkeypatch
     of the zero-padded rows bit for bit, leave their inputs as they were and write only their destination."""
     import scipy.fft as sfft
 
-    if not entry_points:
-        monkeypatch.setattr(fft, "_pocketfft", None)
+    use_library(monkeypatch, "pocketfft" if entry_points else "scipy.fft")
     if band is not None:
         monkeypatch.setattr(pruned_fft, "_BAND", band)
     monkeypatch.setattr(fft, "_override", 2)
