@@ -1,8 +1,8 @@
 """The install: core dependencies and extras, a core-only run, and the stop on a missing extra.
 
 The core-only tests run ``contactlab`` in a subprocess in which matplotlib, gmsh, scikit-fem,
-vtk, pyvista, Pillow, dask, CuPy, SurfaceTopography and numba cannot be imported (a finder at the front of ``sys.meta_path``
-raises ``ModuleNotFoundError`` for them, as if they were not installed).
+vtk, pyvista, Pillow, dask, CuPy, SurfaceTopography, numba and ducc0 cannot be imported (a finder at the front of
+``sys.meta_path`` raises ``ModuleNotFoundError`` for them, as if they were not installed).
 """
 
 import ast
@@ -23,14 +23,14 @@ PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
 PROJECT = PYPROJECT["project"]
 #: what a core install lacks (import names)
 NOT_CORE = ("matplotlib", "gmsh", "skfem", "vtk", "pyvista", "PIL", "dask", "distributed", "cupy",
-            "SurfaceTopography", "numba")
+            "SurfaceTopography", "numba", "ducc0")
 #: import name -> distribution name, for the packages the code may import
 DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "tqdm": "tqdm", "meshio": "meshio", "tomli_w": "tomli-w",
                  "gmsh": "gmsh", "skfem": "scikit-fem", "matplotlib": "matplotlib", "PIL": "pillow",
                  "dask": "dask", "distributed": "dask", "cupy": "cupy-cuda12x", "pytest": "pytest",
                  "html5lib": "html5lib", "yaml": "pyyaml", "SurfaceTopography": "surfacetopography",
                  "pyvista": "pyvista", "array_api_compat": "array-api-compat",
-                 "array_api_strict": "array-api-strict", "sphinx": "sphinx", "numba": "numba"}
+                 "array_api_strict": "array-api-strict", "sphinx": "sphinx", "numba": "numba", "ducc0": "ducc0"}
 OWN = ("bem", "fem_reference", "validation", "tests")
 
 
@@ -78,7 +78,7 @@ def test_extras_layout():
     assert _extra("rough") == {"surfacetopography"}
     assert _extra("docs") == {"sphinx", "numpydoc", "myst-parser"}
     assert _extra("peers") == {"aspher", "tamaas", "contactmechanics"}
-    assert _extra("fast") == {"numba"}
+    assert _extra("fast") == {"numba", "ducc0"}
     assert _extra("all") == _extra("fem") | _extra("report") | _extra("dask") | _extra("rough") | _extra("fast")
     assert _extra("test") == _extra("all") | _extra("3d") | _extra("docs") | {
         "pytest", "pytest-xdist", "html5lib", "pyyaml", "array-api-strict", "array-api-compat"}
