@@ -51,12 +51,11 @@ def forward(x, shape):
 
 def _band(rows, size):
     """Rows of an array of ``size`` entries that a banded transform takes at once: all of them up to twice
-    :data:`_BAND` entries, else bands of about :data:`_BAND` entries (a multiple of :data:`bem.fft.LINES` rows, where
-    there are so many)."""
+    :data:`_BAND` entries, else bands of about :data:`_BAND` entries, a multiple of :data:`bem.fft.LINES` rows (at
+    least that many: the bands begin where a transform's parts may)."""
     if size <= 2 * _BAND:
         return rows
-    step = max(1, rows * _BAND // size)
-    return step // LINES * LINES if step >= LINES else step
+    return min(rows, max(LINES, rows * _BAND // size // LINES * LINES))
 
 
 def forward_parts(parts, shape, dtype=np.float64, scale=None):

@@ -128,9 +128,10 @@ def finest_operator(gap, res):
 
 def primitives(sizes, repeat):
     """The table of ``--primitives`` (module docstring): medians of ``repeat`` interleaved calls [ms]."""
-    libraries = {"pocketfft": bfft._pocketfft}
-    if bfft._ducc0 is not None:
-        libraries["ducc0"] = bfft._ducc0
+    libraries = {k: lib for k, lib in (("pocketfft", bfft._pocketfft), ("ducc0", bfft._ducc0)) if lib is not None}
+    if not libraries:
+        print("# neither SciPy's pocketfft entry points nor ducc0: nothing to compare")
+        return
     print(f"| N | precision | transform | {' | '.join(f'{k} [ms]' for k in libraries)} | load |")
     print("|---|---|---|" + "---|" * len(libraries) + "---|")
     for n in sizes:

@@ -33,6 +33,7 @@ def test_forward_parts_of_strided_rows_is_the_gathered_transform_bit_for_bit(mon
     use_library(monkeypatch, "pocketfft")  # the gathered transform is SciPy's
     if band is not None:
         monkeypatch.setattr(pruned_fft, "_BAND", band)
+        monkeypatch.setattr(pruned_fft, "LINES", 1)  # bands of a few rows
     v = np.random.default_rng(1).standard_normal((23, 17))
     parts = [v[0::2, 2:13], v[1::2, 2:13]]  # 12 and 11 rows, views with a row stride
     keep = v.copy()
@@ -50,6 +51,7 @@ def test_banded_forward_and_inverse_are_the_plain_pair_bit_for_bit(monkeypatch, 
     use_library(monkeypatch, "pocketfft")  # the plain pair is SciPy's
     if band is not None:
         monkeypatch.setattr(pruned_fft, "_BAND", band)
+        monkeypatch.setattr(pruned_fft, "LINES", 1)  # bands of a few rows
     x = np.random.default_rng(2).random((2, 9, 7))
     shape = (fft.fast_length(17, real=False), fft.fast_length(13, real=True))
     spectrum = pruned_fft.forward(x, shape)
@@ -96,6 +98,7 @@ def test_row_transforms_are_scipy_fft_of_the_padded_rows_bit_for_bit(monkeypatch
     use_library(monkeypatch, "pocketfft" if entry_points else "scipy.fft")
     if band is not None:
         monkeypatch.setattr(pruned_fft, "_BAND", band)
+        monkeypatch.setattr(pruned_fft, "LINES", 1)  # bands of a few rows
     monkeypatch.setattr(fft, "_override", 2)
     x = np.random.default_rng(5).standard_normal((301, 200))[:, :150]  # a strided view, 301 x 512 padded
     x0 = x.copy()
