@@ -23,9 +23,7 @@ import logging
 import math
 import os
 import shutil
-import signal
 import tempfile
-import threading
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +32,7 @@ from bem.files import umask, write_text
 
 from .folders import (KINDS, MARKER, NAME_MAX, OutputError, check_output_dir, leftover_prefixes, marked_files,
                       marker_kind, recover_output_dir, remove_marked, write_marker)
+from .signals import signals_deferred
 
 __all__ = ["atomic_write_json", "json_text", "atomic_directory", "to_jsonable", "OutputError",
            "write_marker", "marker_kind", "marked_files", "check_output_dir", "recover_output_dir", "output_errors"]
@@ -157,35 +156,13 @@ def atomic_directory(target, kind="result", names=(), *, what="out_dir", keep=()
             remove_marked(tmp)
 
 
-@contextlib.contextmanager
-def _signals_deferred():
-    """Hold ``SIGINT`` and ``SIGTERM`` back while the block runs (main thread); handle them after it."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    received = []
-    saved = {signum: signal.signal(signum, lambda n, frame: received.append((n, frame)))
-             for signum in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for signum, handler in saved.items():
-            signal.signal(signum, handler)
-        for signum, frame in received:
-            handler = saved[signum]
-            if callable(handler):
-                handler(signum, frame)
-            elif handler == signal.SIG_DFL:
-                os.kill(os.getpid(), signum)
-
-
 def _swap(tmp, target, kind):
     """Move ``tmp`` onto ``target``; a previous ``target`` is moved aside first and removed after.
 
     An interrupt or ``SIGTERM`` is held back until the swap is over, so it never leaves the
     target missing; only a kill (``SIGKILL``) can, and :func:`recover_output_dir` repairs that.
     """
-    with _signals_deferred():
+    with signals_deferred():
         old = None
         if target.exists():
             prefix = f"{leftover_prefixes(target)[1]}{os.getpid()}-"

@@ -326,3 +326,40 @@ def test_a_process_forked_while_sigterm_is_handled_ends_by_sigterm_without_a_tra
                 os._exit(3)
         _, status = os.waitpid(pid, 0)
     assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM, status
+
+
+INTERRUPT_AT_FORK = SLOW_POINTS + textwrap.dedent("""
+    import os
+    import signal
+
+    _armed = [True]
+
+    def _interrupt():  # Ctrl-C in the parent's fork handlers, once (the first fork: the sweep's workers)
+        if _armed[0]:
+            _armed[0] = False
+            os.kill(os.getpid(), signal.SIGINT)
+
+    os.register_at_fork(after_in_parent=_interrupt)
+""")
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="needs Linux /proc")
+def test_an_interrupt_while_the_workers_are_forked_stops_the_sweep(tmp_path):
+    """Python ignores an exception raised in a fork handler: Ctrl-C there (logging's handler, say) was printed as
+    ignored and lost, and the sweep ran on. The workers are forked with the signals held back, so it stops."""
+    hook = tmp_path / "hook"
+    hook.mkdir()
+    (hook / "sitecustomize.py").write_text(INTERRUPT_AT_FORK)
+    proc = _contactlab(tmp_path, "sweep", "elliptic", "--param", "load.force", "--values", "50,100,150,200",
+                       "--workers", "2", "--out", tmp_path / "s", hook=hook, popen=True)
+    try:
+        _out, err = proc.communicate(timeout=30)
+        assert proc.returncode == 128 + signal.SIGINT, err
+        assert "Traceback" not in err and "Exception ignored" not in err, err
+        assert "interrupted" in err
+    finally:
+        if proc.poll() is None:
+            workers = _children(proc.pid)
+            proc.kill()
+            proc.wait()
+            _gone_within(workers, 5)

@@ -7,7 +7,14 @@
 - are killed by the kernel when the parent dies, even by ``SIGKILL`` (Linux: ``prctl``
   ``PR_SET_PDEATHSIG``; elsewhere only the next point applies);
 - are terminated when the block using the pool ends with an exception (an interrupt
-  included), instead of finishing their running jobs.
+  included), instead of finishing their running jobs;
+- are forked (the start method ``fork``) before the block, with ``SIGINT`` and ``SIGTERM`` held back
+  (:func:`validation.signals.signals_deferred`): Python ignores an exception raised in its fork handlers, so that an
+  interrupt there would be lost and the sweep run on.
+
+When the workers are terminated the pool's manager thread is waited for, so that the interpreter's exit finds it
+ended (its exit hook wakes the manager threads still running, and a wakeup that raced the thread's own close of
+its pipe printed an ``OSError`` traceback).
 """
 
 from __future__ import annotations
@@ -17,6 +24,8 @@ import os
 import signal
 import sys
 from concurrent.futures import ProcessPoolExecutor
+
+from ..signals import signals_deferred
 
 __all__ = ["worker_pool"]
 
@@ -38,6 +47,7 @@ def _init_worker(parent):
 
 def _terminate(pool, timeout=5.0):
     processes = list((getattr(pool, "_processes", None) or {}).values())
+    manager = getattr(pool, "_executor_manager_thread", None)  # shutdown() lets go of it
     pool.shutdown(wait=False, cancel_futures=True)
     for proc in processes:
         with contextlib.suppress(OSError, ValueError):
@@ -48,6 +58,8 @@ def _terminate(pool, timeout=5.0):
             if proc.is_alive():
                 proc.kill()
                 proc.join(timeout)
+    if manager is not None:  # it ends once its workers are gone (module docstring)
+        manager.join(timeout)
 
 
 @contextlib.contextmanager
@@ -68,6 +80,8 @@ def worker_pool(workers):
     """
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(os.getpid(),))
     try:
+        with signals_deferred():  # the first job starts the workers (all of them where they are forked)
+            pool.submit(int)
         yield pool
     except BaseException:
         _terminate(pool)
