@@ -18,14 +18,14 @@ Back end
 
 Parts on threads
     :func:`in_parts` runs a kernel on :func:`threads` contiguous parts of an array at once (NumPy's ufuncs,
-    numba's ``nogil`` kernels and pocketfft release the GIL): the calling thread takes the last part itself and a
+    numba's ``nogil`` kernels, pocketfft and ducc0 release the GIL): the calling thread takes the last part itself and a
     pool of ``threads() - 1`` threads the others; arrays below ``2**17`` entries stay in the calling thread. The
     transforms of the solvers' iterations run so too (:func:`rfft_into`, :func:`cfft_in_place`,
-    :func:`irfft_into`, and the pruned transforms of :mod:`bem.pruned_fft`), one single-threaded pocketfft call
-    per part, rather than with pocketfft's ``workers``, whose calling thread sleeps while its pool works and whose
-    pool threads the scheduler may wake on one core, where they take turns (measured in ``docs/performance.md``,
-    "Threads that share a core"). The numbers are the same either way, and on any number of threads: the parts of a
-    transform begin at multiples of :data:`LINES` lines.
+    :func:`irfft_into`, and the pruned transforms of :mod:`bem.pruned_fft`), one single-threaded call of the
+    transform's library per part, rather than with pocketfft's ``workers``, whose calling thread sleeps while its
+    pool works and whose pool threads the scheduler may wake on one core, where they take turns (measured in
+    ``docs/performance.md``, "Threads that share a core"). The numbers are the same either way, and on any number of
+    threads: the parts of a transform begin at multiples of :data:`LINES` lines.
 
 The pruned padded transforms of the half-space's convolutions are :mod:`bem.pruned_fft`.
 """

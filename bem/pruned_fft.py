@@ -10,8 +10,8 @@ or padded input is held beside them; :func:`forward_parts` and :func:`inverse_in
 entries (strided views of a brick array's row parities) and write the product where it goes (no gathered
 copy). Banded or not, the numbers are the same (``tests/bem/test_pruned_fft.py``).
 
-Every transform runs on the threads of :func:`bem.fft.in_parts`, one single-threaded pocketfft call per band
-(:func:`bem.fft.rfft_into`, :func:`bem.fft.cfft_in_place`, :func:`bem.fft.irfft_into`). Each thread takes its
+Every transform runs on the threads of :func:`bem.fft.in_parts`, one single-threaded call of the transform's library
+per band (:func:`bem.fft.rfft_into`, :func:`bem.fft.cfft_in_place`, :func:`bem.fft.irfft_into`). Each thread takes its
 part of the rows a band after another through one buffer of its own, made once per transform: the band's rows
 zero-padded in it (forward) or its whole inverse rows (inverse), the transform written from or into it where the
 data lie (no padded copy and no output array a band).
