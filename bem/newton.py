@@ -31,13 +31,13 @@ import numpy as np
 
 from .brent import brent_root
 from .backend import backend_of, operator_backend
+from . import heap
 from .layers.device import device_layer
 from .cg_rules import QPSolution
 from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
 from .newton_moves import closure_move, model_closure, release, scaled, settle_plastic
-from . import heap
 from .plastic import carry_force, clip, clipped_start, fully_plastic_note, in_place
 
 __all__ = ["solve_newton"]

@@ -3,8 +3,8 @@
 Each surface, size and mean pressure is solved by ``bem.solve_periodic`` (nested iteration, KKT residual ``1e-10``,
 ``E* = 1``) once for each ``theta`` of :mod:`bem.periodic.edge` (``theta = 0``: the correction made and zero, the
 preconditioner ``M_AA`` alone), in one process; the rows give the finest cell's iterations, the products with ``C``
-of every level, the KKT residual and the share of nodes in contact. Iterations and products do not depend on the machine. Surfaces
-(the gap ``max(z) - z``):
+of every level, the KKT residual and the share of nodes in contact. Iterations and products do not depend on the
+machine. Surfaces (the gap ``max(z) - z``):
 
 - ``self-affine``: the surface of ``periodic_rough.py`` (Hurst exponent 0.8, rms slope 0.1, roll-off at 4 and
   cut-off at 128 periods of the cell), seeds 2026 (the benchmark cell's) and ``--seeds``; hundreds of spots;

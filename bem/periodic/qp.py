@@ -67,11 +67,11 @@ import math
 
 import numpy as np
 
+from .. import heap
 from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
                         elastic_displacement, entering_pressure, initial_pressure, is_per_node, is_stiff,
                         iterate_residual, run_constrained_cg)
-from .. import heap
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .edge import EdgeCorrection
 from .passes import kernels

@@ -223,11 +223,11 @@ class KeptOnContact:
 
     def keep(self, nodes, z):
         """Keep ``z`` (1-D), the values at the node selection ``nodes`` (copied)."""
-        bk = self.bk
+        bk, self.nodes = self.bk, nodes
         if not bk.is_numpy:
             self.values = bk.spread(self.shape, nodes, z)
             return
-        self.nodes, self.z, self.filled = nodes, z.astype(np.float32), False
+        self.z, self.filled = z.astype(np.float32), False
 
     def at(self, nodes, contact=None):
         """The kept values at the node selection ``nodes`` (1-D, float64), 0 where not kept; ``contact`` the

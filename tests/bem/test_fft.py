@@ -102,59 +102,46 @@ def test_in_parts_runs_a_part_in_the_calling_thread_and_waits_for_the_others(mon
     assert ran[0] == ran[100] == "done"  # the other parts ended before the error reached the caller
 
 
+def _transforms(x):
+    """The six transforms of ``bem.fft`` of ``x`` (``(256, 2, 512)``: 2**18 entries, in parts on two threads) and
+    scipy.fft's of the same data: the real FFT along the rows, the complex FFT along the columns in place (the
+    parts along another axis), its inverse, unscaled along a short axis, and the inverse real FFT, scaled and not.
+    Each leaves the arrays it does not write as they were."""
+    import scipy.fft as sfft
+
+    x0 = x.copy()
+    spectrum = fft.rfft_into(x, np.empty((256, 2, 257), np.result_type(x.dtype, np.complex64)), 2)
+    np.testing.assert_array_equal(x, x0)
+    ours, theirs = [spectrum.copy()], [sfft.rfft(x, axis=2)]
+    assert fft.cfft_in_place(spectrum, 0, 2) is spectrum  # along axis 0, the parts along axis 2
+    ours.append(spectrum.copy())
+    theirs.append(sfft.fft(ours[0], axis=0))
+    back = fft.cfft_in_place(spectrum.copy(), 0, 2, inverse=True)
+    ours.append(back.copy())
+    theirs.append(sfft.ifft(spectrum, axis=0))
+    ours.append(fft.cfft_in_place(spectrum.copy(), 0, 1, inverse=True, normalise=False))
+    theirs.append(sfft.ifft(spectrum, axis=0, norm="forward"))
+    ours.append(fft.irfft_into(back, np.empty(x.shape, x.dtype), 512, 2))
+    np.testing.assert_array_equal(back, ours[2])
+    theirs.append(sfft.irfft(ours[2], n=512, axis=2))
+    ours.append(fft.irfft_into(back, np.empty(x.shape, x.dtype), 512, 2, normalise=False))
+    theirs.append(sfft.irfft(ours[2], n=512, axis=2, norm="forward"))
+    return ours, theirs
+
+
 @pytest.mark.parametrize("entry_points", [True, False], ids=["pocketfft", "scipy.fft"])
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_transforms_in_parts_equal_scipy_fft(monkeypatch, entry_points, dtype):
     """rfft_into, cfft_in_place and irfft_into on two threads give scipy.fft's numbers bit for bit, with
     pocketfft's own entry points and with the scipy.fft fallback, and leave the inputs they do not write as
-    they were."""
-    import scipy.fft as sfft
-
+    they were (:func:`_transforms`)."""
     use_library(monkeypatch, "pocketfft" if entry_points else "scipy.fft")
     monkeypatch.setattr(fft, "_override", 2)
-    x = np.random.default_rng(3).standard_normal((256, 2, 512)).astype(dtype)  # 2**18 entries: in two parts
-    x0 = x.copy()
-    ctype = np.result_type(dtype, np.complex64)
-    spectrum = fft.rfft_into(x, np.empty((256, 2, 257), ctype), 2)
-    np.testing.assert_array_equal(x, x0)
-    np.testing.assert_array_equal(spectrum, sfft.rfft(x, axis=2))
-    reference = sfft.fft(spectrum, axis=0)
-    assert fft.cfft_in_place(spectrum, 0, 2) is spectrum  # along axis 0, the parts along axis 2
-    np.testing.assert_array_equal(spectrum, reference)
-    back = spectrum.copy()
-    fft.cfft_in_place(back, 0, 2, inverse=True)
-    np.testing.assert_array_equal(back, sfft.ifft(spectrum, axis=0))
-    unscaled = spectrum.copy()
-    fft.cfft_in_place(unscaled, 0, 1, inverse=True, normalise=False)
-    np.testing.assert_array_equal(unscaled, sfft.ifft(spectrum, axis=0, norm="forward"))
-    kept = back.copy()
-    out = fft.irfft_into(back, np.empty(x.shape, dtype), 512, 2)
-    np.testing.assert_array_equal(back, kept)
-    np.testing.assert_array_equal(out, sfft.irfft(kept, n=512, axis=2))
-    np.testing.assert_allclose(out, x, rtol=0, atol=(1e-5 if dtype == np.float32 else 1e-13) * np.abs(x).max())
-    raw = fft.irfft_into(back, np.empty(x.shape, dtype), 512, 2, normalise=False)
-    np.testing.assert_array_equal(raw, sfft.irfft(kept, n=512, axis=2, norm="forward"))
-
-
-def _transforms(x):
-    """The forward and inverse transforms of ``bem.fft`` of ``x`` (``(256, 2, 512)``), as
-    ``test_transforms_in_parts_equal_scipy_fft`` makes them, with scipy.fft's of the same data."""
-    import scipy.fft as sfft
-
-    spectrum = fft.rfft_into(x, np.empty((256, 2, 257), np.result_type(x.dtype, np.complex64)), 2)
-    ours = [spectrum.copy(), fft.cfft_in_place(spectrum, 0, 2).copy()]
-    theirs = [sfft.rfft(x, axis=2), sfft.fft(ours[0], axis=0)]
-    back = spectrum.copy()
-    ours.append(fft.cfft_in_place(back, 0, 2, inverse=True).copy())
-    theirs.append(sfft.ifft(spectrum, axis=0))
-    unscaled = fft.cfft_in_place(spectrum.copy(), 0, 1, inverse=True, normalise=False)
-    ours.append(unscaled)
-    theirs.append(sfft.ifft(spectrum, axis=0, norm="forward"))
-    ours.append(fft.irfft_into(back, np.empty(x.shape, x.dtype), 512, 2))
-    theirs.append(sfft.irfft(ours[2], n=512, axis=2))
-    ours.append(fft.irfft_into(back, np.empty(x.shape, x.dtype), 512, 2, normalise=False))
-    theirs.append(sfft.irfft(ours[2], n=512, axis=2, norm="forward"))
-    return ours, theirs
+    x = np.random.default_rng(3).standard_normal((256, 2, 512)).astype(dtype)
+    ours, theirs = _transforms(x)
+    for a, b in zip(ours, theirs):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_allclose(ours[4], x, rtol=0, atol=(1e-5 if dtype == np.float32 else 1e-13) * np.abs(x).max())
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -163,11 +150,9 @@ def test_transforms_through_ducc0_agree_with_scipy_fft_and_split_into_parts_bit_
     direction or scale fails), the same numbers on two threads as on one, bit for bit, and the input back from the
     forward and inverse pair."""
     use_library(monkeypatch, "ducc0")
-    x = np.random.default_rng(3).standard_normal((256, 2, 512)).astype(dtype)  # 2**18 entries: in two parts
-    x0 = x.copy()
+    x = np.random.default_rng(3).standard_normal((256, 2, 512)).astype(dtype)
     monkeypatch.setattr(fft, "_override", 2)
     two, theirs = _transforms(x)
-    np.testing.assert_array_equal(x, x0)
     monkeypatch.setattr(fft, "_override", 1)
     one, _ = _transforms(x)
     eps = np.finfo(dtype).eps

@@ -105,8 +105,8 @@ def test_the_correction_is_its_definition_by_the_dense_inverse(monkeypatch):
                                                      ("self-affine", 0.01, 0.9), ("self-affine", 0.03, 0.8)])
 def test_the_corrected_preconditioner_conditions_a_fixed_contact_better(surface, load, at_most):
     """The spectrum of the preconditioned contact ``P C_AA`` on the zero-sum pressures of a fixed contact (the
-    force's constraint), dense, ``P = M_AA + diag(c)`` with the ``c`` the library makes: positive definite, and its condition number below ``at_most`` of that of
-    ``M_AA`` alone (measured at 48 x 48: 2.52 -> 1.76 and 2.21 -> 1.76 on the smooth surface, 4.52 -> 3.84 and
+    force's constraint), dense, ``P = M_AA + diag(c)`` with the ``c`` the library makes: positive definite, and its
+    condition number below ``at_most`` of that of ``M_AA`` alone (measured at 48 x 48: 2.52 -> 1.76 and 2.21 -> 1.76 on the smooth surface, 4.52 -> 3.84 and
     5.22 -> 3.93 on the self-affine one)."""
     cell = PeriodicCell(1.0 / 48, 48, 48)
     op, contact = _contact(cell, _rough(cell) if surface == "smooth" else _self_affine(cell), load)
@@ -249,3 +249,26 @@ def test_the_correction_serves_the_qp_without_a_compliance_per_node_or_a_hardnes
         assert made == [pytest.approx(1.5 * op.diagonal)]
     else:
         assert made == []
+
+
+def test_off_numpy_the_correction_is_kept_again_only_where_the_contact_changed(monkeypatch):
+    """Off NumPy the kept correction is a brick array made by a spread; read at the contact it was kept on, it is
+    not spread again (the nodes of a keep are recorded on every namespace)."""
+    xs = pytest.importorskip("array_api_strict")
+    from bem.backend import get_backend
+
+    bk = get_backend(xs)
+    shape = (8, 6)
+    on = bk.select(xs.asarray(np.random.default_rng(1).random(shape) < 0.5))
+    fix = EdgeCorrection(bk, None, shape, 1.0)
+    fix.kept.keep(on, xs.full(bk.count(on), 0.25, dtype=xs.float64))
+    spreads = []
+    real = bk.spread
+    monkeypatch.setattr(bk, "spread", lambda *a: spreads.append(a) or real(*a))
+    for _ in range(2):
+        c = fix._at(on, None)
+        assert bool(xs.all(c == 0.25))
+    assert not spreads
+    other = bk.select(xs.asarray(np.random.default_rng(2).random(shape) < 0.5))
+    fix._at(other, None)  # another contact: kept again there
+    assert len(spreads) == 1
