@@ -156,8 +156,9 @@ class HalfSpaceRegion:
         return InfluenceOperator(lattice, E_star, device=backend, bodies=bodies)
 
     def solve_level(self, run, make_op, lattice, h, kw, delta, solver):
-        """One level of nested iteration (``delta``: the approach it knows, or None): on the candidate
-        window of :mod:`bem.windows` where there is one; the solution and the operators used."""
+        """One level of nested iteration (``delta``: the approach it knows, or None): on a window of
+        :mod:`bem.windows` where there is one; the solution, the operators used and the product ``C p`` on the
+        lattice where the level made it (:func:`bem.windows.solve_in_window`)."""
         return solve_in_window(run, make_op, lattice, h, kw, delta, solver)
 
     def refine(self, coarse, p, fine):

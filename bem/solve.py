@@ -257,20 +257,22 @@ def _solve_on(region, gap, problem, x0, t_start):
         if problem.hardness is not None:
             _check_capacity(region, lat, problem)
             kw["hardness"] = problem.hardness
-        sol, ops = region.solve_level(run, make_op, lat, h_lat, kw, delta if nested else None, problem.solver)
+        sol, ops, u = region.solve_level(run, make_op, lat, h_lat, kw, delta if nested else None, problem.solver)
         delta = sol.approach
         if not finest:  # the coarse solution and operators are released before the finer level is solved
             guess = region.refine(lat, sol.p, levels[0][0])
-            sol = ops = h_lat = None
+            sol = ops = u = h_lat = None
     region.check_solution(lattice, sol.p)
     op = ops[-1] if ops[-1].lattice is lattice else make_op(lattice)
     n_matvec = sum(o.n_matvec for o in ops if o is not op)
-    # the result recomputes C p: the solver's copy, the start and the level's operators go first
+    # the result recomputes C p (where the level did not make it): the solver's copy, the start and the level's
+    # operators go first
     guess = kw = ops = levels = None
     sol.displacement = None
     layer = problem.layer
     closure = None if layer is None else np.where(lattice.mask, layer.w(sol.p), 0.0)
-    u = to_host(op.matvec(sol.p))
+    if u is None:  # (the level's own product where it made one on the finest lattice)
+        u = to_host(op.matvec(sol.p))
     n_matvec += op.n_matvec
     op = None  # its kernel spectra go before the result is made
     g, scale = _deformed_gap(u, closure, h, sol.approach)

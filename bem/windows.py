@@ -7,8 +7,17 @@ on the coarser level), and each finer level is solved on the window of the brick
 holds the nodes with ``h_n < delta + _WINDOW_MARGIN (delta - min h)``, padded by ``_WINDOW_PAD``
 nodes; the window's solution is the full one when every node outside it has ``h_n >= delta`` of
 that solution, which is checked (otherwise the level is solved again on the full lattice from
-the window's solution). The full lattice still gets one product, for the result. The gain is
-measured by ``benchmarks/side_by_side.py`` (docs/performance.md).
+the window's solution). The full lattice still gets one product, for the result.
+
+Where the start of a level (the coarser level's solution, prolonged) touches a smaller block than
+that, the level is solved on the bounding box of the start's contact, padded by ``_START_PAD``
+nodes (:func:`start_window`); on a rough surface, whose gap ``h`` dips below the approach far from
+the contact, it is the only window. Nothing guarantees it, so the full lattice's product ``u = C p``
+of its solution checks it: the solution is accepted where every node outside the window is open,
+``-(u + h - delta) <= rtol max |u|`` (the rule of :func:`bem.kkt.kkt_residual` for the nodes out of
+contact), and is then the full lattice's solution within ``rtol``, that product the result's;
+otherwise the level is solved again on the full lattice from it. The gains are measured by
+``benchmarks/side_by_side.py`` and ``benchmarks/peers.py`` (docs/performance.md).
 """
 
 from __future__ import annotations
@@ -17,15 +26,18 @@ import logging
 
 import numpy as np
 
+from .backend import to_host
 from .cg_rules import QPSolution
 
-__all__ = ["candidate_window", "solve_in_window"]
+__all__ = ["candidate_window", "start_window", "solve_in_window"]
 
 log = logging.getLogger(__name__)
 
 _WINDOW_MARGIN = 0.25
 _WINDOW_PAD = 2
 _WINDOW_UP_TO = 0.6  # a window with more than this fraction of the brick array is not worth it
+_START_PAD = 2  # nodes around the bounding box of the start's contact
+_CHECK_ROWS = 256  # rows of a block of the check outside a window
 
 
 def candidate_window(lat, h, delta):
@@ -36,9 +48,24 @@ def candidate_window(lat, h, delta):
     h_min = float(np.min(h, where=mask, initial=np.inf))
     if not delta > h_min:
         return None
-    near = mask & (h < delta + _WINDOW_MARGIN * (delta - h_min))
+    return _padded(lat, mask & (h < delta + _WINDOW_MARGIN * (delta - h_min)), _WINDOW_PAD)
+
+
+def start_window(lat, x0):
+    """The window of ``lat`` around the contact of the start ``x0`` (its nodes of positive pressure, a brick array),
+    padded by ``_START_PAD`` nodes, or None (no start, no contact, or a window not worth it)."""
+    if x0 is None:
+        return None
+    return _padded(lat, np.asarray(x0) > 0, _START_PAD)
+
+
+def _padded(lat, near, pad):
+    """The bounding box of the nodes ``near`` (a boolean brick array) padded by ``pad`` nodes, as a window of
+    ``lat``; None where there are none, or the box has more than ``_WINDOW_UP_TO`` of the brick array."""
     rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
-    (n_rows, n_cols), pad = lat.shape, _WINDOW_PAD
+    if not rows.size:
+        return None
+    n_rows, n_cols = lat.shape
     r0, r1 = max(int(rows[0]) - pad, 0), min(int(rows[-1]) + 1 + pad, n_rows)
     c0, c1 = max(int(cols[0]) - pad, 0), min(int(cols[-1]) + 1 + pad, n_cols)
     if r1 - r0 < 4 or (r1 - r0) * (c1 - c0) > _WINDOW_UP_TO * n_rows * n_cols:
@@ -70,29 +97,77 @@ def _embedded(sol, window):
                       displacement=None, history=hist)
 
 
+class _Spent:
+    """The record of an operator let go: its lattice and the products it made (what nested iteration reads)."""
+
+    def __init__(self, op):
+        self.lattice, self.n_matvec = op.lattice, op.n_matvec
+
+
+def _window_kw(kw, window, lat, solver):
+    """The keyword arguments of a solve on ``window``: its part of the start, the callback on the full lattice, and
+    the QP's default iteration limit of the full lattice."""
+    kw_w = dict(kw, x0=None if kw["x0"] is None else kw["x0"][window.index])
+    if kw["callback"] is not None:
+        kw_w["callback"] = lambda k, p, cb=kw["callback"]: cb(k, window.embed(p))
+    if solver == "kalker" and "maxiter" not in kw:
+        kw_w["maxiter"] = max(200, int(10 * np.sqrt(lat.n_nodes)))
+    return kw_w
+
+
+def _open_outside(lat, window, u, h, delta, rtol):
+    """Whether the nodes of ``lat`` outside ``window`` are open within ``rtol``: ``-min(u + h - delta) <= rtol max
+    |u|`` over them (``u = C p`` on ``lat``, ``p = 0`` there, ``w(0) = 0``), by blocks of rows (no array of the
+    lattice made)."""
+    (r0, r1), (c0, c1) = window.rows, window.cols
+    g_min = np.inf
+    for lo in range(0, lat.shape[0], _CHECK_ROWS):
+        hi = min(lo + _CHECK_ROWS, lat.shape[0])
+        outside = lat.mask[lo:hi].copy()
+        outside[max(r0 - lo, 0) : max(min(r1, hi) - lo, 0), c0:c1] = False
+        g_min = min(g_min, float(np.min(u[lo:hi] + h[lo:hi], where=outside, initial=np.inf)))
+    return g_min - delta >= -rtol * max(float(np.max(u)), -float(np.min(u)))
+
+
 def solve_in_window(run, make_op, lat, h, kw, delta, solver):
-    """Solve one lattice level, on the candidate window of the approach ``delta`` where there is one.
+    """Solve one lattice level, on a window of it where there is one (the module docstring).
 
     ``run(op, h, kw)`` runs ``solver`` with the keyword arguments ``kw`` on the operator ``op =
-    make_op(lattice)``; returns the solution and the operators used.
+    make_op(lattice)``. ``delta`` is the approach the coarser level found (None: no coarser level, no window).
+    Returns the solution, the operators used (or the records of those let go), and the product ``C p`` of the
+    solution on ``lat`` where the level made it (a window checked on the full lattice; None otherwise).
     """
     window = candidate_window(lat, h, delta)
+    start = start_window(lat, kw["x0"]) if delta is not None else None
+    if start is not None and (window is None or start.n_nodes < window.n_nodes):
+        return _solve_checked(run, make_op, lat, h, kw, solver, start)
     ops = []
     if window is not None:
         op = make_op(window)
         ops.append(op)
-        kw_w = dict(kw, x0=None if kw["x0"] is None else kw["x0"][window.index])
-        if kw["callback"] is not None:
-            kw_w["callback"] = lambda k, p, cb=kw["callback"]: cb(k, window.embed(p))
-        if solver == "kalker" and "maxiter" not in kw:  # the QP's default limit of the full lattice
-            kw_w["maxiter"] = max(200, int(10 * np.sqrt(lat.n_nodes)))
-        sol = _embedded(run(op, h[window.index], kw_w), window)
+        sol = _embedded(run(op, h[window.index], _window_kw(kw, window, lat, solver)), window)
         if _clear_outside(lat, window, h, sol.approach):
-            return sol, ops
+            return sol, ops, None
         # rare: the approach grew past the margin. The full lattice starts from the window's
         # solution; the result reports that solve's iterations.
         log.debug("candidate window too small (approach %.6g): solving on the full lattice", sol.approach)
         kw = dict(kw, x0=sol.p)
     op = make_op(lat)
     ops.append(op)
-    return run(op, h, kw), ops
+    return run(op, h, kw), ops, None
+
+
+def _solve_checked(run, make_op, lat, h, kw, solver, window):
+    """:func:`solve_in_window` on the window of the start's contact, checked by the full lattice's product."""
+    op = make_op(window)
+    sol = _embedded(run(op, h[window.index], _window_kw(kw, window, lat, solver)), window)
+    ops = [_Spent(op)]
+    op = None  # the window's operator (its kernel spectra) goes before the full lattice's product
+    full = make_op(lat)
+    ops.append(full)
+    u = to_host(full.matvec(sol.p))
+    if not sol.converged or _open_outside(lat, window, u, h, sol.approach, kw["rtol"]):
+        return sol, ops, u
+    log.debug("the window of the start's contact misses nodes of the contact: solving on the full lattice")
+    u = None
+    return run(full, h, dict(kw, x0=sol.p)), ops, None

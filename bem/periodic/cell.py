@@ -134,9 +134,9 @@ class PeriodicCell:
         return PeriodicOperator(cell, E_star, device=backend, bodies=bodies)
 
     def solve_level(self, run, make_op, cell, h, kw, delta, solver):
-        """One level of nested iteration, on the whole cell; the solution and the operator used."""
+        """One level of nested iteration, on the whole cell; the solution, the operator used and no product."""
         op = make_op(cell)
-        return run(op, h, kw), [op]
+        return run(op, h, kw), [op], None
 
     def refine(self, coarse, p, fine):
         """The coarse solution interpolated onto the next finer cell; where a product on it (16 bytes a node) is

@@ -107,3 +107,78 @@ def test_qp_window_fallback(monkeypatch):
     full = bem.solve(Paraboloid(1.0), E_star=1.0, force=1e-3, step=0.003, extent=0.3)
     assert small.converged and small.kkt_residual <= 1e-10
     assert np.abs(small.p - full.p).max() <= 1e-8 * full.p.max()
+
+
+def test_start_window_is_the_padded_box_of_the_starts_contact(monkeypatch):
+    lat = Lattice.from_extent(0.1, 1.0)
+    x0 = np.zeros(lat.shape)
+    assert windows_module.start_window(lat, None) is None and windows_module.start_window(lat, x0) is None
+    x0[6:9, 4:7] = 1.0
+    before = x0.copy()
+    win = windows_module.start_window(lat, x0)
+    pad = windows_module._START_PAD
+    assert (win.rows, win.cols) == ((6 - pad, 9 + pad), (4 - pad, 7 + pad))
+    np.testing.assert_array_equal(x0, before)  # the start is not modified
+    x0[0, 0] = x0[-1, -1] = 1.0  # a box of the whole lattice is not worth a window
+    assert windows_module.start_window(lat, x0) is None
+
+
+def _wavy(x, y):
+    """A sphere of radius 1 with a lattice of bumps 0.004 high: the gap dips below the approach over most of the
+    region, and the window of the start's contact is the smaller one."""
+    return (x * x + y * y) / 2.0 - 0.002 * (1 + np.cos(2 * np.pi * x / 0.03) * np.cos(2 * np.pi * y / 0.03))
+
+
+def _spied(monkeypatch):
+    used, products = [], []
+    run, matvec = solve_module._run, InfluenceOperator.matvec
+
+    def spy(solver, op, *args):
+        used.append(op.lattice)
+        return run(solver, op, *args)
+
+    def counted(self, p, **kw):
+        products.append(self.lattice)
+        return matvec(self, p, **kw)
+
+    monkeypatch.setattr(solve_module, "_run", spy)
+    monkeypatch.setattr(InfluenceOperator, "matvec", counted)
+    return used, products
+
+
+@pytest.mark.parametrize("layer", [None, layers.Root(0.005)])
+def test_start_window_gives_the_full_lattice_solution(monkeypatch, layer):
+    kw = dict(E_star=1.0, force=1e-3, step=0.002, extent=0.2, layer=layer)
+    used, products = _spied(monkeypatch)
+    calls = []
+    windowed = bem.solve(_wavy, callback=lambda k, p: calls.append(p.shape), **kw)
+    finest = windowed.lattice
+    h = bem.HalfSpaceRegion(0.002, 0.2).nodal_gap(_wavy, finest)
+    assert windows_module.candidate_window(finest, h, windowed.approach) is None  # h < approach too widely
+    assert type(used[-1]).__name__ == "LatticeWindow" and used[-1].n_nodes < 0.5 * windowed.p.size
+    assert set(calls) == {finest.shape}  # the callback sees the full lattice
+    # the full lattice's one product after the window's solve checks it and is the result's
+    assert sum(lat is finest for lat in products) == 1
+    monkeypatch.setattr(windows_module, "_WINDOW_UP_TO", 0.0)  # no window
+    full = bem.solve(_wavy, **kw)
+    assert windowed.converged and full.converged and windowed.kkt_residual <= 1e-10
+    assert np.abs(windowed.p - full.p).max() <= 1e-8 * full.p.max()
+    assert windowed.approach == pytest.approx(full.approach, rel=1e-9)
+    np.testing.assert_allclose(windowed.displacement, full.displacement, rtol=0, atol=1e-9 * full.displacement.max())
+
+
+@pytest.mark.parametrize("checked", [True, False])
+def test_start_window_that_misses_the_contact_is_solved_again(monkeypatch, checked):
+    kw = dict(E_star=1.0, force=1e-3, step=0.002, extent=0.2)
+    reference = bem.solve(_wavy, **kw)
+    used, _ = _spied(monkeypatch)
+    monkeypatch.setattr(windows_module, "_START_PAD", -6)  # the box cut inside the start's contact
+    if not checked:  # planted fault: the window's solution taken unchecked
+        monkeypatch.setattr(windows_module, "_open_outside", lambda *args: True)
+    res = bem.solve(_wavy, **kw)
+    if checked:
+        assert res.converged and res.kkt_residual <= 1e-10
+        assert type(used[-1]).__name__ == "Lattice" and type(used[-2]).__name__ == "LatticeWindow"
+        assert np.abs(res.p - reference.p).max() <= 1e-8 * reference.p.max()
+    else:  # the full lattice's KKT residual shows the nodes the window left out
+        assert type(used[-1]).__name__ == "LatticeWindow" and res.kkt_residual > 1e-4
