@@ -133,8 +133,8 @@ def solve_in_window(run, make_op, lat, h, kw, delta, solver):
     """Solve one lattice level, on a window of it where there is one (the module docstring).
 
     ``run(op, h, kw)`` runs ``solver`` with the keyword arguments ``kw`` on the operator ``op =
-    make_op(lattice)``. ``delta`` is the approach the coarser level found (None: no coarser level, no window).
-    Returns the solution, the operators used (or the records of those let go), and the product ``C p`` of the
+    make_op(lattice)``. ``delta`` is the approach the level is solved near (the given one, or the coarser level's;
+    None outside nested iteration: no window). Returns the solution, the operators used (or the records of those let go), and the product ``C p`` of the
     solution on ``lat`` where the level made it (a window checked on the full lattice; None otherwise).
     """
     window = candidate_window(lat, h, delta)
