@@ -109,7 +109,8 @@ class InfluenceOperator:
         self.lattice = lattice
         self.backend = get_backend(device)
         self.mask = self.backend.asarray(lattice.mask, dtype=self.backend.xp.bool)  # candidate nodes, on the device
-        self.n_matvec = 0  # products C p so far (the work measure of ContactResult.n_matvec)
+        # products C p and 2-D FFTs of lattice arrays (forward or inverse) so far: ContactResult's work measures
+        self.n_matvec = self.n_transforms = 0
         self.E_star = check_positive("E_star", E_star)
         n_rows, n_cols = lattice.shape
         self._start = tuple(0 if int(lattice.parity[0]) == a else 1 for a in (0, 1))  # first brick row of parity a
@@ -142,10 +143,7 @@ class InfluenceOperator:
     # -- geometry of the 2 x 2 block convolution -------------------------------------------------
 
     def _box(self, v):
-        """Snapped bounding box of the support of ``v``: parity row ranges and a column range.
-
-        Returns ``None`` for ``v = 0``.
-        """
+        """Snapped bounding box of the support of ``v``: parity row ranges and a column range (``None``: ``v = 0``)."""
         n_rows, n_cols = v.shape
         if self.backend.is_numpy:
             rows = np.flatnonzero(v.any(axis=1))  # NaN counts as support
@@ -237,6 +235,7 @@ class InfluenceOperator:
         transforms in single precision, with single-precision spectra)."""
         o_rows, (oq, nq) = out_box
         bk = self.backend
+        self.n_transforms += 2  # the forward transform of the input's box, the inverse onto the output's
         if isinstance(spectra, PairedSymbol) or _by_bands(bk, shape, single):
             dests = [out[_rows(s, k0, na, out.shape[0]), oq : oq + nq] for s, (k0, na) in zip(self._start, o_rows)]
             convolve_by_bands(spectra, shape, self._parts(v, in_box), dests, np.float32 if single else np.float64)
@@ -282,6 +281,7 @@ class InfluenceOperator:
         s = max(float(xp.max(v)), -float(xp.min(v)))  # v / s in single precision: no overflow
         if not math.isfinite(s):
             return math.nan
+        self.n_transforms += 1
         if bk.is_numpy:
             V = pruned_fft.forward_parts(self._parts(v, box), shape, np.float32, scale=1.0 / s)
         else:

@@ -59,6 +59,11 @@ class ContactResult:
     n_matvec : int
         Products with the influence matrix ``C`` (FFT convolutions) on the finest lattice,
         inner solves included: the measure of work that does not depend on the method.
+    n_transforms : int
+        2-D FFTs of the finest lattice's arrays, forward or inverse, in either precision: those of the products
+        with ``C`` (two each), of the preconditioner (two an application) and of the curvature of a step made
+        without a product (one), inner solves included; not those that build the kernel's spectra or symbols.
+        The work measure of a solver's iterations that :attr:`n_matvec` leaves out.
     history : dict
         Per-iteration lists (``residual``, ``p_max``, ``n_contact``, ``changes``
         and method-specific entries).
@@ -105,6 +110,7 @@ class ContactResult:
     history: dict = field(default_factory=dict)
     layer: object = None
     n_matvec: int = 0
+    n_transforms: int = 0
     status: str = ""
     rtol: float = math.nan
     domain: object = None
@@ -152,6 +158,7 @@ class ContactResult:
             "contact_radius": float(self.contact_radius),
             "iterations": int(self.iterations),
             "n_matvec": int(self.n_matvec),
+            "n_transforms": int(self.n_transforms),
             "kkt_residual": float(self.kkt_residual),
             "rtol": float(self.rtol),
             "wall_time_s": float(self.wall_time_s),

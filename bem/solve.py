@@ -265,6 +265,7 @@ def _solve_on(region, gap, problem, x0, t_start):
     region.check_solution(lattice, sol.p)
     op = ops[-1] if ops[-1].lattice is lattice else make_op(lattice)
     n_matvec = sum(o.n_matvec for o in ops if o is not op)
+    n_transforms = sum(o.n_transforms for o in ops if o is not op)
     # the result recomputes C p (where the level did not make it): the solver's copy, the start and the level's
     # operators go first
     guess = kw = ops = levels = None
@@ -274,12 +275,13 @@ def _solve_on(region, gap, problem, x0, t_start):
     if u is None:  # (the level's own product where it made one on the finest lattice)
         u = to_host(op.matvec(sol.p))
     n_matvec += op.n_matvec
+    n_transforms += op.n_transforms
     op = None  # its kernel spectra go before the result is made
     g, scale = _deformed_gap(u, closure, h, sol.approach)
     # the full arrays are handed over in a dict, so that the result can let each go once it has its nodes
     fields = dict(u=u, g=g, closure=closure)
     u = g = closure = h = h_lat = None
-    return _result(region, lattice, fields, scale, sol, problem, t_start, n_matvec)
+    return _result(region, lattice, fields, scale, sol, problem, t_start, (n_matvec, n_transforms))
 
 
 def _deformed_gap(u, closure, h, approach):
@@ -338,11 +340,12 @@ def _dispatch(solver, op, h, layer, precondition, kw, options):
     return run(op, h, layer=layer, precondition=precondition, **kw, **options)
 
 
-def _result(region, lattice, fields, scale, sol, problem, t_start, n_matvec):
+def _result(region, lattice, fields, scale, sol, problem, t_start, work):
     """The result on the candidate nodes from the full arrays ``fields`` (``u``, ``g`` and ``closure``, None
-    without a layer: zeros), each let go once its nodes are taken. Where every node is a candidate (a
-    periodic cell) its arrays are flat views, not copies: x and y (the lattice's, read-only), p, the
-    displacement and the gap; elsewhere the lattice's coordinates are made one at a time and released."""
+    without a layer: zeros), each let go once its nodes are taken; ``work``: the products with ``C`` and the
+    transforms. Where every node is a candidate (a periodic cell) its arrays are flat views, not copies: x and y
+    (the lattice's, read-only), p, the displacement and the gap; elsewhere the lattice's coordinates are made one
+    at a time and released."""
     mask = lattice.mask
     whole = bool(mask.all())
 
@@ -378,6 +381,6 @@ def _result(region, lattice, fields, scale, sol, problem, t_start, n_matvec):
         contact_area=float(a * np.count_nonzero(p_n > 0)), converged=bool(sol.converged),
         message=sol.message, status=sol.status, rtol=float(problem.rtol), iterations=int(sol.iterations),
         kkt_residual=float(kkt), method=problem.solver, wall_time_s=time.perf_counter() - t_start, lattice=lattice,
-        E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=n_matvec,
+        E_star=problem.E_star, history=sol.history, layer=problem.layer, n_matvec=work[0], n_transforms=work[1],
         domain=region, bodies=problem.bodies, hardness=problem.hardness,
         plastic_area=0.0 if problem.hardness is None else float(a * np.count_nonzero(p[mask] >= problem.hardness)))

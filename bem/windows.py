@@ -98,10 +98,11 @@ def _embedded(sol, window):
 
 
 class _Spent:
-    """The record of an operator let go: its lattice and the products it made (what nested iteration reads)."""
+    """The record of an operator let go: its lattice and the products and transforms it made (what nested iteration
+    reads)."""
 
     def __init__(self, op):
-        self.lattice, self.n_matvec = op.lattice, op.n_matvec
+        self.lattice, self.n_matvec, self.n_transforms = op.lattice, op.n_matvec, op.n_transforms
 
 
 def _window_kw(kw, window, lat, solver):
@@ -134,8 +135,9 @@ def solve_in_window(run, make_op, lat, h, kw, delta, solver):
 
     ``run(op, h, kw)`` runs ``solver`` with the keyword arguments ``kw`` on the operator ``op =
     make_op(lattice)``. ``delta`` is the approach the level is solved near (the given one, or the coarser level's;
-    None outside nested iteration: no window). Returns the solution, the operators used (or the records of those let go), and the product ``C p`` of the
-    solution on ``lat`` where the level made it (a window checked on the full lattice; None otherwise).
+    None outside nested iteration: no window). Returns the solution, the operators used (or the records of those
+    let go), and the product ``C p`` of the solution on ``lat`` where the level made it (a window checked on the
+    full lattice; None otherwise).
     """
     window = candidate_window(lat, h, delta)
     start = start_window(lat, kw["x0"]) if delta is not None else None

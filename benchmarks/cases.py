@@ -247,7 +247,8 @@ def prepare(problem, n):
 
 def summary(res):
     """The measurements of a contactlab result, as a dict."""
-    return dict(nodes=int(res.p.size), iterations=int(res.iterations), kkt=float(res.kkt_residual),
+    return dict(nodes=int(res.p.size), iterations=int(res.iterations), products=int(res.n_matvec),
+                transforms=int(res.n_transforms), kkt=float(res.kkt_residual),
                 converged=bool(res.converged), status=str(res.status), contact_fraction=float(np.mean(res.p > 0)))
 
 

@@ -255,7 +255,8 @@ def case_floor(n, repeat=30):
     for dtype in (np.float32, np.float64):
         x = v.astype(dtype)  # outside the clock
         pairs[np.dtype(dtype).name] = float(_median_times(lambda: _pair(x), repeat)[0])
-    print(json.dumps(dict(case="floor", n=n, iterations=res.iterations, products=res.n_matvec, wall_s=round(wall, 3),
+    print(json.dumps(dict(case="floor", n=n, iterations=res.iterations, products=res.n_matvec,
+                          transforms=res.n_transforms, wall_s=round(wall, 3),
                           iteration_ms=round(per_iteration * 1e3, 2),
                           pair_ms={k: round(v * 1e3, 2) for k, v in pairs.items()},
                           iteration_over_pair={k: round(per_iteration / v, 2) for k, v in pairs.items()},

@@ -135,7 +135,7 @@ class PeriodicOperator:
         self.mask = bk.asarray(lattice.mask, dtype=bk.xp.bool)
         self.E_star = check_positive("E_star", E_star)
         self.bodies = _checked_bodies(bodies, self.E_star)
-        self.n_matvec = 0
+        self.n_matvec = self.n_transforms = 0  # products, 2-D FFTs of brick arrays: ContactResult's work measures
         self.diagonal = diagonal_coefficient(lattice.step, self.E_star)
         self._spectrum_shape = (lattice.n_rows // 2, lattice.n_cols // 2 + 1)
         self._symbol32 = self._symbol = self._s00 = None
@@ -171,6 +171,7 @@ class PeriodicOperator:
         columns on each parity's strided rows, so the parities are never copied apart.
         """
         bk = self.backend
+        self.n_transforms += 1
         rows = bk.rfft(v, axis=-1)
         out = bk.xp.empty((2,) + self._spectrum_shape, dtype=bk.xp.complex128)
         for a in (0, 1):
@@ -187,6 +188,7 @@ class PeriodicOperator:
         new array, as off NumPy).
         """
         n_rows, n_cols = self.lattice.shape
+        self.n_transforms += 1
         if not self.backend.is_numpy:
             xp = self.backend.xp
             return xp.fft.fft(xp.fft.rfft(xp.reshape(v, (n_rows // 2, 2, n_cols)), axis=2), axis=0)
@@ -201,6 +203,7 @@ class PeriodicOperator:
         ``overwrite``: the spectrum may be destroyed; ``out``: a C-contiguous array of the lattice's shape and the
         spectrum's real dtype that receives it (NumPy; default: a new array, as off NumPy)."""
         n_rows, n_cols = self.lattice.shape
+        self.n_transforms += 1
         if not self.backend.is_numpy:
             xp = self.backend.xp
             return xp.reshape(xp.fft.irfft(xp.fft.ifft(spectrum, axis=0), n=n_cols, axis=2), (n_rows, n_cols))
@@ -304,6 +307,7 @@ class PeriodicOperator:
         P[0, ...] += s01 * P[1, ...]
         P[1, ...] = u1
         rows = bk.xp.empty((self.lattice.n_rows, self._spectrum_shape[1]), dtype=bk.xp.complex128)
+        self.n_transforms += 1
         for a in (0, 1):
             rows[a::2, :] = bk.cfft(P[a, ...], axis=0, inverse=True)
         return bk.irfft(rows, n=self.lattice.n_cols, axis=-1)

@@ -99,6 +99,49 @@ def test_n_matvec_counts_the_products_with_c(monkeypatch):
         assert res.n_matvec == len(calls) > res.iterations
 
 
+@pytest.mark.parametrize("domain", ["region", "cell"])
+@pytest.mark.parametrize("layer", [None, layers.Root(0.05)])
+def test_n_transforms_counts_the_ffts_of_the_lattices_arrays(monkeypatch, domain, layer):
+    """Counted where the transforms are made, a level below the operators that count them: on a region the
+    forward transform of a box (both parities in one call) and the inverse of each parity; on a cell the real
+    transform along the rows, forward and inverse, once a transform; each called from the operator's module (the
+    kernel's spectra are made through other callers). One level (nested=False): every transform counted is the
+    finest lattice's."""
+    import sys
+
+    from bem import fft as bem_fft
+    from bem import pruned_fft
+
+    counts = {"forward": 0, "inverse": 0}
+
+    def spy(module, name, key, weight):
+        real = getattr(module, name)
+
+        def counting(*args, **kw):
+            if sys._getframe(1).f_code.co_filename.endswith(("operator.py", "influence.py")):
+                counts[key] += weight
+            return real(*args, **kw)
+
+        monkeypatch.setattr(module, name, counting)
+
+    if domain == "region":
+        spy(pruned_fft, "forward_parts", "forward", 1)
+        spy(pruned_fft, "inverse_into", "inverse", 0.5)  # one call a parity
+        res = _hertz(nested=False, layer=layer)
+    else:
+        from bem.periodic import influence
+
+        spy(influence.fft, "rfft_into", "forward", 1)
+        spy(influence.fft, "irfft_into", "inverse", 1)
+        cell = bem.PeriodicCell(1.0 / 64, 64, 64)
+        h = 0.01 * (2 - np.cos(2 * np.pi * cell.x / cell.size[0]) - np.cos(2 * np.pi * cell.y / cell.size[1]))
+        res = bem.solve(h, domain=cell, E_star=1.0, mean_pressure=0.003, layer=layer, nested=False)
+        assert bem_fft is influence.fft
+    assert res.converged
+    assert res.n_transforms == counts["forward"] + counts["inverse"]
+    assert counts["forward"] >= res.iterations and counts["inverse"] >= res.iterations > 0
+
+
 # --- one name, one meaning ------------------------------------------------------------------------
 
 def test_rtol_is_the_kkt_tolerance_of_every_method():
