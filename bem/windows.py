@@ -16,8 +16,11 @@ the contact, it is the only window. Nothing guarantees it, so the full lattice's
 of its solution checks it: the solution is accepted where every node outside the window is open,
 ``-(u + h - delta) <= rtol max |u|`` (the rule of :func:`bem.kkt.kkt_residual` for the nodes out of
 contact), and is then the full lattice's solution within ``rtol``, that product the result's;
-otherwise the level is solved again on the full lattice from it. The gains are measured by
-``benchmarks/side_by_side.py`` and ``benchmarks/peers.py`` (docs/performance.md).
+otherwise the level is solved again from it on the window grown over the nodes it missed (padded
+by ``_START_PAD``; on a rough surface its contact's edge at the finer level reaches asperities the
+coarser one did not see), at most ``_START_TRIES`` windows, then on the full lattice. The gains are
+measured by ``benchmarks/side_by_side.py``, ``benchmarks/peers.py`` and ``benchmarks/two_scale.py``
+(docs/performance.md).
 """
 
 from __future__ import annotations
@@ -36,7 +39,8 @@ log = logging.getLogger(__name__)
 _WINDOW_MARGIN = 0.25
 _WINDOW_PAD = 2
 _WINDOW_UP_TO = 0.6  # a window with more than this fraction of the brick array is not worth it
-_START_PAD = 2  # nodes around the bounding box of the start's contact
+_START_PAD = 2  # nodes around the bounding box of the start's contact, and around the nodes a window missed
+_START_TRIES = 3  # windows of the start's contact tried, each grown over the nodes the last one missed
 _CHECK_ROWS = 256  # rows of a block of the check outside a window
 
 
@@ -65,9 +69,15 @@ def _padded(lat, near, pad):
     rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
     if not rows.size:
         return None
+    return _box_window(lat, (int(rows[0]), int(rows[-1]) + 1), (int(cols[0]), int(cols[-1]) + 1), pad)
+
+
+def _box_window(lat, rows, cols, pad):
+    """The block ``rows x cols`` (``(start, stop)`` ranges) padded by ``pad`` nodes, as a window of ``lat``; None
+    where it has more than ``_WINDOW_UP_TO`` of the brick array."""
     n_rows, n_cols = lat.shape
-    r0, r1 = max(int(rows[0]) - pad, 0), min(int(rows[-1]) + 1 + pad, n_rows)
-    c0, c1 = max(int(cols[0]) - pad, 0), min(int(cols[-1]) + 1 + pad, n_cols)
+    r0, r1 = max(rows[0] - pad, 0), min(rows[1] + pad, n_rows)
+    c0, c1 = max(cols[0] - pad, 0), min(cols[1] + pad, n_cols)
     if r1 - r0 < 4 or (r1 - r0) * (c1 - c0) > _WINDOW_UP_TO * n_rows * n_cols:
         return None
     return lat.window((r0, r1), (c0, c1))
@@ -116,18 +126,22 @@ def _window_kw(kw, window, lat, solver):
     return kw_w
 
 
-def _open_outside(lat, window, u, h, delta, rtol):
-    """Whether the nodes of ``lat`` outside ``window`` are open within ``rtol``: ``-min(u + h - delta) <= rtol max
-    |u|`` over them (``u = C p`` on ``lat``, ``p = 0`` there, ``w(0) = 0``), by blocks of rows (no array of the
-    lattice made)."""
+def _closing_outside(lat, window, u, h, delta, rtol):
+    """The bounding box ``((r0, r1), (c0, c1))`` of the nodes of ``lat`` outside ``window`` that are not open within
+    ``rtol``, ``u + h - delta < -rtol max |u|`` (``u = C p`` on ``lat``, ``p = 0`` there, ``w(0) = 0``); None where
+    every one is open. By blocks of rows (no array of the lattice made)."""
     (r0, r1), (c0, c1) = window.rows, window.cols
-    g_min = np.inf
+    below = delta - rtol * max(float(np.max(u)), -float(np.min(u)))
+    rows, cols = [], []
     for lo in range(0, lat.shape[0], _CHECK_ROWS):
         hi = min(lo + _CHECK_ROWS, lat.shape[0])
-        outside = lat.mask[lo:hi].copy()
-        outside[max(r0 - lo, 0) : max(min(r1, hi) - lo, 0), c0:c1] = False
-        g_min = min(g_min, float(np.min(u[lo:hi] + h[lo:hi], where=outside, initial=np.inf)))
-    return g_min - delta >= -rtol * max(float(np.max(u)), -float(np.min(u)))
+        closing = lat.mask[lo:hi] & (u[lo:hi] + h[lo:hi] < below)
+        closing[max(r0 - lo, 0) : max(min(r1, hi) - lo, 0), c0:c1] = False
+        if closing.any():
+            r, c = np.flatnonzero(closing.any(axis=1)), np.flatnonzero(closing.any(axis=0))
+            rows += [lo + int(r[0]), lo + int(r[-1]) + 1]
+            cols += [int(c[0]), int(c[-1]) + 1]
+    return ((min(rows), max(rows)), (min(cols), max(cols))) if rows else None
 
 
 def solve_in_window(run, make_op, lat, h, kw, delta, solver):
@@ -160,16 +174,24 @@ def solve_in_window(run, make_op, lat, h, kw, delta, solver):
 
 
 def _solve_checked(run, make_op, lat, h, kw, solver, window):
-    """:func:`solve_in_window` on the window of the start's contact, checked by the full lattice's product."""
-    op = make_op(window)
-    sol = _embedded(run(op, h[window.index], _window_kw(kw, window, lat, solver)), window)
-    ops = [_Spent(op)]
-    op = None  # the window's operator (its kernel spectra) goes before the full lattice's product
-    full = make_op(lat)
-    ops.append(full)
-    u = to_host(full.matvec(sol.p))
-    if not sol.converged or _open_outside(lat, window, u, h, sol.approach, kw["rtol"]):
-        return sol, ops, u
-    log.debug("the window of the start's contact misses nodes of the contact: solving on the full lattice")
-    u = None
-    return run(full, h, dict(kw, x0=sol.p)), ops, None
+    """:func:`solve_in_window` on the window of the start's contact, checked by the full lattice's product; a window
+    that misses nodes of the contact is grown over them (at most ``_START_TRIES`` windows)."""
+    ops, full = [], None
+    for _ in range(_START_TRIES):
+        op = make_op(window)
+        sol = _embedded(run(op, h[window.index], _window_kw(kw, window, lat, solver)), window)
+        ops.append(_Spent(op))
+        op = None  # the window's operator (its kernel spectra) goes before the full lattice's product
+        full = make_op(lat) if full is None else full
+        u = to_host(full.matvec(sol.p))
+        closing = _closing_outside(lat, window, u, h, sol.approach, kw["rtol"]) if sol.converged else None
+        if closing is None:
+            return sol, ops + [full], u
+        u, kw = None, dict(kw, x0=sol.p)  # the next solve starts from this one
+        (r0, r1), (c0, c1) = window.rows, window.cols
+        window = _box_window(lat, (min(r0, closing[0][0]), max(r1, closing[0][1])),
+                             (min(c0, closing[1][0]), max(c1, closing[1][1])), _START_PAD)
+        log.debug("the window of the start's contact misses nodes of the contact: %s", "grown" if window else "none")
+        if window is None:
+            break
+    return run(full, h, kw), ops + [full], None

@@ -167,18 +167,27 @@ def test_start_window_gives_the_full_lattice_solution(monkeypatch, layer):
     np.testing.assert_allclose(windowed.displacement, full.displacement, rtol=0, atol=1e-9 * full.displacement.max())
 
 
-@pytest.mark.parametrize("checked", [True, False])
-def test_start_window_that_misses_the_contact_is_solved_again(monkeypatch, checked):
+@pytest.mark.parametrize("case", ["grown", "full", "unchecked"])
+def test_start_window_that_misses_the_contact_is_solved_again(monkeypatch, case):
     kw = dict(E_star=1.0, force=1e-3, step=0.002, extent=0.2)
     reference = bem.solve(_wavy, **kw)
     used, _ = _spied(monkeypatch)
-    monkeypatch.setattr(windows_module, "_START_PAD", -6)  # the box cut inside the start's contact
-    if not checked:  # planted fault: the window's solution taken unchecked
-        monkeypatch.setattr(windows_module, "_open_outside", lambda *args: True)
+    padded = windows_module._padded
+    # every start window cut 6 nodes inside the box of the start's contact
+    monkeypatch.setattr(windows_module, "start_window", lambda lat, x0: None if x0 is None else padded(lat, x0 > 0, -6))
+    if case == "full":  # one window tried, then the full lattice
+        monkeypatch.setattr(windows_module, "_START_TRIES", 1)
+    if case == "unchecked":  # planted fault: the window's solution taken unchecked
+        monkeypatch.setattr(windows_module, "_closing_outside", lambda *args: None)
     res = bem.solve(_wavy, **kw)
-    if checked:
-        assert res.converged and res.kkt_residual <= 1e-10
-        assert type(used[-1]).__name__ == "Lattice" and type(used[-2]).__name__ == "LatticeWindow"
-        assert np.abs(res.p - reference.p).max() <= 1e-8 * reference.p.max()
-    else:  # the full lattice's KKT residual shows the nodes the window left out
-        assert type(used[-1]).__name__ == "LatticeWindow" and res.kkt_residual > 1e-4
+    kinds = [type(lat).__name__ for lat in used]
+    if case == "unchecked":  # the full lattice's KKT residual shows the nodes the window left out
+        assert kinds[-1] == "LatticeWindow" and res.kkt_residual > 1e-4
+        return
+    assert res.converged and res.kkt_residual <= 1e-10
+    assert np.abs(res.p - reference.p).max() <= 1e-8 * reference.p.max()
+    if case == "full":
+        assert kinds[-2:] == ["LatticeWindow", "Lattice"]
+    else:  # the finest level's window grown over the nodes it missed: a larger window, not the full lattice
+        assert kinds[-2:] == ["LatticeWindow", "LatticeWindow"] and used[-1].n_nodes > used[-2].n_nodes
+        assert used[-1].n_nodes < 0.6 * res.p.size
