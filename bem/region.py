@@ -155,11 +155,11 @@ class HalfSpaceRegion:
             return InfluenceOperator(lattice, E_star, device=backend)
         return InfluenceOperator(lattice, E_star, device=backend, bodies=bodies)
 
-    def solve_level(self, run, make_op, lattice, h, kw, delta, solver):
-        """One level of nested iteration (``delta``: the approach it knows, or None): on a window of
-        :mod:`bem.windows` where there is one; the solution, the operators used and the product ``C p`` on the
-        lattice where the level made it (:func:`bem.windows.solve_in_window`)."""
-        return solve_in_window(run, make_op, lattice, h, kw, delta, solver)
+    def solve_level(self, run, make_op, lattice, h, kw, delta, solver, handover=None):
+        """One level of nested iteration (``delta``: the approach it knows, or None; ``handover``: what the coarser
+        level hands over): on a window of :mod:`bem.windows` where there is one; the solution, the operators used
+        and the product ``C p`` on the lattice where the level made it (:func:`bem.windows.solve_in_window`)."""
+        return solve_in_window(run, make_op, lattice, h, kw, delta, solver, handover)
 
     def refine(self, coarse, p, fine):
         """The coarse solution interpolated onto the next finer lattice."""

@@ -244,6 +244,7 @@ def _solve_on(region, gap, problem, x0, t_start):
         return _run(problem.solver, op, h_lat, problem.layer, problem.precondition, kw, problem.options)
 
     rtol, delta = problem.rtol, problem.approach  # the approach, or under force control its coarser estimate
+    handover = {}  # what a level hands over to the next: its product C p prolonged, where it made one
     while levels:  # each level leaves the list as it is solved: a coarser level's arrays go before the next
         lat, h_lat = levels.pop(0)
         finest = not levels
@@ -257,10 +258,12 @@ def _solve_on(region, gap, problem, x0, t_start):
         if problem.hardness is not None:
             _check_capacity(region, lat, problem)
             kw["hardness"] = problem.hardness
-        sol, ops, u = region.solve_level(run, make_op, lat, h_lat, kw, delta if nested else None, problem.solver)
+        sol, ops, u = region.solve_level(run, make_op, lat, h_lat, kw, delta if nested else None, problem.solver,
+                                         handover)
         delta = sol.approach
         if not finest:  # the coarse solution and operators are released before the finer level is solved
             guess = region.refine(lat, sol.p, levels[0][0])
+            handover = {} if u is None else {"u": region.refine(lat, u, levels[0][0])}
             sol = ops = u = h_lat = None
     region.check_solution(lattice, sol.p)
     op = ops[-1] if ops[-1].lattice is lattice else make_op(lattice)

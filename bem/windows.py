@@ -12,8 +12,11 @@ the window's solution). The full lattice still gets one product, for the result.
 Where the start of a level (the coarser level's solution, prolonged) touches a smaller block than
 that, the level is solved on the bounding box of the start's contact, padded by ``_START_PAD``
 nodes (:func:`start_window`); on a rough surface, whose gap ``h`` dips below the approach far from
-the contact, it is the only window. Nothing guarantees it, so the full lattice's product ``u = C p``
-of its solution checks it: the solution is accepted where every node outside the window is open,
+the contact, it is the only window. Where the coarser level made its product ``C p`` (its own window
+checked), that product prolonged estimates the finer gap, and the box takes in the nodes it closes,
+``h + u < delta``: asperities the finer ``h`` raises where the coarser lattice did not see them.
+Nothing guarantees the window, so the full lattice's product ``u = C p`` of its solution checks it:
+the solution is accepted where every node outside the window is open,
 ``-(u + h - delta) <= rtol max |u|`` (the rule of :func:`bem.kkt.kkt_residual` for the nodes out of
 contact), and is then the full lattice's solution within ``rtol``, that product the result's;
 otherwise the level is solved again from it on the window grown over the nodes it missed (padded
@@ -55,12 +58,20 @@ def candidate_window(lat, h, delta):
     return _padded(lat, mask & (h < delta + _WINDOW_MARGIN * (delta - h_min)), _WINDOW_PAD)
 
 
-def start_window(lat, x0):
+def start_window(lat, x0, h=None, u=None, delta=None):
     """The window of ``lat`` around the contact of the start ``x0`` (its nodes of positive pressure, a brick array),
-    padded by ``_START_PAD`` nodes, or None (no start, no contact, or a window not worth it)."""
+    padded by ``_START_PAD`` nodes, or None (no start, no contact, or a window not worth it). With the coarser
+    level's product ``u = C p`` prolonged onto ``lat``, the gap ``h`` and the approach ``delta``, also around the
+    nodes that estimate closes, ``h + u < delta``: asperities that the finer gap ``h`` raises where the coarser one
+    did not (by blocks of rows)."""
     if x0 is None:
         return None
-    return _padded(lat, np.asarray(x0) > 0, _START_PAD)
+    near = np.asarray(x0) > 0
+    if u is not None:
+        for lo in range(0, lat.shape[0], _CHECK_ROWS):
+            near[lo : lo + _CHECK_ROWS] |= lat.mask[lo : lo + _CHECK_ROWS] & (
+                h[lo : lo + _CHECK_ROWS] + u[lo : lo + _CHECK_ROWS] < delta)
+    return _padded(lat, near, _START_PAD)
 
 
 def _padded(lat, near, pad):
@@ -144,17 +155,20 @@ def _closing_outside(lat, window, u, h, delta, rtol):
     return ((min(rows), max(rows)), (min(cols), max(cols))) if rows else None
 
 
-def solve_in_window(run, make_op, lat, h, kw, delta, solver):
+def solve_in_window(run, make_op, lat, h, kw, delta, solver, handover=None):
     """Solve one lattice level, on a window of it where there is one (the module docstring).
 
     ``run(op, h, kw)`` runs ``solver`` with the keyword arguments ``kw`` on the operator ``op =
     make_op(lattice)``. ``delta`` is the approach the level is solved near (the given one, or the coarser level's;
-    None outside nested iteration: no window). Returns the solution, the operators used (or the records of those
-    let go), and the product ``C p`` of the solution on ``lat`` where the level made it (a window checked on the
-    full lattice; None otherwise).
+    None outside nested iteration: no window); ``handover``: a dict that may hold under ``"u"`` the coarser level's
+    product ``C p`` prolonged onto ``lat`` (taken out of it, and let go once the window is chosen). Returns the
+    solution, the operators used (or the records of those let go), and the product ``C p`` of the solution on ``lat``
+    where the level made it (a window checked on the full lattice; None otherwise).
     """
     window = candidate_window(lat, h, delta)
-    start = start_window(lat, kw["x0"]) if delta is not None else None
+    u = (handover or {}).pop("u", None)
+    start = start_window(lat, kw["x0"], h, u, delta) if delta is not None else None
+    u = None
     if start is not None and (window is None or start.n_nodes < window.n_nodes):
         return _solve_checked(run, make_op, lat, h, kw, solver, start)
     ops = []

@@ -133,8 +133,9 @@ class PeriodicCell:
         """The periodic influence operator on ``cell`` (of coated ``bodies`` where given)."""
         return PeriodicOperator(cell, E_star, device=backend, bodies=bodies)
 
-    def solve_level(self, run, make_op, cell, h, kw, delta, solver):
-        """One level of nested iteration, on the whole cell; the solution, the operator used and no product."""
+    def solve_level(self, run, make_op, cell, h, kw, delta, solver, handover=None):
+        """One level of nested iteration, on the whole cell (what the coarser level hands over, ``handover``, unused);
+        the solution, the operator used and no product."""
         op = make_op(cell)
         return run(op, h, kw), [op], None
 

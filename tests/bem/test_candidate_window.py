@@ -119,6 +119,13 @@ def test_start_window_is_the_padded_box_of_the_starts_contact(monkeypatch):
     pad = windows_module._START_PAD
     assert (win.rows, win.cols) == ((6 - pad, 9 + pad), (4 - pad, 7 + pad))
     np.testing.assert_array_equal(x0, before)  # the start is not modified
+    # with the coarser product's estimate of the gap, also around the nodes it closes (here one, below the box)
+    h, u = np.full(lat.shape, 1.0), np.zeros(lat.shape)
+    h[14, 5] = 0.2
+    grown = windows_module.start_window(lat, x0, h, u, 0.5)
+    assert (grown.rows, grown.cols) == ((6 - pad, 15 + pad), (4 - pad, 7 + pad))
+    assert windows_module.start_window(lat, x0, h, u, 0.1) is not None and (
+        windows_module.start_window(lat, x0, h, u, 0.1).rows == win.rows)
     x0[0, 0] = x0[-1, -1] = 1.0  # a box of the whole lattice is not worth a window
     assert windows_module.start_window(lat, x0) is None
 
@@ -174,7 +181,8 @@ def test_start_window_that_misses_the_contact_is_solved_again(monkeypatch, case)
     used, _ = _spied(monkeypatch)
     padded = windows_module._padded
     # every start window cut 6 nodes inside the box of the start's contact
-    monkeypatch.setattr(windows_module, "start_window", lambda lat, x0: None if x0 is None else padded(lat, x0 > 0, -6))
+    monkeypatch.setattr(windows_module, "start_window",
+                        lambda lat, x0, *estimate: None if x0 is None else padded(lat, x0 > 0, -6))
     if case == "full":  # one window tried, then the full lattice
         monkeypatch.setattr(windows_module, "_START_TRIES", 1)
     if case == "unchecked":  # planted fault: the window's solution taken unchecked
@@ -191,3 +199,38 @@ def test_start_window_that_misses_the_contact_is_solved_again(monkeypatch, case)
     else:  # the finest level's window grown over the nodes it missed: a larger window, not the full lattice
         assert kinds[-2:] == ["LatticeWindow", "LatticeWindow"] and used[-1].n_nodes > used[-2].n_nodes
         assert used[-1].n_nodes < 0.6 * res.p.size
+
+
+@pytest.mark.parametrize("estimate", [True, False])
+def test_start_window_takes_in_what_the_coarser_product_closes(monkeypatch, estimate):
+    """A bump one node wide just outside the contact, between the nodes of the coarser lattices (which do not see it):
+    with the coarser level's product prolonged, the finest level's first window takes it in; without that estimate
+    (planted) the window misses it and is grown over it."""
+    kw = dict(E_star=1.0, force=1e-3, step=0.001, extent=0.2)  # three levels: the middle one hands its product over
+    fine = bem.solve(Paraboloid(1.0), **kw).lattice
+    coarse = fine.coarsen()
+    x, y = fine.x[fine.mask], fine.y[fine.mask]
+    cx, cy = coarse.x[coarse.mask], coarse.y[coarse.mask]
+    near = np.flatnonzero((np.abs(np.hypot(x, y) - 0.128) < 0.002) & (np.abs(y) < 0.003))
+    xb, yb = next((x[i], y[i]) for i in near if np.min(np.hypot(cx - x[i], cy - y[i])) > 0.9 * kw["step"])
+
+    def bumpy(x, y):
+        return (x * x + y * y) / 2.0 - 0.004 * np.exp(-((x - xb) ** 2 + (y - yb) ** 2) / (2 * (0.25 * kw["step"]) ** 2))
+
+    found, closing = [], windows_module._closing_outside
+
+    def recorded(lat, *args):  # the nodes each check found closing outside its window (None: none)
+        found.append(closing(lat, *args))
+        return found[-1]
+
+    monkeypatch.setattr(windows_module, "_closing_outside", recorded)
+    if not estimate:
+        start = windows_module.start_window
+        monkeypatch.setattr(windows_module, "start_window", lambda lat, x0, *args: start(lat, x0))
+    res = bem.solve(bumpy, **kw)
+    assert res.converged and res.kkt_residual <= 1e-10
+    assert res.p[np.argmin(np.hypot(res.x - xb, res.y - yb))] > 0  # the bump is in contact
+    if estimate:  # every first window held the contact
+        assert found and all(f is None for f in found)
+    else:  # the finest level's first window missed the bump, the grown one held it
+        assert found[-2] is not None and found[-1] is None
