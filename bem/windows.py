@@ -55,7 +55,8 @@ def candidate_window(lat, h, delta):
     h_min = float(np.min(h, where=mask, initial=np.inf))
     if not delta > h_min:
         return None
-    return _padded(lat, mask & (h < delta + _WINDOW_MARGIN * (delta - h_min)), _WINDOW_PAD)
+    top = delta + _WINDOW_MARGIN * (delta - h_min)
+    return _box_window(lat, _box(lat, lambda lo, hi: mask[lo:hi] & (h[lo:hi] < top)), _WINDOW_PAD)
 
 
 def start_window(lat, x0, h=None, u=None, delta=None):
@@ -63,42 +64,59 @@ def start_window(lat, x0, h=None, u=None, delta=None):
     padded by ``_START_PAD`` nodes, or None (no start, no contact, or a window not worth it). With the coarser
     level's product ``u = C p`` prolonged onto ``lat``, the gap ``h`` and the approach ``delta``, also around the
     nodes that estimate closes, ``h + u < delta``: asperities that the finer gap ``h`` raises where the coarser one
-    did not (by blocks of rows)."""
+    did not."""
     if x0 is None:
         return None
-    near = np.asarray(x0) > 0
-    if u is not None:
-        for lo in range(0, lat.shape[0], _CHECK_ROWS):
-            near[lo : lo + _CHECK_ROWS] |= lat.mask[lo : lo + _CHECK_ROWS] & (
-                h[lo : lo + _CHECK_ROWS] + u[lo : lo + _CHECK_ROWS] < delta)
-    return _padded(lat, near, _START_PAD)
+    x0 = np.asarray(x0)
+
+    def near(lo, hi):
+        on = x0[lo:hi] > 0
+        return on if u is None else on | (lat.mask[lo:hi] & (h[lo:hi] + u[lo:hi] < delta))
+
+    return _box_window(lat, _box(lat, near), _START_PAD)
 
 
-def _padded(lat, near, pad):
-    """The bounding box of the nodes ``near`` (a boolean brick array) padded by ``pad`` nodes, as a window of
-    ``lat``; None where there are none, or the box has more than ``_WINDOW_UP_TO`` of the brick array."""
-    rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
-    if not rows.size:
+def _box(lat, near, outside=None):
+    """The bounding box ``((r0, r1), (c0, c1))`` of the nodes where ``near(lo, hi)``, a boolean block of the brick
+    rows ``lo:hi``, is true (outside the window ``outside`` where given); None where there are none. By blocks of
+    :data:`_CHECK_ROWS` rows: no array of the lattice made."""
+    rows, cols = [], []
+    for lo in range(0, lat.shape[0], _CHECK_ROWS):
+        hi = min(lo + _CHECK_ROWS, lat.shape[0])
+        block = near(lo, hi)
+        if outside is not None:
+            (r0, r1), (c0, c1) = outside.rows, outside.cols
+            block[max(r0 - lo, 0) : max(min(r1, hi) - lo, 0), c0:c1] = False
+        if block.any():
+            r, c = np.flatnonzero(block.any(axis=1)), np.flatnonzero(block.any(axis=0))
+            rows += [lo + int(r[0]), lo + int(r[-1]) + 1]
+            cols += [int(c[0]), int(c[-1]) + 1]
+    return ((min(rows), max(rows)), (min(cols), max(cols))) if rows else None
+
+
+def _box_window(lat, box, pad):
+    """The block ``box = ((r0, r1), (c0, c1))`` padded by ``pad`` nodes, as a window of ``lat``; None where ``box`` is
+    None or the window has more than ``_WINDOW_UP_TO`` of the brick array."""
+    if box is None:
         return None
-    return _box_window(lat, (int(rows[0]), int(rows[-1]) + 1), (int(cols[0]), int(cols[-1]) + 1), pad)
-
-
-def _box_window(lat, rows, cols, pad):
-    """The block ``rows x cols`` (``(start, stop)`` ranges) padded by ``pad`` nodes, as a window of ``lat``; None
-    where it has more than ``_WINDOW_UP_TO`` of the brick array."""
     n_rows, n_cols = lat.shape
-    r0, r1 = max(rows[0] - pad, 0), min(rows[1] + pad, n_rows)
-    c0, c1 = max(cols[0] - pad, 0), min(cols[1] + pad, n_cols)
+    (r0, r1), (c0, c1) = box
+    r0, r1 = max(r0 - pad, 0), min(r1 + pad, n_rows)
+    c0, c1 = max(c0 - pad, 0), min(c1 + pad, n_cols)
     if r1 - r0 < 4 or (r1 - r0) * (c1 - c0) > _WINDOW_UP_TO * n_rows * n_cols:
         return None
     return lat.window((r0, r1), (c0, c1))
 
 
-def _clear_outside(lat, window, h, delta):
-    """Whether every node of ``lat`` outside ``window`` has ``h >= delta`` (then ``g >= 0`` there at ``p = 0``)."""
-    outside = lat.mask.copy()
-    outside[window.index] = False
-    return bool(np.isfinite(delta)) and float(np.min(h, where=outside, initial=np.inf)) >= delta
+def _closing_outside(lat, window, h, delta, u=None, rtol=0.0):
+    """The bounding box of the nodes of ``lat`` outside ``window`` that are not open within ``rtol``: ``h + u - delta
+    < -rtol max |u|`` (``u = C p`` on ``lat``, ``p = 0`` outside, ``w(0) = 0``; without ``u``: ``h < delta``, the
+    nodes whose gap can close); None where every one is open."""
+    mask = lat.mask
+    if u is None:
+        return _box(lat, lambda lo, hi: mask[lo:hi] & (h[lo:hi] < delta), window)
+    below = delta - rtol * max(float(np.max(u)), -float(np.min(u)))
+    return _box(lat, lambda lo, hi: mask[lo:hi] & (u[lo:hi] + h[lo:hi] < below), window)
 
 
 def _embedded(sol, window):
@@ -137,24 +155,6 @@ def _window_kw(kw, window, lat, solver):
     return kw_w
 
 
-def _closing_outside(lat, window, u, h, delta, rtol):
-    """The bounding box ``((r0, r1), (c0, c1))`` of the nodes of ``lat`` outside ``window`` that are not open within
-    ``rtol``, ``u + h - delta < -rtol max |u|`` (``u = C p`` on ``lat``, ``p = 0`` there, ``w(0) = 0``); None where
-    every one is open. By blocks of rows (no array of the lattice made)."""
-    (r0, r1), (c0, c1) = window.rows, window.cols
-    below = delta - rtol * max(float(np.max(u)), -float(np.min(u)))
-    rows, cols = [], []
-    for lo in range(0, lat.shape[0], _CHECK_ROWS):
-        hi = min(lo + _CHECK_ROWS, lat.shape[0])
-        closing = lat.mask[lo:hi] & (u[lo:hi] + h[lo:hi] < below)
-        closing[max(r0 - lo, 0) : max(min(r1, hi) - lo, 0), c0:c1] = False
-        if closing.any():
-            r, c = np.flatnonzero(closing.any(axis=1)), np.flatnonzero(closing.any(axis=0))
-            rows += [lo + int(r[0]), lo + int(r[-1]) + 1]
-            cols += [int(c[0]), int(c[-1]) + 1]
-    return ((min(rows), max(rows)), (min(cols), max(cols))) if rows else None
-
-
 def solve_in_window(run, make_op, lat, h, kw, delta, solver, handover=None):
     """Solve one lattice level, on a window of it where there is one (the module docstring).
 
@@ -176,7 +176,7 @@ def solve_in_window(run, make_op, lat, h, kw, delta, solver, handover=None):
         op = make_op(window)
         ops.append(op)
         sol = _embedded(run(op, h[window.index], _window_kw(kw, window, lat, solver)), window)
-        if _clear_outside(lat, window, h, sol.approach):
+        if np.isfinite(sol.approach) and _closing_outside(lat, window, h, sol.approach) is None:
             return sol, ops, None
         # rare: the approach grew past the margin. The full lattice starts from the window's
         # solution; the result reports that solve's iterations.
@@ -189,23 +189,26 @@ def solve_in_window(run, make_op, lat, h, kw, delta, solver, handover=None):
 
 def _solve_checked(run, make_op, lat, h, kw, solver, window):
     """:func:`solve_in_window` on the window of the start's contact, checked by the full lattice's product; a window
-    that misses nodes of the contact is grown over them (at most ``_START_TRIES`` windows)."""
-    ops, full = [], None
+    that misses nodes of the contact is grown over them (at most ``_START_TRIES`` windows). Each operator, of a
+    window or of the full lattice, is let go before the next is made (its counts kept)."""
+    ops = []
     for _ in range(_START_TRIES):
         op = make_op(window)
         sol = _embedded(run(op, h[window.index], _window_kw(kw, window, lat, solver)), window)
         ops.append(_Spent(op))
-        op = None  # the window's operator (its kernel spectra) goes before the full lattice's product
-        full = make_op(lat) if full is None else full
-        u = to_host(full.matvec(sol.p))
-        closing = _closing_outside(lat, window, u, h, sol.approach, kw["rtol"]) if sol.converged else None
+        op = make_op(lat)  # the window's operator (its kernel spectra) goes before the full lattice's product
+        u = to_host(op.matvec(sol.p))
+        closing = _closing_outside(lat, window, h, sol.approach, u, kw["rtol"]) if sol.converged else None
         if closing is None:
-            return sol, ops + [full], u
-        u, kw = None, dict(kw, x0=sol.p)  # the next solve starts from this one
+            return sol, ops + [op], u
+        ops.append(_Spent(op))
+        op = u = None
+        kw = dict(kw, x0=sol.p)  # the next solve starts from this one
         (r0, r1), (c0, c1) = window.rows, window.cols
-        window = _box_window(lat, (min(r0, closing[0][0]), max(r1, closing[0][1])),
-                             (min(c0, closing[1][0]), max(c1, closing[1][1])), _START_PAD)
+        window = _box_window(lat, ((min(r0, closing[0][0]), max(r1, closing[0][1])),
+                                   (min(c0, closing[1][0]), max(c1, closing[1][1]))), _START_PAD)
         log.debug("the window of the start's contact misses nodes of the contact: %s", "grown" if window else "none")
         if window is None:
             break
-    return run(full, h, kw), ops + [full], None
+    op = make_op(lat)
+    return run(op, h, kw), ops + [op], None

@@ -179,10 +179,10 @@ def test_start_window_that_misses_the_contact_is_solved_again(monkeypatch, case)
     kw = dict(E_star=1.0, force=1e-3, step=0.002, extent=0.2)
     reference = bem.solve(_wavy, **kw)
     used, _ = _spied(monkeypatch)
-    padded = windows_module._padded
+    box, box_window = windows_module._box, windows_module._box_window
     # every start window cut 6 nodes inside the box of the start's contact
-    monkeypatch.setattr(windows_module, "start_window",
-                        lambda lat, x0, *estimate: None if x0 is None else padded(lat, x0 > 0, -6))
+    monkeypatch.setattr(windows_module, "start_window", lambda lat, x0, *estimate: None if x0 is None else box_window(
+        lat, box(lat, lambda lo, hi: x0[lo:hi] > 0), -6))
     if case == "full":  # one window tried, then the full lattice
         monkeypatch.setattr(windows_module, "_START_TRIES", 1)
     if case == "unchecked":  # planted fault: the window's solution taken unchecked
