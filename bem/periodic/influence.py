@@ -27,7 +27,7 @@ from ..backend import backend_of, get_backend
 from ..checks import check_positive, fail
 from ..template import diagonal_coefficient
 from .coated import coated_template
-from .kernel import periodic_template
+from .kernel import periodic_spectra, periodic_template
 from .spectra import mixed, weighted_dot
 from .symbol import Symbol, inverse_blocks
 
@@ -60,11 +60,11 @@ def _checked_out(out, shape, dtype):
 
 
 def _spectra(w):
-    """Spectra of ``K_00 = K_11``, ``K_10`` and ``K_01`` of the kernel ``w`` (brick array), stacked.
+    """Spectra of ``K_00 = K_11`` and ``K_01`` of the kernel ``w`` (brick array), stacked (``K_10``'s is the
+    conjugate of ``K_01``'s): the layout of :func:`bem.periodic.kernel.periodic_spectra`.
 
     Real kernels; the ``1/N`` of the inverse FFT is applied there."""
-    even, odd = w[0::2], w[1::2]
-    return sfft.rfft2(np.stack([even, odd, np.roll(odd, (1, 1), axis=(0, 1))]), workers=fft.threads())
+    return sfft.rfft2(np.stack([w[0::2], np.roll(w[1::2], (1, 1), axis=(0, 1))]), workers=fft.threads())
 
 
 def _packed(spectra):
@@ -72,7 +72,7 @@ def _packed(spectra):
     the spectra themselves are not kept)."""
     d = np.empty((spectra.shape[1], 1, spectra.shape[2]))
     b = np.empty(d.shape, dtype=np.complex128)
-    d[:, 0], b[:, 0] = spectra[0].real, spectra[2]
+    d[:, 0], b[:, 0] = spectra[0].real, spectra[1]
     return d, b
 
 
@@ -85,7 +85,7 @@ def _homogeneous_symbol(n_rows, n_cols, scale):
     the last :data:`_SYMBOLS_KEPT` are kept."""
     key = (n_rows, n_cols, scale)
     if (symbol := _SYMBOLS.pop(key, None)) is None:
-        symbol = _packed(_spectra(periodic_template(n_rows, n_cols, cache=False) * scale))
+        symbol = _packed(periodic_spectra(n_rows, n_cols) * scale)
         for part in symbol:
             part.setflags(write=False)
     _SYMBOLS[key] = symbol
@@ -150,7 +150,7 @@ class PeriodicOperator:
         if bk.is_numpy:
             self._symbol = _packed(spectra)
         else:
-            self._s00, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra[::2])  # S_10 = conj(S_01)
+            self._s00, self._s01 = (bk.asarray(s, dtype=bk.xp.complex128) for s in spectra)  # S_10 = conj(S_01)
 
     def _template(self):
         """The dimensionless template of the cell: periodic, or of the coated bodies."""

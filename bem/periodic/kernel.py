@@ -25,11 +25,14 @@ Ewald split
         W_R(x) = sum_L R(x + L),  R(x) = w_t(x) - int hat(xi) erf(alpha |x - xi|) / |x - xi| dxi,
 
     the constant being the mean of ``W_R`` (``int R = (sqrt3/2) 2 pi / (alpha sqrt pi)``).
-    ``W_F`` is summed over ``|G| <= 12.2 alpha`` (``erfc < 1e-17`` beyond) and evaluated at
-    the nodes by two inverse FFTs, one per row parity. ``R`` is ``w_t`` minus a smooth
-    integral, computed by 10 x 10-point collapsed Gauss rules on the six triangles of the
-    pyramid (the integrand is piecewise linear times an entire function, so the rule is
-    exact to round-off), and is below ``1e-17`` beyond ``|x| = 1 + 6.1 / alpha``.
+    ``W_F`` is summed over ``|G| <= 12.2 alpha`` (``erfc < 1e-17`` beyond), its terms binned onto
+    the cell's discrete Fourier modes (on a cell of more than about 70 columns and 14 rows each
+    term falls on a mode of its own) and evaluated at the nodes by two inverse FFTs, one per row
+    parity; the operator's spectra are made from the binned terms directly
+    (:func:`periodic_spectra`). ``R`` is ``w_t`` minus a smooth integral, computed by 10 x 10-point
+    collapsed Gauss rules on the six triangles of the pyramid (the integrand is piecewise linear
+    times an entire function, so the rule is exact to round-off), once per orbit of the twelve
+    symmetries of the hexagon, and is below ``1e-17`` beyond ``|x| = 1 + 6.1 / alpha``.
 
 Accuracy
     The split parameter ``alpha`` is arbitrary: ``alpha = 0.25, 0.4, 0.6`` agree to 4e-16
@@ -46,7 +49,7 @@ from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["alias_sum", "periodic_template", "pyramid_transform"]
+__all__ = ["alias_sum", "periodic_spectra", "periodic_template", "pyramid_transform"]
 
 _SQRT3 = math.sqrt(3.0)
 # Ewald split [1/lattice step]. The Fourier sum of a cell has about 10 alpha^2 terms per node and
@@ -101,8 +104,25 @@ def _real_space_values(alpha):
     jj, ii = np.meshgrid(j, i, indexing="ij")
     vx, vy = ii + jj / 2.0, jj * (_SQRT3 / 2)
     near = vx * vx + vy * vy <= r_cut * r_cut
-    values = template(vx[near], vy[near]) - _smooth_part(vx[near], vy[near], alpha)
-    return ii[near], jj[near], values
+    vx, vy = vx[near], vy[near]
+    first, orbit = _orbits(vx, vy)  # R has the twelve symmetries of the hexagon: once per orbit
+    values = template(vx[first], vy[first]) - _smooth_part(vx[first], vy[first], alpha)
+    return ii[near], jj[near], values[orbit]
+
+
+def _orbits(x, y):
+    """The lattice vectors ``(x, y)`` grouped by the twelve symmetries of the hexagon (which map the lattice and
+    the pyramid onto themselves): ``(first, orbit)``, the index of one vector of each orbit and the orbit of each
+    vector (``first[orbit]`` a vector of the same orbit). Each vector is reflected into the sector ``0 <= angle <=
+    30`` degrees (about the axes, then the lines at 60 and at 30 degrees), where each orbit has one point."""
+    x, y = np.abs(x), np.abs(y)
+    for angle in (math.pi / 3, math.pi / 6):  # reflect about the line at angle where the vector lies above it
+        c, s = math.cos(2 * angle), math.sin(2 * angle)
+        above = y * math.cos(angle) > x * math.sin(angle)
+        x, y = np.where(above, x * c + y * s, x), np.where(above, x * s - y * c, y)
+    key = np.round(x * 2 ** 20) * 2 ** 22 + np.round(y * 2 ** 20)  # the folded point, to well below a lattice step
+    _, first, orbit = np.unique(key, return_index=True, return_inverse=True)
+    return first, orbit
 
 
 def _real_part(n_rows, n_cols, alpha):
@@ -110,8 +130,7 @@ def _real_part(n_rows, n_cols, alpha):
     ii, jj, values = _real_space_values(alpha)
     out = np.zeros((n_rows, n_cols))
     np.add.at(out, (np.mod(jj, n_rows), np.mod(ii + np.floor_divide(jj, 2), n_cols)), values)
-    area = n_cols * n_rows * _SQRT3 / 2
-    return out - math.sqrt(3 * math.pi) / (alpha * area)
+    return out - math.sqrt(3 * math.pi) / (alpha * _area(n_rows, n_cols))
 
 
 def _sin_over(x):
@@ -154,12 +173,29 @@ def alias_sum(n_rows, n_cols, radial, g_cut, *, weight=None, block=None):
     ndarray, shape ``(n_rows, n_cols)``
         The sum at the offset of node ``(q, r)`` from node ``(0, 0)``, brick storage: ``G`` over the
         reciprocal lattice of the periods, each term binned onto the cell's discrete Fourier modes
-        and brought to the nodes by two inverse FFTs, one per row parity.
+        (:func:`_binned`) and brought to the nodes by two inverse FFTs, one per row parity.
     """
     import scipy.fft as sfft
 
     from .. import fft
 
+    sums = _binned(n_rows, n_cols, radial, g_cut, weight, block)
+    # W_F(s)[k, q] = (1/A) sum A_s(n0, m0) exp(2 pi i (m0 q / n_cols + n0 k / half))
+    nodes = sfft.ifft2(sums, axes=(-2, -1), overwrite_x=True, workers=fft.threads()).real
+    nodes *= sums.shape[1] * n_cols / _area(n_rows, n_cols)
+    out = np.empty((n_rows, n_cols))
+    out[0::2], out[1::2] = nodes[0], nodes[1]
+    return out
+
+
+def _area(n_rows, n_cols):
+    """The area of the cell in lattice units, ``Lx Ly``."""
+    return n_cols * n_rows * _SQRT3 / 2
+
+
+def _binned(n_rows, n_cols, radial, g_cut, weight, block):
+    """The terms of :func:`alias_sum` binned onto the discrete Fourier modes of each row parity: ``A_s(n0, m0)``,
+    complex, shape ``(2, n_rows/2, n_cols)`` (the real part of their inverse DFT is the sum, up to ``1/A``)."""
     half = n_rows // 2
     lx, ly = float(n_cols), n_rows * _SQRT3 / 2
     m_max, n_max = int(g_cut * lx / (2 * math.pi)) + 1, int(g_cut * ly / (2 * math.pi)) + 1
@@ -167,33 +203,83 @@ def alias_sum(n_rows, n_cols, radial, g_cut, *, weight=None, block=None):
     gx = 2 * math.pi * m / lx
     sinc_x = np.sinc(gx / (2 * math.pi))  # the factor of pyramid_transform that depends on m only
     phase_x = np.exp(1j * math.pi * m / n_cols)
-    sums = np.zeros((2, half * n_cols), dtype=complex)
+    sums = np.zeros((2, half, n_cols), dtype=complex)
     # the terms of G and -G are complex conjugates (the summand is even in G, the parity phase
     # conjugates), and only the real part of the sum is kept: half the plane (n > 0, or n = 0 and
     # m > 0), counted twice
     block = max(1, 2 ** 20 // m.size) if block is None else block  # rows per block: small temporaries
+    distinct = 2 * m_max + 1 <= n_cols and n_max < half  # every term a mode of its own: no binning
     for n0 in range(0, n_max + 1, block):
         n = np.arange(n0, min(n0 + block, n_max + 1))[:, None]
         gy = 2 * math.pi * n / ly
         k = np.sqrt(gx * gx + gy * gy)
         keep = (k <= g_cut) & ((n > 0) | (m > 0))
+        if distinct:  # the terms on the whole block of G, 0 where not kept, written onto their modes
+            f = _terms(gx, gy, sinc_x, np.where(keep, k, g_cut), radial, weight)
+            f[~keep] = 0.0
+            odd = f * (phase_x * np.exp(2j * math.pi * n / n_rows))
+            for s, values in ((0, f), (1, odd)):  # m >= 0 on columns m, m < 0 on columns n_cols + m
+                sums[s, n0:n0 + n.size, :m_max + 1] += values[:, m_max:]
+                sums[s, n0:n0 + n.size, n_cols - m_max:] += values[:, :m_max]
+            continue
         rows, cols = np.nonzero(keep)
-        kk = k[keep]
-        s2 = (gx[cols] / 2 + gy[rows, 0] * (_SQRT3 / 2)) / 2  # pyramid_transform by its three factors
-        hat = sinc_x[cols] * _sin_over(s2) * _sin_over(s2 - gx[cols] / 2)
-        f = (_SQRT3 * radial(kk) if weight is None else weight(kk)) * hat  # twice f(k) (sqrt3 / 2) hat
+        f = _terms(gx[cols], gy[rows, 0], sinc_x[cols], k[keep], radial, weight)
         # node of parity s = 1: phase exp(i pi (m / n_cols + 2 n / n_rows)) relative to parity 0
         phase = phase_x[cols] * np.exp(2j * math.pi * n[:, 0] / n_rows)[rows]
         index = np.mod(n[rows, 0], half) * n_cols + np.mod(m[cols], n_cols)
         odd = f * phase
-        sums[0].real += np.bincount(index, weights=f, minlength=sums.shape[1])
-        sums[1].real += np.bincount(index, weights=odd.real, minlength=sums.shape[1])
-        sums[1].imag += np.bincount(index, weights=odd.imag, minlength=sums.shape[1])
-    # W_F(s)[k, q] = (1/A) sum A_s(n0, m0) exp(2 pi i (m0 q / n_cols + n0 k / half))
-    nodes = sfft.ifft2(sums.reshape(2, half, n_cols), axes=(-2, -1), overwrite_x=True, workers=fft.threads()).real
-    nodes *= half * n_cols / (lx * ly)
-    out = np.empty((n_rows, n_cols))
-    out[0::2], out[1::2] = nodes[0], nodes[1]
+        flat = sums.reshape(2, half * n_cols)
+        flat[0].real += np.bincount(index, weights=f, minlength=flat.shape[1])
+        flat[1].real += np.bincount(index, weights=odd.real, minlength=flat.shape[1])
+        flat[1].imag += np.bincount(index, weights=odd.imag, minlength=flat.shape[1])
+    return sums
+
+
+def _terms(gx, gy, sinc_x, k, radial, weight):
+    """``sqrt3 f(|G|) hat(G)`` (``weight(|G|) hat(G)`` where given) at ``G = (gx, gy)``, ``sinc_x`` the factor of
+    ``hat`` that depends on ``gx`` only, ``k = |G|``: arrays that broadcast."""
+    s2 = (gx / 2 + gy * (_SQRT3 / 2)) / 2  # pyramid_transform by its three factors
+    hat = sinc_x * _sin_over(s2) * _sin_over(s2 - gx / 2)
+    return (_SQRT3 * radial(k) if weight is None else weight(k)) * hat  # twice f(k) (sqrt3 / 2) hat
+
+
+def periodic_spectra(n_rows, n_cols, alpha=ALPHA):
+    """The spectra of ``W`` (:func:`periodic_template`) that the cell's operator keeps: ``K_00``'s and ``K_01``'s.
+
+    The real FFTs of the even rows of ``W`` and of its odd rows shifted by a row and a column (``np.roll(odd, (1,
+    1))``, the kernel of the even rows on the odd ones), stacked: complex, shape ``(2, n_rows/2, n_cols/2 + 1)``.
+    They are made from the Fourier sum's binned terms directly, without the inverse FFT to the nodes and the
+    forward FFT back: the spectrum of the real part of ``Z = ifft2(A)`` is ``(A_j + conj(A_-j)) / 2``, and a shift
+    by a row and a column multiplies it by ``exp(-2 pi i (j / half + l / n_cols))``; the real-space part is
+    transformed as it is, and the mean over the cell taken out of the frequency 0 of both (as
+    :func:`periodic_template` takes it out at the nodes). The same numbers as the FFTs of the template's rows, to
+    round-off.
+    """
+    import scipy.fft as sfft
+    from scipy.special import erfc
+
+    from .. import fft
+
+    def weight(k):  # as in _fourier_part
+        return (2 * _SQRT3 * math.pi) / k * erfc(k / (2 * alpha))
+
+    half, n_half = n_rows // 2, n_cols // 2 + 1
+    sums = _binned(n_rows, n_cols, None, 2 * alpha * _ERFC_ZERO, weight, 256)
+    real = _real_part(n_rows, n_cols, alpha)
+    out = sfft.rfft2(np.stack([real[0::2], np.roll(real[1::2], (1, 1), axis=(0, 1))]), workers=fft.threads())
+    fourier = np.empty((2, half, n_half), dtype=complex)  # (A_j + conj(A_-j)) / 2: A_-j, at the rows (-j) % half
+    fourier[:, :1, :1] = sums[:, :1, :1]  # and the columns (-l) % n_cols, conjugated, plus A_j
+    fourier[:, :1, 1:] = sums[:, :1, :n_cols - n_half:-1]
+    fourier[:, 1:, :1] = sums[:, :0:-1, :1]
+    fourier[:, 1:, 1:] = sums[:, :0:-1, :n_cols - n_half:-1]
+    np.conjugate(fourier, out=fourier)
+    fourier += sums[:, :, :n_half]
+    fourier *= 0.5 * half * n_cols / _area(n_rows, n_cols)
+    fourier[1] *= np.exp(-2j * math.pi * np.arange(half) / half)[:, None]  # the shift by a row and a column
+    fourier[1] *= np.exp(-2j * math.pi * np.arange(n_half) / n_cols)
+    out += fourier
+    mean = (out[0, 0, 0] + out[1, 0, 0]).real / (n_rows * n_cols)
+    out[:, 0, 0] -= mean * half * n_cols
     return out
 
 

@@ -7,6 +7,7 @@ import pytest
 
 import bem
 from bem.periodic import PeriodicCell, PeriodicOperator, periodic_template
+from bem.periodic.kernel import periodic_spectra
 
 SQRT3 = math.sqrt(3.0)
 
@@ -17,12 +18,42 @@ def _offsets(n_rows, n_cols):
 
 
 def test_periodic_template_does_not_depend_on_the_ewald_split():
-    # the split parameter only moves work between the Fourier and the real-space sums
-    for shape in ((6, 5), (8, 12), (20, 7)):
+    # the split parameter only moves work between the Fourier and the real-space sums; on the 16 x 80 cell the terms
+    # of alpha = 0.25 fall each on a mode of its own (no binning), those of 0.4 and 0.6 are binned: both ways agree
+    for shape in ((6, 5), (8, 12), (20, 7), (16, 80)):
         ref = periodic_template(*shape, alpha=0.4)
         for alpha in (0.25, 0.6):
             other = periodic_template(*shape, alpha=alpha)
             assert np.abs(other - ref).max() <= 1e-13 * np.abs(ref).max()  # measured <= 4e-16
+
+
+@pytest.mark.parametrize("shape", [(6, 5), (12, 9), (16, 80), (130, 77)])
+def test_periodic_spectra_are_the_ffts_of_the_templates_rows(shape):
+    # made from the Fourier sum's terms without the template at the nodes: the real FFTs of its even rows and of its
+    # odd rows shifted by a row and a column, the kernels of a parity on itself and of the even rows on the odd ones
+    w = periodic_template(*shape)
+    even, odd = w[0::2], np.roll(w[1::2], (1, 1), axis=(0, 1))
+    expected = np.stack([np.fft.rfft2(even), np.fft.rfft2(odd)])
+    got = periodic_spectra(*shape)
+    assert got.shape == expected.shape
+    assert np.abs(got - expected).max() <= 1e-14 * np.abs(expected).max()  # measured <= 4e-16
+
+
+def test_the_real_space_values_are_computed_once_per_orbit_of_the_hexagon():
+    # the twelve symmetries of the hexagon map the lattice and the pyramid onto themselves: each vector takes the
+    # value at one vector of its orbit, which is the value at itself to the template's round-off
+    from bem.periodic.kernel import _real_space_values, _smooth_part
+
+    i, j, values = _real_space_values(0.25)
+    x, y = i + j / 2, j * SQRT3 / 2
+    direct = bem.template(x, y) - _smooth_part(x, y, 0.25)
+    assert np.abs(values - direct).max() <= 1e-13 * np.abs(direct).max()  # measured 4.7e-15
+    # and exactly the same values on a vector and its images by a turn of 60 degrees and a reflection about x,
+    # which generate the twelve: (i, j) -> (-j, i + j) and (i, j) -> (i + j, -j) in the lattice's coordinates
+    where = {(a, b): n for n, (a, b) in enumerate(zip(i.tolist(), j.tolist()))}
+    for image in ((-j, i + j), (i + j, -j)):
+        index = [where[(a, b)] for a, b in zip(image[0].tolist(), image[1].tolist())]
+        assert np.array_equal(values[index], values)
 
 
 def test_periodic_template_is_the_limit_of_the_image_sum_of_the_template():
