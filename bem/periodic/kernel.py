@@ -264,20 +264,24 @@ def periodic_spectra(n_rows, n_cols, alpha=ALPHA):
         return (2 * _SQRT3 * math.pi) / k * erfc(k / (2 * alpha))
 
     half, n_half = n_rows // 2, n_cols // 2 + 1
-    sums = _binned(n_rows, n_cols, None, 2 * alpha * _ERFC_ZERO, weight, 256)
     real = _real_part(n_rows, n_cols, alpha)
-    out = sfft.rfft2(np.stack([real[0::2], np.roll(real[1::2], (1, 1), axis=(0, 1))]), workers=fft.threads())
-    fourier = np.empty((2, half, n_half), dtype=complex)  # (A_j + conj(A_-j)) / 2: A_-j, at the rows (-j) % half
-    fourier[:, :1, :1] = sums[:, :1, :1]  # and the columns (-l) % n_cols, conjugated, plus A_j
-    fourier[:, :1, 1:] = sums[:, :1, :n_cols - n_half:-1]
-    fourier[:, 1:, :1] = sums[:, :0:-1, :1]
-    fourier[:, 1:, 1:] = sums[:, :0:-1, :n_cols - n_half:-1]
-    np.conjugate(fourier, out=fourier)
-    fourier += sums[:, :, :n_half]
-    fourier *= 0.5 * half * n_cols / _area(n_rows, n_cols)
-    fourier[1] *= np.exp(-2j * math.pi * np.arange(half) / half)[:, None]  # the shift by a row and a column
-    fourier[1] *= np.exp(-2j * math.pi * np.arange(n_half) / n_cols)
-    out += fourier
+    out = np.empty((2, half, n_half), dtype=complex)  # a parity at a time: the temporaries of half the spectra
+    out[0] = sfft.rfft2(real[0::2], workers=fft.threads())
+    out[1] = sfft.rfft2(np.roll(real[1::2], (1, 1), axis=(0, 1)), workers=fft.threads())
+    real = None
+    sums = _binned(n_rows, n_cols, None, 2 * alpha * _ERFC_ZERO, weight, 256)
+    shift = (np.exp(-2j * math.pi * np.arange(half) / half)[:, None], np.exp(-2j * math.pi * np.arange(n_half) / n_cols))
+    for parity, a in enumerate(sums):  # (A_j + conj(A_-j)) / 2, A_-j at the rows (-j) % half, columns (-l) % n_cols
+        fourier = np.empty((half, n_half), dtype=complex)
+        fourier[:1, :1], fourier[:1, 1:] = a[:1, :1], a[:1, :n_cols - n_half:-1]
+        fourier[1:, :1], fourier[1:, 1:] = a[:0:-1, :1], a[:0:-1, :n_cols - n_half:-1]
+        np.conjugate(fourier, out=fourier)
+        fourier += a[:, :n_half]
+        fourier *= 0.5 * half * n_cols / _area(n_rows, n_cols)
+        if parity:  # the shift by a row and a column
+            fourier *= shift[0]
+            fourier *= shift[1]
+        out[parity] += fourier
     mean = (out[0, 0, 0] + out[1, 0, 0]).real / (n_rows * n_cols)
     out[:, 0, 0] -= mean * half * n_cols
     return out
