@@ -142,14 +142,19 @@ def _sin_over(x):
     return out
 
 
-def _fourier_part(n_rows, n_cols, alpha):
-    """``W_F`` at every node of the cell, brick array ``(n_rows, n_cols)``."""
+def _fourier_terms(n_rows, n_cols, alpha):
+    """The Ewald Fourier part's terms binned onto the cell's modes (:func:`_binned`), ``|G| <= 2 alpha 6.1``."""
     from scipy.special import erfc
 
     def weight(k):  # twice 2 pi / k erfc(k / (2 alpha)) (sqrt3 / 2)
         return (2 * _SQRT3 * math.pi) / k * erfc(k / (2 * alpha))
 
-    return alias_sum(n_rows, n_cols, None, 2 * alpha * _ERFC_ZERO, weight=weight, block=256)
+    return _binned(n_rows, n_cols, None, 2 * alpha * _ERFC_ZERO, weight, 256)
+
+
+def _fourier_part(n_rows, n_cols, alpha):
+    """``W_F`` at every node of the cell, brick array ``(n_rows, n_cols)``."""
+    return _at_nodes(_fourier_terms(n_rows, n_cols, alpha), n_rows, n_cols)
 
 
 def alias_sum(n_rows, n_cols, radial, g_cut, *, weight=None, block=None):
@@ -175,11 +180,15 @@ def alias_sum(n_rows, n_cols, radial, g_cut, *, weight=None, block=None):
         reciprocal lattice of the periods, each term binned onto the cell's discrete Fourier modes
         (:func:`_binned`) and brought to the nodes by two inverse FFTs, one per row parity.
     """
+    return _at_nodes(_binned(n_rows, n_cols, radial, g_cut, weight, block), n_rows, n_cols)
+
+
+def _at_nodes(sums, n_rows, n_cols):
+    """The sum of :func:`alias_sum` at the nodes from its binned terms ``sums`` (consumed)."""
     import scipy.fft as sfft
 
     from .. import fft
 
-    sums = _binned(n_rows, n_cols, radial, g_cut, weight, block)
     # W_F(s)[k, q] = (1/A) sum A_s(n0, m0) exp(2 pi i (m0 q / n_cols + n0 k / half))
     nodes = sfft.ifft2(sums, axes=(-2, -1), overwrite_x=True, workers=fft.threads()).real
     nodes *= sums.shape[1] * n_cols / _area(n_rows, n_cols)
@@ -256,12 +265,8 @@ def periodic_spectra(n_rows, n_cols, alpha=ALPHA):
     round-off.
     """
     import scipy.fft as sfft
-    from scipy.special import erfc
 
     from .. import fft
-
-    def weight(k):  # as in _fourier_part
-        return (2 * _SQRT3 * math.pi) / k * erfc(k / (2 * alpha))
 
     half, n_half = n_rows // 2, n_cols // 2 + 1
     real = _real_part(n_rows, n_cols, alpha)
@@ -269,8 +274,8 @@ def periodic_spectra(n_rows, n_cols, alpha=ALPHA):
     out[0] = sfft.rfft2(real[0::2], workers=fft.threads())
     out[1] = sfft.rfft2(np.roll(real[1::2], (1, 1), axis=(0, 1)), workers=fft.threads())
     real = None
-    sums = _binned(n_rows, n_cols, None, 2 * alpha * _ERFC_ZERO, weight, 256)
-    shift = (np.exp(-2j * math.pi * np.arange(half) / half)[:, None], np.exp(-2j * math.pi * np.arange(n_half) / n_cols))
+    sums = _fourier_terms(n_rows, n_cols, alpha)
+    shift = np.exp(-2j * math.pi * np.arange(half) / half)[:, None], np.exp(-2j * math.pi * np.arange(n_half) / n_cols)
     for parity, a in enumerate(sums):  # (A_j + conj(A_-j)) / 2, A_-j at the rows (-j) % half, columns (-l) % n_cols
         fourier = np.empty((half, n_half), dtype=complex)
         fourier[:1, :1], fourier[:1, 1:] = a[:1, :1], a[:1, :n_cols - n_half:-1]

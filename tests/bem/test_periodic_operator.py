@@ -39,23 +39,6 @@ def test_periodic_spectra_are_the_ffts_of_the_templates_rows(shape):
     assert np.abs(got - expected).max() <= 1e-14 * np.abs(expected).max()  # measured <= 4e-16
 
 
-def test_the_real_space_values_are_computed_once_per_orbit_of_the_hexagon():
-    # the twelve symmetries of the hexagon map the lattice and the pyramid onto themselves: each vector takes the
-    # value at one vector of its orbit, which is the value at itself to the template's round-off
-    from bem.periodic.kernel import _real_space_values, _smooth_part
-
-    i, j, values = _real_space_values(0.25)
-    x, y = i + j / 2, j * SQRT3 / 2
-    direct = bem.template(x, y) - _smooth_part(x, y, 0.25)
-    assert np.abs(values - direct).max() <= 1e-13 * np.abs(direct).max()  # measured 4.7e-15
-    # and exactly the same values on a vector and its images by a turn of 60 degrees and a reflection about x,
-    # which generate the twelve: (i, j) -> (-j, i + j) and (i, j) -> (i + j, -j) in the lattice's coordinates
-    where = {(a, b): n for n, (a, b) in enumerate(zip(i.tolist(), j.tolist()))}
-    for image in ((-j, i + j), (i + j, -j)):
-        index = [where[(a, b)] for a, b in zip(image[0].tolist(), image[1].tolist())]
-        assert np.array_equal(values[index], values)
-
-
 def test_periodic_template_is_the_limit_of_the_image_sum_of_the_template():
     """Brute force: sum over the images L in a disc of radius R of w_t(x + L) - w_t(L).
 
