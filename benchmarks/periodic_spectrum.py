@@ -211,9 +211,9 @@ def markdown(rows):
     lines = [head, "|" + "---|" * 12]
     for r in rows:
         lines.append(f"| {r['n']}^2 | {r['contact_fraction']} | {r['spots']} | {r['edge_share_of_contact']} | "
-                     f"{r['preconditioner']} | {r['pairs_per_iteration']} | {r['coarse_products']} | {r['iterations']} | "
-                     f"{r['lambda_min']} | "
-                     f"{r['lambda_max']} | {r['kappa']} | {r['top_share_on_edges']} |")
+                     f"{r['preconditioner']} | {r['pairs_per_iteration']} | {r['coarse_products']} | "
+                     f"{r['iterations']} | {r['lambda_min']} | {r['lambda_max']} | {r['kappa']} | "
+                     f"{r['top_share_on_edges']} |")
     return "\n".join(lines) + "\n"
 
 
@@ -269,7 +269,8 @@ def main(argv=None):
         rows += new
         for r in new:
             print(json.dumps(r), flush=True)
-    cases.write_whole(os.path.join(args.out, "spectrum.json"), json.dumps(dict(machine=cases.machine(), rows=rows), indent=1))
+    data = json.dumps(dict(machine=cases.machine(), rows=rows), indent=1)
+    cases.write_whole(os.path.join(args.out, "spectrum.json"), data)
     cases.write_whole(os.path.join(args.out, "spectrum.md"), markdown(rows))
     plot(rows, shown, os.path.join(args.out, "spectrum.png"))
     print(markdown(rows))
