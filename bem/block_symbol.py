@@ -294,7 +294,8 @@ def kernel_spectra(backend, table, start, out_box, in_box, hermitian=False):
         raise ValueError(f"hermitian = True needs out_box == in_box, got {out_box!r} and {in_box!r}")
     lk, lq = padded_shape(out_box, in_box)
     # on NumPy one block at a time into the spectra (the same numbers as the batch: each line is
-    # transformed alone), so that the padded kernels are never all held at once
+    # transformed alone), so that the padded kernels are never all held at once; the four complex blocks
+    # transformed in the array that keeps them (no spectrum of a block made beside it and copied)
     numpy = backend.is_numpy
     # the complex block last: two real diagonal blocks held while it is made (not a complex and a real one)
     blocks = ((0, 0), (1, 1), (0, 1)) if hermitian else ((0, 0), (0, 1), (1, 0), (1, 1))
@@ -307,9 +308,12 @@ def kernel_spectra(backend, table, start, out_box, in_box, hermitian=False):
                                None if numpy else out[a, b])
         if numpy:
             kernel /= lk * lq
+            if not hermitian:
+                pruned_fft.forward_parts([kernel], (lk, lq), out=out[a, b][None])
+                continue
             spectrum = pruned_fft.forward(kernel, (lk, lq))
             del kernel
-            out[a, b] = spectrum.real.copy() if hermitian and a == b else spectrum
+            out[a, b] = spectrum.real.copy() if a == b else spectrum
             del spectrum
     if numpy:
         return (lk, lq), (((out[0, 0], out[0, 1]), (None, out[1, 1])) if hermitian else out)

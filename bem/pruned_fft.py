@@ -58,7 +58,7 @@ def _band(rows, size):
     return min(rows, max(LINES, rows * _BAND // size // LINES * LINES))
 
 
-def forward_parts(parts, shape, dtype=np.float64, scale=None):
+def forward_parts(parts, shape, dtype=np.float64, scale=None, out=None):
     """:func:`forward` of a batch given as its entries: 2-D real arrays (views allowed, not modified), each
     zero-padded to ``shape`` and rounded to ``dtype`` band by band (no gathered copy of the batch).
 
@@ -72,14 +72,23 @@ def forward_parts(parts, shape, dtype=np.float64, scale=None):
         ``float64``, or ``float32`` for a single-precision spectrum.
     scale : float, optional
         A factor applied to the data before it is rounded to ``dtype`` (band by band: no scaled copy of a part).
+    out : ndarray, optional
+        The array the spectra are written into (C-contiguous, of the returned shape and dtype); default: a new one.
 
     Returns
     -------
     ndarray, shape ``(len(parts), Lk, Lq // 2 + 1)``
-        The spectra, complex128 (complex64 for ``float32``).
+        The spectra, complex128 (complex64 for ``float32``): ``out`` where given.
     """
     lk, lq = shape
-    out = np.empty((len(parts), lk, lq // 2 + 1), dtype=np.result_type(dtype, np.complex64))
+    spectra = (len(parts), lk, lq // 2 + 1), np.result_type(dtype, np.complex64)
+    if out is None:
+        out = np.empty(*spectra)
+    elif not (out.shape == spectra[0] and out.dtype == spectra[1] and out.flags.c_contiguous):
+        from .checks import fail
+
+        fail("out", f"<array of shape {out.shape}, {out.dtype}>", f"a C-contiguous {spectra[1]} array of shape "
+             f"{spectra[0]}")
     for b, x in enumerate(parts):
         out[b, x.shape[0] :, :] = 0.0  # the padding rows
         rfft_rows(x, out[b, : x.shape[0]], lq, dtype, scale, size=out[b].size)

@@ -44,6 +44,20 @@ def test_forward_parts_of_strided_rows_is_the_gathered_transform_bit_for_bit(mon
     assert got.dtype == want.dtype and np.array_equal(got, want)
 
 
+def test_forward_parts_into_a_given_array_writes_the_same_spectra_there():
+    v = np.random.default_rng(4).standard_normal((2, 9, 7))
+    shape = (fft.fast_length(17, real=False), fft.fast_length(13, real=True))
+    want = pruned_fft.forward_parts(list(v), shape)
+    held = np.full((3, 2) + want.shape[1:], np.nan + 0j)  # a view of it as out: the block [1] of a larger array
+    got = pruned_fft.forward_parts(list(v), shape, out=held[1])
+    assert got is held[1] or np.shares_memory(got, held[1])
+    assert np.array_equal(held[1], want) and np.isnan(held[0]).all() and np.isnan(held[2]).all()
+    for bad in (np.empty(want.shape, dtype=np.complex64), np.empty(want.shape[::-1], dtype=complex),
+                np.empty((2, want.shape[1], 2 * want.shape[2]), dtype=complex)[..., ::2]):
+        with pytest.raises(ValueError, match="out = .* is not allowed"):
+            pruned_fft.forward_parts(list(v), shape, out=bad)
+
+
 @pytest.mark.parametrize("band", [None, 3])
 def test_banded_forward_and_inverse_are_the_plain_pair_bit_for_bit(monkeypatch, band):
     import scipy.fft as sfft
