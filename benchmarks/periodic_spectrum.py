@@ -98,17 +98,9 @@ def preconditioner(op, contact, kind):
     return apply
 
 
-def coarse_correction(op, contact):
-    """``Q r = Z E^-1 Z' r`` of the ``two-level`` preconditioner on the contact's nodes (flat, zero-sum), ``Z`` the
-    contact of each block of ``N / BLOCKS`` nodes a side (its zero-sum part), ``E = Z' C_AA Z`` (a product a block)."""
-    rows, cols = np.nonzero(contact)
-    side = max(1, contact.shape[1] // BLOCKS)
-    _, label = np.unique((rows // side) * (contact.shape[1] // side + 1) + cols // side, return_inverse=True)
-    n_blocks, m = int(label.max()) + 1, label.size
-
-    def spread(y):  # Z y, its mean taken out (the force constraint)
-        v = y[label]
-        return v - v.mean()
+def contact_operator(op, contact):
+    """``C_A(x)``: ``C_AA x`` on the contact's nodes (flat) less its mean (the force constraint: the mean is the
+    change of ``delta``)."""
 
     def C_A(x):
         v = np.zeros(contact.shape)
@@ -116,11 +108,27 @@ def coarse_correction(op, contact):
         y = op.matvec(v)[contact]
         return y - y.mean()
 
+    return C_A
+
+
+def coarse_correction(op, contact):
+    """``Q r = Z E^-1 Z' r`` of the ``two-level`` preconditioner on the contact's nodes (flat, zero-sum), ``Z`` the
+    contact of each block of ``N / BLOCKS`` nodes a side (its zero-sum part), ``E = Z' C_AA Z`` (a product a block)."""
+    rows, cols = np.nonzero(contact)
+    side = max(1, contact.shape[1] // BLOCKS)
+    _, label = np.unique((rows // side) * (contact.shape[1] // side + 1) + cols // side, return_inverse=True)
+    n_blocks = int(label.max()) + 1
+
+    def spread(y):  # Z y, its mean taken out (the force constraint)
+        v = y[label]
+        return v - v.mean()
+
+    C_A = contact_operator(op, contact)
     E = np.empty((n_blocks, n_blocks))
     for j in range(n_blocks):
         E[:, j] = np.bincount(label, weights=C_A(spread(np.eye(1, n_blocks, j)[0])), minlength=n_blocks)
     inverse = np.linalg.pinv(0.5 * (E + E.T), rcond=1e-10, hermitian=True)  # one zero mode: the constant
-    return (lambda r: spread(inverse @ np.bincount(label, weights=r - r.mean(), minlength=n_blocks))), n_blocks, m
+    return (lambda r: spread(inverse @ np.bincount(label, weights=r - r.mean(), minlength=n_blocks))), n_blocks
 
 
 def fixed_contact_cg(op, contact, h, force_sum, precondition, maxiter=500, coarse=None):
@@ -131,13 +139,7 @@ def fixed_contact_cg(op, contact, h, force_sum, precondition, maxiter=500, coars
     eigenvalues and the Ritz vector of the largest one on the contact's nodes.
     """
     m = int(np.count_nonzero(contact))
-
-    def C_A(x):
-        v = np.zeros(contact.shape)
-        v[contact] = x
-        y = op.matvec(v)[contact]
-        return y - y.mean()  # the force constraint: the mean is the change of delta
-
+    C_A = contact_operator(op, contact)
     x = np.full(m, force_sum / m)
     r = -(h[contact] + C_A(x))
     r -= r.mean()
@@ -192,7 +194,7 @@ def case(n):
     rows = []
     for kind in PRECONDITIONERS:
         t0 = time.perf_counter()
-        coarse, n_blocks, _ = coarse_correction(op, contact) if kind == "two-level" else (None, None, None)
+        coarse, n_blocks = coarse_correction(op, contact) if kind == "two-level" else (None, None)
         k, _, eig, top = fixed_contact_cg(op, contact, h, p.sum(), preconditioner(op, contact, kind), coarse=coarse)
         w = top**2 / float(top @ top)
         if kind == "cell":

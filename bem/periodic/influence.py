@@ -20,14 +20,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import scipy.fft as sfft
 
 from .. import fft
 from ..backend import backend_of, get_backend
 from ..checks import check_positive, fail
 from ..template import diagonal_coefficient
 from .coated import coated_template
-from .kernel import periodic_spectra, periodic_template
+from .kernel import parity_spectra, periodic_spectra, periodic_template
 from .spectra import mixed, weighted_dot
 from .symbol import Symbol, inverse_blocks
 
@@ -59,17 +58,9 @@ def _checked_out(out, shape, dtype):
     return out
 
 
-def _spectra(w):
-    """Spectra of ``K_00 = K_11`` and ``K_01`` of the kernel ``w`` (brick array), stacked (``K_10``'s is the
-    conjugate of ``K_01``'s): the layout of :func:`bem.periodic.kernel.periodic_spectra`.
-
-    Real kernels; the ``1/N`` of the inverse FFT is applied there."""
-    return sfft.rfft2(np.stack([w[0::2], np.roll(w[1::2], (1, 1), axis=(0, 1))]), workers=fft.threads())
-
-
 def _packed(spectra):
-    """The packed symbol ``(S_00, S_01)`` of :class:`bem.periodic.symbol.Symbol` from :func:`_spectra` (new arrays:
-    the spectra themselves are not kept)."""
+    """The packed symbol ``(S_00, S_01)`` of :class:`bem.periodic.symbol.Symbol` from the spectra of
+    :func:`bem.periodic.kernel.parity_spectra` (new arrays: the spectra themselves are not kept)."""
     d = np.empty((spectra.shape[1], 1, spectra.shape[2]))
     b = np.empty(d.shape, dtype=np.complex128)
     d[:, 0], b[:, 0] = spectra[0].real, spectra[1]
@@ -146,7 +137,7 @@ class PeriodicOperator:
         w = self._template()
         if self.bodies is not None:
             self.diagonal *= w[0, 0] / periodic_template(lattice.n_rows, lattice.n_cols)[0, 0]
-        spectra = _spectra(w * scale)
+        spectra = parity_spectra(w * scale)
         if bk.is_numpy:
             self._symbol = _packed(spectra)
         else:

@@ -49,7 +49,7 @@ from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["alias_sum", "periodic_spectra", "periodic_template", "pyramid_transform"]
+__all__ = ["alias_sum", "parity_spectra", "periodic_spectra", "periodic_template", "pyramid_transform"]
 
 _SQRT3 = math.sqrt(3.0)
 # Ewald split [1/lattice step]. The Fourier sum of a cell has about 10 alpha^2 terms per node and
@@ -252,28 +252,34 @@ def _terms(gx, gy, sinc_x, k, radial, weight):
     return (_SQRT3 * radial(k) if weight is None else weight(k)) * hat  # twice f(k) (sqrt3 / 2) hat
 
 
+def parity_spectra(w):
+    """The spectra of ``K_00 = K_11`` and ``K_01`` of a cell's kernel ``w`` (a real brick array, the kernel from node
+    ``(0, 0)``), stacked: the real FFTs of its even rows and of its odd rows shifted by a row and a column
+    (``np.roll(odd, (1, 1))``, the kernel of the even rows on the odd ones); ``K_10``'s is the conjugate of ``K_01``'s.
+    Complex, shape ``(2, n_rows/2, n_cols/2 + 1)``, made a parity at a time (the temporaries of half the spectra);
+    the ``1/N`` of the inverse FFT is applied there."""
+    import scipy.fft as sfft
+
+    from .. import fft
+
+    out = np.empty((2, w.shape[0] // 2, w.shape[1] // 2 + 1), dtype=complex)
+    out[0] = sfft.rfft2(w[0::2], workers=fft.threads())
+    out[1] = sfft.rfft2(np.roll(w[1::2], (1, 1), axis=(0, 1)), workers=fft.threads())
+    return out
+
+
 def periodic_spectra(n_rows, n_cols, alpha=ALPHA):
     """The spectra of ``W`` (:func:`periodic_template`) that the cell's operator keeps: ``K_00``'s and ``K_01``'s.
 
-    The real FFTs of the even rows of ``W`` and of its odd rows shifted by a row and a column (``np.roll(odd, (1,
-    1))``, the kernel of the even rows on the odd ones), stacked: complex, shape ``(2, n_rows/2, n_cols/2 + 1)``.
-    They are made from the Fourier sum's binned terms directly, without the inverse FFT to the nodes and the
+    :func:`parity_spectra` of ``W``, made from the Fourier sum's binned terms directly, without the inverse FFT to the nodes and the
     forward FFT back: the spectrum of the real part of ``Z = ifft2(A)`` is ``(A_j + conj(A_-j)) / 2``, and a shift
     by a row and a column multiplies it by ``exp(-2 pi i (j / half + l / n_cols))``; the real-space part is
     transformed as it is, and the mean over the cell taken out of the frequency 0 of both (as
     :func:`periodic_template` takes it out at the nodes). The same numbers as the FFTs of the template's rows, to
     round-off.
     """
-    import scipy.fft as sfft
-
-    from .. import fft
-
     half, n_half = n_rows // 2, n_cols // 2 + 1
-    real = _real_part(n_rows, n_cols, alpha)
-    out = np.empty((2, half, n_half), dtype=complex)  # a parity at a time: the temporaries of half the spectra
-    out[0] = sfft.rfft2(real[0::2], workers=fft.threads())
-    out[1] = sfft.rfft2(np.roll(real[1::2], (1, 1), axis=(0, 1)), workers=fft.threads())
-    real = None
+    out = parity_spectra(_real_part(n_rows, n_cols, alpha))
     sums = _fourier_terms(n_rows, n_cols, alpha)
     shift = np.exp(-2j * math.pi * np.arange(half) / half)[:, None], np.exp(-2j * math.pi * np.arange(n_half) / n_cols)
     for parity, a in enumerate(sums):  # (A_j + conj(A_-j)) / 2, A_-j at the rows (-j) % half, columns (-l) % n_cols

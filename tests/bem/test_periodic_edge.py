@@ -106,8 +106,8 @@ def test_the_correction_is_its_definition_by_the_dense_inverse(monkeypatch):
 def test_the_corrected_preconditioner_conditions_a_fixed_contact_better(surface, load, at_most):
     """The spectrum of the preconditioned contact ``P C_AA`` on the zero-sum pressures of a fixed contact (the
     force's constraint), dense, ``P = M_AA + diag(c)`` with the ``c`` the library makes: positive definite, and its
-    condition number below ``at_most`` of that of ``M_AA`` alone (measured at 48 x 48: 2.52 -> 1.76 and 2.21 -> 1.76 on the smooth surface, 4.52 -> 3.84 and
-    5.22 -> 3.93 on the self-affine one)."""
+    condition number below ``at_most`` of that of ``M_AA`` alone (measured at 48 x 48: 2.52 -> 1.76 and 2.21 -> 1.76
+    on the smooth surface, 4.52 -> 3.84 and 5.22 -> 3.93 on the self-affine one)."""
     cell = PeriodicCell(1.0 / 48, 48, 48)
     op, contact = _contact(cell, _rough(cell) if surface == "smooth" else _self_affine(cell), load)
     C, M = _dense_inverse(op)
