@@ -31,6 +31,13 @@ once the nodes changed since exceed :data:`REMAKE` of them; between, the nodes t
 and a node that entered takes 0 (``M_AA``'s own diagonal). Making it takes a transform pair in single precision,
 ``M (1_A - |A| / N)``, and once a solve a second for ``M_nn``; ``c`` is held at the contact's nodes only (float32).
 A step whose corrected ``z`` is not a descent direction (``r.z <= 0``) takes the uncorrected one.
+
+With a compliance ``D`` per node (a Newton step's model, :func:`bem.kalker.compliance_preconditioner`) ``M`` inverts
+``C + lam`` for the median ``lam`` of ``D`` on the stiff contact and preconditions those nodes only (Jacobi at the
+nodes whose ``D`` dominates, the soft ones): ``A`` is the stiff contact, the soft nodes count as off it, and ``c`` is
+0 at them. On the six model QPs of the finest level of the root-layer cell of ``benchmarks/periodic_rough.py`` at
+1024^2, each from Newton's start and to Newton's tolerance, 43 iterations against 53 uncorrected (and, each to
+``1e-9``, 118 against 153).
 """
 
 from __future__ import annotations
@@ -63,27 +70,44 @@ class EdgeCorrection:
         The shape of the cell's brick arrays.
     diagonal : float
         ``C_nn`` of the operator the preconditioner inverts (with any uniform compliance added) [length/pressure].
+    scratch : callable, optional
+        ``scratch()``: a float32 brick array that making the correction may overwrite (the QP's work array, free
+        while the preconditioned gap is corrected), or None; default (or None from it) new arrays.
     """
 
-    def __init__(self, bk, apply_m, shape, diagonal):
+    def __init__(self, bk, apply_m, shape, diagonal, scratch=None):
         self.bk, self.apply_m, self.shape, self.diagonal = bk, apply_m, tuple(shape), float(diagonal)
+        self.scratch = scratch
         self.kept = KeptOnContact(bk, shape, hold=False)  # c at the nodes of the contact of the last step
         self.on = False  # made
         self.floor = None  # FLOOR / C_nn - M_nn
         self.changed = 0  # nodes changed since the correction was made
 
-    def _make(self, idx):
+    def _brick(self, value):
+        """A float32 brick array of the cell filled with ``value`` (in the scratch array where there is one)."""
+        xp = self.bk.xp
+        v = None if self.scratch is None else self.scratch()
+        if v is None:
+            return xp.full(self.shape, value, dtype=xp.float32)
+        v.fill(value)
+        return v
+
+    def _make(self, idx, soft):
         bk, xp = self.bk, self.bk.xp
+        single = xp.float32
         if self.floor is None:  # M_nn: M of a unit pressure at the first node, there
-            unit = xp.zeros(self.shape, dtype=xp.float32)
+            unit = self._brick(0.0)
             unit[0, 0] = 1.0
             self.floor = FLOOR / self.diagonal - float(self.apply_m(unit, unit)[0, 0])
-        share = bk.count(idx) / (self.shape[0] * self.shape[1])
-        v = xp.full(self.shape, -share, dtype=xp.float32)  # 1_A - |A| / N
-        v = bk.put(v, idx, xp.full(bk.count(idx), 1.0 - share, dtype=xp.float32))
+        n = bk.count(idx) - (0 if soft is None else int(xp.count_nonzero(soft)))  # |A|
+        share = n / (self.shape[0] * self.shape[1])
+        v = bk.put(self._brick(-share), idx, 1.0 - share)  # 1_A - |A| / N
+        if soft is not None:
+            v = bk.put(v, bk.subset(idx, soft), -share)
         c = bk.take(self.apply_m(v, v), idx)  # M (1_A - f_A) = -M (1_I - f) at the contact: -1 / theta times c
         c *= -THETA
-        self.kept.keep(idx, xp.maximum(c, xp.asarray(self.floor, dtype=xp.float32)))
+        c = xp.maximum(c, xp.asarray(self.floor, dtype=single))
+        self.kept.keep(idx, c if soft is None else xp.where(soft, xp.asarray(0.0, dtype=single), c))
         self.on, self.changed = True, 0
 
     def _at(self, idx, contact):
@@ -95,7 +119,7 @@ class EdgeCorrection:
             self.kept.keep(idx, c)
         return c
 
-    def applied(self, z, r, idx, changes, contact=None):
+    def applied(self, z, r, idx, changes, contact=None, soft=None):
         """``z + c r`` at the contact's nodes ``idx`` where the correction is on; the uncorrected ``z`` before it
         starts and where ``r.(z + c r)`` is not positive.
 
@@ -110,6 +134,9 @@ class EdgeCorrection:
             from no earlier contact).
         contact : bem.periodic.qp_parts.ContactNodes, optional
             The QP's contact, ``idx`` its last read (on NumPy its step maps the correction onto ``idx``).
+        soft : array of bool, optional
+            At the contact's nodes, those the preconditioner takes by Jacobi, not by ``M`` (a compliance per node):
+            off ``A``, ``c = 0`` there. Default: none.
 
         Returns
         -------
@@ -124,7 +151,7 @@ class EdgeCorrection:
         else:
             self.changed += changes[-1]
         if not self.on or self.changed > REMAKE * n:
-            self._make(idx)
+            self._make(idx, soft)
         corrected = self._at(idx, contact) * r
         corrected += z
         return corrected if bk.dot(r, corrected) > 0 else z

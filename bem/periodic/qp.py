@@ -25,8 +25,8 @@ leaving, at a constant KKT residual, on a 672 x 776 rough cell at 1e-4 of the me
   takes its ``u``) or off NumPy;
 - the curvature ``t.(C + lam) t`` is a sum over the spectrum of that product (Parseval, summed in double precision,
   block by block as the product is made: :func:`bem.periodic.spectra.mixed`);
-- the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``; without a compliance per
-  node or a hardness it is corrected at the edges of the contact once the contact settles (:mod:`bem.periodic.edge`);
+- the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``; without a hardness it is
+  corrected at the edges of the contact once the contact settles (:mod:`bem.periodic.edge`);
 - so does the recomputed ``u`` while the KKT residual is above ``1e-4`` (:data:`SINGLE_ABOVE`), in a solve that
   starts above ``1e-2`` (:data:`SINGLE_START` times that) or stops above ``1e-4`` (``rtol >= SINGLE_ABOVE``, a
   Newton step's model far from the answer), where the rounding of single precision (a relative ``1e-7`` of ``C p``)
@@ -39,10 +39,10 @@ leaving, at a constant KKT residual, on a 672 x 776 rough cell at 1e-4 of the me
 - on a large cell, with numba, the block products and three passes over the whole cell run compiled on the FFT
   threads (:mod:`bem.periodic.passes`).
 
-With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are those of ``C`` alone,
-``u = C p + D p`` (plus the gap's ``offset``) and the curvature adds ``sum D t^2``; the preconditioner is that of
-:func:`bem.kalker.compliance_preconditioner` (single precision), with its oblique projection under force control (by
-``M 1`` of the starting contact, kept in half precision on NumPy: a direction, whose sum only has to be nonzero).
+With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are those of ``C`` alone, ``u =
+C p + D p`` (plus the gap's ``offset``) and the curvature adds ``sum D t^2``; the preconditioner is that of
+:func:`bem.kalker.compliance_preconditioner` (single precision), corrected at the edges of its FFT part's nodes, with
+its oblique projection under force control (by ``M 1`` of the starting contact: any direction of nonzero sum).
 
 With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H`` and the step is
 :func:`bem.cg_rules.bounded_move`; the directions restart (``beta = 0``) after a step shortened or capped at ``H`` to
@@ -211,7 +211,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     idx = g_c = p_c0 = g_min = u_range = None  # u_range: max u, min u
 
     bounded, sets, restart = hardness is not None, None, False  # restart: a bounded step shortened to carry the force
-    edge = None if per_node or bounded else EdgeCorrection(bk, apply_m, lat.shape, diag + lam)  # M at the edges
+    edge = None if bounded else EdgeCorrection(bk, apply_m, lat.shape, diag + lam_pc, work.brick32)  # M at the edges
     was_on, was_plastic = (nodes.was_on, p >= hardness) if bounded else (None, None)  # the bound's own counts
     g = np.empty(lat.shape) if bounded and bk.is_numpy else None  # the gap u + h, an array in the bounded QP only
     enter = np.empty(lat.shape, dtype=bool) if bk.is_numpy and not bounded else None  # nodes that may enter
@@ -276,7 +276,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             nodes.kept = D_c, (soft_c := None if not soft else ~is_stiff(D_c, diag, threshold))
         # the gap on the contact, single precision (on its stiff part with a per-node compliance)
         z = precondition(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, D_c)
-        z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"], nodes)
+        z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"], nodes, soft_c)
         if force is not None and not soft:
             z -= xp.mean(z)
         elif force is not None:

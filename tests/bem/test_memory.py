@@ -158,8 +158,9 @@ def _traced_peak_per_node(solve):
 # layer's model QP holding its preconditioned gap, its direction, its gap and D p beside the product of a changed
 # step, the Jacobi estimate at its contact and M 1 beside it, and M 1 of its start in single precision, 93.1 and 76.5
 # (86.0 and 71.2 without; with M 1 of its start in single precision alone, 87.1 and 73.2); Newton's C p handed to
-# the model QPs 78.0 and 63.2, their product in single precision in an array of its own beside it 81.2 and 65.6.
-# Measured
+# the model QPs 78.0 and 63.2, their product in single precision in an array of its own beside it 81.2 and 65.6; the
+# model QPs' preconditioner corrected at the edges (bem.periodic.edge) made in the QP's work array: the root layer
+# 82.3, 66.2, 74.3 and 60.3 against 82.3, 65.3, 74.3 and 60.4 (made in new arrays 90.6, 70.6, 82.6 and 62.6). Measured
 # before the warm-up solve (after the other problems in the process): a solve that holds its coarser levels, the
 # spectra its symbols are made of and its copies of the iterates traced 176, 275, 180 and 343; Newton holding its
 # step and the model's gap through the line search, and its iterate beside its start, 132 with the root layer; a
