@@ -29,7 +29,8 @@ While the contact set moves, the correction's longer steps at the edges move it 
 correction is made from the first step that changes at most :data:`SETTLED` of the contact's nodes, and made again
 once the nodes changed since exceed :data:`REMAKE` of them; between, the nodes that stay in contact keep their ``c``
 and a node that entered takes 0 (``M_AA``'s own diagonal). Making it takes a transform pair in single precision,
-``M (1_A - |A| / N)``, and once a solve a second for ``M_nn``; ``c`` is held at the contact's nodes only (float32).
+``M (1_A - |A| / N)``, and once a solve ``M_nn``, the mean of ``M``'s symbol; ``c`` is held at the contact's nodes
+only (float32).
 A step whose corrected ``z`` is not a descent direction (``r.z <= 0``) takes the uncorrected one.
 
 With a compliance ``D`` per node (a Newton step's model, :func:`bem.kalker.compliance_preconditioner`) ``M`` inverts
@@ -43,6 +44,7 @@ nodes whose ``D`` dominates, the soft ones): ``A`` is the stiff contact, the sof
 from __future__ import annotations
 
 from .qp_parts import KeptOnContact
+from .symbol import Symbol, mirrored_sum
 
 __all__ = ["FLOOR", "REMAKE", "SETTLED", "THETA", "EdgeCorrection"]
 
@@ -73,15 +75,32 @@ class EdgeCorrection:
     scratch : callable, optional
         ``scratch()``: a float32 brick array that making the correction may overwrite (the QP's work array, free
         while the preconditioned gap is corrected), or None; default (or None from it) new arrays.
+    symbol : bem.periodic.symbol.Symbol or tuple, optional
+        ``M``'s symbol (on NumPy a :class:`~bem.periodic.symbol.Symbol`, elsewhere its blocks ``(D, B)``), whose
+        diagonal blocks' mean is ``M_nn``; without it ``M_nn`` is ``M`` of a unit pressure at a node, there (a
+        transform pair).
     """
 
-    def __init__(self, bk, apply_m, shape, diagonal, scratch=None):
+    def __init__(self, bk, apply_m, shape, diagonal, scratch=None, symbol=None):
         self.bk, self.apply_m, self.shape, self.diagonal = bk, apply_m, tuple(shape), float(diagonal)
-        self.scratch = scratch
+        self.scratch, self.symbol = scratch, symbol
         self.kept = KeptOnContact(bk, shape, hold=False)  # c at the nodes of the contact of the last step
         self.on = False  # made
         self.floor = None  # FLOOR / C_nn - M_nn
         self.changed = 0  # nodes changed since the correction was made
+
+    def _m_nn(self):
+        """``M_nn`` [pressure/length]: the mean of the symbol's diagonal blocks over the whole spectrum, or ``M`` of a
+        unit pressure at the first node, there."""
+        n_cols = self.shape[1]
+        if isinstance(self.symbol, Symbol):
+            return self.symbol.diagonal(n_cols)
+        if self.symbol is not None:
+            d = self.symbol[0]
+            return mirrored_sum(self.bk.xp, d, n_cols) / (d.shape[0] * n_cols)
+        unit = self._brick(0.0)
+        unit[0, 0] = 1.0
+        return float(self.apply_m(unit, unit)[0, 0])
 
     def _brick(self, value):
         """A float32 brick array of the cell filled with ``value`` (in the scratch array where there is one)."""
@@ -95,10 +114,8 @@ class EdgeCorrection:
     def _make(self, idx, soft):
         bk, xp = self.bk, self.bk.xp
         single = xp.float32
-        if self.floor is None:  # M_nn: M of a unit pressure at the first node, there
-            unit = self._brick(0.0)
-            unit[0, 0] = 1.0
-            self.floor = FLOOR / self.diagonal - float(self.apply_m(unit, unit)[0, 0])
+        if self.floor is None:
+            self.floor = FLOOR / self.diagonal - self._m_nn()
         n = bk.count(idx) - (0 if soft is None else int(xp.count_nonzero(soft)))  # |A|
         share = n / (self.shape[0] * self.shape[1])
         v = bk.put(self._brick(-share), idx, 1.0 - share)  # 1_A - |A| / N

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Symbol", "inverse_blocks"]
+__all__ = ["Symbol", "inverse_blocks", "mirrored_sum"]
 
 
 def inverse_blocks(xp, a, b, shift=None):
@@ -73,3 +73,29 @@ class Symbol:
         out[:, :1] = b
         np.conjugate(out[:, :1], out=out[:, 1:])
         return (a.astype(np.float32) if self.single else a), out
+
+    def diagonal(self, n_cols, rows=None):
+        """The diagonal entry of the product the symbol makes, the same at every node (of the inverse: the
+        preconditioner's ``M_nn``) [length/pressure, or its inverse], in double precision: the mean of the diagonal
+        blocks over the cell's whole spectrum, a column of the half spectrum counted with its mirror (``n_cols``, the
+        cell's columns, says whether the last one is its own mirror); ``rows`` rows of the spectrum at a time (default
+        a sixteenth of them: a few bytes a node at most beside the symbol)."""
+        total, n = 0.0, self.d.shape[0]
+        rows = max(1, n // 16) if rows is None else rows
+        for lo in range(0, n, rows):
+            a = self.d[lo:lo + rows] + self.lam
+            if self.inverse:
+                first = lo == 0
+                b = self.b[lo:lo + rows]
+                a = inverse_blocks(np, a, b.copy() if first else b, self.shift if first else None)[0]
+            total += mirrored_sum(np, a, n_cols)
+        return total / (n * n_cols)
+
+
+def mirrored_sum(xp, a, n_cols):
+    """The sum of a real array ``a`` of the layout of a cell's half spectrum (its last axis the columns ``0 ..
+    n_cols // 2``) over the whole spectrum, each column counted with its mirror (``n_cols`` even: the last column is
+    its own), in the namespace ``xp``; a float."""
+    last = a.shape[-1] - 1
+    own = xp.sum(a[..., 0]) + (xp.sum(a[..., last]) if n_cols % 2 == 0 else 0.0)
+    return 2.0 * float(xp.sum(a)) - float(own)

@@ -130,6 +130,10 @@ def test_with_soft_nodes_the_correction_is_its_definition_over_the_stiff_contact
     in_scratch = EdgeCorrection(operator_backend(op)[0], _apply_m(op), cell.shape, op.diagonal, lambda: scratch)
     assert np.array_equal(in_scratch.applied(z, r, idx, [idx.size, 0], None, soft), got)
     assert not np.isnan(scratch).any()
+    symbol = op.symbol(inverse=True)  # M_nn from M's symbol (a Symbol, and a device's blocks) instead of a product
+    for form in (symbol, symbol.rows()):
+        fix = EdgeCorrection(operator_backend(op)[0], _apply_m(op), cell.shape, op.diagonal, None, form)
+        assert np.abs(fix.applied(z, r, idx, [idx.size, 0], None, soft) - got).max() <= 1e-5 * np.abs(c * r).max()
 
 
 @pytest.mark.parametrize("surface, load, at_most", [("smooth", 0.03, 0.75), ("smooth", 0.003, 0.85),

@@ -79,3 +79,24 @@ def test_a_symbol_holds_no_array_of_its_own_and_leaves_the_packed_one_as_it_was(
         op.mix(x, symbol, out=x)
     assert np.array_equal(base.d, keep[0]) and np.array_equal(base.b, keep[1])
     assert not base.d.flags.writeable and not base.b.flags.writeable  # shared by the operators of a cell
+
+
+@pytest.mark.parametrize("cell", [CELL, PeriodicCell(0.3, 11, 8), PeriodicCell(0.2, 7, 6)])
+@pytest.mark.parametrize("lam", [0.0, 0.4])
+@pytest.mark.parametrize("inverse", [False, True])
+def test_the_diagonal_is_the_product_of_a_unit_pressure_at_every_node(cell, lam, inverse):
+    """:meth:`Symbol.diagonal` (in blocks of 2 rows, even and odd numbers of columns) is the product of the symbol
+    with a unit pressure at a node, read there, at nodes of both row parities (made by the operator's transforms);
+    :func:`mirrored_sum` of the blocks of the symbol's rows, its form for a device's ``(D, B)``, the same."""
+    from bem.periodic.symbol import mirrored_sum
+
+    op = PeriodicOperator(cell, 2.0)
+    symbol = op.symbol(lam, inverse=inverse)
+    apply = op.preconditioner(lam) if inverse else (lambda v: op.matvec(v) + lam * v)
+    got = symbol.diagonal(cell.n_cols, rows=2)
+    for node in [(0, 0), (1, 3), (cell.n_rows - 1, cell.n_cols - 1)]:
+        unit = np.zeros(cell.shape)
+        unit[node] = 1.0
+        assert got == pytest.approx(apply(unit)[node], rel=1e-13)
+    d, _ = symbol.rows()
+    assert mirrored_sum(np, d, cell.n_cols) / (d.shape[0] * cell.n_cols) == pytest.approx(got, rel=1e-14)
