@@ -71,7 +71,8 @@ class EdgeCorrection:
     shape : tuple of int
         The shape of the cell's brick arrays.
     diagonal : float
-        ``C_nn`` of the operator the preconditioner inverts (with any uniform compliance added) [length/pressure].
+        ``C_nn`` of the operator the preconditioner inverts, with the compliance it inverts added (a uniform one, or
+        the median of one per node) [length/pressure].
     scratch : callable, optional
         ``scratch()``: a float32 brick array that making the correction may overwrite (the QP's work array, free
         while the preconditioned gap is corrected), or None; default (or None from it) new arrays.
