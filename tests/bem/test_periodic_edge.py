@@ -136,6 +136,26 @@ def test_with_soft_nodes_the_correction_is_its_definition_over_the_stiff_contact
         assert np.abs(fix.applied(z, r, idx, [idx.size, 0], None, soft) - got).max() <= 1e-5 * np.abs(c * r).max()
 
 
+def test_no_correction_in_a_solve_whose_settled_contact_is_mostly_soft(monkeypatch):
+    """Where the soft nodes (Jacobi) are more than half of the contact when it settles, the stiff contact is islands
+    among nodes that carry pressure, not the edge of the pressure: the correction is not made in that solve (nor
+    after, as the contact changes); at half or less it is."""
+    cell = PeriodicCell(1.0 / 48, 48, 48)
+    op, contact = _contact(cell, _self_affine(cell), 0.01)
+    idx = np.flatnonzero(contact)
+    n = idx.size
+    r = np.random.default_rng(9).standard_normal(n)
+    z = _preconditioned(op, contact, r)
+    made = _counted(monkeypatch)
+    for share, makes in ((0.5, 1), (0.5 + 2.0 / n, 0)):
+        soft = np.arange(n) < round(share * n)
+        fix, _ = _correction(op, contact)
+        outs = [fix.applied(z, r, idx, [n] + [0] * k, None, soft) for k in (1, 2, 3)]
+        outs.append(fix.applied(z, r, idx, [n, 0, 0, 0], None, ~soft))  # fewer soft nodes later: still none
+        assert len(made) == makes and (makes or all(out is z for out in outs))
+        made.clear()
+
+
 @pytest.mark.parametrize("surface, load, at_most", [("smooth", 0.03, 0.75), ("smooth", 0.003, 0.85),
                                                      ("self-affine", 0.01, 0.9), ("self-affine", 0.03, 0.8)])
 def test_the_corrected_preconditioner_conditions_a_fixed_contact_better(surface, load, at_most):
