@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .checks import fail
 from .fft import LINES, cfft_in_place, in_parts, irfft_into, rfft_into
 
 __all__ = ["forward", "forward_parts", "inverse", "inverse_into", "rfft_rows", "irfft_rows"]
@@ -85,8 +86,6 @@ def forward_parts(parts, shape, dtype=np.float64, scale=None, out=None):
     if out is None:
         out = np.empty(*spectra)
     elif not (out.shape == spectra[0] and out.dtype == spectra[1] and out.flags.c_contiguous):
-        from .checks import fail
-
         fail("out", f"<array of shape {out.shape}, {out.dtype}>", f"a C-contiguous {spectra[1]} array of shape "
              f"{spectra[0]}")
     for b, x in enumerate(parts):

@@ -37,8 +37,8 @@ With a compliance ``D`` per node (a Newton step's model, :func:`bem.kalker.compl
 ``C + lam`` for the median ``lam`` of ``D`` on the stiff contact and preconditions those nodes only (Jacobi at the
 nodes whose ``D`` dominates, the soft ones): ``A`` is the stiff contact, the soft nodes count as off it, and ``c`` is
 0 at them. On the six model QPs of the finest level of the root-layer cell of ``benchmarks/periodic_rough.py`` at
-1024^2, each from Newton's start and to Newton's tolerance, 43 iterations against 53 uncorrected (and, each to
-``1e-9``, 118 against 153). Where the soft nodes are more than half of the contact when it settles, the stiff contact
+1024^2, each from Newton's start and to Newton's tolerance, 45 iterations against 52 uncorrected (and, each to
+``1e-9``, 120 against 153). Where the soft nodes are more than half of the contact when it settles, the stiff contact
 is islands among nodes that carry pressure, not the edge of the pressure, and no correction is made in that solve:
 on the model QPs of a bilinear law soft below its knee (``5 C_nn`` there, 70 % of the contact soft) at 256^2,
 corrected, 237 iterations to ``1e-9`` against 211 (a root law, 4-7 % soft: 132 against 161; a power law of exponent
@@ -77,16 +77,15 @@ class EdgeCorrection:
     diagonal : float
         ``C_nn`` of the operator the preconditioner inverts, with the compliance it inverts added (a uniform one, or
         the median of one per node) [length/pressure].
+    symbol : bem.periodic.symbol.Symbol or tuple
+        ``M``'s symbol (on NumPy a :class:`~bem.periodic.symbol.Symbol`, elsewhere its blocks ``(D, B)``), whose
+        diagonal blocks' mean is ``M_nn``.
     scratch : callable, optional
         ``scratch()``: a float32 brick array that making the correction may overwrite (the QP's work array, free
         while the preconditioned gap is corrected), or None; default (or None from it) new arrays.
-    symbol : bem.periodic.symbol.Symbol or tuple, optional
-        ``M``'s symbol (on NumPy a :class:`~bem.periodic.symbol.Symbol`, elsewhere its blocks ``(D, B)``), whose
-        diagonal blocks' mean is ``M_nn``; without it ``M_nn`` is ``M`` of a unit pressure at a node, there (a
-        transform pair).
     """
 
-    def __init__(self, bk, apply_m, shape, diagonal, scratch=None, symbol=None):
+    def __init__(self, bk, apply_m, shape, diagonal, symbol, scratch=None):
         self.bk, self.apply_m, self.shape, self.diagonal = bk, apply_m, tuple(shape), float(diagonal)
         self.scratch, self.symbol = scratch, symbol
         self.kept = KeptOnContact(bk, shape, hold=False)  # c at the nodes of the contact of the last step
@@ -95,17 +94,12 @@ class EdgeCorrection:
         self.changed = 0  # nodes changed since the correction was made
 
     def _m_nn(self):
-        """``M_nn`` [pressure/length]: the mean of the symbol's diagonal blocks over the whole spectrum, or ``M`` of a
-        unit pressure at the first node, there."""
+        """``M_nn`` [pressure/length]: the mean of the symbol's diagonal blocks over the whole spectrum."""
         n_cols = self.shape[1]
         if isinstance(self.symbol, Symbol):
             return self.symbol.diagonal(n_cols)
-        if self.symbol is not None:
-            d = self.symbol[0]
-            return mirrored_sum(self.bk.xp, d, n_cols) / (d.shape[0] * n_cols)
-        unit = self._brick(0.0)
-        unit[0, 0] = 1.0
-        return float(self.apply_m(unit, unit)[0, 0])
+        d = self.symbol[0]
+        return mirrored_sum(self.bk.xp, d, n_cols) / (d.shape[0] * n_cols)
 
     def _brick(self, value):
         """A float32 brick array of the cell filled with ``value`` (in the scratch array where there is one)."""

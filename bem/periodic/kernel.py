@@ -271,10 +271,10 @@ def parity_spectra(w):
 def periodic_spectra(n_rows, n_cols, alpha=ALPHA):
     """The spectra of ``W`` (:func:`periodic_template`) that the cell's operator keeps: ``K_00``'s and ``K_01``'s.
 
-    :func:`parity_spectra` of ``W``, made from the Fourier sum's binned terms directly, without the inverse FFT to the nodes and the
-    forward FFT back: the spectrum of the real part of ``Z = ifft2(A)`` is ``(A_j + conj(A_-j)) / 2``, and a shift
-    by a row and a column multiplies it by ``exp(-2 pi i (j / half + l / n_cols))``; the real-space part is
-    transformed as it is, and the mean over the cell taken out of the frequency 0 of both (as
+    :func:`parity_spectra` of ``W``, made from the Fourier sum's binned terms directly, without the inverse FFT to
+    the nodes and the forward FFT back: the spectrum of the real part of ``Z = ifft2(A)`` is ``(A_j + conj(A_-j)) /
+    2``, and a shift by a row and a column multiplies it by ``exp(-2 pi i (j / half + l / n_cols))``; the real-space
+    part is transformed as it is, and the mean over the cell taken out of the frequency 0 of both (as
     :func:`periodic_template` takes it out at the nodes). The same numbers as the FFTs of the template's rows, to
     round-off.
     """

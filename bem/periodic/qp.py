@@ -211,7 +211,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     idx = g_c = p_c0 = g_min = u_range = None  # u_range: max u, min u
 
     bounded, sets, restart = hardness is not None, None, False  # restart: a bounded step shortened to carry the force
-    edge = None if bounded else EdgeCorrection(bk, apply_m, lat.shape, diag + lam_pc, work.brick32, M)  # M at edges
+    edge = None if bounded else EdgeCorrection(bk, apply_m, lat.shape, diag + lam_pc, M, work.brick32)  # M at edges
     was_on, was_plastic = (nodes.was_on, p >= hardness) if bounded else (None, None)  # the bound's own counts
     g = np.empty(lat.shape) if bounded and bk.is_numpy else None  # the gap u + h, an array in the bounded QP only
     enter = np.empty(lat.shape, dtype=bool) if bk.is_numpy and not bounded else None  # nodes that may enter

@@ -62,7 +62,8 @@ def _apply_m(op):
 
 def _correction(op, contact):
     """An :class:`EdgeCorrection` of the cell and the contact's flat node indices."""
-    return EdgeCorrection(operator_backend(op)[0], _apply_m(op), contact.shape, op.diagonal), np.flatnonzero(contact)
+    fix = EdgeCorrection(operator_backend(op)[0], _apply_m(op), contact.shape, op.diagonal, op.symbol(inverse=True))
+    return fix, np.flatnonzero(contact)
 
 
 def _counted(monkeypatch):
@@ -127,13 +128,13 @@ def test_with_soft_nodes_the_correction_is_its_definition_over_the_stiff_contact
     assert np.array_equal(got[soft], z[soft])  # no correction where Jacobi preconditions
     assert np.abs(got - (z + c * r)).max() <= 1e-5 * np.abs(c * r).max()
     scratch = np.full(cell.shape, np.nan, dtype=np.float32)  # made in a scratch array of the caller's: the same
-    in_scratch = EdgeCorrection(operator_backend(op)[0], _apply_m(op), cell.shape, op.diagonal, lambda: scratch)
+    in_scratch = EdgeCorrection(operator_backend(op)[0], _apply_m(op), cell.shape, op.diagonal,
+                                op.symbol(inverse=True), lambda: scratch)
     assert np.array_equal(in_scratch.applied(z, r, idx, [idx.size, 0], None, soft), got)
     assert not np.isnan(scratch).any()
-    symbol = op.symbol(inverse=True)  # M_nn from M's symbol (a Symbol, and a device's blocks) instead of a product
-    for form in (symbol, symbol.rows()):
-        fix = EdgeCorrection(operator_backend(op)[0], _apply_m(op), cell.shape, op.diagonal, None, form)
-        assert np.abs(fix.applied(z, r, idx, [idx.size, 0], None, soft) - got).max() <= 1e-5 * np.abs(c * r).max()
+    # M_nn from a device's blocks of M's symbol (D, B): the same
+    fix = EdgeCorrection(operator_backend(op)[0], _apply_m(op), cell.shape, op.diagonal, op.symbol(inverse=True).rows())
+    assert np.abs(fix.applied(z, r, idx, [idx.size, 0], None, soft) - got).max() <= 1e-5 * np.abs(c * r).max()
 
 
 def test_no_correction_in_a_solve_whose_settled_contact_is_mostly_soft(monkeypatch):
@@ -336,7 +337,7 @@ def test_off_numpy_the_correction_is_kept_again_only_where_the_contact_changed(m
     bk = get_backend(xs)
     shape = (8, 6)
     on = bk.select(xs.asarray(np.random.default_rng(1).random(shape) < 0.5))
-    fix = EdgeCorrection(bk, None, shape, 1.0)
+    fix = EdgeCorrection(bk, None, shape, 1.0, None)
     fix.kept.keep(on, xs.full(bk.count(on), 0.25, dtype=xs.float64))
     spreads = []
     real = bk.spread

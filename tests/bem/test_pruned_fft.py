@@ -50,7 +50,7 @@ def test_forward_parts_into_a_given_array_writes_the_same_spectra_there():
     want = pruned_fft.forward_parts(list(v), shape)
     held = np.full((3, 2) + want.shape[1:], np.nan + 0j)  # a view of it as out: the block [1] of a larger array
     got = pruned_fft.forward_parts(list(v), shape, out=held[1])
-    assert got is held[1] or np.shares_memory(got, held[1])
+    assert np.shares_memory(got, held[1])
     assert np.array_equal(held[1], want) and np.isnan(held[0]).all() and np.isnan(held[2]).all()
     for bad in (np.empty(want.shape, dtype=np.complex64), np.empty(want.shape[::-1], dtype=complex),
                 np.empty((2, want.shape[1], 2 * want.shape[2]), dtype=complex)[..., ::2]):
