@@ -57,7 +57,9 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None, hard
     xp = bk.xp
     p = bk.asarray(p)
     gap = bk.asarray(gap)
-    if not (bool(xp.all(xp.isfinite(p))) and bool(xp.all(xp.isfinite(gap)))):
+    with bk.errstate(over="ignore", invalid="ignore"):  # a sum is finite only where every term is, or overflows
+        sums = math.isfinite(float(xp.sum(p))) and math.isfinite(float(xp.sum(gap)))
+    if not sums and not (bool(xp.all(xp.isfinite(p))) and bool(xp.all(xp.isfinite(gap)))):
         return float("inf")
     s = float(displacement_scale)
     if s <= 0:  # no deformation at all: measure the gap against itself
@@ -126,13 +128,13 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, c
     if hardness is not None:
         return _bounded_state(bk, lat, h, p, total, force, approach, mask, hardness)
     if bool(xp.all(mask)):  # every node of the lattice (a periodic cell): the same numbers without the masking
+        scale = max(bk.max0(total), -bk.min0(total))  # max |C p + w| (a NaN reaches the residual through the gap)
+        gap = total  # C p + w + h - delta in total's bytes
+        gap += h
         contact = p > 0
-        gap = total + h
         delta = float(approach) if force is None else float(xp.mean(gap[contact])) if bool(xp.any(contact)) else 0.0
         gap -= delta
-        kkt = kkt_residual(p, gap, displacement_scale=float(xp.max(xp.abs(total))), force=force,
-                           node_area=lat.node_area)
-        return gap, delta, kkt
+        return gap, delta, kkt_residual(p, gap, displacement_scale=scale, force=force, node_area=lat.node_area)
     contact = mask & (p > 0)
     if force is not None:
         delta = float(xp.mean(total[contact] + h[contact])) if bool(xp.any(contact)) else 0.0

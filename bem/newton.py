@@ -217,6 +217,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
     bound = {} if hardness is None else {"hardness": hardness}  # the elastic inner solves take no bound
     prev = p > 0
     full = bool(xp.all(mask))  # every node a candidate (a periodic cell): no masking
+    shared = op.shared_model_state() if precondition and hasattr(op, "shared_model_state") else {}  # (a cell's)
 
     def masked(x):
         return x if full else xp.where(mask, x, 0.0)
@@ -260,7 +261,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         # the model starts at p with Newton's u and Newton checks each step on its own residual: no product to start
         # or to confirm the inner solve (fewer products on benchmarks/side_by_side.py's root layer)
         sub, p, u = _model_qp(op, h, layer, D, contact, precondition, p, u, full, force=force, approach=approach,
-                              rtol=inner, maxiter=inner_maxiter, confirm=False, **bound)
+                              rtol=inner, maxiter=inner_maxiter, confirm=False, **bound, **shared)
         _count_inner(hist, sub)
         # the step d = q - p of the model's solution q (C d = uq - u) is formed where it is used, not held
         t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, None if full else mask)
@@ -271,19 +272,18 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             wp = sub = None
             sub, p, u = _model_qp(op, h, layer, D, contact, precondition, p, u, full, force=force,
                                   approach=approach, rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter,
-                                  scale=scale, confirm=False, **bound)
+                                  scale=scale, confirm=False, **bound, **shared)
             _count_inner(hist, sub)
             t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, None if full else mask)
-        # the model's closure at the step, for the closure move (not for linear laws, where it is the step itself)
-        moves = t > 0.0 and hardness is None and not layer.is_linear
-        w_model = model_closure(bk, layer, p, sub.p, D, t) if moves else None
-        D = None
-        judged = None
+        # the model's closure at the step on the nodes it keeps in contact, for the closure move (not for linear laws,
+        # where it is the step itself)
+        kept = bk.select(sub.p > 0) if t > 0.0 and hardness is None and not layer.is_linear else None
+        w_model = None if kept is None else model_closure(bk, layer, p, sub.p, D, t, kept)
+        D = judged = None
         if t == 0.0:
-            # No decrease of Phi measurable along d: the change of Phi falls below its round-off
-            # while nodes of tiny pressure (where w' is huge, e.g. a power law with small s)
-            # still violate their gap. The step is then chosen by the KKT residual instead:
-            # t = 1, 1/2, 1/4, 1/8, the first that lowers it.
+            # No decrease of Phi measurable along d: the change of Phi falls below its round-off while nodes of tiny
+            # pressure (where w' is huge, e.g. a power law with small s) still violate their gap. The step is then
+            # chosen by the KKT residual instead: t = 1, 1/2, 1/4, 1/8, the first that lowers it.
             d = sub.p - p
             for t_try in (1.0, 0.5, 0.25, 0.125):
                 trial = scaled(clip(xp, p + t_try * d, hardness), force, op.lattice.node_area, hardness)
@@ -309,9 +309,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             exact = False
         sub = None
         if w_model is not None:  # t > 0: the step along d was taken
-            p, u, moved = closure_move(op, layer, h, p, u, w_model, ~released, delta, force=force)
+            p, u, moved = closure_move(op, layer, h, p, u, w_model, kept, delta, force=force)
             hist["closure_moves"] += moved
-        w_model = None
+        w_model = kept = None
         p, u = release(op, layer, h, p, u, released, delta, force=force, hardness=hardness)
         if hardness is not None:
             p, u = settle_plastic(op, layer, h, p, u, at_bound, delta, force=force, hardness=hardness)

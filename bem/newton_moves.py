@@ -117,21 +117,18 @@ def settle_plastic(op, layer, h, p, u, at_bound, delta, *, force, hardness):
     return p, u
 
 
-def model_closure(bk, layer, p, q, D, t):
-    """``w(p) + t D (q - p)`` [length]: the closure of a Newton step's model (compliance ``D`` per node) at
-    ``p + t (q - p)``, in double precision. On NumPy in the buffer of a float64 ``D``, which it consumes."""
-    if not in_place(bk, D):  # (a float32 D: the sum in double precision)
-        return bk.asarray(layer.w(p)) + D * (t * (q - p))
-    D *= t
-    D *= np.subtract(q, p)
-    D += layer.w(p)
-    return D
+def model_closure(bk, layer, p, q, D, t, sel):
+    """``w(p) + t D (q - p)`` [length] at the selected nodes (1-D, double precision): the closure of a Newton step's
+    model (compliance ``D`` per node) at ``p + t (q - p)``."""
+    ps = bk.take(p, sel)
+    return bk.asarray(layer.w(ps)) + bk.xp.astype(bk.take(D, sel), bk.float64) * (t * (bk.take(q, sel) - ps))
 
 
 def closure_move(op, layer, h, p, u, closure, kept, delta, *, force):
-    """Move to the pressure ``w^-1(closure)`` at the nodes of ``kept`` (boolean), 0 elsewhere, if that lowers ``Phi``.
+    """Move to the pressure ``w^-1(closure)`` at the nodes of ``kept`` (a selection, :meth:`bem.backend.Backend.select`),
+    0 elsewhere, if that lowers ``Phi``.
 
-    ``closure`` is the model's (:func:`model_closure`) at the step's pressure ``p`` (``u = C p``). The model
+    ``closure`` is the model's at those nodes (:func:`model_closure`; 1-D) at the step's pressure ``p`` (``u = C p``). The model
     linearises ``w`` about the last pressure; at a node the layer dominates (``w'`` large against ``C_nn``) its
     closure is right where its pressure is not: for a root law ``w = lam sqrt(p)`` and a node that carries its
     load by the layer alone, ``w^-1`` of the model's closure is the answer in one step, where the full step along
@@ -142,11 +139,10 @@ def closure_move(op, layer, h, p, u, closure, kept, delta, *, force):
     """
     bk, mask = operator_backend(op)
     xp = bk.xp
-    sel = bk.select(kept)
     with bk.errstate(over="ignore", invalid="ignore"):
-        reach = bk.asarray(layer.inverse(xp.maximum(bk.take(closure, sel), 0.0)))
+        reach = bk.asarray(layer.inverse(xp.maximum(closure, 0.0)))
     closure = None
-    trial = bk.spread(p.shape, sel, xp.where(xp.isfinite(reach), reach, bk.take(p, sel)))
+    trial = bk.spread(p.shape, kept, xp.where(xp.isfinite(reach), reach, bk.take(p, kept)))
     if force is not None:
         total = float(xp.sum(trial))
         if not (total > 0 and math.isfinite(total)):

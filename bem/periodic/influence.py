@@ -327,6 +327,13 @@ class PeriodicOperator:
 
         return constrained_cg(self, h, lam=lam, precondition=precondition, contact=contact, **kw)
 
+    def shared_model_state(self):
+        """Keyword arguments of :meth:`qp` that the preconditioned model QPs of one Newton solve share
+        (:func:`bem.newton.solve_newton`): the direction of their oblique projection (made by the first)."""
+        from .qp_parts import Projection
+
+        return {"projection": Projection()}
+
     def preconditioner(self, lam=0.0, single=False):
         """``z = (C + lam I)^-1 r`` on the whole cell, by the inverse 2 x 2 block symbol.
 

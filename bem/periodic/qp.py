@@ -19,10 +19,10 @@ leaving, at a constant KKT residual, on a 672 x 776 rough cell at 1e-4 of the me
 - the iteration keeps ``u = (C + lam) p`` in double precision, updated after a step by the product of its move in
   single precision (rounded to a relative ``1e-7`` of the step, which falls with the residual): where the contact set
   did not change ``tau (C + lam) t``, the search direction's product; where it changed (NumPy, a confirmed stop)
-  that of ``t'``, ``tau t' = p - p_new / s``: ``t`` but at the clipped and entering nodes. ``u`` is recomputed
-  from ``p`` after every 20 updates, and at a change while the products run in single precision (below), before
-  ``u`` was once recomputed in double precision (from the caller's ``u0``), in an unconfirmed solve (whose caller
-  takes its ``u``) or off NumPy;
+  that of ``t'``, ``tau t' = p - p_new / s``: ``t`` but at the clipped and entering nodes. ``u`` is recomputed from
+  ``p`` after every 20 updates, and at a change while the products run in single precision (below), before ``u`` was
+  once recomputed in double precision (from the caller's ``u0``), in an unconfirmed solve (whose caller takes its
+  ``u``) or off NumPy;
 - the curvature ``t.(C + lam) t`` is a sum over the spectrum of that product (Parseval, summed in double precision,
   block by block as the product is made: :func:`bem.periodic.spectra.mixed`);
 - the preconditioner runs in single precision: it only has to approximate ``(C + lam)^-1``; without a hardness it is
@@ -36,13 +36,13 @@ leaving, at a constant KKT residual, on a 672 x 776 rough cell at 1e-4 of the me
 - after a step that let no node enter and left every contact node a positive pressure, the contact is the same: the
   next iteration reuses its nodes, the step's pressures and direction there and ``D`` on it, with no selection and no
   gathers; after another, the next contact is made from the step's arrays (:class:`bem.periodic.qp_parts.ContactNodes`);
-- on a large cell, with numba, the block products and three passes over the whole cell run compiled on the FFT
-  threads (:mod:`bem.periodic.passes`).
+- on a large cell, with numba, the block products and three passes over the cell run compiled on the FFT threads.
 
 With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are those of ``C`` alone, ``u =
 C p + D p`` (plus the gap's ``offset``) and the curvature adds ``sum D t^2``; the preconditioner is that of
 :func:`bem.kalker.compliance_preconditioner` (single precision), corrected at the edges of its FFT part's nodes, with
-its oblique projection under force control (by ``M 1`` of the starting contact: any direction of nonzero sum).
+its oblique projection under force control (by ``M 1`` of the starting contact, or of the first model QP of the
+Newton solve, its ``projection``: any direction of nonzero sum).
 
 With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H`` and the step is
 :func:`bem.cg_rules.bounded_move`; the directions restart (``beta = 0``) after a step shortened or capped at ``H`` to
@@ -51,9 +51,8 @@ cell at 18 % of ``H``, ``tests/bem/test_hardness_units.py``), not where nodes en
 pressures at ``H = E* h'_rms``: 531 iterations, 695 when those restart too).
 
 A step costs four transforms of the cell in single precision while the contact set does not change (two for the
-preconditioner, one forward for the search direction, one inverse for its product), five where it changes (where
-``u`` is recomputed, two of them in double precision once the residual is below ``SINGLE_ABOVE``; the general loop:
-four or six in double precision, or up to eight with a compliance per node).
+preconditioner, one forward for the search direction, one inverse for its product), five where it changes (``u``
+recomputed: two in double precision below ``SINGLE_ABOVE``; the general loop: four to eight in double precision).
 
 The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any array API
 namespace with ``xp.fft``); the host receives its scalars (about 16 a step, more with a compliance per node or a
@@ -75,8 +74,8 @@ from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bou
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .edge import EdgeCorrection
 from .passes import kernels
-from .qp_parts import (ContactBrick, ContactNodes, KeptOnContact, StepArrays, added_into, multiplied_into,
-                       product_array, weighted_square)
+from .qp_parts import (ContactBrick, ContactNodes, KeptOnContact, Projection, StepArrays, added_into,
+                       multiplied_into, product_array, weighted_square)
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -86,7 +85,7 @@ SINGLE_START = 100.0  # ... from a first residual above SINGLE_START * SINGLE_AB
 
 def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rtol=1e-10, maxiter=None,
                       callback=None, scale=None, u0=None, confirm=True, threshold=4.0, hardness=None,
-                      overwrite_x0=False, offset=None, overwrite_u0=False):
+                      overwrite_x0=False, offset=None, overwrite_u0=False, projection=None):
     """Solve the Kalker QP ``min 1/2 p.(C + lam) p + p.(h - delta), p >= 0`` on a periodic cell.
 
     Parameters
@@ -98,9 +97,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     force, approach : float
         Exactly one: total force on the cell ``P`` [force] or approach ``delta`` [length].
     lam : float or ndarray
-        Linear layer compliance [length/pressure], >= 0: uniform, or per node (brick array; Newton's
-        model compliance ``D``, with the preconditioner of :func:`bem.kalker.compliance_preconditioner`
-        on the contact of ``x0``).
+        Linear layer compliance [length/pressure], >= 0: uniform, or per node (brick array; Newton's model compliance
+        ``D``, with the preconditioner of :func:`bem.kalker.compliance_preconditioner` on the contact of ``x0``).
     x0 : ndarray, optional
         Initial pressure (brick array); negative entries are clipped.
     overwrite_x0 : bool
@@ -120,6 +118,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     overwrite_u0 : bool
         Whether a float64 NumPy ``u0`` may hold the iteration's ``(C + lam) p``, in either precision (not copied: one
         array of the cell fewer; ``u0`` is then no longer ``C x0``).
+    projection : bem.periodic.qp_parts.Projection, optional
+        With a per-node ``lam``, ``M 1`` of the oblique projection: used where it holds one, else made here into it.
     threshold : float
         With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner (as in
         :func:`bem.kalker.compliance_preconditioner`).
@@ -152,7 +152,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         p = x0 if overwrite_x0 and in_place(bk, x0) else bk.copy(bk.asarray(x0))  # updated in place below
     A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
     passes = kernels(lat.n_nodes, bk)  # the passes over the whole cell (bem.periodic.passes)
-    soft, stiff = False, None  # soft: some node's compliance dominates (Jacobi there); stiff: for M 1 then
+    soft, stiff, made = False, None, False  # soft: some node's compliance dominates (Jacobi there); stiff: for M 1
     lam_pc, jacobi = lam, 1.0 / (diag + lam)
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
         stiff = is_stiff(D, diag, threshold)
@@ -160,7 +160,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
         jacobi = 1.0 / (diag + xp.astype(D, xp.float64)) if hardness is not None else None  # for bounded_move
         soft = not bool(xp.all(stiff))
-        sel, stiff = None, stiff if soft else None  # not held through the solve (stiff: until M 1 is made)
+        made = projection is not None and projection.values is not None  # M 1 given: stiff not held
+        sel, stiff = None, stiff if soft and not made else None  # not held through the solve (stiff: to M 1)
     M, A32 = op.symbol(lam_pc, inverse=True, single=True), op.symbol(lam, single=True)
     brick = ContactBrick(bk, lat.shape)  # the gap on the contact, then the search direction t (float32)
     work = StepArrays(bk, lat.shape)  # the spectra and bricks of the products (NumPy: one array, reused)
@@ -206,7 +207,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         u = bk.copy(bk.asarray(u0)) if home is None else u0
         u, stale = offset_added(added_into(bk, u, times_p(D)) if per_node else u), 1
     last_z, record = KeptOnContact(bk, lat.shape), Record(rtol, maxiter)  # last_z: the last preconditioned gap
-    gz_old, m_one, m_full, m_at, m_scale, fixed_scale, delta = 1.0, None, None, None, 1.0, scale, approach
+    gz_old, m_one, m_full, m_at, fixed_scale, delta = 1.0, None, None, None, scale, approach
     nodes = ContactNodes(bk, p, getattr(passes, "merge", None))  # the iterate's contact (steady: the last step's)
     idx = g_c = p_c0 = g_min = u_range = None  # u_range: max u, min u
 
@@ -264,7 +265,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return bk.max0(p_c0), n, changes, n == 0 and g_min >= 0
 
     def advance(k):  # one step of the constrained CG in the Fourier basis; (message, status) where none is taken
-        nonlocal m_full, m_one, m_at, m_scale, gz_old, u, stale, stiff, g_c
+        nonlocal m_full, m_one, m_at, gz_old, u, stale, stiff, g_c
         if bounded and not bk.count(idx):  # every contact node plastic: only entering and leaving nodes move
             return bounded_step(0.0, xp.zeros(0, dtype=xp.float64), None, None)
         steady = nodes.steady  # the last direction on the contact (float32) as written, D and what follows there
@@ -280,14 +281,13 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if force is not None and not soft:
             z -= xp.mean(z)
         elif force is not None:
-            # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), with M1
-            # of the starting contact (any M1 with a nonzero sum keeps sum z = 0; one product a solve)
-            if m_full is None:  # M (contact & stiff), kept in half precision over its largest magnitude m_scale
-                m_full, stiff = apply_m(xp.astype((p > 0) & stiff, xp.float32)), None
-                m_scale = float(xp.max(xp.abs(m_full))) or 1.0
-                m_full = xp.astype(m_full * (1.0 / m_scale), np.float16 if bk.is_numpy else xp.float32)  # (no float16)
+            # oblique projection onto sum z = 0, as in bem.kalker.solve_qp: z - M1 (1.z) / (1.M1), M1 the given
+            # projection's or of the starting contact (any M1 with a nonzero sum keeps sum z = 0; a product at most)
+            if m_full is None:  # M (contact & stiff), made into the given projection where it holds none
+                m_full, stiff = projection if made else (projection or Projection()).make(
+                    bk, apply_m(xp.astype((p > 0) & stiff, xp.float32))), None
             if not steady:  # m_at: M 1 at the contact's nodes, the Jacobi estimate at the soft ones (they stay soft)
-                m_at = nodes.over(idx, lambda n: xp.astype(bk.take(m_full, n), xp.float64) * m_scale, m_at)
+                m_at = nodes.over(idx, lambda n: m_full.at(bk, n), m_at)
                 m_one = m_at = xp.where(soft_c, jacobi_at(idx, D_c), m_at)
                 if not float(xp.sum(m_one)) > 0:  # a contact far from the starting one: the mean instead
                     m_one = xp.ones(bk.count(idx), dtype=xp.float64)

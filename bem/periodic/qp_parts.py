@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-__all__ = ["ContactBrick", "ContactNodes", "KeptOnContact", "StepArrays", "weighted_square"]
+__all__ = ["ContactBrick", "ContactNodes", "KeptOnContact", "Projection", "StepArrays", "weighted_square"]
 
 
 def weighted_square(bk, d, t):
@@ -256,6 +256,27 @@ class KeptOnContact:
     def _lookup(self, nodes):  # the kept values at a few sorted nodes, 0 where not kept
         at = np.minimum(np.searchsorted(self.nodes, nodes), self.nodes.size - 1)
         return np.where(self.nodes[at] == nodes, self.z[at], np.float32(0))
+
+
+class Projection:
+    """The direction ``m = M 1`` of the oblique projection ``z - m (1.z) / (1.m)`` of a QP with a compliance per node
+    (:mod:`bem.periodic.qp`): ``M`` of the stiff nodes of a contact, held over its largest magnitude ``scale`` in half
+    precision on NumPy (2 bytes a node), in single precision elsewhere (no float16 there). Any direction of nonzero
+    sum on the contact keeps ``sum z = 0``; one made on an earlier contact of the same cell serves a later one.
+    """
+
+    def __init__(self):
+        self.values, self.scale = None, 1.0
+
+    def make(self, bk, m):
+        """Hold ``m`` (a brick array of the cell); returns ``self``."""
+        self.scale = float(bk.xp.max(bk.xp.abs(m))) or 1.0
+        self.values = bk.xp.astype(m * (1.0 / self.scale), np.float16 if bk.is_numpy else bk.xp.float32)
+        return self
+
+    def at(self, bk, nodes):
+        """``m`` at the node selection ``nodes`` (1-D, double precision)."""
+        return bk.xp.astype(bk.take(self.values, nodes), bk.float64) * self.scale
 
 
 class StepArrays:
