@@ -37,7 +37,7 @@ from .cg_rules import QPSolution
 from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
-from .newton_moves import closure_move, model_closure, release, scaled, settle_plastic
+from .newton_moves import closure_move, line_search, model_closure, release, scaled, settle_plastic, step_nodes
 from .plastic import carry_force, clip, clipped_start, fully_plastic_note, in_place
 
 __all__ = ["solve_newton"]
@@ -57,28 +57,6 @@ _SINGLE_MAX = float(np.finfo(np.float32).max)  # the model's D in single precisi
 # Dot products go through Backend.dot: on NumPy np.einsum, because np.dot and np.vdot call the
 # threaded OpenBLAS ddot, which waits for its second thread and is slow by orders of magnitude
 # when the other cores are busy; np.einsum is not (docs/performance.md, "The FFT back end").
-
-
-def _line_search(bk, layer, p, q, u, uq, h, delta, mask):
-    """Exact minimiser of ``Phi(p + t d)``, ``d = q - p``, on ``(0, 1]``: root of the slope ``d.grad Phi(p + t d) =
-    a + t b + d.w(p + t d)``, ``a = d.(u + h - delta)`` and ``b = d.C d`` summed once (``u = C p``, ``uq = C q``; on
-    the nodes that move only; ``mask`` None: every node). Under force control ``sum d = 0``: ``delta`` drops out."""
-    xp = bk.xp
-    sel = bk.select(q != p if mask is None else mask & (q != p))
-    ps, us = bk.take(p, sel), bk.take(u, sel)
-    ds = bk.take(q, sel) - ps
-    a = bk.dot(ds, us + bk.take(h, sel) - delta)
-    b = bk.dot(ds, bk.take(uq, sel) - us)
-
-    def slope(t):
-        return a + t * b + bk.dot(ds, layer.w(xp.maximum(ps + t * ds, 0.0)))
-
-    s0, s1 = slope(0.0), slope(1.0)
-    if s0 >= 0:
-        return 0.0
-    if s1 <= 0:
-        return 1.0
-    return brent_root(slope, 0.0, 1.0, s0, s1, xtol=1e-14, rtol=4 * np.finfo(float).eps)
 
 
 def _advance(bk, p, u, sub, t, force, node_area, hardness):
@@ -263,23 +241,24 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         sub, p, u = _model_qp(op, h, layer, D, contact, precondition, p, u, full, force=force, approach=approach,
                               rtol=inner, maxiter=inner_maxiter, confirm=False, **bound, **shared)
         _count_inner(hist, sub)
-        # the step d = q - p of the model's solution q (C d = uq - u) is formed where it is used, not held
-        t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, None if full else mask)
+        # the step d = q - p of the model's solution q (C d = uq - u), on the nodes with pressure before or after it
+        at = step_nodes(bk, p, sub.p, u, sub.displacement, h, None if full else mask)
+        t = line_search(bk, layer, at, delta)
         if t < 1e-10:  # no useful descent: tighter model solve where the model is too soft, then retry
             wp = closure(p)
             scale = float(xp.max(xp.abs(u + wp)))
             D = majorant(op, layer, p, sub.p, xp.astype(D, xp.float64), mask)  # (raised past single precision's range)
-            wp = sub = None
+            wp = sub = at = None
             sub, p, u = _model_qp(op, h, layer, D, contact, precondition, p, u, full, force=force,
                                   approach=approach, rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter,
                                   scale=scale, confirm=False, **bound, **shared)
             _count_inner(hist, sub)
-            t = _line_search(bk, layer, p, sub.p, u, sub.displacement, h, delta, None if full else mask)
-        # the model's closure at the step on the nodes it keeps in contact, for the closure move (not for linear laws,
-        # where it is the step itself)
-        kept = bk.select(sub.p > 0) if t > 0.0 and hardness is None and not layer.is_linear else None
-        w_model = None if kept is None else model_closure(bk, layer, p, sub.p, D, t, kept)
-        D = judged = None
+            at = step_nodes(bk, p, sub.p, u, sub.displacement, h, None if full else mask)
+            t = line_search(bk, layer, at, delta)
+        # the model's closure at the step, for the closure move (not for linear laws, where it is the step itself)
+        moves = t > 0.0 and hardness is None and not layer.is_linear
+        w_model = model_closure(bk, layer, at, D, t) if moves else None
+        at, D, judged = at if moves else None, None, None
         if t == 0.0:
             # No decrease of Phi measurable along d: the change of Phi falls below its round-off while nodes of tiny
             # pressure (where w' is huge, e.g. a power law with small s) still violate their gap. The step is then
@@ -309,9 +288,9 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             exact = False
         sub = None
         if w_model is not None:  # t > 0: the step along d was taken
-            p, u, moved = closure_move(op, layer, h, p, u, w_model, kept, delta, force=force)
+            p, u, moved = closure_move(op, layer, p, u, w_model, at, t, delta, force=force)
             hist["closure_moves"] += moved
-        w_model = kept = None
+        w_model = at = None
         p, u = release(op, layer, h, p, u, released, delta, force=force, hardness=hardness)
         if hardness is not None:
             p, u = settle_plastic(op, layer, h, p, u, at_bound, delta, force=force, hardness=hardness)

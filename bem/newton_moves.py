@@ -1,4 +1,5 @@
-"""Moves of a Newton step (:mod:`bem.newton`) onto the bounds of the pressure, and the change of the functional.
+"""Moves of a Newton step (:mod:`bem.newton`): along ``d = q - p`` (:func:`line_search`), onto the bounds of the
+pressure and to the model's closure, and the change of the functional.
 
 Damped Newton steps approach a bound of ``p`` geometrically and never reach it: a node that the model
 releases (``q = 0``) where ``w`` is concave (:func:`release`), and, with a hardness ``H``
@@ -12,13 +13,55 @@ decreases (:func:`energy_change`).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from .backend import backend_of, operator_backend
+from .brent import brent_root
 from .plastic import fill_force, in_place
 
-__all__ = ["energy_change", "scaled", "release", "settle_plastic", "model_closure", "closure_move"]
+__all__ = ["StepNodes", "step_nodes", "line_search", "energy_change", "scaled", "release", "settle_plastic",
+           "model_closure", "closure_move"]
+
+
+class StepNodes(NamedTuple):
+    """The nodes of a Newton step ``p -> p + t (q - p)`` (:func:`step_nodes`) and what the step reads there (1-D)."""
+
+    sel: object  #: every node with pressure before or after the step (the others stay 0; Backend.select)
+    p: object  #: the pressure before the step [pressure]
+    q: object  #: the model's answer [pressure]
+    u: object  #: ``C p`` [length]
+    uq: object  #: ``C q`` [length]
+    h: object  #: the gap [length]
+
+
+def step_nodes(bk, p, q, u, uq, h, mask=None):
+    """:class:`StepNodes` of the step from ``p`` to ``q`` (brick arrays; ``u = C p``, ``uq = C q``; on ``mask``)."""
+    moving = (p > 0) | (q > 0)
+    sel = bk.select(moving if mask is None else mask & moving)
+    return StepNodes(sel, *(bk.take(x, sel) for x in (p, q, u, uq, h)))
+
+
+def line_search(bk, layer, at, delta):
+    """Exact minimiser of ``Phi(p + t d)``, ``d = q - p``, on ``[0, 1]`` at the step's nodes ``at``
+    (:class:`StepNodes`; ``d = 0`` elsewhere): the root of the slope ``d.grad Phi(p + t d) = a + t b + d.w(p + t d)``,
+    ``a = d.(u + h - delta)`` and ``b = d.C d`` summed once; 0 where the slope is not negative at 0, 1 where it is
+    negative at 1. Under force control ``sum d = 0``: ``delta`` drops out."""
+    xp = bk.xp
+    ds = at.q - at.p
+    a = bk.dot(ds, at.u + at.h - delta)
+    b = bk.dot(ds, at.uq - at.u)
+
+    def slope(t):
+        return a + t * b + bk.dot(ds, layer.w(xp.maximum(at.p + t * ds, 0.0)))
+
+    s0, s1 = slope(0.0), slope(1.0)
+    if s0 >= 0:
+        return 0.0
+    if s1 <= 0:
+        return 1.0
+    return brent_root(slope, 0.0, 1.0, s0, s1, xtol=1e-14, rtol=4 * np.finfo(float).eps)
 
 
 def energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
@@ -28,11 +71,15 @@ def energy_change(bk, layer, p, delta_p, u, c_dp, h, delta, mask):
     is tiny against the pressure, so that changes far below the round-off of ``Phi``
     itself are still measured with their sign.
     """
-    xp = bk.xp
     # the nodes that move or carry pressure: every other node adds exactly 0
     sel = bk.select(mask & ((delta_p != 0) | (p > 0)))
-    dp, pp = bk.take(delta_p, sel), bk.take(p, sel)
-    lin = bk.dot(dp, bk.take(u, sel) + bk.take(h, sel) - delta) + 0.5 * bk.dot(dp, bk.take(c_dp, sel))
+    return _change(bk, layer, *(bk.take(x, sel) for x in (p, delta_p, u, h, c_dp)), delta)
+
+
+def _change(bk, layer, pp, dp, u, h, c_dp, delta):
+    """:func:`energy_change` on the nodes that move or carry pressure (1-D arrays there)."""
+    xp = bk.xp
+    lin = bk.dot(dp, u + h - delta) + 0.5 * bk.dot(dp, c_dp)
     small = xp.abs(dp) < 1e-4 * pp
     with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
         taylor = layer.w(pp) * dp + 0.5 * bk.asarray(layer.dw(pp)) * dp * dp
@@ -117,44 +164,46 @@ def settle_plastic(op, layer, h, p, u, at_bound, delta, *, force, hardness):
     return p, u
 
 
-def model_closure(bk, layer, p, q, D, t, sel):
-    """``w(p) + t D (q - p)`` [length] at the selected nodes (1-D, double precision): the closure of a Newton step's
-    model (compliance ``D`` per node) at ``p + t (q - p)``."""
-    ps = bk.take(p, sel)
-    return bk.asarray(layer.w(ps)) + bk.xp.astype(bk.take(D, sel), bk.float64) * (t * (bk.take(q, sel) - ps))
+def model_closure(bk, layer, at, D, t):
+    """``w(p) + t D (q - p)`` [length] at the step's nodes ``at`` (:class:`StepNodes`; 1-D, double precision): the
+    closure of a Newton step's model (compliance ``D`` per node, a brick array) at ``p + t (q - p)``."""
+    return bk.asarray(layer.w(at.p)) + bk.xp.astype(bk.take(D, at.sel), bk.float64) * (t * (at.q - at.p))
 
 
-def closure_move(op, layer, h, p, u, closure, kept, delta, *, force):
-    """Move to the pressure ``w^-1(closure)`` at the nodes of ``kept`` (a selection, :meth:`bem.backend.Backend.select`),
-    0 elsewhere, if that lowers ``Phi``.
+def closure_move(op, layer, p, u, closure, at, t, delta, *, force):
+    """Move to the pressure ``w^-1(closure)`` where the model keeps a node in contact (``q > 0``), 0 elsewhere, if
+    that lowers ``Phi``.
 
-    ``closure`` is the model's at those nodes (:func:`model_closure`; 1-D) at the step's pressure ``p`` (``u = C p``). The model
-    linearises ``w`` about the last pressure; at a node the layer dominates (``w'`` large against ``C_nn``) its
-    closure is right where its pressure is not: for a root law ``w = lam sqrt(p)`` and a node that carries its
-    load by the layer alone, ``w^-1`` of the model's closure is the answer in one step, where the full step along
-    ``d`` from below the answer ``p*`` leaves ``1 - p_new / p* = (1 - sqrt(p / p*))^2``. The nodes off ``kept``
-    (those the model releases) go to 0, a node where ``w^-1`` is not finite (a rigid branch) keeps ``p``; under
-    force control the move is scaled to the force. ``w^-1`` is evaluated at the nodes of ``kept`` only. It costs
-    one product with ``C``. Returns ``(p, u, moved)``; on NumPy ``p`` and ``u`` are updated in place.
+    ``p`` (``u = C p``) is the pressure after the step ``t`` along ``d = q - p`` of the step's nodes ``at``
+    (:class:`StepNodes`: ``p`` is 0 off them), ``closure`` the model's closure there at that step
+    (:func:`model_closure`). The model linearises ``w`` about the last pressure; at a node the layer dominates (``w'``
+    large against ``C_nn``) its closure is right where its pressure is not: for a root law ``w = lam sqrt(p)`` and a
+    node that carries its load by the layer alone, ``w^-1`` of the model's closure is the answer in one step, where
+    the full step along ``d`` from below the answer ``p*`` leaves ``1 - p_new / p* = (1 - sqrt(p / p*))^2``. The nodes
+    the model releases go to 0, a node where ``w^-1`` is not finite (a rigid branch) keeps ``p``; under force control
+    the move is scaled to the force. It costs one product with ``C``; the change of ``Phi`` is measured at the step's
+    nodes, with ``u`` there from ``at`` (``u + t (uq - u)``). Returns ``(p, u, moved)``; on NumPy ``u`` is updated in
+    place.
     """
-    bk, mask = operator_backend(op)
+    bk, _ = operator_backend(op)
     xp = bk.xp
+    keep = at.q > 0
+    ps = bk.take(p, at.sel)
     with bk.errstate(over="ignore", invalid="ignore"):
         reach = bk.asarray(layer.inverse(xp.maximum(closure, 0.0)))
-    closure = None
-    trial = bk.spread(p.shape, kept, xp.where(xp.isfinite(reach), reach, bk.take(p, kept)))
+    trial = xp.where(keep, xp.where(xp.isfinite(reach), reach, ps), 0.0)
+    reach = closure = None
     if force is not None:
         total = float(xp.sum(trial))
         if not (total > 0 and math.isfinite(total)):
             return p, u, False
         trial *= force / op.lattice.node_area / total
-    trial -= p  # the move dp: under force control sum dp = 0, and Phi does not depend on delta
-    c_dp = op.matvec(trial)
-    if not energy_change(bk, layer, p, trial, u, c_dp, h, delta, mask) < 0:
+    trial -= ps  # the move dp: under force control sum dp = 0, and Phi does not depend on delta
+    c_dp = op.matvec(bk.spread(p.shape, at.sel, trial))
+    if not _change(bk, layer, ps, trial, (at.uq - at.u) * t + at.u, at.h, bk.take(c_dp, at.sel), delta) < 0:
         return p, u, False
+    moved = xp.maximum(ps + trial, 0.0)  # p + (w^-1 - p) rounds below 0 only where w^-1 is below 1e-16 p
     if not (in_place(bk, p) and in_place(bk, u)):
-        return xp.maximum(p + trial, 0.0), u + c_dp, True
-    p += trial
-    np.maximum(p, 0.0, out=p)  # p + (w^-1 - p) rounds below 0 only where w^-1 is below 1e-16 p
+        return bk.put(bk.copy(p), at.sel, moved), u + c_dp, True
     u += c_dp
-    return p, u, True
+    return bk.put(p, at.sel, moved), u, True

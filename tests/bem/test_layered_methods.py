@@ -87,7 +87,7 @@ def test_newton_retries_with_a_majorised_model_where_a_step_finds_no_descent(pap
     finest level is made to find none."""
     import bem.newton as newton
 
-    calls, real = [], newton._line_search
+    calls, real = [], newton.line_search
 
     def first_finds_none(*args):
         calls.append(args)
@@ -95,7 +95,7 @@ def test_newton_retries_with_a_majorised_model_where_a_step_finds_no_descent(pap
 
     layer = paper_laws(0.3)["root"]
     reference = paper(layer, nested=False)  # one level: the first search is the finest level's
-    monkeypatch.setattr(newton, "_line_search", first_finds_none)
+    monkeypatch.setattr(newton, "line_search", first_finds_none)
     res = paper(layer, nested=False)
     assert len(calls) >= 2  # the refused search and the retry's
     assert res.converged and res.kkt_residual <= 1e-10

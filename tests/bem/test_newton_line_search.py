@@ -1,12 +1,13 @@
-"""The line search of a Newton step (``bem.newton._line_search``): the step ``t`` that minimises the functional along
-``d = q - p``, checked against the slope and the functional made by their definitions with whole products."""
+"""The line search of a Newton step (:func:`bem.newton_moves.line_search`): the step ``t`` that minimises the
+functional along ``d = q - p``, checked against the slope and the functional made by their definitions with whole
+products."""
 
 import numpy as np
 import pytest
 
 import bem
-from bem import newton
 from bem.backend import get_backend
+from bem.newton_moves import line_search, step_nodes
 from bem.periodic import PeriodicOperator
 
 from .newton_cases import CELL, FORCE, phi, root_law, waves
@@ -15,6 +16,10 @@ from .newton_cases import CELL, FORCE, phi, root_law, waves
 def _slope(op, layer, h, p, d, delta):
     """``d.grad Phi(p)`` by its definition: ``d.(C p + w(p) + h - delta)``, every node."""
     return float(np.sum(d * (op.matvec(p) + layer.w(p) + h - delta)))
+
+
+def _search(bk, layer, p, q, u, uq, h, delta, mask):
+    return line_search(bk, layer, step_nodes(bk, p, q, u, uq, h, mask), delta)
 
 
 def _case(seed, overshoot):
@@ -36,7 +41,7 @@ def test_the_step_is_the_minimiser_of_the_functional_along_the_direction(seed):
     before = (p.copy(), q.copy(), h.copy())
     u, uq = op.matvec(p), op.matvec(q)
     bk = get_backend("cpu")
-    t = newton._line_search(bk, layer, p, q, u, uq, h, delta, None)
+    t = _search(bk, layer, p, q, u, uq, h, delta, None)
     d = q - p
     assert 0.0 < t < 1.0
     # the slope by its definition changes sign at t, and t is within 1e-9 of its root
@@ -47,7 +52,7 @@ def test_the_step_is_the_minimiser_of_the_functional_along_the_direction(seed):
     # the inputs are not modified; a mask of every node gives the same step
     for a, b in zip((p, q, h), before):
         np.testing.assert_array_equal(a, b)
-    assert newton._line_search(bk, layer, p, q, u, uq, h, delta, np.ones(CELL.shape, dtype=bool)) == t
+    assert _search(bk, layer, p, q, u, uq, h, delta, np.ones(CELL.shape, dtype=bool)) == t
 
 
 def test_the_full_step_where_the_functional_falls_all_the_way_and_none_where_it_rises():
@@ -55,10 +60,10 @@ def test_the_full_step_where_the_functional_falls_all_the_way_and_none_where_it_
     bk = get_backend("cpu")
     d = q - p
     assert _slope(op, layer, h, q, d, delta) < 0  # still descending at the model's answer
-    assert newton._line_search(bk, layer, p, q, op.matvec(p), op.matvec(q), h, delta, None) == 1.0
+    assert _search(bk, layer, p, q, op.matvec(p), op.matvec(q), h, delta, None) == 1.0
     # the direction reversed: no descent
     back = np.maximum(p - d, 0.0)
-    assert newton._line_search(bk, layer, p, back, op.matvec(p), op.matvec(back), h, delta, None) == 0.0
+    assert _search(bk, layer, p, back, op.matvec(p), op.matvec(back), h, delta, None) == 0.0
 
 
 def test_a_mask_leaves_the_nodes_off_it_out_of_the_slope():
@@ -68,11 +73,11 @@ def test_a_mask_leaves_the_nodes_off_it_out_of_the_slope():
     mask[: CELL.shape[0] // 2] = False
     bk = get_backend("cpu")
     u, uq = op.matvec(p), op.matvec(q)
-    t = newton._line_search(bk, layer, p, q, u, uq, h, delta, mask)
+    t = _search(bk, layer, p, q, u, uq, h, delta, mask)
     d = np.where(mask, q - p, 0.0)  # the slope on the mask: d.(C p + t C (q - p) + w(p + t d) + h - delta) there
 
     def slope(s):
         return float(np.sum(d * (u + s * (uq - u) + layer.w(p + s * d) + h - delta)))
 
-    assert 0.0 < t < 1.0 and t != newton._line_search(bk, layer, p, q, u, uq, h, delta, None)
+    assert 0.0 < t < 1.0 and t != _search(bk, layer, p, q, u, uq, h, delta, None)
     assert slope(t - 1e-9) < 0 < slope(t + 1e-9)
