@@ -258,7 +258,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         # the model's closure at the step, for the closure move (not for linear laws, where it is the step itself)
         moves = t > 0.0 and hardness is None and not layer.is_linear
         w_model = model_closure(bk, layer, at, D, t) if moves else None
-        at, D, judged = at if moves else None, None, None
+        at, D, judged = at.end(t) if moves else None, None, None  # (p, q and C q there not held)
         if t == 0.0:
             # No decrease of Phi measurable along d: the change of Phi falls below its round-off while nodes of tiny
             # pressure (where w' is huge, e.g. a power law with small s) still violate their gap. The step is then
@@ -288,7 +288,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             exact = False
         sub = None
         if w_model is not None:  # t > 0: the step along d was taken
-            p, u, moved = closure_move(op, layer, p, u, w_model, at, t, delta, force=force)
+            p, u, moved = closure_move(op, layer, p, u, w_model, at, delta, force=force)
             hist["closure_moves"] += moved
         w_model = at = None
         p, u = release(op, layer, h, p, u, released, delta, force=force, hardness=hardness)

@@ -21,7 +21,7 @@ from .backend import backend_of, operator_backend
 from .brent import brent_root
 from .plastic import fill_force, in_place
 
-__all__ = ["StepNodes", "step_nodes", "line_search", "energy_change", "scaled", "release", "settle_plastic",
+__all__ = ["StepNodes", "StepEnd", "step_nodes", "line_search", "energy_change", "scaled", "release", "settle_plastic",
            "model_closure", "closure_move"]
 
 
@@ -33,6 +33,19 @@ class StepNodes(NamedTuple):
     q: object  #: the model's answer [pressure]
     u: object  #: ``C p`` [length]
     uq: object  #: ``C q`` [length]
+    h: object  #: the gap [length]
+
+    def end(self, t):
+        """:class:`StepEnd` of the step ``t`` along ``d = q - p`` (the arrays of ``p``, ``q`` and ``C q`` not held)."""
+        return StepEnd(self.sel, self.q > 0, (self.uq - self.u) * t + self.u, self.h)
+
+
+class StepEnd(NamedTuple):
+    """What the closure move reads at a step's nodes after the step (:meth:`StepNodes.end`; 1-D)."""
+
+    sel: object  #: the step's nodes
+    keep: object  #: where the model keeps a node in contact (``q > 0``; boolean)
+    u: object  #: ``C p`` after the step, ``u + t (C q - u)`` [length]
     h: object  #: the gap [length]
 
 
@@ -170,28 +183,26 @@ def model_closure(bk, layer, at, D, t):
     return bk.asarray(layer.w(at.p)) + bk.xp.astype(bk.take(D, at.sel), bk.float64) * (t * (at.q - at.p))
 
 
-def closure_move(op, layer, p, u, closure, at, t, delta, *, force):
+def closure_move(op, layer, p, u, closure, end, delta, *, force):
     """Move to the pressure ``w^-1(closure)`` where the model keeps a node in contact (``q > 0``), 0 elsewhere, if
     that lowers ``Phi``.
 
-    ``p`` (``u = C p``) is the pressure after the step ``t`` along ``d = q - p`` of the step's nodes ``at``
-    (:class:`StepNodes`: ``p`` is 0 off them), ``closure`` the model's closure there at that step
+    ``p`` (``u = C p``) is the pressure after a step along ``d = q - p``, ``end`` (:class:`StepEnd`) that step's
+    nodes (``p`` is 0 off them) and ``u`` there, ``closure`` the model's closure there at that step
     (:func:`model_closure`). The model linearises ``w`` about the last pressure; at a node the layer dominates (``w'``
     large against ``C_nn``) its closure is right where its pressure is not: for a root law ``w = lam sqrt(p)`` and a
     node that carries its load by the layer alone, ``w^-1`` of the model's closure is the answer in one step, where
     the full step along ``d`` from below the answer ``p*`` leaves ``1 - p_new / p* = (1 - sqrt(p / p*))^2``. The nodes
     the model releases go to 0, a node where ``w^-1`` is not finite (a rigid branch) keeps ``p``; under force control
     the move is scaled to the force. It costs one product with ``C``; the change of ``Phi`` is measured at the step's
-    nodes, with ``u`` there from ``at`` (``u + t (uq - u)``). Returns ``(p, u, moved)``; on NumPy ``u`` is updated in
-    place.
+    nodes, with ``u`` there from ``end``. Returns ``(p, u, moved)``; on NumPy ``p`` and ``u`` are updated in place.
     """
     bk, _ = operator_backend(op)
     xp = bk.xp
-    keep = at.q > 0
-    ps = bk.take(p, at.sel)
+    ps = bk.take(p, end.sel)
     with bk.errstate(over="ignore", invalid="ignore"):
         reach = bk.asarray(layer.inverse(xp.maximum(closure, 0.0)))
-    trial = xp.where(keep, xp.where(xp.isfinite(reach), reach, ps), 0.0)
+    trial = xp.where(end.keep, xp.where(xp.isfinite(reach), reach, ps), 0.0)
     reach = closure = None
     if force is not None:
         total = float(xp.sum(trial))
@@ -199,11 +210,11 @@ def closure_move(op, layer, p, u, closure, at, t, delta, *, force):
             return p, u, False
         trial *= force / op.lattice.node_area / total
     trial -= ps  # the move dp: under force control sum dp = 0, and Phi does not depend on delta
-    c_dp = op.matvec(bk.spread(p.shape, at.sel, trial))
-    if not _change(bk, layer, ps, trial, (at.uq - at.u) * t + at.u, at.h, bk.take(c_dp, at.sel), delta) < 0:
+    c_dp = op.matvec(bk.spread(p.shape, end.sel, trial))
+    if not _change(bk, layer, ps, trial, end.u, end.h, bk.take(c_dp, end.sel), delta) < 0:
         return p, u, False
     moved = xp.maximum(ps + trial, 0.0)  # p + (w^-1 - p) rounds below 0 only where w^-1 is below 1e-16 p
     if not (in_place(bk, p) and in_place(bk, u)):
-        return bk.put(bk.copy(p), at.sel, moved), u + c_dp, True
+        return bk.put(bk.copy(p), end.sel, moved), u + c_dp, True
     u += c_dp
-    return bk.put(p, at.sel, moved), u, True
+    return bk.put(p, end.sel, moved), u, True

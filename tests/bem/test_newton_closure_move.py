@@ -52,7 +52,7 @@ def _moved(op, layer, h, p, u, closure, q, delta):
     """The closure move from ``p`` (``u = C p``) with the model's answer ``q`` and its ``closure`` (brick arrays), as a
     step that has reached ``p`` (``t = 1``, ``C q = u``)."""
     at = step_nodes(get_backend("cpu"), p, q, u, u, h)
-    return closure_move(op, layer, p, u, closure.reshape(-1)[at.sel], at, 1.0, delta, force=FORCE)
+    return closure_move(op, layer, p, u, closure.reshape(-1)[at.sel], at.end(1.0), delta, force=FORCE)
 
 
 def _state(layer, x0):
@@ -161,7 +161,7 @@ def test_after_a_partial_step_the_move_is_taken_exactly_where_it_lowers_phi():
 
     def taken(s):  # the move, checked against its definition where taken
         closure, want = candidate(s)
-        new_p, new_u, moved = closure_move(op, layer, p.copy(), op.matvec(p), closure.reshape(-1)[at.sel], at, t,
+        new_p, new_u, moved = closure_move(op, layer, p.copy(), op.matvec(p), closure.reshape(-1)[at.sel], at.end(t),
                                            answer.approach, force=FORCE)
         np.testing.assert_allclose(new_p, want if moved else p, rtol=1e-12, atol=1e-15 * p.max())
         np.testing.assert_allclose(new_u, op.matvec(new_p), rtol=0, atol=1e-12 * np.abs(new_u).max())
