@@ -224,7 +224,8 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             message, status = "the iteration produced a non-finite value", "nonfinite"
             break
         if kkt <= rtol:
-            converged, status, message = True, "converged", f"KKT residual {kkt:.2e} <= rtol {rtol:.1e} after {k} Newton steps"
+            converged, status = True, "converged"
+            message = f"KKT residual {kkt:.2e} <= rtol {rtol:.1e} after {k} Newton steps"
             break
         if k == maxiter:
             message = f"no convergence in maxiter = {maxiter} Newton steps (KKT residual {kkt:.2e} > rtol {rtol:.1e})"

@@ -104,8 +104,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     overwrite_x0 : bool
         Whether a float64 NumPy ``x0`` may hold the iterate (not copied: one array of the cell fewer).
     rtol : float
-        Tolerance on the KKT residual (the rule of :func:`bem.kalker.solve_qp`, checked on an
-        exactly recomputed ``C p`` unless ``confirm`` is False).
+        Tolerance on the KKT residual (:func:`bem.kalker.solve_qp`'s rule, on an exact ``C p`` unless not ``confirm``).
     maxiter : int, optional
         Iteration limit (default ``max(200, 10 * sqrt(N))``).
     callback : callable, optional
@@ -124,14 +123,14 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         With a per-node ``lam``: nodes with ``lam > threshold C_nn`` get the Jacobi preconditioner (as in
         :func:`bem.kalker.compliance_preconditioner`).
     hardness : float, optional
-        The bound ``p <= H`` [pressure] (:mod:`bem.plastic`): the search direction lives on the elastic
-        contact ``0 < p < H`` and the step is :func:`bem.cg_rules.bounded_move`.
+        The bound ``p <= H`` [pressure] (:mod:`bem.plastic`): the search direction lives on the elastic contact ``0 <
+        p < H`` and the step is :func:`bem.cg_rules.bounded_move`.
 
     Returns
     -------
     bem.cg_rules.QPSolution
-        As :func:`bem.kalker.solve_qp` with its FFT preconditioner; ``op.n_matvec`` counts the
-        products ``(C + lam) v`` (spectral multiplications, in single or double precision).
+        As :func:`bem.kalker.solve_qp` with its FFT preconditioner; ``op.n_matvec`` counts the products ``(C + lam) v``
+        (spectral multiplications, in single or double precision).
     """
     lat, bk = op.lattice, operator_backend(op)[0]
     a, xp, per_node = lat.node_area, bk.xp, is_per_node(lam)
@@ -243,7 +242,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         enter, g_low, *u_range = passes.scan(u, h, delta, p, enter)  # with the mask of the entering test
         g_c -= delta
         g_min = g_low - delta
-        return residual(k, bk.max0(xp.abs(g_c)), None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force)
+        force_error = None if force is None else abs(a * float(xp.sum(p_c0)) - force) / force
+        return residual(k, bk.max0(xp.abs(g_c)), force_error)
 
     def confirms(kkt):  # recompute C p exactly at the tolerance, or in double precision below SINGLE_ABOVE
         nonlocal single, u, stale
