@@ -213,20 +213,22 @@ def prepare(problem, n):
     """``(solve, gap)``: ``solve()`` runs contactlab on ``problem`` at size ``n``; ``gap`` is what it solves
     (a brick array, a :mod:`bem.gaps` shape or a :class:`RoughSphere`), made here, outside any clock.
 
-    For a periodic cell the compiled passes are loaded here too (:func:`bem.periodic.passes.load`, where numba is
-    installed), as a peer's compiled module is imported before its clock: numba's import and the load of the
-    kernels' cached code (:data:`LOAD_S` holds how long it took in this process).
+    For a periodic cell the compiled passes are loaded here too (:func:`bem.periodic.passes.load` and
+    :func:`bem.periodic.step_passes.load`, where numba is installed), as a peer's compiled module is imported before
+    its clock: numba's import and the load of the kernels' cached code (:data:`LOAD_S` holds how long it took in this
+    process).
     """
     global LOAD_S
     import bem
 
     LOAD_S = None
     if problem.startswith("periodic"):
-        from bem.periodic import passes
+        from bem.periodic import passes, step_passes
         from periodic_rough import _root
 
         t = time.perf_counter()
         passes.load()
+        step_passes.load()
         LOAD_S = time.perf_counter() - t
 
         cell, h = periodic_cell(n)

@@ -21,11 +21,13 @@ from functools import cached_property
 
 import numpy as np
 
-from .. import heap
+from .. import fft, heap
 from ..checks import check_int, check_node_count, check_positive, fail
 from .gap import cell_gap, check_cell_gap, coarse_gap
 from .influence import PeriodicOperator, forget_symbols
+from .passes import MIN_NODES
 from .result import PeriodicContactResult
+from .step_passes import prolong_kernel
 
 __all__ = ["PeriodicCell"]
 
@@ -227,7 +229,9 @@ class PeriodicCell:
         """The piecewise-linear field of the coarse nodal ``values`` (cell :meth:`coarsen`) at this cell's nodes.
 
         A fine node is a coarse node or the midpoint of a coarse edge (along ``e1``, ``e2`` or
-        ``e2 - e1``): it takes the coarse value or the mean of two. Periodic.
+        ``e2 - e1``): it takes the coarse value or the mean of two. Periodic. On a cell of at least
+        :data:`bem.periodic.passes.MIN_NODES` nodes with numba the rows are made by the compiled kernel of
+        :func:`bem.periodic.step_passes.prolong_kernel` on the FFT threads (the same numbers).
         """
         coarse = self.coarsen()
         values = np.asarray(values, dtype=float)
@@ -238,6 +242,10 @@ class PeriodicCell:
         # columns are midpoints along e1; fine row 2k + 1 holds the midpoints of the edges between
         # coarse rows k and k + 1, the means of neighbouring columns of those rows interleaved
         out = np.empty(self.shape)
+        if self.n_nodes >= MIN_NODES and (kernel := prolong_kernel()) is not None:  # the same numbers, in parts
+            values = np.ascontiguousarray(values)
+            fft.in_parts(lambda part: kernel(values, out, part.start, part.stop), coarse.n_rows, out.size)
+            return out
         even, nxt = out[0::2], np.roll(values, -1, axis=0)
         even[0::2, 0::2] = values[0::2]
         even[1::2, 1::2] = values[1::2]

@@ -130,7 +130,8 @@ def _real_part(n_rows, n_cols, alpha):
     ii, jj, values = _real_space_values(alpha)
     out = np.zeros((n_rows, n_cols))
     np.add.at(out, (np.mod(jj, n_rows), np.mod(ii + np.floor_divide(jj, 2), n_cols)), values)
-    return out - math.sqrt(3 * math.pi) / (alpha * _area(n_rows, n_cols))
+    out -= math.sqrt(3 * math.pi) / (alpha * _area(n_rows, n_cols))
+    return out
 
 
 def _sin_over(x):
@@ -204,7 +205,9 @@ def _area(n_rows, n_cols):
 
 def _binned(n_rows, n_cols, radial, g_cut, weight, block):
     """The terms of :func:`alias_sum` binned onto the discrete Fourier modes of each row parity: ``A_s(n0, m0)``,
-    complex, shape ``(2, n_rows/2, n_cols)`` (the real part of their inverse DFT is the sum, up to ``1/A``)."""
+    complex, shape ``(2, n_rows/2, n_cols)`` (the real part of their inverse DFT is the sum, up to ``1/A``). Where each
+    term has a mode of its own the blocks of rows of ``G`` are made on the FFT threads (:func:`bem.fft.in_parts`), each
+    block into its own rows of modes: the same numbers as one after the other."""
     half = n_rows // 2
     lx, ly = float(n_cols), n_rows * _SQRT3 / 2
     m_max, n_max = int(g_cut * lx / (2 * math.pi)) + 1, int(g_cut * ly / (2 * math.pi)) + 1
@@ -217,20 +220,31 @@ def _binned(n_rows, n_cols, radial, g_cut, weight, block):
     # conjugates), and only the real part of the sum is kept: half the plane (n > 0, or n = 0 and
     # m > 0), counted twice
     block = max(1, 2 ** 20 // m.size) if block is None else block  # rows per block: small temporaries
-    distinct = 2 * m_max + 1 <= n_cols and n_max < half  # every term a mode of its own: no binning
-    for n0 in range(0, n_max + 1, block):
+    starts = range(0, n_max + 1, block)
+
+    def keep_of(n0):  # the block's rows of G, gy, |G| and the terms kept
         n = np.arange(n0, min(n0 + block, n_max + 1))[:, None]
         gy = 2 * math.pi * n / ly
         k = np.sqrt(gx * gx + gy * gy)
-        keep = (k <= g_cut) & ((n > 0) | (m > 0))
-        if distinct:  # the terms on the whole block of G, 0 where not kept, written onto their modes
+        return n, gy, k, (k <= g_cut) & ((n > 0) | (m > 0))
+
+    def distinct_blocks(part):  # the terms on whole blocks of G, 0 where not kept, written onto their own modes
+        for n0 in starts[part]:
+            n, gy, k, keep = keep_of(n0)
             f = _terms(gx, gy, sinc_x, np.where(keep, k, g_cut), radial, weight)
             f[~keep] = 0.0
             odd = f * (phase_x * np.exp(2j * math.pi * n / n_rows))
             for s, values in ((0, f), (1, odd)):  # m >= 0 on columns m, m < 0 on columns n_cols + m
                 sums[s, n0:n0 + n.size, :m_max + 1] += values[:, m_max:]
                 sums[s, n0:n0 + n.size, n_cols - m_max:] += values[:, :m_max]
-            continue
+
+    if 2 * m_max + 1 <= n_cols and n_max < half:  # every term a mode of its own, each block its own rows: in parts
+        from .. import fft
+
+        fft.in_parts(distinct_blocks, len(starts), sums.size)
+        return sums
+    for n0 in starts:
+        n, gy, k, keep = keep_of(n0)
         rows, cols = np.nonzero(keep)
         f = _terms(gx[cols], gy[rows, 0], sinc_x[cols], k[keep], radial, weight)
         # node of parity s = 1: phase exp(i pi (m / n_cols + 2 n / n_rows)) relative to parity 0

@@ -163,13 +163,28 @@ def kernels(n_nodes, bk=None):
         ``mix(spectrum, symbol, out, even, rows)`` and ``merge(idx, values, stayed, new, new_values, out_idx,
         out_values, at)``) and the flag ``compiled``.
     """
+    return chosen(n_nodes, bk, _NumPyKernels, _NamespaceKernels, _COMPILED, _compile)
+
+
+def chosen(n_nodes, bk, numpy_form, namespace_form, compiled, compile):
+    """The form of a family of kernels for a cell of ``n_nodes`` nodes: ``namespace_form(bk)`` off NumPy, else the
+    compiled one where the cell has at least :data:`MIN_NODES` nodes and ``compile()`` made one (kept in the list
+    ``compiled`` at its first call; None without numba), else ``numpy_form``."""
     if bk is not None and not bk.is_numpy:
-        return _NamespaceKernels(bk)
+        return namespace_form(bk)
     if n_nodes < MIN_NODES:
-        return _NumPyKernels
-    if not _COMPILED:
-        _COMPILED.append(_compile())
-    return _COMPILED[0] or _NumPyKernels
+        return numpy_form
+    if not compiled:
+        compiled.append(compile())
+    return compiled[0] or numpy_form
+
+
+def run_in_parts(kernel, n):
+    """``kernel(lo, hi)`` on the parts of ``range(n)`` on the FFT threads (:func:`bem.fft.in_parts`); their results
+    in the order of the parts."""
+    res = {}
+    fft.in_parts(lambda part: res.__setitem__(part.start, kernel(part.start, part.stop)), n, n)
+    return [res[k] for k in sorted(res)]
 
 
 def load():
@@ -310,10 +325,7 @@ def _compile():
             o, m = o + 1, m + 1
         return o
 
-    def run(kernel, n):  # kernel(lo, hi) on the parts of range(n); their results in the order of the parts
-        res = {}
-        fft.in_parts(lambda part: res.__setitem__(part.start, kernel(part.start, part.stop)), n, n)
-        return [res[k] for k in sorted(res)]
+    run = run_in_parts
 
     class Compiled:
         compiled = True

@@ -36,7 +36,8 @@ leaving, at a constant KKT residual, on a 672 x 776 rough cell at 1e-4 of the me
 - after a step that let no node enter and left every contact node a positive pressure, the contact is the same: the
   next iteration reuses its nodes, the step's pressures and direction there and ``D`` on it, with no selection and no
   gathers; after another, the next contact is made from the step's arrays (:class:`bem.periodic.qp_parts.ContactNodes`);
-- on a large cell, with numba, the block products and three passes over the cell run compiled on the FFT threads.
+- on a large cell, with numba, the block products, three passes over the cell and the step's move, put and brick
+  writes (:mod:`bem.periodic.step_passes`) run compiled on the FFT threads.
 
 With a compliance per node (the model of a Newton step, :mod:`bem.newton`) the products are those of ``C`` alone, ``u =
 C p + D p`` (plus the gap's ``offset``) and the curvature adds ``sum D t^2``; the preconditioner is that of
@@ -76,6 +77,7 @@ from .edge import EdgeCorrection
 from .passes import kernels
 from .qp_parts import (ContactBrick, ContactNodes, KeptOnContact, Projection, StepArrays, added_into,
                        multiplied_into, product_array, weighted_square)
+from .step_passes import step_kernels
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
 
@@ -150,7 +152,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     else:  # the caller's iterate and its product, as they are
         p = x0 if overwrite_x0 and in_place(bk, x0) else bk.copy(bk.asarray(x0))  # updated in place below
     A, diag = op.symbol(lam), float(op.diagonal)  # C + lam I, C_nn
-    passes = kernels(lat.n_nodes, bk)  # the passes over the whole cell (bem.periodic.passes)
+    passes, steps = kernels(lat.n_nodes, bk), step_kernels(lat.n_nodes, bk)  # over the cell, over the contact
     soft, stiff, made = False, None, False  # soft: some node's compliance dominates (Jacobi there); stiff: for M 1
     lam_pc, jacobi = lam, 1.0 / (diag + lam)
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
@@ -162,7 +164,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         made = projection is not None and projection.values is not None  # M 1 given: stiff not held
         sel, stiff = None, stiff if soft and not made else None  # not held through the solve (stiff: to M 1)
     M, A32 = op.symbol(lam_pc, inverse=True, single=True), op.symbol(lam, single=True)
-    brick = ContactBrick(bk, lat.shape)  # the gap on the contact, then the search direction t (float32)
+    brick = ContactBrick(bk, lat.shape, getattr(steps, "write", None))  # the gap on the contact, then the direction
     work = StepArrays(bk, lat.shape)  # the spectra and bricks of the products (NumPy: one array, reused)
 
     def product(v):  # (C + lam) v, a spectrum in work's bytes
@@ -318,12 +320,9 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             tau = gt / tt  # the minimum along t (gt = gz when the contact has not changed)
         if bounded:
             return bounded_step(tau, t_c, R, D_c if per_node else None)
-        p_c = p_c0 - tau * t_c
-        clipped = p_c < 0
-        p_c = xp.where(clipped, 0.0, p_c)
-        changed = bool(xp.any(clipped))
-        if not (positive := bool(xp.all(p_c > 0))):  # else p = 0 at the same nodes (p_c0 > 0): put once below
-            bk.put(p, idx, p_c)  # p is 0 off idx
+        p_c, clipped, changed, positive = steps.move(p_c0, t_c, tau)  # max(p_c0 - tau t_c, 0)
+        if not positive and (target is None or not bk.is_numpy):  # else p = 0 at the same nodes: put once below
+            bk.put(p, idx, p_c)  # p is 0 off idx (read by the entering test off NumPy)
         # re-entering nodes (p = 0, g < 0): the step tau of the preconditioned direction with the Jacobi
         # estimate of M there, -f min(tau, 1) g / (C_nn + lam) (module docstring: entering nodes)
         if bk.is_numpy:  # g < 0 and p = 0 from measure (the same u and delta), and at the nodes clipped to 0 here
@@ -345,9 +344,8 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
                 bk.put(p, idx, p_c0)
                 return "the iteration produced a non-finite value", "nonfinite"
             s = target / total
-            p_c *= s
         if target is not None or positive:
-            bk.put(p, idx, p_c)
+            steps.scale_put(p, idx, p_c, s)  # p_c *= s, then p at idx
         if entered:
             bk.put(p, overlap, (p_o := multiplied_into(bk, p_o, s)))
         if t_move is not None:  # p = s (p - tau t'): u = s (u - tau (C + lam) t'), plus D's terms per node

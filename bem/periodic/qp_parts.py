@@ -146,10 +146,13 @@ class ContactBrick:
     bk, shape
         The backend of the iteration and the shape of the cell's brick arrays (as for
         :class:`KeptOnContact`).
+    write : callable, optional
+        The compiled write of :mod:`bem.periodic.step_passes` (``write(brick, nodes, values, fill) -> last``, on
+        NumPy): the fill and the put in one pass on the threads; the same values as without it.
     """
 
-    def __init__(self, bk, shape):
-        self.bk, self.shape = bk, shape
+    def __init__(self, bk, shape, write=None):
+        self.bk, self.shape, self._write = bk, shape, write
         self.values = np.zeros(shape, dtype=np.float32) if bk.is_numpy else bk.xp.zeros(shape, dtype=bk.xp.float32)
         self.nodes = self.last = None
 
@@ -161,10 +164,14 @@ class ContactBrick:
             self.last = xp.astype(values, xp.float32)
             self.values = bk.put(xp.zeros(self.shape, dtype=xp.float32), nodes, self.last)
             return self.values
-        if nodes is not self.nodes:
-            self.values.fill(0.0)  # a fill: faster than zeroing the nodes of the last write
-        self.last = values.astype(np.float32)  # rounded first: a faster scatter, the same values
-        self.values.reshape(-1)[nodes] = self.last
+        fill = nodes is not self.nodes  # a fill: faster than zeroing the nodes of the last write
+        if self._write is not None:
+            self.last = self._write(self.values, nodes, values, fill)
+        else:
+            if fill:
+                self.values.fill(0.0)
+            self.last = values.astype(np.float32)  # rounded first: a faster scatter, the same values
+            self.values.reshape(-1)[nodes] = self.last
         self.nodes = nodes
         return self.values
 

@@ -37,3 +37,13 @@ def paper():
                          layer=layer, method=method, **kw)
 
     return run
+
+
+@pytest.fixture
+def two_threads():
+    """The FFT threads (and the compiled passes' parts) set to two for the test, restored after it."""
+    from bem import fft
+
+    previous = fft.set_threads(2)
+    yield
+    fft.set_threads(previous)

@@ -47,3 +47,54 @@ def test_the_layered_state_of_a_cell_is_its_definition_and_leaves_its_inputs():
                                              force=FORCE, node_area=CELL.node_area), rel=1e-12)
     for now, before in zip((p, u, h, closure), given):
         np.testing.assert_array_equal(now, before)
+
+
+def _residual_by_definition(p, gap, s, force, node_area):
+    """The KKT residual written out (bem.kkt's docstring), with NumPy's own passes."""
+    contact = p > 0
+    parts = [max(0.0, -p.min()) / p.max() if p.max() > 0 else 0.0,
+             np.abs(gap[contact]).max(initial=0.0) / s, max(0.0, -gap[~contact].min(initial=0.0)) / s]
+    return max(parts + ([abs(node_area * p.sum() - force) / force] if force is not None else []))
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("case", ["mixed", "all_in_contact", "none_in_contact", "negative"])
+def test_the_residual_of_a_large_state_is_its_definition(case, threads):
+    """On arrays of ``bem.extremes.MIN_NODES`` entries and more (the extremes in one pass, compiled where numba is
+    installed, in parts on the threads) the residual is the one written out with NumPy's passes, exactly; the inputs
+    untouched."""
+    from bem import extremes, fft
+
+    rng = np.random.default_rng(9)
+    n = extremes.MIN_NODES + 1001
+    p = {"mixed": np.maximum(rng.standard_normal(n), 0.0), "all_in_contact": rng.uniform(0.5, 1.0, n),
+         "none_in_contact": np.zeros(n), "negative": rng.standard_normal(n)}[case]
+    gap = rng.standard_normal(n) * 1e-3
+    gap[n - 1], gap[5] = -0.7, 0.9  # extremes in the first and the last part
+    p[n // 2] = max(p[n // 2], 0.0) * 3 + (1.0 if case != "none_in_contact" else 0.0)
+    given = p.copy(), gap.copy()
+    previous = fft.set_threads(threads)
+    try:
+        for force in (None, 1.3 * n):
+            got = kkt_residual(p, gap, displacement_scale=0.5, force=force, node_area=1.0)
+            assert got == _residual_by_definition(p, gap, 0.5, force, 1.0)
+    finally:
+        fft.set_threads(previous)
+    assert np.array_equal(p, given[0]) and np.array_equal(gap, given[1])
+
+
+def test_the_compiled_extremes_are_numpys():
+    """:func:`bem.extremes.residual_extremes` on a large array (compiled, in parts) gives the extremes NumPy gives,
+    where no node and where every node is in contact too."""
+    from bem import extremes
+
+    pytest.importorskip("numba", reason="the compiled pass needs numba (contactlab[fast])")
+    rng = np.random.default_rng(12)
+    n = extremes.MIN_NODES + 77
+    gap = rng.standard_normal(n)
+    for p in (np.maximum(rng.standard_normal(n), 0.0), np.zeros(n), rng.uniform(0.1, 1.0, n)):
+        contact = p > 0
+        expected = (p.min(), p.max(), np.abs(gap[contact]).max() if contact.any() else 0.0,
+                    gap[~contact].min() if (~contact).any() else np.inf)
+        assert extremes.residual_extremes(p, gap) == expected
+    assert extremes._COMPILED and extremes._COMPILED[0] is not None  # the compiled kernel took them

@@ -8,7 +8,6 @@ import pytest
 
 import bem.periodic.passes as passes
 import bem.periodic.spectra as spectra
-from bem import fft
 from bem.periodic import PeriodicCell, PeriodicOperator
 from bem.periodic.qp import solve_periodic_qp
 
@@ -17,13 +16,6 @@ from .fourier_qp_cases import assert_same_bits, cell_qp
 numba = pytest.importorskip("numba", reason="the compiled passes need numba (contactlab[fast])")
 
 N = (1 << 17) + 5  # over bem.fft's threshold for parts: split over the threads, parts of unequal length
-
-
-@pytest.fixture
-def two_threads():
-    previous = fft.set_threads(2)
-    yield
-    fft.set_threads(previous)
 
 
 def _compiled():
