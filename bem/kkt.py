@@ -59,29 +59,19 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None, hard
     p = bk.asarray(p)
     gap = bk.asarray(gap)
     with bk.errstate(over="ignore", invalid="ignore"):  # a sum is finite only where every term is, or overflows
-        sums = math.isfinite(float(xp.sum(p))) and math.isfinite(float(xp.sum(gap)))
-    if not sums and not (bool(xp.all(xp.isfinite(p))) and bool(xp.all(xp.isfinite(gap)))):
+        p_sum, gap_sum = float(xp.sum(p)), float(xp.sum(gap))
+    if not (math.isfinite(p_sum) and math.isfinite(gap_sum)) and not (
+            bool(xp.all(xp.isfinite(p))) and bool(xp.all(xp.isfinite(gap)))):
         return float("inf")
     s = float(displacement_scale)
     if s <= 0:  # no deformation at all: measure the gap against itself
         s = bk.max0(xp.abs(gap)) or 1.0
-    if hardness is None and bk.is_numpy:  # the four extremes in one pass (compiled on large arrays)
-        p_min, p_max, g_contact, g_open = residual_extremes(p, gap)
+    if hardness is None:  # four extremes: on NumPy in one pass (bem.extremes: compiled on large arrays)
+        p_min, p_max, g_contact, g_open = residual_extremes(p, gap) if bk.is_numpy else _extremes(bk, p, gap)
         p_max = max(p_max, 0.0)
         parts = [max(0.0, -p_min) / p_max if p_max > 0 else 0.0, g_contact / s, max(0.0, -g_open) / s]
-        if force is not None:
-            parts.append(abs(node_area * float(xp.sum(p)) - force) / force)
-        return max(parts)
-    p_max = bk.max0(p)
-    contact = p > 0
-    if hardness is None:
-        parts = [
-            max(0.0, -bk.min0(p)) / p_max if p_max > 0 else 0.0,
-            bk.max0(xp.abs(gap[contact])) / s,
-            max(0.0, -bk.min0(gap[~contact])) / s,
-        ]
     else:
-        plastic = p >= hardness
+        p_max, contact, plastic = bk.max0(p), p > 0, p >= hardness
         parts = [
             max(0.0, -bk.min0(p)) / p_max if p_max > 0 else 0.0,
             max(0.0, p_max - hardness) / hardness,
@@ -90,8 +80,15 @@ def kkt_residual(p, gap, *, displacement_scale, force=None, node_area=None, hard
             max(0.0, bk.max0(gap[plastic])) / s,
         ]
     if force is not None:
-        parts.append(abs(node_area * float(xp.sum(p)) - force) / force)
+        parts.append(abs(node_area * p_sum - force) / force)
     return max(parts)
+
+
+def _extremes(bk, p, gap):
+    """:func:`bem.extremes.residual_extremes` in the backend's namespace (0 for an empty selection's extreme, which the
+    residual reads as none)."""
+    contact = p > 0
+    return bk.min0(p), bk.max0(p), bk.max0(bk.xp.abs(gap[contact])), bk.min0(gap[~contact])
 
 
 def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, closure=None, hardness=None):

@@ -86,15 +86,18 @@ def test_the_compiled_prolongation_is_the_slices(monkeypatch):
     the numbers of its slices bit for bit."""
     fine = PeriodicCell(1.0 / 512, 512, step_passes.MIN_NODES // 512)
     values = np.random.default_rng(2).standard_normal(fine.coarsen().shape)
-    outs = []
+    outs, asked = [], []
+    monkeypatch.setattr("bem.periodic.cell.prolong_kernel", lambda: asked.append(1) or step_passes.prolong_kernel())
     for threads in (1, 2):
         previous = fft.set_threads(threads)
         try:
             outs.append(fine.prolong(values))
         finally:
             fft.set_threads(previous)
+    assert len(asked) == 2  # the compiled rows made both
     monkeypatch.setattr("bem.periodic.cell.MIN_NODES", 10**12)  # the slices
     slices = fine.prolong(values)
+    assert len(asked) == 2
     assert all(_identical(out, slices) for out in outs)
     assert _identical(slices[0::2][0::2, 0::2], values[0::2])  # the coarse nodes themselves
 
