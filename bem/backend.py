@@ -143,10 +143,11 @@ class Backend:
             return float(np.linalg.norm(x))
         return float(self.xp.sqrt(self.xp.sum(x * x)))
 
-    def median(self, values):
-        """``numpy.median`` of a non-empty 1-D array, as a Python float."""
+    def median(self, values, *, overwrite=False):
+        """``numpy.median`` of a non-empty 1-D array, as a Python float (``overwrite``: ``values`` may be reordered,
+        a copy fewer on NumPy)."""
         if self.is_numpy:
-            return float(np.median(values))
+            return float(np.median(values, overwrite_input=overwrite))
         v = self.xp.sort(values)
         n = v.shape[0]
         return float(v[n // 2]) if n % 2 else float(self.xp.mean(v[n // 2 - 1 : n // 2 + 1]))

@@ -21,6 +21,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from .backend import operator_backend
+from .newton_passes import with_compliance
 from .plastic import carry_force, clipped_start, fill_force, leaving_pressure, plastic_approach, plastic_start
 
 __all__ = ["QPSolution", "Record", "CGStep", "run_constrained_cg", "initial_pressure", "iterate_residual",
@@ -282,6 +283,8 @@ def elastic_displacement(bk, u, lam, p, out=None, offset=None):
     both are 0; ``out``: a float64 brick array for it on NumPy, not ``u``."""
     if not is_per_node(lam) and not lam:
         v = bk.xp.astype(u, bk.xp.float64, copy=False)
+    elif bk.is_numpy and out is not None and is_per_node(lam):
+        v = with_compliance(u, lam, p, out, -1)  # (bem.newton_passes: one pass on a large lattice)
     else:
         v = np.subtract(u, np.multiply(lam, p, out=out), out=out) if bk.is_numpy else u - lam * p
     return v if offset is None else bk.add_at(v, offset[0], -offset[1])

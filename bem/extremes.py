@@ -14,7 +14,7 @@ import numpy as np
 
 from . import fft
 
-__all__ = ["MIN_NODES", "residual_extremes"]
+__all__ = ["MIN_NODES", "load", "residual_extremes"]
 
 MIN_NODES = 1 << 18  # entries below which NumPy's passes are used (the threads' start costs more than they save)
 _COMPILED = []  # the compiled kernel, made at the first call on a large array
@@ -50,6 +50,24 @@ def residual_extremes(p, gap):
     pf, gf, parts = p.reshape(-1), gap.reshape(-1), []
     fft.in_parts(lambda part: parts.append(kernel(pf, gf, part.start, part.stop)), pf.size, pf.size)
     return (min(e[0] for e in parts), max(e[1] for e in parts), max(e[2] for e in parts), min(e[3] for e in parts))
+
+
+def load():
+    """Load the compiled kernel now (numba's import and its cached machine code), rather than at the first large
+    state; does nothing without numba.
+
+    Returns
+    -------
+    bool
+        Whether the compiled kernel is in use on large arrays.
+    """
+    if not _COMPILED:
+        _COMPILED.append(_compile())
+    if _COMPILED[0] is None:
+        return False
+    x = np.zeros(4)
+    _COMPILED[0](x, x, 0, 4)
+    return True
 
 
 def _compile():

@@ -387,7 +387,7 @@ def compliance_preconditioner(op, D, contact, threshold=4.0):
     xp = bk.xp
     stiff = is_stiff(D, op.diagonal, threshold)
     sel = stiff & contact
-    lam = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
+    lam = bk.median(D[sel], overwrite=True) if bool(xp.any(sel)) else 0.0
     fft = op.preconditioner(lam=lam, single=True)
     jacobi = 1.0 / (op.diagonal + D)
     if bool(xp.all(stiff)):

@@ -91,7 +91,8 @@ def _extremes(bk, p, gap):
     return bk.min0(p), bk.max0(p), bk.max0(bk.xp.abs(gap[contact])), bk.min0(gap[~contact])
 
 
-def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, closure=None, hardness=None):
+def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, closure=None, hardness=None,
+                  overwrite_closure=False, positive=None):
     """Deformed gap, approach and KKT residual of a pressure with a layer.
 
     Parameters
@@ -110,6 +111,10 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, c
         Nodes of the problem (default: the lattice's candidate nodes).
     closure : ndarray, optional
         ``w(p)`` (0 off ``mask``) where the caller has it [length].
+    overwrite_closure : bool
+        Whether a NumPy ``closure`` may hold ``C p + w(p)`` and the gap (not copied: an array of the lattice fewer).
+    positive : ndarray of bool, optional
+        ``p > 0`` where the caller has it.
     hardness : float, optional
         The bound ``H`` of ``p`` [pressure]: under force control ``delta`` is the mean over the
         elastic contact (``0 < p < H``), or :func:`bem.plastic.plastic_approach` without one.
@@ -128,19 +133,23 @@ def layered_state(op, h, layer, p, u, *, force=None, approach=None, mask=None, c
     xp = bk.xp
     mask = op_mask if mask is None else mask
     if closure is None:
-        closure = xp.zeros_like(p) if layer is None else xp.where(mask, layer.w(p), 0.0)
-    total = u + closure
+        closure, overwrite_closure = xp.zeros_like(p) if layer is None else xp.where(mask, layer.w(p), 0.0), True
+    if overwrite_closure and bk.is_numpy:
+        total = closure  # w + C p: the same sums as C p + w
+        total += u
+    else:
+        total = u + closure
     if hardness is not None:
         return _bounded_state(bk, lat, h, p, total, force, approach, mask, hardness)
     if bool(xp.all(mask)):  # every node of the lattice (a periodic cell): the same numbers without the masking
         scale = max(bk.max0(total), -bk.min0(total))  # max |C p + w| (a NaN reaches the residual through the gap)
         gap = total  # C p + w + h - delta in total's bytes
         gap += h
-        contact = p > 0
+        contact = p > 0 if positive is None else positive
         delta = float(approach) if force is None else float(xp.mean(gap[contact])) if bool(xp.any(contact)) else 0.0
         gap -= delta
         return gap, delta, kkt_residual(p, gap, displacement_scale=scale, force=force, node_area=lat.node_area)
-    contact = mask & (p > 0)
+    contact = mask & (p > 0 if positive is None else positive)
     if force is not None:
         delta = float(xp.mean(total[contact] + h[contact])) if bool(xp.any(contact)) else 0.0
     else:

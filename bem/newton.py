@@ -37,6 +37,7 @@ from .cg_rules import QPSolution
 from .kalker import solve_qp
 from .kkt import layered_state
 from .newton_model import majorant, tangent
+from .newton_passes import advance
 from .newton_moves import closure_move, line_search, model_closure, release, scaled, settle_plastic, step_nodes
 from .plastic import carry_force, clip, clipped_start, fully_plastic_note, in_place
 
@@ -66,24 +67,19 @@ def _advance(bk, p, u, sub, t, force, node_area, hardness):
     q, uq = sub.p, sub.displacement
     if not (in_place(bk, q) and in_place(bk, uq)):
         return scaled(clip(bk.xp, p + t * (q - p), hardness), force, node_area, hardness), u + t * (uq - u)
-    q -= p  # d, then t d, then p + t d
-    q *= t
-    q += p
-    np.maximum(q, 0.0, out=q)
+    advance(p, q, u, uq, t)  # q = max(p + t d, 0), uq = u + t C d (bem.newton_passes)
     if hardness is not None:
         np.minimum(q, hardness, out=q)
     if force is not None and hardness is None:
         q *= force / node_area / float(np.sum(q))
     else:
         q = scaled(q, force, node_area, hardness)
-    uq -= u  # C d, then t C d, then u + t C d
-    uq *= t
-    uq += u
     return q, uq
 
 
-def _model_qp(op, h, layer, D, contact, precondition, p, u, periodic, **kw):
-    """The QP of a Newton step's model (compliance ``D`` per node, ``contact`` the current one) from ``p`` and ``u = C
+def _model_qp(op, h, layer, D, contact, on, precondition, p, u, periodic, **kw):
+    """The QP of a Newton step's model (compliance ``D`` per node, ``contact``: ``p > 0``, ``on``: its node selection and
+    ``p`` there) from ``p`` and ``u = C
     p`` by the operator's constrained-CG step (``op.qp``); ``(solution, p, u)``. Its gap ``h + w(p) - D p`` goes as
     ``h`` and the offset ``w(p) - D p`` on the nodes of nonzero pressure (``w(0) = 0``, :mod:`bem.layers.base`): no
     array of it. Where it can (:func:`bem.plastic.in_place`) the QP holds its iterate in ``p``, kept meanwhile on those
@@ -91,8 +87,7 @@ def _model_qp(op, h, layer, D, contact, precondition, p, u, periodic, **kw):
     and ``u``) takes more than :data:`bem.heap.RELEASE_ABOVE` bytes its product in ``u`` (``overwrite_u0``), made again
     after (one product a step): an array of the lattice fewer through the QP each (a region's QP makes new ones)."""
     bk = backend_of(p)
-    at = bk.select(p > 0)
-    kept = bk.take(p, at)
+    at, kept = on  # (kept: a copy, not p's bytes)
     offset = (at, bk.asarray(layer.w(kept)) - bk.take(D, at) * kept)
     own, hand = in_place(bk, p), periodic and in_place(bk, u) and heap.above(2 * u.nbytes)
     kw = dict(kw, overwrite_u0=True) if hand else kw  # (the region's QP takes no overwrite_u0)
@@ -205,14 +200,13 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
 
     for k in range(maxiter + 1):
         heap.release(24 * math.prod(p.shape))  # the free heap (the last QP's arrays) before the closure, C p + w, gap
-        wp = closure(p)
-        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp,
-                                         hardness=hardness)
+        contact = p > 0  # read by the state, the model and its QP (p is not changed before)
+        gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=closure(p),
+                                         hardness=hardness, overwrite_closure=True, positive=contact)  # gap in w's
         if kkt <= rtol and not exact:  # confirm on an exact product before stopping
             u, exact = op.matvec(p), True
-            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=wp,
-                                         hardness=hardness)
-        contact = p > 0
+            gap, delta, kkt = layered_state(op, h, layer, p, u, force=force, approach=approach, closure=closure(p),
+                                         hardness=hardness, overwrite_closure=True, positive=contact)
         hist["residual"].append(kkt)
         hist["p_max"].append(float(xp.max(p)))
         hist["n_contact"].append(int(xp.count_nonzero(contact)))
@@ -230,16 +224,20 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
         if k == maxiter:
             message = f"no convergence in maxiter = {maxiter} Newton steps (KKT residual {kkt:.2e} > rtol {rtol:.1e})"
             break
-        p_ref = float(xp.mean(p[contact])) if bool(xp.any(contact)) else 1.0
-        D = masked(tangent(bk, layer, p, gap, p_ref))
-        D = xp.astype(D, xp.float32) if float(xp.max(D)) < _SINGLE_MAX else D  # a model's: single precision will do
-        gap = wp = None  # made again at the next step or where needed: not held through the model's solve
+        on = (nodes := bk.select(contact)), bk.take(p, nodes)  # the contact's nodes and pressures, for the model
+        p_ref = float(xp.mean(on[1])) if bk.count(on[0]) else 1.0
+        if full:  # a model's D: single precision will do, made so where it can be
+            D = tangent(bk, layer, p, gap, p_ref, single_below=_SINGLE_MAX, positive=contact, on=on)
+        else:
+            D = masked(tangent(bk, layer, p, gap, p_ref, positive=contact, on=on))
+            D = xp.astype(D, xp.float32) if float(xp.max(D)) < _SINGLE_MAX else D
+        gap = None  # made again at the next step or where needed: not held through the model's solve
         # forcing term: _FORCING, or less where the last step reduced the residual (Eisenstat & Walker)
         eta = min(_FORCING, _GAMMA * (kkt / hist["residual"][-2]) ** _ALPHA) if len(hist["residual"]) > 1 else _FORCING
         inner = max(rtol / 3, min(1e-2, eta * kkt))
         # the model starts at p with Newton's u and Newton checks each step on its own residual: no product to start
         # or to confirm the inner solve (fewer products on benchmarks/side_by_side.py's root layer)
-        sub, p, u = _model_qp(op, h, layer, D, contact, precondition, p, u, full, force=force, approach=approach,
+        sub, p, u = _model_qp(op, h, layer, D, contact, on, precondition, p, u, full, force=force, approach=approach,
                               rtol=inner, maxiter=inner_maxiter, confirm=False, **bound, **shared)
         _count_inner(hist, sub)
         # the step d = q - p of the model's solution q (C d = uq - u), on the nodes with pressure before or after it
@@ -250,7 +248,7 @@ def solve_newton(op, h, *, layer, force=None, approach=None, x0=None, rtol=1e-10
             scale = float(xp.max(xp.abs(u + wp)))
             D = majorant(op, layer, p, sub.p, xp.astype(D, xp.float64), mask)  # (raised past single precision's range)
             wp = sub = at = None
-            sub, p, u = _model_qp(op, h, layer, D, contact, precondition, p, u, full, force=force,
+            sub, p, u = _model_qp(op, h, layer, D, contact, on, precondition, p, u, full, force=force,
                                   approach=approach, rtol=max(rtol / 3, 1e-3 * kkt), maxiter=4 * inner_maxiter,
                                   scale=scale, confirm=False, **bound, **shared)
             _count_inner(hist, sub)

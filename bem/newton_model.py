@@ -12,21 +12,31 @@ from .backend import operator_backend
 __all__ = ["tangent", "secant", "majorant"]
 
 
-def tangent(bk, layer, p, gap, p_ref):
-    """Per-node model compliance ``D``: ``w'(p)`` where finite, else a secant (each on its nodes only)."""
+def tangent(bk, layer, p, gap, p_ref, *, single_below=None, positive=None, on=None):
+    """Per-node model compliance ``D``: ``w'(p)`` where finite, else a secant (each on its nodes only).
+
+    ``single_below``: ``D`` in single precision where every entry is below it (NaN is not), made so at once (no
+    double-precision array of the lattice); double precision otherwise and by default. ``positive``: ``p > 0``, and
+    ``on``: its node selection and ``p`` there, where the caller has them."""
     xp = bk.xp
-    pos = p > 0
-    contact, shut = bk.select(pos), bk.select(~pos & ~(gap >= 0))  # shut: no pressure, a closed gap (or NaN)
+    pos = p > 0 if positive is None else positive
+    contact = bk.select(pos) if on is None else on[0]
+    shut = bk.select(~pos & ~(gap >= 0))  # no pressure, a closed gap (or NaN)
     with bk.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        # an open gap: the secant at the closure 0, one value
-        out = xp.full_like(p, float(secant(bk, layer, xp.zeros(1, dtype=p.dtype), p_ref)[0]))
-        d = bk.asarray(layer.dw(bk.take(p, contact)))
+        fill = float(secant(bk, layer, xp.zeros(1, dtype=p.dtype), p_ref)[0])  # an open gap: the secant at closure 0
+        d = bk.asarray(layer.dw(bk.take(p, contact) if on is None else on[1]))
         finite = xp.isfinite(d)
-        bk.put(out, contact, d)
-        bk.put(out, shut, secant(bk, layer, bk.take(gap, shut), p_ref))
-        if not bool(xp.all(finite)):
-            bad = bk.subset(contact, ~finite)
-            bk.put(out, bad, secant(bk, layer, bk.take(gap, bad), p_ref))
+        on_shut = secant(bk, layer, bk.take(gap, shut), p_ref)
+        bad = None if bool(xp.all(finite)) else bk.subset(contact, ~finite)
+        on_bad = None if bad is None else secant(bk, layer, bk.take(gap, bad), p_ref)
+    single = False
+    if single_below is not None:  # the largest entry of D: over the parts it is made of
+        parts = [d if bad is None else xp.where(finite, d, 0.0), on_shut] + ([] if bad is None else [on_bad])
+        largest = [bk.max0(x) for x in parts] + ([fill] if p.size > bk.count(contact) + bk.count(shut) else [])
+        single = all(x < single_below for x in largest)
+    out = xp.full(p.shape, fill, dtype=xp.float32 if single else p.dtype)
+    for sel, values in [(contact, d), (shut, on_shut)] + ([] if bad is None else [(bad, on_bad)]):
+        bk.put(out, sel, values if bk.is_numpy else xp.astype(values, out.dtype))  # (NumPy rounds in the put)
     return out
 
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from .backend import backend_of, operator_backend
 from .brent import brent_root
+from .newton_passes import gather
 from .plastic import fill_force, in_place
 
 __all__ = ["StepNodes", "StepEnd", "step_nodes", "line_search", "energy_change", "scaled", "release", "settle_plastic",
@@ -53,7 +54,8 @@ def step_nodes(bk, p, q, u, uq, h, mask=None):
     """:class:`StepNodes` of the step from ``p`` to ``q`` (brick arrays; ``u = C p``, ``uq = C q``; on ``mask``)."""
     moving = (p > 0) | (q > 0)
     sel = bk.select(moving if mask is None else mask & moving)
-    return StepNodes(sel, *(bk.take(x, sel) for x in (p, q, u, uq, h)))
+    arrays = (p, q, u, uq, h)
+    return StepNodes(sel, *(gather(sel, *arrays) if bk.is_numpy else (bk.take(x, sel) for x in arrays)))
 
 
 def line_search(bk, layer, at, delta):

@@ -37,7 +37,7 @@ RADIUS, SIDE, A_HERTZ, A_ROUGH, ROOT_K = 1.0, 1.0, 0.1, 0.3, 0.04
 PBAR = 0.01
 PROBLEMS = ("periodic", "periodic-root", "hertz", "hertz-root", "hertz-wide", "rough-sphere")
 RTOL = 1e-10
-LOAD_S = None  # seconds of the last prepare()'s load of the compiled passes (None: not a periodic cell)
+LOAD_S = None  # seconds of the last prepare()'s load of the compiled kernels (numba's import and cached code)
 
 
 def hertz_force(a):
@@ -213,15 +213,19 @@ def prepare(problem, n):
     """``(solve, gap)``: ``solve()`` runs contactlab on ``problem`` at size ``n``; ``gap`` is what it solves
     (a brick array, a :mod:`bem.gaps` shape or a :class:`RoughSphere`), made here, outside any clock.
 
-    For a periodic cell the compiled passes are loaded here too (:func:`bem.periodic.passes.load` and
-    :func:`bem.periodic.step_passes.load`, where numba is installed), as a peer's compiled module is imported before
-    its clock: numba's import and the load of the kernels' cached code (:data:`LOAD_S` holds how long it took in this
-    process).
+    The compiled kernels are loaded here too, where numba is installed (:func:`bem.extremes.load`,
+    :func:`bem.newton_passes.load`, and for a periodic cell :func:`bem.periodic.passes.load` and
+    :func:`bem.periodic.step_passes.load`), as a peer's compiled module is imported before its clock: numba's import and
+    the load of the kernels' cached code (:data:`LOAD_S` holds how long it took in this process).
     """
     global LOAD_S
     import bem
+    from bem import extremes, newton_passes
 
-    LOAD_S = None
+    t = time.perf_counter()
+    extremes.load()
+    newton_passes.load()
+    LOAD_S = time.perf_counter() - t
     if problem.startswith("periodic"):
         from bem.periodic import passes, step_passes
         from periodic_rough import _root
@@ -229,7 +233,7 @@ def prepare(problem, n):
         t = time.perf_counter()
         passes.load()
         step_passes.load()
-        LOAD_S = time.perf_counter() - t
+        LOAD_S += time.perf_counter() - t
 
         cell, h = periodic_cell(n)
         layer = _root(cell) if problem == "periodic-root" else None

@@ -30,9 +30,9 @@ def as_pressure(p):
 
     A float64 array of another namespace (a device array) stays in its namespace.
     """
-    if _on_host(p):
-        return np.maximum(np.asarray(p, dtype=float), 0.0) + 0.0
-    return backend_of(p).xp.maximum(p, 0.0) + 0.0
+    x = np.maximum(np.asarray(p, dtype=float), 0.0) if _on_host(p) else backend_of(p).xp.maximum(p, 0.0)
+    x += 0.0  # in the new array (a NumPy scalar for a scalar)
+    return x
 
 
 def as_closure(closure):

@@ -138,23 +138,39 @@ class Root(Power):
         return {"lam": self.lam}
 
     # Square roots instead of the general power: np.power with exponent -0.5 or 1.5 costs
-    # 10x np.sqrt (measured: 1,048,703 nodes, dw 29 ms against 3 ms).
+    # 10x np.sqrt (measured: 1,048,703 nodes, dw 29 ms against 3 ms). Each works in the new array
+    # of as_pressure (or of the square root) where it has one: the same numbers, fewer arrays.
     def w(self, p):
-        return out(self.lam * anp.sqrt(as_pressure(p)))
+        r = _sqrt_of_new(as_pressure(p))
+        r *= self.lam
+        return out(r)
 
     def dw(self, p):
         with np.errstate(divide="ignore", over="ignore"):
-            return out((0.5 * self.lam) / anp.sqrt(as_pressure(p)))
+            return out(_divided(0.5 * self.lam, _sqrt_of_new(as_pressure(p))))
 
     def energy(self, p):
         p = as_pressure(p)
         with np.errstate(over="ignore"):
-            return out((2.0 / 3.0 * self.lam) * (p * anp.sqrt(p)))
+            r = anp.sqrt(p)  # (2 lam / 3) (p sqrt(p)), the products in the new array of the root
+            r *= p
+            r *= 2.0 / 3.0 * self.lam
+            return out(r)
 
     def secant(self, p):
         """``lam / sqrt(p)``; ``inf`` at ``p = 0``."""
         with np.errstate(divide="ignore", over="ignore"):
-            return out(self.lam / anp.sqrt(as_pressure(p)))
+            return out(_divided(self.lam, _sqrt_of_new(as_pressure(p))))
+
+
+def _sqrt_of_new(x):
+    """``sqrt(x)`` of a new array ``x`` (as_pressure's), in its buffer where it is a NumPy array."""
+    return np.sqrt(x, out=x) if isinstance(x, np.ndarray) else anp.sqrt(x)
+
+
+def _divided(c, x):
+    """``c / x`` of a new array ``x``, in its buffer where it is a NumPy array."""
+    return np.divide(c, x, out=x) if isinstance(x, np.ndarray) else c / x
 
 
 class Bilinear(LawBase):

@@ -214,10 +214,15 @@ def load():
             k.gather(u, idx)
         at, flag = np.empty(1, dtype=np.intp), np.ones(2, dtype=bool)
         k.merge(idx, x64[:2], flag, idx[:1], x64[:1], np.empty(3, dtype=idx.dtype), np.empty(3), at)
-        symbol = Symbol(np.ones((2, 1, 3)), np.zeros((2, 1, 3), dtype=complex), inverse=True, shift=1.0)
-        for cplx in (np.complex64, np.complex128):  # the spectra's precisions
-            x = np.zeros((2, 2, 3), dtype=cplx)
-            k.mix(x, symbol, x, True, 1)
+        d, b = np.ones((2, 1, 3)), np.zeros((2, 1, 3), dtype=complex)
+        kept = d.copy(), b.copy()
+        for a in kept:  # a cell's kept symbol is read-only (bem.periodic.influence): a signature of its own
+            a.setflags(write=False)
+        for blocks in ((d, b), kept):
+            symbol = Symbol(*blocks, inverse=True, shift=1.0)
+            for cplx in (np.complex64, np.complex128):  # the spectra's precisions
+                x = np.zeros((2, 2, 3), dtype=cplx)
+                k.mix(x, symbol, x, True, 1)
     return k.compiled
 
 

@@ -72,6 +72,7 @@ from ..backend import operator_backend
 from ..cg_rules import (BACKTRACK_HALVINGS, RECOMPUTE_EVERY, CGStep, Record, bounded_move, bounded_sets,
                         elastic_displacement, entering_pressure, initial_pressure, is_per_node, is_stiff,
                         iterate_residual, run_constrained_cg)
+from ..newton_passes import with_compliance
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .edge import EdgeCorrection
 from .passes import kernels
@@ -158,7 +159,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     if per_node:  # compliance_preconditioner: the FFT inverse of C + median D on the stiff contact, Jacobi elsewhere
         stiff = is_stiff(D, diag, threshold)
         sel = stiff & (p > 0)
-        lam_pc = bk.median(D[sel]) if bool(xp.any(sel)) else 0.0
+        lam_pc = bk.median(D[sel], overwrite=True) if bool(xp.any(sel)) else 0.0
         jacobi = 1.0 / (diag + xp.astype(D, xp.float64)) if hardness is not None else None  # for bounded_move
         soft = not bool(xp.all(stiff))
         made = projection is not None and projection.values is not None  # M 1 given: stiff not held
@@ -177,14 +178,14 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return op.brick(op.mix(x, M, out=x), overwrite=True, out=out)
 
     def precondition(r32, sel, r_c, soft_c, D_c):  # M r at sel (r32: r at its stiff nodes, r_c: r; Jacobi at soft_c)
-        z = passes.gather(apply_m(r32, work.brick32()), sel)
-        return z if soft_c is None else xp.where(soft_c, jacobi_at(sel, D_c) * r_c, z)
+        m = apply_m(r32, work.brick32())
+        return passes.gather(m, sel) if soft_c is None else steps.soft_gather(m, sel, soft_c, r_c, D_c, diag)
 
     def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
         return 1.0 / (diag + (passes.gather(D, sel) if D_n is None else D_n))
 
-    def times_p(c):  # c p for a compliance c (per node or uniform), in work's bytes on NumPy (no spectrum held there)
-        return np.multiply(c, p, out=work.brick64()) if bk.is_numpy else c * p
+    def plus_dp(v):  # v + D p (NumPy: into v, D p in work's bytes where not compiled; no spectrum held there)
+        return with_compliance(v, D, p, v, 1, scratch=work.brick64()) if bk.is_numpy else added_into(bk, v, D * p)
 
     def product_u():  # u = (C + lam) p; on NumPy in the last u or in u0's bytes (qp_parts.product_array)
         nonlocal u, exact_base
@@ -197,7 +198,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         return v if offset is None or not times else passes.add_at(v, *offset, times)
 
     def exact_u():  # (C + lam) p, D p per node, and the gap's offset
-        return offset_added(added_into(bk, product_u(), times_p(D)) if per_node else product_u())
+        return offset_added(plus_dp(product_u()) if per_node else product_u())
 
     # the first product in double precision (the KKT residual's scale); exact_base: u from a double-precision product
     single, u, exact_base, home = False, None, False, None  # (not the caller's u0 nor single); stale: updates since
@@ -206,7 +207,7 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
     else:  # C x0 from the caller, confirmed like an incremental update; home: u0 holding u, in either precision
         home = u0 if overwrite_u0 and in_place(bk, u0) else None
         u = bk.copy(bk.asarray(u0)) if home is None else u0
-        u, stale = offset_added(added_into(bk, u, times_p(D)) if per_node else u), 1
+        u, stale = offset_added(plus_dp(u) if per_node else u), 1
     last_z, record = KeptOnContact(bk, lat.shape), Record(rtol, maxiter)  # last_z: the last preconditioned gap
     gz_old, m_one, m_full, m_at, fixed_scale, delta = 1.0, None, None, None, scale, approach
     nodes = ContactNodes(bk, p, getattr(passes, "merge", None))  # the iterate's contact (steady: the last step's)

@@ -13,6 +13,8 @@ each split into :func:`bem.fft.threads` parts run at once (:func:`bem.fft.in_par
 - ``write``: the float32 brick array of the gap on the contact, then of the search direction
   (:class:`bem.periodic.qp_parts.ContactBrick`): the brick set to 0 where asked, and the values rounded to float32 put
   at the contact's nodes, each part over its own range of the cell's nodes;
+- ``soft_gather``: with a compliance ``D`` per node, the preconditioned gap at the contact's nodes, ``M r`` gathered
+  from its brick, but the Jacobi estimate ``r / (C_nn + D)`` at the soft nodes, one pass instead of five;
 - :func:`prolong_kernel`: :meth:`bem.periodic.PeriodicCell.prolong` over parts of the coarse rows.
 
 Each gives NumPy's numbers bit for bit (the same operations in the same precision at every node; the flags are "any"
@@ -71,6 +73,17 @@ class _NumPySteps:
         brick.reshape(-1)[nodes] = last
         return last
 
+    @staticmethod
+    def soft_gather(x, idx, soft, r, D, diag):
+        """:func:`_soft_gathered` on NumPy."""
+        return _soft_gathered(np, np.take(x.reshape(-1), idx).astype(np.float64), soft, r, D, diag)
+
+
+def _soft_gathered(xp, z, soft, r, D, diag):
+    """``z`` but ``(1 / (diag + D)) r`` where ``soft`` (1-D arrays at the contact's nodes, ``z`` ``x`` gathered there in
+    double precision)."""
+    return xp.where(soft, 1.0 / (diag + D) * r, z)
+
 
 class _NamespaceSteps:
     """The forms on another array namespace (:class:`bem.backend.Backend` ``bk``)."""
@@ -88,12 +101,16 @@ class _NamespaceSteps:
             p_c *= s
         return self.bk.put(p, idx, p_c)
 
+    def soft_gather(self, x, idx, soft, r, D, diag):
+        xp = self.bk.xp
+        return _soft_gathered(xp, xp.astype(self.bk.take(x, idx), xp.float64), soft, r, D, diag)
+
 
 def step_kernels(n_nodes, bk=None):
     """The step's kernels for a cell of ``n_nodes`` nodes, in the form :func:`bem.periodic.passes.kernels` takes for
     its own (:func:`bem.periodic.passes.chosen`; ``bk`` the arrays' :class:`bem.backend.Backend`, default NumPy):
-    methods ``move(p_c0, t_c, tau)``, ``scale_put(p, idx, p_c, s=1.0)`` and, on NumPy, ``write(brick, nodes, values,
-    fill)`` (the module's docstring), and the flag ``compiled``."""
+    methods ``move(p_c0, t_c, tau)``, ``scale_put(p, idx, p_c, s=1.0)``, ``soft_gather(x, idx, soft, r, D, diag)`` and,
+    on NumPy, ``write(brick, nodes, values, fill)`` (the module's docstring), and the flag ``compiled``."""
     return chosen(n_nodes, bk, _NumPySteps, _NamespaceSteps, _COMPILED, _compile)
 
 
@@ -112,6 +129,7 @@ def load():
         k.move(x, x, 1.0)
         k.scale_put(x, idx, x[:2].copy(), 2.0)
         k.write(np.zeros(4, dtype=np.float32), idx, x[:2], True)
+        k.soft_gather(np.zeros(4, dtype=np.float32), idx, np.ones(2, dtype=bool), x[:2], x[:2] + 1.0, 1.0)
         prolong_kernel()(np.zeros((2, 2)), np.empty((4, 4)), 0, 2)
     return k.compiled
 
@@ -157,6 +175,7 @@ def _compile():
     """The compiled kernels (a class of static methods with the NumPy forms' signatures), or None without numba."""
     if (jit := _jit()) is None:
         return None
+    from numba import njit
 
     @jit
     def _move(p_c0, t_c, tau, p_c, clipped, lo, hi):
@@ -187,6 +206,11 @@ def _compile():
             v = np.float32(values[j])
             last[j] = v
             brick[nodes[j]] = v
+
+    @njit(cache=True, nogil=True, error_model="numpy")  # a zero divisor gives inf, as NumPy's
+    def _soft_gather(x, idx, soft, r, D, diag, out, lo, hi):
+        for j in range(lo, hi):
+            out[j] = 1.0 / (diag + D[j]) * r[j] if soft[j] else np.float64(x[idx[j]])
 
     run = run_in_parts
 
@@ -221,5 +245,13 @@ def _compile():
 
             run(part, flat.size)
             return last
+
+        @staticmethod
+        def soft_gather(x, idx, soft, r, D, diag):
+            if not (x.flags.c_contiguous and D.dtype == np.float64 and r.dtype == np.float64):
+                return _NumPySteps.soft_gather(x, idx, soft, r, D, diag)
+            out, flat, diag = np.empty(idx.size), x.reshape(-1), float(diag)
+            run(lambda lo, hi: _soft_gather(flat, idx, soft, r, D, diag, out, lo, hi), idx.size)
+            return out
 
     return Compiled

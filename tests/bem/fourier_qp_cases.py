@@ -37,10 +37,10 @@ def _newton_model(h, step=3):
     models = []
     model_qp = bem.newton._model_qp
 
-    def spy(op, h, layer, D, contact, precondition, p, u, periodic, **kw):
+    def spy(op, h, layer, D, contact, on, precondition, p, u, periodic, **kw):
         b = h + layer.w(p) - D * p
         models.append((b, D.copy(), p.copy()))
-        return model_qp(op, h, layer, D, contact, precondition, p, u, periodic, **kw)
+        return model_qp(op, h, layer, D, contact, on, precondition, p, u, periodic, **kw)
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(bem.newton, "_model_qp", spy)

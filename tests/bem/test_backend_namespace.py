@@ -204,3 +204,17 @@ def test_the_fourier_qp_takes_the_numpy_path_on_the_flat_index_path_of_cupy(monk
     from bem.backend import Backend
 
     compare(case, Backend(compat, "compat-numpy", flat_indices=True), compat.asarray, monkeypatch)
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 10])
+def test_the_median_with_and_without_leave_to_overwrite(strict, n):
+    """``Backend.median``: NumPy's median of the values, with ``overwrite`` too (the values then in any order), and
+    the values untouched without it; on NumPy and on the strict namespace."""
+    values = np.random.default_rng(n).standard_normal(n).astype(np.float32)
+    expected, kept = float(np.median(values)), values.copy()
+    bk = bem.backend.backend_of(values)
+    assert bk.median(values) == expected and np.array_equal(values, kept)
+    assert bk.median(values.copy(), overwrite=True) == expected
+    device = strict.asarray(values)
+    bk = bem.backend.backend_of(device)
+    assert bk.median(device) == expected and bk.median(device, overwrite=True) == expected

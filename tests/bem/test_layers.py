@@ -507,3 +507,20 @@ def test_unknown_key_message_names_the_key():
 def test_all_laws_are_layers():
     for name in IDS:
         assert isinstance(law_of(name), Layer)
+
+
+def test_root_law_gives_its_formulas_numbers_in_place():
+    """The root law evaluates in the new arrays of its clipped input: bit for bit its formulas as written, on an
+    array and on a scalar, and a new array each time."""
+    law, lam = Root(0.7), 0.7
+    p = np.array([-1.0, -0.0, 0.0, 5e-324, 1e-300, 0.3, 2.0, 1e300, np.inf, np.nan])
+    q = np.maximum(p, 0.0) + 0.0
+    with np.errstate(divide="ignore", over="ignore"):
+        expected = {"w": lam * np.sqrt(q), "dw": (0.5 * lam) / np.sqrt(q), "secant": lam / np.sqrt(q),
+                    "energy": (2.0 / 3.0 * lam) * (q * np.sqrt(q))}
+    for name, values in expected.items():
+        got = getattr(law, name)(p)
+        assert got.dtype == np.float64 and got.tobytes() == values.tobytes(), name
+        assert not np.shares_memory(got, p) and got is not getattr(law, name)(p)
+        scalar = getattr(law, name)(0.3)
+        assert np.ndim(scalar) == 0 and float(scalar) == values[5], name

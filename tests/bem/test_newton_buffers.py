@@ -102,8 +102,8 @@ def test_the_model_qp_iterates_in_newtons_pressure_which_keeps_its_values(monkey
     checks = []
     original = newton._model_qp
 
-    def model_qp(op_, h_, layer, D, contact, precondition, p, u, periodic, **kw):
-        sub, back, u = original(op_, h_, layer, D, contact, precondition, p, u, periodic, **kw)
+    def model_qp(op_, h_, layer, D, contact, on, precondition, p, u, periodic, **kw):
+        sub, back, u = original(op_, h_, layer, D, contact, on, precondition, p, u, periodic, **kw)
         checks.append(np.array_equal(back, seen[-1][2]) and back is not sub.p)
         return sub, back, u
 

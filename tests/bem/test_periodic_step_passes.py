@@ -48,6 +48,23 @@ def test_the_compiled_move_gives_the_numpy_forms_numbers(two_threads, kind):
         assert b[1][: N // 2].any() and b[1][N // 2 :].any()
 
 
+@pytest.mark.parametrize("soft_share", [0.0, 0.07, 1.0])
+def test_the_compiled_soft_gather_gives_the_numpy_forms_numbers(two_threads, soft_share):
+    """The preconditioned gap gathered from its float32 brick in double precision, the Jacobi estimate ``r / (C_nn +
+    D)`` at the soft nodes (none, some in every part, all), as NumPy makes them; the inputs untouched."""
+    rng = np.random.default_rng(8)
+    idx = np.sort(rng.choice(4 * N, N, replace=False))
+    x = rng.standard_normal(4 * N).astype(np.float32)
+    soft = rng.uniform(size=N) < soft_share
+    r, D = rng.standard_normal(N), rng.uniform(0.0, 50.0, N)
+    inputs = [a.copy() for a in (x, idx, soft, r, D)]
+    ref, fast = _forms()
+    a, b = ref.soft_gather(x, idx, soft, r, D, 0.75), fast.soft_gather(x, idx, soft, r, D, 0.75)
+    assert _identical(a, b) and a.dtype == np.float64
+    assert _identical(a[~soft], x[idx[~soft]].astype(np.float64)) and _identical(a[soft], (1 / (0.75 + D) * r)[soft])
+    assert all(_identical(v, w) for v, w in zip((x, idx, soft, r, D), inputs))
+
+
 @pytest.mark.parametrize("s", [1.0, 1.0 + 3e-7])
 def test_the_compiled_scale_and_put_give_the_numpy_forms_numbers(two_threads, s):
     rng = np.random.default_rng(5)
@@ -141,7 +158,7 @@ def test_the_qp_with_the_compiled_step_passes_is_the_qp_without(monkeypatch, two
     monkeypatch.setattr("bem.periodic.qp.step_kernels", lambda n, bk=None: counted)
     with_kernels = solve_periodic_qp(op, h, **kw)
     n_with = op.n_matvec
-    assert {"move", "scale_put", "write"} <= set(calls)
+    assert {"move", "scale_put", "write"} | ({"soft_gather"} if case == "per_node" else set()) <= set(calls)
     monkeypatch.setattr("bem.periodic.qp.step_kernels", lambda n, bk=None: step_passes.step_kernels(1))
     op.n_matvec = 0
     without = solve_periodic_qp(op, h, **kw)
