@@ -278,15 +278,12 @@ def is_per_node(lam):
 
 
 def elastic_displacement(bk, u, lam, p, out=None, offset=None):
-    """``C p = u - lam p - offset`` (float64) from ``u = (C + lam) p + offset``, ``lam`` per node or uniform
-    [length/pressure], ``offset`` None or ``(nodes, values)`` (a QP's, 0 elsewhere): ``u`` itself (float64) where
-    both are 0; ``out``: a float64 brick array for it on NumPy, not ``u``."""
+    """``C p = u - lam p - offset`` (float64) from ``u = (C + lam) p + offset``, ``lam`` [length/pressure] per node
+    or uniform, ``offset`` None or ``(nodes, values)`` (0 elsewhere): ``u`` where both are 0; ``out``: its array."""
     if not is_per_node(lam) and not lam:
         v = bk.xp.astype(u, bk.xp.float64, copy=False)
-    elif bk.is_numpy and out is not None and is_per_node(lam):
-        v = with_compliance(u, lam, p, out, -1)  # (bem.newton_passes: one pass on a large lattice)
-    else:
-        v = np.subtract(u, np.multiply(lam, p, out=out), out=out) if bk.is_numpy else u - lam * p
+    else:  # (NumPy: bem.newton_passes, one pass on a large lattice)
+        v = with_compliance(u, lam, p, out, -1) if bk.is_numpy else u - lam * p
     return v if offset is None else bk.add_at(v, offset[0], -offset[1])
 
 

@@ -78,14 +78,14 @@ def _advance(bk, p, u, sub, t, force, node_area, hardness):
 
 
 def _model_qp(op, h, layer, D, contact, on, precondition, p, u, periodic, **kw):
-    """The QP of a Newton step's model (compliance ``D`` per node, ``contact``: ``p > 0``, ``on``: its node selection and
-    ``p`` there) from ``p`` and ``u = C
-    p`` by the operator's constrained-CG step (``op.qp``); ``(solution, p, u)``. Its gap ``h + w(p) - D p`` goes as
-    ``h`` and the offset ``w(p) - D p`` on the nodes of nonzero pressure (``w(0) = 0``, :mod:`bem.layers.base`): no
-    array of it. Where it can (:func:`bem.plastic.in_place`) the QP holds its iterate in ``p``, kept meanwhile on those
-    nodes only and returned as a new array (the same values), and on a ``periodic`` cell whose product ``C p`` (spectrum
-    and ``u``) takes more than :data:`bem.heap.RELEASE_ABOVE` bytes its product in ``u`` (``overwrite_u0``), made again
-    after (one product a step): an array of the lattice fewer through the QP each (a region's QP makes new ones)."""
+    """The QP of a Newton step's model (compliance ``D`` per node, ``contact``: ``p > 0``, ``on``: its node
+    selection and ``p`` there) from ``p`` and ``u = C p`` by the operator's constrained-CG step (``op.qp``);
+    ``(solution, p, u)``. Its gap ``h + w(p) - D p`` goes as ``h`` and the offset ``w(p) - D p`` on the nodes of
+    nonzero pressure (``w(0) = 0``, :mod:`bem.layers.base`): no array of it. Where it can
+    (:func:`bem.plastic.in_place`) the QP holds its iterate in ``p``, kept meanwhile on those nodes only and
+    returned as a new array (the same values), and on a ``periodic`` cell whose product ``C p`` (spectrum and ``u``)
+    takes more than :data:`bem.heap.RELEASE_ABOVE` bytes its product in ``u`` (``overwrite_u0``), made again after
+    (one product a step): an array of the lattice fewer through the QP each (a region's QP makes new ones)."""
     bk = backend_of(p)
     at, kept = on  # (kept: a copy, not p's bytes)
     offset = (at, bk.asarray(layer.w(kept)) - bk.take(D, at) * kept)

@@ -72,10 +72,10 @@ def gather(sel, *arrays):
 
 
 def with_compliance(u, D, p, out, sign, scratch=None):
-    """``u + sign D p`` (``sign`` +1 or -1) into ``out`` (float64, or ``u`` itself in its precision), made in double
-    precision and rounded to ``out``'s; ``out``. The NumPy form makes ``D p`` in ``out``, or where ``out`` is ``u`` in
-    the float64 array ``scratch`` (a new array without it)."""
-    k = _kernels(out.size, u, D, p, out)
+    """``u + sign D p`` (``sign`` +1 or -1; ``D`` per node, or uniform) into ``out`` (float64, ``u`` itself in its
+    precision, or None: a new array), made in double precision and rounded to ``out``'s; ``out``. The NumPy form makes
+    ``D p`` in ``out``, or where ``out`` is ``u`` in the float64 array ``scratch`` (a new array without it)."""
+    k = None if out is None else _kernels(out.size, u, D, p, out)
     if k is None:
         dp = np.multiply(D, p, out=scratch if out is u else out)
         return (np.add if sign > 0 else np.subtract)(u, dp, out=out)

@@ -8,12 +8,15 @@ a candidate. Nodes entering the contact do not restart the directions: ``t = z +
 ``beta = max(0, g.(z - z_old) / g_old.z_old)`` (Polak-Ribiere+), the step the minimum along ``t``, ``tau = g.t / t.(C +
 lam) t`` (``g.t = g.z`` while the contact does not change), and ``t = z`` where ``g.t <= 0``. On a rough surface, whose
 contact set changes at most iterations until it settles, a loop that restarts at every entering node degrades to
-preconditioned steepest descent (``tests/bem/test_periodic_qp.py``: 82 iterations against 57, 52 with
-:mod:`bem.periodic.edge`, on a 256^2 self-affine cell). An entering node (``p = 0``, ``g < 0``) takes the step with a
-share of the Jacobi estimate of the preconditioner there, ``p = -f min(tau, 1) g / (C_nn + lam)`` (``f`` =
-:data:`bem.cg_rules.ENTERING_FRACTION`): ``tau`` is dimensionless here (``t`` is ``M g``), and ``-tau g`` would give it
-``tau C_nn`` of its Jacobi pressure, a fraction that falls with the step (nodes entering with almost no pressure and
-leaving, at a constant KKT residual, on a 672 x 776 rough cell at 1e-4 of the mean contact pressure:
+preconditioned steepest descent (82 iterations against 48 on a 256^2 self-affine cell,
+``tests/bem/test_periodic_qp.py``). While the contact changes in the first ``EARLY`` iterations (uniform compliance, no
+hardness; :mod:`bem.periodic.qp_parts`) the step is ``STEP_SHARE`` of that minimum (with nodes clipped, the energy along
+the clipped path is least at 0.85-0.95 of it) and only the nodes whose gap is below ``ENTER_SHARE`` times the most
+negative one enter (without it, half of those that enter leave at the next step). An entering node (``p = 0``, ``g <
+0``) takes the step with a share of the Jacobi estimate of the preconditioner there, ``p = -f min(tau, 1) g / (C_nn +
+lam)`` (``f`` = :data:`bem.cg_rules.ENTERING_FRACTION`): ``tau`` is dimensionless here (``t`` is ``M g``), and ``-tau
+g`` would give it ``tau C_nn`` of its Jacobi pressure, a fraction that falls with the step (nodes entering with almost
+no pressure and leaving, at a constant KKT residual, on a 672 x 776 rough cell at 1e-4 of the mean contact pressure:
 ``tests/bem/test_periodic_robustness.py``). Further:
 
 - the iteration keeps ``u = (C + lam) p`` in double precision, updated after a step by the product of its move in
@@ -47,18 +50,16 @@ Newton solve, its ``projection``: any direction of nonzero sum).
 
 With a hardness ``H`` (:mod:`bem.plastic`) the direction lives on the elastic contact ``0 < p < H`` and the step is
 :func:`bem.cg_rules.bounded_move`; the directions restart (``beta = 0``) after a step shortened or capped at ``H`` to
-carry the force, which breaks the conjugacy (without: no convergence in 688 iterations on a 64-column self-affine
-cell at 18 % of ``H``, ``tests/bem/test_hardness_units.py``), not where nodes enter or leave (a 512^2 law of 20
-pressures at ``H = E* h'_rms``: 531 iterations, 695 when those restart too).
+carry the force (without: no convergence in 688 iterations on a 64-column self-affine cell at 18 % of ``H``,
+``tests/bem/test_hardness_units.py``), not where nodes enter or leave (531 iterations on a 512^2 law of 20 pressures at
+``H = E* h'_rms``, 695 when those restart too).
 
 A step costs four transforms of the cell in single precision while the contact set does not change (two for the
-preconditioner, one forward for the search direction, one inverse for its product), five where it changes (``u``
-recomputed: two in double precision below ``SINGLE_ABOVE``; the general loop: four to eight in double precision).
-
-The step runs on the array namespace of the operator's device (:mod:`bem.backend`: NumPy, CuPy or any array API
-namespace with ``xp.fft``); the host receives its scalars (about 16 a step, more with a compliance per node or a
-hardness, and the sizes of three node selections). Other transforms round differently and take the same iterations
-(``tests/bem/test_backend_namespace.py``); NumPy reuses arrays from step to step (:mod:`bem.periodic.qp_parts`).
+preconditioner, two for the search direction's product), five where it changes (``u`` recomputed: two in double
+precision below ``SINGLE_ABOVE``). The step runs on the array namespace of the operator's device (:mod:`bem.backend`:
+NumPy, CuPy or any array API namespace with ``xp.fft``); the host receives its scalars (about 16 a step, more with a
+compliance per node or a hardness, and the sizes of three node selections). Other transforms round differently and take
+the same iterations (``tests/bem/test_backend_namespace.py``); NumPy reuses arrays (:mod:`bem.periodic.qp_parts`).
 """
 
 from __future__ import annotations
@@ -76,8 +77,8 @@ from ..newton_passes import with_compliance
 from ..plastic import carry_force, in_place, note_fully_plastic
 from .edge import EdgeCorrection
 from .passes import kernels
-from .qp_parts import (ContactBrick, ContactNodes, KeptOnContact, Projection, StepArrays, added_into,
-                       multiplied_into, product_array, weighted_square)
+from .qp_parts import (STEP_SHARE, ContactBrick, ContactNodes, KeptOnContact, Projection, StepArrays, added_into,
+                       early_steps, most_open, multiplied_into, product_array, weighted_square)
 from .step_passes import step_kernels
 
 __all__ = ["solve_periodic_qp", "SINGLE_ABOVE", "SINGLE_START"]
@@ -177,10 +178,6 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         x = op.spectrum(r32, out=work.spectrum(np.complex64))
         return op.brick(op.mix(x, M, out=x), overwrite=True, out=out)
 
-    def precondition(r32, sel, r_c, soft_c, D_c):  # M r at sel (r32: r at its stiff nodes, r_c: r; Jacobi at soft_c)
-        m = apply_m(r32, work.brick32())
-        return passes.gather(m, sel) if soft_c is None else steps.soft_gather(m, sel, soft_c, r_c, D_c, diag)
-
     def jacobi_at(sel, D_n=None):  # 1 / (C_nn + D) at the selected nodes (D_n: D there, where the caller has it)
         return 1.0 / (diag + (passes.gather(D, sel) if D_n is None else D_n))
 
@@ -278,8 +275,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             t_old = nodes.over(idx, lambda n: bk.take(brick.values, n), brick.last)
             D_c = nodes.over(idx, lambda n: passes.gather(D, n), nodes.kept[0]) if per_node else None
             nodes.kept = D_c, (soft_c := None if not soft else ~is_stiff(D_c, diag, threshold))
-        # the gap on the contact, single precision (on its stiff part with a per-node compliance)
-        z = precondition(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), idx, g_c, soft_c, D_c)
+        # M g of the gap on the contact in single precision (on its stiff part, and Jacobi at the soft nodes, with a
+        # compliance per node), gathered there
+        z = apply_m(brick.write(idx, g_c if not soft else xp.where(soft_c, 0.0, g_c)), work.brick32())
+        z = passes.gather(z, idx) if soft_c is None else steps.soft_gather(z, idx, soft_c, g_c, D_c, diag)
         z = z if edge is None else edge.applied(z, g_c, idx, record.history["changes"], nodes, soft_c)
         if force is not None and not soft:
             z -= xp.mean(z)
@@ -314,11 +313,11 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
         if per_node:
             tt += weighted_square(bk, D_c, t_c)
         if not bool(xp.any(t_c != 0)):
-            tau = 0.0  # a single contact node under force control: only entering nodes can move
+            tau, early = 0.0, False  # a single contact node under force control: only entering nodes can move
         elif tt <= 0 or not math.isfinite(tt):
             return f"search direction lost positive curvature (t.Ct = {tt:.3e})", "stalled"
-        else:
-            tau = gt / tt  # the minimum along t (gt = gz when the contact has not changed)
+        else:  # the minimum along t (gt = gz when the contact has not changed); shortened while the contact moves
+            tau = gt / tt * (STEP_SHARE if (early := early_steps(k, record, per_node or bounded)) else 1.0)
         if bounded:
             return bounded_step(tau, t_c, R, D_c if per_node else None)
         p_c, clipped, changed, positive = steps.move(p_c0, t_c, tau)  # max(p_c0 - tau t_c, 0)
@@ -330,8 +329,10 @@ def solve_periodic_qp(op, h, *, force=None, approach=None, lam=0.0, x0=None, rto
             enter.reshape(-1)[idx[clipped]] = g_c[clipped] < 0
         overlap = bk.select(enter if bk.is_numpy else (u + h < delta) & (p == 0))
         entered, g_c = bool(bk.count(overlap)), None  # the gap not held past the entering test
-        p_o = entering_pressure(xp, passes.gap_at(u, h, overlap) - delta, tau, jacobi_at(overlap) if (
-            per_node) else jacobi, per_node, preconditioned=True) if entered else None
+        g_o = passes.gap_at(u, h, overlap) - delta if entered else None
+        overlap, g_o = most_open(bk, overlap, g_o) if entered and early else (overlap, g_o)
+        p_o = entering_pressure(xp, g_o, tau, jacobi_at(overlap) if per_node else jacobi, per_node,
+                                preconditioned=True) if entered else None
         t_move = terms = None  # a change in double precision: u from the product of the move t' (module docstring)
         if (changed or entered) and confirm and exact_base and not single and tau > 0 and stale < RECOMPUTE_EVERY and (
                 bk.is_numpy):

@@ -8,7 +8,27 @@ import math
 
 import numpy as np
 
-__all__ = ["ContactBrick", "ContactNodes", "KeptOnContact", "Projection", "StepArrays", "weighted_square"]
+__all__ = ["ContactBrick", "ContactNodes", "EARLY", "ENTER_SHARE", "KeptOnContact", "Projection", "STEP_SHARE",
+           "StepArrays", "early_steps", "most_open", "weighted_square"]
+
+#: while the contact moves in the first EARLY iterations, the step is STEP_SHARE of the minimum along the direction
+#: and only the nodes whose gap is below ENTER_SHARE times the most negative one enter (docs/performance.md, "The
+#: first steps of the cell's QP")
+EARLY, STEP_SHARE, ENTER_SHARE = 20, 0.9, 0.3
+
+
+def early_steps(k, record, excluded):
+    """Whether iteration ``k`` is one of the first :data:`EARLY` and the last step changed the contact (``record``:
+    the loop's :class:`bem.cg_rules.Record`), unless ``excluded`` (a compliance per node, a hardness)."""
+    changes = record.history["changes"]
+    return k <= EARLY and bool(changes) and changes[-1] > 0 and not excluded
+
+
+def most_open(bk, nodes, gap):
+    """The node selection ``nodes`` (of the backend ``bk``) and their gaps ``gap`` (1-D, negative) where the gap is
+    below :data:`ENTER_SHARE` times the most negative one."""
+    keep = gap < ENTER_SHARE * float(bk.xp.min(gap))
+    return bk.subset(nodes, keep), gap[keep]
 
 
 def weighted_square(bk, d, t):

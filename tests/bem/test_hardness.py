@@ -230,11 +230,12 @@ def test_a_hardness_above_the_peak_pressure_gives_the_elastic_answer(monkeypatch
     with monkeypatch.context() as m:
         # the elastic cell with the bounded step's update of C p at a change of the contact, an exact product (its
         # default, the product of the move, differs by rounding: 8.5e-11 of p_max here;
-        # tests/bem/test_periodic_move_product.py), and the bounded step's preconditioner, not corrected at the
+        # tests/bem/test_periodic_move_product.py), the bounded step's preconditioner, not corrected at the
         # contact's edges (bem.periodic.edge; with the correction the elastic cell takes other iterations: 8.4e-10
-        # of p_max)
+        # of p_max), and its full steps (bem.periodic.qp_parts.EARLY: with the first steps shortened, 5.5e-10)
         m.setattr(ContactBrick, "write_move", lambda self, *args: None)
         m.setattr("bem.periodic.edge.THETA", 0.0)
+        m.setattr("bem.periodic.qp_parts.EARLY", 0)
         elastic = bem.solve_periodic(h, step=CELL.step, E_star=1.0, mean_pressure=0.02)
     capped = bem.solve_periodic(h, step=CELL.step, E_star=1.0, mean_pressure=0.02, hardness=1.01 * elastic.p_max)
     assert capped.plastic_area == 0.0 and capped.status == "converged"
