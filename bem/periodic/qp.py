@@ -8,7 +8,7 @@ a candidate. Nodes entering the contact do not restart the directions: ``t = z +
 ``beta = max(0, g.(z - z_old) / g_old.z_old)`` (Polak-Ribiere+), the step the minimum along ``t``, ``tau = g.t / t.(C +
 lam) t`` (``g.t = g.z`` while the contact does not change), and ``t = z`` where ``g.t <= 0``. On a rough surface, whose
 contact set changes at most iterations until it settles, a loop that restarts at every entering node degrades to
-preconditioned steepest descent (82 iterations against 48 on a 256^2 self-affine cell,
+preconditioned steepest descent (82 iterations against 51 on a 256^2 self-affine cell,
 ``tests/bem/test_periodic_qp.py``). While the contact changes in the first ``EARLY`` iterations (uniform compliance, no
 hardness; :mod:`bem.periodic.qp_parts`) the step is ``STEP_SHARE`` of that minimum (with nodes clipped, the energy along
 the clipped path is least at 0.85-0.95 of it) and only the nodes whose gap is below ``ENTER_SHARE`` times the most

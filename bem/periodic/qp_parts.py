@@ -14,7 +14,7 @@ __all__ = ["ContactBrick", "ContactNodes", "EARLY", "ENTER_SHARE", "KeptOnContac
 #: while the contact moves in the first EARLY iterations, the step is STEP_SHARE of the minimum along the direction
 #: and only the nodes whose gap is below ENTER_SHARE times the most negative one enter (measured in
 #: docs/performance.md, "Newton's step in fewer passes, and the first steps of the cell's QP")
-EARLY, STEP_SHARE, ENTER_SHARE = 20, 0.9, 0.3
+EARLY, STEP_SHARE, ENTER_SHARE = 12, 0.9, 0.3
 
 
 def early_steps(k, record, excluded):

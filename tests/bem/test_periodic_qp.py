@@ -120,7 +120,7 @@ def _self_affine(cell, seed=2026, hurst=0.8, rolloff=4, cutoff=128):
 def test_periodic_qp_keeps_its_conjugate_directions_when_the_contact_changes():
     """On a rough cell whose contact set changes over most of the iterations, the QP in the Fourier basis and the
     general loop (which keeps its directions by the same rule) reach the answer of a constrained CG that restarts
-    at every entering node (tests/bem/restarted_cg.py) in fewer iterations (measured: 60, and 48 with the cell's
+    at every entering node (tests/bem/restarted_cg.py) in fewer iterations (measured: 60, and 51 with the cell's
     preconditioner corrected at the contact's edges, bem.periodic.edge, and its first steps' rule, against 82)."""
     cell = PeriodicCell(1.0 / 256, 256, 256)
     h = _self_affine(cell)
