@@ -19,7 +19,7 @@ Back end
 Parts on threads
     :func:`in_parts` runs a kernel on :func:`threads` contiguous parts of an array at once (NumPy's ufuncs,
     numba's ``nogil`` kernels, pocketfft and ducc0 release the GIL): the calling thread takes the last part itself and a
-    pool of ``threads() - 1`` threads the others; arrays below ``2**17`` entries stay in the calling thread. The
+    pool of ``threads() - 1`` threads the others (each handed its part through a pair of locks); arrays below ``2**17`` entries stay in the calling thread. The
     transforms of the solvers' iterations run so too (:func:`rfft_into`, :func:`cfft_in_place`,
     :func:`irfft_into`, and the pruned transforms of :mod:`bem.pruned_fft`), one single-threaded call of the
     transform's library per part, rather than with pocketfft's ``workers``, whose calling thread sleeps while its
@@ -33,7 +33,7 @@ The pruned padded transforms of the half-space's convolutions are :mod:`bem.prun
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor
+import threading
 
 import numpy as np
 import scipy.fft as _sfft
@@ -97,7 +97,54 @@ _PARTS_MIN = 1 << 17  # entries below which in_parts runs in the calling thread
 #: in groups of its vector length and the last few apart, rounded otherwise, so that parts beginning at multiples of
 #: the group give the numbers of one call on the whole array
 LINES = 64
-_pool, _pool_size = None, 0
+
+
+class _Worker:
+    """A pool thread of :func:`in_parts`: one part at a time, handed over and collected through two locks (a
+    future's queue and condition variable cost the caller more: ``benchmarks/handover.py``, in
+    ``docs/performance.md``, "Parts on threads through two locks")."""
+
+    def __init__(self, name):
+        self._go, self._done = threading.Lock(), threading.Lock()
+        self._go.acquire()
+        self._done.acquire()
+        self._task = self._error = None
+        threading.Thread(target=self._loop, name=name, daemon=True).start()
+
+    def _loop(self):
+        while True:
+            self._go.acquire()
+            kernel, part = self._task
+            self._task = None
+            try:
+                kernel(part)
+            except BaseException as error:  # handed to the caller by join  # noqa: BLE001
+                self._error = error
+            kernel = part = None  # the kernel's arrays not held past the call
+            self._done.release()
+
+    def start(self, kernel, part):
+        self._task = (kernel, part)
+        self._go.release()
+
+    def join(self):
+        """Wait for the part; its exception, or None."""
+        self._done.acquire()
+        error, self._error = self._error, None
+        return error
+
+
+_workers = []  # the pool, grown to the parts asked for
+_busy = threading.Lock()  # held while the pool runs one caller's parts
+
+
+def _after_fork():  # a forked child has none of its parent's threads
+    global _workers, _busy
+    _workers, _busy = [], threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_after_fork)
 
 
 def _available_cpus():
@@ -156,13 +203,14 @@ def set_threads(n):
 def in_parts(kernel, n, size, align=1):
     """Call ``kernel(part)`` on contiguous slices ``part`` of ``range(n)``, on :func:`threads` threads.
 
-    The calling thread runs the last part, a pool of ``threads() - 1`` threads the others.
+    The calling thread runs the last part, a pool of ``threads() - 1`` threads the others. Where another thread's
+    call holds the pool, the parts run one after another in the calling thread (the same parts).
 
     Parameters
     ----------
     kernel : callable
-        ``kernel(part)`` with ``part`` a ``slice``; the calls must touch disjoint data and must not
-        call :func:`in_parts` themselves (the pool's threads would wait for one another).
+        ``kernel(part)`` with ``part`` a ``slice``; the calls must touch disjoint data (a call of
+        :func:`in_parts` inside one runs its parts in its own thread).
     n : int
         Length of the axis that is split.
     size : int
@@ -170,22 +218,38 @@ def in_parts(kernel, n, size, align=1):
         runs once on the whole axis in the calling thread.
     align : int
         The parts begin at multiples of ``align`` (fewer parts where ``n`` is short of them).
+
+    Raises
+    ------
+    Exception
+        The first part's exception (the caller's first), after every part has ended.
     """
-    global _pool, _pool_size
     k = min(threads(), n)
     bounds = sorted({0, n} | {n * i // k // align * align for i in range(1, k)}) if k > 1 else [0, n]
     k = len(bounds) - 1
     if k < 2 or size < _PARTS_MIN:
         kernel(slice(0, n))
         return
-    if _pool_size < k - 1:
-        _pool, _pool_size = ThreadPoolExecutor(max_workers=k - 1, thread_name_prefix="contactlab"), k - 1
-    others = [_pool.submit(kernel, slice(lo, hi)) for lo, hi in zip(bounds[:-2], bounds[1:-1])]
+    parts = [slice(lo, hi) for lo, hi in zip(bounds[:-1], bounds[1:])]
+    if not _busy.acquire(blocking=False):
+        for part in parts:
+            kernel(part)
+        return
     try:
-        kernel(slice(bounds[-2], bounds[-1]))
-    finally:  # the other parts end before the caller goes on (or raises), as they touch its arrays
-        for f in others:
-            f.result()
+        while len(_workers) < k - 1:
+            _workers.append(_Worker(f"contactlab_{len(_workers)}"))
+        started = []
+        try:
+            for worker, part in zip(_workers, parts[:-1]):
+                worker.start(kernel, part)
+                started.append(worker)
+            kernel(parts[-1])
+        finally:  # the other parts end before the caller goes on (or raises), as they touch its arrays
+            errors = [error for error in (worker.join() for worker in started) if error is not None]
+        if errors:
+            raise errors[0]
+    finally:
+        _busy.release()
 
 
 def _by_parts(call, shape, split, size):
