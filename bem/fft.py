@@ -19,7 +19,8 @@ Back end
 Parts on threads
     :func:`in_parts` runs a kernel on :func:`threads` contiguous parts of an array at once (NumPy's ufuncs,
     numba's ``nogil`` kernels, pocketfft and ducc0 release the GIL): the calling thread takes the last part itself and a
-    pool of ``threads() - 1`` threads the others (each handed its part through a pair of locks); arrays below ``2**17`` entries stay in the calling thread. The
+    pool of ``threads() - 1`` threads the others (:mod:`bem.pool`: each handed its part through a pair of locks);
+    arrays below ``2**17`` entries stay in the calling thread. The
     transforms of the solvers' iterations run so too (:func:`rfft_into`, :func:`cfft_in_place`,
     :func:`irfft_into`, and the pruned transforms of :mod:`bem.pruned_fft`), one single-threaded call of the
     transform's library per part, rather than with pocketfft's ``workers``, whose calling thread sleeps while its
@@ -33,10 +34,11 @@ The pruned padded transforms of the half-space's convolutions are :mod:`bem.prun
 from __future__ import annotations
 
 import os
-import threading
 
 import numpy as np
 import scipy.fft as _sfft
+
+from .pool import run_parts
 
 
 def _checks_out(lib):
@@ -97,54 +99,6 @@ _PARTS_MIN = 1 << 17  # entries below which in_parts runs in the calling thread
 #: in groups of its vector length and the last few apart, rounded otherwise, so that parts beginning at multiples of
 #: the group give the numbers of one call on the whole array
 LINES = 64
-
-
-class _Worker:
-    """A pool thread of :func:`in_parts`: one part at a time, handed over and collected through two locks (a
-    future's queue and condition variable cost the caller more: ``benchmarks/handover.py``, in
-    ``docs/performance.md``, "Parts on threads through two locks")."""
-
-    def __init__(self, name):
-        self._go, self._done = threading.Lock(), threading.Lock()
-        self._go.acquire()
-        self._done.acquire()
-        self._task = self._error = None
-        threading.Thread(target=self._loop, name=name, daemon=True).start()
-
-    def _loop(self):
-        while True:
-            self._go.acquire()
-            kernel, part = self._task
-            self._task = None
-            try:
-                kernel(part)
-            except BaseException as error:  # handed to the caller by join  # noqa: BLE001
-                self._error = error
-            kernel = part = None  # the kernel's arrays not held past the call
-            self._done.release()
-
-    def start(self, kernel, part):
-        self._task = (kernel, part)
-        self._go.release()
-
-    def join(self):
-        """Wait for the part; its exception, or None."""
-        self._done.acquire()
-        error, self._error = self._error, None
-        return error
-
-
-_workers = []  # the pool, grown to the parts asked for
-_busy = threading.Lock()  # held while the pool runs one caller's parts
-
-
-def _after_fork():  # a forked child has none of its parent's threads
-    global _workers, _busy
-    _workers, _busy = [], threading.Lock()
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_after_fork)
 
 
 def _available_cpus():
@@ -222,7 +176,7 @@ def in_parts(kernel, n, size, align=1):
     Raises
     ------
     Exception
-        The first part's exception (the caller's first), after every part has ended.
+        As :func:`bem.pool.run_parts`: the first part's exception after every part has ended.
     """
     k = min(threads(), n)
     bounds = sorted({0, n} | {n * i // k // align * align for i in range(1, k)}) if k > 1 else [0, n]
@@ -230,26 +184,7 @@ def in_parts(kernel, n, size, align=1):
     if k < 2 or size < _PARTS_MIN:
         kernel(slice(0, n))
         return
-    parts = [slice(lo, hi) for lo, hi in zip(bounds[:-1], bounds[1:])]
-    if not _busy.acquire(blocking=False):
-        for part in parts:
-            kernel(part)
-        return
-    try:
-        while len(_workers) < k - 1:
-            _workers.append(_Worker(f"contactlab_{len(_workers)}"))
-        started = []
-        try:
-            for worker, part in zip(_workers, parts[:-1]):
-                worker.start(kernel, part)
-                started.append(worker)
-            kernel(parts[-1])
-        finally:  # the other parts end before the caller goes on (or raises), as they touch its arrays
-            errors = [error for error in (worker.join() for worker in started) if error is not None]
-        if errors:
-            raise errors[0]
-    finally:
-        _busy.release()
+    run_parts(kernel, [slice(lo, hi) for lo, hi in zip(bounds[:-1], bounds[1:])])
 
 
 def _by_parts(call, shape, split, size):

@@ -1,4 +1,5 @@
-"""The pool of :func:`bem.fft.in_parts`: parts handed over through locks, one caller at a time, errors and forks."""
+"""The pool of :func:`bem.fft.in_parts` (:mod:`bem.pool`): parts handed over through locks, one caller at a time, errors,
+interruptions and forks."""
 
 import os
 import signal
@@ -123,3 +124,40 @@ def test_the_pool_holds_no_kernel_after_the_call(monkeypatch):
     fft.in_parts(kernel, 300, 1 << 20)
     del kernel
     assert gone() is None
+
+
+class _Interrupted(Exception):
+    pass
+
+
+def test_a_wait_interrupted_leaves_no_busy_worker_in_the_pool(monkeypatch):
+    """A caller interrupted while its pool part runs (Ctrl-C): the next call's parts all end before it returns."""
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signal handlers are set in the main thread only")
+    monkeypatch.setattr(fft, "_override", 2)
+
+    def interrupt(signum, frame):
+        raise _Interrupted
+
+    previous = signal.signal(signal.SIGINT, interrupt)
+    try:
+        def slow(part):
+            if part.start == 0:  # the pool's part
+                time.sleep(0.5)
+
+        threading.Timer(0.1, os.kill, (os.getpid(), signal.SIGINT)).start()
+        with pytest.raises(_Interrupted):
+            fft.in_parts(slow, 300, 1 << 20)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    hits = np.zeros(300, dtype=int)
+
+    def quick(part):
+        if part.start == 0:
+            time.sleep(0.05)
+        hits[part] += 1
+
+    fft.in_parts(quick, 300, 1 << 20)  # while the interrupted part may still run
+    assert np.all(hits == 1)  # every part ended before the call returned
+    time.sleep(0.6)  # the interrupted part ends meanwhile: nothing more is written
+    assert np.all(hits == 1)
