@@ -5,6 +5,7 @@ import os
 import signal
 import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -88,7 +89,9 @@ def test_a_forked_child_makes_its_own_pool(monkeypatch):
     monkeypatch.setattr(fft, "_override", 2)
     fft.in_parts(lambda part: None, 300, 1 << 20)  # the parent's pool exists
     read, write = os.pipe()
-    pid = os.fork()
+    with warnings.catch_warnings():  # Python 3.12+ warns that a threaded process forks: the point of this test
+        warnings.simplefilter("ignore", DeprecationWarning)
+        pid = os.fork()
     if pid == 0:  # the child: its parent's workers are gone
         try:
             seen = []
