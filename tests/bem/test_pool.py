@@ -143,16 +143,20 @@ def test_a_wait_interrupted_leaves_no_busy_worker_in_the_pool(monkeypatch):
         raise _Interrupted
 
     previous = signal.signal(signal.SIGINT, interrupt)
+    began, ended = threading.Event(), threading.Event()
     try:
         def slow(part):
             if part.start == 0:  # the pool's part
+                began.set()
                 time.sleep(0.5)
+                ended.set()
 
         threading.Timer(0.1, os.kill, (os.getpid(), signal.SIGINT)).start()
         with pytest.raises(_Interrupted):
             fft.in_parts(slow, 300, 1 << 20)
     finally:
         signal.signal(signal.SIGINT, previous)
+    assert began.is_set() and not ended.is_set()  # interrupted while the pool's part ran
     hits = np.zeros(300, dtype=int)
 
     def quick(part):
